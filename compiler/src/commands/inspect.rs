@@ -1,0 +1,186 @@
+//! `kiln inspect`: what a file holds.
+
+use kiln_format::{Checksums, KilnFile, sections};
+use serde::Serialize;
+
+use crate::cli::InspectArgs;
+use crate::exit::{CliResult, format_error};
+use crate::output::{print_json, size};
+
+#[derive(Serialize)]
+struct SectionJson {
+    position: usize,
+    kind: String,
+    /// Name to pass to `kiln export`, if this reader knows the kind.
+    name: Option<&'static str>,
+    index: u32,
+    version: u16,
+    codec: String,
+    offset: u64,
+    size: u64,
+    raw_size: u64,
+    checksum: String,
+    checksum_ok: bool,
+    content_hash: String,
+    /// False for kinds (or versions) this reader does not know and skips.
+    understood: bool,
+}
+
+#[derive(Serialize)]
+struct InspectJson {
+    path: String,
+    format_version: String,
+    file_size: u64,
+    flags: u32,
+    sections: Vec<SectionJson>,
+    /// Null when the manifest cannot be decoded (see `manifest_error`).
+    manifest: Option<kiln_format::Manifest>,
+    manifest_error: Option<String>,
+    summary: Summary,
+}
+
+#[derive(Serialize, Default)]
+struct Summary {
+    vertices: u64,
+    triangles: u64,
+    materials: u64,
+    textures: u64,
+    bvh_nodes: u64,
+    lights: u64,
+    cameras: u64,
+}
+
+/// Runs `kiln inspect`.
+pub fn run(args: &InspectArgs) -> CliResult {
+    let file =
+        KilnFile::open(&args.file, Checksums::Deferred).map_err(|e| format_error(&args.file, e))?;
+    let sections: Vec<SectionJson> = file
+        .sections()
+        .iter()
+        .map(|s| {
+            let e = &s.entry;
+            SectionJson {
+                position: s.position,
+                kind: e.kind.name(),
+                name: s.known.map(|k| k.name),
+                index: e.index,
+                version: e.version,
+                codec: kiln_format::table::Codec::from_u8(e.codec).map_or_else(
+                    || format!("unknown ({})", e.codec),
+                    |c| c.name().to_string(),
+                ),
+                offset: e.offset,
+                size: e.size,
+                raw_size: e.raw_size,
+                checksum: format!("{:016x}", e.checksum),
+                checksum_ok: file.verify_section(s.position).is_ok(),
+                content_hash: e.content_hash.to_hex(),
+                understood: s.known.is_some(),
+            }
+        })
+        .collect();
+    let (manifest, manifest_error) = match file.manifest() {
+        Ok(m) => (Some(m), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
+    let elements = |kind| {
+        file.find(kind, 0)
+            .and_then(|s| s.known.map(|k| s.entry.raw_size / k.element_size as u64))
+            .unwrap_or(0)
+    };
+    let summary = Summary {
+        vertices: elements(sections::VERTICES),
+        triangles: elements(sections::TRIANGLES),
+        materials: elements(sections::MATERIALS),
+        textures: file.all_of(sections::TEXTURE).len() as u64,
+        bvh_nodes: elements(sections::BVH_NODES),
+        lights: manifest.as_ref().map_or(0, |m| m.lights.len() as u64),
+        cameras: manifest.as_ref().map_or(0, |m| m.cameras.len() as u64),
+    };
+    let h = file.header();
+    let report = InspectJson {
+        path: args.file.display().to_string(),
+        format_version: format!("{}.{}", h.version_major, h.version_minor),
+        file_size: h.file_size,
+        flags: h.flags,
+        sections,
+        manifest,
+        manifest_error,
+        summary,
+    };
+    if args.json {
+        print_json(&report);
+    } else {
+        print_text(&report);
+    }
+    Ok(())
+}
+
+fn print_text(r: &InspectJson) {
+    println!(
+        "{}: kiln format {}, {} sections, {}",
+        r.path,
+        r.format_version,
+        r.sections.len(),
+        size(r.file_size)
+    );
+    println!(
+        "  {:>3}  {:<4} {:<19} {:>5} {:>3}  {:<5} {:>10} {:>10}  {:<8} content hash",
+        "#", "kind", "name", "index", "ver", "codec", "offset", "size", "checksum"
+    );
+    for s in &r.sections {
+        println!(
+            "  {:>3}  {:<4} {:<19} {:>5} {:>3}  {:<5} {:>10} {:>10}  {:<8} {}",
+            s.position,
+            s.kind,
+            s.name.unwrap_or("(unknown: skipped)"),
+            s.index,
+            s.version,
+            s.codec,
+            format!("{:#x}", s.offset),
+            size(s.size),
+            if s.checksum_ok { "ok" } else { "BAD" },
+            &s.content_hash[..16],
+        );
+    }
+    let sm = &r.summary;
+    match (&r.manifest, &r.manifest_error) {
+        (Some(m), _) => {
+            println!("scene '{}', written by {}", m.scene_name, m.generator);
+            println!(
+                "  {} triangles, {} vertices, {} materials, {} textures, {} BVH nodes, {} lights, {} cameras, {} media",
+                sm.triangles,
+                sm.vertices,
+                sm.materials,
+                sm.textures,
+                sm.bvh_nodes,
+                sm.lights,
+                sm.cameras,
+                m.media.len()
+            );
+            let b = &m.bounds;
+            println!("  bounds {:?} .. {:?}", b.min, b.max);
+            if m.degenerate_triangles > 0 {
+                println!(
+                    "  {} degenerate triangles dropped at import",
+                    m.degenerate_triangles
+                );
+            }
+            for s in &m.skipped {
+                println!("  skipped {}: {}", s.stage, s.reason);
+            }
+            if !m.inputs.is_empty() {
+                println!(
+                    "  inputs: {}",
+                    m.inputs
+                        .iter()
+                        .map(|i| i.path.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+        }
+        (None, Some(e)) => println!("manifest: cannot be decoded: {e}"),
+        (None, None) => {}
+    }
+}

@@ -1,0 +1,270 @@
+//! The manifest section: everything about a scene that is not bulk data, encoded with bincode 2
+//! (standard configuration: little-endian, variable-length integers).
+//!
+//! Compatibility rule: a newer manifest version only appends top-level fields. A reader decodes
+//! the fields it knows and ignores what follows them when the section's version is newer than its
+//! own; for its own version, trailing bytes are an error.
+
+use bincode::{Decode, Encode};
+use serde::Serialize;
+
+use crate::error::{ErrorKind, FormatError, Result};
+
+/// Axis-aligned box, scene units.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Encode, Decode, Serialize)]
+pub struct Bounds {
+    /// Minimum corner.
+    pub min: [f32; 3],
+    /// Maximum corner.
+    pub max: [f32; 3],
+}
+
+/// A file the compiler read, for depfiles, caches and provenance.
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct InputFile {
+    /// Path as given to (or resolved by) the compiler.
+    pub path: String,
+    /// Length in bytes.
+    pub bytes: u64,
+    /// XXH3-128 of the contents, hex.
+    pub hash: String,
+}
+
+/// A material's metadata (the shading parameters are in the `MATL` section).
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct MaterialInfo {
+    /// Name in the source asset, or a generated one.
+    pub name: String,
+}
+
+/// How texels are to be interpreted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Encode, Decode, Serialize)]
+pub enum ColorSpace {
+    /// sRGB-encoded colour (base colour, emissive).
+    Srgb,
+    /// Linear data (normals, metallic-roughness, occlusion).
+    Linear,
+}
+
+/// Texture addressing per axis (glTF sampler wrap modes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Encode, Decode, Serialize)]
+pub enum Wrap {
+    /// Repeat.
+    Repeat,
+    /// Mirrored repeat.
+    MirroredRepeat,
+    /// Clamp to edge.
+    ClampToEdge,
+}
+
+/// Metadata of one `TEXL` section (same index).
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct TextureInfo {
+    /// Source image name or URI.
+    pub name: String,
+    /// Width of mip 0 in texels.
+    pub width: u32,
+    /// Height of mip 0 in texels.
+    pub height: u32,
+    /// Number of mip levels (full chain down to 1×1).
+    pub mip_levels: u32,
+    /// Colour space of the texels.
+    pub color_space: ColorSpace,
+    /// Wrap mode along u.
+    pub wrap_u: Wrap,
+    /// Wrap mode along v.
+    pub wrap_v: Wrap,
+    /// Nearest (false) or linear (true) magnification.
+    pub mag_linear: bool,
+}
+
+/// The kind of an analytic light, with its kind-specific parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Encode, Decode, Serialize)]
+pub enum LightKind {
+    /// Point light; intensity in W/sr.
+    Point,
+    /// Spot light; intensity in W/sr on the axis; cone half-angles in radians.
+    Spot {
+        /// Full intensity inside this half-angle.
+        inner_cone: f32,
+        /// Zero intensity outside this half-angle.
+        outer_cone: f32,
+    },
+    /// Directional light; intensity is irradiance in W/m² on a surface facing it.
+    Directional,
+    /// One-sided rectangle centred at `position`; intensity is radiance in W/(sr·m²).
+    Rect {
+        /// Extent along `right`.
+        width: f32,
+        /// Extent along `direction × right`.
+        height: f32,
+    },
+}
+
+/// An analytic light.
+#[derive(Debug, Clone, PartialEq, Encode, Decode, Serialize)]
+pub struct Light {
+    /// Name (from the asset or the sidecar).
+    pub name: String,
+    /// Kind and kind-specific parameters.
+    pub kind: LightKind,
+    /// Position (point, spot, rect centre); unused for directional.
+    pub position: [f32; 3],
+    /// Unit direction the light travels (directional, spot) or faces (rect).
+    pub direction: [f32; 3],
+    /// Unit vector along a rect light's width; zero for other kinds.
+    pub right: [f32; 3],
+    /// Linear RGB colour.
+    pub color: [f32; 3],
+    /// Scalar intensity in the kind's unit (see [`LightKind`]).
+    pub intensity: f32,
+    /// Distance beyond which the light is cut off (0 = unlimited).
+    pub range: f32,
+    /// Whether it casts shadows.
+    pub casts_shadows: bool,
+}
+
+/// A perspective camera.
+#[derive(Debug, Clone, PartialEq, Encode, Decode, Serialize)]
+pub struct Camera {
+    /// Name.
+    pub name: String,
+    /// Eye position.
+    pub position: [f32; 3],
+    /// Point looked at.
+    pub target: [f32; 3],
+    /// Up vector (not necessarily orthogonal to the view direction).
+    pub up: [f32; 3],
+    /// Vertical field of view, degrees.
+    pub vfov_degrees: f32,
+    /// Near plane distance.
+    pub znear: f32,
+    /// Far plane distance (0 = infinite).
+    pub zfar: f32,
+}
+
+/// Constant sky radiance seen by rays that leave the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Encode, Decode, Serialize)]
+pub struct Sky {
+    /// Linear RGB radiance, W/(sr·m²).
+    pub radiance: [f32; 3],
+}
+
+/// A homogeneous participating medium filling a box.
+#[derive(Debug, Clone, Copy, PartialEq, Encode, Decode, Serialize)]
+pub struct Medium {
+    /// Region the medium fills.
+    pub bounds: Bounds,
+    /// Absorption coefficient per scene unit, RGB.
+    pub sigma_a: [f32; 3],
+    /// Scattering coefficient per scene unit, RGB.
+    pub sigma_s: [f32; 3],
+    /// Henyey–Greenstein anisotropy in (-1, 1).
+    pub g: f32,
+}
+
+/// A bake stage the compiler did not run, and why.
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct SkippedStage {
+    /// Stage name as in `kiln plan`.
+    pub stage: String,
+    /// Why it was skipped.
+    pub reason: String,
+}
+
+/// A bake setting, for provenance and `inspect`.
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct Setting {
+    /// Name, as the command-line flag without dashes.
+    pub key: String,
+    /// Value as text.
+    pub value: String,
+}
+
+/// The scene manifest.
+#[derive(Debug, Clone, PartialEq, Default, Encode, Decode, Serialize)]
+pub struct Manifest {
+    /// Program and version that wrote the file, e.g. `kiln 0.1.0`.
+    pub generator: String,
+    /// Name of the scene (the input file's stem).
+    pub scene_name: String,
+    /// Every file read to produce this one.
+    pub inputs: Vec<InputFile>,
+    /// Bake settings in effect.
+    pub settings: Vec<Setting>,
+    /// Bounds of all triangles.
+    pub bounds: Bounds,
+    /// One per `MATL` element.
+    pub materials: Vec<MaterialInfo>,
+    /// One per `TEXL` section.
+    pub textures: Vec<TextureInfo>,
+    /// Analytic lights.
+    pub lights: Vec<Light>,
+    /// Cameras; the first is the default view.
+    pub cameras: Vec<Camera>,
+    /// Constant sky.
+    pub sky: Sky,
+    /// Participating media.
+    pub media: Vec<Medium>,
+    /// Stages not run, with reasons.
+    pub skipped: Vec<SkippedStage>,
+    /// Triangles dropped as degenerate during import.
+    pub degenerate_triangles: u64,
+}
+
+/// Manifest version this crate reads and writes (equals the `MANI` kind's version).
+pub const MANIFEST_VERSION: u16 = 1;
+
+impl Manifest {
+    /// Encodes with bincode's standard configuration.
+    pub fn encode(&self) -> Vec<u8> {
+        // Encoding into a Vec cannot fail for these types (no maps with fallible keys, no limits).
+        bincode::encode_to_vec(self, bincode::config::standard())
+            .unwrap_or_else(|e| unreachable!("manifest encoding failed: {e}"))
+    }
+
+    /// Decodes a manifest section of version `version`. Allocation is bounded by bincode's
+    /// limit, set to the smallest power of two at least four times the section length, so that
+    /// no length read from the file can claim more memory than the file could describe.
+    pub fn decode(bytes: &[u8], version: u16) -> Result<Manifest> {
+        let (manifest, used) = decode_limited(bytes)?;
+        if used != bytes.len() && version <= MANIFEST_VERSION {
+            return Err(FormatError::new(ErrorKind::Manifest(format!(
+                "{} trailing bytes after the manifest",
+                bytes.len() - used
+            ))));
+        }
+        Ok(manifest)
+    }
+}
+
+fn decode_limited(bytes: &[u8]) -> Result<(Manifest, usize)> {
+    macro_rules! with_limit {
+        ($($log2:literal)*) => {{
+            let need = (bytes.len().max(256) as u64).saturating_mul(4);
+            $(
+                if need <= (1u64 << $log2) {
+                    let cfg = bincode::config::standard().with_limit::<{ 1usize << $log2 }>();
+                    return bincode::decode_from_slice(bytes, cfg).map_err(manifest_error);
+                }
+            )*
+            Err(FormatError::new(ErrorKind::Manifest(format!(
+                "manifest section of {} bytes is larger than the 1 GiB a manifest may have",
+                bytes.len()
+            ))))
+        }};
+    }
+    with_limit!(10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30)
+}
+
+fn manifest_error(e: bincode::error::DecodeError) -> FormatError {
+    use bincode::error::DecodeError as D;
+    let msg = match e {
+        D::UnexpectedEnd { additional } => {
+            format!("it ends {additional} bytes early")
+        }
+        D::LimitExceeded => "a length in it is larger than the section could hold".to_string(),
+        other => other.to_string(),
+    };
+    FormatError::new(ErrorKind::Manifest(msg))
+}

@@ -1,0 +1,316 @@
+//! A validated view of a file's scene sections: every cross-reference checked once, so that
+//! the player and the queries can index without further checks.
+
+use crate::error::{FormatError, Result};
+use crate::manifest::{LightKind, Manifest};
+use crate::read::KilnFile;
+use crate::sections::{
+    BVH_NODES, BVH_TRAVERSAL_STACK, CwbvhNode, GpuMaterial, MATERIALS, MaterialFlags, NO_TEXTURE,
+    TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, VERTICES, Vertex,
+};
+
+/// Borrowed, validated scene data of a [`KilnFile`].
+#[derive(Debug)]
+pub struct SceneView<'a> {
+    /// The decoded manifest.
+    pub manifest: Manifest,
+    /// Vertices (empty if the file has no geometry).
+    pub vertices: &'a [Vertex],
+    /// Triangles as vertex index triples, in BVH leaf order.
+    pub triangles: &'a [[u32; 3]],
+    /// Material of each triangle.
+    pub triangle_materials: &'a [u32],
+    /// Materials.
+    pub materials: &'a [GpuMaterial],
+    /// BVH nodes (empty if the file has no BVH).
+    pub bvh: &'a [CwbvhNode],
+    /// Texel data per texture (RGBA8, mip chain), indexed like `manifest.textures`.
+    pub textures: Vec<&'a [u8]>,
+}
+
+fn finite(v: &[f32]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+impl<'a> SceneView<'a> {
+    /// Reads and validates the scene sections of `file`.
+    pub fn new(file: &'a KilnFile) -> Result<SceneView<'a>> {
+        let manifest = file.manifest()?;
+        let vertices: &[Vertex] = file.pod(VERTICES, 0)?.unwrap_or(&[]);
+        let triangles: &[[u32; 3]] = file.pod(TRIANGLES, 0)?.unwrap_or(&[]);
+        let triangle_materials: &[u32] = file.pod(TRIANGLE_MATERIALS, 0)?.unwrap_or(&[]);
+        let materials: &[GpuMaterial] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
+        let bvh: &[CwbvhNode] = file.pod(BVH_NODES, 0)?.unwrap_or(&[]);
+        let mut textures = Vec::with_capacity(manifest.textures.len().min(file.sections().len()));
+        for (i, info) in manifest.textures.iter().enumerate() {
+            let s = file.find(TEXTURE, i as u32).ok_or_else(|| {
+                FormatError::invalid(format!(
+                    "manifest lists texture {i} ('{}') but no texture#{i} section exists",
+                    info.name
+                ))
+            })?;
+            let expected =
+                mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(|| {
+                    FormatError::invalid(format!(
+                        "texture {i} has impossible dimensions {}x{} with {} mip levels",
+                        info.width, info.height, info.mip_levels
+                    ))
+                })?;
+            if s.entry.raw_size != expected {
+                return Err(FormatError::invalid(format!(
+                    "texture {i} is {} bytes, its {}x{} RGBA8 mip chain needs {expected}",
+                    s.entry.raw_size, info.width, info.height
+                ))
+                .in_section(s.position, TEXTURE, i as u32));
+            }
+            textures.push(
+                file.pod::<u32>(TEXTURE, i as u32)?
+                    .map(bytemuck::cast_slice)
+                    .unwrap_or(&[]),
+            );
+        }
+        if file.all_of(TEXTURE).len() != manifest.textures.len() {
+            return Err(FormatError::invalid(format!(
+                "{} texture sections but the manifest lists {} textures",
+                file.all_of(TEXTURE).len(),
+                manifest.textures.len()
+            )));
+        }
+        let view = SceneView {
+            manifest,
+            vertices,
+            triangles,
+            triangle_materials,
+            materials,
+            bvh,
+            textures,
+        };
+        view.check_geometry()?;
+        view.check_materials()?;
+        view.check_manifest()?;
+        view.check_bvh()?;
+        Ok(view)
+    }
+
+    fn check_geometry(&self) -> Result<()> {
+        let nv = self.vertices.len() as u64;
+        if self.triangle_materials.len() != self.triangles.len() {
+            return Err(FormatError::invalid(format!(
+                "{} triangles but {} triangle materials",
+                self.triangles.len(),
+                self.triangle_materials.len()
+            )));
+        }
+        if let Some((i, v)) = self
+            .vertices
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !finite(&v.position) || !finite(&v.normal) || !finite(&v.uv))
+        {
+            return Err(FormatError::invalid(format!(
+                "vertex {i} has a non-finite value: {v:?}"
+            )));
+        }
+        if let Some((i, t)) = self
+            .triangles
+            .iter()
+            .enumerate()
+            .find(|(_, t)| t.iter().any(|&x| x as u64 >= nv))
+        {
+            return Err(FormatError::invalid(format!(
+                "triangle {i} uses vertex indices {t:?} but there are {nv} vertices"
+            )));
+        }
+        let nm = self.materials.len() as u64;
+        if let Some((i, m)) = self
+            .triangle_materials
+            .iter()
+            .enumerate()
+            .find(|&(_, &m)| m as u64 >= nm)
+        {
+            return Err(FormatError::invalid(format!(
+                "triangle {i} uses material {m} but there are {nm} materials"
+            )));
+        }
+        Ok(())
+    }
+
+    fn check_materials(&self) -> Result<()> {
+        if self.materials.len() != self.manifest.materials.len() {
+            return Err(FormatError::invalid(format!(
+                "{} materials but the manifest names {}",
+                self.materials.len(),
+                self.manifest.materials.len()
+            )));
+        }
+        let nt = self.textures.len() as u64;
+        for (i, m) in self.materials.iter().enumerate() {
+            let scalars = [
+                m.metallic,
+                m.roughness,
+                m.alpha_cutoff,
+                m.normal_scale,
+                m.occlusion_strength,
+            ];
+            if !finite(&m.base_color) || !finite(&m.emission) || !finite(&scalars) {
+                return Err(FormatError::invalid(format!(
+                    "material {i} has a non-finite parameter"
+                )));
+            }
+            if let Some(t) = m
+                .textures()
+                .into_iter()
+                .find(|&t| t != NO_TEXTURE && t as u64 >= nt)
+            {
+                return Err(FormatError::invalid(format!(
+                    "material {i} uses texture {t} but there are {nt} textures"
+                )));
+            }
+            if m.flags & !MaterialFlags::ALL != 0
+                || m.alpha_mode().is_none()
+                || m.reserved != [0; 2]
+            {
+                return Err(FormatError::invalid(format!(
+                    "material {i} has undefined flag bits {:#x}",
+                    m.flags
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn check_manifest(&self) -> Result<()> {
+        let m = &self.manifest;
+        if !finite(&m.bounds.min) || !finite(&m.bounds.max) {
+            return Err(FormatError::invalid("scene bounds are not finite"));
+        }
+        for (i, l) in m.lights.iter().enumerate() {
+            let extra = match l.kind {
+                LightKind::Spot {
+                    inner_cone,
+                    outer_cone,
+                } => vec![inner_cone, outer_cone],
+                LightKind::Rect { width, height } => vec![width, height],
+                _ => vec![],
+            };
+            if ![
+                &l.position[..],
+                &l.direction,
+                &l.right,
+                &l.color,
+                &[l.intensity, l.range],
+                &extra,
+            ]
+            .iter()
+            .all(|v| finite(v))
+            {
+                return Err(FormatError::invalid(format!(
+                    "light {i} ('{}') has a non-finite value",
+                    l.name
+                )));
+            }
+        }
+        for (i, c) in m.cameras.iter().enumerate() {
+            if ![
+                &c.position[..],
+                &c.target,
+                &c.up,
+                &[c.vfov_degrees, c.znear, c.zfar],
+            ]
+            .iter()
+            .all(|v| finite(v))
+            {
+                return Err(FormatError::invalid(format!(
+                    "camera {i} ('{}') has a non-finite value",
+                    c.name
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that the BVH is a tree over exactly the triangles: every node reached once, child
+    /// and triangle ranges in bounds, every triangle in exactly one leaf, depth within the
+    /// traversal stack.
+    fn check_bvh(&self) -> Result<()> {
+        if self.bvh.is_empty() {
+            return Ok(());
+        }
+        let n = self.bvh.len();
+        let nt = self.triangles.len();
+        let mut node_seen = vec![false; n];
+        let mut tri_seen = vec![false; nt];
+        let mut stack = vec![(0usize, 1usize)];
+        node_seen[0] = true;
+        while let Some((i, depth)) = stack.pop() {
+            let node = &self.bvh[i];
+            let bad = |msg: String| FormatError::invalid(format!("BVH node {i}: {msg}"));
+            if depth > BVH_TRAVERSAL_STACK {
+                return Err(bad(format!("deeper than {BVH_TRAVERSAL_STACK} levels")));
+            }
+            if !finite(&node.p) || node.e.iter().any(|&e| e == 0 || e == 255) {
+                return Err(bad("non-finite origin or degenerate scale".into()));
+            }
+            for slot in 0..8 {
+                let meta = node.child_meta[slot];
+                if node.is_internal(slot) {
+                    if meta != 0b0010_0000 | (24 + slot as u8) {
+                        return Err(bad(format!("internal slot {slot} has meta {meta:#010b}")));
+                    }
+                    let c = node.child_node(slot);
+                    if c as usize >= n || c == 0 {
+                        return Err(bad(format!("child {c} out of range (nodes: {n})")));
+                    }
+                    if std::mem::replace(&mut node_seen[c as usize], true) {
+                        return Err(bad(format!("child {c} is referenced twice")));
+                    }
+                    stack.push((c as usize, depth + 1));
+                } else if meta != 0 {
+                    let (first, count) = node.leaf_range(slot);
+                    let unary = meta >> 5;
+                    if unary & (unary + 1) != 0 || first + count as u64 > nt as u64 {
+                        return Err(bad(format!(
+                            "leaf slot {slot} meta {meta:#010b} invalid for {nt} triangles"
+                        )));
+                    }
+                    for t in first..first + count as u64 {
+                        if std::mem::replace(&mut tri_seen[t as usize], true) {
+                            return Err(bad(format!("triangle {t} is in two leaves")));
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(i) = node_seen.iter().position(|s| !s) {
+            return Err(FormatError::invalid(format!(
+                "BVH node {i} is not reachable from the root"
+            )));
+        }
+        if let Some(t) = tri_seen.iter().position(|s| !s) {
+            return Err(FormatError::invalid(format!(
+                "triangle {t} is in no BVH leaf"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Bytes of a full RGBA8 mip chain, or `None` if the description is impossible (zero size,
+/// wrong level count, overflow).
+pub fn mip_chain_bytes(width: u32, height: u32, levels: u32) -> Option<u64> {
+    if width == 0 || height == 0 || levels != mip_levels(width, height) {
+        return None;
+    }
+    let mut total: u64 = 0;
+    for l in 0..levels {
+        let w = (width >> l).max(1) as u64;
+        let h = (height >> l).max(1) as u64;
+        total = total.checked_add(w.checked_mul(h)?.checked_mul(4)?)?;
+    }
+    Some(total)
+}
+
+/// Number of levels of a full mip chain down to 1×1.
+pub fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}

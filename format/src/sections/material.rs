@@ -1,0 +1,115 @@
+//! Material layout shared with the player's shaders.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Texture slot value meaning "no texture".
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// How a material's alpha is used (glTF `alphaMode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum AlphaMode {
+    /// Alpha ignored.
+    Opaque = 0,
+    /// Alpha below `alpha_cutoff` discards.
+    Mask = 1,
+    /// Alpha blends.
+    Blend = 2,
+}
+
+/// Bits of [`GpuMaterial::flags`].
+#[derive(Debug)]
+pub struct MaterialFlags;
+
+impl MaterialFlags {
+    /// Both faces are shaded (glTF `doubleSided`).
+    pub const DOUBLE_SIDED: u32 = 1 << 0;
+    /// Bits 1..3: [`AlphaMode`].
+    pub const ALPHA_MODE_SHIFT: u32 = 1;
+    /// Mask of the alpha-mode bits.
+    pub const ALPHA_MODE_MASK: u32 = 0b11 << 1;
+    /// Pure Lambertian diffuse, no specular lobe (OBJ materials with `Ks 0 0 0`).
+    pub const DIFFUSE_ONLY: u32 = 1 << 3;
+    /// Every flag bit defined in this version.
+    pub const ALL: u32 = Self::DOUBLE_SIDED | Self::ALPHA_MODE_MASK | Self::DIFFUSE_ONLY;
+}
+
+/// A metallic-roughness PBR material. 80 bytes; std430-compatible (vec4, vec3 + float, scalars).
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuMaterial {
+    /// Linear RGBA base colour factor.
+    pub base_color: [f32; 4],
+    /// Emitted radiance, W/(sr·m²) per linear RGB channel (emissive factor × strength).
+    pub emission: [f32; 3],
+    /// Metalness factor in [0, 1].
+    pub metallic: f32,
+    /// Perceptual roughness factor in [0, 1]; GGX α = roughness².
+    pub roughness: f32,
+    /// Alpha threshold for [`AlphaMode::Mask`].
+    pub alpha_cutoff: f32,
+    /// Scale of the tangent-space normal map's xy.
+    pub normal_scale: f32,
+    /// Strength of the occlusion texture.
+    pub occlusion_strength: f32,
+    /// Texture numbers (or [`NO_TEXTURE`]); base colour is sRGB, the others linear.
+    pub base_color_texture: u32,
+    /// Metalness in B, roughness in G (glTF).
+    pub metallic_roughness_texture: u32,
+    /// Tangent-space normal map.
+    pub normal_texture: u32,
+    /// Ambient occlusion in R.
+    pub occlusion_texture: u32,
+    /// Emission colour (sRGB), multiplied by `emission`.
+    pub emissive_texture: u32,
+    /// [`MaterialFlags`].
+    pub flags: u32,
+    /// Zero.
+    pub reserved: [u32; 2],
+}
+
+const _: () = assert!(size_of::<GpuMaterial>() == 80);
+
+impl Default for GpuMaterial {
+    fn default() -> Self {
+        GpuMaterial {
+            base_color: [1.0; 4],
+            emission: [0.0; 3],
+            metallic: 1.0,
+            roughness: 1.0,
+            alpha_cutoff: 0.5,
+            normal_scale: 1.0,
+            occlusion_strength: 1.0,
+            base_color_texture: NO_TEXTURE,
+            metallic_roughness_texture: NO_TEXTURE,
+            normal_texture: NO_TEXTURE,
+            occlusion_texture: NO_TEXTURE,
+            emissive_texture: NO_TEXTURE,
+            flags: 0,
+            reserved: [0; 2],
+        }
+    }
+}
+
+impl GpuMaterial {
+    /// The texture slots, in field order.
+    pub fn textures(&self) -> [u32; 5] {
+        [
+            self.base_color_texture,
+            self.metallic_roughness_texture,
+            self.normal_texture,
+            self.occlusion_texture,
+            self.emissive_texture,
+        ]
+    }
+
+    /// The alpha mode, if the bits hold a defined one.
+    pub fn alpha_mode(&self) -> Option<AlphaMode> {
+        match (self.flags & MaterialFlags::ALPHA_MODE_MASK) >> MaterialFlags::ALPHA_MODE_SHIFT {
+            0 => Some(AlphaMode::Opaque),
+            1 => Some(AlphaMode::Mask),
+            2 => Some(AlphaMode::Blend),
+            _ => None,
+        }
+    }
+}

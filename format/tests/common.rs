@@ -1,0 +1,94 @@
+//! Fixtures shared by the format tests: a small but complete scene file.
+
+#![allow(dead_code)]
+
+use kiln_format::manifest::*;
+use kiln_format::sections::{self, CwbvhNode, GpuMaterial, Vertex};
+use kiln_format::{ContentHash, FileWriter};
+
+/// A one-quad scene with every section kind the format knows, a valid one-node BVH and a
+/// 2x2 texture, written by the reference writer.
+pub fn small_file() -> Vec<u8> {
+    let vertices = [
+        Vertex {
+            position: [0.0, 0.0, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [0.0, 0.0],
+        },
+        Vertex {
+            position: [1.0, 0.0, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [1.0, 0.0],
+        },
+        Vertex {
+            position: [1.0, 1.0, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [1.0, 1.0],
+        },
+        Vertex {
+            position: [0.0, 1.0, 0.0],
+            normal: [0.0, 0.0, 1.0],
+            uv: [0.0, 1.0],
+        },
+    ];
+    let triangles: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
+    let tmat = [0u32, 0];
+    let materials = [GpuMaterial {
+        base_color_texture: 0,
+        ..Default::default()
+    }];
+    // One root with one leaf of two triangles; box [0,1]^2 x [0, 0].
+    let mut root = CwbvhNode {
+        p: [0.0; 3],
+        e: [127 - 8, 127 - 8, 127 - 8],
+        ..Default::default()
+    };
+    root.child_meta[0] = 0b0110_0000;
+    root.child_max_x[0] = 255;
+    root.child_max_y[0] = 255;
+    let nodes = [root];
+    let texels: Vec<u8> = (0..(4 + 1) * 4).map(|i| i as u8).collect();
+    let manifest = Manifest {
+        generator: "test".into(),
+        scene_name: "quad".into(),
+        bounds: Bounds {
+            min: [0.0; 3],
+            max: [1.0, 1.0, 0.0],
+        },
+        materials: vec![MaterialInfo { name: "m".into() }],
+        textures: vec![TextureInfo {
+            name: "t".into(),
+            width: 2,
+            height: 2,
+            mip_levels: 2,
+            color_space: ColorSpace::Srgb,
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::ClampToEdge,
+            mag_linear: true,
+        }],
+        lights: vec![Light {
+            name: "l".into(),
+            kind: LightKind::Point,
+            position: [0.5, 0.5, 1.0],
+            direction: [0.0, 0.0, -1.0],
+            right: [0.0; 3],
+            color: [1.0; 3],
+            intensity: 2.0,
+            range: 0.0,
+            casts_shadows: true,
+        }],
+        ..Default::default()
+    };
+    let h = ContentHash::of;
+    let mut w = FileWriter::new();
+    w.manifest(&manifest, h(b"m")).unwrap();
+    w.pod(sections::VERTICES, 0, &vertices, h(b"v")).unwrap();
+    w.pod(sections::TRIANGLES, 0, &triangles, h(b"t")).unwrap();
+    w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h(b"tm"))
+        .unwrap();
+    w.pod(sections::MATERIALS, 0, &materials, h(b"mat"))
+        .unwrap();
+    w.pod(sections::BVH_NODES, 0, &nodes, h(b"b")).unwrap();
+    w.bytes(sections::TEXTURE, 0, texels, h(b"tex")).unwrap();
+    w.to_bytes().unwrap()
+}

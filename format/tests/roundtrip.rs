@@ -1,0 +1,311 @@
+//! Round trips: write → read → equal, and re-write → byte-identical, for random contents.
+
+mod common;
+
+use kiln_format::manifest::*;
+use kiln_format::sections::{self, CwbvhNode, GpuMaterial, Vertex};
+use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile, SectionKind};
+use proptest::prelude::*;
+
+fn f32s<const N: usize>() -> impl Strategy<Value = [f32; N]> {
+    proptest::array::uniform(proptest::num::f32::ANY)
+}
+
+fn text() -> impl Strategy<Value = String> {
+    "\\PC{0,12}"
+}
+
+fn light() -> impl Strategy<Value = Light> {
+    let kind = prop_oneof![
+        Just(LightKind::Point),
+        Just(LightKind::Directional),
+        (any::<f32>(), any::<f32>()).prop_map(|(a, b)| LightKind::Spot {
+            inner_cone: a,
+            outer_cone: b
+        }),
+        (any::<f32>(), any::<f32>()).prop_map(|(w, h)| LightKind::Rect {
+            width: w,
+            height: h
+        }),
+    ];
+    (
+        text(),
+        kind,
+        f32s::<3>(),
+        f32s::<3>(),
+        f32s::<3>(),
+        f32s::<3>(),
+        any::<f32>(),
+        any::<bool>(),
+    )
+        .prop_map(
+            |(name, kind, position, direction, right, color, intensity, casts_shadows)| Light {
+                name,
+                kind,
+                position,
+                direction,
+                right,
+                color,
+                intensity,
+                range: 0.0,
+                casts_shadows,
+            },
+        )
+}
+
+fn texture_info() -> impl Strategy<Value = TextureInfo> {
+    (text(), 1u32..5000, 1u32..5000, any::<bool>(), any::<bool>()).prop_map(
+        |(name, w, h, srgb, lin)| TextureInfo {
+            name,
+            width: w,
+            height: h,
+            mip_levels: 32 - w.max(h).leading_zeros(),
+            color_space: if srgb {
+                ColorSpace::Srgb
+            } else {
+                ColorSpace::Linear
+            },
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::MirroredRepeat,
+            mag_linear: lin,
+        },
+    )
+}
+
+fn manifest() -> impl Strategy<Value = Manifest> {
+    (
+        text(),
+        text(),
+        prop::collection::vec((text(), any::<u64>(), text()), 0..4),
+        prop::collection::vec(light(), 0..4),
+        prop::collection::vec(texture_info(), 0..4),
+        prop::collection::vec(text(), 0..4),
+        (f32s::<3>(), f32s::<3>(), f32s::<3>(), any::<f32>()),
+        any::<u64>(),
+    )
+        .prop_map(
+            |(generator, scene_name, inputs, lights, textures, mats, cam, degenerate)| Manifest {
+                generator,
+                scene_name,
+                inputs: inputs
+                    .into_iter()
+                    .map(|(path, bytes, hash)| InputFile { path, bytes, hash })
+                    .collect(),
+                settings: vec![Setting {
+                    key: "bvh-preset".into(),
+                    value: "medium".into(),
+                }],
+                bounds: Bounds {
+                    min: cam.0,
+                    max: cam.1,
+                },
+                materials: mats.into_iter().map(|name| MaterialInfo { name }).collect(),
+                textures,
+                lights,
+                cameras: vec![Camera {
+                    name: "c".into(),
+                    position: cam.0,
+                    target: cam.1,
+                    up: cam.2,
+                    vfov_degrees: cam.3,
+                    znear: 0.1,
+                    zfar: 0.0,
+                }],
+                sky: Sky { radiance: cam.2 },
+                media: vec![Medium {
+                    bounds: Bounds::default(),
+                    sigma_a: cam.0,
+                    sigma_s: cam.1,
+                    g: cam.3,
+                }],
+                skipped: vec![SkippedStage {
+                    stage: "shadow-maps".into(),
+                    reason: "no lights".into(),
+                }],
+                degenerate_triangles: degenerate,
+            },
+        )
+}
+
+/// Bitwise equality (NaN payloads included), which is what "round trip" means for a file.
+fn same_bits<T: bytemuck::Pod>(a: &[T], b: &[T]) -> bool {
+    bytemuck::cast_slice::<T, u8>(a) == bytemuck::cast_slice::<T, u8>(b)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn manifest_round_trips(m in manifest()) {
+        let bytes = FileWriter::new().manifest(&m, ContentHash::of(b"x")).unwrap().to_bytes().unwrap();
+        let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+        let back = file.manifest().unwrap();
+        // Compare encodings: f32 NaNs are not equal to themselves, their bytes are.
+        prop_assert_eq!(back.encode(), m.encode());
+        let again = FileWriter::new().manifest(&back, ContentHash::of(b"x")).unwrap().to_bytes().unwrap();
+        prop_assert_eq!(again, bytes);
+    }
+
+    #[test]
+    fn every_pod_section_round_trips(
+        nv in 0usize..50, nt in 0usize..50, nm in 0usize..8, nb in 0usize..8, ntex in 0usize..4,
+        seed in any::<u64>(), hash in any::<[u8; 16]>(),
+    ) {
+        let mut state = seed;
+        let mut gen_bytes = |n: usize| -> Vec<u8> { (0..n).map(|_| splitmix(&mut state)).collect() };
+        let vertices: Vec<Vertex> = bytemuck::pod_collect_to_vec(&gen_bytes(nv * 32));
+        let triangles: Vec<[u32; 3]> = bytemuck::pod_collect_to_vec(&gen_bytes(nt * 12));
+        let tmat: Vec<u32> = bytemuck::pod_collect_to_vec(&gen_bytes(nt * 4));
+        let mats: Vec<GpuMaterial> = bytemuck::pod_collect_to_vec(&gen_bytes(nm * 80));
+        let nodes: Vec<CwbvhNode> = bytemuck::pod_collect_to_vec(&gen_bytes(nb * 80));
+        let textures: Vec<Vec<u8>> = (0..ntex).map(|i| gen_bytes(4 * (i + 1) * 7)).collect();
+        let h = ContentHash(hash);
+        let m = Manifest::default();
+        let write = |order: bool| {
+            let mut w = FileWriter::new();
+            if order {
+                w.manifest(&m, h).unwrap();
+                w.pod(sections::VERTICES, 0, &vertices, h).unwrap();
+                w.pod(sections::TRIANGLES, 0, &triangles, h).unwrap();
+                w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h).unwrap();
+                w.pod(sections::MATERIALS, 0, &mats, h).unwrap();
+                w.pod(sections::BVH_NODES, 0, &nodes, h).unwrap();
+                for (i, t) in textures.iter().enumerate() {
+                    w.bytes(sections::TEXTURE, i as u32, t.as_slice(), h).unwrap();
+                }
+            } else {
+                for (i, t) in textures.iter().enumerate().rev() {
+                    w.bytes(sections::TEXTURE, i as u32, t.as_slice(), h).unwrap();
+                }
+                w.pod(sections::BVH_NODES, 0, &nodes, h).unwrap();
+                w.pod(sections::MATERIALS, 0, &mats, h).unwrap();
+                w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h).unwrap();
+                w.pod(sections::TRIANGLES, 0, &triangles, h).unwrap();
+                w.pod(sections::VERTICES, 0, &vertices, h).unwrap();
+                w.manifest(&m, h).unwrap();
+            }
+            w.to_bytes().unwrap()
+        };
+        let bytes = write(true);
+        prop_assert_eq!(&bytes, &write(false), "layout depends on insertion order");
+        let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+        prop_assert!(same_bits(f.pod::<Vertex>(sections::VERTICES, 0).unwrap().unwrap(), &vertices));
+        prop_assert!(same_bits(f.pod::<[u32; 3]>(sections::TRIANGLES, 0).unwrap().unwrap(), &triangles));
+        prop_assert!(same_bits(f.pod::<u32>(sections::TRIANGLE_MATERIALS, 0).unwrap().unwrap(), &tmat));
+        prop_assert!(same_bits(f.pod::<GpuMaterial>(sections::MATERIALS, 0).unwrap().unwrap(), &mats));
+        prop_assert!(same_bits(f.pod::<CwbvhNode>(sections::BVH_NODES, 0).unwrap().unwrap(), &nodes));
+        for (i, t) in textures.iter().enumerate() {
+            let s = *f.find(sections::TEXTURE, i as u32).unwrap();
+            prop_assert_eq!(&*f.section_bytes(&s).unwrap(), t.as_slice());
+            prop_assert_eq!(s.entry.content_hash, h);
+        }
+        for s in f.sections() {
+            prop_assert_eq!(s.entry.offset % 64, 0);
+        }
+    }
+}
+
+/// SplitMix64: a seeded byte source for random section contents.
+fn splitmix(state: &mut u64) -> u8 {
+    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    (z ^ (z >> 31)) as u8
+}
+
+#[test]
+fn unknown_sections_are_skipped_and_reported() {
+    let m = Manifest {
+        scene_name: "s".into(),
+        ..Default::default()
+    };
+    let future = SectionKind(*b"ZZZZ");
+    let mut w = FileWriter::new();
+    w.manifest(&m, ContentHash::default()).unwrap();
+    w.raw(future, 3, 1, vec![7u8; 10], ContentHash::default())
+        .unwrap();
+    // A known kind at a newer layout version is skipped too.
+    w.raw(
+        sections::VERTICES,
+        0,
+        99,
+        vec![1u8; 7],
+        ContentHash::default(),
+    )
+    .unwrap();
+    let bytes = w.to_bytes().unwrap();
+    let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let skipped: Vec<_> = f.skipped().map(|s| (s.entry.kind, s.entry.index)).collect();
+    assert_eq!(skipped, vec![(sections::VERTICES, 0), (future, 3)]);
+    assert!(f.pod::<Vertex>(sections::VERTICES, 0).unwrap().is_none());
+    assert_eq!(f.manifest().unwrap(), m);
+}
+
+#[test]
+fn newer_manifest_version_reads_its_known_prefix() {
+    let m = Manifest {
+        scene_name: "future".into(),
+        ..Default::default()
+    };
+    let mut body = m.encode();
+    body.extend_from_slice(b"fields of manifest v2");
+    let mut w = FileWriter::new();
+    w.raw(
+        sections::MANIFEST,
+        0,
+        2,
+        body.clone(),
+        ContentHash::default(),
+    )
+    .unwrap();
+    let f = KilnFile::from_bytes(&w.to_bytes().unwrap(), Checksums::Eager).unwrap();
+    assert_eq!(f.manifest().unwrap(), m);
+    // The same trailing bytes at the current version are damage.
+    let mut w = FileWriter::new();
+    w.raw(sections::MANIFEST, 0, 1, body, ContentHash::default())
+        .unwrap();
+    let f = KilnFile::from_bytes(&w.to_bytes().unwrap(), Checksums::Eager).unwrap();
+    assert!(f.manifest().unwrap_err().to_string().contains("trailing"));
+}
+
+#[test]
+fn atomic_write_replaces_and_leaves_no_temp_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.kiln");
+    std::fs::write(&path, b"old").unwrap();
+    let bytes = common::small_file();
+    let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let m = f.manifest().unwrap();
+    let mut w = FileWriter::new();
+    w.manifest(&m, ContentHash::default()).unwrap();
+    w.write_atomic(&path).unwrap();
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 1, "{names:?}");
+    let back = KilnFile::open(&path, Checksums::Eager).unwrap();
+    assert_eq!(back.manifest().unwrap(), m);
+}
+
+#[test]
+fn failed_atomic_write_keeps_the_old_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.kiln");
+    std::fs::write(&path, b"old").unwrap();
+    // No manifest: the writer refuses before touching the target.
+    let mut w = FileWriter::new();
+    w.raw(
+        SectionKind(*b"ZZZZ"),
+        0,
+        1,
+        vec![1u8],
+        ContentHash::default(),
+    )
+    .unwrap();
+    assert!(w.write_atomic(&path).is_err());
+    assert_eq!(std::fs::read(&path).unwrap(), b"old");
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1);
+}
