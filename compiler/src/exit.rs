@@ -7,8 +7,12 @@
 //! | 2 | usage error: unknown flag, missing argument, conflicting options |
 //! | 3 | unsupported: another major format version, a feature this build lacks |
 //! | 4 | I/O failure: a file that cannot be read or written |
+//! | 70 | internal error (a bug in kiln) |
 
 use std::fmt;
+
+/// Exit code of an internal error (a panic caught at the top).
+pub const INTERNAL_ERROR: u8 = 70;
 
 /// Process exit status of `kiln`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,10 +39,7 @@ pub struct CliError {
 impl CliError {
     /// Error with exit code.
     pub fn new(exit: Exit, message: impl Into<String>) -> Self {
-        Self {
-            exit,
-            message: message.into(),
-        }
+        Self { exit, message: message.into() }
     }
     /// Bad input.
     pub fn input(message: impl Into<String>) -> Self {

@@ -2,7 +2,15 @@
 //!
 //! The binary `kiln` only parses arguments and dispatches to [`commands`].
 
+pub mod analyze;
+pub mod bake;
 pub mod cli;
 pub mod commands;
 pub mod exit;
+pub mod import;
+pub mod ir;
 pub mod output;
+pub mod pipeline;
+pub mod progress;
+pub mod raycheck;
+pub mod settings;

@@ -116,21 +116,12 @@ pub struct FormatError {
 impl FormatError {
     /// An error at no particular place.
     pub fn new(kind: ErrorKind) -> Self {
-        Self {
-            kind,
-            location: Location::default(),
-        }
+        Self { kind, location: Location::default() }
     }
 
     /// An error at a byte offset.
     pub fn at(kind: ErrorKind, offset: u64) -> Self {
-        Self {
-            kind,
-            location: Location {
-                section: None,
-                offset: Some(offset),
-            },
-        }
+        Self { kind, location: Location { section: None, offset: Some(offset) } }
     }
 
     /// Attaches a section to the location (keeping an offset already there).
@@ -152,10 +143,7 @@ impl FormatError {
 
     /// Whether the error is a refusal of an incompatible version (not damage).
     pub fn is_unsupported(&self) -> bool {
-        matches!(
-            self.kind,
-            ErrorKind::UnsupportedVersion { .. } | ErrorKind::UnknownCodec(_)
-        )
+        matches!(self.kind, ErrorKind::UnsupportedVersion { .. } | ErrorKind::UnknownCodec(_))
     }
 }
 

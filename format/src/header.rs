@@ -77,10 +77,7 @@ impl Header {
         // reported as "not a kiln file" rather than as "too short".
         let prefix = &file[..file.len().min(8)];
         if prefix != &MAGIC[..prefix.len()] || prefix.is_empty() {
-            return Err(FormatError::at(
-                ErrorKind::BadMagic(diagnose_magic(file)),
-                0,
-            ));
+            return Err(FormatError::at(ErrorKind::BadMagic(diagnose_magic(file)), 0));
         }
         if file.len() < HEADER_SIZE {
             return Err(FormatError::at(ErrorKind::TooShort(len), 0));
@@ -102,14 +99,7 @@ impl Header {
         let stored = u64_at(b, 56);
         let computed = checksum64(&b[0..56]);
         if stored != computed {
-            return Err(FormatError::at(
-                ErrorKind::Checksum {
-                    what: "header",
-                    stored,
-                    computed,
-                },
-                56,
-            ));
+            return Err(FormatError::at(ErrorKind::Checksum { what: "header", stored, computed }, 56));
         }
         let flags = u32_at(b, 12);
         let header_size = u32_at(b, 16);
@@ -124,17 +114,12 @@ impl Header {
         };
         let bad = |msg: String, at: u64| Err(FormatError::at(ErrorKind::BadField(msg), at));
         if header_size as usize != HEADER_SIZE {
-            return bad(
-                format!("header size is {header_size}, must be {HEADER_SIZE}"),
-                16,
-            );
+            return bad(format!("header size is {header_size}, must be {HEADER_SIZE}"), 16);
         }
         let unknown_required = flags & REQUIRED_FLAGS_MASK & !KNOWN_FLAGS;
         if unknown_required != 0 {
             return bad(
-                format!(
-                    "file needs features this reader lacks (required flag bits {unknown_required:#06x})"
-                ),
+                format!("file needs features this reader lacks (required flag bits {unknown_required:#06x})"),
                 12,
             );
         }
@@ -143,19 +128,13 @@ impl Header {
         }
         if header.table_offset != HEADER_SIZE as u64 {
             return bad(
-                format!(
-                    "section table offset is {}, must be {HEADER_SIZE}",
-                    header.table_offset
-                ),
+                format!("section table offset is {}, must be {HEADER_SIZE}", header.table_offset),
                 24,
             );
         }
         if header.file_size != len {
             return Err(FormatError::at(
-                ErrorKind::SizeMismatch {
-                    expected: header.file_size,
-                    actual: len,
-                },
+                ErrorKind::SizeMismatch { expected: header.file_size, actual: len },
                 32,
             ));
         }
@@ -180,11 +159,7 @@ fn diagnose_magic(file: &[u8]) -> &'static str {
     if file.starts_with(b"glTF") {
         return "this is a binary glTF (.glb), not a kiln file: compile it with `kiln compile`";
     }
-    if file
-        .iter()
-        .take(64)
-        .all(|&c| c == b'\t' || c == b'\n' || c == b'\r' || (0x20..0x7f).contains(&c))
-    {
+    if file.iter().take(64).all(|&c| c == b'\t' || c == b'\n' || c == b'\r' || (0x20..0x7f).contains(&c)) {
         return "not a kiln file: it looks like text";
     }
     "not a kiln file: its first bytes are not the kiln signature"

@@ -22,6 +22,7 @@ pub mod checksum;
 pub mod error;
 pub mod header;
 pub mod manifest;
+pub mod query;
 pub mod read;
 pub mod scene;
 pub mod sections;

@@ -13,9 +13,7 @@ use crate::error::{ErrorKind, FormatError, Result};
 use crate::header::{HEADER_SIZE, Header};
 use crate::manifest::Manifest;
 use crate::sections::{self, KindInfo, MANIFEST};
-use crate::table::{
-    Codec, ENTRY_SIZE, MAX_ALIGN_LOG2, MIN_ALIGN_LOG2, SectionEntry, SectionKind, align_up,
-};
+use crate::table::{Codec, ENTRY_SIZE, MAX_ALIGN_LOG2, MIN_ALIGN_LOG2, SectionEntry, SectionKind, align_up};
 
 /// When section checksums are verified.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -48,9 +46,8 @@ impl Backing {
             Backing::Owned { blocks, len } => {
                 // SAFETY: `Block` is 64 plain bytes with no padding, so a slice of blocks is a
                 // slice of `64 * blocks.len()` initialised bytes; `len` never exceeds that.
-                let all = unsafe {
-                    std::slice::from_raw_parts(blocks.as_ptr().cast::<u8>(), blocks.len() * 64)
-                };
+                let all =
+                    unsafe { std::slice::from_raw_parts(blocks.as_ptr().cast::<u8>(), blocks.len() * 64) };
                 &all[..*len]
             }
         }
@@ -61,10 +58,7 @@ impl Backing {
         for (block, chunk) in blocks.iter_mut().zip(bytes.chunks(64)) {
             block.0[..chunk.len()].copy_from_slice(chunk);
         }
-        Backing::Owned {
-            blocks,
-            len: bytes.len(),
-        }
+        Backing::Owned { blocks, len: bytes.len() }
     }
 }
 
@@ -129,13 +123,7 @@ impl KilnFile {
     fn from_backing(backing: Backing, policy: Checksums) -> Result<KilnFile> {
         let (header, sections) = validate_layout(backing.bytes())?;
         let verified = (0..sections.len()).map(|_| OnceLock::new()).collect();
-        let file = KilnFile {
-            backing,
-            header,
-            sections,
-            verified,
-            policy,
-        };
+        let file = KilnFile { backing, header, sections, verified, policy };
         if policy == Checksums::Eager {
             file.verify_all()?;
         }
@@ -164,18 +152,13 @@ impl KilnFile {
 
     /// The section of `kind` and `index` this reader understands, if present.
     pub fn find(&self, kind: SectionKind, index: u32) -> Option<&Section> {
-        self.sections
-            .iter()
-            .find(|s| s.entry.kind == kind && s.entry.index == index && s.known.is_some())
+        self.sections.iter().find(|s| s.entry.kind == kind && s.entry.index == index && s.known.is_some())
     }
 
     /// Every understood section of `kind`, in index order.
     pub fn all_of(&self, kind: SectionKind) -> Vec<&Section> {
-        let mut v: Vec<&Section> = self
-            .sections
-            .iter()
-            .filter(|s| s.entry.kind == kind && s.known.is_some())
-            .collect();
+        let mut v: Vec<&Section> =
+            self.sections.iter().filter(|s| s.entry.kind == kind && s.known.is_some()).collect();
         v.sort_by_key(|s| s.entry.index);
         v
     }
@@ -191,11 +174,7 @@ impl KilnFile {
                     Ok(())
                 } else {
                     Err(FormatError::at(
-                        ErrorKind::Checksum {
-                            what: "section",
-                            stored: s.entry.checksum,
-                            computed,
-                        },
+                        ErrorKind::Checksum { what: "section", stored: s.entry.checksum, computed },
                         s.entry.offset,
                     )
                     .in_section(position, s.entry.kind, s.entry.index))
@@ -221,12 +200,11 @@ impl KilnFile {
         }
         match Codec::from_u8(s.entry.codec) {
             Some(Codec::None) => Ok(Cow::Borrowed(self.stored_bytes(s))),
-            None => {
-                Err(
-                    FormatError::at(ErrorKind::UnknownCodec(s.entry.codec), s.entry.offset)
-                        .in_section(s.position, s.entry.kind, s.entry.index),
-                )
-            }
+            None => Err(FormatError::at(ErrorKind::UnknownCodec(s.entry.codec), s.entry.offset).in_section(
+                s.position,
+                s.entry.kind,
+                s.entry.index,
+            )),
         }
     }
 
@@ -235,10 +213,7 @@ impl KilnFile {
         let Some(s) = self.find(kind, index) else {
             return Ok(None);
         };
-        let loc = |e: FormatError| {
-            e.in_section(s.position, kind, index)
-                .or_offset(s.entry.offset)
-        };
+        let loc = |e: FormatError| e.in_section(s.position, kind, index).or_offset(s.entry.offset);
         if s.known.map(|k| k.element_size) != Some(size_of::<T>()) {
             return Err(loc(FormatError::invalid(format!(
                 "element type of {} bytes requested, the section holds {}-byte elements",
@@ -247,28 +222,21 @@ impl KilnFile {
             ))));
         }
         match self.section_bytes(s).map_err(loc)? {
-            Cow::Borrowed(bytes) => bytemuck::try_cast_slice(bytes).map(Some).map_err(|e| {
-                loc(FormatError::invalid(format!(
-                    "cannot view section as elements: {e}"
-                )))
-            }),
+            Cow::Borrowed(bytes) => bytemuck::try_cast_slice(bytes)
+                .map(Some)
+                .map_err(|e| loc(FormatError::invalid(format!("cannot view section as elements: {e}")))),
             // No compressing codec exists yet; when one does, decoded sections are cached.
-            Cow::Owned(_) => Err(loc(FormatError::invalid(
-                "compressed POD sections are not supported",
-            ))),
+            Cow::Owned(_) => Err(loc(FormatError::invalid("compressed POD sections are not supported"))),
         }
     }
 
     /// Decodes the manifest.
     pub fn manifest(&self) -> Result<Manifest> {
-        let s = self
-            .find(MANIFEST, 0)
-            .ok_or_else(|| FormatError::new(ErrorKind::MissingSection(MANIFEST)))?;
+        let s =
+            self.find(MANIFEST, 0).ok_or_else(|| FormatError::new(ErrorKind::MissingSection(MANIFEST)))?;
         let bytes = self.section_bytes(s)?;
-        Manifest::decode(&bytes, s.entry.version).map_err(|e| {
-            e.in_section(s.position, MANIFEST, 0)
-                .or_offset(s.entry.offset)
-        })
+        Manifest::decode(&bytes, s.entry.version)
+            .map_err(|e| e.in_section(s.position, MANIFEST, 0).or_offset(s.entry.offset))
     }
 }
 
@@ -294,11 +262,7 @@ fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
     let computed = checksum64(table);
     if computed != header.table_checksum {
         return Err(FormatError::at(
-            ErrorKind::Checksum {
-                what: "section table",
-                stored: header.table_checksum,
-                computed,
-            },
+            ErrorKind::Checksum { what: "section table", stored: header.table_checksum, computed },
             header.table_offset,
         ));
     }
@@ -324,45 +288,32 @@ fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
             ));
         }
         if entry.flags != 0 {
-            return Err(bad(
-                format!("reserved entry flags are {:#x}, must be 0", entry.flags),
-                12,
-            ));
+            return Err(bad(format!("reserved entry flags are {:#x}, must be 0", entry.flags), 12));
         }
         let expected = align_up(cursor, entry.alignment()).unwrap_or(u64::MAX);
         if entry.offset != expected {
             let why = if entry.offset < cursor {
                 "overlaps the previous section or the table"
-            } else if entry.offset % entry.alignment() != 0 {
+            } else if !entry.offset.is_multiple_of(entry.alignment()) {
                 "is misaligned"
             } else {
                 "leaves a gap after the previous section"
             };
             return Err(bad(
-                format!(
-                    "section offset {:#x} {why} (expected {expected:#x})",
-                    entry.offset
-                ),
+                format!("section offset {:#x} {why} (expected {expected:#x})", entry.offset),
                 16,
             ));
         }
-        let end = entry
-            .offset
-            .checked_add(entry.size)
-            .filter(|&e| e <= len)
-            .ok_or_else(|| {
-                bad(
-                    format!(
-                        "section of {} bytes at {:#x} runs past the end of the {len}-byte file",
-                        entry.size, entry.offset
-                    ),
-                    24,
-                )
-            })?;
-        if let Some(i) = file[cursor as usize..entry.offset as usize]
-            .iter()
-            .position(|&b| b != 0)
-        {
+        let end = entry.offset.checked_add(entry.size).filter(|&e| e <= len).ok_or_else(|| {
+            bad(
+                format!(
+                    "section of {} bytes at {:#x} runs past the end of the {len}-byte file",
+                    entry.size, entry.offset
+                ),
+                24,
+            )
+        })?;
+        if let Some(i) = file[cursor as usize..entry.offset as usize].iter().position(|&b| b != 0) {
             return Err(FormatError::at(
                 ErrorKind::NonZeroPadding(file[cursor as usize + i]),
                 cursor + i as u64,
@@ -380,8 +331,7 @@ fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
             ));
         }
 
-        let known =
-            sections::info(entry.kind).filter(|k| entry.version <= k.version || k.kind == MANIFEST);
+        let known = sections::info(entry.kind).filter(|k| entry.version <= k.version || k.kind == MANIFEST);
         if let Some(k) = known {
             if codec.is_none() {
                 return Err(here(ErrorKind::UnknownCodec(entry.codec), entry_at + 6));
@@ -391,14 +341,11 @@ fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
             }
             if !k.indexed && entry.index != 0 {
                 return Err(bad(
-                    format!(
-                        "{} is not an indexed kind but has index {}",
-                        k.name, entry.index
-                    ),
+                    format!("{} is not an indexed kind but has index {}", k.name, entry.index),
                     8,
                 ));
             }
-            if entry.raw_size % k.element_size as u64 != 0 {
+            if !entry.raw_size.is_multiple_of(k.element_size as u64) {
                 return Err(bad(
                     format!(
                         "{} section of {} bytes is not a whole number of {}-byte elements",
@@ -409,16 +356,9 @@ fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
             }
         }
         if !seen.insert((entry.kind, entry.index)) {
-            return Err(here(
-                ErrorKind::DuplicateSection(entry.kind, entry.index),
-                entry_at,
-            ));
+            return Err(here(ErrorKind::DuplicateSection(entry.kind, entry.index), entry_at));
         }
-        sections.push(Section {
-            position,
-            entry,
-            known,
-        });
+        sections.push(Section { position, entry, known });
         cursor = end;
     }
     if cursor != len {

@@ -5,8 +5,8 @@ use crate::error::{FormatError, Result};
 use crate::manifest::{LightKind, Manifest};
 use crate::read::KilnFile;
 use crate::sections::{
-    BVH_NODES, BVH_TRAVERSAL_STACK, CwbvhNode, GpuMaterial, MATERIALS, MaterialFlags, NO_TEXTURE,
-    TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, VERTICES, Vertex,
+    BVH_NODES, BVH_TRAVERSAL_STACK, CwbvhNode, GpuMaterial, MATERIALS, MaterialFlags, NO_TEXTURE, TEXTURE,
+    TRIANGLE_MATERIALS, TRIANGLES, UVS, VERTICES, Vertex,
 };
 
 /// Borrowed, validated scene data of a [`KilnFile`].
@@ -16,6 +16,8 @@ pub struct SceneView<'a> {
     pub manifest: Manifest,
     /// Vertices (empty if the file has no geometry).
     pub vertices: &'a [Vertex],
+    /// Texture coordinates per vertex (empty when no material samples a texture).
+    pub uvs: &'a [[f32; 2]],
     /// Triangles as vertex index triples, in BVH leaf order.
     pub triangles: &'a [[u32; 3]],
     /// Material of each triangle.
@@ -37,6 +39,7 @@ impl<'a> SceneView<'a> {
     pub fn new(file: &'a KilnFile) -> Result<SceneView<'a>> {
         let manifest = file.manifest()?;
         let vertices: &[Vertex] = file.pod(VERTICES, 0)?.unwrap_or(&[]);
+        let uvs: &[[f32; 2]] = file.pod(UVS, 0)?.unwrap_or(&[]);
         let triangles: &[[u32; 3]] = file.pod(TRIANGLES, 0)?.unwrap_or(&[]);
         let triangle_materials: &[u32] = file.pod(TRIANGLE_MATERIALS, 0)?.unwrap_or(&[]);
         let materials: &[GpuMaterial] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
@@ -49,13 +52,12 @@ impl<'a> SceneView<'a> {
                     info.name
                 ))
             })?;
-            let expected =
-                mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(|| {
-                    FormatError::invalid(format!(
-                        "texture {i} has impossible dimensions {}x{} with {} mip levels",
-                        info.width, info.height, info.mip_levels
-                    ))
-                })?;
+            let expected = mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(|| {
+                FormatError::invalid(format!(
+                    "texture {i} has impossible dimensions {}x{} with {} mip levels",
+                    info.width, info.height, info.mip_levels
+                ))
+            })?;
             if s.entry.raw_size != expected {
                 return Err(FormatError::invalid(format!(
                     "texture {i} is {} bytes, its {}x{} RGBA8 mip chain needs {expected}",
@@ -63,11 +65,7 @@ impl<'a> SceneView<'a> {
                 ))
                 .in_section(s.position, TEXTURE, i as u32));
             }
-            textures.push(
-                file.pod::<u32>(TEXTURE, i as u32)?
-                    .map(bytemuck::cast_slice)
-                    .unwrap_or(&[]),
-            );
+            textures.push(file.pod::<u32>(TEXTURE, i as u32)?.map(bytemuck::cast_slice).unwrap_or(&[]));
         }
         if file.all_of(TEXTURE).len() != manifest.textures.len() {
             return Err(FormatError::invalid(format!(
@@ -76,15 +74,8 @@ impl<'a> SceneView<'a> {
                 manifest.textures.len()
             )));
         }
-        let view = SceneView {
-            manifest,
-            vertices,
-            triangles,
-            triangle_materials,
-            materials,
-            bvh,
-            textures,
-        };
+        let view =
+            SceneView { manifest, vertices, uvs, triangles, triangle_materials, materials, bvh, textures };
         view.check_geometry()?;
         view.check_materials()?;
         view.check_manifest()?;
@@ -101,33 +92,36 @@ impl<'a> SceneView<'a> {
                 self.triangle_materials.len()
             )));
         }
-        if let Some((i, v)) = self
-            .vertices
-            .iter()
-            .enumerate()
-            .find(|(_, v)| !finite(&v.position) || !finite(&v.normal) || !finite(&v.uv))
+        if let Some((i, v)) =
+            self.vertices.iter().enumerate().find(|(_, v)| !finite(&v.position) || !finite(&v.normal))
         {
+            return Err(FormatError::invalid(format!("vertex {i} has a non-finite value: {v:?}")));
+        }
+        if !self.uvs.is_empty() && self.uvs.len() != self.vertices.len() {
             return Err(FormatError::invalid(format!(
-                "vertex {i} has a non-finite value: {v:?}"
+                "{} texture coordinates for {} vertices",
+                self.uvs.len(),
+                self.vertices.len()
             )));
         }
-        if let Some((i, t)) = self
-            .triangles
-            .iter()
-            .enumerate()
-            .find(|(_, t)| t.iter().any(|&x| x as u64 >= nv))
+        if let Some(i) = self.uvs.iter().position(|uv| !finite(uv)) {
+            return Err(FormatError::invalid(format!("texture coordinate {i} is not finite")));
+        }
+        let textured = self.materials.iter().any(|m| m.textures().iter().any(|&t| t != NO_TEXTURE));
+        if textured && self.uvs.is_empty() && !self.vertices.is_empty() {
+            return Err(FormatError::invalid(
+                "materials sample textures but the file has no texture coordinates",
+            ));
+        }
+        if let Some((i, t)) =
+            self.triangles.iter().enumerate().find(|(_, t)| t.iter().any(|&x| x as u64 >= nv))
         {
             return Err(FormatError::invalid(format!(
                 "triangle {i} uses vertex indices {t:?} but there are {nv} vertices"
             )));
         }
         let nm = self.materials.len() as u64;
-        if let Some((i, m)) = self
-            .triangle_materials
-            .iter()
-            .enumerate()
-            .find(|&(_, &m)| m as u64 >= nm)
-        {
+        if let Some((i, m)) = self.triangle_materials.iter().enumerate().find(|&(_, &m)| m as u64 >= nm) {
             return Err(FormatError::invalid(format!(
                 "triangle {i} uses material {m} but there are {nm} materials"
             )));
@@ -145,31 +139,16 @@ impl<'a> SceneView<'a> {
         }
         let nt = self.textures.len() as u64;
         for (i, m) in self.materials.iter().enumerate() {
-            let scalars = [
-                m.metallic,
-                m.roughness,
-                m.alpha_cutoff,
-                m.normal_scale,
-                m.occlusion_strength,
-            ];
+            let scalars = [m.metallic, m.roughness, m.alpha_cutoff, m.normal_scale, m.occlusion_strength];
             if !finite(&m.base_color) || !finite(&m.emission) || !finite(&scalars) {
-                return Err(FormatError::invalid(format!(
-                    "material {i} has a non-finite parameter"
-                )));
+                return Err(FormatError::invalid(format!("material {i} has a non-finite parameter")));
             }
-            if let Some(t) = m
-                .textures()
-                .into_iter()
-                .find(|&t| t != NO_TEXTURE && t as u64 >= nt)
-            {
+            if let Some(t) = m.textures().into_iter().find(|&t| t != NO_TEXTURE && t as u64 >= nt) {
                 return Err(FormatError::invalid(format!(
                     "material {i} uses texture {t} but there are {nt} textures"
                 )));
             }
-            if m.flags & !MaterialFlags::ALL != 0
-                || m.alpha_mode().is_none()
-                || m.reserved != [0; 2]
-            {
+            if m.flags & !MaterialFlags::ALL != 0 || m.alpha_mode().is_none() || m.reserved != [0; 2] {
                 return Err(FormatError::invalid(format!(
                     "material {i} has undefined flag bits {:#x}",
                     m.flags
@@ -186,39 +165,21 @@ impl<'a> SceneView<'a> {
         }
         for (i, l) in m.lights.iter().enumerate() {
             let extra = match l.kind {
-                LightKind::Spot {
-                    inner_cone,
-                    outer_cone,
-                } => vec![inner_cone, outer_cone],
+                LightKind::Spot { inner_cone, outer_cone } => vec![inner_cone, outer_cone],
                 LightKind::Rect { width, height } => vec![width, height],
                 _ => vec![],
             };
-            if ![
-                &l.position[..],
-                &l.direction,
-                &l.right,
-                &l.color,
-                &[l.intensity, l.range],
-                &extra,
-            ]
-            .iter()
-            .all(|v| finite(v))
+            if ![&l.position[..], &l.direction, &l.right, &l.color, &[l.intensity, l.range], &extra]
+                .iter()
+                .all(|v| finite(v))
             {
-                return Err(FormatError::invalid(format!(
-                    "light {i} ('{}') has a non-finite value",
-                    l.name
-                )));
+                return Err(FormatError::invalid(format!("light {i} ('{}') has a non-finite value", l.name)));
             }
         }
         for (i, c) in m.cameras.iter().enumerate() {
-            if ![
-                &c.position[..],
-                &c.target,
-                &c.up,
-                &[c.vfov_degrees, c.znear, c.zfar],
-            ]
-            .iter()
-            .all(|v| finite(v))
+            if ![&c.position[..], &c.target, &c.up, &[c.vfov_degrees, c.znear, c.zfar]]
+                .iter()
+                .all(|v| finite(v))
             {
                 return Err(FormatError::invalid(format!(
                     "camera {i} ('{}') has a non-finite value",
@@ -282,14 +243,10 @@ impl<'a> SceneView<'a> {
             }
         }
         if let Some(i) = node_seen.iter().position(|s| !s) {
-            return Err(FormatError::invalid(format!(
-                "BVH node {i} is not reachable from the root"
-            )));
+            return Err(FormatError::invalid(format!("BVH node {i} is not reachable from the root")));
         }
         if let Some(t) = tri_seen.iter().position(|s| !s) {
-            return Err(FormatError::invalid(format!(
-                "triangle {t} is in no BVH leaf"
-            )));
+            return Err(FormatError::invalid(format!("triangle {t} is in no BVH leaf")));
         }
         Ok(())
     }

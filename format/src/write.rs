@@ -62,9 +62,7 @@ pub struct FileWriter<'a> {
 
 impl std::fmt::Debug for FileWriter<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("FileWriter")
-            .field("sections", &self.pending.len())
-            .finish()
+        f.debug_struct("FileWriter").field("sections", &self.pending.len()).finish()
     }
 }
 
@@ -80,13 +78,7 @@ impl<'a> FileWriter<'a> {
         manifest: &Manifest,
         content_hash: ContentHash,
     ) -> Result<&mut Self, WriteError> {
-        self.raw(
-            MANIFEST,
-            0,
-            MANIFEST_VERSION,
-            manifest.encode(),
-            content_hash,
-        )
+        self.raw(MANIFEST, 0, MANIFEST_VERSION, manifest.encode(), content_hash)
     }
 
     /// Adds a POD section of a known kind, at that kind's current version.
@@ -126,27 +118,12 @@ impl<'a> FileWriter<'a> {
             && version <= k.version
             && bytes.len() % k.element_size != 0
         {
-            return Err(WriteError::Ragged {
-                kind,
-                len: bytes.len(),
-                element: k.element_size,
-            });
+            return Err(WriteError::Ragged { kind, len: bytes.len(), element: k.element_size });
         }
-        if self
-            .pending
-            .iter()
-            .any(|p| p.kind == kind && p.index == index)
-        {
+        if self.pending.iter().any(|p| p.kind == kind && p.index == index) {
             return Err(WriteError::Duplicate(kind, index));
         }
-        self.pending.push(Pending {
-            kind,
-            index,
-            version,
-            align_log2: MIN_ALIGN_LOG2,
-            bytes,
-            content_hash,
-        });
+        self.pending.push(Pending { kind, index, version, align_log2: MIN_ALIGN_LOG2, bytes, content_hash });
         Ok(self)
     }
 
@@ -155,8 +132,7 @@ impl<'a> FileWriter<'a> {
         if !self.pending.iter().any(|p| p.kind == MANIFEST) {
             return Err(WriteError::NoManifest);
         }
-        self.pending
-            .sort_by_key(|p| (sections::stream_rank(p.kind), p.kind, p.index));
+        self.pending.sort_by_key(|p| (sections::stream_rank(p.kind), p.kind, p.index));
         let mut cursor = (HEADER_SIZE + ENTRY_SIZE * self.pending.len()) as u64;
         let entries: Vec<SectionEntry> = self
             .pending
@@ -196,10 +172,7 @@ impl<'a> FileWriter<'a> {
     /// Writes the file to `out`; returns its length.
     pub fn write_to(&mut self, out: &mut dyn Write) -> Result<u64, WriteError> {
         let (header, entries) = self.layout()?;
-        let io = |source| WriteError::Io {
-            path: PathBuf::from("<stream>"),
-            source,
-        };
+        let io = |source| WriteError::Io { path: PathBuf::from("<stream>"), source };
         out.write_all(&header.to_bytes()).map_err(io)?;
         for e in &entries {
             out.write_all(&e.to_bytes()).map_err(io)?;
@@ -207,8 +180,7 @@ impl<'a> FileWriter<'a> {
         let mut cursor = (HEADER_SIZE + ENTRY_SIZE * entries.len()) as u64;
         let zeros = [0u8; 1 << 16];
         for (e, p) in entries.iter().zip(&self.pending) {
-            out.write_all(&zeros[..(e.offset - cursor) as usize])
-                .map_err(io)?;
+            out.write_all(&zeros[..(e.offset - cursor) as usize]).map_err(io)?;
             out.write_all(&p.bytes).map_err(io)?;
             cursor = e.offset + e.size;
         }
@@ -226,18 +198,12 @@ impl<'a> FileWriter<'a> {
     /// disk and renamed over `path`, and the directory is synced. A crash or error at any point
     /// leaves an earlier `path` intact (a stray `.*.kiln-tmp*` file may remain after a crash).
     pub fn write_atomic(&mut self, path: &Path) -> Result<u64, WriteError> {
-        let err = |source| WriteError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
+        let err = |source| WriteError::Io { path: path.to_path_buf(), source };
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let tmp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(".kiln-tmp")

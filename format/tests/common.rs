@@ -10,39 +10,17 @@ use kiln_format::{ContentHash, FileWriter};
 /// 2x2 texture, written by the reference writer.
 pub fn small_file() -> Vec<u8> {
     let vertices = [
-        Vertex {
-            position: [0.0, 0.0, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0, 0.0],
-        },
-        Vertex {
-            position: [1.0, 0.0, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [1.0, 0.0],
-        },
-        Vertex {
-            position: [1.0, 1.0, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [1.0, 1.0],
-        },
-        Vertex {
-            position: [0.0, 1.0, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            uv: [0.0, 1.0],
-        },
+        Vertex { position: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
+        Vertex { position: [1.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
+        Vertex { position: [1.0, 1.0, 0.0], normal: [0.0, 0.0, 1.0] },
+        Vertex { position: [0.0, 1.0, 0.0], normal: [0.0, 0.0, 1.0] },
     ];
+    let uvs: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
     let triangles: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
     let tmat = [0u32, 0];
-    let materials = [GpuMaterial {
-        base_color_texture: 0,
-        ..Default::default()
-    }];
+    let materials = [GpuMaterial { base_color_texture: 0, ..Default::default() }];
     // One root with one leaf of two triangles; box [0,1]^2 x [0, 0].
-    let mut root = CwbvhNode {
-        p: [0.0; 3],
-        e: [127 - 8, 127 - 8, 127 - 8],
-        ..Default::default()
-    };
+    let mut root = CwbvhNode { p: [0.0; 3], e: [127 - 8, 127 - 8, 127 - 8], ..Default::default() };
     root.child_meta[0] = 0b0110_0000;
     root.child_max_x[0] = 255;
     root.child_max_y[0] = 255;
@@ -51,10 +29,7 @@ pub fn small_file() -> Vec<u8> {
     let manifest = Manifest {
         generator: "test".into(),
         scene_name: "quad".into(),
-        bounds: Bounds {
-            min: [0.0; 3],
-            max: [1.0, 1.0, 0.0],
-        },
+        bounds: Bounds { min: [0.0; 3], max: [1.0, 1.0, 0.0] },
         materials: vec![MaterialInfo { name: "m".into() }],
         textures: vec![TextureInfo {
             name: "t".into(),
@@ -83,11 +58,10 @@ pub fn small_file() -> Vec<u8> {
     let mut w = FileWriter::new();
     w.manifest(&manifest, h(b"m")).unwrap();
     w.pod(sections::VERTICES, 0, &vertices, h(b"v")).unwrap();
+    w.pod(sections::UVS, 0, &uvs, h(b"uv")).unwrap();
     w.pod(sections::TRIANGLES, 0, &triangles, h(b"t")).unwrap();
-    w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h(b"tm"))
-        .unwrap();
-    w.pod(sections::MATERIALS, 0, &materials, h(b"mat"))
-        .unwrap();
+    w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h(b"tm")).unwrap();
+    w.pod(sections::MATERIALS, 0, &materials, h(b"mat")).unwrap();
     w.pod(sections::BVH_NODES, 0, &nodes, h(b"b")).unwrap();
     w.bytes(sections::TEXTURE, 0, texels, h(b"tex")).unwrap();
     w.to_bytes().unwrap()

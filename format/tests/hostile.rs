@@ -51,9 +51,7 @@ fn entry(kind: SectionKind, offset: u64, size: u64) -> SectionEntry {
 }
 
 fn error_of(bytes: &[u8]) -> String {
-    KilnFile::from_bytes(bytes, Checksums::Eager)
-        .expect_err("hostile file accepted")
-        .to_string()
+    KilnFile::from_bytes(bytes, Checksums::Eager).expect_err("hostile file accepted").to_string()
 }
 
 /// A manifest body of 64 bytes (an empty manifest padded out would fail decoding; we only need
@@ -210,11 +208,7 @@ fn unknown_required_flag_is_refused_and_optional_flag_is_not() {
         let mut header = Header::parse(&f).unwrap();
         header.flags = flag;
         f[..HEADER_SIZE].copy_from_slice(&header.to_bytes());
-        assert_eq!(
-            KilnFile::from_bytes(&f, Checksums::Eager).is_err(),
-            refused,
-            "flag {flag:#x}"
-        );
+        assert_eq!(KilnFile::from_bytes(&f, Checksums::Eager).is_err(), refused, "flag {flag:#x}");
     }
 }
 

@@ -19,57 +19,37 @@ fn light() -> impl Strategy<Value = Light> {
     let kind = prop_oneof![
         Just(LightKind::Point),
         Just(LightKind::Directional),
-        (any::<f32>(), any::<f32>()).prop_map(|(a, b)| LightKind::Spot {
-            inner_cone: a,
-            outer_cone: b
-        }),
-        (any::<f32>(), any::<f32>()).prop_map(|(w, h)| LightKind::Rect {
-            width: w,
-            height: h
-        }),
+        (any::<f32>(), any::<f32>()).prop_map(|(a, b)| LightKind::Spot { inner_cone: a, outer_cone: b }),
+        (any::<f32>(), any::<f32>()).prop_map(|(w, h)| LightKind::Rect { width: w, height: h }),
     ];
-    (
-        text(),
-        kind,
-        f32s::<3>(),
-        f32s::<3>(),
-        f32s::<3>(),
-        f32s::<3>(),
-        any::<f32>(),
-        any::<bool>(),
+    (text(), kind, f32s::<3>(), f32s::<3>(), f32s::<3>(), f32s::<3>(), any::<f32>(), any::<bool>()).prop_map(
+        |(name, kind, position, direction, right, color, intensity, casts_shadows)| Light {
+            name,
+            kind,
+            position,
+            direction,
+            right,
+            color,
+            intensity,
+            range: 0.0,
+            casts_shadows,
+        },
     )
-        .prop_map(
-            |(name, kind, position, direction, right, color, intensity, casts_shadows)| Light {
-                name,
-                kind,
-                position,
-                direction,
-                right,
-                color,
-                intensity,
-                range: 0.0,
-                casts_shadows,
-            },
-        )
 }
 
 fn texture_info() -> impl Strategy<Value = TextureInfo> {
-    (text(), 1u32..5000, 1u32..5000, any::<bool>(), any::<bool>()).prop_map(
-        |(name, w, h, srgb, lin)| TextureInfo {
+    (text(), 1u32..5000, 1u32..5000, any::<bool>(), any::<bool>()).prop_map(|(name, w, h, srgb, lin)| {
+        TextureInfo {
             name,
             width: w,
             height: h,
             mip_levels: 32 - w.max(h).leading_zeros(),
-            color_space: if srgb {
-                ColorSpace::Srgb
-            } else {
-                ColorSpace::Linear
-            },
+            color_space: if srgb { ColorSpace::Srgb } else { ColorSpace::Linear },
             wrap_u: Wrap::Repeat,
             wrap_v: Wrap::MirroredRepeat,
             mag_linear: lin,
-        },
-    )
+        }
+    })
 }
 
 fn manifest() -> impl Strategy<Value = Manifest> {
@@ -83,48 +63,29 @@ fn manifest() -> impl Strategy<Value = Manifest> {
         (f32s::<3>(), f32s::<3>(), f32s::<3>(), any::<f32>()),
         any::<u64>(),
     )
-        .prop_map(
-            |(generator, scene_name, inputs, lights, textures, mats, cam, degenerate)| Manifest {
-                generator,
-                scene_name,
-                inputs: inputs
-                    .into_iter()
-                    .map(|(path, bytes, hash)| InputFile { path, bytes, hash })
-                    .collect(),
-                settings: vec![Setting {
-                    key: "bvh-preset".into(),
-                    value: "medium".into(),
-                }],
-                bounds: Bounds {
-                    min: cam.0,
-                    max: cam.1,
-                },
-                materials: mats.into_iter().map(|name| MaterialInfo { name }).collect(),
-                textures,
-                lights,
-                cameras: vec![Camera {
-                    name: "c".into(),
-                    position: cam.0,
-                    target: cam.1,
-                    up: cam.2,
-                    vfov_degrees: cam.3,
-                    znear: 0.1,
-                    zfar: 0.0,
-                }],
-                sky: Sky { radiance: cam.2 },
-                media: vec![Medium {
-                    bounds: Bounds::default(),
-                    sigma_a: cam.0,
-                    sigma_s: cam.1,
-                    g: cam.3,
-                }],
-                skipped: vec![SkippedStage {
-                    stage: "shadow-maps".into(),
-                    reason: "no lights".into(),
-                }],
-                degenerate_triangles: degenerate,
-            },
-        )
+        .prop_map(|(generator, scene_name, inputs, lights, textures, mats, cam, degenerate)| Manifest {
+            generator,
+            scene_name,
+            inputs: inputs.into_iter().map(|(path, bytes, hash)| InputFile { path, bytes, hash }).collect(),
+            settings: vec![Setting { key: "bvh-preset".into(), value: "medium".into() }],
+            bounds: Bounds { min: cam.0, max: cam.1 },
+            materials: mats.into_iter().map(|name| MaterialInfo { name }).collect(),
+            textures,
+            lights,
+            cameras: vec![Camera {
+                name: "c".into(),
+                position: cam.0,
+                target: cam.1,
+                up: cam.2,
+                vfov_degrees: cam.3,
+                znear: 0.1,
+                zfar: 0.0,
+            }],
+            sky: Sky { radiance: cam.2 },
+            media: vec![Medium { bounds: Bounds::default(), sigma_a: cam.0, sigma_s: cam.1, g: cam.3 }],
+            skipped: vec![SkippedStage { stage: "shadow-maps".into(), reason: "no lights".into() }],
+            degenerate_triangles: degenerate,
+        })
 }
 
 /// Bitwise equality (NaN payloads included), which is what "round trip" means for a file.
@@ -153,7 +114,8 @@ proptest! {
     ) {
         let mut state = seed;
         let mut gen_bytes = |n: usize| -> Vec<u8> { (0..n).map(|_| splitmix(&mut state)).collect() };
-        let vertices: Vec<Vertex> = bytemuck::pod_collect_to_vec(&gen_bytes(nv * 32));
+        let vertices: Vec<Vertex> = bytemuck::pod_collect_to_vec(&gen_bytes(nv * 24));
+        let uvs: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&gen_bytes(nv * 8));
         let triangles: Vec<[u32; 3]> = bytemuck::pod_collect_to_vec(&gen_bytes(nt * 12));
         let tmat: Vec<u32> = bytemuck::pod_collect_to_vec(&gen_bytes(nt * 4));
         let mats: Vec<GpuMaterial> = bytemuck::pod_collect_to_vec(&gen_bytes(nm * 80));
@@ -166,6 +128,7 @@ proptest! {
             if order {
                 w.manifest(&m, h).unwrap();
                 w.pod(sections::VERTICES, 0, &vertices, h).unwrap();
+                w.pod(sections::UVS, 0, &uvs, h).unwrap();
                 w.pod(sections::TRIANGLES, 0, &triangles, h).unwrap();
                 w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h).unwrap();
                 w.pod(sections::MATERIALS, 0, &mats, h).unwrap();
@@ -181,6 +144,7 @@ proptest! {
                 w.pod(sections::MATERIALS, 0, &mats, h).unwrap();
                 w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h).unwrap();
                 w.pod(sections::TRIANGLES, 0, &triangles, h).unwrap();
+                w.pod(sections::UVS, 0, &uvs, h).unwrap();
                 w.pod(sections::VERTICES, 0, &vertices, h).unwrap();
                 w.manifest(&m, h).unwrap();
             }
@@ -190,6 +154,7 @@ proptest! {
         prop_assert_eq!(&bytes, &write(false), "layout depends on insertion order");
         let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
         prop_assert!(same_bits(f.pod::<Vertex>(sections::VERTICES, 0).unwrap().unwrap(), &vertices));
+        prop_assert!(same_bits(f.pod::<[f32; 2]>(sections::UVS, 0).unwrap().unwrap(), &uvs));
         prop_assert!(same_bits(f.pod::<[u32; 3]>(sections::TRIANGLES, 0).unwrap().unwrap(), &triangles));
         prop_assert!(same_bits(f.pod::<u32>(sections::TRIANGLE_MATERIALS, 0).unwrap().unwrap(), &tmat));
         prop_assert!(same_bits(f.pod::<GpuMaterial>(sections::MATERIALS, 0).unwrap().unwrap(), &mats));
@@ -216,24 +181,13 @@ fn splitmix(state: &mut u64) -> u8 {
 
 #[test]
 fn unknown_sections_are_skipped_and_reported() {
-    let m = Manifest {
-        scene_name: "s".into(),
-        ..Default::default()
-    };
+    let m = Manifest { scene_name: "s".into(), ..Default::default() };
     let future = SectionKind(*b"ZZZZ");
     let mut w = FileWriter::new();
     w.manifest(&m, ContentHash::default()).unwrap();
-    w.raw(future, 3, 1, vec![7u8; 10], ContentHash::default())
-        .unwrap();
+    w.raw(future, 3, 1, vec![7u8; 10], ContentHash::default()).unwrap();
     // A known kind at a newer layout version is skipped too.
-    w.raw(
-        sections::VERTICES,
-        0,
-        99,
-        vec![1u8; 7],
-        ContentHash::default(),
-    )
-    .unwrap();
+    w.raw(sections::VERTICES, 0, 99, vec![1u8; 7], ContentHash::default()).unwrap();
     let bytes = w.to_bytes().unwrap();
     let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
     let skipped: Vec<_> = f.skipped().map(|s| (s.entry.kind, s.entry.index)).collect();
@@ -244,27 +198,16 @@ fn unknown_sections_are_skipped_and_reported() {
 
 #[test]
 fn newer_manifest_version_reads_its_known_prefix() {
-    let m = Manifest {
-        scene_name: "future".into(),
-        ..Default::default()
-    };
+    let m = Manifest { scene_name: "future".into(), ..Default::default() };
     let mut body = m.encode();
     body.extend_from_slice(b"fields of manifest v2");
     let mut w = FileWriter::new();
-    w.raw(
-        sections::MANIFEST,
-        0,
-        2,
-        body.clone(),
-        ContentHash::default(),
-    )
-    .unwrap();
+    w.raw(sections::MANIFEST, 0, 2, body.clone(), ContentHash::default()).unwrap();
     let f = KilnFile::from_bytes(&w.to_bytes().unwrap(), Checksums::Eager).unwrap();
     assert_eq!(f.manifest().unwrap(), m);
     // The same trailing bytes at the current version are damage.
     let mut w = FileWriter::new();
-    w.raw(sections::MANIFEST, 0, 1, body, ContentHash::default())
-        .unwrap();
+    w.raw(sections::MANIFEST, 0, 1, body, ContentHash::default()).unwrap();
     let f = KilnFile::from_bytes(&w.to_bytes().unwrap(), Checksums::Eager).unwrap();
     assert!(f.manifest().unwrap_err().to_string().contains("trailing"));
 }
@@ -280,10 +223,7 @@ fn atomic_write_replaces_and_leaves_no_temp_files() {
     let mut w = FileWriter::new();
     w.manifest(&m, ContentHash::default()).unwrap();
     w.write_atomic(&path).unwrap();
-    let names: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
     assert_eq!(names.len(), 1, "{names:?}");
     let back = KilnFile::open(&path, Checksums::Eager).unwrap();
     assert_eq!(back.manifest().unwrap(), m);
@@ -296,14 +236,7 @@ fn failed_atomic_write_keeps_the_old_file() {
     std::fs::write(&path, b"old").unwrap();
     // No manifest: the writer refuses before touching the target.
     let mut w = FileWriter::new();
-    w.raw(
-        SectionKind(*b"ZZZZ"),
-        0,
-        1,
-        vec![1u8],
-        ContentHash::default(),
-    )
-    .unwrap();
+    w.raw(SectionKind(*b"ZZZZ"), 0, 1, vec![1u8], ContentHash::default()).unwrap();
     assert!(w.write_atomic(&path).is_err());
     assert_eq!(std::fs::read(&path).unwrap(), b"old");
     let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();

@@ -23,10 +23,7 @@ fn main() -> std::process::ExitCode {
             std::process::ExitCode::SUCCESS
         }
         Some(path) => {
-            eprintln!(
-                "error: {}: rendering is not available in this build of kiln-play yet",
-                path.display()
-            );
+            eprintln!("error: {}: rendering is not available in this build of kiln-play yet", path.display());
             std::process::ExitCode::from(3)
         }
     }

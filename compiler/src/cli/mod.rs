@@ -4,14 +4,14 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 
+use crate::settings::BvhPreset;
+
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
 /// lighting structures a player needs, checksummed, versioned and ready to memory-map.
 #[derive(Debug, Parser)]
 #[command(name = "kiln", version, about, long_about = None, propagate_version = true)]
-#[command(
-    after_help = "Exit codes: 0 success, 1 bad input or failed verification, 2 usage error, \
-3 unsupported (e.g. another major format version), 4 I/O failure."
-)]
+#[command(after_help = "Exit codes: 0 success, 1 bad input or failed verification, 2 usage error, \
+3 unsupported (e.g. another major format version), 4 I/O failure.")]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]
@@ -21,6 +21,12 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Compile a glTF (.gltf, .glb) or OBJ scene into a .kiln file.
+    Compile(CompileArgs),
+    /// Show every bake stage with run or skip and the reason, without writing anything.
+    Plan(PlanArgs),
+    /// Compile the built-in demo scene (a Cornell box with a ceiling light and a camera).
+    Demo(DemoArgs),
     /// Show a .kiln file's version, sections (kind, size, codec, checksum status) and manifest.
     Inspect(InspectArgs),
     /// Validate a .kiln file completely: layout, every checksum, every cross-reference.
@@ -43,9 +49,91 @@ pub struct InspectArgs {
 pub struct VerifyArgs {
     /// The .kiln file.
     pub file: PathBuf,
+    /// Also trace N seeded rays (random, aimed at triangles, and adversarial: axis-aligned,
+    /// through vertices and edges, grazing, starting on surfaces) through the baked BVH and by
+    /// brute force over all triangles, and count disagreements of the closest hit.
+    #[arg(long, value_name = "N")]
+    pub rays: Option<u64>,
+    /// Seed of the ray generator.
+    #[arg(long, default_value_t = 1, requires = "rays")]
+    pub seed: u64,
     /// Print a JSON report instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Options shared by commands that import a scene.
+#[derive(Debug, Args, Clone)]
+pub struct SceneArgs {
+    /// Input scene: .gltf, .glb or .obj.
+    pub input: PathBuf,
+    /// TOML sidecar with what the asset lacks: camera, lights, sky, media, material fixes,
+    /// bake settings (see docs/sidecar.md).
+    #[arg(long, short = 'c', value_name = "SIDECAR.toml")]
+    pub config: Option<PathBuf>,
+    /// BVH build effort [default: medium, or the sidecar's bake.bvh_preset].
+    #[arg(long, value_enum, help_heading = "BVH")]
+    pub bvh_preset: Option<BvhPreset>,
+    /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
+    /// an error.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// Options of commands that write a file.
+#[derive(Debug, Args, Clone)]
+pub struct OutputArgs {
+    /// Write a JSON report: per-stage wall time and bytes, counts, skips with reasons, warnings.
+    #[arg(long, value_name = "REPORT.json")]
+    pub report: Option<PathBuf>,
+    /// Write a make/ninja depfile listing every file read.
+    #[arg(long, value_name = "DEPS.d")]
+    pub depfile: Option<PathBuf>,
+    /// Worker threads [default: all cores]. The output is identical for every count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub threads: Option<u16>,
+    /// Print nothing but errors and warnings.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// `kiln compile`.
+#[derive(Debug, Args)]
+pub struct CompileArgs {
+    /// Scene and settings.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Output file [default: INPUT's name with .kiln, in the current directory].
+    #[arg(long, short = 'o', value_name = "OUT.kiln")]
+    pub output: Option<PathBuf>,
+    /// Report, depfile, threads.
+    #[command(flatten)]
+    pub out: OutputArgs,
+}
+
+/// `kiln plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Scene and settings.
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `kiln demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Output file.
+    #[arg(long, short = 'o', value_name = "OUT.kiln", default_value = "demo.kiln")]
+    pub output: PathBuf,
+    /// BVH build effort.
+    #[arg(long, value_enum, default_value_t = BvhPreset::Medium, help_heading = "BVH")]
+    pub bvh_preset: BvhPreset,
+    /// Report, depfile, threads.
+    #[command(flatten)]
+    pub out: OutputArgs,
 }
 
 /// Parses the process arguments; exits with code 2 and a usage message on error.

@@ -52,8 +52,7 @@ struct Summary {
 
 /// Runs `kiln inspect`.
 pub fn run(args: &InspectArgs) -> CliResult {
-    let file =
-        KilnFile::open(&args.file, Checksums::Deferred).map_err(|e| format_error(&args.file, e))?;
+    let file = KilnFile::open(&args.file, Checksums::Deferred).map_err(|e| format_error(&args.file, e))?;
     let sections: Vec<SectionJson> = file
         .sections()
         .iter()
@@ -65,10 +64,8 @@ pub fn run(args: &InspectArgs) -> CliResult {
                 name: s.known.map(|k| k.name),
                 index: e.index,
                 version: e.version,
-                codec: kiln_format::table::Codec::from_u8(e.codec).map_or_else(
-                    || format!("unknown ({})", e.codec),
-                    |c| c.name().to_string(),
-                ),
+                codec: kiln_format::table::Codec::from_u8(e.codec)
+                    .map_or_else(|| format!("unknown ({})", e.codec), |c| c.name().to_string()),
                 offset: e.offset,
                 size: e.size,
                 raw_size: e.raw_size,
@@ -161,10 +158,7 @@ fn print_text(r: &InspectJson) {
             let b = &m.bounds;
             println!("  bounds {:?} .. {:?}", b.min, b.max);
             if m.degenerate_triangles > 0 {
-                println!(
-                    "  {} degenerate triangles dropped at import",
-                    m.degenerate_triangles
-                );
+                println!("  {} degenerate triangles dropped at import", m.degenerate_triangles);
             }
             for s in &m.skipped {
                 println!("  skipped {}: {}", s.stage, s.reason);
@@ -172,11 +166,7 @@ fn print_text(r: &InspectJson) {
             if !m.inputs.is_empty() {
                 println!(
                     "  inputs: {}",
-                    m.inputs
-                        .iter()
-                        .map(|i| i.path.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    m.inputs.iter().map(|i| i.path.as_str()).collect::<Vec<_>>().join(", ")
                 );
             }
         }

@@ -1,6 +1,8 @@
 //! One module per subcommand; [`run`] dispatches.
 
+mod compile;
 mod inspect;
+mod plan;
 mod verify;
 
 use crate::cli::{Cli, Command};
@@ -9,6 +11,9 @@ use crate::exit::CliResult;
 /// Runs the parsed command.
 pub fn run(cli: Cli) -> CliResult {
     match cli.command {
+        Command::Compile(args) => compile::run(&args),
+        Command::Plan(args) => plan::run(&args),
+        Command::Demo(args) => compile::demo(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Verify(args) => verify::run(&args),
     }

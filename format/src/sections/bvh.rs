@@ -69,25 +69,14 @@ impl CwbvhNode {
     /// First triangle and triangle count of leaf slot `i` (no range check).
     pub fn leaf_range(&self, i: usize) -> (u64, u32) {
         let m = self.child_meta[i];
-        (
-            self.primitive_base_idx as u64 + (m & 0x1f) as u64,
-            (m >> 5).count_ones(),
-        )
+        (self.primitive_base_idx as u64 + (m & 0x1f) as u64, (m >> 5).count_ones())
     }
 
     /// Decoded box of slot `i`: (min, max).
     pub fn child_box(&self, i: usize) -> ([f32; 3], [f32; 3]) {
         let s = self.extent();
-        let lo = [
-            self.child_min_x[i],
-            self.child_min_y[i],
-            self.child_min_z[i],
-        ];
-        let hi = [
-            self.child_max_x[i],
-            self.child_max_y[i],
-            self.child_max_z[i],
-        ];
+        let lo = [self.child_min_x[i], self.child_min_y[i], self.child_min_z[i]];
+        let hi = [self.child_max_x[i], self.child_max_y[i], self.child_max_z[i]];
         (
             std::array::from_fn(|a| self.p[a] + s[a] * lo[a] as f32),
             std::array::from_fn(|a| self.p[a] + s[a] * hi[a] as f32),

@@ -2,7 +2,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// A world-space vertex. 32 bytes, no padding; GLSL reads it as 8 floats.
+/// A world-space vertex. 24 bytes, no padding; GLSL reads it as 6 floats. Texture
+/// coordinates are a separate stream (`UVS0`), present only when a material samples a texture.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
 #[repr(C)]
 pub struct Vertex {
@@ -10,8 +11,6 @@ pub struct Vertex {
     pub position: [f32; 3],
     /// Unit shading normal.
     pub normal: [f32; 3],
-    /// Texture coordinate set 0 (glTF convention: v points down the image).
-    pub uv: [f32; 2],
 }
 
-const _: () = assert!(size_of::<Vertex>() == 32);
+const _: () = assert!(size_of::<Vertex>() == 24);

@@ -17,6 +17,8 @@ use crate::table::SectionKind;
 pub const MANIFEST: SectionKind = SectionKind(*b"MANI");
 /// Vertices ([`Vertex`]), world space.
 pub const VERTICES: SectionKind = SectionKind(*b"VERT");
+/// Texture coordinates (`[f32; 2]`, set 0, glTF convention: v down the image), one per vertex.
+pub const UVS: SectionKind = SectionKind(*b"UVS0");
 /// Triangles as three `u32` vertex indices each, in BVH leaf order.
 pub const TRIANGLES: SectionKind = SectionKind(*b"TRIS");
 /// Material index (`u32`) of each triangle.
@@ -74,7 +76,16 @@ pub const KNOWN: &[KindInfo] = &[
         element_size: size_of::<Vertex>(),
         required: false,
         indexed: false,
-        description: "world-space vertices (position, normal, uv)",
+        description: "world-space vertices (position, normal)",
+    },
+    KindInfo {
+        kind: UVS,
+        name: "uvs",
+        version: 1,
+        element_size: 8,
+        required: false,
+        indexed: false,
+        description: "texture coordinates per vertex",
     },
     KindInfo {
         kind: TRIANGLES,
@@ -126,8 +137,5 @@ pub fn by_name(name: &str) -> Option<&'static KindInfo> {
 
 /// Position of `kind` in the streaming order; unknown kinds sort last.
 pub fn stream_rank(kind: SectionKind) -> usize {
-    KNOWN
-        .iter()
-        .position(|k| k.kind == kind)
-        .unwrap_or(KNOWN.len())
+    KNOWN.iter().position(|k| k.kind == kind).unwrap_or(KNOWN.len())
 }

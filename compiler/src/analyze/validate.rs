@@ -1,0 +1,101 @@
+//! Scene validation after import and sidecar: drops degenerate triangles, refuses empty
+//! scenes, fills defaults that depend on the whole scene (camera, media bounds).
+
+use glam::{DVec3, Vec3};
+use kiln_format::manifest::{Bounds, Camera};
+
+use crate::exit::{CliError, CliResult};
+use crate::ir::Scene;
+
+/// Whether a triangle has zero area: repeated indices, or corners that are collinear in
+/// double precision.
+pub fn is_degenerate(scene: &Scene, t: [u32; 3]) -> bool {
+    if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+        return true;
+    }
+    let p = |i: u32| DVec3::from(scene.vertices[i as usize].position.map(f64::from));
+    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+    (b - a).cross(c - a) == DVec3::ZERO
+}
+
+/// Bounds of all vertices referenced by triangles.
+pub fn bounds(scene: &Scene) -> Bounds {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for t in &scene.triangles {
+        for &i in t {
+            let p = Vec3::from(scene.vertices[i as usize].position);
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    Bounds { min: lo.to_array(), max: hi.to_array() }
+}
+
+/// Validates and completes `scene`; `source` names the input in messages.
+pub fn finish(scene: &mut Scene, source: &str) -> CliResult<()> {
+    let before = scene.triangles.len();
+    let keep: Vec<bool> = scene.triangles.iter().map(|&t| !is_degenerate(scene, t)).collect();
+    let mut k = keep.iter();
+    scene.triangles.retain(|_| *k.next().unwrap_or(&true));
+    let mut k = keep.iter();
+    scene.triangle_materials.retain(|_| *k.next().unwrap_or(&true));
+    let dropped = (before - scene.triangles.len()) as u64;
+    scene.degenerate_triangles += dropped;
+    if dropped > 0 {
+        scene.warn(format!("{source}: {dropped} degenerate (zero-area) triangles dropped"));
+    }
+    if scene.triangles.is_empty() {
+        return Err(CliError::input(format!(
+            "{source}: the scene has no triangles{}",
+            if before > 0 { " (all were degenerate)" } else { "" }
+        )));
+    }
+    if !scene.uses_textures() {
+        scene.uvs.clear();
+    }
+    let b = bounds(scene);
+    let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
+    let diagonal = (hi - lo).length().max(f32::MIN_POSITIVE);
+    for m in &mut scene.media {
+        if m.bounds.min[0].is_nan() {
+            m.bounds = b;
+        }
+        let non_empty = (0..3).all(|a| m.bounds.min[a] < m.bounds.max[a]);
+        if !non_empty {
+            return Err(CliError::input(format!(
+                "{source}: medium box {:?}..{:?} is empty",
+                m.bounds.min, m.bounds.max
+            )));
+        }
+    }
+    if scene.cameras.is_empty() {
+        // Look at the scene from +z, far enough for a 45° field of view to hold it.
+        let centre = (lo + hi) * 0.5;
+        let distance = diagonal * 0.5 / (22.5f32.to_radians().tan()) + (hi.z - lo.z) * 0.5;
+        scene.cameras.push(Camera {
+            name: "default".into(),
+            position: (centre + Vec3::Z * distance).to_array(),
+            target: centre.to_array(),
+            up: [0.0, 1.0, 0.0],
+            vfov_degrees: 45.0,
+            znear: 0.0,
+            zfar: 0.0,
+        });
+        scene.warn(format!(
+            "{source}: no camera in the asset or sidecar; a default camera framing the scene was added"
+        ));
+    }
+    for c in &mut scene.cameras {
+        if c.znear <= 0.0 {
+            c.znear = diagonal * 1e-4;
+        }
+    }
+    if scene.lights.is_empty()
+        && scene.materials.iter().all(|m| m.gpu.emission == [0.0; 3])
+        && scene.sky.radiance == [0.0; 3]
+    {
+        scene.warn(format!("{source}: the scene has no lights, no emissive materials and a black sky; it will render black (add lights in a sidecar)"));
+    }
+    Ok(())
+}

@@ -1,0 +1,226 @@
+//! Bake stages: each a function of (scene, settings) producing sections, timed, with a content
+//! hash computed from what it depends on.
+
+pub mod bvh;
+pub mod textures;
+
+use std::time::Instant;
+
+use kiln_format::manifest::{InputFile, Manifest, MaterialInfo, Setting, SkippedStage, TextureInfo};
+use kiln_format::sections::{self, GpuMaterial};
+use kiln_format::{ContentHash, ContentHasher, SectionKind};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::analyze::plan::{Plan, Stage};
+use crate::analyze::validate::bounds;
+use crate::exit::CliResult;
+use crate::ir::Scene;
+use crate::progress::Progress;
+use crate::settings::Settings;
+
+/// Bumped when a stage's algorithm changes its output, so that caches keyed by content hashes
+/// do not reuse stale sections.
+const ALGORITHM_VERSION: &str = "kiln-bake-1";
+
+/// A baked section ready to be written.
+#[derive(Debug, Clone)]
+pub struct BakedSection {
+    /// Kind.
+    pub kind: SectionKind,
+    /// Index.
+    pub index: u32,
+    /// Bytes.
+    pub bytes: Vec<u8>,
+    /// Content hash of what produced it.
+    pub hash: ContentHash,
+}
+
+/// Timing and size of one stage, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct StageReport {
+    /// Stage name.
+    pub stage: &'static str,
+    /// Whether it ran.
+    pub run: bool,
+    /// Why it ran or was skipped.
+    pub reason: String,
+    /// Wall time in milliseconds.
+    pub ms: f64,
+    /// Bytes of the sections it produced.
+    pub bytes: u64,
+}
+
+/// Everything to write.
+#[derive(Debug, Clone)]
+pub struct Baked {
+    /// The manifest.
+    pub manifest: Manifest,
+    /// Its content hash.
+    pub manifest_hash: ContentHash,
+    /// Bulk sections.
+    pub sections: Vec<BakedSection>,
+    /// Per-stage report, in plan order.
+    pub stages: Vec<StageReport>,
+}
+
+/// Hash of the inputs: the contents of every file read, in reading order, or the scene data
+/// itself when it came from no file (the demo).
+pub fn input_hash(scene: &Scene, inputs: &[InputFile]) -> ContentHash {
+    let mut h = ContentHasher::new();
+    h.part("algorithm", ALGORITHM_VERSION.as_bytes());
+    if inputs.is_empty() {
+        h.part("vertices", bytemuck::cast_slice(&scene.vertices));
+        h.part("triangles", bytemuck::cast_slice(&scene.triangles));
+        h.part(
+            "materials",
+            &scene.materials.iter().flat_map(|m| bytemuck::bytes_of(&m.gpu).to_vec()).collect::<Vec<u8>>(),
+        );
+        h.part("lights", format!("{:?}{:?}{:?}", scene.lights, scene.cameras, scene.sky).as_bytes());
+    }
+    for i in inputs {
+        h.part("input", i.hash.as_bytes());
+    }
+    h.finish()
+}
+
+/// Runs every stage the plan allows.
+pub fn bake(
+    scene: &Scene,
+    settings: &Settings,
+    plan: &Plan,
+    inputs: Vec<InputFile>,
+    progress: &Progress,
+) -> CliResult<Baked> {
+    let root = input_hash(scene, &inputs);
+    let hash = |label: &str, extra: &[(&str, &str)]| {
+        let mut h = ContentHasher::new();
+        h.hash("inputs", &root).part("stage", label.as_bytes());
+        for (k, v) in extra {
+            h.part(k, v.as_bytes());
+        }
+        h.finish()
+    };
+    let preset = settings.bvh_preset.name();
+    let mut sections: Vec<BakedSection> = Vec::new();
+    let mut stages = Vec::new();
+    let mut push =
+        |kind, index, bytes: Vec<u8>, hash| sections.push(BakedSection { kind, index, bytes, hash });
+
+    // BVH first: the geometry is stored in its leaf order.
+    let t0 = Instant::now();
+    progress.stage("bvh");
+    let tris = bvh::triangles(scene.triangles.iter().map(|t| t.map(|i| scene.vertices[i as usize].position)));
+    let built = bvh::build(&tris, settings.bvh_preset)?;
+    let bvh_bytes = bytemuck::cast_slice(&built.nodes).to_vec();
+    let bvh_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let bvh_len = bvh_bytes.len() as u64;
+    push(sections::BVH_NODES, 0, bvh_bytes, hash("bvh", &[("preset", preset)]));
+
+    for decision in &plan.stages {
+        let start = Instant::now();
+        let mut bytes = 0u64;
+        if decision.run {
+            progress.stage(decision.stage.name());
+            match decision.stage {
+                Stage::Geometry => {
+                    let tris: Vec<[u32; 3]> =
+                        built.order.iter().map(|&i| scene.triangles[i as usize]).collect();
+                    let tmat: Vec<u32> =
+                        built.order.iter().map(|&i| scene.triangle_materials[i as usize]).collect();
+                    let v = bytemuck::cast_slice(&scene.vertices).to_vec();
+                    let t = bytemuck::cast_slice(&tris).to_vec();
+                    let m = bytemuck::cast_slice(&tmat).to_vec();
+                    bytes = (v.len() + t.len() + m.len()) as u64;
+                    push(sections::VERTICES, 0, v, hash("vertices", &[]));
+                    push(sections::TRIANGLES, 0, t, hash("triangles", &[("preset", preset)]));
+                    push(
+                        sections::TRIANGLE_MATERIALS,
+                        0,
+                        m,
+                        hash("triangle-materials", &[("preset", preset)]),
+                    );
+                }
+                Stage::Uvs => {
+                    let b = bytemuck::cast_slice(&scene.uvs).to_vec();
+                    bytes = b.len() as u64;
+                    push(sections::UVS, 0, b, hash("uvs", &[]));
+                }
+                Stage::Materials => {
+                    let mats: Vec<GpuMaterial> = scene.materials.iter().map(|m| m.gpu).collect();
+                    let b = bytemuck::cast_slice(&mats).to_vec();
+                    bytes = b.len() as u64;
+                    push(sections::MATERIALS, 0, b, hash("materials", &[]));
+                }
+                Stage::Textures => {
+                    let chains: Vec<Vec<u8>> = scene.textures.par_iter().map(textures::mip_chain).collect();
+                    for (i, chain) in chains.into_iter().enumerate() {
+                        bytes += chain.len() as u64;
+                        push(
+                            sections::TEXTURE,
+                            i as u32,
+                            chain,
+                            hash("texture", &[("index", &i.to_string())]),
+                        );
+                    }
+                }
+                Stage::Bvh => bytes = bvh_len,
+            }
+        }
+        let ms = if decision.stage == Stage::Bvh { bvh_ms } else { start.elapsed().as_secs_f64() * 1e3 };
+        stages.push(StageReport {
+            stage: decision.stage.name(),
+            run: decision.run,
+            reason: decision.reason.clone(),
+            ms,
+            bytes,
+        });
+    }
+
+    let manifest = Manifest {
+        generator: format!("kiln {}", env!("CARGO_PKG_VERSION")),
+        scene_name: scene.name.clone(),
+        inputs,
+        settings: settings.pairs().into_iter().map(|(key, value)| Setting { key, value }).collect(),
+        bounds: bounds(scene),
+        materials: scene.materials.iter().map(|m| MaterialInfo { name: m.name.clone() }).collect(),
+        textures: scene
+            .textures
+            .iter()
+            .map(|t| TextureInfo {
+                name: t.name.clone(),
+                width: t.width,
+                height: t.height,
+                mip_levels: kiln_format::scene::mip_levels(t.width, t.height),
+                color_space: t.role.color_space(),
+                wrap_u: t.wrap_u,
+                wrap_v: t.wrap_v,
+                mag_linear: t.mag_linear,
+            })
+            .collect(),
+        lights: scene.lights.clone(),
+        cameras: scene.cameras.clone(),
+        sky: scene.sky,
+        media: scene.media.clone(),
+        skipped: plan
+            .stages
+            .iter()
+            .filter(|d| !d.run)
+            .map(|d| SkippedStage { stage: d.stage.name().into(), reason: d.reason.clone() })
+            .collect(),
+        degenerate_triangles: scene.degenerate_triangles,
+    };
+    let settings_text: String = settings.pairs().iter().map(|(k, v)| format!("{k}={v};")).collect();
+    let manifest_hash = hash("manifest", &[("settings", &settings_text)]);
+    Ok(Baked { manifest, manifest_hash, sections, stages })
+}
+
+/// Writes the baked file atomically; returns its size.
+pub fn write(baked: &Baked, path: &std::path::Path) -> Result<u64, kiln_format::WriteError> {
+    let mut w = kiln_format::FileWriter::new();
+    w.manifest(&baked.manifest, baked.manifest_hash)?;
+    for s in &baked.sections {
+        w.bytes(s.kind, s.index, s.bytes.as_slice(), s.hash)?;
+    }
+    w.write_atomic(path)
+}

@@ -1,0 +1,88 @@
+//! The texture stage: full mip chains, filtered in linear space.
+//!
+//! Each level halves the previous one (rounding down, at least 1) with a 2×2 box filter, edge
+//! texels clamped for odd sizes. sRGB colour is filtered after conversion to linear light and
+//! converted back; normal maps are averaged as vectors and renormalised; other data is averaged
+//! as is. Alpha is always linear.
+
+use rayon::prelude::*;
+
+use crate::ir::{Texture, TextureRole};
+
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+fn linear_to_srgb(l: f32) -> u8 {
+    let l = l.clamp(0.0, 1.0);
+    let c = if l <= 0.003_130_8 { l * 12.92 } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
+    (c * 255.0 + 0.5) as u8
+}
+
+/// Texels of one level, as floats in the role's filtering space.
+struct Level {
+    width: u32,
+    height: u32,
+    texels: Vec<[f32; 4]>,
+}
+
+/// The whole mip chain of `t` as RGBA8, level 0 first.
+pub fn mip_chain(t: &Texture) -> Vec<u8> {
+    let levels = kiln_format::scene::mip_levels(t.width, t.height);
+    let mut out = Vec::with_capacity(t.rgba.len() * 4 / 3 + 4);
+    out.extend_from_slice(&t.rgba);
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    let decode = |px: &[u8]| -> [f32; 4] {
+        let a = px[3] as f32 / 255.0;
+        match t.role {
+            TextureRole::Color => [lut[px[0] as usize], lut[px[1] as usize], lut[px[2] as usize], a],
+            TextureRole::Data => [px[0] as f32 / 255.0, px[1] as f32 / 255.0, px[2] as f32 / 255.0, a],
+            TextureRole::Normal => {
+                [px[0] as f32 / 127.5 - 1.0, px[1] as f32 / 127.5 - 1.0, px[2] as f32 / 127.5 - 1.0, a]
+            }
+        }
+    };
+    let encode = |v: [f32; 4]| -> [u8; 4] {
+        let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+        match t.role {
+            TextureRole::Color => {
+                [linear_to_srgb(v[0]), linear_to_srgb(v[1]), linear_to_srgb(v[2]), unorm(v[3])]
+            }
+            TextureRole::Data => [unorm(v[0]), unorm(v[1]), unorm(v[2]), unorm(v[3])],
+            TextureRole::Normal => {
+                let n = glam::Vec3::new(v[0], v[1], v[2]).try_normalize().unwrap_or(glam::Vec3::Z);
+                let snorm = |x: f32| ((x * 0.5 + 0.5).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+                [snorm(n.x), snorm(n.y), snorm(n.z), unorm(v[3])]
+            }
+        }
+    };
+    let mut level =
+        Level { width: t.width, height: t.height, texels: t.rgba.chunks_exact(4).map(decode).collect() };
+    for _ in 1..levels {
+        let (w, h) = ((level.width / 2).max(1), (level.height / 2).max(1));
+        let src = &level;
+        let texels: Vec<[f32; 4]> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                (0..w).map(move |x| {
+                    let xs = [(2 * x).min(src.width - 1), (2 * x + 1).min(src.width - 1)];
+                    let ys = [(2 * y).min(src.height - 1), (2 * y + 1).min(src.height - 1)];
+                    let mut sum = [0.0f32; 4];
+                    for yy in ys {
+                        for xx in xs {
+                            let p = src.texels[(yy * src.width + xx) as usize];
+                            for c in 0..4 {
+                                sum[c] += p[c];
+                            }
+                        }
+                    }
+                    sum.map(|s| s * 0.25)
+                })
+            })
+            .collect();
+        out.extend(texels.iter().flat_map(|&v| encode(v)));
+        level = Level { width: w, height: h, texels };
+    }
+    out
+}

@@ -1,0 +1,731 @@
+//! glTF 2.0 import (`.gltf` with external or data-URI buffers and images, `.glb`).
+//!
+//! Every accessor is checked against its buffer before it is read, so that a hostile or
+//! truncated file gives an error naming the mesh, primitive and accessor instead of a panic.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use ::gltf::accessor::{DataType, Dimensions};
+use ::gltf::mesh::Mode;
+use ::gltf::{Accessor, Document, Gltf};
+use base64::Engine;
+use glam::{DMat3, DMat4, DVec3};
+use kiln_format::manifest::{Camera, Light, LightKind, Wrap};
+use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
+
+use super::geometry::{angle_weighted_normals, check_position};
+use super::images::{TextureRequest, decode_all};
+use super::read_input;
+use crate::exit::{CliError, CliResult, Exit};
+use crate::ir::{Material, Scene, TextureRole};
+
+/// Extensions whose meaning kiln implements; a file requiring any other is refused.
+const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+
+/// World triangles beyond this are refused (instancing can multiply a small file's geometry).
+const MAX_TRIANGLES: usize = 1 << 28;
+
+struct Importer<'a> {
+    file: String,
+    base: PathBuf,
+    doc: &'a Document,
+    buffers: Vec<Vec<u8>>,
+    scene: &'a mut Scene,
+    /// glTF material index → IR material index.
+    materials: HashMap<Option<usize>, u32>,
+    /// (glTF texture index, role) → IR texture index.
+    textures: HashMap<(usize, TextureRole), u32>,
+    requests: Vec<TextureRequest>,
+}
+
+/// Imports a `.gltf` or `.glb` file into `scene`.
+pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
+    let bytes = read_input(path, &mut scene.inputs)?;
+    let file = path.display().to_string();
+    let gltf = Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| CliError::input(format!("{file}: not a valid glTF 2.0 file: {e}")))?;
+    let unsupported: Vec<&str> =
+        gltf.document.extensions_required().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
+    if !unsupported.is_empty() {
+        return Err(CliError::new(
+            Exit::Unsupported,
+            format!("{file}: requires glTF extensions kiln does not support: {}", unsupported.join(", ")),
+        ));
+    }
+    let blob = gltf.blob;
+    let doc = Document::from_json(gltf.document.into_json())
+        .map_err(|e| CliError::input(format!("{file}: invalid glTF: {}", describe_validation(&e))))?;
+    for ext in doc.extensions_used().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)) {
+        scene.warn(format!("{file}: extension {ext} is used but not supported; its effect is ignored"));
+    }
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let buffers = load_buffers(&doc, blob, &file, &base, &mut scene.inputs)?;
+    let mut imp = Importer {
+        file,
+        base,
+        doc: &doc,
+        buffers,
+        scene,
+        materials: HashMap::new(),
+        textures: HashMap::new(),
+        requests: Vec::new(),
+    };
+    imp.walk_scene()?;
+    let (textures, warnings) = decode_all(std::mem::take(&mut imp.requests));
+    for w in warnings {
+        imp.scene.warn(format!("{}: {w}", imp.file));
+    }
+    imp.scene.textures.extend(textures);
+    Ok(())
+}
+
+fn describe_validation(e: &::gltf::Error) -> String {
+    match e {
+        ::gltf::Error::Validation(list) => list
+            .iter()
+            .take(8)
+            .map(|(path, err)| format!("{}: {err}", path.as_str()))
+            .collect::<Vec<_>>()
+            .join("; "),
+        other => other.to_string(),
+    }
+}
+
+fn load_buffers(
+    doc: &Document,
+    mut blob: Option<Vec<u8>>,
+    file: &str,
+    base: &Path,
+    inputs: &mut Vec<PathBuf>,
+) -> CliResult<Vec<Vec<u8>>> {
+    let mut buffers = Vec::new();
+    for b in doc.buffers() {
+        let (data, name) = match b.source() {
+            ::gltf::buffer::Source::Bin => {
+                let data = blob.take().ok_or_else(|| {
+                    CliError::input(format!(
+                        "{file}: buffer {} refers to the GLB binary chunk, which is missing",
+                        b.index()
+                    ))
+                })?;
+                (data, "GLB binary chunk".to_string())
+            }
+            ::gltf::buffer::Source::Uri(uri) => {
+                let data = load_uri(uri, base, inputs).map_err(|e| {
+                    CliError::input(format!("{file}: buffer {} ('{}'): {e}", b.index(), short(uri)))
+                })?;
+                (data, format!("'{}'", short(uri)))
+            }
+        };
+        if data.len() < b.length() {
+            return Err(CliError::input(format!(
+                "{file}: buffer {} ({name}) has {} bytes but the glTF declares {} (truncated?)",
+                b.index(),
+                data.len(),
+                b.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// A URI shortened for messages (data URIs can be megabytes long).
+fn short(uri: &str) -> String {
+    if uri.len() > 48 {
+        format!("{}…", &uri[..uri.char_indices().nth(40).map_or(uri.len(), |(i, _)| i)])
+    } else {
+        uri.into()
+    }
+}
+
+/// Reads a data URI or a file relative to `base`.
+fn load_uri(uri: &str, base: &Path, inputs: &mut Vec<PathBuf>) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (meta, data) = rest.split_once(',').ok_or("malformed data URI (no comma)")?;
+        return if meta.ends_with(";base64") {
+            base64::engine::general_purpose::STANDARD
+                .decode(data.trim())
+                .map_err(|e| format!("malformed base64 in data URI: {e}"))
+        } else {
+            Ok(percent_decode(data)?.into_bytes())
+        };
+    }
+    if uri.contains("://") {
+        return Err(
+            "external URLs are not fetched; download the file and refer to it by a relative path".into()
+        );
+    }
+    let rel = percent_decode(uri)?;
+    let path = base.join(&rel);
+    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    if !inputs.contains(&path) {
+        inputs.push(path);
+    }
+    Ok(bytes)
+}
+
+fn percent_decode(s: &str) -> Result<String, String> {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' {
+            let hex = b.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
+            let v = hex.and_then(|h| u8::from_str_radix(h, 16).ok()).ok_or("malformed %-escape in URI")?;
+            out.push(v);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).map_err(|_| "URI is not UTF-8 after %-decoding".to_string())
+}
+
+impl Importer<'_> {
+    fn walk_scene(&mut self) -> CliResult<()> {
+        let doc = self.doc;
+        let roots: Vec<::gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+            Some(s) => s.nodes().collect(),
+            None => {
+                // No scene: every node that is nobody's child is a root.
+                let mut child = vec![false; doc.nodes().len()];
+                for n in doc.nodes() {
+                    for c in n.children() {
+                        child[c.index()] = true;
+                    }
+                }
+                doc.nodes().filter(|n| !child[n.index()]).collect()
+            }
+        };
+        let mut path = Vec::new();
+        for root in roots {
+            self.visit(root, DMat4::IDENTITY, &mut path)?;
+        }
+        Ok(())
+    }
+
+    fn visit(&mut self, node: ::gltf::Node, parent: DMat4, path: &mut Vec<usize>) -> CliResult<()> {
+        if path.contains(&node.index()) {
+            return Err(CliError::input(format!(
+                "{}: node hierarchy has a cycle through node {}",
+                self.file,
+                node.index()
+            )));
+        }
+        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+        let world = parent * local;
+        if !world.is_finite() {
+            return Err(CliError::input(format!(
+                "{}: node {} has a non-finite transform",
+                self.file,
+                node.index()
+            )));
+        }
+        if let Some(mesh) = node.mesh() {
+            self.add_mesh(&mesh, &world)?;
+        }
+        if let Some(camera) = node.camera() {
+            self.add_camera(&camera, &world, node.index());
+        }
+        if let Some(light) = node.light() {
+            self.add_light(&light, &world, node.index())?;
+        }
+        path.push(node.index());
+        for child in node.children() {
+            self.visit(child, world, path)?;
+        }
+        path.pop();
+        Ok(())
+    }
+
+    fn mesh_name(mesh: &::gltf::Mesh) -> String {
+        match mesh.name() {
+            Some(n) => format!("mesh {} '{n}'", mesh.index()),
+            None => format!("mesh {}", mesh.index()),
+        }
+    }
+
+    fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: &DMat4) -> CliResult<()> {
+        let mirrored = world.determinant() < 0.0;
+        let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
+        for prim in mesh.primitives() {
+            let at = format!("{}: {} primitive {}", self.file, Self::mesh_name(mesh), prim.index());
+            let mode = prim.mode();
+            if matches!(mode, Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip) {
+                self.scene.warn(format!("{at}: mode {mode:?} has no triangles; skipped"));
+                continue;
+            }
+            let pos_acc = prim
+                .get(&::gltf::Semantic::Positions)
+                .ok_or_else(|| CliError::input(format!("{at}: has no POSITION attribute")))?;
+            self.check_accessor(&pos_acc, &at, "POSITION", &[Dimensions::Vec3], &[DataType::F32], false)?;
+            let count = pos_acc.count();
+            let reader = prim.reader(|b| self.buffers.get(b.index()).map(Vec::as_slice));
+            let local_pos: Vec<[f32; 3]> = reader
+                .read_positions()
+                .ok_or_else(|| {
+                    CliError::input(format!("{at}: POSITION accessor {} has no data", pos_acc.index()))
+                })?
+                .collect();
+            let mut positions = Vec::with_capacity(count);
+            for (i, p) in local_pos.iter().enumerate() {
+                let w = world.transform_point3(DVec3::from(p.map(f64::from))).as_vec3().to_array();
+                check_position(w, || format!("{at}: POSITION accessor {} element {i}", pos_acc.index()))?;
+                positions.push(w);
+            }
+
+            let normals_in: Option<Vec<[f32; 3]>> = match prim.get(&::gltf::Semantic::Normals) {
+                Some(acc) => {
+                    self.check_accessor(&acc, &at, "NORMAL", &[Dimensions::Vec3], &[DataType::F32], false)?;
+                    self.check_count(&acc, count, &at, "NORMAL")?;
+                    reader.read_normals().map(|it| it.collect())
+                }
+                None => None,
+            };
+            let uvs: Option<Vec<[f32; 2]>> = match prim.get(&::gltf::Semantic::TexCoords(0)) {
+                Some(acc) => {
+                    self.check_accessor(
+                        &acc,
+                        &at,
+                        "TEXCOORD_0",
+                        &[Dimensions::Vec2],
+                        &[DataType::F32, DataType::U8, DataType::U16],
+                        true,
+                    )?;
+                    self.check_count(&acc, count, &at, "TEXCOORD_0")?;
+                    reader.read_tex_coords(0).map(|it| it.into_f32().collect())
+                }
+                None => None,
+            };
+            if let Some((i, uv)) =
+                uvs.iter().flatten().enumerate().find(|(_, uv)| !uv.iter().all(|c| c.is_finite()))
+            {
+                return Err(CliError::input(format!("{at}: TEXCOORD_0 element {i} is not finite: {uv:?}")));
+            }
+
+            let indices: Vec<u32> = match prim.indices() {
+                Some(acc) => {
+                    self.check_accessor(
+                        &acc,
+                        &at,
+                        "indices",
+                        &[Dimensions::Scalar],
+                        &[DataType::U8, DataType::U16, DataType::U32],
+                        false,
+                    )?;
+                    let idx: Vec<u32> = reader
+                        .read_indices()
+                        .ok_or_else(|| {
+                            CliError::input(format!("{at}: indices accessor {} has no data", acc.index()))
+                        })?
+                        .into_u32()
+                        .collect();
+                    if let Some((i, &v)) = idx.iter().enumerate().find(|&(_, &v)| v as usize >= count) {
+                        return Err(CliError::input(format!(
+                            "{at}: indices accessor {} element {i} is {v}, but there are {count} vertices",
+                            acc.index()
+                        )));
+                    }
+                    idx
+                }
+                None => (0..count as u32).collect(),
+            };
+            let mut tris = assemble(mode, &indices);
+            if tris.is_empty() {
+                self.scene.warn(format!("{at}: has no triangles"));
+                continue;
+            }
+            if mirrored {
+                for t in &mut tris {
+                    t.swap(1, 2);
+                }
+            }
+
+            let normals: Vec<[f32; 3]> = match normals_in {
+                Some(n) => {
+                    let mut bad = 0usize;
+                    let mut out: Vec<[f32; 3]> = n
+                        .iter()
+                        .map(|n| match (normal_matrix * DVec3::from(n.map(f64::from))).try_normalize() {
+                            Some(v) => v.as_vec3().to_array(),
+                            None => {
+                                bad += 1;
+                                [f32::NAN; 3]
+                            }
+                        })
+                        .collect();
+                    if bad > 0 {
+                        self.scene.warn(format!(
+                            "{at}: {bad} NORMAL values are zero or not finite; replaced by generated normals"
+                        ));
+                        let generated = angle_weighted_normals(&positions, &tris);
+                        for (o, g) in out.iter_mut().zip(generated) {
+                            if o[0].is_nan() {
+                                *o = g;
+                            }
+                        }
+                    }
+                    out
+                }
+                None => angle_weighted_normals(&positions, &tris),
+            };
+
+            let material = self.material(prim.material())?;
+            if self.scene.triangles.len() + tris.len() > MAX_TRIANGLES {
+                return Err(CliError::input(format!(
+                    "{}: the scene expands to more than {MAX_TRIANGLES} triangles",
+                    self.file
+                )));
+            }
+            let base = self.scene.vertices.len() as u32;
+            self.scene
+                .vertices
+                .extend(positions.iter().zip(&normals).map(|(p, n)| Vertex { position: *p, normal: *n }));
+            match uvs {
+                Some(uv) => self.scene.uvs.extend(uv),
+                None => self.scene.uvs.extend(std::iter::repeat_n([0.0; 2], count)),
+            }
+            self.scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base)));
+            self.scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
+        }
+        Ok(())
+    }
+
+    fn check_count(&self, acc: &Accessor, count: usize, at: &str, what: &str) -> CliResult<()> {
+        if acc.count() != count {
+            return Err(CliError::input(format!(
+                "{at}: {what} accessor {} has {} elements but POSITION has {count}",
+                acc.index(),
+                acc.count()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Checks type and byte ranges of an accessor (and its sparse parts) against the loaded
+    /// buffers, so that reading it can neither fail silently nor run out of bounds.
+    fn check_accessor(
+        &self,
+        acc: &Accessor,
+        at: &str,
+        what: &str,
+        dims: &[Dimensions],
+        types: &[DataType],
+        normalized_ok: bool,
+    ) -> CliResult<()> {
+        let name = format!("{at}: {what} accessor {}", acc.index());
+        let bad = |msg: String| Err(CliError::input(format!("{name} {msg}")));
+        if !dims.contains(&acc.dimensions()) || !types.contains(&acc.data_type()) {
+            return bad(format!(
+                "has type {:?} {:?}, expected {dims:?} of {types:?}",
+                acc.dimensions(),
+                acc.data_type()
+            ));
+        }
+        if acc.data_type() != DataType::F32 && normalized_ok && !acc.normalized() {
+            return bad("is an integer type but not normalized".into());
+        }
+        let count = acc.count();
+        if count == 0 {
+            return bad("has no elements".into());
+        }
+        let elem = acc.size();
+        self.check_range(&name, acc.view(), acc.offset(), elem, count)?;
+        if acc.view().is_none() && acc.sparse().is_none() {
+            return bad("has neither a buffer view nor sparse data".into());
+        }
+        if let Some(sparse) = acc.sparse() {
+            let sc = sparse.count();
+            if sc == 0 || sc > count {
+                return bad(format!("has {sc} sparse elements for {count} elements"));
+            }
+            let idx = sparse.indices();
+            let isize = idx.index_type().size();
+            self.check_range(&format!("{name} sparse indices"), Some(idx.view()), idx.offset(), isize, sc)?;
+            let vals = sparse.values();
+            self.check_range(&format!("{name} sparse values"), Some(vals.view()), vals.offset(), elem, sc)?;
+            // Indices must be strictly increasing and below count (glTF 2.0, 3.6.2.3).
+            let view = idx.view();
+            let data = &self.buffers[view.buffer().index()][view.offset()..view.offset() + view.length()];
+            let stride = view.stride().unwrap_or(isize);
+            let mut prev: Option<u64> = None;
+            for k in 0..sc {
+                let o = idx.offset() + k * stride;
+                let v = match isize {
+                    1 => data[o] as u64,
+                    2 => u16::from_le_bytes([data[o], data[o + 1]]) as u64,
+                    _ => u32::from_le_bytes([data[o], data[o + 1], data[o + 2], data[o + 3]]) as u64,
+                };
+                if v >= count as u64 || prev.is_some_and(|p| v <= p) {
+                    return bad(format!(
+                        "sparse index {k} is {v}: indices must increase and stay below {count}"
+                    ));
+                }
+                prev = Some(v);
+            }
+        }
+        Ok(())
+    }
+
+    fn check_range(
+        &self,
+        name: &str,
+        view: Option<::gltf::buffer::View>,
+        offset: usize,
+        elem: usize,
+        count: usize,
+    ) -> CliResult<()> {
+        let Some(view) = view else { return Ok(()) };
+        let stride = view.stride().unwrap_or(elem);
+        if stride < elem {
+            return Err(CliError::input(format!(
+                "{name}: byte stride {stride} is smaller than its {elem}-byte elements"
+            )));
+        }
+        let need = stride
+            .checked_mul(count - 1)
+            .and_then(|v| v.checked_add(offset))
+            .and_then(|v| v.checked_add(elem));
+        if need.is_none_or(|n| n > view.length()) {
+            return Err(CliError::input(format!(
+                "{name}: {count} elements of {elem} bytes (stride {stride}) at offset {offset} do not fit in buffer view {} of {} bytes",
+                view.index(),
+                view.length()
+            )));
+        }
+        let buf = &self.buffers[view.buffer().index()];
+        if view.offset().checked_add(view.length()).is_none_or(|end| end > buf.len()) {
+            return Err(CliError::input(format!(
+                "{name}: buffer view {} ({} bytes at {}) runs past the end of buffer {} ({} bytes)",
+                view.index(),
+                view.length(),
+                view.offset(),
+                view.buffer().index(),
+                buf.len()
+            )));
+        }
+        Ok(())
+    }
+
+    fn material(&mut self, m: ::gltf::Material) -> CliResult<u32> {
+        if let Some(&i) = self.materials.get(&m.index()) {
+            return Ok(i);
+        }
+        let name = match (m.index(), m.name()) {
+            (_, Some(n)) => n.to_string(),
+            (Some(i), None) => format!("material{i}"),
+            (None, None) => "default".to_string(),
+        };
+        let pbr = m.pbr_metallic_roughness();
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let mut gpu = GpuMaterial {
+            base_color: pbr.base_color_factor(),
+            emission: m.emissive_factor().map(|e| e * strength),
+            metallic: pbr.metallic_factor(),
+            roughness: pbr.roughness_factor(),
+            alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
+            normal_scale: m.normal_texture().map_or(1.0, |t| t.scale()),
+            occlusion_strength: m.occlusion_texture().map_or(1.0, |t| t.strength()),
+            ..GpuMaterial::default()
+        };
+        let params = [
+            gpu.metallic,
+            gpu.roughness,
+            gpu.alpha_cutoff,
+            gpu.normal_scale,
+            gpu.occlusion_strength,
+            strength,
+        ];
+        if !gpu.base_color.iter().chain(&gpu.emission).chain(&params).all(|v| v.is_finite()) {
+            return Err(CliError::input(format!(
+                "{}: material '{name}' has a non-finite parameter",
+                self.file
+            )));
+        }
+        let alpha = match m.alpha_mode() {
+            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            ::gltf::material::AlphaMode::Mask => AlphaMode::Mask,
+            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        gpu.flags = (alpha as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
+        if m.double_sided() {
+            gpu.flags |= MaterialFlags::DOUBLE_SIDED;
+        }
+        let slot = |this: &mut Self, tex: Option<(::gltf::Texture, u32)>, role| -> u32 {
+            match tex {
+                Some((t, 0)) => this.texture(t, role),
+                Some((t, set)) => {
+                    this.scene.warn(format!(
+                        "{}: material '{name}' samples texture {} with TEXCOORD_{set}; only set 0 is supported, the texture is ignored",
+                        this.file,
+                        t.index()
+                    ));
+                    NO_TEXTURE
+                }
+                None => NO_TEXTURE,
+            }
+        };
+        gpu.base_color_texture =
+            slot(self, pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Color);
+        gpu.metallic_roughness_texture = slot(
+            self,
+            pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())),
+            TextureRole::Data,
+        );
+        gpu.normal_texture =
+            slot(self, m.normal_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Normal);
+        gpu.occlusion_texture =
+            slot(self, m.occlusion_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Data);
+        gpu.emissive_texture =
+            slot(self, m.emissive_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Color);
+        let index = self.scene.materials.len() as u32;
+        self.scene.materials.push(Material { name, gpu });
+        self.materials.insert(m.index(), index);
+        Ok(index)
+    }
+
+    fn texture(&mut self, t: ::gltf::Texture, role: TextureRole) -> u32 {
+        if let Some(&i) = self.textures.get(&(t.index(), role)) {
+            return i;
+        }
+        let img = t.source();
+        let name = img.name().map(str::to_string).unwrap_or_else(|| match img.source() {
+            ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => uri.to_string(),
+            _ => format!("image{}", img.index()),
+        });
+        let bytes = match img.source() {
+            ::gltf::image::Source::View { view, .. } => {
+                let buf = &self.buffers[view.buffer().index()];
+                buf.get(view.offset()..view.offset().saturating_add(view.length()))
+                    .map(<[u8]>::to_vec)
+                    .ok_or_else(|| format!("buffer view {} runs past the end of its buffer", view.index()))
+            }
+            ::gltf::image::Source::Uri { uri, .. } => load_uri(uri, &self.base, &mut self.scene.inputs),
+        };
+        let s = t.sampler();
+        let wrap = |w: ::gltf::texture::WrappingMode| match w {
+            ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            ::gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        };
+        let index = (self.scene.textures.len() + self.requests.len()) as u32;
+        self.requests.push(TextureRequest {
+            name,
+            bytes,
+            role,
+            wrap_u: wrap(s.wrap_s()),
+            wrap_v: wrap(s.wrap_t()),
+            mag_linear: s.mag_filter() != Some(::gltf::texture::MagFilter::Nearest),
+        });
+        self.textures.insert((t.index(), role), index);
+        index
+    }
+
+    fn add_camera(&mut self, camera: &::gltf::Camera, world: &DMat4, node: usize) {
+        let name = camera.name().map_or_else(|| format!("camera{}", camera.index()), str::to_string);
+        match camera.projection() {
+            ::gltf::camera::Projection::Perspective(p) => {
+                let position = world.transform_point3(DVec3::ZERO);
+                let forward = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
+                let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
+                let cam = Camera {
+                    name,
+                    position: position.as_vec3().to_array(),
+                    target: (position + forward).as_vec3().to_array(),
+                    up: up.as_vec3().to_array(),
+                    vfov_degrees: p.yfov().to_degrees(),
+                    znear: p.znear(),
+                    zfar: p.zfar().unwrap_or(0.0),
+                };
+                let vals = [cam.position, cam.target, cam.up].concat();
+                if forward == DVec3::ZERO
+                    || up == DVec3::ZERO
+                    || !vals.iter().all(|v| v.is_finite())
+                    || !cam.vfov_degrees.is_finite()
+                {
+                    self.scene.warn(format!(
+                        "{}: camera '{}' on node {node} has a degenerate transform; skipped",
+                        self.file, cam.name
+                    ));
+                } else {
+                    self.scene.cameras.push(cam);
+                }
+            }
+            ::gltf::camera::Projection::Orthographic(_) => {
+                self.scene.warn(format!(
+                    "{}: orthographic camera '{name}' on node {node} is not supported; skipped",
+                    self.file
+                ));
+            }
+        }
+    }
+
+    fn add_light(
+        &mut self,
+        light: &::gltf::khr_lights_punctual::Light,
+        world: &DMat4,
+        node: usize,
+    ) -> CliResult<()> {
+        use ::gltf::khr_lights_punctual::Kind;
+        let name = light.name().map_or_else(|| format!("light{}", light.index()), str::to_string);
+        let kind = match light.kind() {
+            Kind::Point => LightKind::Point,
+            Kind::Directional => LightKind::Directional,
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
+            }
+        };
+        let position = world.transform_point3(DVec3::ZERO).as_vec3().to_array();
+        let direction = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero().as_vec3().to_array();
+        let l = Light {
+            name,
+            kind,
+            position,
+            direction,
+            right: [0.0; 3],
+            color: light.color(),
+            intensity: light.intensity(),
+            range: light.range().unwrap_or(0.0),
+            casts_shadows: true,
+        };
+        let vals = [&l.position[..], &l.direction, &l.color, &[l.intensity, l.range]].concat();
+        if !vals.iter().all(|v| v.is_finite()) {
+            return Err(CliError::input(format!(
+                "{}: light '{}' on node {node} has a non-finite value",
+                self.file, l.name
+            )));
+        }
+        if l.direction == [0.0; 3] && !matches!(l.kind, LightKind::Point) {
+            self.scene.warn(format!(
+                "{}: light '{}' on node {node} has no direction (degenerate transform); skipped",
+                self.file, l.name
+            ));
+            return Ok(());
+        }
+        self.scene.lights.push(l);
+        Ok(())
+    }
+}
+
+/// Triangles from an index list in the given mode (glTF 2.0, 3.7.2.1).
+fn assemble(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => {
+            (0..idx.len().saturating_sub(2))
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [idx[i], idx[i + 1], idx[i + 2]]
+                    } else {
+                        [idx[i + 1], idx[i], idx[i + 2]]
+                    }
+                })
+                .collect()
+        }
+        Mode::TriangleFan => (1..idx.len().saturating_sub(1)).map(|i| [idx[i], idx[i + 1], idx[0]]).collect(),
+        _ => Vec::new(),
+    }
+}

@@ -1,0 +1,280 @@
+//! Wavefront OBJ/MTL import through `tobj`.
+//!
+//! A first pass over the OBJ text checks what `tobj` would reject or silently accept (face
+//! references out of range, polygons with fewer than three corners, non-finite positions) and
+//! reports it with its line number; then `tobj` loads the file.
+//!
+//! MTL → PBR rule (documented in the README):
+//! - `Kd` is the base colour (albedo), `map_Kd` its texture; `d` (or `1 - Tr`) its alpha.
+//! - `Ks 0 0 0` (or no `Ks`) with no metalness `Pm` → **pure Lambertian diffuse**: no specular
+//!   lobe at all (flag `DIFFUSE_ONLY`), metallic 0, roughness 1.
+//! - Otherwise a GGX material: metallic `Pm` (default 0), roughness `Pr`, or from the Phong
+//!   exponent `Ns` as `(2 / (Ns + 2))^(1/4)` (Walter et al.'s Beckmann–Phong correspondence
+//!   α = √(2/(Ns+2)), with perceptual roughness √α); `Ks` itself only decides that a specular
+//!   lobe exists (dielectric F0 = 0.04).
+//! - `Ke` is emitted radiance in W/(sr·m²), `map_Ke` its texture; `norm`/`map_Bump` a normal map.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use kiln_format::manifest::Wrap;
+use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
+
+use super::geometry::{angle_weighted_normals, check_position};
+use super::images::{TextureRequest, decode_all};
+use super::read_input;
+use crate::exit::{CliError, CliResult};
+use crate::ir::{Material, Scene, TextureRole};
+
+/// Imports an `.obj` file (and the MTL files it names) into `scene`.
+pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
+    let file = path.display().to_string();
+    let text = read_input(path, &mut scene.inputs)?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mtllibs = precheck(&file, &text)?;
+    let options =
+        tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
+    let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(&text), &options, |p| {
+        let full = base.join(p);
+        tobj::load_mtl(&full)
+    })
+    .map_err(|e| CliError::input(format!("{file}: cannot read OBJ: {e}")))?;
+    for lib in &mtllibs {
+        let full = base.join(lib);
+        if full.is_file() && !scene.inputs.contains(&full) {
+            scene.inputs.push(full);
+        }
+    }
+    let materials = match materials {
+        Ok(m) => m,
+        Err(e) => {
+            let which = if mtllibs.is_empty() {
+                "names no material library".to_string()
+            } else {
+                format!("material library {} cannot be read ({e})", mtllibs.join(", "))
+            };
+            scene.warn(format!("{file}: {which}; every face gets the default material"));
+            Vec::new()
+        }
+    };
+
+    let mut requests: Vec<TextureRequest> = Vec::new();
+    let mut tex_cache: HashMap<(String, TextureRole), u32> = HashMap::new();
+    let first_material = scene.materials.len() as u32;
+    let mtl_base = |name: &str| base.join(name);
+    for m in &materials {
+        let gpu = convert_material(m, &mut |name: &str, role| {
+            if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
+                return i;
+            }
+            let full = mtl_base(name);
+            let bytes = std::fs::read(&full).map_err(|e| format!("cannot read {}: {e}", full.display()));
+            if bytes.is_ok() && !scene.inputs.contains(&full) {
+                scene.inputs.push(full.clone());
+            }
+            let i = (scene.textures.len() + requests.len()) as u32;
+            requests.push(TextureRequest {
+                name: name.to_string(),
+                bytes,
+                role,
+                wrap_u: Wrap::Repeat,
+                wrap_v: Wrap::Repeat,
+                mag_linear: true,
+            });
+            tex_cache.insert((name.to_string(), role), i);
+            i
+        });
+        scene.materials.push(Material { name: m.name.clone(), gpu });
+    }
+    let mut default_material: Option<u32> = None;
+
+    for model in &models {
+        let mesh = &model.mesh;
+        let at = format!("{file}: object '{}'", model.name);
+        let positions: Vec<[f32; 3]> = mesh.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        for (i, p) in positions.iter().enumerate() {
+            check_position(*p, || format!("{at}: vertex {i}"))?;
+        }
+        let tris: Vec<[u32; 3]> = mesh.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        if tris.is_empty() {
+            continue;
+        }
+        let normals: Vec<[f32; 3]> = if mesh.normals.len() == mesh.positions.len() {
+            let given: Vec<[f32; 3]> = mesh.normals.chunks_exact(3).map(|n| [n[0], n[1], n[2]]).collect();
+            let generated = angle_weighted_normals(&positions, &tris);
+            given
+                .iter()
+                .zip(generated)
+                .map(|(n, g)| glam::Vec3::from(*n).try_normalize().map_or(g, |v| v.to_array()))
+                .collect()
+        } else {
+            angle_weighted_normals(&positions, &tris)
+        };
+        // OBJ's v runs up the image; kiln (like glTF) stores v running down.
+        let uvs: Vec<[f32; 2]> = if mesh.texcoords.len() / 2 == positions.len() {
+            mesh.texcoords.chunks_exact(2).map(|t| [t[0], 1.0 - t[1]]).collect()
+        } else {
+            vec![[0.0; 2]; positions.len()]
+        };
+        if let Some(i) = uvs.iter().position(|uv| !uv.iter().all(|c| c.is_finite())) {
+            return Err(CliError::input(format!("{at}: texture coordinate {i} is not finite")));
+        }
+        let material = match mesh.material_id {
+            Some(id) if id < materials.len() => first_material + id as u32,
+            _ => *default_material.get_or_insert_with(|| {
+                scene.materials.push(Material { name: "default".into(), gpu: lambert([0.8; 3]) });
+                scene.materials.len() as u32 - 1
+            }),
+        };
+        let base_index = scene.vertices.len() as u32;
+        scene
+            .vertices
+            .extend(positions.iter().zip(&normals).map(|(p, n)| Vertex { position: *p, normal: *n }));
+        scene.uvs.extend(uvs);
+        scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base_index)));
+        scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
+    }
+    let (textures, warnings) = decode_all(requests);
+    for w in warnings {
+        scene.warn(format!("{file}: {w}"));
+    }
+    scene.textures.extend(textures);
+    Ok(())
+}
+
+/// A pure Lambertian material with albedo `kd`.
+pub(crate) fn lambert(kd: [f32; 3]) -> GpuMaterial {
+    GpuMaterial {
+        base_color: [kd[0], kd[1], kd[2], 1.0],
+        metallic: 0.0,
+        roughness: 1.0,
+        flags: MaterialFlags::DIFFUSE_ONLY,
+        ..GpuMaterial::default()
+    }
+}
+
+fn param(m: &tobj::Material, key: &str) -> Option<f32> {
+    m.unknown_param.get(key).and_then(|v| v.split_whitespace().next()?.parse().ok())
+}
+
+fn convert_material(m: &tobj::Material, texture: &mut dyn FnMut(&str, TextureRole) -> u32) -> GpuMaterial {
+    let kd = m.diffuse.unwrap_or([0.8; 3]);
+    let ks = m.specular.unwrap_or([0.0; 3]);
+    let metallic = param(m, "Pm");
+    let alpha = m.dissolve.or_else(|| param(m, "Tr").map(|t| 1.0 - t)).unwrap_or(1.0).clamp(0.0, 1.0);
+    let mut gpu = if ks == [0.0; 3] && metallic.is_none_or(|v| v == 0.0) {
+        lambert(kd)
+    } else {
+        let roughness = param(m, "Pr").unwrap_or_else(|| {
+            let ns = m.shininess.unwrap_or(0.0).max(0.0);
+            (2.0 / (ns + 2.0)).powf(0.25)
+        });
+        GpuMaterial {
+            base_color: [kd[0], kd[1], kd[2], 1.0],
+            metallic: metallic.unwrap_or(0.0).clamp(0.0, 1.0),
+            roughness: roughness.clamp(0.0, 1.0),
+            ..GpuMaterial::default()
+        }
+    };
+    gpu.base_color[3] = alpha;
+    if alpha < 1.0 {
+        gpu.flags |= (AlphaMode::Blend as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
+    }
+    gpu.emission = m.emissive.unwrap_or([0.0; 3]);
+    let name_of = |s: &str| s.split_whitespace().last().unwrap_or("").to_string();
+    if let Some(t) = &m.diffuse_texture {
+        gpu.base_color_texture = texture(&name_of(t), TextureRole::Color);
+    }
+    if let Some(t) = m.unknown_param.get("map_Ke") {
+        gpu.emissive_texture = texture(&name_of(t), TextureRole::Color);
+        if gpu.emission == [0.0; 3] {
+            gpu.emission = [1.0; 3];
+        }
+    }
+    if let Some(t) = &m.normal_texture {
+        gpu.normal_texture = texture(&name_of(t), TextureRole::Normal);
+    }
+    // Non-finite MTL values are replaced by defaults here; the validator would refuse them.
+    for v in gpu.base_color.iter_mut().chain(gpu.emission.iter_mut()) {
+        if !v.is_finite() {
+            *v = 0.0;
+        }
+    }
+    debug_assert!(gpu.textures().iter().all(|&t| t == NO_TEXTURE || t < u32::MAX));
+    gpu
+}
+
+/// Checks face references and positions line by line; returns the `mtllib` names.
+fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
+    let text = String::from_utf8_lossy(text);
+    let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
+    let mut libs = Vec::new();
+    let mut faces = 0u64;
+    let mut logical = String::new();
+    let mut first_line = 0;
+    for (i, raw) in text.lines().enumerate() {
+        // Lines ending in a backslash continue on the next one.
+        if logical.is_empty() {
+            first_line = i + 1;
+        }
+        if let Some(stripped) = raw.strip_suffix('\\') {
+            logical.push_str(stripped);
+            logical.push(' ');
+            continue;
+        }
+        logical.push_str(raw);
+        let line = std::mem::take(&mut logical);
+        let line = line.split('#').next().unwrap_or("");
+        let mut words = line.split_whitespace();
+        let at = |msg: String| CliError::input(format!("{file}:{first_line}: {msg}"));
+        match words.next() {
+            Some("v") => {
+                nv += 1;
+                let vals: Vec<f32> = words.take(3).map(|w| w.parse::<f32>().unwrap_or(f32::NAN)).collect();
+                if vals.len() < 3 || vals.iter().any(|v| !v.is_finite()) {
+                    return Err(at(format!("vertex position '{}' is not three finite numbers", line.trim())));
+                }
+                check_position([vals[0], vals[1], vals[2]], || {
+                    format!("{file}:{first_line}: vertex position")
+                })?;
+            }
+            Some("vt") => nt += 1,
+            Some("vn") => nn += 1,
+            Some("mtllib") => libs.extend(words.map(str::to_string)),
+            Some("f") => {
+                faces += 1;
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(at(format!("face has {} vertices; a face needs at least 3", corners.len())));
+                }
+                for (k, c) in corners.iter().enumerate() {
+                    for (slot, (part, count, what)) in c
+                        .split('/')
+                        .zip([(nv, "position"), (nt, "texture coordinate"), (nn, "normal")])
+                        .map(|(p, (n, w))| (p, n, w))
+                        .enumerate()
+                    {
+                        if part.is_empty() && slot > 0 {
+                            continue;
+                        }
+                        let idx: i64 = part.parse().map_err(|_| {
+                            at(format!("face vertex {} '{c}' is not a valid reference", k + 1))
+                        })?;
+                        let resolved = if idx < 0 { count + 1 + idx } else { idx };
+                        if idx == 0 || resolved < 1 || resolved > count {
+                            return Err(at(format!(
+                                "face vertex {} refers to {what} {idx}, but only {count} are defined before this line",
+                                k + 1
+                            )));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    if faces == 0 {
+        return Err(CliError::input(format!("{file}: has no faces")));
+    }
+    Ok(libs)
+}

@@ -1,0 +1,367 @@
+//! The TOML sidecar: what an asset lacks (camera, lights, sky, media, material fixes) and bake
+//! settings. Unknown keys are rejected by name. The schema is documented in `docs/sidecar.md`.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use glam::Vec3;
+use kiln_format::manifest::{Bounds, Camera, Light, LightKind, Medium, Sky};
+use kiln_format::sections::MaterialFlags;
+use serde::Deserialize;
+
+use crate::exit::{CliError, CliResult};
+use crate::ir::Scene;
+
+/// A parsed sidecar.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sidecar {
+    /// The default camera (replaces the asset's first camera as the default).
+    pub camera: Option<CameraToml>,
+    /// Lights added to the asset's own.
+    #[serde(default, rename = "light")]
+    pub lights: Vec<LightToml>,
+    /// Constant sky.
+    pub sky: Option<SkyToml>,
+    /// Homogeneous media.
+    #[serde(default, rename = "medium")]
+    pub media: Vec<MediumToml>,
+    /// Material overrides by material name.
+    #[serde(default, rename = "material")]
+    pub materials: BTreeMap<String, MaterialToml>,
+    /// Bake settings (the command line overrides them).
+    #[serde(default)]
+    pub bake: BakeToml,
+}
+
+/// `[camera]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraToml {
+    /// Eye position.
+    pub position: [f32; 3],
+    /// Point looked at.
+    pub target: [f32; 3],
+    /// Up vector.
+    #[serde(default = "up")]
+    pub up: [f32; 3],
+    /// Vertical field of view, degrees.
+    #[serde(default = "vfov")]
+    pub vfov_degrees: f32,
+    /// Near plane (default: 1/1000 of the scene's diagonal).
+    pub znear: Option<f32>,
+    /// Far plane (default: infinite).
+    pub zfar: Option<f32>,
+}
+
+fn up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn vfov() -> f32 {
+    45.0
+}
+fn white() -> [f32; 3] {
+    [1.0; 3]
+}
+fn yes() -> bool {
+    true
+}
+
+/// Light kinds of the sidecar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightKindToml {
+    /// Point light.
+    Point,
+    /// Spot light.
+    Spot,
+    /// Directional light.
+    Directional,
+    /// One-sided rectangular area light.
+    Rect,
+}
+
+/// `[[light]]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightToml {
+    /// Kind.
+    pub kind: LightKindToml,
+    /// Name (default `light<N>`).
+    pub name: Option<String>,
+    /// Position (point, spot, rect centre).
+    pub position: Option<[f32; 3]>,
+    /// Linear RGB colour.
+    #[serde(default = "white")]
+    pub color: [f32; 3],
+    /// Point, spot: W/sr; directional: W/m²; rect: W/(sr·m²).
+    pub intensity: f32,
+    /// Directional and spot: where the light travels; rect: the side it emits to.
+    pub direction: Option<[f32; 3]>,
+    /// Rect: `[width, height]`.
+    pub size: Option<[f32; 2]>,
+    /// Rect: the direction of the width.
+    pub right: Option<[f32; 3]>,
+    /// Spot: full intensity inside this half-angle (default 0.8 × outer).
+    pub inner_cone_degrees: Option<f32>,
+    /// Spot: zero intensity outside this half-angle (default 45).
+    pub outer_cone_degrees: Option<f32>,
+    /// Cut-off distance (default unlimited).
+    pub range: Option<f32>,
+    /// Whether it casts shadows (default true).
+    #[serde(default = "yes")]
+    pub casts_shadows: bool,
+}
+
+/// `[sky]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SkyToml {
+    /// Radiance W/(sr·m²), linear RGB.
+    pub radiance: [f32; 3],
+}
+
+/// `[[medium]]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumToml {
+    /// Minimum corner of the box it fills (default: the scene bounds).
+    pub min: Option<[f32; 3]>,
+    /// Maximum corner.
+    pub max: Option<[f32; 3]>,
+    /// Absorption per scene unit, RGB.
+    #[serde(default)]
+    pub sigma_a: [f32; 3],
+    /// Scattering per scene unit, RGB.
+    pub sigma_s: [f32; 3],
+    /// Henyey–Greenstein g in (-1, 1).
+    #[serde(default)]
+    pub g: f32,
+}
+
+/// `[material."NAME"]`: fields replace the asset's values.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialToml {
+    /// Linear RGB or RGBA base colour.
+    pub base_color: Option<Vec<f32>>,
+    /// Emitted radiance W/(sr·m²), linear RGB.
+    pub emission: Option<[f32; 3]>,
+    /// Metalness.
+    pub metallic: Option<f32>,
+    /// Perceptual roughness.
+    pub roughness: Option<f32>,
+    /// Pure Lambertian (no specular lobe).
+    pub diffuse_only: Option<bool>,
+    /// Shade both faces.
+    pub double_sided: Option<bool>,
+}
+
+/// `[bake]`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BakeToml {
+    /// `fast`, `medium` or `slow`.
+    pub bvh_preset: Option<String>,
+}
+
+impl Sidecar {
+    /// Reads and parses a sidecar file.
+    pub fn load(path: &Path, inputs: &mut Vec<std::path::PathBuf>) -> CliResult<Sidecar> {
+        let bytes = super::read_input(path, inputs)?;
+        let text = String::from_utf8(bytes)
+            .map_err(|_| CliError::input(format!("{}: not UTF-8 text", path.display())))?;
+        Self::parse(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+    }
+
+    /// Parses sidecar text.
+    pub fn parse(text: &str) -> Result<Sidecar, String> {
+        toml::from_str(text).map_err(|e| e.to_string().trim_end().replace('\n', " "))
+    }
+
+    /// Applies the sidecar to an imported scene; `source` names the file in messages.
+    pub fn apply(&self, scene: &mut Scene, source: &str) -> CliResult<()> {
+        let err = |msg: String| CliError::input(format!("{source}: {msg}"));
+        let bad = |msg: String| Err(err(msg));
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        if let Some(c) = &self.camera {
+            let vals = [&c.position[..], &c.target, &c.up, &[c.vfov_degrees]].concat();
+            if !finite(&vals) {
+                return bad("[camera] has a non-finite value".into());
+            }
+            let fwd = Vec3::from(c.target) - Vec3::from(c.position);
+            if fwd.length_squared() == 0.0 || fwd.cross(Vec3::from(c.up)).length_squared() == 0.0 {
+                return bad("[camera] target equals position, or up is parallel to the view direction".into());
+            }
+            if !(c.vfov_degrees > 0.0 && c.vfov_degrees < 180.0) {
+                return bad(format!("[camera] vfov_degrees is {}, must be in (0, 180)", c.vfov_degrees));
+            }
+            scene.cameras.insert(
+                0,
+                Camera {
+                    name: "sidecar".into(),
+                    position: c.position,
+                    target: c.target,
+                    up: c.up,
+                    vfov_degrees: c.vfov_degrees,
+                    znear: c.znear.unwrap_or(0.0),
+                    zfar: c.zfar.unwrap_or(0.0),
+                },
+            );
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            scene
+                .lights
+                .push(convert_light(l, i).map_err(|e| err(format!("light {} ({:?}): {e}", i + 1, l.kind)))?);
+        }
+        if let Some(s) = &self.sky {
+            if !finite(&s.radiance) || s.radiance.iter().any(|&v| v < 0.0) {
+                return bad("[sky] radiance must be finite and non-negative".into());
+            }
+            scene.sky = Sky { radiance: s.radiance };
+        }
+        for (i, m) in self.media.iter().enumerate() {
+            let vals = [&m.sigma_a[..], &m.sigma_s, &[m.g]].concat();
+            if !finite(&vals) || vals[..6].iter().any(|&v| v < 0.0) || !(m.g > -1.0 && m.g < 1.0) {
+                return bad(format!(
+                    "medium {}: coefficients must be finite and non-negative, g in (-1, 1)",
+                    i + 1
+                ));
+            }
+            let (min, max) = match (m.min, m.max) {
+                (Some(a), Some(b)) => (a, b),
+                (None, None) => ([f32::NAN; 3], [f32::NAN; 3]), // filled with the scene bounds later
+                _ => return bad(format!("medium {}: give both min and max, or neither", i + 1)),
+            };
+            scene.media.push(Medium {
+                bounds: Bounds { min, max },
+                sigma_a: m.sigma_a,
+                sigma_s: m.sigma_s,
+                g: m.g,
+            });
+        }
+        for (name, o) in &self.materials {
+            let mut found = false;
+            for m in scene.materials.iter_mut().filter(|m| &m.name == name) {
+                found = true;
+                apply_material(o, &mut m.gpu).map_err(|e| err(format!("material \"{name}\": {e}")))?;
+            }
+            if !found {
+                let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+                return bad(format!(
+                    "material \"{name}\" is not in the scene (materials: {})",
+                    names.join(", ")
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn apply_material(o: &MaterialToml, gpu: &mut kiln_format::sections::GpuMaterial) -> Result<(), String> {
+    if let Some(c) = &o.base_color {
+        match c.as_slice() {
+            [r, g, b] => gpu.base_color = [*r, *g, *b, gpu.base_color[3]],
+            [r, g, b, a] => gpu.base_color = [*r, *g, *b, *a],
+            _ => return Err("base_color needs 3 or 4 numbers".into()),
+        }
+    }
+    if let Some(e) = o.emission {
+        gpu.emission = e;
+    }
+    if let Some(v) = o.metallic {
+        gpu.metallic = v;
+    }
+    if let Some(v) = o.roughness {
+        gpu.roughness = v;
+    }
+    for (flag, value) in
+        [(MaterialFlags::DIFFUSE_ONLY, o.diffuse_only), (MaterialFlags::DOUBLE_SIDED, o.double_sided)]
+    {
+        match value {
+            Some(true) => gpu.flags |= flag,
+            Some(false) => gpu.flags &= !flag,
+            None => {}
+        }
+    }
+    let vals = [&gpu.base_color[..], &gpu.emission, &[gpu.metallic, gpu.roughness]].concat();
+    if !vals.iter().all(|v| v.is_finite() && *v >= 0.0) || gpu.metallic > 1.0 || gpu.roughness > 1.0 {
+        return Err("values must be finite and non-negative; metallic and roughness at most 1".into());
+    }
+    Ok(())
+}
+
+fn convert_light(l: &LightToml, i: usize) -> Result<Light, String> {
+    let need = |v: Option<[f32; 3]>, what: &str| v.ok_or_else(|| format!("`{what}` is required"));
+    let unit = |v: [f32; 3], what: &str| {
+        Vec3::from(v)
+            .try_normalize()
+            .map(|v| v.to_array())
+            .ok_or_else(|| format!("`{what}` must be a non-zero vector"))
+    };
+    let mut light = Light {
+        name: l.name.clone().unwrap_or_else(|| format!("light{}", i + 1)),
+        kind: LightKind::Point,
+        position: [0.0; 3],
+        direction: [0.0, -1.0, 0.0],
+        right: [0.0; 3],
+        color: l.color,
+        intensity: l.intensity,
+        range: l.range.unwrap_or(0.0),
+        casts_shadows: l.casts_shadows,
+    };
+    match l.kind {
+        LightKindToml::Point => light.position = need(l.position, "position")?,
+        LightKindToml::Directional => light.direction = unit(need(l.direction, "direction")?, "direction")?,
+        LightKindToml::Spot => {
+            light.position = need(l.position, "position")?;
+            light.direction = unit(need(l.direction, "direction")?, "direction")?;
+            let outer = l.outer_cone_degrees.unwrap_or(45.0);
+            let inner = l.inner_cone_degrees.unwrap_or(0.8 * outer);
+            if !(inner >= 0.0 && inner <= outer && outer > 0.0 && outer <= 90.0) {
+                return Err(format!(
+                    "cone angles must satisfy 0 <= inner ({inner}) <= outer ({outer}) <= 90 degrees, outer > 0"
+                ));
+            }
+            light.kind = LightKind::Spot { inner_cone: inner.to_radians(), outer_cone: outer.to_radians() };
+        }
+        LightKindToml::Rect => {
+            light.position = need(l.position, "position")?;
+            let dir = Vec3::from(unit(need(l.direction, "direction")?, "direction")?);
+            let right = Vec3::from(need(l.right, "right")?);
+            // Keep only the part of `right` orthogonal to the direction.
+            let right = (right - dir * right.dot(dir))
+                .try_normalize()
+                .ok_or("`right` must not be parallel to `direction`")?;
+            let [w, h] = l.size.ok_or("`size` = [width, height] is required")?;
+            if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
+                return Err(format!("size must be positive, got [{w}, {h}]"));
+            }
+            light.direction = dir.to_array();
+            light.right = right.to_array();
+            light.kind = LightKind::Rect { width: w, height: h };
+        }
+    }
+    let vals = [&light.position[..], &light.color, &[light.intensity, light.range]].concat();
+    if !vals.iter().all(|v| v.is_finite()) {
+        return Err("values must be finite".into());
+    }
+    if light.intensity < 0.0 || light.color.iter().any(|&c| c < 0.0) || light.range < 0.0 {
+        return Err("intensity, color and range must be non-negative".into());
+    }
+    let unused: Vec<&str> = [
+        ("size", l.size.is_some() && l.kind != LightKindToml::Rect),
+        ("right", l.right.is_some() && l.kind != LightKindToml::Rect),
+        ("direction", l.direction.is_some() && l.kind == LightKindToml::Point),
+        ("position", l.position.is_some() && l.kind == LightKindToml::Directional),
+        ("inner_cone_degrees", l.inner_cone_degrees.is_some() && l.kind != LightKindToml::Spot),
+        ("outer_cone_degrees", l.outer_cone_degrees.is_some() && l.kind != LightKindToml::Spot),
+    ]
+    .into_iter()
+    .filter_map(|(k, on)| on.then_some(k))
+    .collect();
+    if !unused.is_empty() {
+        return Err(format!("{} do(es) not apply to this kind of light", unused.join(", ")));
+    }
+    Ok(light)
+}

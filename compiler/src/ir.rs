@@ -1,0 +1,120 @@
+//! The scene IR: what every importer produces and every bake stage reads. Plain data, world
+//! space, no loader types.
+
+use std::path::PathBuf;
+
+use kiln_format::manifest::{Camera, ColorSpace, Light, Medium, Sky, Wrap};
+use kiln_format::sections::{GpuMaterial, Vertex};
+
+/// A material: shading parameters as stored, plus its name.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// Name in the asset (or generated).
+    pub name: String,
+    /// Shading parameters; texture slots index [`Scene::textures`].
+    pub gpu: GpuMaterial,
+}
+
+/// What a texture is sampled for; decides its colour space and its placeholder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum TextureRole {
+    /// sRGB colour (base colour, emissive).
+    Color,
+    /// Linear data (metallic-roughness, occlusion).
+    Data,
+    /// Tangent-space normal map (linear; placeholder is the flat normal).
+    Normal,
+}
+
+impl TextureRole {
+    /// Colour space of textures in this role.
+    pub fn color_space(self) -> ColorSpace {
+        match self {
+            TextureRole::Color => ColorSpace::Srgb,
+            TextureRole::Data | TextureRole::Normal => ColorSpace::Linear,
+        }
+    }
+
+    /// The texel that stands in for an image that could not be read: neutral for the role.
+    pub fn placeholder(self) -> [u8; 4] {
+        match self {
+            TextureRole::Color | TextureRole::Data => [255, 255, 255, 255],
+            TextureRole::Normal => [128, 128, 255, 255],
+        }
+    }
+}
+
+/// A decoded texture (mip 0 only; the texture bake builds the chain).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    /// Image name or URI, for messages and the manifest.
+    pub name: String,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// RGBA8 texels, rows top to bottom.
+    pub rgba: Vec<u8>,
+    /// Role (colour space).
+    pub role: TextureRole,
+    /// Wrap along u.
+    pub wrap_u: Wrap,
+    /// Wrap along v.
+    pub wrap_v: Wrap,
+    /// Linear magnification.
+    pub mag_linear: bool,
+}
+
+/// A non-fatal problem found while importing, with the object it concerns.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Warning {
+    /// The message, naming file and object.
+    pub message: String,
+}
+
+/// An imported scene.
+#[derive(Debug, Clone, Default)]
+pub struct Scene {
+    /// Scene name (the input's file stem).
+    pub name: String,
+    /// Vertices, world space.
+    pub vertices: Vec<Vertex>,
+    /// Texture coordinate per vertex.
+    pub uvs: Vec<[f32; 2]>,
+    /// Triangles (vertex index triples), front faces counter-clockwise.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material of each triangle.
+    pub triangle_materials: Vec<u32>,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Textures referenced by materials.
+    pub textures: Vec<Texture>,
+    /// Analytic lights.
+    pub lights: Vec<Light>,
+    /// Cameras, default first.
+    pub cameras: Vec<Camera>,
+    /// Sky.
+    pub sky: Sky,
+    /// Participating media.
+    pub media: Vec<Medium>,
+    /// Every file read (asset, buffers, images, sidecar), in reading order.
+    pub inputs: Vec<PathBuf>,
+    /// Warnings.
+    pub warnings: Vec<Warning>,
+    /// Degenerate triangles dropped.
+    pub degenerate_triangles: u64,
+}
+
+impl Scene {
+    /// Records a warning.
+    pub fn warn(&mut self, message: impl Into<String>) {
+        self.warnings.push(Warning { message: message.into() });
+    }
+
+    /// Whether some material samples a texture.
+    pub fn uses_textures(&self) -> bool {
+        self.materials
+            .iter()
+            .any(|m| m.gpu.textures().iter().any(|&t| t != kiln_format::sections::NO_TEXTURE))
+    }
+}

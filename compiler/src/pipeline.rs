@@ -1,0 +1,231 @@
+//! The compile pipeline shared by `compile`, `plan` and `demo`: load → validate → plan → bake →
+//! write, with the report and the depfile.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use kiln_format::ContentHash;
+use kiln_format::manifest::InputFile;
+use serde::Serialize;
+
+use crate::analyze::plan::Plan;
+use crate::analyze::validate;
+use crate::bake::{self, StageReport};
+use crate::cli::{OutputArgs, SceneArgs};
+use crate::exit::{CliError, CliResult};
+use crate::import::{self, sidecar::Sidecar};
+use crate::ir::Scene;
+use crate::progress::Progress;
+use crate::settings::{BvhPreset, Settings};
+
+/// A scene ready to bake.
+#[derive(Debug)]
+pub struct Loaded {
+    /// The validated scene.
+    pub scene: Scene,
+    /// Settings in effect.
+    pub settings: Settings,
+    /// The plan.
+    pub plan: Plan,
+    /// Wall time of import, sidecar and validation, ms.
+    pub import_ms: f64,
+}
+
+/// Imports, applies the sidecar, validates and plans. Warnings are printed to stderr unless
+/// `quiet`; with `strict` any warning is an error.
+pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
+    let start = Instant::now();
+    let mut scene = import::import(&args.input)?;
+    let mut preset = None;
+    if let Some(cfg) = &args.config {
+        let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
+        sidecar.apply(&mut scene, &cfg.display().to_string())?;
+        if let Some(p) = &sidecar.bake.bvh_preset {
+            preset = Some(BvhPreset::parse(p).ok_or_else(|| {
+                CliError::input(format!(
+                    "{}: bake.bvh_preset is '{p}'; use fast, medium or slow",
+                    cfg.display()
+                ))
+            })?);
+        }
+    }
+    let settings = Settings { bvh_preset: args.bvh_preset.or(preset).unwrap_or_default() };
+    finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
+}
+
+/// Validates and plans an imported scene (also the entry point of the demo).
+pub fn finish(
+    mut scene: Scene,
+    settings: Settings,
+    source: &str,
+    strict: bool,
+    quiet: bool,
+    start: Instant,
+) -> CliResult<Loaded> {
+    validate::finish(&mut scene, source)?;
+    if !quiet || strict {
+        for w in &scene.warnings {
+            eprintln!("warning: {}", w.message);
+        }
+    }
+    if strict && !scene.warnings.is_empty() {
+        return Err(CliError::input(format!("{} warnings and --strict is set", scene.warnings.len())));
+    }
+    let plan = Plan::new(&scene, &settings);
+    Ok(Loaded { scene, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
+}
+
+/// Reads and hashes every input file for the manifest.
+pub fn hash_inputs(paths: &[PathBuf]) -> CliResult<Vec<InputFile>> {
+    paths
+        .iter()
+        .map(|p| {
+            let bytes = std::fs::read(p).map_err(|e| CliError::io(format!("{}: {e}", p.display())))?;
+            Ok(InputFile {
+                path: p.display().to_string(),
+                bytes: bytes.len() as u64,
+                hash: ContentHash::of(&bytes).to_hex(),
+            })
+        })
+        .collect()
+}
+
+/// Counts for reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct Counts {
+    /// Triangles written.
+    pub triangles: usize,
+    /// Vertices written.
+    pub vertices: usize,
+    /// Materials.
+    pub materials: usize,
+    /// Textures.
+    pub textures: usize,
+    /// Lights.
+    pub lights: usize,
+    /// Cameras.
+    pub cameras: usize,
+    /// BVH nodes.
+    pub bvh_nodes: usize,
+    /// Degenerate triangles dropped.
+    pub degenerate_triangles: u64,
+}
+
+/// The JSON report of one compile.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Input path (or "demo").
+    pub input: String,
+    /// Output path.
+    pub output: String,
+    /// Output size.
+    pub bytes: u64,
+    /// Total wall time, ms.
+    pub total_ms: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Settings in effect.
+    pub settings: Vec<(String, String)>,
+    /// Per-stage timing and size, including `import` and `write`.
+    pub stages: Vec<StageReport>,
+    /// Counts.
+    pub counts: Counts,
+    /// Every warning.
+    pub warnings: Vec<String>,
+    /// Every file read.
+    pub inputs: Vec<String>,
+}
+
+/// Bakes and writes `loaded` to `output`; writes the report and depfile if asked.
+pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArgs) -> CliResult<Report> {
+    let start = Instant::now();
+    let threads =
+        out.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), usize::from);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CliError::io(format!("cannot start {threads} worker threads: {e}")))?;
+    let progress = Progress::new(!out.quiet);
+    let inputs = hash_inputs(&loaded.scene.inputs)?;
+    let baked =
+        pool.install(|| bake::bake(&loaded.scene, &loaded.settings, &loaded.plan, inputs, &progress))?;
+    progress.stage("write");
+    let t_write = Instant::now();
+    let bytes = bake::write(&baked, output).map_err(|e| CliError::io(e.to_string()))?;
+    progress.finish();
+    let mut stages = vec![StageReport {
+        stage: "import",
+        run: true,
+        reason: "read, validate and plan".into(),
+        ms: loaded.import_ms,
+        bytes: baked.manifest.inputs.iter().map(|i| i.bytes).sum(),
+    }];
+    stages.extend(baked.stages.iter().cloned());
+    stages.push(StageReport {
+        stage: "write",
+        run: true,
+        reason: "atomic write".into(),
+        ms: t_write.elapsed().as_secs_f64() * 1e3,
+        bytes,
+    });
+    let s = &loaded.scene;
+    let report = Report {
+        input: input_name.to_string(),
+        output: output.display().to_string(),
+        bytes,
+        total_ms: loaded.import_ms + start.elapsed().as_secs_f64() * 1e3,
+        threads,
+        settings: loaded.settings.pairs(),
+        stages,
+        counts: Counts {
+            triangles: s.triangles.len(),
+            vertices: s.vertices.len(),
+            materials: s.materials.len(),
+            textures: s.textures.len(),
+            lights: s.lights.len(),
+            cameras: s.cameras.len(),
+            bvh_nodes: baked
+                .sections
+                .iter()
+                .find(|x| x.kind == kiln_format::sections::BVH_NODES)
+                .map_or(0, |x| x.bytes.len() / 80),
+            degenerate_triangles: s.degenerate_triangles,
+        },
+        warnings: s.warnings.iter().map(|w| w.message.clone()).collect(),
+        inputs: s.inputs.iter().map(|p| p.display().to_string()).collect(),
+    };
+    if let Some(path) = &out.report {
+        let json = serde_json::to_string_pretty(&report).map_err(|e| CliError::io(e.to_string()))?;
+        std::fs::write(path, json + "\n").map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    }
+    if let Some(path) = &out.depfile {
+        std::fs::write(path, depfile(output, &s.inputs))
+            .map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    }
+    Ok(report)
+}
+
+/// A make/ninja depfile: `OUT: IN...`, spaces, `#` and `\` escaped with `\`, `$` as `$$`.
+pub fn depfile(output: &Path, inputs: &[PathBuf]) -> String {
+    let esc = |p: &Path| {
+        let mut s = String::new();
+        for c in p.display().to_string().chars() {
+            match c {
+                ' ' | '#' | '\\' => {
+                    s.push('\\');
+                    s.push(c);
+                }
+                '$' => s.push_str("$$"),
+                _ => s.push(c),
+            }
+        }
+        s
+    };
+    let mut out = format!("{}:", esc(output));
+    for i in inputs {
+        out.push_str(" \\\n  ");
+        out.push_str(&esc(i));
+    }
+    out.push('\n');
+    out
+}
