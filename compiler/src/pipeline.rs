@@ -62,12 +62,14 @@ pub fn finish(
     quiet: bool,
     start: Instant,
 ) -> CliResult<Loaded> {
-    validate::finish(&mut scene, source)?;
-    if !quiet || strict {
+    let valid = validate::finish(&mut scene, source);
+    // Warnings first, also when validation failed: they often explain the failure.
+    if !quiet || strict || valid.is_err() {
         for w in &scene.warnings {
             eprintln!("warning: {}", w.message);
         }
     }
+    valid?;
     if strict && !scene.warnings.is_empty() {
         return Err(CliError::input(format!("{} warnings and --strict is set", scene.warnings.len())));
     }

@@ -1,0 +1,105 @@
+//! The command line: demo, inspect, verify, plan, help and exit codes.
+
+mod util;
+
+use util::kiln;
+
+#[test]
+fn demo_inspect_verify() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = kiln(dir.path(), &["demo", "-o", "demo.kiln"]);
+    run.expect(0);
+    assert!(run.stdout.contains("wrote demo.kiln"), "{run:?}");
+    let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
+    run.expect(0);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
+    assert_eq!(j["format_version"], "1.0");
+    let kinds: Vec<&str> =
+        j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
+    assert_eq!(kinds, ["MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV"]);
+    assert!(j["sections"].as_array().unwrap().iter().all(|s| s["checksum_ok"] == true));
+    assert_eq!(j["summary"]["triangles"], 30);
+    assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");
+    let skipped: Vec<&str> =
+        j["manifest"]["skipped"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
+    assert_eq!(skipped, ["uvs", "textures"]);
+    let run = kiln(dir.path(), &["verify", "demo.kiln", "--rays", "20000", "--json"]);
+    run.expect(0);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(j["ok"], true);
+    assert_eq!(j["bvh"]["mismatches"], 0);
+    assert_eq!(j["bvh"]["rays"], 20000);
+    assert!(j["bvh"]["hits"].as_u64().unwrap() > 15000);
+}
+
+#[test]
+fn verify_reports_what_and_where() {
+    let dir = tempfile::tempdir().unwrap();
+    kiln(dir.path(), &["demo", "-o", "d.kiln"]).expect(0);
+    let path = dir.path().join("d.kiln");
+    let mut bytes = std::fs::read(&path).unwrap();
+    let last = bytes.len() - 10;
+    bytes[last] ^= 0x40;
+    std::fs::write(&path, &bytes).unwrap();
+    let run = kiln(dir.path(), &["verify", "d.kiln"]);
+    run.expect(1).says("CWBV").says("checksum mismatch").says("offset 0x");
+    assert_eq!(run.stderr.lines().count(), 1, "one line: {run:?}");
+    let run = kiln(dir.path(), &["verify", "d.kiln", "--json"]);
+    run.expect(1);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(j["ok"], false);
+    assert!(j["error"].as_str().unwrap().contains("checksum"));
+}
+
+#[test]
+fn exit_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    kiln(dir.path(), &["inspect", "missing.kiln"]).expect(4);
+    kiln(dir.path(), &["inspect", "."]).expect(4).says("not a regular file");
+    kiln(dir.path(), &["frobnicate"]).expect(2);
+    kiln(dir.path(), &["compile"]).expect(2);
+    kiln(dir.path(), &["compile", "x.obj", "--threads", "0"]).expect(2);
+    std::fs::write(dir.path().join("scene.fbx"), b"x").unwrap();
+    kiln(dir.path(), &["compile", "scene.fbx"]).expect(3).says("unsupported input format");
+    std::fs::write(dir.path().join("notes.kiln"), b"hello\n").unwrap();
+    kiln(dir.path(), &["verify", "notes.kiln"]).expect(1).says("looks like text");
+    // Another major version: unsupported (3), naming both versions.
+    kiln(dir.path(), &["demo", "-o", "d.kiln", "-q"]).expect(0);
+    let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
+    b[8] = 9;
+    std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.0").says("1.x");
+}
+
+#[test]
+fn help_explains_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = kiln(dir.path(), &["--help"]);
+    for cmd in ["compile", "plan", "demo", "inspect", "verify", "Exit codes"] {
+        assert!(run.stdout.contains(cmd), "--help lacks {cmd}");
+    }
+    let run = kiln(dir.path(), &["compile", "--help"]);
+    for flag in [
+        "--config",
+        "--bvh-preset",
+        "--report",
+        "--depfile",
+        "--threads",
+        "--strict",
+        "fast",
+        "medium",
+        "slow",
+    ] {
+        assert!(run.stdout.contains(flag), "compile --help lacks {flag}");
+    }
+}
+
+#[test]
+fn demo_is_deterministic_across_thread_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    kiln(dir.path(), &["demo", "-o", "a.kiln", "--threads", "1", "-q"]).expect(0);
+    kiln(dir.path(), &["demo", "-o", "b.kiln", "--threads", "2", "-q"]).expect(0);
+    let a = std::fs::read(dir.path().join("a.kiln")).unwrap();
+    let b = std::fs::read(dir.path().join("b.kiln")).unwrap();
+    assert!(a == b, "demo output differs between 1 and 2 threads");
+}

@@ -1,0 +1,218 @@
+//! Import semantics: transforms, winding, primitive modes, sparse accessors, normals, GLB and
+//! data URIs, lights and cameras, OBJ/MTL rules, texture colour spaces and mip chains.
+
+mod util;
+
+use base64::Engine;
+use glam::Vec3;
+use kiln_compiler::import::import;
+use kiln_compiler::ir::{Scene, TextureRole};
+use kiln_format::manifest::LightKind;
+use kiln_format::sections::MaterialFlags;
+use serde_json::json;
+use util::Gltf;
+
+fn corners(s: &Scene, t: usize) -> [Vec3; 3] {
+    s.triangles[t].map(|i| Vec3::from(s.vertices[i as usize].position))
+}
+
+fn geometric_normal(s: &Scene, t: usize) -> Vec3 {
+    let c = corners(s, t);
+    (c[1] - c[0]).cross(c[2] - c[0]).normalize()
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-5
+}
+
+#[test]
+fn node_hierarchy_composes_transforms() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    g.json["nodes"] = json!([
+        {"translation": [10.0, 0.0, 0.0], "children": [1]},
+        {"mesh": 0, "scale": [2.0, 2.0, 2.0], "rotation": [0.0, 0.0, 0.7071068, 0.7071068]}
+    ]);
+    let s = import(&g.write(d.path(), "h")).unwrap();
+    // Corner (1, 0, 0): scaled to (2, 0, 0), rotated 90° about z to (0, 2, 0), moved to (10, 2, 0).
+    assert!(close(Vec3::from(s.vertices[1].position), Vec3::new(10.0, 2.0, 0.0)), "{:?}", s.vertices[1]);
+}
+
+#[test]
+fn mirroring_flips_winding() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    g.json["nodes"] = json!([{"mesh": 0}, {"mesh": 0, "scale": [-1.0, 1.0, 1.0]}]);
+    g.json["scenes"][0]["nodes"] = json!([0, 1]);
+    let s = import(&g.write(d.path(), "m")).unwrap();
+    assert_eq!(s.triangles.len(), 4);
+    for t in 0..4 {
+        // The front face keeps facing +z, mirrored or not.
+        assert!(close(geometric_normal(&s, t), Vec3::Z), "triangle {t}: {:?}", geometric_normal(&s, t));
+        assert!(close(Vec3::from(s.vertices[s.triangles[t][0] as usize].normal), Vec3::Z));
+    }
+}
+
+#[test]
+fn strips_and_fans() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::new();
+    let p =
+        g.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 2.0, 0.0]]);
+    g.json["meshes"] = json!([{"primitives": [{"attributes": {"POSITION": p}, "mode": 5}, {"attributes": {"POSITION": p}, "mode": 6}]}]);
+    let s = import(&g.write(d.path(), "sf")).unwrap();
+    assert_eq!(&s.triangles[..3], &[[0, 1, 2], [2, 1, 3], [2, 3, 4]]);
+    assert_eq!(&s.triangles[3..], &[[6, 7, 5], [7, 8, 5], [8, 9, 5]]);
+    for t in 0..3 {
+        assert!(close(geometric_normal(&s, t), Vec3::Z), "strip triangle {t} winding");
+    }
+}
+
+#[test]
+fn sparse_accessor_overrides_values() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    let idx = g.view(&2u16.to_le_bytes(), None);
+    let vals: Vec<u8> = [5.0f32, 6.0, 7.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+    let val = g.view(&vals, None);
+    g.json["accessors"][0]["sparse"] = json!({"count": 1, "indices": {"bufferView": idx, "componentType": 5123}, "values": {"bufferView": val}});
+    let s = import(&g.write(d.path(), "sp")).unwrap();
+    assert_eq!(s.vertices[2].position, [5.0, 6.0, 7.0]);
+    assert_eq!(s.vertices[1].position, [1.0, 0.0, 0.0]);
+}
+
+#[test]
+fn generated_normals_are_angle_weighted() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::new();
+    // Vertex 0 is shared by a triangle in z = 0 (corner angle 90°) and one in x = 0 (45°).
+    let p =
+        g.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, -1.0]]);
+    let i = g.indices(&[0, 1, 2, 0, 2, 4, 0, 4, 3]);
+    g.mesh(json!({"attributes": {"POSITION": p}, "indices": i}));
+    let s = import(&g.write(d.path(), "n")).unwrap();
+    // Face normals: +z (angle 90° at v0), -x (two triangles, 45° each).
+    let expected = (Vec3::Z * 90f32.to_radians() + Vec3::NEG_X * 90f32.to_radians()).normalize();
+    assert!(close(Vec3::from(s.vertices[0].normal), expected), "{:?}", s.vertices[0].normal);
+}
+
+#[test]
+fn glb_and_data_uri_give_the_same_scene_as_gltf() {
+    let d = tempfile::tempdir().unwrap();
+    let a = import(&Gltf::quad().write(d.path(), "a")).unwrap();
+    let b = import(&Gltf::quad().write_glb(d.path(), "b")).unwrap();
+    let mut g = Gltf::quad();
+    let f = g.write(d.path(), "c");
+    let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(&f).unwrap()).unwrap();
+    let b64 = base64::engine::general_purpose::STANDARD.encode(&g.bin);
+    j["buffers"][0]["uri"] = format!("data:application/octet-stream;base64,{b64}").into();
+    std::fs::write(&f, serde_json::to_vec(&j).unwrap()).unwrap();
+    let c = import(&f).unwrap();
+    for s in [&b, &c] {
+        assert_eq!(s.vertices, a.vertices);
+        assert_eq!(s.triangles, a.triangles);
+    }
+    assert_eq!(c.inputs.len(), 1, "a data URI reads no file");
+}
+
+#[test]
+fn lights_cameras_and_emissive_strength() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    g.json["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_emissive_strength"]);
+    g.json["extensions"] = json!({"KHR_lights_punctual": {"lights": [
+        {"type": "spot", "intensity": 30.0, "color": [1.0, 0.5, 0.25], "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.5}},
+        {"type": "directional", "intensity": 3.0}
+    ]}});
+    g.json["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]);
+    g.json["nodes"] = json!([
+        {"mesh": 0},
+        {"translation": [0.0, 5.0, 0.0], "rotation": [-0.7071068, 0.0, 0.0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        {"extensions": {"KHR_lights_punctual": {"light": 1}}},
+        {"translation": [0.0, 0.0, 4.0], "camera": 0}
+    ]);
+    g.json["scenes"][0]["nodes"] = json!([0, 1, 2, 3]);
+    g.json["materials"] = json!([{"emissiveFactor": [1.0, 0.5, 0.0], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}}}]);
+    g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
+    let s = import(&g.write(d.path(), "l")).unwrap();
+    assert_eq!(s.lights.len(), 2);
+    let spot = &s.lights[0];
+    assert!(
+        matches!(spot.kind, LightKind::Spot { inner_cone, outer_cone } if inner_cone == 0.2 && outer_cone == 0.5)
+    );
+    assert!(close(Vec3::from(spot.position), Vec3::new(0.0, 5.0, 0.0)));
+    // -z rotated by -90° about x points down.
+    assert!(close(Vec3::from(spot.direction), Vec3::NEG_Y), "{:?}", spot.direction);
+    assert_eq!((spot.intensity, spot.color), (30.0, [1.0, 0.5, 0.25]));
+    assert!(matches!(s.lights[1].kind, LightKind::Directional));
+    assert!(close(Vec3::from(s.lights[1].direction), Vec3::NEG_Z));
+    let cam = &s.cameras[0];
+    assert!(close(Vec3::from(cam.position), Vec3::new(0.0, 0.0, 4.0)));
+    assert!(close(Vec3::from(cam.target), Vec3::new(0.0, 0.0, 3.0)));
+    assert!((cam.vfov_degrees - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(s.materials[0].gpu.emission, [4.0, 2.0, 0.0]);
+}
+
+#[test]
+fn obj_mtl_rule() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("m.mtl"),
+        "newmtl matte\nKd 0.5 0.25 0.125\nKs 0 0 0\n\nnewmtl shiny\nKd 0.8 0.8 0.8\nKs 0.5 0.5 0.5\nNs 98\n\nnewmtl lamp\nKd 0 0 0\nKe 10 9 8\n",
+    )
+    .unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+               o a\nusemtl matte\nf 1/1 2/2 3/3 4/4\no b\nusemtl shiny\nf -4 -3 -2\nusemtl lamp\nf 1 3 4\n";
+    std::fs::write(d.path().join("s.obj"), obj).unwrap();
+    let s = import(&d.path().join("s.obj")).unwrap();
+    let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
+    let matte = m("matte");
+    assert_eq!(matte.flags & MaterialFlags::DIFFUSE_ONLY, MaterialFlags::DIFFUSE_ONLY);
+    assert_eq!(&matte.base_color[..3], &[0.5, 0.25, 0.125]);
+    assert_eq!(matte.metallic, 0.0);
+    let shiny = m("shiny");
+    assert_eq!(shiny.flags & MaterialFlags::DIFFUSE_ONLY, 0);
+    assert!((shiny.roughness - (2.0f32 / 100.0).powf(0.25)).abs() < 1e-6);
+    assert_eq!(m("lamp").emission, [10.0, 9.0, 8.0]);
+    // The quad became two triangles, the negative-index face one.
+    assert_eq!(s.triangles.len(), 4);
+    assert!(s.inputs.iter().any(|p| p.ends_with("m.mtl")));
+    // OBJ v runs up; kiln's v runs down.
+    let top = s.vertices.iter().position(|v| v.position == [1.0, 1.0, 0.0]).unwrap();
+    assert_eq!(s.uvs[top], [1.0, 0.0]);
+}
+
+#[test]
+fn texture_roles_and_mip_chain_filtering() {
+    let d = tempfile::tempdir().unwrap();
+    // A 2x2 image: black and white texels; its 1x1 mip is their average in linear light.
+    let mut png = Vec::new();
+    let img = image::RgbaImage::from_raw(
+        2,
+        2,
+        vec![0, 0, 0, 255, 255, 255, 255, 255, 0, 0, 0, 255, 255, 255, 255, 255],
+    )
+    .unwrap();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+    std::fs::write(d.path().join("bw.png"), &png).unwrap();
+    let mut g = Gltf::quad();
+    let tc: Vec<u8> = [[0.0f32, 0.0]; 4].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let v = g.view(&tc, None);
+    let a = g.accessor(Some(v), 5126, 4, "VEC2", json!({}));
+    g.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = a.into();
+    g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
+    g.json["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}}}]);
+    g.json["textures"] = json!([{"source": 0}]);
+    g.json["images"] = json!([{"uri": "bw.png"}]);
+    let s = import(&g.write(d.path(), "tex")).unwrap();
+    // One image used in two roles gives two textures (sRGB and linear).
+    assert_eq!(s.textures.len(), 2);
+    let color = s.textures.iter().find(|t| t.role == TextureRole::Color).unwrap();
+    let data = s.textures.iter().find(|t| t.role == TextureRole::Data).unwrap();
+    let chain = kiln_compiler::bake::textures::mip_chain(color);
+    assert_eq!(chain.len(), (4 + 1) * 4);
+    // Linear average 0.5 → sRGB 0.7354 → 188.
+    assert_eq!(&chain[16..20], &[188, 188, 188, 255]);
+    let chain = kiln_compiler::bake::textures::mip_chain(data);
+    assert_eq!(&chain[16..20], &[128, 128, 128, 255]);
+}

@@ -1,0 +1,105 @@
+//! The real scenes in ../shared/scenes: compile with the shipped sidecars, verify with 10⁵
+//! rays, determinism across thread counts, depfile and report contents.
+
+mod util;
+
+use util::{kiln, shared_scene, sidecar};
+
+fn compile_scene(name: &str, dir: &std::path::Path, threads: &str) -> Option<std::path::PathBuf> {
+    let input = shared_scene(name)?;
+    let out = dir.join(format!("{name}-{threads}.kiln"));
+    let side = sidecar(name);
+    kiln(
+        dir,
+        &[
+            "compile",
+            input.to_str()?,
+            "--config",
+            side.to_str()?,
+            "-o",
+            out.to_str()?,
+            "--threads",
+            threads,
+            "--report",
+            &format!("{name}-{threads}.json"),
+            "--depfile",
+            &format!("{name}-{threads}.d"),
+        ],
+    )
+    .expect(0);
+    Some(out)
+}
+
+fn check_scene(name: &str, triangles: u64, textures: u64) {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(one) = compile_scene(name, dir.path(), "1") else { return };
+    let two = compile_scene(name, dir.path(), "2").unwrap();
+    assert!(
+        std::fs::read(&one).unwrap() == std::fs::read(&two).unwrap(),
+        "{name}: output differs between 1 and 2 threads"
+    );
+
+    let run = kiln(dir.path(), &["verify", one.to_str().unwrap(), "--rays", "100000", "--json"]);
+    run.expect(0);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(j["bvh"]["mismatches"], 0, "{name}: {}", j["bvh"]);
+    assert_eq!(j["bvh"]["rays"], 100000);
+
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join(format!("{name}-1.json"))).unwrap()).unwrap();
+    assert_eq!(report["counts"]["triangles"], triangles);
+    assert_eq!(report["counts"]["textures"], textures);
+    assert_eq!(report["threads"], 1);
+    let stages: Vec<&str> =
+        report["stages"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
+    assert_eq!(stages, ["import", "geometry", "uvs", "materials", "textures", "bvh", "write"]);
+    for s in report["stages"].as_array().unwrap() {
+        assert!(s["ms"].as_f64().unwrap() >= 0.0);
+        assert!(!s["reason"].as_str().unwrap().is_empty());
+        if s["run"] == false {
+            assert_eq!(s["bytes"], 0);
+        }
+    }
+    assert_eq!(report["bytes"], std::fs::metadata(&one).unwrap().len());
+
+    let dep = std::fs::read_to_string(dir.path().join(format!("{name}-1.d"))).unwrap();
+    let (target, deps) = dep.split_once(':').unwrap();
+    assert_eq!(target, one.to_str().unwrap());
+    let listed: Vec<&str> = deps.split_whitespace().filter(|w| *w != "\\").collect();
+    let input = shared_scene(name).unwrap();
+    let folder = input.parent().unwrap();
+    assert!(listed.contains(&input.to_str().unwrap()), "{dep}");
+    assert!(listed.contains(&sidecar(name).to_str().unwrap()), "{dep}");
+    assert!(listed.contains(&folder.join("scene.bin").to_str().unwrap()), "{dep}");
+    let pngs = listed.iter().filter(|p| p.ends_with(".png")).count() as u64;
+    assert_eq!(pngs, textures, "{dep}");
+}
+
+#[test]
+fn cornell_box() {
+    check_scene("cornell_box", 32, 0);
+}
+
+#[test]
+fn pica_pica() {
+    check_scene("pica_pica", 76_274, 6);
+}
+
+#[test]
+fn plan_names_every_stage() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(input) = shared_scene("cornell_box") else { return };
+    let run = kiln(
+        dir.path(),
+        &["plan", input.to_str().unwrap(), "--json", "--config", sidecar("cornell_box").to_str().unwrap()],
+    );
+    run.expect(0);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let stages = j["stages"].as_array().unwrap();
+    let find = |n: &str| stages.iter().find(|s| s["stage"] == n).unwrap().clone();
+    assert_eq!(find("textures")["run"], false);
+    assert_eq!(find("textures")["reason"], "the scene has no textures");
+    assert_eq!(find("uvs")["reason"], "no material samples a texture");
+    assert_eq!(find("bvh")["run"], true);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "plan wrote files");
+}

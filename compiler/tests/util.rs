@@ -1,0 +1,190 @@
+//! Helpers for CLI tests: run `kiln` in a fresh directory, build small glTF and OBJ files.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The outcome of one `kiln` run.
+#[derive(Debug)]
+pub struct Run {
+    pub code: i32,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+impl Run {
+    /// Asserts the exit code and that nothing panicked.
+    pub fn expect(&self, code: i32) -> &Self {
+        assert!(!self.stderr.contains("panicked") && self.code != 70, "kiln panicked: {self:#?}");
+        assert_eq!(self.code, code, "unexpected exit code: {self:#?}");
+        self
+    }
+    /// Asserts that stderr mentions `text`.
+    pub fn says(&self, text: &str) -> &Self {
+        assert!(self.stderr.contains(text), "stderr lacks {text:?}: {self:#?}");
+        self
+    }
+}
+
+/// Runs `kiln` with `args` in `dir`.
+pub fn kiln(dir: &Path, args: &[&str]) -> Run {
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_kiln")).args(args).current_dir(dir).output().expect("kiln runs");
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// The shared scenes folder, or `None` (the caller skips with a message).
+pub fn shared_scene(name: &str) -> Option<PathBuf> {
+    let p =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes").join(name).join("scene.gltf");
+    if p.is_file() {
+        Some(p)
+    } else {
+        eprintln!("skipped: {} is absent (the shared scenes live beside the checkout)", p.display());
+        None
+    }
+}
+
+/// The sidecar the tests ship for a shared scene.
+pub fn sidecar(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/scenes").join(format!("{name}.toml"))
+}
+
+/// A glTF document builder: one buffer (written as `scene.bin` or a data URI), accessors
+/// appended as needed.
+pub struct Gltf {
+    pub json: serde_json::Value,
+    pub bin: Vec<u8>,
+}
+
+impl Gltf {
+    /// A scene with one node pointing at mesh 0 (meshes added by the caller).
+    pub fn new() -> Gltf {
+        Gltf {
+            json: serde_json::json!({
+                "asset": {"version": "2.0"},
+                "scene": 0,
+                "scenes": [{"nodes": [0]}],
+                "nodes": [{"mesh": 0}],
+                "meshes": [],
+                "accessors": [],
+                "bufferViews": [],
+                "buffers": [],
+            }),
+            bin: Vec::new(),
+        }
+    }
+
+    /// Appends raw bytes as a buffer view; returns its index.
+    pub fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut v = serde_json::json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(s) = stride {
+            v["byteStride"] = s.into();
+        }
+        self.bin.extend_from_slice(bytes);
+        let views = self.json["bufferViews"].as_array_mut().unwrap();
+        views.push(v);
+        views.len() - 1
+    }
+
+    /// Adds an accessor; returns its index.
+    pub fn accessor(
+        &mut self,
+        view: Option<usize>,
+        component: u32,
+        count: usize,
+        ty: &str,
+        extra: serde_json::Value,
+    ) -> usize {
+        let mut a = serde_json::json!({"componentType": component, "count": count, "type": ty});
+        if let Some(v) = view {
+            a["bufferView"] = v.into();
+        }
+        if let Some(o) = extra.as_object() {
+            for (k, v) in o {
+                a[k] = v.clone();
+            }
+        }
+        let acc = self.json["accessors"].as_array_mut().unwrap();
+        acc.push(a);
+        acc.len() - 1
+    }
+
+    /// Adds a float VEC3 position accessor with min/max.
+    pub fn positions(&mut self, p: &[[f32; 3]]) -> usize {
+        let bytes: Vec<u8> = p.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let v = self.view(&bytes, None);
+        let finite: Vec<[f32; 3]> = p.iter().copied().filter(|q| q.iter().all(|c| c.is_finite())).collect();
+        let lo: Vec<f32> =
+            (0..3).map(|a| finite.iter().map(|q| q[a]).fold(f32::INFINITY, f32::min)).collect();
+        let hi: Vec<f32> =
+            (0..3).map(|a| finite.iter().map(|q| q[a]).fold(f32::NEG_INFINITY, f32::max)).collect();
+        self.accessor(Some(v), 5126, p.len(), "VEC3", serde_json::json!({"min": lo, "max": hi}))
+    }
+
+    /// Adds u32 indices.
+    pub fn indices(&mut self, idx: &[u32]) -> usize {
+        let bytes: Vec<u8> = idx.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let v = self.view(&bytes, None);
+        self.accessor(Some(v), 5125, idx.len(), "SCALAR", serde_json::json!({}))
+    }
+
+    /// Adds a mesh with one primitive.
+    pub fn mesh(&mut self, primitive: serde_json::Value) {
+        self.json["meshes"].as_array_mut().unwrap().push(serde_json::json!({"primitives": [primitive]}));
+    }
+
+    /// A one-quad scene (two triangles).
+    pub fn quad() -> Gltf {
+        let mut g = Gltf::new();
+        let p = g.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]);
+        let i = g.indices(&[0, 1, 2, 0, 2, 3]);
+        g.mesh(serde_json::json!({"attributes": {"POSITION": p}, "indices": i}));
+        g
+    }
+
+    /// Writes `name.gltf` and `name.bin` into `dir`; returns the .gltf path.
+    pub fn write(&mut self, dir: &Path, name: &str) -> PathBuf {
+        self.json["buffers"] =
+            serde_json::json!([{"uri": format!("{name}.bin"), "byteLength": self.bin.len()}]);
+        std::fs::write(dir.join(format!("{name}.bin")), &self.bin).unwrap();
+        let path = dir.join(format!("{name}.gltf"));
+        std::fs::write(&path, serde_json::to_vec_pretty(&self.json).unwrap()).unwrap();
+        path
+    }
+
+    /// Writes a `.glb` with the buffer in its binary chunk.
+    pub fn write_glb(&mut self, dir: &Path, name: &str) -> PathBuf {
+        self.json["buffers"] = serde_json::json!([{"byteLength": self.bin.len()}]);
+        let mut json = serde_json::to_vec(&self.json).unwrap();
+        while !json.len().is_multiple_of(4) {
+            json.push(b' ');
+        }
+        let mut bin = self.bin.clone();
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        let total = 12 + 8 + json.len() + 8 + bin.len();
+        let mut out = Vec::new();
+        out.extend_from_slice(b"glTF");
+        out.extend_from_slice(&2u32.to_le_bytes());
+        out.extend_from_slice(&(total as u32).to_le_bytes());
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"JSON");
+        out.extend_from_slice(&json);
+        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&bin);
+        let path = dir.join(format!("{name}.glb"));
+        std::fs::write(&path, out).unwrap();
+        path
+    }
+}
