@@ -12,6 +12,9 @@ use kiln_format::sections::MaterialFlags;
 use serde_json::json;
 use util::Gltf;
 
+/// cos 45° = sin 45°, for quaternions of 90° turns.
+const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
 fn corners(s: &Scene, t: usize) -> [Vec3; 3] {
     s.triangles[t].map(|i| Vec3::from(s.vertices[i as usize].position))
 }
@@ -31,7 +34,7 @@ fn node_hierarchy_composes_transforms() {
     let mut g = Gltf::quad();
     g.json["nodes"] = json!([
         {"translation": [10.0, 0.0, 0.0], "children": [1]},
-        {"mesh": 0, "scale": [2.0, 2.0, 2.0], "rotation": [0.0, 0.0, 0.7071068, 0.7071068]}
+        {"mesh": 0, "scale": [2.0, 2.0, 2.0], "rotation": [0.0, 0.0, H, H]}
     ]);
     let s = import(&g.write(d.path(), "h")).unwrap();
     // Corner (1, 0, 0): scaled to (2, 0, 0), rotated 90° about z to (0, 2, 0), moved to (10, 2, 0).
@@ -127,7 +130,7 @@ fn lights_cameras_and_emissive_strength() {
     g.json["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]);
     g.json["nodes"] = json!([
         {"mesh": 0},
-        {"translation": [0.0, 5.0, 0.0], "rotation": [-0.7071068, 0.0, 0.0, 0.7071068], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        {"translation": [0.0, 5.0, 0.0], "rotation": [-H, 0.0, 0.0, H], "extensions": {"KHR_lights_punctual": {"light": 0}}},
         {"extensions": {"KHR_lights_punctual": {"light": 1}}},
         {"translation": [0.0, 0.0, 4.0], "camera": 0}
     ]);
