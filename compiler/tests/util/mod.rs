@@ -57,9 +57,16 @@ pub fn sidecar(name: &str) -> PathBuf {
 
 /// A glTF document builder: one buffer (written as `scene.bin` or a data URI), accessors
 /// appended as needed.
+#[derive(Debug)]
 pub struct Gltf {
     pub json: serde_json::Value,
     pub bin: Vec<u8>,
+}
+
+impl Default for Gltf {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 impl Gltf {
