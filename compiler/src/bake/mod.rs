@@ -215,12 +215,21 @@ pub fn bake(
     Ok(Baked { manifest, manifest_hash, sections, stages })
 }
 
-/// Writes the baked file atomically; returns its size.
-pub fn write(baked: &Baked, path: &std::path::Path) -> Result<u64, kiln_format::WriteError> {
+fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::WriteError> {
     let mut w = kiln_format::FileWriter::new();
     w.manifest(&baked.manifest, baked.manifest_hash)?;
     for s in &baked.sections {
         w.bytes(s.kind, s.index, s.bytes.as_slice(), s.hash)?;
     }
-    w.write_atomic(path)
+    Ok(w)
+}
+
+/// Writes the baked file atomically; returns its size.
+pub fn write(baked: &Baked, path: &std::path::Path) -> Result<u64, kiln_format::WriteError> {
+    writer(baked)?.write_atomic(path)
+}
+
+/// The baked file in memory.
+pub fn to_bytes(baked: &Baked) -> Result<Vec<u8>, kiln_format::WriteError> {
+    writer(baked)?.to_bytes()
 }
