@@ -74,9 +74,7 @@ fn bad_data_uri() {
     let d = tempfile::tempdir().unwrap();
     let mut g = Gltf::quad();
     let f = g.write(d.path(), "u");
-    let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(&f).unwrap()).unwrap();
-    j["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@not base64@@".into();
-    std::fs::write(&f, serde_json::to_vec(&j).unwrap()).unwrap();
+    Gltf::set_buffer_uri(&f, "data:application/octet-stream;base64,@@not base64@@");
     compile(d.path(), &f, &[]).expect(1).says("malformed base64");
 }
 
@@ -84,18 +82,7 @@ fn bad_data_uri() {
 fn missing_image_warns_and_strict_refuses() {
     let d = tempfile::tempdir().unwrap();
     let f = quad_with(d.path(), "img", |g| {
-        let tc: Vec<u8> = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
-            .iter()
-            .flatten()
-            .flat_map(|v| v.to_le_bytes())
-            .collect();
-        let v = g.view(&tc, None);
-        let a = g.accessor(Some(v), 5126, 4, "VEC2", json!({}));
-        g.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = a.into();
-        g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
-        g.json["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]);
-        g.json["textures"] = json!([{"source": 0}]);
-        g.json["images"] = json!([{"uri": "nowhere.png"}]);
+        g.textured(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}), "nowhere.png")
     });
     let run = compile(d.path(), &f, &[]);
     run.expect(0).says("warning:").says("image 'nowhere.png': cannot read").says("placeholder");
@@ -107,16 +94,7 @@ fn missing_image_warns_and_strict_refuses() {
 fn undecodable_image_warns() {
     let d = tempfile::tempdir().unwrap();
     std::fs::write(d.path().join("junk.png"), b"\x89PNG\r\n\x1a\nthis is not a png").unwrap();
-    let f = quad_with(d.path(), "junk", |g| {
-        let tc: Vec<u8> = [[0.0f32, 0.0]; 4].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-        let v = g.view(&tc, None);
-        let a = g.accessor(Some(v), 5126, 4, "VEC2", json!({}));
-        g.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = a.into();
-        g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
-        g.json["materials"] = json!([{"normalTexture": {"index": 0}}]);
-        g.json["textures"] = json!([{"source": 0}]);
-        g.json["images"] = json!([{"uri": "junk.png"}]);
-    });
+    let f = quad_with(d.path(), "junk", |g| g.textured(json!({"normalTexture": {"index": 0}}), "junk.png"));
     compile(d.path(), &f, &[]).expect(0).says("image 'junk.png': cannot decode");
 }
 
@@ -214,9 +192,7 @@ fn external_url() {
     let d = tempfile::tempdir().unwrap();
     let mut g = Gltf::quad();
     let f = g.write(d.path(), "url");
-    let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(&f).unwrap()).unwrap();
-    j["buffers"][0]["uri"] = "https://example.com/scene.bin".into();
-    std::fs::write(&f, serde_json::to_vec(&j).unwrap()).unwrap();
+    Gltf::set_buffer_uri(&f, "https://example.com/scene.bin");
     compile(d.path(), &f, &[]).expect(1).says("external URLs are not fetched");
 }
 

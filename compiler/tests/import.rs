@@ -106,10 +106,8 @@ fn glb_and_data_uri_give_the_same_scene_as_gltf() {
     let b = import(&Gltf::quad().write_glb(d.path(), "b")).unwrap();
     let mut g = Gltf::quad();
     let f = g.write(d.path(), "c");
-    let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(&f).unwrap()).unwrap();
     let b64 = base64::engine::general_purpose::STANDARD.encode(&g.bin);
-    j["buffers"][0]["uri"] = format!("data:application/octet-stream;base64,{b64}").into();
-    std::fs::write(&f, serde_json::to_vec(&j).unwrap()).unwrap();
+    Gltf::set_buffer_uri(&f, &format!("data:application/octet-stream;base64,{b64}"));
     let c = import(&f).unwrap();
     for s in [&b, &c] {
         assert_eq!(s.vertices, a.vertices);
@@ -199,14 +197,10 @@ fn texture_roles_and_mip_chain_filtering() {
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
     std::fs::write(d.path().join("bw.png"), &png).unwrap();
     let mut g = Gltf::quad();
-    let tc: Vec<u8> = [[0.0f32, 0.0]; 4].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-    let v = g.view(&tc, None);
-    let a = g.accessor(Some(v), 5126, 4, "VEC2", json!({}));
-    g.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = a.into();
-    g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
-    g.json["materials"] = json!([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}}}]);
-    g.json["textures"] = json!([{"source": 0}]);
-    g.json["images"] = json!([{"uri": "bw.png"}]);
+    g.textured(
+        json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicRoughnessTexture": {"index": 0}}}),
+        "bw.png",
+    );
     let s = import(&g.write(d.path(), "tex")).unwrap();
     // One image used in two roles gives two textures (sRGB and linear).
     assert_eq!(s.textures.len(), 2);

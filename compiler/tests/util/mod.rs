@@ -149,6 +149,31 @@ impl Gltf {
         self.json["meshes"].as_array_mut().unwrap().push(serde_json::json!({"primitives": [primitive]}));
     }
 
+    /// Gives mesh 0's first primitive texture coordinates and material 0 (`material`, whose
+    /// textures all use texture 0 showing the image at `uri`).
+    pub fn textured(&mut self, material: serde_json::Value, uri: &str) {
+        let tc: Vec<u8> = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let v = self.view(&tc, None);
+        let a = self.accessor(Some(v), 5126, 4, "VEC2", serde_json::json!({}));
+        let prim = &mut self.json["meshes"][0]["primitives"][0];
+        prim["attributes"]["TEXCOORD_0"] = a.into();
+        prim["material"] = 0.into();
+        self.json["materials"] = serde_json::json!([material]);
+        self.json["textures"] = serde_json::json!([{"source": 0}]);
+        self.json["images"] = serde_json::json!([{ "uri": uri }]);
+    }
+
+    /// Rewrites the buffer URI of a written `.gltf`.
+    pub fn set_buffer_uri(path: &Path, uri: &str) {
+        let mut j: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+        j["buffers"][0]["uri"] = uri.into();
+        std::fs::write(path, serde_json::to_vec(&j).unwrap()).unwrap();
+    }
+
     /// A one-quad scene (two triangles).
     pub fn quad() -> Gltf {
         let mut g = Gltf::new();
