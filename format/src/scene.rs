@@ -26,8 +26,8 @@ pub struct SceneView<'a> {
     pub materials: &'a [GpuMaterial],
     /// BVH nodes (empty if the file has no BVH).
     pub bvh: &'a [CwbvhNode],
-    /// Texel data per texture (RGBA8, mip chain), indexed like `manifest.textures`.
-    pub textures: Vec<&'a [u8]>,
+    /// The file, for sections read on demand (textures).
+    file: &'a KilnFile,
 }
 
 fn finite(v: &[f32]) -> bool {
@@ -44,7 +44,8 @@ impl<'a> SceneView<'a> {
         let triangle_materials: &[u32] = file.pod(TRIANGLE_MATERIALS, 0)?.unwrap_or(&[]);
         let materials: &[GpuMaterial] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
         let bvh: &[CwbvhNode] = file.pod(BVH_NODES, 0)?.unwrap_or(&[]);
-        let mut textures = Vec::with_capacity(manifest.textures.len().min(file.sections().len()));
+        // Texture sizes are checked here from the table; their bytes (the bulk of most files)
+        // are checksummed when first read, through `texture`.
         for (i, info) in manifest.textures.iter().enumerate() {
             let s = file.find(TEXTURE, i as u32).ok_or_else(|| {
                 FormatError::invalid(format!(
@@ -65,7 +66,6 @@ impl<'a> SceneView<'a> {
                 ))
                 .in_section(s.position, TEXTURE, i as u32));
             }
-            textures.push(file.pod::<u32>(TEXTURE, i as u32)?.map(bytemuck::cast_slice).unwrap_or(&[]));
         }
         if file.all_of(TEXTURE).len() != manifest.textures.len() {
             return Err(FormatError::invalid(format!(
@@ -74,13 +74,23 @@ impl<'a> SceneView<'a> {
                 manifest.textures.len()
             )));
         }
-        let view =
-            SceneView { manifest, vertices, uvs, triangles, triangle_materials, materials, bvh, textures };
+        let view = SceneView { manifest, vertices, uvs, triangles, triangle_materials, materials, bvh, file };
         view.check_geometry()?;
         view.check_materials()?;
         view.check_manifest()?;
         view.check_bvh()?;
         Ok(view)
+    }
+
+    /// Texels of texture `i` (RGBA8 mip chain, level 0 first), checksummed on first access.
+    pub fn texture(&self, i: usize) -> Result<&'a [u8]> {
+        let bytes: &'a [u32] = self.file.pod(TEXTURE, i as u32)?.ok_or_else(|| {
+            FormatError::invalid(format!(
+                "texture {i} does not exist ({} textures)",
+                self.manifest.textures.len()
+            ))
+        })?;
+        Ok(bytemuck::cast_slice(bytes))
     }
 
     fn check_geometry(&self) -> Result<()> {
@@ -137,7 +147,7 @@ impl<'a> SceneView<'a> {
                 self.manifest.materials.len()
             )));
         }
-        let nt = self.textures.len() as u64;
+        let nt = self.manifest.textures.len() as u64;
         for (i, m) in self.materials.iter().enumerate() {
             let scalars = [m.metallic, m.roughness, m.alpha_cutoff, m.normal_scale, m.occlusion_strength];
             if !finite(&m.base_color) || !finite(&m.emission) || !finite(&scalars) {
