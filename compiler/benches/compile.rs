@@ -40,6 +40,9 @@ fn main() {
         input: input.clone(),
         config: Some(root.join("tests/scenes/pica_pica.toml")),
         bvh_preset: Some(BvhPreset::Medium),
+        voxel_res: None,
+        shaft_res: None,
+        shaft_variants: Some(0),
         strict: false,
     };
     let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };

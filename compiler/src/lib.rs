@@ -4,6 +4,7 @@
 
 pub mod analyze;
 pub mod bake;
+pub mod bench_scenes;
 pub mod cli;
 pub mod commands;
 pub mod exit;

@@ -16,7 +16,7 @@ use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
 use crate::ir::Scene;
 use crate::progress::Progress;
-use crate::settings::{BvhPreset, Settings};
+use crate::settings::{BvhPreset, Settings, VoxelRes};
 
 /// A scene ready to bake.
 #[derive(Debug)]
@@ -36,21 +36,50 @@ pub struct Loaded {
 pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     let start = Instant::now();
     let mut scene = import::import(&args.input)?;
-    let mut preset = None;
+    let mut settings = Settings::default();
     if let Some(cfg) = &args.config {
         let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
-        if let Some(p) = &sidecar.bake.bvh_preset {
-            preset = Some(BvhPreset::parse(p).ok_or_else(|| {
-                CliError::input(format!(
-                    "{}: bake.bvh_preset is '{p}'; use fast, medium or slow",
-                    cfg.display()
-                ))
-            })?);
-        }
+        apply_bake_table(&sidecar.bake, &mut settings).map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
     }
-    let settings = Settings { bvh_preset: args.bvh_preset.or(preset).unwrap_or_default() };
+    // The command line overrides the sidecar.
+    if let Some(p) = args.bvh_preset {
+        settings.bvh_preset = p;
+    }
+    if let Some(r) = args.voxel_res {
+        settings.voxel_res = r;
+    }
+    if let Some(n) = args.shaft_res {
+        settings.shaft_res = n;
+    }
+    if let Some(v) = args.shaft_variants {
+        settings.shaft_variants = Some(v);
+    }
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
+}
+
+fn apply_bake_table(b: &crate::import::sidecar::BakeToml, settings: &mut Settings) -> Result<(), String> {
+    if let Some(p) = &b.bvh_preset {
+        settings.bvh_preset = BvhPreset::parse(p).ok_or_else(|| format!("bvh_preset is '{p}'; use fast, medium or slow"))?;
+    }
+    if let Some(v) = &b.voxel_res {
+        let text = match v {
+            toml::Value::String(s) => s.clone(),
+            toml::Value::Integer(i) => i.to_string(),
+            other => other.to_string(),
+        };
+        settings.voxel_res = VoxelRes::parse(&text).map_err(|e| format!("voxel_res: {e}"))?;
+    }
+    if let Some(n) = b.shaft_res {
+        if !(1..=8).contains(&n) {
+            return Err(format!("shaft_res is {n}; use 1..=8"));
+        }
+        settings.shaft_res = n;
+    }
+    if let Some(v) = &b.shaft_variants {
+        settings.shaft_variants = Some(crate::settings::parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
+    }
+    Ok(())
 }
 
 /// Validates and plans an imported scene (also the entry point of the demo).
@@ -136,6 +165,8 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// Every file read.
     pub inputs: Vec<String>,
+    /// Voxel grid and line space figures (memory per variant), when baked.
+    pub line_space: Option<crate::bake::LineSpaceStats>,
 }
 
 /// Bakes and writes `loaded` to `output`; writes the report and depfile if asked.
@@ -195,6 +226,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         },
         warnings: s.warnings.iter().map(|w| w.message.clone()).collect(),
         inputs: s.inputs.iter().map(|p| p.display().to_string()).collect(),
+        line_space: baked.line_space.clone(),
     };
     if let Some(path) = &out.report {
         let json = serde_json::to_string_pretty(&report).map_err(|e| CliError::io(e.to_string()))?;

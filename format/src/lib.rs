@@ -21,6 +21,7 @@ compile_error!("kiln-format reads sections zero-copy and supports little-endian 
 pub mod checksum;
 pub mod error;
 pub mod header;
+pub mod linespace;
 pub mod manifest;
 pub mod query;
 pub mod read;

@@ -4,7 +4,10 @@
 use serde::Serialize;
 
 use crate::ir::Scene;
-use crate::settings::Settings;
+use kiln_format::linespace::Variants;
+
+use crate::bake::linespace::voxelize::auto_resolution;
+use crate::settings::{Settings, VoxelRes, variants_name};
 
 /// The bake stages, in the order they run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -20,6 +23,10 @@ pub enum Stage {
     Textures,
     /// The compressed wide BVH.
     Bvh,
+    /// Cell triangle lists of the voxel grid.
+    VoxelGrid,
+    /// Shafts per non-empty cell: binary, candidates, PNMT.
+    LineSpace,
 }
 
 impl Stage {
@@ -31,6 +38,8 @@ impl Stage {
             Stage::Materials => "materials",
             Stage::Textures => "textures",
             Stage::Bvh => "bvh",
+            Stage::VoxelGrid => "voxel-grid",
+            Stage::LineSpace => "line-space",
         }
     }
 }
@@ -51,6 +60,10 @@ pub struct Decision {
 pub struct Plan {
     /// Every stage, in order.
     pub stages: Vec<Decision>,
+    /// Voxel grid cells along the longest axis (resolved from `auto`).
+    pub voxel_res: u32,
+    /// Line-space variants to bake (0: none).
+    pub shaft_variants: u32,
 }
 
 impl Plan {
@@ -78,7 +91,40 @@ impl Plan {
             },
             run(Stage::Bvh, format!("CWBVH, preset {}", settings.bvh_preset.name())),
         ];
-        Plan { stages }
+        let mut stages = stages;
+        let voxel_res = match settings.voxel_res {
+            VoxelRes::Auto => auto_resolution(scene.triangles.len()),
+            VoxelRes::Cells(n) => n,
+        };
+        let lit = !scene.lights.is_empty()
+            || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
+            || scene.sky.radiance.iter().any(|&r| r > 0.0);
+        let res_text = match settings.voxel_res {
+            VoxelRes::Auto => format!("{voxel_res} cells on the longest axis (auto: cube root of {} triangles)", scene.triangles.len()),
+            VoxelRes::Cells(n) => format!("{n} cells on the longest axis"),
+        };
+        let shaft_variants = match settings.shaft_variants {
+            Some(v) => v,
+            None if lit => Variants::ALL,
+            None => 0,
+        };
+        if shaft_variants == 0 {
+            let why = if settings.shaft_variants.is_some() {
+                "disabled by --shaft-variants none"
+            } else {
+                "nothing emits light, so no shadow or GI query needs it (ask with --shaft-variants)"
+            };
+            stages.push(skip(Stage::VoxelGrid, why));
+            stages.push(skip(Stage::LineSpace, why));
+        } else {
+            stages.push(run(Stage::VoxelGrid, res_text));
+            let chosen = if settings.shaft_variants.is_some() { "requested" } else { "all variants: the scene is lit" };
+            stages.push(run(
+                Stage::LineSpace,
+                format!("N = {}, {} ({chosen})", settings.shaft_res, variants_name(shaft_variants | Variants::BINARY)),
+            ));
+        }
+        Plan { stages, voxel_res, shaft_variants }
     }
 
     /// Whether `stage` runs.

@@ -2,6 +2,7 @@
 //! hash computed from what it depends on.
 
 pub mod bvh;
+pub mod linespace;
 pub mod textures;
 
 use std::time::Instant;
@@ -62,6 +63,39 @@ pub struct Baked {
     pub sections: Vec<BakedSection>,
     /// Per-stage report, in plan order.
     pub stages: Vec<StageReport>,
+    /// Voxel grid and line-space figures, when baked.
+    pub line_space: Option<LineSpaceStats>,
+}
+
+/// Figures of the voxel grid and line space, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct LineSpaceStats {
+    /// Cells per axis.
+    pub cells: [u32; 3],
+    /// Non-empty cells.
+    pub slots: u32,
+    /// Shaft resolution.
+    pub shaft_res: u32,
+    /// Variants baked.
+    pub variants: String,
+    /// Filled shafts.
+    pub filled_shafts: u64,
+    /// Candidate entries.
+    pub candidate_entries: u64,
+    /// Triangles of the fullest cell.
+    pub max_cell_triangles: u32,
+    /// Shaft–triangle overlap tests run by the hierarchical search.
+    pub overlap_tests: u64,
+    /// Filled shafts with a missing front or back PNMT record.
+    pub pnmt_missing_records: u64,
+    /// Bytes of the voxel grid (header, offsets, triangle lists).
+    pub bytes_voxel_grid: u64,
+    /// Bytes of the binary line space (slots, bits, ranks).
+    pub bytes_binary: u64,
+    /// Bytes of the candidate lists.
+    pub bytes_candidates: u64,
+    /// Bytes of the PNMT records.
+    pub bytes_pnmt: u64,
 }
 
 /// Hash of the inputs: the contents of every file read, in reading order, or the scene data
@@ -116,6 +150,10 @@ pub fn bake(
     let bvh_ms = t0.elapsed().as_secs_f64() * 1e3;
     let bvh_len = bvh_bytes.len() as u64;
     push(sections::BVH_NODES, 0, bvh_bytes, hash("bvh", &[("preset", preset)]));
+    let tris: Vec<[u32; 3]> = built.order.iter().map(|&i| scene.triangles[i as usize]).collect();
+    let tmat: Vec<u32> = built.order.iter().map(|&i| scene.triangle_materials[i as usize]).collect();
+    let grid_settings = format!("{};{};{}", plan.voxel_res, settings.shaft_res, plan.shaft_variants);
+    let mut line_space: Option<linespace::BakedLineSpace> = None;
 
     for decision in &plan.stages {
         let start = Instant::now();
@@ -165,9 +203,54 @@ pub fn bake(
                     }
                 }
                 Stage::Bvh => bytes = bvh_len,
+                Stage::VoxelGrid => {
+                    let attrs = linespace::SceneAttributes {
+                        vertices: &scene.vertices,
+                        uvs: &scene.uvs,
+                        triangles: &tris,
+                        materials: &tmat,
+                    };
+                    let ls = linespace::bake(&attrs, &bounds(scene), plan.voxel_res, settings.shaft_res, plan.shaft_variants, progress)?;
+                    let h = hash("voxel-grid", &[("preset", preset), ("grid", &grid_settings)]);
+                    let header = bytemuck::bytes_of(&ls.header).to_vec();
+                    let offsets = bytemuck::cast_slice(&ls.voxel_offsets).to_vec();
+                    let cells = bytemuck::cast_slice(&ls.voxel_triangles).to_vec();
+                    bytes = (header.len() + offsets.len() + cells.len()) as u64;
+                    push(sections::GRID, 0, header, h);
+                    push(sections::VOXEL_OFFSETS, 0, offsets, h);
+                    push(sections::VOXEL_TRIANGLES, 0, cells, h);
+                    line_space = Some(ls);
+                }
+                Stage::LineSpace => {
+                    if let Some(ls) = &line_space {
+                        let h = hash("line-space", &[("preset", preset), ("grid", &grid_settings)]);
+                        let mut add = |kind, data: &[u8]| {
+                            bytes += data.len() as u64;
+                            push(kind, 0, data.to_vec(), h);
+                        };
+                        add(sections::SHAFT_SLOTS, bytemuck::cast_slice(&ls.slots));
+                        add(sections::SHAFT_BITS, bytemuck::cast_slice(&ls.bits));
+                        add(sections::SHAFT_RANKS, bytemuck::cast_slice(&ls.ranks));
+                        if ls.header.variants & kiln_format::linespace::Variants::CANDIDATES != 0 {
+                            add(sections::CANDIDATE_OFFSETS, bytemuck::cast_slice(&ls.candidate_offsets));
+                            add(sections::CANDIDATES, bytemuck::cast_slice(&ls.candidates));
+                        }
+                        if ls.header.variants & kiln_format::linespace::Variants::PNMT != 0 {
+                            add(sections::PNMT, bytemuck::cast_slice(&ls.pnmt));
+                        }
+                    }
+                }
             }
         }
-        let ms = if decision.stage == Stage::Bvh { bvh_ms } else { start.elapsed().as_secs_f64() * 1e3 };
+        let ms = match decision.stage {
+            Stage::Bvh => bvh_ms,
+            Stage::VoxelGrid => line_space.as_ref().map_or(0.0, |l| l.voxel_ms),
+            Stage::LineSpace => {
+                let grid_ms = stages.iter().find(|s: &&StageReport| s.stage == "voxel-grid").map_or(0.0, |s| s.ms);
+                line_space.as_ref().map_or(0.0, |l| l.total_ms - grid_ms)
+            }
+            _ => start.elapsed().as_secs_f64() * 1e3,
+        };
         stages.push(StageReport {
             stage: decision.stage.name(),
             run: decision.run,
@@ -212,7 +295,22 @@ pub fn bake(
     };
     let settings_text: String = settings.pairs().iter().map(|(k, v)| format!("{k}={v};")).collect();
     let manifest_hash = hash("manifest", &[("settings", &settings_text)]);
-    Ok(Baked { manifest, manifest_hash, sections, stages })
+    let line_space = line_space.map(|l| LineSpaceStats {
+        cells: l.header.dims,
+        slots: l.header.slots,
+        shaft_res: l.header.shaft_res,
+        variants: crate::settings::variants_name(l.header.variants),
+        filled_shafts: l.header.filled,
+        candidate_entries: l.header.entries,
+        max_cell_triangles: l.header.max_cell_triangles,
+        overlap_tests: l.tests,
+        pnmt_missing_records: l.pnmt_missing,
+        bytes_voxel_grid: 96 + 4 * (l.voxel_offsets.len() + l.voxel_triangles.len()) as u64,
+        bytes_binary: 4 * (l.slots.len() + l.bits.len() + l.ranks.len()) as u64,
+        bytes_candidates: 4 * (l.candidate_offsets.len() + l.candidates.len()) as u64,
+        bytes_pnmt: 16 * l.pnmt.len() as u64,
+    });
+    Ok(Baked { manifest, manifest_hash, sections, stages, line_space })
 }
 
 fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::WriteError> {

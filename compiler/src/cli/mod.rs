@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 
-use crate::settings::BvhPreset;
+use crate::settings::{BvhPreset, DEFAULT_SHAFT_RES, VoxelRes, parse_variants};
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
 /// lighting structures a player needs, checksummed, versioned and ready to memory-map.
@@ -74,6 +74,17 @@ pub struct SceneArgs {
     /// BVH build effort [default: medium, or the sidecar's bake.bvh_preset].
     #[arg(long, value_enum, help_heading = "BVH")]
     pub bvh_preset: Option<BvhPreset>,
+    /// Voxel grid cells along the scene's longest axis (cubic cells), or `auto`: the cube root
+    /// of the triangle count, clamped to 4..=64 [default: auto].
+    #[arg(long, value_name = "N|auto", value_parser = VoxelRes::parse, help_heading = "Voxel grid and line space")]
+    pub voxel_res: Option<VoxelRes>,
+    /// Shaft resolution N: patches per voxel face edge, 15·N⁴ shafts per voxel, 1..=8 [default: 4].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), help_heading = "Voxel grid and line space")]
+    pub shaft_res: Option<u32>,
+    /// Line-space variants to bake, comma-separated: binary (one bit per shaft), candidates
+    /// (exact triangle lists), pnmt (front/back hit records), or none [default: chosen by the plan].
+    #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
+    pub shaft_variants: Option<u32>,
     /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
     /// an error.
     #[arg(long)]
@@ -131,6 +142,15 @@ pub struct DemoArgs {
     /// BVH build effort.
     #[arg(long, value_enum, default_value_t = BvhPreset::Medium, help_heading = "BVH")]
     pub bvh_preset: BvhPreset,
+    /// Voxel grid cells along the longest axis, or `auto`.
+    #[arg(long, value_name = "N|auto", value_parser = VoxelRes::parse, default_value = "auto", help_heading = "Voxel grid and line space")]
+    pub voxel_res: VoxelRes,
+    /// Shaft resolution N (1..=8).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), default_value_t = DEFAULT_SHAFT_RES, help_heading = "Voxel grid and line space")]
+    pub shaft_res: u32,
+    /// Line-space variants (binary, candidates, pnmt, none) [default: chosen by the plan].
+    #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
+    pub shaft_variants: Option<u32>,
     /// Report, depfile, threads.
     #[command(flatten)]
     pub out: OutputArgs,

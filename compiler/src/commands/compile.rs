@@ -31,7 +31,12 @@ pub fn demo(args: &DemoArgs) -> CliResult {
     let scene = crate::import::demo::cornell_box();
     let loaded = pipeline::finish(
         scene,
-        Settings { bvh_preset: args.bvh_preset },
+        Settings {
+            bvh_preset: args.bvh_preset,
+            voxel_res: args.voxel_res,
+            shaft_res: args.shaft_res,
+            shaft_variants: args.shaft_variants,
+        },
         "demo",
         false,
         args.out.quiet,

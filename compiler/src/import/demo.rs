@@ -7,6 +7,11 @@ use kiln_format::manifest::{Camera, Light, LightKind, Sky};
 use kiln_format::sections::Vertex;
 
 use super::obj::lambert;
+
+/// A pure Lambertian material of albedo `kd` (as the OBJ rule makes for `Ks 0 0 0`).
+pub fn lambert_material(kd: [f32; 3]) -> kiln_format::sections::GpuMaterial {
+    lambert(kd)
+}
 use crate::ir::{Material, Scene};
 
 /// The sidecar equivalent of the demo's camera and light, for documentation and tests.

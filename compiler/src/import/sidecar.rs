@@ -163,6 +163,12 @@ pub struct MaterialToml {
 pub struct BakeToml {
     /// `fast`, `medium` or `slow`.
     pub bvh_preset: Option<String>,
+    /// `"auto"` or a cell count.
+    pub voxel_res: Option<toml::Value>,
+    /// Shaft resolution 1..=8.
+    pub shaft_res: Option<u32>,
+    /// Comma-separated variants or `"none"`.
+    pub shaft_variants: Option<String>,
 }
 
 impl Sidecar {

@@ -30,6 +30,25 @@ pub const TEXTURE: SectionKind = SectionKind(*b"TEXL");
 /// Compressed wide BVH nodes ([`CwbvhNode`]); root is node 0.
 pub const BVH_NODES: SectionKind = SectionKind(*b"CWBV");
 
+/// Voxel grid and line-space header ([`crate::linespace::GridHeader`], one element).
+pub const GRID: SectionKind = SectionKind(*b"VGRD");
+/// Voxel triangle lists: CSR offsets, `u32` per cell plus one.
+pub const VOXEL_OFFSETS: SectionKind = SectionKind(*b"VOXO");
+/// Voxel triangle lists: triangle numbers, ascending within a cell.
+pub const VOXEL_TRIANGLES: SectionKind = SectionKind(*b"VOXT");
+/// Line-space slot of each cell (`u32`, `0xFFFFFFFF` for empty cells).
+pub const SHAFT_SLOTS: SectionKind = SectionKind(*b"LSLT");
+/// One bit per shaft, `u32` words, `ceil(15 N⁴ / 32)` words per slot.
+pub const SHAFT_BITS: SectionKind = SectionKind(*b"LSBN");
+/// Filled shafts before each word of `LSBN` (`u32`, a global exclusive prefix count).
+pub const SHAFT_RANKS: SectionKind = SectionKind(*b"LSRK");
+/// Candidate lists: CSR offsets, `u32` per filled shaft plus one.
+pub const CANDIDATE_OFFSETS: SectionKind = SectionKind(*b"LSCO");
+/// Candidate list entries (`u32`: cell-local triangle, key bounds).
+pub const CANDIDATES: SectionKind = SectionKind(*b"LSCE");
+/// PNMT records ([`crate::linespace::PnmtRecord`]), front and back per filled shaft.
+pub const PNMT: SectionKind = SectionKind(*b"LSPN");
+
 /// What the format knows of a section kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct KindInfo {
@@ -123,7 +142,21 @@ pub const KNOWN: &[KindInfo] = &[
         indexed: false,
         description: "compressed wide BVH (8-ary) nodes",
     },
+    pod_kind(GRID, "voxel-grid", 96, "voxel grid and line-space header"),
+    pod_kind(VOXEL_OFFSETS, "voxel-offsets", 4, "voxel triangle list offsets"),
+    pod_kind(VOXEL_TRIANGLES, "voxel-triangles", 4, "voxel triangle lists"),
+    pod_kind(SHAFT_SLOTS, "shaft-slots", 4, "line-space slot per voxel"),
+    pod_kind(SHAFT_BITS, "shaft-bits", 4, "binary line space: one bit per shaft"),
+    pod_kind(SHAFT_RANKS, "shaft-ranks", 4, "filled-shaft prefix counts per bit word"),
+    pod_kind(CANDIDATE_OFFSETS, "candidate-offsets", 4, "candidate list offsets per filled shaft"),
+    pod_kind(CANDIDATES, "candidates", 4, "exact candidate lists per filled shaft"),
+    pod_kind(PNMT, "pnmt", 16, "front and back hit records per filled shaft"),
 ];
+
+/// A non-indexed, optional POD kind at version 1.
+const fn pod_kind(kind: SectionKind, name: &'static str, element_size: usize, description: &'static str) -> KindInfo {
+    KindInfo { kind, name, version: 1, element_size, required: false, indexed: false, description }
+}
 
 /// What this crate knows of `kind`, if anything.
 pub fn info(kind: SectionKind) -> Option<&'static KindInfo> {

@@ -1,0 +1,110 @@
+//! Voxel grid and line-space bake time and memory for the configurations of seed 004's Table 1,
+//! with PNMT and with candidates, against the thesis's GTX 1080 times; and query throughput of
+//! every variant against BVH closest hit on the same rays.
+//!
+//! `cargo bench -p kiln-compiler --bench linespace [-- ROWS]` (ROWS: comma-separated row numbers,
+//! default all; KILN_BENCH_RUNS: runs per row, default 3).
+
+use std::time::Instant;
+
+use kiln_compiler::bake::linespace::{self, SceneAttributes};
+use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
+use kiln_compiler::ir::Scene;
+use kiln_format::linespace::Variants;
+
+struct Row {
+    scene: u32,
+    object: usize,
+    res: u32,
+    n: u32,
+    thesis_voxel_ms: f64,
+    thesis_ls_ms: f64,
+}
+
+const ROWS: [Row; 8] = [
+    Row { scene: 4, object: 0, res: 8, n: 4, thesis_voxel_ms: 43.0, thesis_ls_ms: 154.0 },
+    Row { scene: 4, object: 0, res: 8, n: 5, thesis_voxel_ms: 43.0, thesis_ls_ms: 269.0 },
+    Row { scene: 5, object: TEAPOT, res: 8, n: 5, thesis_voxel_ms: 58.0, thesis_ls_ms: 644.0 },
+    Row { scene: 5, object: TEAPOT, res: 32, n: 5, thesis_voxel_ms: 47.0, thesis_ls_ms: 1795.0 },
+    Row { scene: 6, object: BUNNY, res: 8, n: 5, thesis_voxel_ms: 51.0, thesis_ls_ms: 3915.0 },
+    Row { scene: 6, object: BUNNY, res: 64, n: 5, thesis_voxel_ms: 71.0, thesis_ls_ms: 10081.0 },
+    Row { scene: 7, object: DRAGON, res: 8, n: 5, thesis_voxel_ms: 95.0, thesis_ls_ms: 94393.0 },
+    Row { scene: 7, object: DRAGON, res: 72, n: 5, thesis_voxel_ms: 88.0, thesis_ls_ms: 53675.0 },
+];
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn mib(b: u64) -> f64 {
+    b as f64 / (1024.0 * 1024.0)
+}
+
+fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64) {
+    let bounds = kiln_compiler::analyze::validate::bounds(scene);
+    let attrs = SceneAttributes { vertices: &scene.vertices, uvs: &scene.uvs, triangles: &scene.triangles, materials: &scene.triangle_materials };
+    let t = Instant::now();
+    let ls = linespace::bake(&attrs, &bounds, res, n, variants, &kiln_compiler::progress::Progress::hidden()).expect("bake");
+    (ls, t.elapsed().as_secs_f64() * 1e3)
+}
+
+fn main() {
+    let rows: Vec<usize> = std::env::args()
+        .skip(1)
+        .find(|a| !a.starts_with('-'))
+        .map(|s| s.split(',').filter_map(|x| x.parse::<usize>().ok()).map(|x| x - 1).collect())
+        .unwrap_or_else(|| (0..ROWS.len()).collect());
+    let runs: usize = std::env::var("KILN_BENCH_RUNS").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
+    println!("line-space bake, {} threads, median of {runs} runs; thesis: GTX 1080, PNMT", rayon::current_num_threads());
+    println!(
+        "{:>3} {:>6} {:>9} {:>3} | {:>9} {:>9} | {:>10} {:>10} {:>7} | {:>10} {:>10} {:>7} | {:>8} {:>9} {:>9}",
+        "row", "scene", "triangles", "N", "grid", "voxel ms", "PNMT ms", "thesis ms", "ratio", "cand. ms", "thesis ms", "ratio", "slots", "PNMT MiB", "cand. MiB"
+    );
+    for &r in &rows {
+        let row = &ROWS[r];
+        let scene = cornell_with_object(row.object, 42);
+        let tris = scene.triangles.len();
+        let mut voxel = Vec::new();
+        let (mut pnmt_ms, mut cand_ms) = (Vec::new(), Vec::new());
+        let mut last = None;
+        for _ in 0..runs {
+            let (ls, ms) = bake(&scene, row.res, row.n, Variants::BINARY | Variants::PNMT);
+            voxel.push(ls.voxel_ms);
+            pnmt_ms.push(ms - ls.voxel_ms);
+            let (lc, ms) = bake(&scene, row.res, row.n, Variants::BINARY | Variants::CANDIDATES);
+            cand_ms.push(ms - lc.voxel_ms);
+            last = Some((ls, lc));
+        }
+        let (ls, lc) = last.expect("runs >= 1");
+        let (p, c) = (median(pnmt_ms), median(cand_ms));
+        println!(
+            "{:>3} {:>6} {:>9} {:>3} | {:>9} {:>9.1} | {:>10.1} {:>10.0} {:>7.3} | {:>10.1} {:>10.0} {:>7.3} | {:>8} {:>9.1} {:>9.1}",
+            r + 1,
+            row.scene,
+            tris,
+            row.n,
+            format!("{}x{}x{}", ls.header.dims[0], ls.header.dims[1], ls.header.dims[2]),
+            median(voxel),
+            p,
+            row.thesis_ls_ms,
+            p / row.thesis_ls_ms,
+            c,
+            row.thesis_ls_ms,
+            c / row.thesis_ls_ms,
+            ls.header.slots,
+            mib(16 * ls.pnmt.len() as u64 + 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len()) as u64),
+            mib(4 * (lc.candidates.len() + lc.candidate_offsets.len() + lc.bits.len() + lc.ranks.len() + lc.slots.len()) as u64),
+        );
+        let _ = row.thesis_voxel_ms;
+        println!(
+            "      tests {} ({:.2} per candidate entry), filled {} ({:.1}%), entries {}, PNMT records missing {}",
+            lc.tests,
+            lc.tests as f64 / lc.header.entries.max(1) as f64,
+            ls.header.filled,
+            100.0 * ls.header.filled as f64 / (ls.header.slots as f64 * 15.0 * (row.n as f64).powi(4)),
+            lc.header.entries,
+            ls.pnmt_missing
+        );
+    }
+}

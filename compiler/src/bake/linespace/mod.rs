@@ -1,0 +1,186 @@
+//! The voxel grid and line-space stages (seed 004, made exact and sparse): voxelize, then fill
+//! the shafts of every non-empty cell in parallel, then lay the results out as sections.
+
+mod geometry;
+mod shafts;
+pub mod voxelize;
+
+use glam::{DVec3, Vec2, Vec3};
+use kiln_format::linespace::index::MAX_SHAFT_RES;
+use kiln_format::linespace::{GridHeader, MAX_CANDIDATE_CELL_TRIANGLES, NO_SLOT, PnmtRecord, Variants};
+use kiln_format::manifest::Bounds;
+use kiln_format::sections::Vertex;
+use rayon::prelude::*;
+
+pub use shafts::HitAttributes;
+
+use crate::exit::{CliError, CliResult};
+use crate::progress::Progress;
+
+/// The baked grid and line space, ready to be written.
+#[derive(Debug, Clone, Default)]
+pub struct BakedLineSpace {
+    /// Header.
+    pub header: GridHeader,
+    /// Cell triangle list offsets.
+    pub voxel_offsets: Vec<u32>,
+    /// Cell triangle lists.
+    pub voxel_triangles: Vec<u32>,
+    /// Slot per cell.
+    pub slots: Vec<u32>,
+    /// Shaft bits.
+    pub bits: Vec<u32>,
+    /// Ranks per bit word.
+    pub ranks: Vec<u32>,
+    /// Candidate offsets.
+    pub candidate_offsets: Vec<u32>,
+    /// Candidate entries.
+    pub candidates: Vec<u32>,
+    /// PNMT records.
+    pub pnmt: Vec<PnmtRecord>,
+    /// Shaft–triangle overlap tests run.
+    pub tests: u64,
+    /// Filled shafts whose PNMT sample rays all missed (no record).
+    pub pnmt_missing: u64,
+    /// Wall time of voxelization, ms.
+    pub voxel_ms: f64,
+    /// Wall time of the whole bake, ms.
+    pub total_ms: f64,
+}
+
+/// Scene attributes for PNMT records, over triangles in stored (BVH) order.
+#[derive(Debug)]
+pub struct SceneAttributes<'a> {
+    /// Vertices.
+    pub vertices: &'a [Vertex],
+    /// Texture coordinates (may be empty).
+    pub uvs: &'a [[f32; 2]],
+    /// Triangles in stored order.
+    pub triangles: &'a [[u32; 3]],
+    /// Material per stored triangle.
+    pub materials: &'a [u32],
+}
+
+impl HitAttributes for SceneAttributes<'_> {
+    fn corners(&self, t: u32) -> [Vec3; 3] {
+        self.triangles[t as usize].map(|i| Vec3::from(self.vertices[i as usize].position))
+    }
+    fn normal(&self, t: u32, u: f32, v: f32) -> Vec3 {
+        let [a, b, c] = self.triangles[t as usize].map(|i| Vec3::from(self.vertices[i as usize].normal));
+        (a * (1.0 - u - v) + b * u + c * v).try_normalize().unwrap_or_else(|| {
+            let [p, q, r] = self.corners(t);
+            (q - p).cross(r - p).normalize_or(Vec3::Z)
+        })
+    }
+    fn uv(&self, t: u32, u: f32, v: f32) -> Vec2 {
+        if self.uvs.is_empty() {
+            return Vec2::ZERO;
+        }
+        let [a, b, c] = self.triangles[t as usize].map(|i| Vec2::from(self.uvs[i as usize]));
+        a * (1.0 - u - v) + b * u + c * v
+    }
+    fn material(&self, t: u32) -> u16 {
+        self.materials[t as usize].min(u16::MAX as u32 - 1) as u16
+    }
+}
+
+/// Bakes the grid over `bounds` at `res` cells along the longest axis, and the line space at
+/// shaft resolution `n` with `variants` (0: grid only).
+pub fn bake(
+    attrs: &SceneAttributes,
+    bounds: &Bounds,
+    res: u32,
+    n: u32,
+    variants: u32,
+    progress: &Progress,
+) -> CliResult<BakedLineSpace> {
+    let start = std::time::Instant::now();
+    let mut header = voxelize::grid(bounds, res);
+    let corners: Vec<[[f32; 3]; 3]> =
+        attrs.triangles.iter().map(|t| t.map(|i| attrs.vertices[i as usize].position)).collect();
+    let local = voxelize::local_triangles(&header, &corners);
+    let (voxel_offsets, voxel_triangles) = voxelize::voxelize(&header, &local);
+    let cells = header.cell_count() as usize;
+    let cell_len = |c: usize| (voxel_offsets[c + 1] - voxel_offsets[c]) as usize;
+    header.max_cell_triangles = (0..cells).map(cell_len).max().unwrap_or(0) as u32;
+    let voxel_ms = start.elapsed().as_secs_f64() * 1e3;
+    let mut out = BakedLineSpace { voxel_ms, ..Default::default() };
+    if variants == 0 {
+        out.total_ms = voxel_ms;
+        out.header = header;
+        out.voxel_offsets = voxel_offsets;
+        out.voxel_triangles = voxel_triangles;
+        return Ok(out);
+    }
+    let variants = variants | Variants::BINARY;
+    if !(1..=MAX_SHAFT_RES).contains(&n) {
+        return Err(CliError::usage(format!("shaft resolution {n} is outside 1..=8")));
+    }
+    let candidates = variants & Variants::CANDIDATES != 0;
+    let pnmt = variants & Variants::PNMT != 0;
+    if candidates && header.max_cell_triangles > MAX_CANDIDATE_CELL_TRIANGLES {
+        return Err(CliError::input(format!(
+            "a cell holds {} triangles, more than the {MAX_CANDIDATE_CELL_TRIANGLES} candidate lists can address; raise --voxel-res",
+            header.max_cell_triangles
+        )));
+    }
+    header.shaft_res = n;
+    header.variants = variants;
+    let occupied: Vec<usize> = (0..cells).filter(|&c| cell_len(c) > 0).collect();
+    let mut slots = vec![NO_SLOT; cells];
+    for (s, &c) in occupied.iter().enumerate() {
+        slots[c] = s as u32;
+    }
+    header.slots = occupied.len() as u32;
+    let margin_local = header.margin / header.cell;
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let per_cell: Vec<shafts::CellShafts> = occupied
+        .par_iter()
+        .map(|&c| {
+            let cc = header.cell_coords(c);
+            let cell_min = DVec3::new(cc[0] as f64, cc[1] as f64, cc[2] as f64);
+            let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
+            let r = shafts::bake_cell(tris, &local, cell_min, header.cell_min(cc), header.cell, n, margin_local, candidates, pnmt, attrs);
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            if k % 64 == 0 {
+                progress.stage(&format!("line space: {k}/{} cells", occupied.len()));
+            }
+            r
+        })
+        .collect();
+    let mut rank = 0u64;
+    for cell in &per_cell {
+        out.tests += cell.tests;
+        for &w in &cell.bits {
+            out.ranks.push(u32::try_from(rank).map_err(|_| too_many())?);
+            rank += w.count_ones() as u64;
+        }
+        out.bits.extend_from_slice(&cell.bits);
+    }
+    header.filled = rank;
+    if candidates {
+        out.candidate_offsets.reserve(rank as usize + 1);
+        out.candidate_offsets.push(0);
+        for list in per_cell.iter().flat_map(|c| &c.lists) {
+            out.candidates.extend_from_slice(list);
+            out.candidate_offsets.push(u32::try_from(out.candidates.len()).map_err(|_| too_many())?);
+        }
+        header.entries = out.candidates.len() as u64;
+    }
+    if pnmt {
+        for r in per_cell.iter().flat_map(|c| &c.pnmt) {
+            out.pnmt_missing += (!r[0].is_some() || !r[1].is_some()) as u64;
+            out.pnmt.extend_from_slice(r);
+        }
+    }
+    out.header = header;
+    out.voxel_offsets = voxel_offsets;
+    out.voxel_triangles = voxel_triangles;
+    out.slots = slots;
+    out.total_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok(out)
+}
+
+fn too_many() -> CliError {
+    CliError::input("the line space has more than 2^32 filled shafts or candidate entries; lower --voxel-res or --shaft-res")
+}

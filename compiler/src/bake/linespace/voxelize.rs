@@ -1,0 +1,96 @@
+//! The voxel grid: resolution, margin, and exact conservative triangle–cell overlap (separating
+//! axes, cells widened by the margin) stored as CSR lists.
+
+use glam::DVec3;
+use kiln_format::linespace::GridHeader;
+use kiln_format::manifest::Bounds;
+use rayon::prelude::*;
+
+use super::geometry::Prepared;
+
+/// Cells along the longest axis chosen by `--voxel-res auto`: the cube root of the triangle
+/// count (about one triangle per cell of a cube's volume, O(T^⅔) non-empty cells on surfaces),
+/// clamped to 4..=64.
+pub fn auto_resolution(triangles: usize) -> u32 {
+    ((triangles as f64).cbrt().round() as u32).clamp(4, 64)
+}
+
+/// How far voxels and shafts are widened: 8 single-precision ulps of the largest coordinate
+/// magnitude of the grid plus its diagonal (the reach of the f32 ray–triangle test's rounding
+/// for rays that start within that range), and a millionth of a cell.
+pub fn margin(origin: DVec3, extent: DVec3, cell: f64) -> f64 {
+    let far = origin.abs().max((origin + extent).abs()).max_element();
+    (far + extent.length()) * 8.0 * f32::EPSILON as f64 + cell * 1e-6
+}
+
+/// The grid over `bounds` with `res` cubic cells along the longest axis. The bounds are first
+/// widened by four margins on every side, so that every point within a margin of a triangle (every
+/// point the single-precision ray–triangle test can report as a hit) lies strictly inside a cell.
+pub fn grid(bounds: &Bounds, res: u32) -> GridHeader {
+    let lo0 = DVec3::from(bounds.min.map(f64::from));
+    let hi0 = DVec3::from(bounds.max.map(f64::from));
+    let pad = 4.0 * margin(lo0, (hi0 - lo0).max(DVec3::ZERO), (hi0 - lo0).max_element() / res as f64);
+    let (lo, hi) = (lo0 - pad, hi0 + pad);
+    let extent = hi - lo;
+    let cell = (extent.max_element() / res as f64).max(f64::MIN_POSITIVE);
+    let dims = [0, 1, 2].map(|a| ((extent[a] / cell).ceil() as u32).clamp(1, res));
+    // Centre the grid on the bounds so that both sides have the same slack.
+    let size = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) * cell;
+    let origin = lo - (size - extent) * 0.5;
+    GridHeader { origin: origin.to_array(), cell, margin: margin(origin, size, cell), dims, ..Default::default() }
+}
+
+/// Triangle corners in grid-local coordinates (cells are unit cubes, the grid starts at 0).
+pub fn local_triangles(grid: &GridHeader, corners: &[[[f32; 3]; 3]]) -> Vec<[DVec3; 3]> {
+    let o = DVec3::from(grid.origin);
+    corners.iter().map(|c| c.map(|p| (DVec3::from(p.map(f64::from)) - o) / grid.cell)).collect()
+}
+
+/// CSR lists of the triangles meeting each (widened) cell: (offsets, triangles), triangles
+/// ascending within a cell. Deterministic for any thread count.
+pub fn voxelize(grid: &GridHeader, local: &[[DVec3; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let m = grid.margin / grid.cell;
+    let dims = grid.dims.map(|d| d as i64);
+    let pairs: Vec<Vec<(u32, u32)>> = local
+        .par_chunks(4096)
+        .enumerate()
+        .map(|(chunk, tris)| {
+            let mut out = Vec::new();
+            for (k, v) in tris.iter().enumerate() {
+                let t = (chunk * 4096 + k) as u32;
+                let prep = Prepared::new(*v);
+                let lo = v[0].min(v[1]).min(v[2]) - m;
+                let hi = v[0].max(v[1]).max(v[2]) + m;
+                let range = |a: usize| ((lo[a].floor() as i64).clamp(0, dims[a] - 1), (hi[a].floor() as i64).clamp(0, dims[a] - 1));
+                let ((x0, x1), (y0, y1), (z0, z1)) = (range(0), range(1), range(2));
+                for z in z0..=z1 {
+                    for y in y0..=y1 {
+                        for x in x0..=x1 {
+                            let centre = DVec3::new(x as f64 + 0.5, y as f64 + 0.5, z as f64 + 0.5);
+                            if prep.overlaps_box(centre, DVec3::splat(0.5 + m)) {
+                                out.push((grid.cell_index([x as u32, y as u32, z as u32]) as u32, t));
+                            }
+                        }
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    let cells = grid.cell_count() as usize;
+    let mut offsets = vec![0u32; cells + 1];
+    for &(c, _) in pairs.iter().flatten() {
+        offsets[c as usize + 1] += 1;
+    }
+    for i in 0..cells {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut tris = vec![0u32; offsets[cells] as usize];
+    // Chunks are in triangle order, so each cell's list comes out ascending.
+    for &(c, t) in pairs.iter().flatten() {
+        tris[fill[c as usize] as usize] = t;
+        fill[c as usize] += 1;
+    }
+    (offsets, tris)
+}

@@ -1,0 +1,138 @@
+//! PNMT records: position, normal, material and texture coordinates of the front or back hit
+//! of a shaft's midpoint ray, in 16 bytes.
+//!
+//! | bytes | field | encoding | precision |
+//! |---|---|---|---|
+//! | 0..6 | position | u16 × 3, the voxel [0, 1]³ mapped to 0..65535 | cell / 65535 per axis |
+//! | 6..8 | material | u16; 0xFFFF = no record | exact |
+//! | 8..12 | normal | octahedral (Meyer et al. 2010), snorm16 × 2 | < 0.005° |
+//! | 12..16 | uv | f16 × 2 | 11-bit mantissa |
+//!
+//! The thesis stored 16 half floats per shaft (32 bytes, world positions in half precision); kiln
+//! stores the same 32 bytes per filled shaft (front and back), positions relative to the voxel.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{DVec3, Vec2, Vec3};
+use half::f16;
+
+/// Material value of an absent record.
+pub const NO_RECORD: u16 = 0xffff;
+
+/// One hit record. 16 bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Pod, Zeroable)]
+#[repr(C)]
+pub struct PnmtRecord {
+    /// Position in the voxel, quantised.
+    pub position: [u16; 3],
+    /// Material index, or [`NO_RECORD`].
+    pub material: u16,
+    /// Octahedral normal, snorm16.
+    pub normal: [i16; 2],
+    /// Texture coordinates, binary16 bits.
+    pub uv: [u16; 2],
+}
+
+const _: () = assert!(size_of::<PnmtRecord>() == 16);
+
+/// A decoded record.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PnmtHit {
+    /// World position.
+    pub position: DVec3,
+    /// Unit normal.
+    pub normal: Vec3,
+    /// Material index.
+    pub material: u16,
+    /// Texture coordinates.
+    pub uv: Vec2,
+}
+
+/// Octahedral encoding of a unit vector into [-1, 1]².
+pub fn oct_encode(n: Vec3) -> Vec2 {
+    let n = n / (n.x.abs() + n.y.abs() + n.z.abs());
+    let p = Vec2::new(n.x, n.y);
+    if n.z >= 0.0 {
+        p
+    } else {
+        let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+        Vec2::new((1.0 - p.y.abs()) * sign(p.x), (1.0 - p.x.abs()) * sign(p.y))
+    }
+}
+
+/// Inverse of [`oct_encode`].
+pub fn oct_decode(e: Vec2) -> Vec3 {
+    let z = 1.0 - e.x.abs() - e.y.abs();
+    let t = (-z).max(0.0);
+    let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+    Vec3::new(e.x - t * sign(e.x), e.y - t * sign(e.y), z).normalize()
+}
+
+impl PnmtRecord {
+    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell`.
+    pub fn encode(position: DVec3, normal: Vec3, material: u16, uv: Vec2, cell_min: DVec3, cell: f64) -> PnmtRecord {
+        let local = ((position - cell_min) / cell).clamp(DVec3::ZERO, DVec3::ONE);
+        let q = |x: f64| (x * 65535.0).round() as u16;
+        let e = oct_encode(normal.try_normalize().unwrap_or(Vec3::Z));
+        let s = |x: f32| (x.clamp(-1.0, 1.0) * 32767.0).round() as i16;
+        PnmtRecord {
+            position: [q(local.x), q(local.y), q(local.z)],
+            material: material.min(NO_RECORD - 1),
+            normal: [s(e.x), s(e.y)],
+            uv: [f16::from_f32(uv.x).to_bits(), f16::from_f32(uv.y).to_bits()],
+        }
+    }
+
+    /// Whether the record holds a hit.
+    pub fn is_some(&self) -> bool {
+        self.material != NO_RECORD
+    }
+
+    /// Decodes the record of the voxel with minimum corner `cell_min` and edge `cell`.
+    pub fn decode(&self, cell_min: DVec3, cell: f64) -> Option<PnmtHit> {
+        if !self.is_some() {
+            return None;
+        }
+        let p = DVec3::new(self.position[0] as f64, self.position[1] as f64, self.position[2] as f64) / 65535.0;
+        let n = oct_decode(Vec2::new(self.normal[0] as f32 / 32767.0, self.normal[1] as f32 / 32767.0));
+        Some(PnmtHit {
+            position: cell_min + p * cell,
+            normal: n,
+            material: self.material,
+            uv: Vec2::new(f16::from_bits(self.uv[0]).to_f32(), f16::from_bits(self.uv[1]).to_f32()),
+        })
+    }
+
+    /// The absent record.
+    pub const NONE: PnmtRecord = PnmtRecord { position: [0; 3], material: NO_RECORD, normal: [0; 2], uv: [0; 2] };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn octahedral_round_trip_is_within_0_005_degrees() {
+        let mut worst = 0.0f32;
+        for i in 0..2000 {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
+            let phi = i as f32 * 2.399_963;
+            let r = (1.0 - z * z).sqrt();
+            let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let rec = PnmtRecord::encode(DVec3::ZERO, n, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
+            let back = rec.decode(DVec3::ZERO, 1.0).unwrap().normal;
+            worst = worst.max(n.dot(back).clamp(-1.0, 1.0).acos().to_degrees());
+        }
+        assert!(worst < 0.005, "worst normal error {worst} degrees");
+    }
+
+    #[test]
+    fn positions_quantise_to_the_cell() {
+        let min = DVec3::new(1e5, -3.0, 7.0);
+        let p = min + DVec3::new(0.25, 0.5, 0.999) * 0.1;
+        let rec = PnmtRecord::encode(p, Vec3::X, 3, Vec2::new(0.5, 2.0), min, 0.1);
+        let hit = rec.decode(min, 0.1).unwrap();
+        assert!((hit.position - p).abs().max_element() <= 0.1 / 65535.0);
+        assert_eq!((hit.material, hit.uv), (3, Vec2::new(0.5, 2.0)));
+        assert!(PnmtRecord::NONE.decode(min, 0.1).is_none());
+    }
+}
