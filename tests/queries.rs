@@ -3,7 +3,7 @@
 //! from the origin, tiny and huge; plus watertightness of closed meshes.
 
 use glam::Vec3;
-use kiln_compiler::raycheck::{Agreement, Rng, compare, generate};
+use kiln_compiler::raycheck::{Agreement, RaySample, Rng, compare, generate};
 use kiln_compiler::settings::{BvhPreset, Settings};
 use kiln_format::query::{BruteForce, BvhQuery, IndexedTriangles, Ray, closest_hit_brute_force};
 use kiln_format::{Checksums, KilnFile, SceneView};
@@ -12,7 +12,7 @@ use proptest::prelude::*;
 
 /// Compiles `tris`, then checks `rays` rays of every class: BVH against brute force.
 fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<(), String> {
-    let bytes = compile(scene_of(tris), Settings { bvh_preset: preset });
+    let bytes = compile(scene_of(tris), Settings { bvh_preset: preset, ..Default::default() });
     let file = KilnFile::from_bytes(&bytes, Checksums::Eager).map_err(|e| e.to_string())?;
     let view = SceneView::new(&file).map_err(|e| e.to_string())?;
     let t = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
@@ -20,7 +20,7 @@ fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<
     let brute = BruteForce::new(&t);
     let (lo, hi) = (Vec3::from(view.manifest.bounds.min), Vec3::from(view.manifest.bounds.max));
     let tol = 1e-6 * (hi - lo).length();
-    for (class, ray) in generate(&t, lo, hi, rays, seed) {
+    for RaySample { class, ray, .. } in generate(&t, lo, hi, rays, seed) {
         let want = brute.closest_hit(&ray);
         // The prefiltered brute force agrees with the plain one.
         let plain = closest_hit_brute_force(&t, &ray);

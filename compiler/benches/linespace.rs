@@ -41,11 +41,26 @@ fn mib(b: u64) -> f64 {
     b as f64 / (1024.0 * 1024.0)
 }
 
+fn attrs_of(scene: &Scene) -> SceneAttributes<'_> {
+    SceneAttributes {
+        vertices: &scene.vertices,
+        uvs: &scene.uvs,
+        triangles: &scene.triangles,
+        materials: &scene.triangle_materials,
+    }
+}
+
 fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64) {
     let bounds = kiln_compiler::analyze::validate::bounds(scene);
-    let attrs = SceneAttributes { vertices: &scene.vertices, uvs: &scene.uvs, triangles: &scene.triangles, materials: &scene.triangle_materials };
+    let attrs = SceneAttributes {
+        vertices: &scene.vertices,
+        uvs: &scene.uvs,
+        triangles: &scene.triangles,
+        materials: &scene.triangle_materials,
+    };
     let t = Instant::now();
-    let ls = linespace::bake(&attrs, &bounds, res, n, variants, &kiln_compiler::progress::Progress::hidden()).expect("bake");
+    let ls = linespace::bake(&attrs, &bounds, res, n, variants, &kiln_compiler::progress::Progress::hidden())
+        .expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
 }
 
@@ -56,10 +71,27 @@ fn main() {
         .map(|s| s.split(',').filter_map(|x| x.parse::<usize>().ok()).map(|x| x - 1).collect())
         .unwrap_or_else(|| (0..ROWS.len()).collect());
     let runs: usize = std::env::var("KILN_BENCH_RUNS").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
-    println!("line-space bake, {} threads, median of {runs} runs; thesis: GTX 1080, PNMT", rayon::current_num_threads());
+    println!(
+        "line-space bake, {} threads, median of {runs} runs; thesis: GTX 1080, PNMT",
+        rayon::current_num_threads()
+    );
     println!(
         "{:>3} {:>6} {:>9} {:>3} | {:>9} {:>9} | {:>10} {:>10} {:>7} | {:>10} {:>10} {:>7} | {:>8} {:>9} {:>9}",
-        "row", "scene", "triangles", "N", "grid", "voxel ms", "PNMT ms", "thesis ms", "ratio", "cand. ms", "thesis ms", "ratio", "slots", "PNMT MiB", "cand. MiB"
+        "row",
+        "scene",
+        "triangles",
+        "N",
+        "grid",
+        "voxel ms",
+        "PNMT ms",
+        "thesis ms",
+        "ratio",
+        "cand. ms",
+        "thesis ms",
+        "ratio",
+        "slots",
+        "PNMT MiB",
+        "cand. MiB"
     );
     for &r in &rows {
         let row = &ROWS[r];
@@ -94,15 +126,21 @@ fn main() {
             c / row.thesis_ls_ms,
             ls.header.slots,
             mib(16 * ls.pnmt.len() as u64 + 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len()) as u64),
-            mib(4 * (lc.candidates.len() + lc.candidate_offsets.len() + lc.bits.len() + lc.ranks.len() + lc.slots.len()) as u64),
+            mib(4
+                * (lc.candidates.len()
+                    + lc.candidate_offsets.len()
+                    + lc.bits.len()
+                    + lc.ranks.len()
+                    + lc.slots.len()) as u64),
         );
         let _ = row.thesis_voxel_ms;
         println!(
-            "      tests {} ({:.2} per candidate entry), filled {} ({:.1}%), entries {}, PNMT records missing {}",
+            "      tests {} ({:.2} per candidate entry), filled {} ({:.1}%), false fills {:.3}% (of 20,000 sampled), entries {}, PNMT records missing {}",
             lc.tests,
             lc.tests as f64 / lc.header.entries.max(1) as f64,
             ls.header.filled,
             100.0 * ls.header.filled as f64 / (ls.header.slots as f64 * 15.0 * (row.n as f64).powi(4)),
+            100.0 * linespace::false_fill_rate(&attrs_of(&scene), &ls, 20_000),
             lc.header.entries,
             ls.pnmt_missing
         );

@@ -37,7 +37,10 @@ pub fn cornell_with_object(object_triangles: usize, seed: u64) -> Scene {
     s.triangles.extend([[base, base + 2, base + 1], [base, base + 3, base + 2]]);
     s.triangle_materials.extend([0, 0]);
     if object_triangles > 0 {
-        s.materials.push(Material { name: "object".into(), gpu: crate::import::demo::lambert_material([0.8, 0.8, 0.8]) });
+        s.materials.push(Material {
+            name: "object".into(),
+            gpu: crate::import::demo::lambert_material([0.8, 0.8, 0.8]),
+        });
         let material = (s.materials.len() - 1) as u32;
         spiral_blob(&mut s, object_triangles, Vec3::new(0.0, 0.7, 0.0), 0.6, seed, material);
     }
@@ -66,7 +69,8 @@ fn spiral_blob(s: &mut Scene, n: usize, centre: Vec3, radius: f32, seed: u64, ma
         let band = std::f64::consts::PI / (turns + 1.0);
         let theta = (std::f64::consts::PI - band) * s_ + band * edge;
         let phi = std::f64::consts::TAU * turns * s_;
-        let d = Vec3::new((theta.sin() * phi.cos()) as f32, theta.cos() as f32, (theta.sin() * phi.sin()) as f32);
+        let d =
+            Vec3::new((theta.sin() * phi.cos()) as f32, theta.cos() as f32, (theta.sin() * phi.sin()) as f32);
         let bump: f32 = bumps.iter().map(|(c, a)| a * (-(1.0 - d.dot(*c)) * 12.0).exp()).sum();
         centre + d * radius * (1.0 + bump)
     };

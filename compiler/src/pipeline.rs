@@ -40,7 +40,8 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some(cfg) = &args.config {
         let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
-        apply_bake_table(&sidecar.bake, &mut settings).map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
+        apply_bake_table(&sidecar.bake, &mut settings)
+            .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
     }
     // The command line overrides the sidecar.
     if let Some(p) = args.bvh_preset {
@@ -60,7 +61,8 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
 
 fn apply_bake_table(b: &crate::import::sidecar::BakeToml, settings: &mut Settings) -> Result<(), String> {
     if let Some(p) = &b.bvh_preset {
-        settings.bvh_preset = BvhPreset::parse(p).ok_or_else(|| format!("bvh_preset is '{p}'; use fast, medium or slow"))?;
+        settings.bvh_preset =
+            BvhPreset::parse(p).ok_or_else(|| format!("bvh_preset is '{p}'; use fast, medium or slow"))?;
     }
     if let Some(v) = &b.voxel_res {
         let text = match v {
@@ -77,7 +79,8 @@ fn apply_bake_table(b: &crate::import::sidecar::BakeToml, settings: &mut Setting
         settings.shaft_res = n;
     }
     if let Some(v) = &b.shaft_variants {
-        settings.shaft_variants = Some(crate::settings::parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
+        settings.shaft_variants =
+            Some(crate::settings::parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
     }
     Ok(())
 }

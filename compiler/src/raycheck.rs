@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 
 use glam::{DVec3, Vec3};
-use kiln_format::linespace::{LineSpace, Variants};
 use kiln_format::SceneView;
+use kiln_format::linespace::{LineSpace, Variants};
 use kiln_format::query::{BruteForce, BvhQuery, Hit, IndexedTriangles, Ray, TriangleSource};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -303,14 +303,28 @@ pub fn check_bvh(view: &SceneView, n: u64, seed: u64) -> BvhCheck {
 
 /// Line-space checks: rays of every general class plus grid-specific ones (through grid
 /// corners and edges, lying in cell planes, starting inside cells, finite segments).
-pub fn generate_grid(tris: &(impl TriangleSource + ?Sized), ls: &LineSpace, lo: Vec3, hi: Vec3, n: u64, seed: u64) -> Vec<RaySample> {
+pub fn generate_grid(
+    tris: &(impl TriangleSource + ?Sized),
+    ls: &LineSpace,
+    lo: Vec3,
+    hi: Vec3,
+    n: u64,
+    seed: u64,
+) -> Vec<RaySample> {
     let general = generate(tris, lo, hi, n / 2, seed);
     let h = &ls.header;
     let (glo, ghi) = (DVec3::from(h.origin), h.grid_max());
     let ext = (hi - lo).max(Vec3::splat(1e-3 * (hi - lo).max_element().max(1e-6)));
     let (blo, bhi) = (lo - ext * 0.1, hi + ext * 0.1);
-    let occupied: Vec<usize> = (0..h.cell_count() as usize).filter(|&c| !ls.cell_triangles(c).is_empty()).collect();
-    let classes = [RayClass::VoxelCorner, RayClass::VoxelEdge, RayClass::FacePlane, RayClass::InsideCell, RayClass::Segment];
+    let occupied: Vec<usize> =
+        (0..h.cell_count() as usize).filter(|&c| !ls.cell_triangles(c).is_empty()).collect();
+    let classes = [
+        RayClass::VoxelCorner,
+        RayClass::VoxelEdge,
+        RayClass::FacePlane,
+        RayClass::InsideCell,
+        RayClass::Segment,
+    ];
     let mut rng = Rng::new(seed ^ 0x5151_5151);
     let grid_point = |rng: &mut Rng| {
         DVec3::new(
@@ -349,7 +363,9 @@ pub fn generate_grid(tris: &(impl TriangleSource + ?Sized), ls: &LineSpace, lo: 
                 Ray::new(o, d, 0.0, f32::INFINITY)
             }
             RayClass::InsideCell => {
-                let c = h.cell_coords(occupied[rng.below(occupied.len().max(1)).min(occupied.len().saturating_sub(1))]);
+                let c = h.cell_coords(
+                    occupied[rng.below(occupied.len().max(1)).min(occupied.len().saturating_sub(1))],
+                );
                 let cmin = h.cell_min(c).as_vec3();
                 let o = rng.in_box(cmin, cmin + Vec3::splat(h.cell as f32));
                 Ray::new(o, rng.direction(), 0.0, f32::INFINITY)
@@ -470,14 +486,17 @@ pub fn check_line_space(view: &SceneView, ls: &LineSpace, n: u64, seed: u64) -> 
     let has_cand = ls.has(Variants::CANDIDATES);
     let has_pnmt = ls.has(Variants::PNMT);
     let shading_normal = |h: &Hit| {
-        let [a, b, c] = view.triangles[h.triangle as usize].map(|i| Vec3::from(view.vertices[i as usize].normal));
+        let [a, b, c] =
+            view.triangles[h.triangle as usize].map(|i| Vec3::from(view.vertices[i as usize].normal));
         (a * (1.0 - h.u - h.v) + b * h.u + c * h.v).normalize_or(Vec3::Z)
     };
+    /// PNMT outcome of one ray: (position and normal errors when both hit, PNMT hit, reference hit).
+    type PnmtOutcome = (Option<(f64, f64)>, bool, bool);
     struct One {
         cand: Option<(Agreement, bool, Option<Hit>)>,
         binary: bool,
         reference: Option<Hit>,
-        pnmt: Option<(Option<(f64, f64)>, bool, bool)>,
+        pnmt: Option<PnmtOutcome>,
     }
     let results: Vec<One> = rays
         .par_iter()
@@ -535,7 +554,10 @@ pub fn check_line_space(view: &SceneView, ls: &LineSpace, n: u64, seed: u64) -> 
                 Agreement::Mismatch => {
                     c.mismatches += 1;
                     if c.examples.len() < 10 {
-                        c.examples.push(format!("{:?}: {:?}: candidates {got:?}, brute force {:?}", r.class, r.ray, one.reference));
+                        c.examples.push(format!(
+                            "{:?}: {:?}: candidates {got:?}, brute force {:?}",
+                            r.class, r.ray, one.reference
+                        ));
                     }
                 }
             }

@@ -79,7 +79,11 @@ pub fn parse_variants(s: &str) -> Result<u32, String> {
             "binary" => Variants::BINARY,
             "candidates" => Variants::CANDIDATES,
             "pnmt" => Variants::PNMT,
-            other => return Err(format!("unknown shaft variant '{other}' (use binary, candidates, pnmt or none)")),
+            other => {
+                return Err(format!(
+                    "unknown shaft variant '{other}' (use binary, candidates, pnmt or none)"
+                ));
+            }
         };
     }
     Ok(v)
@@ -87,10 +91,11 @@ pub fn parse_variants(s: &str) -> Result<u32, String> {
 
 /// A variant set as text.
 pub fn variants_name(v: u32) -> String {
-    let names: Vec<&str> = [(Variants::BINARY, "binary"), (Variants::CANDIDATES, "candidates"), (Variants::PNMT, "pnmt")]
-        .into_iter()
-        .filter_map(|(bit, name)| (v & bit != 0).then_some(name))
-        .collect();
+    let names: Vec<&str> =
+        [(Variants::BINARY, "binary"), (Variants::CANDIDATES, "candidates"), (Variants::PNMT, "pnmt")]
+            .into_iter()
+            .filter_map(|(bit, name)| (v & bit != 0).then_some(name))
+            .collect();
     if names.is_empty() { "none".into() } else { names.join(",") }
 }
 
@@ -109,7 +114,12 @@ pub struct Settings {
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings { bvh_preset: BvhPreset::default(), voxel_res: VoxelRes::Auto, shaft_res: DEFAULT_SHAFT_RES, shaft_variants: None }
+        Settings {
+            bvh_preset: BvhPreset::default(),
+            voxel_res: VoxelRes::Auto,
+            shaft_res: DEFAULT_SHAFT_RES,
+            shaft_variants: None,
+        }
     }
 }
 

@@ -16,7 +16,15 @@ fn demo_inspect_verify() {
     assert_eq!(j["format_version"], "1.0");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
-    assert_eq!(kinds, ["MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV"]);
+    assert_eq!(
+        kinds,
+        [
+            "MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV", "VGRD", "VOXO", "VOXT", "LSLT", "LSBN", "LSRK",
+            "LSCO", "LSCE", "LSPN"
+        ]
+    );
+    assert_eq!(j["line_space"]["shaft_res"], 4);
+    assert!(j["line_space"]["bytes_pnmt"].as_u64().unwrap() > 0);
     assert!(j["sections"].as_array().unwrap().iter().all(|s| s["checksum_ok"] == true));
     assert_eq!(j["summary"]["triangles"], 30);
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");
@@ -30,6 +38,15 @@ fn demo_inspect_verify() {
     assert_eq!(j["bvh"]["mismatches"], 0);
     assert_eq!(j["bvh"]["rays"], 20000);
     assert!(j["bvh"]["hits"].as_u64().unwrap() > 15000);
+    assert_eq!(j["candidates"]["mismatches"], 0);
+    assert_eq!(j["binary"]["false_misses"], 0);
+    assert!(j["binary"]["false_hits"].as_u64().is_some());
+    for k in ["median", "p99", "max"] {
+        assert!(j["pnmt"]["position_error"][k].as_f64().is_some());
+        assert!(j["pnmt"]["normal_error_degrees"][k].as_f64().is_some());
+    }
+    assert!(j["pnmt"]["hit_disagreements"].as_u64().is_some());
+    assert_eq!(j["line_space"]["rays"], 20000);
 }
 
 #[test]
@@ -37,9 +54,12 @@ fn verify_reports_what_and_where() {
     let dir = tempfile::tempdir().unwrap();
     kiln(dir.path(), &["demo", "-o", "d.kiln"]).expect(0);
     let path = dir.path().join("d.kiln");
+    let j: serde_json::Value =
+        serde_json::from_str(&kiln(dir.path(), &["inspect", "d.kiln", "--json"]).stdout).unwrap();
+    let bvh = j["sections"].as_array().unwrap().iter().find(|s| s["kind"] == "CWBV").unwrap().clone();
     let mut bytes = std::fs::read(&path).unwrap();
-    let last = bytes.len() - 10;
-    bytes[last] ^= 0x40;
+    let at = bvh["offset"].as_u64().unwrap() as usize + 10;
+    bytes[at] ^= 0x40;
     std::fs::write(&path, &bytes).unwrap();
     let run = kiln(dir.path(), &["verify", "d.kiln"]);
     run.expect(1).says("CWBV").says("checksum mismatch").says("offset 0x");
@@ -69,6 +89,36 @@ fn exit_codes() {
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
     kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.0").says("1.x");
+}
+
+#[test]
+fn shaft_variants_and_resolutions_are_honoured() {
+    let dir = tempfile::tempdir().unwrap();
+    kiln(
+        dir.path(),
+        &["demo", "-o", "b.kiln", "-q", "--shaft-variants", "binary", "--voxel-res", "3", "--shaft-res", "2"],
+    )
+    .expect(0);
+    let j: serde_json::Value =
+        serde_json::from_str(&kiln(dir.path(), &["inspect", "b.kiln", "--json"]).stdout).unwrap();
+    assert_eq!(j["line_space"]["variants"], "binary");
+    assert_eq!(j["line_space"]["shaft_res"], 2);
+    assert_eq!(j["line_space"]["cells"][0], 3);
+    assert_eq!(j["line_space"]["bytes_candidates"], 0);
+    let run = kiln(dir.path(), &["verify", "b.kiln", "--rays", "5000", "--json"]);
+    run.expect(0);
+    let v: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(v["binary"]["false_misses"], 0);
+    assert!(v["candidates"].is_null() && v["pnmt"].is_null());
+    kiln(dir.path(), &["demo", "-o", "n.kiln", "-q", "--shaft-variants", "none"]).expect(0);
+    let j: serde_json::Value =
+        serde_json::from_str(&kiln(dir.path(), &["inspect", "n.kiln", "--json"]).stdout).unwrap();
+    assert!(j["line_space"].is_null());
+    kiln(dir.path(), &["demo", "-o", "x.kiln", "--shaft-variants", "fancy"])
+        .expect(2)
+        .says("unknown shaft variant");
+    kiln(dir.path(), &["demo", "-o", "x.kiln", "--shaft-res", "9"]).expect(2);
+    kiln(dir.path(), &["demo", "-o", "x.kiln", "--voxel-res", "huge"]).expect(2).says("neither 'auto'");
 }
 
 #[test]

@@ -5,7 +5,12 @@ mod util;
 
 use util::{kiln, shared_scene, sidecar};
 
-fn compile_scene(name: &str, dir: &std::path::Path, threads: &str) -> Option<std::path::PathBuf> {
+fn compile_scene(
+    name: &str,
+    dir: &std::path::Path,
+    threads: &str,
+    extra: &[&str],
+) -> Option<std::path::PathBuf> {
     let input = shared_scene(name)?;
     let out = dir.join(format!("{name}-{threads}.kiln"));
     let side = sidecar(name);
@@ -24,16 +29,19 @@ fn compile_scene(name: &str, dir: &std::path::Path, threads: &str) -> Option<std
             &format!("{name}-{threads}.json"),
             "--depfile",
             &format!("{name}-{threads}.d"),
-        ],
+        ]
+        .into_iter()
+        .chain(extra.iter().copied())
+        .collect::<Vec<_>>(),
     )
     .expect(0);
     Some(out)
 }
 
-fn check_scene(name: &str, triangles: u64, textures: u64) {
+fn check_scene(name: &str, triangles: u64, textures: u64, extra: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
-    let Some(one) = compile_scene(name, dir.path(), "1") else { return };
-    let two = compile_scene(name, dir.path(), "2").unwrap();
+    let Some(one) = compile_scene(name, dir.path(), "1", extra) else { return };
+    let two = compile_scene(name, dir.path(), "2", extra).unwrap();
     assert!(
         std::fs::read(&one).unwrap() == std::fs::read(&two).unwrap(),
         "{name}: output differs between 1 and 2 threads"
@@ -44,6 +52,12 @@ fn check_scene(name: &str, triangles: u64, textures: u64) {
     let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
     assert_eq!(j["bvh"]["mismatches"], 0, "{name}: {}", j["bvh"]);
     assert_eq!(j["bvh"]["rays"], 100000);
+    if !j["binary"].is_null() {
+        assert_eq!(j["binary"]["false_misses"], 0, "{name}: {}", j["binary"]);
+    }
+    if !j["candidates"].is_null() {
+        assert_eq!(j["candidates"]["mismatches"], 0, "{name}: {}", j["candidates"]);
+    }
 
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join(format!("{name}-1.json"))).unwrap()).unwrap();
@@ -52,7 +66,10 @@ fn check_scene(name: &str, triangles: u64, textures: u64) {
     assert_eq!(report["threads"], 1);
     let stages: Vec<&str> =
         report["stages"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
-    assert_eq!(stages, ["import", "geometry", "uvs", "materials", "textures", "bvh", "write"]);
+    assert_eq!(
+        stages,
+        ["import", "geometry", "uvs", "materials", "textures", "bvh", "voxel-grid", "line-space", "write"]
+    );
     for s in report["stages"].as_array().unwrap() {
         assert!(s["ms"].as_f64().unwrap() >= 0.0);
         assert!(!s["reason"].as_str().unwrap().is_empty());
@@ -77,12 +94,47 @@ fn check_scene(name: &str, triangles: u64, textures: u64) {
 
 #[test]
 fn cornell_box() {
-    check_scene("cornell_box", 32, 0);
+    // Every line-space variant (the plan's default for this lit scene).
+    check_scene("cornell_box", 32, 0, &[]);
 }
 
 #[test]
 fn pica_pica() {
-    check_scene("pica_pica", 76_274, 6);
+    // Binary line space only here: the default (binary and PNMT, 300 MB) is covered below at a
+    // coarser resolution to keep the test quick.
+    check_scene("pica_pica", 76_274, 6, &["--shaft-variants", "binary"]);
+}
+
+#[test]
+fn pica_pica_every_line_space_variant() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(input) = shared_scene("pica_pica") else { return };
+    let out = dir.path().join("p.kiln");
+    kiln(
+        dir.path(),
+        &[
+            "compile",
+            input.to_str().unwrap(),
+            "-c",
+            sidecar("pica_pica").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--voxel-res",
+            "12",
+            "--shaft-res",
+            "3",
+            "--shaft-variants",
+            "binary,candidates,pnmt",
+        ],
+    )
+    .expect(0);
+    let run = kiln(dir.path(), &["verify", out.to_str().unwrap(), "--rays", "20000", "--json"]);
+    run.expect(0);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    assert_eq!(j["candidates"]["mismatches"], 0, "{}", j["candidates"]);
+    assert_eq!(j["binary"]["false_misses"], 0, "{}", j["binary"]);
+    assert!(j["pnmt"]["position_error"]["median"].as_f64().unwrap() < 2.0, "{}", j["pnmt"]);
 }
 
 #[test]

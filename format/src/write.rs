@@ -204,11 +204,17 @@ impl<'a> FileWriter<'a> {
             _ => Path::new("."),
         };
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let tmp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".kiln-tmp")
-            .tempfile_in(dir)
-            .map_err(err)?;
+        let prefix = format!(".{name}.");
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".kiln-tmp");
+        // Temporary files are private by default; the result should get the permissions of
+        // any file the user creates (0666 less the umask).
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let tmp = builder.tempfile_in(dir).map_err(err)?;
         let mut buf = io::BufWriter::with_capacity(1 << 20, tmp);
         let len = self.write_to(&mut buf).map_err(|e| match e {
             WriteError::Io { source, .. } => err(source),

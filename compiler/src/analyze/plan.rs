@@ -44,6 +44,50 @@ impl Stage {
     }
 }
 
+/// Size budget of the line space chosen by default (variants are dropped, most expensive
+/// first, until the estimate fits); `--shaft-variants` overrides it.
+pub const DEFAULT_LINE_SPACE_BUDGET: u64 = 384 << 20;
+
+/// Default variants for a lit scene: all three, unless the estimated size exceeds
+/// [`DEFAULT_LINE_SPACE_BUDGET`]. The estimate voxelizes (cheap) to count non-empty cells and
+/// assumes 70% of their shafts filled with 5 candidate entries each, as measured on the benchmark
+/// and shared scenes.
+fn default_variants(scene: &Scene, res: u32, n: u32) -> (u32, String) {
+    let bounds = crate::analyze::validate::bounds(scene);
+    let grid = crate::bake::linespace::voxelize::grid(&bounds, res);
+    let corners: Vec<[[f32; 3]; 3]> =
+        scene.triangles.iter().map(|t| t.map(|i| scene.vertices[i as usize].position)).collect();
+    let local = crate::bake::linespace::voxelize::local_triangles(&grid, &corners);
+    let (offsets, _) = crate::bake::linespace::voxelize::voxelize(&grid, &local);
+    let slots = offsets.windows(2).filter(|w| w[1] > w[0]).count() as u64;
+    let filled = slots * kiln_format::linespace::index::shafts_per_voxel(n) as u64 * 7 / 10;
+    let pnmt = filled * 32;
+    let candidates = filled * (4 + 5 * 4);
+    let mib = |b: u64| b >> 20;
+    let budget = DEFAULT_LINE_SPACE_BUDGET;
+    if pnmt + candidates <= budget {
+        (Variants::ALL, format!("all variants: the scene is lit; about {} MiB", mib(pnmt + candidates)))
+    } else if pnmt <= budget {
+        (
+            Variants::BINARY | Variants::PNMT,
+            format!(
+                "candidate lists skipped: with PNMT about {} MiB, over the {} MiB default budget",
+                mib(pnmt + candidates),
+                mib(budget)
+            ),
+        )
+    } else {
+        (
+            Variants::BINARY,
+            format!(
+                "PNMT and candidates skipped: about {} MiB, over the {} MiB default budget",
+                mib(pnmt + candidates),
+                mib(budget)
+            ),
+        )
+    }
+}
+
 /// One stage's decision.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Decision {
@@ -100,13 +144,16 @@ impl Plan {
             || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
             || scene.sky.radiance.iter().any(|&r| r > 0.0);
         let res_text = match settings.voxel_res {
-            VoxelRes::Auto => format!("{voxel_res} cells on the longest axis (auto: cube root of {} triangles)", scene.triangles.len()),
+            VoxelRes::Auto => format!(
+                "{voxel_res} cells on the longest axis (auto: cube root of {} triangles)",
+                scene.triangles.len()
+            ),
             VoxelRes::Cells(n) => format!("{n} cells on the longest axis"),
         };
-        let shaft_variants = match settings.shaft_variants {
-            Some(v) => v,
-            None if lit => Variants::ALL,
-            None => 0,
+        let (shaft_variants, chosen) = match settings.shaft_variants {
+            Some(v) => (v, "requested".to_string()),
+            None if lit => default_variants(scene, voxel_res, settings.shaft_res),
+            None => (0, String::new()),
         };
         if shaft_variants == 0 {
             let why = if settings.shaft_variants.is_some() {
@@ -118,10 +165,13 @@ impl Plan {
             stages.push(skip(Stage::LineSpace, why));
         } else {
             stages.push(run(Stage::VoxelGrid, res_text));
-            let chosen = if settings.shaft_variants.is_some() { "requested" } else { "all variants: the scene is lit" };
             stages.push(run(
                 Stage::LineSpace,
-                format!("N = {}, {} ({chosen})", settings.shaft_res, variants_name(shaft_variants | Variants::BINARY)),
+                format!(
+                    "N = {}, {} ({chosen})",
+                    settings.shaft_res,
+                    variants_name(shaft_variants | Variants::BINARY)
+                ),
             ));
         }
         Plan { stages, voxel_res, shaft_variants }

@@ -210,7 +210,14 @@ pub fn bake(
                         triangles: &tris,
                         materials: &tmat,
                     };
-                    let ls = linespace::bake(&attrs, &bounds(scene), plan.voxel_res, settings.shaft_res, plan.shaft_variants, progress)?;
+                    let ls = linespace::bake(
+                        &attrs,
+                        &bounds(scene),
+                        plan.voxel_res,
+                        settings.shaft_res,
+                        plan.shaft_variants,
+                        progress,
+                    )?;
                     let h = hash("voxel-grid", &[("preset", preset), ("grid", &grid_settings)]);
                     let header = bytemuck::bytes_of(&ls.header).to_vec();
                     let offsets = bytemuck::cast_slice(&ls.voxel_offsets).to_vec();
@@ -246,7 +253,8 @@ pub fn bake(
             Stage::Bvh => bvh_ms,
             Stage::VoxelGrid => line_space.as_ref().map_or(0.0, |l| l.voxel_ms),
             Stage::LineSpace => {
-                let grid_ms = stages.iter().find(|s: &&StageReport| s.stage == "voxel-grid").map_or(0.0, |s| s.ms);
+                let grid_ms =
+                    stages.iter().find(|s: &&StageReport| s.stage == "voxel-grid").map_or(0.0, |s| s.ms);
                 line_space.as_ref().map_or(0.0, |l| l.total_ms - grid_ms)
             }
             _ => start.elapsed().as_secs_f64() * 1e3,

@@ -37,6 +37,23 @@ struct InspectJson {
     manifest: Option<kiln_format::Manifest>,
     manifest_error: Option<String>,
     summary: Summary,
+    /// Voxel grid and line space, when present.
+    line_space: Option<LineSpaceJson>,
+}
+
+#[derive(Serialize)]
+struct LineSpaceJson {
+    cells: [u32; 3],
+    cell_size: f64,
+    shaft_res: u32,
+    variants: String,
+    slots: u32,
+    filled_shafts: u64,
+    candidate_entries: u64,
+    bytes_voxel_grid: u64,
+    bytes_binary: u64,
+    bytes_candidates: u64,
+    bytes_pnmt: u64,
 }
 
 #[derive(Serialize, Default)]
@@ -94,6 +111,29 @@ pub fn run(args: &InspectArgs) -> CliResult {
         lights: manifest.as_ref().map_or(0, |m| m.lights.len() as u64),
         cameras: manifest.as_ref().map_or(0, |m| m.cameras.len() as u64),
     };
+    let line_space = file
+        .pod::<kiln_format::linespace::GridHeader>(sections::GRID, 0)
+        .ok()
+        .flatten()
+        .and_then(|g| g.first().copied())
+        .map(|g| {
+            let size = |kinds: &[kiln_format::SectionKind]| {
+                kinds.iter().filter_map(|&k| file.find(k, 0)).map(|s| s.entry.size).sum::<u64>()
+            };
+            LineSpaceJson {
+                cells: g.dims,
+                cell_size: g.cell,
+                shaft_res: g.shaft_res,
+                variants: crate::settings::variants_name(g.variants),
+                slots: g.slots,
+                filled_shafts: g.filled,
+                candidate_entries: g.entries,
+                bytes_voxel_grid: size(&[sections::GRID, sections::VOXEL_OFFSETS, sections::VOXEL_TRIANGLES]),
+                bytes_binary: size(&[sections::SHAFT_SLOTS, sections::SHAFT_BITS, sections::SHAFT_RANKS]),
+                bytes_candidates: size(&[sections::CANDIDATE_OFFSETS, sections::CANDIDATES]),
+                bytes_pnmt: size(&[sections::PNMT]),
+            }
+        });
     let h = file.header();
     let report = InspectJson {
         path: args.file.display().to_string(),
@@ -104,6 +144,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
         manifest,
         manifest_error,
         summary,
+        line_space,
     };
     if args.json {
         print_json(&report);
@@ -114,6 +155,31 @@ pub fn run(args: &InspectArgs) -> CliResult {
 }
 
 fn print_text(r: &InspectJson) {
+    print_sections(r);
+    if let Some(l) = &r.line_space {
+        println!(
+            "voxel grid {}x{}x{} (cell {:.4}), {} non-empty; line space N = {}, {}: {} filled shafts, {} candidate entries",
+            l.cells[0],
+            l.cells[1],
+            l.cells[2],
+            l.cell_size,
+            l.slots,
+            l.shaft_res,
+            l.variants,
+            l.filled_shafts,
+            l.candidate_entries
+        );
+        println!(
+            "  memory: voxel grid {}, binary {}, candidates {}, PNMT {}",
+            size(l.bytes_voxel_grid),
+            size(l.bytes_binary),
+            size(l.bytes_candidates),
+            size(l.bytes_pnmt)
+        );
+    }
+}
+
+fn print_sections(r: &InspectJson) {
     println!(
         "{}: kiln format {}, {} sections, {}",
         r.path,

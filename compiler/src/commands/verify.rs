@@ -44,19 +44,18 @@ struct LineSpaceMeta {
 /// Runs `kiln verify`.
 pub fn run(args: &VerifyArgs) -> CliResult {
     let path = args.file.display().to_string();
-    let mut report =
-        VerifyJson {
-            path,
-            ok: false,
-            error: None,
-            sections: 0,
-            skipped_sections: vec![],
-            bvh: None,
-            line_space: None,
-            candidates: None,
-            binary: None,
-            pnmt: None,
-        };
+    let mut report = VerifyJson {
+        path,
+        ok: false,
+        error: None,
+        sections: 0,
+        skipped_sections: vec![],
+        bvh: None,
+        line_space: None,
+        candidates: None,
+        binary: None,
+        pnmt: None,
+    };
     let outcome = check(args, &mut report);
     if let Err(e) = &outcome {
         report.error = Some(e.message.clone());
@@ -75,17 +74,30 @@ pub fn run(args: &VerifyArgs) -> CliResult {
             );
         }
         if let Some(c) = &report.candidates {
-            println!("{}: candidates: {} mismatches, {} ties, {} any-hit mismatches", report.path, c.mismatches, c.ties, c.any_hit_mismatches);
+            println!(
+                "{}: candidates: {} mismatches, {} ties, {} any-hit mismatches",
+                report.path, c.mismatches, c.ties, c.any_hit_mismatches
+            );
         }
         if let Some(b) = &report.binary {
-            println!("{}: binary: {} false misses, {} false hits ({} rays hit)", report.path, b.false_misses, b.false_hits, b.hits);
+            println!(
+                "{}: binary: {} false misses, {} false hits ({} rays hit)",
+                report.path, b.false_misses, b.false_hits, b.hits
+            );
         }
         if let Some(p) = &report.pnmt {
             println!(
                 "{}: pnmt: {} hit disagreements ({} only PNMT, {} only exact); position error median {:.3e} p99 {:.3e} max {:.3e}; normal error median {:.2}° p99 {:.2}° max {:.2}°",
-                report.path, p.hit_disagreements, p.pnmt_only, p.reference_only,
-                p.position_error.median, p.position_error.p99, p.position_error.max,
-                p.normal_error_degrees.median, p.normal_error_degrees.p99, p.normal_error_degrees.max
+                report.path,
+                p.hit_disagreements,
+                p.pnmt_only,
+                p.reference_only,
+                p.position_error.median,
+                p.position_error.p99,
+                p.position_error.max,
+                p.normal_error_degrees.median,
+                p.normal_error_degrees.p99,
+                p.normal_error_degrees.max
             );
         }
         println!("{}: ok ({} sections)", report.path, report.sections);
@@ -96,7 +108,8 @@ pub fn run(args: &VerifyArgs) -> CliResult {
 fn check(args: &VerifyArgs, report: &mut VerifyJson) -> CliResult {
     let file = KilnFile::open(&args.file, Checksums::Eager).map_err(|e| format_error(&args.file, e))?;
     let view = SceneView::new(&file).map_err(|e| format_error(&args.file, e))?;
-    let line_space = LineSpace::new(&file, view.triangles.len(), view.materials.len()).map_err(|e| format_error(&args.file, e))?;
+    let line_space = LineSpace::new(&file, view.triangles.len(), view.materials.len())
+        .map_err(|e| format_error(&args.file, e))?;
     report.sections = file.sections().len();
     report.skipped_sections = file
         .skipped()

@@ -75,7 +75,8 @@ impl GridHeader {
 
     /// Maximum corner of the grid.
     pub fn grid_max(&self) -> DVec3 {
-        DVec3::from(self.origin) + DVec3::new(self.dims[0] as f64, self.dims[1] as f64, self.dims[2] as f64) * self.cell
+        DVec3::from(self.origin)
+            + DVec3::new(self.dims[0] as f64, self.dims[1] as f64, self.dims[2] as f64) * self.cell
     }
 }
 
@@ -146,7 +147,13 @@ impl Dda {
                 c -= 1;
             }
             dda.cell[a] = c.clamp(0, dims[a] - 1);
-            dda.step[a] = if d[a] > 0.0 { 1 } else if d[a] < 0.0 { -1 } else { 0 };
+            dda.step[a] = if d[a] > 0.0 {
+                1
+            } else if d[a] < 0.0 {
+                -1
+            } else {
+                0
+            };
             dda.t_next[a] = dda.boundary(a);
         }
         dda

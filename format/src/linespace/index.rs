@@ -61,7 +61,13 @@ pub fn patch_of(u: f64, v: f64, n: u32) -> u32 {
 /// The shaft through entry (face, patch) and exit (face, patch), and whether it is traversed
 /// front to back. `None` when both faces are the same (no volume: such a line only touches the
 /// voxel along a face).
-pub fn shaft(entry_face: u32, entry_patch: u32, exit_face: u32, exit_patch: u32, n: u32) -> Option<(u32, bool)> {
+pub fn shaft(
+    entry_face: u32,
+    entry_patch: u32,
+    exit_face: u32,
+    exit_patch: u32,
+    n: u32,
+) -> Option<(u32, bool)> {
     let n2 = n * n;
     if entry_face == exit_face {
         return None;

@@ -10,6 +10,7 @@
 //! - **PNMT**: position, normal, material and texture coordinates of the front and back hit of
 //!   each filled shaft's midpoint ray: an approximate hit without any triangle test.
 
+pub mod glsl;
 mod grid;
 pub mod index;
 mod pnmt;
@@ -94,14 +95,25 @@ impl<'a> LineSpace<'a> {
     /// `materials` are the scene's counts.
     pub fn new(file: &'a KilnFile, triangles: usize, materials: usize) -> Result<Option<LineSpace<'a>>> {
         let Some(header) = file.pod::<GridHeader>(GRID, 0)? else {
-            for k in [VOXEL_OFFSETS, VOXEL_TRIANGLES, SHAFT_SLOTS, SHAFT_BITS, SHAFT_RANKS, CANDIDATE_OFFSETS, CANDIDATES, PNMT] {
+            for k in [
+                VOXEL_OFFSETS,
+                VOXEL_TRIANGLES,
+                SHAFT_SLOTS,
+                SHAFT_BITS,
+                SHAFT_RANKS,
+                CANDIDATE_OFFSETS,
+                CANDIDATES,
+                PNMT,
+            ] {
                 if file.find(k, 0).is_some() {
                     return Err(bad(format!("section {k} without a VGRD header")));
                 }
             }
             return Ok(None);
         };
-        let [h] = header else { return Err(bad(format!("VGRD holds {} headers, must hold 1", header.len()))) };
+        let [h] = header else {
+            return Err(bad(format!("VGRD holds {} headers, must hold 1", header.len())));
+        };
         let h = *h;
         let get = |k| -> Result<&'a [u32]> { Ok(file.pod::<u32>(k, 0)?.unwrap_or(&[])) };
         let ls = LineSpace {
@@ -147,24 +159,42 @@ impl<'a> LineSpace<'a> {
             }
         }
         if max_tris != h.max_cell_triangles {
-            return Err(bad(format!("header says {} triangles in the fullest cell, found {max_tris}", h.max_cell_triangles)));
+            return Err(bad(format!(
+                "header says {} triangles in the fullest cell, found {max_tris}",
+                h.max_cell_triangles
+            )));
         }
         if h.variants == 0 {
-            let extra = [self.slots, self.bits, self.ranks, self.candidate_offsets, self.candidates].iter().any(|s| !s.is_empty());
-            if h.shaft_res != 0 || h.slots != 0 || h.filled != 0 || h.entries != 0 || extra || !self.pnmt.is_empty() {
+            let extra = [self.slots, self.bits, self.ranks, self.candidate_offsets, self.candidates]
+                .iter()
+                .any(|s| !s.is_empty());
+            if h.shaft_res != 0
+                || h.slots != 0
+                || h.filled != 0
+                || h.entries != 0
+                || extra
+                || !self.pnmt.is_empty()
+            {
                 return Err(bad("line-space data without line-space variants in the header".into()));
             }
             return Ok(());
         }
         if h.variants & !Variants::ALL != 0 || h.variants & Variants::BINARY == 0 {
-            return Err(bad(format!("variant bits {:#x} are not a defined set including binary", h.variants)));
+            return Err(bad(format!(
+                "variant bits {:#x} are not a defined set including binary",
+                h.variants
+            )));
         }
         if !(1..=MAX_SHAFT_RES).contains(&h.shaft_res) {
             return Err(bad(format!("shaft resolution {} is outside 1..=8", h.shaft_res)));
         }
         // Slots are numbered in cell order over non-empty cells.
         if self.slots.len() as u64 != cells || h.slots != nonempty {
-            return Err(bad(format!("{} slots for {cells} cells ({nonempty} non-empty, header says {})", self.slots.len(), h.slots)));
+            return Err(bad(format!(
+                "{} slots for {cells} cells ({nonempty} non-empty, header says {})",
+                self.slots.len(),
+                h.slots
+            )));
         }
         let mut next = 0u32;
         for (c, &s) in self.slots.iter().enumerate() {
@@ -176,7 +206,12 @@ impl<'a> LineSpace<'a> {
         }
         let wps = self.words_per_slot;
         if self.bits.len() != wps * h.slots as usize || self.ranks.len() != self.bits.len() {
-            return Err(bad(format!("{} bit words and {} rank words for {} slots of {wps} words", self.bits.len(), self.ranks.len(), h.slots)));
+            return Err(bad(format!(
+                "{} bit words and {} rank words for {} slots of {wps} words",
+                self.bits.len(),
+                self.ranks.len(),
+                h.slots
+            )));
         }
         let tail = shafts_per_voxel(h.shaft_res) as usize % 32;
         let mut rank = 0u64;
@@ -199,10 +234,18 @@ impl<'a> LineSpace<'a> {
             }
             let offs = self.candidate_offsets;
             if offs.len() as u64 != h.filled + 1 || offs[0] != 0 || offs.windows(2).any(|w| w[0] > w[1]) {
-                return Err(bad(format!("{} candidate offsets for {} filled shafts, or not increasing", offs.len(), h.filled)));
+                return Err(bad(format!(
+                    "{} candidate offsets for {} filled shafts, or not increasing",
+                    offs.len(),
+                    h.filled
+                )));
             }
             if *offs.last().unwrap_or(&0) as u64 != h.entries || self.candidates.len() as u64 != h.entries {
-                return Err(bad(format!("{} candidate entries, header says {}", self.candidates.len(), h.entries)));
+                return Err(bad(format!(
+                    "{} candidate entries, header says {}",
+                    self.candidates.len(),
+                    h.entries
+                )));
             }
             for (c, &slot) in self.slots.iter().enumerate() {
                 if slot == NO_SLOT {
@@ -214,7 +257,9 @@ impl<'a> LineSpace<'a> {
                 let count: usize = words.iter().map(|w| w.count_ones() as usize).sum();
                 let (a, b) = (offs[first] as usize, offs[first + count] as usize);
                 if let Some(e) = self.candidates[a..b].iter().find(|&&e| entry::local(e) >= n) {
-                    return Err(bad(format!("cell {c}: candidate entry {e:#x} names a triangle beyond its {n}")));
+                    return Err(bad(format!(
+                        "cell {c}: candidate entry {e:#x} names a triangle beyond its {n}"
+                    )));
                 }
             }
         } else if !self.candidate_offsets.is_empty() || !self.candidates.is_empty() || h.entries != 0 {
@@ -224,7 +269,9 @@ impl<'a> LineSpace<'a> {
             if self.pnmt.len() as u64 != 2 * h.filled {
                 return Err(bad(format!("{} PNMT records for {} filled shafts", self.pnmt.len(), h.filled)));
             }
-            if let Some(r) = self.pnmt.iter().find(|r| r.material != NO_RECORD && r.material as usize >= materials) {
+            if let Some(r) =
+                self.pnmt.iter().find(|r| r.material != NO_RECORD && r.material as usize >= materials)
+            {
                 return Err(bad(format!("PNMT record names material {} of {materials}", r.material)));
             }
         } else if !self.pnmt.is_empty() {

@@ -69,7 +69,14 @@ pub fn oct_decode(e: Vec2) -> Vec3 {
 
 impl PnmtRecord {
     /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell`.
-    pub fn encode(position: DVec3, normal: Vec3, material: u16, uv: Vec2, cell_min: DVec3, cell: f64) -> PnmtRecord {
+    pub fn encode(
+        position: DVec3,
+        normal: Vec3,
+        material: u16,
+        uv: Vec2,
+        cell_min: DVec3,
+        cell: f64,
+    ) -> PnmtRecord {
         let local = ((position - cell_min) / cell).clamp(DVec3::ZERO, DVec3::ONE);
         let q = |x: f64| (x * 65535.0).round() as u16;
         let e = oct_encode(normal.try_normalize().unwrap_or(Vec3::Z));
@@ -92,7 +99,8 @@ impl PnmtRecord {
         if !self.is_some() {
             return None;
         }
-        let p = DVec3::new(self.position[0] as f64, self.position[1] as f64, self.position[2] as f64) / 65535.0;
+        let p =
+            DVec3::new(self.position[0] as f64, self.position[1] as f64, self.position[2] as f64) / 65535.0;
         let n = oct_decode(Vec2::new(self.normal[0] as f32 / 32767.0, self.normal[1] as f32 / 32767.0));
         Some(PnmtHit {
             position: cell_min + p * cell,
@@ -103,7 +111,8 @@ impl PnmtRecord {
     }
 
     /// The absent record.
-    pub const NONE: PnmtRecord = PnmtRecord { position: [0; 3], material: NO_RECORD, normal: [0; 2], uv: [0; 2] };
+    pub const NONE: PnmtRecord =
+        PnmtRecord { position: [0; 3], material: NO_RECORD, normal: [0; 2], uv: [0; 2] };
 }
 
 #[cfg(test)]

@@ -47,7 +47,7 @@ pub struct PnmtQueryHit {
 /// Outward normal of a face as a vector.
 fn outward(face: u32) -> DVec3 {
     let mut n = DVec3::ZERO;
-    n[(face / 2) as usize] = if face % 2 == 0 { -1.0 } else { 1.0 };
+    n[(face / 2) as usize] = if face.is_multiple_of(2) { -1.0 } else { 1.0 };
     n
 }
 
@@ -66,8 +66,10 @@ impl LineSpace<'_> {
                 far[a] = t0.max(t1);
             }
         }
-        let ea = (0..3).filter(|&a| d[a] != 0.0).max_by(|&x, &y| near[x].total_cmp(&near[y]).then(y.cmp(&x)))?;
-        let xa = (0..3).filter(|&a| d[a] != 0.0).min_by(|&x, &y| far[x].total_cmp(&far[y]).then(x.cmp(&y)))?;
+        let ea =
+            (0..3).filter(|&a| d[a] != 0.0).max_by(|&x, &y| near[x].total_cmp(&near[y]).then(y.cmp(&x)))?;
+        let xa =
+            (0..3).filter(|&a| d[a] != 0.0).min_by(|&x, &y| far[x].total_cmp(&far[y]).then(x.cmp(&y)))?;
         if near[ea] > far[xa] {
             return None;
         }
@@ -79,7 +81,8 @@ impl LineSpace<'_> {
             let (u, v) = face_uv_axes(face);
             patch_of(q[u], q[v], n)
         };
-        let (s, front) = shaft(entry_face, patch(entry_face, near[ea]), exit_face, patch(exit_face, far[xa]), n)?;
+        let (s, front) =
+            shaft(entry_face, patch(entry_face, near[ea]), exit_face, patch(exit_face, far[xa]), n)?;
         let (fa, fb) = if front { (entry_face, exit_face) } else { (exit_face, entry_face) };
         let key_dir = outward(fb) - outward(fa);
         Some(ShaftLookup { shaft: s, front, key_dir, key_lo: key_dir.min(DVec3::ZERO).element_sum() })

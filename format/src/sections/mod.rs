@@ -154,7 +154,12 @@ pub const KNOWN: &[KindInfo] = &[
 ];
 
 /// A non-indexed, optional POD kind at version 1.
-const fn pod_kind(kind: SectionKind, name: &'static str, element_size: usize, description: &'static str) -> KindInfo {
+const fn pod_kind(
+    kind: SectionKind,
+    name: &'static str,
+    element_size: usize,
+    description: &'static str,
+) -> KindInfo {
     KindInfo { kind, name, version: 1, element_size, required: false, indexed: false, description }
 }
 

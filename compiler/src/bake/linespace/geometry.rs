@@ -46,7 +46,13 @@ impl Prepared {
                 axes.push(b.cross(ei));
             }
         }
-        let mut lanes = Lanes { l: [[0.0; LANES]; 3], a: [[0.0; LANES]; 3], l1: [0.0; LANES], t0: [-1.0; LANES], t1: [1.0; LANES] };
+        let mut lanes = Lanes {
+            l: [[0.0; LANES]; 3],
+            a: [[0.0; LANES]; 3],
+            l1: [0.0; LANES],
+            t0: [-1.0; LANES],
+            t1: [1.0; LANES],
+        };
         for (i, l) in axes.into_iter().enumerate() {
             let p = [l.dot(v[0]), l.dot(v[1]), l.dot(v[2])];
             for k in 0..3 {
@@ -254,6 +260,13 @@ mod tests {
         let poly = clip_to_box(v, DVec3::ZERO, DVec3::ONE);
         assert!(poly.len() >= 3);
         assert!(poly.iter().all(|p| p.cmpge(DVec3::ZERO).all() && p.cmple(DVec3::ONE).all()));
-        assert!(clip_to_box([DVec3::splat(2.0), DVec3::splat(3.0), DVec3::new(2.0, 3.0, 2.0)], DVec3::ZERO, DVec3::ONE).is_empty());
+        assert!(
+            clip_to_box(
+                [DVec3::splat(2.0), DVec3::splat(3.0), DVec3::new(2.0, 3.0, 2.0)],
+                DVec3::ZERO,
+                DVec3::ONE
+            )
+            .is_empty()
+        );
     }
 }

@@ -136,18 +136,33 @@ pub fn bake(
     let done = std::sync::atomic::AtomicUsize::new(0);
     let per_cell: Vec<shafts::CellShafts> = occupied
         .par_iter()
-        .map(|&c| {
+        .map_init(shafts::Scratch::default, |scratch, &c| {
             let cc = header.cell_coords(c);
             let cell_min = DVec3::new(cc[0] as f64, cc[1] as f64, cc[2] as f64);
             let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
-            let r = shafts::bake_cell(tris, &local, cell_min, header.cell_min(cc), header.cell, n, margin_local, candidates, pnmt, attrs);
+            let r = shafts::bake_cell(
+                tris,
+                &local,
+                cell_min,
+                header.cell_min(cc),
+                header.cell,
+                n,
+                margin_local,
+                candidates,
+                pnmt,
+                attrs,
+                scratch,
+            );
             let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            if k % 64 == 0 {
+            if k.is_multiple_of(64) {
                 progress.stage(&format!("line space: {k}/{} cells", occupied.len()));
             }
             r
         })
         .collect();
+    let words: usize = per_cell.iter().map(|c| c.bits.len()).sum();
+    out.bits.reserve_exact(words);
+    out.ranks.reserve_exact(words);
     let mut rank = 0u64;
     for cell in &per_cell {
         out.tests += cell.tests;
@@ -159,20 +174,26 @@ pub fn bake(
     }
     header.filled = rank;
     if candidates {
-        out.candidate_offsets.reserve(rank as usize + 1);
+        let entries: usize = per_cell.iter().flat_map(|c| &c.lists).map(Vec::len).sum();
+        out.candidates.reserve_exact(entries);
+        out.candidate_offsets.reserve_exact(rank as usize + 1);
         out.candidate_offsets.push(0);
-        for list in per_cell.iter().flat_map(|c| &c.lists) {
-            out.candidates.extend_from_slice(list);
-            out.candidate_offsets.push(u32::try_from(out.candidates.len()).map_err(|_| too_many())?);
-        }
-        header.entries = out.candidates.len() as u64;
     }
     if pnmt {
-        for r in per_cell.iter().flat_map(|c| &c.pnmt) {
+        out.pnmt.reserve_exact(2 * rank as usize);
+    }
+    // Consume the cells one by one, so that their memory is freed as it is copied.
+    for cell in per_cell {
+        for list in cell.lists {
+            out.candidates.extend_from_slice(&list);
+            out.candidate_offsets.push(u32::try_from(out.candidates.len()).map_err(|_| too_many())?);
+        }
+        for r in cell.pnmt {
             out.pnmt_missing += (!r[0].is_some() || !r[1].is_some()) as u64;
-            out.pnmt.extend_from_slice(r);
+            out.pnmt.extend_from_slice(&r);
         }
     }
+    header.entries = out.candidates.len() as u64;
     out.header = header;
     out.voxel_offsets = voxel_offsets;
     out.voxel_triangles = voxel_triangles;
@@ -181,6 +202,58 @@ pub fn bake(
     Ok(out)
 }
 
+/// Fraction of filled shafts that no triangle meets exactly (the price of taking small
+/// triangles' projected reach without exact tests), estimated from up to `samples` filled shafts
+/// spread evenly over the line space.
+pub fn false_fill_rate(attrs: &SceneAttributes, ls: &BakedLineSpace, samples: usize) -> f64 {
+    let h = &ls.header;
+    if h.filled == 0 {
+        return 0.0;
+    }
+    let corners: Vec<[[f32; 3]; 3]> =
+        attrs.triangles.iter().map(|t| t.map(|i| attrs.vertices[i as usize].position)).collect();
+    let local = voxelize::local_triangles(h, &corners);
+    let wps = kiln_format::linespace::words_per_slot(h.shaft_res);
+    let step = (h.filled as usize / samples.max(1)).max(1);
+    let mut picked = Vec::new();
+    let mut rank = 0usize;
+    for (c, &slot) in ls.slots.iter().enumerate() {
+        if slot == NO_SLOT {
+            continue;
+        }
+        for w in 0..wps {
+            let mut word = ls.bits[slot as usize * wps + w];
+            while word != 0 {
+                let bit = word.trailing_zeros();
+                word &= word - 1;
+                if rank.is_multiple_of(step) {
+                    picked.push((c, (w * 32) as u32 + bit));
+                }
+                rank += 1;
+            }
+        }
+    }
+    let margin = h.margin / h.cell;
+    let false_fills = picked
+        .par_iter()
+        .filter(|&&(c, shaft)| {
+            let cc = h.cell_coords(c);
+            let tris = &ls.voxel_triangles[ls.voxel_offsets[c] as usize..ls.voxel_offsets[c + 1] as usize];
+            !shafts::meets_exactly(
+                tris,
+                &local,
+                DVec3::new(cc[0] as f64, cc[1] as f64, cc[2] as f64),
+                shaft,
+                h.shaft_res,
+                margin,
+            )
+        })
+        .count();
+    false_fills as f64 / picked.len().max(1) as f64
+}
+
 fn too_many() -> CliError {
-    CliError::input("the line space has more than 2^32 filled shafts or candidate entries; lower --voxel-res or --shaft-res")
+    CliError::input(
+        "the line space has more than 2^32 filled shafts or candidate entries; lower --voxel-res or --shaft-res",
+    )
 }

@@ -4,10 +4,10 @@
 //! (triangle, shaft) pair; then the bits, the sorted candidate lists and the PNMT records.
 
 use glam::{DVec3, Vec2, Vec3};
-use kiln_format::linespace::index::{FACE_PAIRS, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel};
+use kiln_format::linespace::index::{
+    FACE_PAIRS, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel,
+};
 use kiln_format::linespace::{PnmtRecord, entry, words_per_slot};
-use kiln_format::query::{Ray, intersect_triangle};
-
 
 use super::geometry::{Prepared, clip_to_box};
 
@@ -52,7 +52,7 @@ fn face_box(face: u32, u: (f64, f64), v: (f64, f64)) -> (DVec3, DVec3) {
 /// Outward normal of a face.
 fn outward(face: u32) -> DVec3 {
     let mut n = DVec3::ZERO;
-    n[face_axis(face)] = if face % 2 == 0 { -1.0 } else { 1.0 };
+    n[face_axis(face)] = if face.is_multiple_of(2) { -1.0 } else { 1.0 };
     n
 }
 
@@ -89,7 +89,8 @@ fn reach(from_rect: &[DVec3; 4], poly: &[DVec3], to: u32, n: u32, pad: f64) -> O
     let j = face_axis(to);
     let bj = (to % 2) as f64;
     let (ua, va) = face_uv_axes(to);
-    let (mut umin, mut umax, mut vmin, mut vmax) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut umin, mut umax, mut vmin, mut vmax) =
+        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
     let mut sign = 0.0f64;
     for x in from_rect {
         let reach = bj - x[j];
@@ -118,7 +119,17 @@ fn reach(from_rect: &[DVec3; 4], poly: &[DVec3], to: u32, n: u32, pad: f64) -> O
 /// on face b its projection reaches. Where the projection is undefined or reaches many patches,
 /// exact tests decide (a hierarchical search over patch ranges, see [`exact_search`]).
 #[allow(clippy::too_many_arguments)]
-fn search(tri: &Prepared, poly: &[DVec3], pair: u32, n: u32, margin: f64, direct_limit: u32, tests: &mut u64, found: &mut impl FnMut(u32)) {
+fn search(
+    tri: &Prepared,
+    poly: &[DVec3],
+    pair: u32,
+    n: u32,
+    margin: f64,
+    direct_limit: u32,
+    stack: &mut Vec<[u32; 8]>,
+    tests: &mut u64,
+    found: &mut impl FnMut(u32),
+) {
     let (fa, fb) = pair_faces(pair);
     if poly.is_empty() {
         return;
@@ -128,7 +139,8 @@ fn search(tri: &Prepared, poly: &[DVec3], pair: u32, n: u32, margin: f64, direct
     let prange = reach(&corners(fb, (0.0, 1.0), (0.0, 1.0)), poly, fa, n, margin).unwrap_or([0, n, 0, n]);
     for au in prange[0]..prange[1] {
         for av in prange[2]..prange[3] {
-            let p_rect = corners(fa, (au as f64 * s, (au + 1) as f64 * s), (av as f64 * s, (av + 1) as f64 * s));
+            let p_rect =
+                corners(fa, (au as f64 * s, (au + 1) as f64 * s), (av as f64 * s, (av + 1) as f64 * s));
             match reach(&p_rect, poly, fb, n, margin) {
                 Some(q) if (q[1] - q[0]) * (q[3] - q[2]) <= direct_limit => {
                     for bu in q[0]..q[1] {
@@ -139,7 +151,16 @@ fn search(tri: &Prepared, poly: &[DVec3], pair: u32, n: u32, margin: f64, direct
                 }
                 q => {
                     let q = q.unwrap_or([0, n, 0, n]);
-                    exact_search(tri, pair, n, margin, [au, au + 1, av, av + 1, q[0], q[1], q[2], q[3]], tests, found);
+                    exact_search(
+                        tri,
+                        pair,
+                        n,
+                        margin,
+                        [au, au + 1, av, av + 1, q[0], q[1], q[2], q[3]],
+                        stack,
+                        tests,
+                        found,
+                    );
                 }
             }
         }
@@ -148,7 +169,17 @@ fn search(tri: &Prepared, poly: &[DVec3], pair: u32, n: u32, margin: f64, direct
 
 /// Exact hierarchical search from the range pair `start`: ranges whose hull misses the
 /// triangle are dropped, ranges it covers are emitted whole, others split.
-fn exact_search(tri: &Prepared, pair: u32, n: u32, margin: f64, start: [u32; 8], tests: &mut u64, found: &mut impl FnMut(u32)) {
+#[allow(clippy::too_many_arguments)]
+fn exact_search(
+    tri: &Prepared,
+    pair: u32,
+    n: u32,
+    margin: f64,
+    start: [u32; 8],
+    stack: &mut Vec<[u32; 8]>,
+    tests: &mut u64,
+    found: &mut impl FnMut(u32),
+) {
     let (fa, fb) = pair_faces(pair);
     let s = 1.0 / n as f64;
     let n2 = n * n;
@@ -163,7 +194,8 @@ fn exact_search(tri: &Prepared, pair: u32, n: u32, margin: f64, start: [u32; 8],
             }
         }
     };
-    let mut stack = vec![start];
+    stack.clear();
+    stack.push(start);
     while let Some(r) = stack.pop() {
         if (0..4).any(|k| r[2 * k] >= r[2 * k + 1]) {
             continue;
@@ -192,7 +224,10 @@ fn exact_search(tri: &Prepared, pair: u32, n: u32, margin: f64, start: [u32; 8],
             continue;
         }
         let leaves = (r[1] - r[0]) * (r[3] - r[2]) * (r[5] - r[4]) * (r[7] - r[6]);
-        if leaves >= 4 && tri.separates(ca, ha, cb, hb, margin) && tri.covers(&corners(fa, ua, va), &corners(fb, ub, vb), margin) {
+        if leaves >= 4
+            && tri.separates(ca, ha, cb, hb, margin)
+            && tri.covers(&corners(fa, ua, va), &corners(fb, ub, vb), margin)
+        {
             emit(&r, found);
             continue;
         }
@@ -233,6 +268,18 @@ struct End {
     local: u32,
 }
 
+/// Buffers reused across the cells one worker thread bakes (allocating them per cell costs
+/// page faults on every cell).
+#[derive(Debug, Default)]
+pub struct Scratch {
+    stack: Vec<[u32; 8]>,
+    hits: Vec<(u32, u8, u8, u16)>,
+    sorted: Vec<(u32, u8, u8, u16)>,
+    counts: Vec<u32>,
+    ends: Vec<[End; 2]>,
+    polys: Vec<Vec<DVec3>>,
+}
+
 const NO_END: End = End { t: f32::NAN, triangle: u32::MAX, u: 0.0, v: 0.0, key: f64::NAN, local: u32::MAX };
 
 /// Bakes one cell. `tris` are the cell's global triangle numbers, `local` their grid-local
@@ -253,13 +300,18 @@ pub fn bake_cell(
     candidates: bool,
     pnmt: bool,
     attrs: &dyn HitAttributes,
+    scratch: &mut Scratch,
 ) -> CellShafts {
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
+    let Scratch { stack, hits, sorted, counts, ends, polys } = scratch;
     // (shaft, key min, key max, local triangle)
-    let mut hits: Vec<(u32, u8, u8, u16)> = Vec::new();
-    let mut ends: Vec<[End; 2]> = if pnmt { vec![[NO_END; 2]; shafts] } else { Vec::new() };
-    let mut polys: Vec<Vec<DVec3>> = Vec::with_capacity(tris.len());
+    hits.clear();
+    ends.clear();
+    if pnmt {
+        ends.resize(shafts, [NO_END; 2]);
+    }
+    polys.clear();
     let lo_box = DVec3::splat(-margin);
     let hi_box = DVec3::splat(1.0 + margin);
     // Midpoint segments: patch centres in world space, per face and patch.
@@ -281,7 +333,7 @@ pub fn bake_cell(
         let v = local[t as usize].map(|p| p - cell_min);
         let prep = Prepared::new(v);
         let poly = clip_to_box(v, lo_box, hi_box);
-        let corners_world = if pnmt { attrs.corners(t) } else { [Vec3::ZERO; 3] };
+        let seg = if pnmt { SegmentTest::new(attrs.corners(t)) } else { SegmentTest::new([Vec3::ZERO; 3]) };
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let w = outward(fb) - outward(fa);
@@ -289,10 +341,13 @@ pub fn bake_cell(
             let (kmin, kmax) = if poly.is_empty() {
                 (f64::NEG_INFINITY, f64::INFINITY)
             } else {
-                poly.iter().map(|p| p.dot(w)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
+                poly.iter()
+                    .map(|p| p.dot(w))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
             };
-            let (qmin, qmax) = (quantise(kmin - 2.0 * margin, key_lo, false), quantise(kmax + 2.0 * margin, key_lo, true));
-            search(&prep, &poly, pair, n, margin, DIRECT_LIMIT, &mut out.tests, &mut |shaft| {
+            let (qmin, qmax) =
+                (quantise(kmin - 2.0 * margin, key_lo, false), quantise(kmax + 2.0 * margin, key_lo, true));
+            search(&prep, &poly, pair, n, margin, DIRECT_LIMIT, stack, &mut out.tests, &mut |shaft| {
                 out.bits[(shaft / 32) as usize] |= 1 << (shaft % 32);
                 if candidates {
                     hits.push((shaft, qmin as u8, qmax as u8, li as u16));
@@ -300,9 +355,8 @@ pub fn bake_cell(
                 if pnmt {
                     let (_, pa, _, pb) = shaft_parts(shaft, n);
                     let (o, e) = (centres[fa as usize][pa as usize], centres[fb as usize][pb as usize]);
-                    let ray = Ray::new(o, e - o, 0.0, 1.0);
                     let end = &mut ends[shaft as usize];
-                    if let Some(h) = intersect_triangle(&ray, corners_world, 1.0) {
+                    if let Some(h) = seg.hit(o, e) {
                         if !(h.t >= end[0].t) {
                             end[0] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[0] };
                         }
@@ -325,21 +379,25 @@ pub fn bake_cell(
     }
     if candidates {
         // Bucket by shaft (stable: triangle order), then order each bucket by key.
-        let mut counts = vec![0u32; shafts + 1];
-        for h in &hits {
+        counts.clear();
+        counts.resize(shafts + 1, 0);
+        for h in hits.iter() {
             counts[h.0 as usize + 1] += 1;
         }
         for i in 0..shafts {
             counts[i + 1] += counts[i];
         }
-        let mut sorted = vec![(0u32, 0u8, 0u8, 0u16); hits.len()];
-        let mut fill = counts.clone();
-        for h in &hits {
-            sorted[fill[h.0 as usize] as usize] = *h;
-            fill[h.0 as usize] += 1;
+        sorted.clear();
+        sorted.resize(hits.len(), (0, 0, 0, 0));
+        for h in hits.iter() {
+            let slot = &mut counts[h.0 as usize];
+            sorted[*slot as usize] = *h;
+            *slot += 1;
         }
+        // counts[s] now ends bucket s; bucket s starts where bucket s − 1 ended.
         for shaft in 0..shafts {
-            let group = &mut sorted[counts[shaft] as usize..counts[shaft + 1] as usize];
+            let start = if shaft == 0 { 0 } else { counts[shaft - 1] as usize };
+            let group = &mut sorted[start..counts[shaft] as usize];
             if group.is_empty() {
                 continue;
             }
@@ -388,12 +446,62 @@ pub fn bake_cell(
                 let t = tris[e.local as usize];
                 let world = world_cell_min + q.clamp(DVec3::ZERO, DVec3::ONE) * cell;
                 let (u, v) = barycentric(attrs.corners(t), world.as_vec3());
-                PnmtRecord::encode(world, attrs.normal(t, u, v), attrs.material(t), attrs.uv(t, u, v), world_cell_min, cell)
+                PnmtRecord::encode(
+                    world,
+                    attrs.normal(t, u, v),
+                    attrs.material(t),
+                    attrs.uv(t, u, v),
+                    world_cell_min,
+                    cell,
+                )
             };
             out.pnmt.push([record(&end[0], true), record(&end[1], false)]);
         }
     }
     out
+}
+
+/// A segment–triangle test for midpoint segments (PNMT records need the nearest hit, not a
+/// watertight one): plane crossing, then three edge functions.
+#[derive(Debug, Clone, Copy)]
+struct SegmentTest {
+    c: [Vec3; 3],
+    n: Vec3,
+    n2: f32,
+}
+
+impl SegmentTest {
+    fn new(c: [Vec3; 3]) -> SegmentTest {
+        let n = (c[1] - c[0]).cross(c[2] - c[0]);
+        SegmentTest { c, n, n2: n.length_squared() }
+    }
+
+    /// (t, u, v) where the segment o → e crosses the triangle.
+    fn hit(&self, o: Vec3, e: Vec3) -> Option<Intersection> {
+        let d = e - o;
+        let denom = self.n.dot(d);
+        if denom == 0.0 || self.n2 == 0.0 {
+            return None;
+        }
+        let t = self.n.dot(self.c[0] - o) / denom;
+        if !(0.0..=1.0).contains(&t) {
+            return None;
+        }
+        let p = o + d * t;
+        let [a, b, c] = self.c;
+        let w0 = self.n.dot((b - a).cross(p - a));
+        let w1 = self.n.dot((c - b).cross(p - b));
+        let w2 = self.n.dot((a - c).cross(p - c));
+        (w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0).then(|| Intersection { t, u: w2 / self.n2, v: w0 / self.n2 })
+    }
+}
+
+/// Where a midpoint segment crosses a triangle.
+#[derive(Debug, Clone, Copy)]
+struct Intersection {
+    t: f32,
+    u: f32,
+    v: f32,
 }
 
 /// Barycentric weights (of corners 1 and 2) of the point of the triangle's plane nearest `p`.
@@ -406,4 +514,32 @@ fn barycentric(c: [Vec3; 3], p: Vec3) -> (f32, f32) {
         return (0.0, 0.0);
     }
     ((cc * x - b * y) / det, (a * y - b * x) / det)
+}
+
+/// Whether any of `tris` (grid-local corners `local`) meets the widened shaft of cell `cell_min`
+/// exactly: the reference for the false-fill measurement of the bake.
+pub fn meets_exactly(
+    tris: &[u32],
+    local: &[[DVec3; 3]],
+    cell_min: DVec3,
+    shaft: u32,
+    n: u32,
+    margin: f64,
+) -> bool {
+    let (fa, pa, fb, pb) = shaft_parts(shaft, n);
+    let s = 1.0 / n as f64;
+    let rect =
+        |p: u32| (((p / n) as f64 * s, (p / n + 1) as f64 * s), ((p % n) as f64 * s, (p % n + 1) as f64 * s));
+    let ((ua, va), (ub, vb)) = (rect(pa), rect(pb));
+    let (ca, ha) = face_box(fa, ua, va);
+    let (cb, hb) = face_box(fb, ub, vb);
+    tris.iter().any(|&t| {
+        Prepared::new(local[t as usize].map(|p| p - cell_min)).overlaps_sweep(
+            ca,
+            cb - ca,
+            ha,
+            hb - ha,
+            margin,
+        )
+    })
 }

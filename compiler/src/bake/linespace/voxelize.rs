@@ -37,7 +37,13 @@ pub fn grid(bounds: &Bounds, res: u32) -> GridHeader {
     // Centre the grid on the bounds so that both sides have the same slack.
     let size = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) * cell;
     let origin = lo - (size - extent) * 0.5;
-    GridHeader { origin: origin.to_array(), cell, margin: margin(origin, size, cell), dims, ..Default::default() }
+    GridHeader {
+        origin: origin.to_array(),
+        cell,
+        margin: margin(origin, size, cell),
+        dims,
+        ..Default::default()
+    }
 }
 
 /// Triangle corners in grid-local coordinates (cells are unit cubes, the grid starts at 0).
@@ -61,7 +67,12 @@ pub fn voxelize(grid: &GridHeader, local: &[[DVec3; 3]]) -> (Vec<u32>, Vec<u32>)
                 let prep = Prepared::new(*v);
                 let lo = v[0].min(v[1]).min(v[2]) - m;
                 let hi = v[0].max(v[1]).max(v[2]) + m;
-                let range = |a: usize| ((lo[a].floor() as i64).clamp(0, dims[a] - 1), (hi[a].floor() as i64).clamp(0, dims[a] - 1));
+                let range = |a: usize| {
+                    (
+                        (lo[a].floor() as i64).clamp(0, dims[a] - 1),
+                        (hi[a].floor() as i64).clamp(0, dims[a] - 1),
+                    )
+                };
                 let ((x0, x1), (y0, y1), (z0, z1)) = (range(0), range(1), range(2));
                 for z in z0..=z1 {
                     for y in y0..=y1 {

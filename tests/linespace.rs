@@ -1,0 +1,208 @@
+//! The voxel grid and line space against brute force: random soups at every grid and shaft
+//! resolution, scenes far from the origin, tiny and huge, slivers, coplanar overlaps, triangles
+//! lying exactly on cell faces, edges and corners, one-cell and one-triangle scenes; and the
+//! validation of damaged line-space sections.
+
+use glam::Vec3;
+use kiln_compiler::raycheck::{Rng, check_line_space};
+use kiln_compiler::settings::{Settings, VoxelRes};
+use kiln_format::linespace::{LineSpace, Variants};
+use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile, SceneView, sections};
+use kiln_tests::{compile, scene_of};
+use proptest::prelude::*;
+
+fn settings(res: u32, n: u32) -> Settings {
+    Settings {
+        voxel_res: VoxelRes::Cells(res),
+        shaft_res: n,
+        shaft_variants: Some(Variants::ALL),
+        ..Default::default()
+    }
+}
+
+/// Compiles `tris` with every variant and checks `rays` rays: exact candidates, no binary false
+/// misses. Returns the PNMT disagreement count for information.
+fn check(tris: &[[Vec3; 3]], res: u32, n: u32, rays: u64, seed: u64) -> Result<u64, String> {
+    let bytes = compile(scene_of(tris), settings(res, n));
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).map_err(|e| e.to_string())?;
+    let view = SceneView::new(&file).map_err(|e| e.to_string())?;
+    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len())
+        .map_err(|e| e.to_string())?
+        .ok_or("no line space")?;
+    let c = check_line_space(&view, &ls, rays, seed);
+    let cand = c.candidates.as_ref().ok_or("no candidates")?;
+    if cand.mismatches != 0 || cand.any_hit_mismatches != 0 {
+        return Err(format!(
+            "{} candidate mismatches, {} any-hit: {:?}",
+            cand.mismatches, cand.any_hit_mismatches, cand.examples
+        ));
+    }
+    if c.binary.false_misses != 0 {
+        return Err(format!("{} binary false misses: {:?}", c.binary.false_misses, c.binary.examples));
+    }
+    Ok(c.pnmt.map_or(0, |p| p.hit_disagreements))
+}
+
+fn soup(rng: &mut Rng, n: usize, size: f32) -> Vec<[Vec3; 3]> {
+    (0..n)
+        .map(|_| {
+            let c = rng.in_box(Vec3::splat(-1.0), Vec3::splat(1.0));
+            [c, c + rng.direction() * size * rng.f32(), c + rng.direction() * size * rng.f32()]
+        })
+        .collect()
+}
+
+fn grid_mesh(n: usize, rng: &mut Rng) -> Vec<[Vec3; 3]> {
+    let h: Vec<f32> = (0..(n + 1) * (n + 1)).map(|_| rng.f32() * 0.3).collect();
+    let p = |i: usize, j: usize| Vec3::new(i as f32 / n as f32, h[i * (n + 1) + j], j as f32 / n as f32);
+    (0..n * n)
+        .flat_map(|k| {
+            let (i, j) = (k / n, k % n);
+            [[p(i, j), p(i + 1, j), p(i + 1, j + 1)], [p(i, j), p(i + 1, j + 1), p(i, j + 1)]]
+        })
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(20))]
+
+    #[test]
+    fn soups_at_every_resolution(seed in any::<u64>(), n in 1usize..150, size in 0.02f32..1.5, res in 1u32..10, shaft in 1u32..=6) {
+        let mut rng = Rng::new(seed);
+        let tris = soup(&mut rng, n, size);
+        prop_assert!(check(&tris, res, shaft, 400, seed).is_ok(), "{:?}", check(&tris, res, shaft, 400, seed));
+    }
+}
+
+#[test]
+fn far_tiny_and_huge_scenes() {
+    let mut rng = Rng::new(3);
+    let base = grid_mesh(12, &mut rng);
+    for (scale, offset) in [
+        (1.0, Vec3::ZERO),
+        (1e-3, Vec3::ZERO),
+        (1e3, Vec3::ZERO),
+        (1.0, Vec3::splat(1e5)),
+        (1e3, Vec3::new(1e5, -1e5, 3e4)),
+    ] {
+        let tris: Vec<[Vec3; 3]> = base.iter().map(|t| t.map(|p| p * scale + offset)).collect();
+        check(&tris, 6, 4, 3000, 1).unwrap_or_else(|e| panic!("scale {scale}, offset {offset}: {e}"));
+    }
+}
+
+#[test]
+fn slivers_and_coplanar_overlaps() {
+    let mut tris = Vec::new();
+    for i in 0..40 {
+        let x = i as f32 * 0.025;
+        tris.push([Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1e-6, 1.0, 0.0), Vec3::new(x, 1.0, 1e-7)]);
+    }
+    for i in 0..40 {
+        let o = i as f32 * 0.01;
+        tris.push([Vec3::new(o, o, 0.5), Vec3::new(1.0, o, 0.5), Vec3::new(o, 1.0, 0.5)]);
+    }
+    check(&tris, 5, 4, 4000, 2).unwrap();
+}
+
+/// Triangles lying exactly (to f32) in cell planes, along cell edges and through cell corners.
+#[test]
+fn triangles_on_cell_faces_edges_and_corners() {
+    // A frame fixing the bounds to [0, 4]³, then the grid it gets at 4 cells.
+    let frame = vec![
+        [Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 4.0, 4.0)],
+        [Vec3::splat(4.0), Vec3::new(4.0, 0.0, 4.0), Vec3::new(0.0, 4.0, 0.0)],
+    ];
+    let bounds = kiln_format::manifest::Bounds { min: [0.0; 3], max: [4.0; 3] };
+    let g = kiln_compiler::bake::linespace::voxelize::grid(&bounds, 4);
+    let plane = |k: f64| (g.origin[0] + k * g.cell) as f32;
+    let mut tris = frame;
+    for k in 1..4 {
+        let (x, y) = (plane(k as f64), (g.origin[1] + k as f64 * g.cell) as f32);
+        // In the plane x = x_k, and along the edge x = x_k, y = y_k, and through a corner.
+        tris.push([Vec3::new(x, 0.5, 0.5), Vec3::new(x, 3.5, 0.5), Vec3::new(x, 0.5, 3.5)]);
+        tris.push([Vec3::new(x, y, 0.2), Vec3::new(x, y, 3.8), Vec3::new(x + 0.5, y + 0.5, 2.0)]);
+        let z = (g.origin[2] + k as f64 * g.cell) as f32;
+        tris.push([Vec3::new(x, y, z), Vec3::new(x + 0.3, y, z + 0.2), Vec3::new(x, y + 0.3, z - 0.2)]);
+    }
+    check(&tris, 4, 3, 6000, 4).unwrap();
+    check(&tris, 4, 1, 3000, 5).unwrap();
+}
+
+#[test]
+fn one_cell_one_triangle_and_extreme_shaft_resolutions() {
+    let tri = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+    for n in [1, 2, 8] {
+        check(&tri, 1, n, 2000, n as u64).unwrap();
+    }
+    let mut rng = Rng::new(9);
+    let tris = soup(&mut rng, 60, 0.6);
+    check(&tris, 1, 8, 2000, 6).unwrap();
+    check(&tris, 3, 1, 2000, 7).unwrap();
+    check(&tris, 3, 8, 2000, 8).unwrap();
+}
+
+/// Re-writes a file with one section's bytes changed (checksums made right again), so that
+/// only the contents' validation can refuse it.
+fn rewrite(bytes: &[u8], kind: kiln_format::SectionKind, edit: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
+    let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
+    let mut w = FileWriter::new();
+    let mut edit = Some(edit);
+    for s in file.sections() {
+        let mut data = file.section_bytes(s).unwrap().into_owned();
+        if s.entry.kind == kind {
+            (edit.take().unwrap())(&mut data);
+        }
+        w.raw(s.entry.kind, s.entry.index, s.entry.version, data, ContentHash::default()).unwrap();
+    }
+    w.to_bytes().unwrap()
+}
+
+#[test]
+fn damaged_line_space_sections_are_refused() {
+    let mut rng = Rng::new(1);
+    let bytes = compile(scene_of(&soup(&mut rng, 40, 0.5)), settings(3, 3));
+    let refused = |b: &[u8]| {
+        let f = KilnFile::from_bytes(b, Checksums::Eager).unwrap();
+        let v = SceneView::new(&f).unwrap();
+        LineSpace::new(&f, v.triangles.len(), v.materials.len()).expect_err("damage accepted").to_string()
+    };
+    let set_u32 = |d: &mut Vec<u8>, i: usize, v: u32| d[4 * i..4 * i + 4].copy_from_slice(&v.to_le_bytes());
+    // A bit flipped in the shaft bits breaks the ranks.
+    let msg = refused(&rewrite(&bytes, sections::SHAFT_BITS, |d| d[0] ^= 0x10));
+    assert!(msg.contains("rank") || msg.contains("filled"), "{msg}");
+    // A slot out of order.
+    let msg = refused(&rewrite(&bytes, sections::SHAFT_SLOTS, |d| {
+        let i = (0..d.len() / 4).find(|&i| d[4 * i..4 * i + 4] != [0xff; 4]).unwrap();
+        set_u32(d, i, 7777)
+    }));
+    assert!(msg.contains("slot"), "{msg}");
+    // A candidate entry naming a triangle beyond its cell.
+    let msg = refused(&rewrite(&bytes, sections::CANDIDATES, |d| set_u32(d, 0, 0xffff)));
+    assert!(msg.contains("candidate entry"), "{msg}");
+    // A PNMT record naming a missing material.
+    let msg = refused(&rewrite(&bytes, sections::PNMT, |d| d[6..8].copy_from_slice(&77u16.to_le_bytes())));
+    assert!(msg.contains("material"), "{msg}");
+    // A voxel triangle out of range.
+    let msg = refused(&rewrite(&bytes, sections::VOXEL_TRIANGLES, |d| set_u32(d, 0, 1_000_000)));
+    assert!(msg.contains("triangle numbers"), "{msg}");
+    // A section the header does not announce.
+    let no_pnmt = compile(
+        scene_of(&soup(&mut Rng::new(1), 40, 0.5)),
+        Settings { shaft_variants: Some(Variants::BINARY), ..settings(3, 3) },
+    );
+    let f = KilnFile::from_bytes(&no_pnmt, Checksums::Eager).unwrap();
+    let mut w = FileWriter::new();
+    for s in f.sections() {
+        w.raw(
+            s.entry.kind,
+            s.entry.index,
+            s.entry.version,
+            f.section_bytes(s).unwrap().into_owned(),
+            ContentHash::default(),
+        )
+        .unwrap();
+    }
+    w.raw(sections::PNMT, 0, 1, vec![0u8; 32], ContentHash::default()).unwrap();
+    let msg = refused(&w.to_bytes().unwrap());
+    assert!(msg.contains("PNMT"), "{msg}");
+}
