@@ -43,6 +43,9 @@ fn main() {
         voxel_res: None,
         shaft_res: None,
         shaft_variants: Some(0),
+        brdf_lut_res: None,
+        shadow_res: None,
+        media_volume_res: None,
         strict: false,
     };
     let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };

@@ -59,8 +59,16 @@ fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLine
         materials: &scene.triangle_materials,
     };
     let t = Instant::now();
-    let ls = linespace::bake(&attrs, &bounds, res, n, variants, &kiln_compiler::progress::Progress::hidden())
-        .expect("bake");
+    let ls = linespace::bake(
+        &attrs,
+        &bounds,
+        res,
+        n,
+        variants,
+        None,
+        &kiln_compiler::progress::Progress::hidden(),
+    )
+    .expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
 }
 

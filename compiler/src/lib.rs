@@ -15,3 +15,4 @@ pub mod pipeline;
 pub mod progress;
 pub mod raycheck;
 pub mod settings;
+pub mod shading;

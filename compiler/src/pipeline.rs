@@ -56,6 +56,15 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some(v) = args.shaft_variants {
         settings.shaft_variants = Some(v);
     }
+    if let Some(n) = args.brdf_lut_res {
+        settings.brdf_lut_res = n;
+    }
+    if let Some(n) = args.shadow_res {
+        settings.shadow_res = n;
+    }
+    if let Some(n) = args.media_volume_res {
+        settings.media_volume_res = n;
+    }
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
 }
 
@@ -77,6 +86,21 @@ fn apply_bake_table(b: &crate::import::sidecar::BakeToml, settings: &mut Setting
             return Err(format!("shaft_res is {n}; use 1..=8"));
         }
         settings.shaft_res = n;
+    }
+    let ranged = |name: &str, v: Option<u32>, lo: u32, hi: u32| -> Result<Option<u32>, String> {
+        match v {
+            Some(n) if !(lo..=hi).contains(&n) => Err(format!("{name} is {n}; use {lo}..={hi}")),
+            other => Ok(other),
+        }
+    };
+    if let Some(n) = ranged("brdf_lut_res", b.brdf_lut_res, 8, 1024)? {
+        settings.brdf_lut_res = n;
+    }
+    if let Some(n) = ranged("shadow_res", b.shadow_res, 16, 8192)? {
+        settings.shadow_res = n;
+    }
+    if let Some(n) = ranged("media_volume_res", b.media_volume_res, 2, 512)? {
+        settings.media_volume_res = n;
     }
     if let Some(v) = &b.shaft_variants {
         settings.shaft_variants =

@@ -110,6 +110,12 @@ pub struct Settings {
     pub shaft_res: u32,
     /// Line-space variants; `None` lets the plan choose.
     pub shaft_variants: Option<u32>,
+    /// BRDF table size.
+    pub brdf_lut_res: u32,
+    /// Shadow map size (2D maps; cube faces get half).
+    pub shadow_res: u32,
+    /// Light-visibility volume cells along the medium's longest axis.
+    pub media_volume_res: u32,
 }
 
 impl Default for Settings {
@@ -119,6 +125,9 @@ impl Default for Settings {
             voxel_res: VoxelRes::Auto,
             shaft_res: DEFAULT_SHAFT_RES,
             shaft_variants: None,
+            brdf_lut_res: crate::bake::brdf_lut::DEFAULT_RESOLUTION,
+            shadow_res: crate::bake::shadow::DEFAULT_RESOLUTION,
+            media_volume_res: crate::bake::media::DEFAULT_RESOLUTION,
         }
     }
 }
@@ -131,6 +140,9 @@ impl Settings {
             ("voxel-res".into(), self.voxel_res.name()),
             ("shaft-res".into(), self.shaft_res.to_string()),
             ("shaft-variants".into(), self.shaft_variants.map_or_else(|| "plan".into(), variants_name)),
+            ("brdf-lut-res".into(), self.brdf_lut_res.to_string()),
+            ("shadow-res".into(), self.shadow_res.to_string()),
+            ("media-volume-res".into(), self.media_volume_res.to_string()),
         ]
     }
 }

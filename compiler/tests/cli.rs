@@ -19,8 +19,8 @@ fn demo_inspect_verify() {
     assert_eq!(
         kinds,
         [
-            "MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV", "VGRD", "VOXO", "VOXT", "LSLT", "LSBN", "LSRK",
-            "LSCO", "LSCE", "LSPN"
+            "MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV", "SHDW", "VGRD", "VOXO", "VOXT", "LSLT", "LSBN",
+            "LSRK", "LSCO", "LSCE", "LSPN"
         ]
     );
     assert_eq!(j["line_space"]["shaft_res"], 4);
@@ -30,7 +30,7 @@ fn demo_inspect_verify() {
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");
     let skipped: Vec<&str> =
         j["manifest"]["skipped"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
-    assert_eq!(skipped, ["uvs", "textures"]);
+    assert_eq!(skipped, ["uvs", "textures", "brdf-lut", "media-visibility"]);
     let run = kiln(dir.path(), &["verify", "demo.kiln", "--rays", "20000", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();

@@ -213,3 +213,51 @@ fn texture_roles_and_mip_chain_filtering() {
     let chain = kiln_compiler::bake::textures::mip_chain(data);
     assert_eq!(&chain[16..20], &[128, 128, 128, 255]);
 }
+
+#[test]
+fn sidecar_lights_keep_their_kinds_and_units() {
+    use kiln_compiler::import::sidecar::Sidecar;
+    let d = tempfile::tempdir().unwrap();
+    let mut s = import(&Gltf::quad().write(d.path(), "q")).unwrap();
+    let side = Sidecar::parse(
+        r#"
+[[light]]
+kind = "directional"
+direction = [0.0, -2.0, 0.0]
+intensity = 3.0
+
+[[light]]
+kind = "point"
+position = [0.0, 1.9, 0.0]
+color = [1.0, 0.9, 0.8]
+intensity = 5.0
+
+[[light]]
+kind = "spot"
+position = [0.0, 3.0, 0.0]
+direction = [0.0, -1.0, 0.0]
+intensity = 7.0
+outer_cone_degrees = 40.0
+
+[[light]]
+kind = "rect"
+position = [0.0, 2.0, 0.0]
+direction = [0.0, -1.0, 0.0]
+right = [1.0, 0.0, 0.5]
+size = [0.5, 0.25]
+intensity = 9.0
+"#,
+    )
+    .unwrap();
+    side.apply(&mut s, "test.toml").unwrap();
+    let kinds: Vec<String> = s.lights.iter().map(|l| format!("{:?}", l.kind)).collect();
+    assert!(matches!(s.lights[0].kind, LightKind::Directional), "{kinds:?}");
+    assert_eq!(s.lights[0].direction, [0.0, -1.0, 0.0]);
+    assert!(matches!(s.lights[1].kind, LightKind::Point));
+    assert_eq!((s.lights[1].color, s.lights[1].intensity), ([1.0, 0.9, 0.8], 5.0));
+    assert!(matches!(s.lights[2].kind, LightKind::Spot { inner_cone, outer_cone }
+        if (outer_cone - 40f32.to_radians()).abs() < 1e-6 && (inner_cone - 32f32.to_radians()).abs() < 1e-6));
+    assert!(matches!(s.lights[3].kind, LightKind::Rect { width, height } if width == 0.5 && height == 0.25));
+    // `right` is made orthogonal to the direction and unit length.
+    assert!(close(Vec3::from(s.lights[3].right), Vec3::new(1.0, 0.0, 0.5).normalize()));
+}

@@ -68,7 +68,20 @@ fn check_scene(name: &str, triangles: u64, textures: u64, extra: &[&str]) {
         report["stages"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
     assert_eq!(
         stages,
-        ["import", "geometry", "uvs", "materials", "textures", "bvh", "voxel-grid", "line-space", "write"]
+        [
+            "import",
+            "geometry",
+            "uvs",
+            "materials",
+            "textures",
+            "bvh",
+            "brdf-lut",
+            "shadow-maps",
+            "media-visibility",
+            "voxel-grid",
+            "line-space",
+            "write"
+        ]
     );
     for s in report["stages"].as_array().unwrap() {
         assert!(s["ms"].as_f64().unwrap() >= 0.0);

@@ -163,6 +163,65 @@ pub struct Medium {
     pub g: f32,
 }
 
+/// How a shadow map projects the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Encode, Decode, Serialize)]
+pub enum ShadowProjection {
+    /// Orthographic along the light direction (directional lights): one N × N map.
+    Orthographic,
+    /// Perspective from the light position (spot lights): one N × N map.
+    Perspective,
+    /// Cube map around the light position (point and rect lights): six N × N faces in Vulkan
+    /// order (+X −X +Y −Y +Z −Z) and orientation.
+    Cube,
+}
+
+/// Metadata of one `SHDW` section (same index).
+#[derive(Debug, Clone, PartialEq, Encode, Decode, Serialize)]
+pub struct ShadowMapInfo {
+    /// The light it belongs to (index into `lights`).
+    pub light: u32,
+    /// Projection.
+    pub projection: ShadowProjection,
+    /// Texels per side.
+    pub resolution: u32,
+    /// World to clip space (Vulkan: x, y in [−1, 1], y up, z in [0, 1]), column-major; identity
+    /// for cube maps, which are sampled by direction.
+    pub view_proj: [f32; 16],
+    /// Ray origin: the light position (perspective, cube) or the centre of the near plane
+    /// (orthographic).
+    pub origin: [f32; 3],
+    /// View axis (orthographic, perspective).
+    pub direction: [f32; 3],
+    /// Near distance.
+    pub near: f32,
+    /// Farthest distance to the scene bounds.
+    pub far: f32,
+    /// Texel footprint: world size (orthographic) or angle in radians (perspective, cube).
+    pub texel: f32,
+}
+
+/// Metadata of the `BRDF` section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct BrdfLutInfo {
+    /// Texels per side.
+    pub resolution: u32,
+    /// Hammersley samples per texel.
+    pub samples: u32,
+}
+
+/// Metadata of the `MVIS` sections: the light-visibility volume of one medium.
+#[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
+pub struct MediaVisibilityInfo {
+    /// The medium (index into `media`) whose box the volume covers.
+    pub medium: u32,
+    /// Cells along x, y, z (cubic cells over the medium's box).
+    pub dims: [u32; 3],
+    /// Shadow rays per cell and light.
+    pub samples: u32,
+    /// The lights with a volume, in `MVIS` index order.
+    pub lights: Vec<u32>,
+}
+
 /// A bake stage the compiler did not run, and why.
 #[derive(Debug, Clone, PartialEq, Eq, Encode, Decode, Serialize)]
 pub struct SkippedStage {
@@ -210,6 +269,12 @@ pub struct Manifest {
     pub skipped: Vec<SkippedStage>,
     /// Triangles dropped as degenerate during import.
     pub degenerate_triangles: u64,
+    /// The BRDF lookup table, when baked.
+    pub brdf_lut: Option<BrdfLutInfo>,
+    /// One per `SHDW` section.
+    pub shadow_maps: Vec<ShadowMapInfo>,
+    /// The light-visibility volume, when baked.
+    pub media_visibility: Option<MediaVisibilityInfo>,
 }
 
 /// Manifest version this crate reads and writes (equals the `MANI` kind's version).

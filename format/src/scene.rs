@@ -2,11 +2,11 @@
 //! the player and the queries can index without further checks.
 
 use crate::error::{FormatError, Result};
-use crate::manifest::{LightKind, Manifest};
+use crate::manifest::{LightKind, Manifest, ShadowProjection};
 use crate::read::KilnFile;
 use crate::sections::{
-    BVH_NODES, BVH_TRAVERSAL_STACK, CwbvhNode, GpuMaterial, MATERIALS, MaterialFlags, NO_TEXTURE, TEXTURE,
-    TRIANGLE_MATERIALS, TRIANGLES, UVS, VERTICES, Vertex,
+    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
+    MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, UVS, VERTICES, Vertex,
 };
 
 /// Borrowed, validated scene data of a [`KilnFile`].
@@ -79,6 +79,7 @@ impl<'a> SceneView<'a> {
         view.check_materials()?;
         view.check_manifest()?;
         view.check_bvh()?;
+        view.check_lighting()?;
         Ok(view)
     }
 
@@ -195,6 +196,83 @@ impl<'a> SceneView<'a> {
                     "camera {i} ('{}') has a non-finite value",
                     c.name
                 )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the BRDF table, shadow maps and light-visibility volumes against their manifest
+    /// records.
+    fn check_lighting(&self) -> Result<()> {
+        let m = &self.manifest;
+        let file = self.file;
+        match (&m.brdf_lut, file.find(BRDF_LUT, 0)) {
+            (None, None) => {}
+            (Some(info), Some(_)) => {
+                let texels = file.pod::<[u16; 2]>(BRDF_LUT, 0)?.unwrap_or(&[]).len() as u64;
+                if info.resolution == 0 || texels != info.resolution as u64 * info.resolution as u64 {
+                    return Err(FormatError::invalid(format!(
+                        "BRDF table of {texels} texels, manifest says {0}x{0}",
+                        info.resolution
+                    )));
+                }
+            }
+            _ => return Err(FormatError::invalid("BRDF table and its manifest record must come together")),
+        }
+        if file.all_of(SHADOW_MAP).len() != m.shadow_maps.len() {
+            return Err(FormatError::invalid(format!(
+                "{} shadow-map sections but the manifest lists {}",
+                file.all_of(SHADOW_MAP).len(),
+                m.shadow_maps.len()
+            )));
+        }
+        for (i, info) in m.shadow_maps.iter().enumerate() {
+            let depths: &[f32] = file
+                .pod(SHADOW_MAP, i as u32)?
+                .ok_or_else(|| FormatError::invalid(format!("shadow map {i} is missing")))?;
+            let faces = if info.projection == ShadowProjection::Cube { 6 } else { 1 };
+            let n = info.resolution as u64;
+            if info.light as usize >= m.lights.len() || n == 0 || depths.len() as u64 != faces * n * n {
+                return Err(FormatError::invalid(format!(
+                    "shadow map {i}: light {} of {}, {} depths for {faces} face(s) of {n}x{n}",
+                    info.light,
+                    m.lights.len(),
+                    depths.len()
+                )));
+            }
+            let numbers =
+                [&info.view_proj[..], &info.origin, &info.direction, &[info.near, info.far, info.texel]]
+                    .concat();
+            if !finite(&numbers) || depths.iter().any(|d| !(*d >= 0.0)) {
+                return Err(FormatError::invalid(format!(
+                    "shadow map {i} has a non-finite parameter or a negative or NaN depth"
+                )));
+            }
+        }
+        let volumes = file.all_of(MEDIA_VISIBILITY).len();
+        match &m.media_visibility {
+            None if volumes == 0 => {}
+            None => return Err(FormatError::invalid("light-visibility volumes without a manifest record")),
+            Some(v) => {
+                let cells = v.dims.iter().map(|&d| d as u64).product::<u64>();
+                if v.medium as usize >= m.media.len() || v.dims.contains(&0) || volumes != v.lights.len() {
+                    return Err(FormatError::invalid(format!(
+                        "light-visibility volume: medium {} of {}, dims {:?}, {volumes} sections for {} lights",
+                        v.medium,
+                        m.media.len(),
+                        v.dims,
+                        v.lights.len()
+                    )));
+                }
+                for (i, &l) in v.lights.iter().enumerate() {
+                    let data: &[u8] = file.pod(MEDIA_VISIBILITY, i as u32)?.unwrap_or(&[]);
+                    if l as usize >= m.lights.len() || data.len() as u64 != cells {
+                        return Err(FormatError::invalid(format!(
+                            "light-visibility volume {i}: light {l}, {} cells of {cells}",
+                            data.len()
+                        )));
+                    }
+                }
             }
         }
         Ok(())

@@ -85,6 +85,24 @@ fn manifest() -> impl Strategy<Value = Manifest> {
             media: vec![Medium { bounds: Bounds::default(), sigma_a: cam.0, sigma_s: cam.1, g: cam.3 }],
             skipped: vec![SkippedStage { stage: "shadow-maps".into(), reason: "no lights".into() }],
             degenerate_triangles: degenerate,
+            brdf_lut: Some(BrdfLutInfo { resolution: 128, samples: 4096 }),
+            shadow_maps: vec![ShadowMapInfo {
+                light: 1,
+                projection: ShadowProjection::Cube,
+                resolution: 512,
+                view_proj: [cam.3; 16],
+                origin: cam.0,
+                direction: cam.1,
+                near: 0.0,
+                far: cam.3,
+                texel: 0.5,
+            }],
+            media_visibility: Some(MediaVisibilityInfo {
+                medium: 0,
+                dims: [4, 5, 6],
+                samples: 8,
+                lights: vec![0, 2],
+            }),
         })
 }
 

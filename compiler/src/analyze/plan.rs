@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use crate::ir::Scene;
 use kiln_format::linespace::Variants;
+use kiln_format::manifest::LightKind;
 
 use crate::bake::linespace::voxelize::auto_resolution;
 use crate::settings::{Settings, VoxelRes, variants_name};
@@ -23,6 +24,12 @@ pub enum Stage {
     Textures,
     /// The compressed wide BVH.
     Bvh,
+    /// The split-sum BRDF table.
+    BrdfLut,
+    /// Shadow maps of the shadow-casting lights.
+    ShadowMaps,
+    /// Light-visibility volume of the participating medium.
+    MediaVisibility,
     /// Cell triangle lists of the voxel grid.
     VoxelGrid,
     /// Shafts per non-empty cell: binary, candidates, PNMT.
@@ -38,6 +45,9 @@ impl Stage {
             Stage::Materials => "materials",
             Stage::Textures => "textures",
             Stage::Bvh => "bvh",
+            Stage::BrdfLut => "brdf-lut",
+            Stage::ShadowMaps => "shadow-maps",
+            Stage::MediaVisibility => "media-visibility",
             Stage::VoxelGrid => "voxel-grid",
             Stage::LineSpace => "line-space",
         }
@@ -66,7 +76,7 @@ fn default_variants(scene: &Scene, res: u32, n: u32) -> (u32, String) {
     let mib = |b: u64| b >> 20;
     let budget = DEFAULT_LINE_SPACE_BUDGET;
     if pnmt + candidates <= budget {
-        (Variants::ALL, format!("all variants: the scene is lit; about {} MiB", mib(pnmt + candidates)))
+        (Variants::DEFAULT, format!("all variants: the scene is lit; about {} MiB", mib(pnmt + candidates)))
     } else if pnmt <= budget {
         (
             Variants::BINARY | Variants::PNMT,
@@ -136,6 +146,56 @@ impl Plan {
             run(Stage::Bvh, format!("CWBVH, preset {}", settings.bvh_preset.name())),
         ];
         let mut stages = stages;
+        let specular = scene
+            .materials
+            .iter()
+            .filter(|m| m.gpu.flags & kiln_format::sections::MaterialFlags::DIFFUSE_ONLY == 0)
+            .count();
+        stages.push(if specular == 0 {
+            skip(Stage::BrdfLut, "every material is pure Lambertian: no specular lobe to pre-integrate")
+        } else {
+            run(
+                Stage::BrdfLut,
+                format!(
+                    "{0}x{0} texels for {specular} materials with a specular lobe",
+                    settings.brdf_lut_res
+                ),
+            )
+        });
+        let casters = scene.lights.iter().filter(|l| l.casts_shadows).count();
+        stages.push(if scene.lights.is_empty() {
+            skip(Stage::ShadowMaps, "the scene has no analytic lights")
+        } else if casters == 0 {
+            skip(Stage::ShadowMaps, "no light casts shadows")
+        } else {
+            let cubes = scene
+                .lights
+                .iter()
+                .filter(|l| l.casts_shadows && matches!(l.kind, LightKind::Point | LightKind::Rect { .. }))
+                .count();
+            run(
+                Stage::ShadowMaps,
+                format!(
+                    "{} maps of {1}x{1}, {cubes} cube maps of 6x{2}x{2}",
+                    casters - cubes,
+                    settings.shadow_res,
+                    (settings.shadow_res / 2).max(1)
+                ),
+            )
+        });
+        stages.push(if scene.media.is_empty() {
+            skip(Stage::MediaVisibility, "the scene has no participating medium")
+        } else if casters == 0 {
+            skip(Stage::MediaVisibility, "no light casts shadows: every cell sees every light")
+        } else {
+            run(
+                Stage::MediaVisibility,
+                format!(
+                    "medium 0, {casters} lights, {} cells on the longest axis",
+                    settings.media_volume_res
+                ),
+            )
+        });
         let voxel_res = match settings.voxel_res {
             VoxelRes::Auto => auto_resolution(scene.triangles.len()),
             VoxelRes::Cells(n) => n,

@@ -1,13 +1,18 @@
 //! Bake stages: each a function of (scene, settings) producing sections, timed, with a content
 //! hash computed from what it depends on.
 
+pub mod brdf_lut;
 pub mod bvh;
 pub mod linespace;
+pub mod media;
+pub mod shadow;
 pub mod textures;
 
 use std::time::Instant;
 
-use kiln_format::manifest::{InputFile, Manifest, MaterialInfo, Setting, SkippedStage, TextureInfo};
+use kiln_format::manifest::{
+    BrdfLutInfo, InputFile, Manifest, MaterialInfo, Setting, SkippedStage, TextureInfo,
+};
 use kiln_format::sections::{self, GpuMaterial};
 use kiln_format::{ContentHash, ContentHasher, SectionKind};
 use rayon::prelude::*;
@@ -154,6 +159,12 @@ pub fn bake(
     let tmat: Vec<u32> = built.order.iter().map(|&i| scene.triangle_materials[i as usize]).collect();
     let grid_settings = format!("{};{};{}", plan.voxel_res, settings.shaft_res, plan.shaft_variants);
     let mut line_space: Option<linespace::BakedLineSpace> = None;
+    let mut lut: Vec<[u16; 2]> = Vec::new();
+    let mut brdf_info = None;
+    let mut shadow_infos = Vec::new();
+    let mut media_info = None;
+    let gpu_materials: Vec<GpuMaterial> = scene.materials.iter().map(|m| m.gpu).collect();
+    let scene_bounds = bounds(scene);
 
     for decision in &plan.stages {
         let start = Instant::now();
@@ -203,7 +214,82 @@ pub fn bake(
                     }
                 }
                 Stage::Bvh => bytes = bvh_len,
+                Stage::BrdfLut => {
+                    lut = brdf_lut::bake(settings.brdf_lut_res, brdf_lut::SAMPLES);
+                    let b = bytemuck::cast_slice(&lut).to_vec();
+                    bytes = b.len() as u64;
+                    let h = ContentHasher::new()
+                        .part("stage", b"brdf-lut")
+                        .part("algorithm", ALGORITHM_VERSION.as_bytes())
+                        .part("res", &settings.brdf_lut_res.to_le_bytes())
+                        .part("samples", &brdf_lut::SAMPLES.to_le_bytes())
+                        .finish();
+                    push(sections::BRDF_LUT, 0, b, h);
+                    brdf_info =
+                        Some(BrdfLutInfo { resolution: settings.brdf_lut_res, samples: brdf_lut::SAMPLES });
+                }
+                Stage::ShadowMaps => {
+                    let t =
+                        kiln_format::query::IndexedTriangles { vertices: &scene.vertices, triangles: &tris };
+                    for (i, light) in scene.lights.iter().enumerate() {
+                        let Some(layout) =
+                            shadow::layout(light, i as u32, &scene_bounds, settings.shadow_res)
+                        else {
+                            continue;
+                        };
+                        progress.stage(&format!("shadow map of light {i}"));
+                        let depths = shadow::render(&layout, &built.nodes, &t);
+                        let b = bytemuck::cast_slice(&depths).to_vec();
+                        bytes += b.len() as u64;
+                        let index = shadow_infos.len() as u32;
+                        push(
+                            sections::SHADOW_MAP,
+                            index,
+                            b,
+                            hash(
+                                "shadow-map",
+                                &[("preset", preset), ("light", &format!("{i}:{}", settings.shadow_res))],
+                            ),
+                        );
+                        shadow_infos.push(layout.info);
+                    }
+                }
+                Stage::MediaVisibility => {
+                    let shading = shading_scene(
+                        scene,
+                        &gpu_materials,
+                        &built.nodes,
+                        &tris,
+                        &lut,
+                        settings.brdf_lut_res,
+                    );
+                    let (info, volumes) = media::bake(&shading, &scene.media, 0, settings.media_volume_res);
+                    for (i, v) in volumes.into_iter().enumerate() {
+                        bytes += v.len() as u64;
+                        push(
+                            sections::MEDIA_VISIBILITY,
+                            i as u32,
+                            v,
+                            hash(
+                                "media-visibility",
+                                &[("res", &settings.media_volume_res.to_string()), ("index", &i.to_string())],
+                            ),
+                        );
+                    }
+                    media_info = Some(info);
+                }
                 Stage::VoxelGrid => {
+                    let shading = shading_scene(
+                        scene,
+                        &gpu_materials,
+                        &built.nodes,
+                        &tris,
+                        &lut,
+                        settings.brdf_lut_res,
+                    );
+                    let shade = |p: glam::DVec3, n: glam::Vec3, v: glam::Vec3, m: u16, uv: glam::Vec2| {
+                        shading.radiance(p.as_vec3(), n, n, v, m as u32, uv)
+                    };
                     let attrs = linespace::SceneAttributes {
                         vertices: &scene.vertices,
                         uvs: &scene.uvs,
@@ -216,6 +302,7 @@ pub fn bake(
                         plan.voxel_res,
                         settings.shaft_res,
                         plan.shaft_variants,
+                        Some(&shade),
                         progress,
                     )?;
                     let h = hash("voxel-grid", &[("preset", preset), ("grid", &grid_settings)]);
@@ -244,6 +331,9 @@ pub fn bake(
                         }
                         if ls.header.variants & kiln_format::linespace::Variants::PNMT != 0 {
                             add(sections::PNMT, bytemuck::cast_slice(&ls.pnmt));
+                        }
+                        if ls.header.variants & kiln_format::linespace::Variants::PREILLUM != 0 {
+                            add(sections::PREILLUM, bytemuck::cast_slice(&ls.preillum));
                         }
                     }
                 }
@@ -300,6 +390,9 @@ pub fn bake(
             .map(|d| SkippedStage { stage: d.stage.name().into(), reason: d.reason.clone() })
             .collect(),
         degenerate_triangles: scene.degenerate_triangles,
+        brdf_lut: brdf_info,
+        shadow_maps: shadow_infos,
+        media_visibility: media_info,
     };
     let settings_text: String = settings.pairs().iter().map(|(k, v)| format!("{k}={v};")).collect();
     let manifest_hash = hash("manifest", &[("settings", &settings_text)]);
@@ -328,6 +421,27 @@ fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::Wri
         w.bytes(s.kind, s.index, s.bytes.as_slice(), s.hash)?;
     }
     Ok(w)
+}
+
+/// The shading view of a scene whose triangles are stored in `tris` order.
+fn shading_scene<'a>(
+    scene: &'a Scene,
+    materials: &'a [GpuMaterial],
+    bvh: &'a [kiln_format::sections::CwbvhNode],
+    tris: &'a [[u32; 3]],
+    lut: &'a [[u16; 2]],
+    lut_res: u32,
+) -> crate::shading::ShadingScene<'a> {
+    crate::shading::ShadingScene {
+        materials,
+        textures: &scene.textures,
+        lights: &scene.lights,
+        bvh,
+        vertices: &scene.vertices,
+        triangles: tris,
+        lut,
+        lut_res,
+    }
 }
 
 /// Writes the baked file atomically; returns its size.

@@ -27,6 +27,9 @@ pub enum Command {
     Plan(PlanArgs),
     /// Compile the built-in demo scene (a Cornell box with a ceiling light and a camera).
     Demo(DemoArgs),
+    /// Write an image-like section (brdf-lut, shadow-map, texture, media-visibility) as PFM or
+    /// EXR (float) or PNG, chosen by the output's extension.
+    Export(ExportArgs),
     /// Show a .kiln file's version, sections (kind, size, codec, checksum status) and manifest.
     Inspect(InspectArgs),
     /// Validate a .kiln file completely: layout, every checksum, every cross-reference.
@@ -82,9 +85,19 @@ pub struct SceneArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), help_heading = "Voxel grid and line space")]
     pub shaft_res: Option<u32>,
     /// Line-space variants to bake, comma-separated: binary (one bit per shaft), candidates
-    /// (exact triangle lists), pnmt (front/back hit records), or none [default: chosen by the plan].
+    /// (exact triangle lists), pnmt (front/back hit records), preillum (front/back radiance under
+    /// the static lights), or none [default: chosen by the plan].
     #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
     pub shaft_variants: Option<u32>,
+    /// BRDF lookup table size N (N × N texels, 8..=1024) [default: 128].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(8..=1024), help_heading = "Lighting bakes")]
+    pub brdf_lut_res: Option<u32>,
+    /// Shadow map size N (N × N for directional and spot lights; cube faces of N/2), 16..=8192 [default: 1024].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=8192), help_heading = "Lighting bakes")]
+    pub shadow_res: Option<u32>,
+    /// Light-visibility volume cells along the medium's longest axis, 2..=512 [default: 64].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=512), help_heading = "Lighting bakes")]
+    pub media_volume_res: Option<u32>,
     /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
     /// an error.
     #[arg(long)]
@@ -122,6 +135,22 @@ pub struct CompileArgs {
     pub out: OutputArgs,
 }
 
+/// `kiln export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The .kiln file.
+    pub file: PathBuf,
+    /// Section name and index, e.g. `brdf-lut`, `shadow-map:1`, `texture:0` (`kiln inspect` lists
+    /// the sections a file has).
+    pub section: String,
+    /// Output image: .pfm, .exr or .png.
+    #[arg(long, short = 'o', value_name = "PATH")]
+    pub output: PathBuf,
+    /// Print nothing but errors.
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
 /// `kiln plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
@@ -148,9 +177,18 @@ pub struct DemoArgs {
     /// Shaft resolution N (1..=8).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), default_value_t = DEFAULT_SHAFT_RES, help_heading = "Voxel grid and line space")]
     pub shaft_res: u32,
-    /// Line-space variants (binary, candidates, pnmt, none) [default: chosen by the plan].
+    /// Line-space variants (binary, candidates, pnmt, preillum, none) [default: chosen by the plan].
     #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
     pub shaft_variants: Option<u32>,
+    /// BRDF lookup table size N (N × N texels, 8..=1024) [default: 128].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(8..=1024), help_heading = "Lighting bakes")]
+    pub brdf_lut_res: Option<u32>,
+    /// Shadow map size N (N × N for directional and spot lights; cube faces of N/2), 16..=8192 [default: 1024].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=8192), help_heading = "Lighting bakes")]
+    pub shadow_res: Option<u32>,
+    /// Light-visibility volume cells along the medium's longest axis, 2..=512 [default: 64].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=512), help_heading = "Lighting bakes")]
+    pub media_volume_res: Option<u32>,
     /// Report, depfile, threads.
     #[command(flatten)]
     pub out: OutputArgs,

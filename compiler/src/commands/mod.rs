@@ -1,6 +1,7 @@
 //! One module per subcommand; [`run`] dispatches.
 
 mod compile;
+mod export;
 mod inspect;
 mod plan;
 mod verify;
@@ -14,6 +15,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Compile(args) => compile::run(&args),
         Command::Plan(args) => plan::run(&args),
         Command::Demo(args) => compile::demo(&args),
+        Command::Export(args) => export::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Verify(args) => verify::run(&args),
     }

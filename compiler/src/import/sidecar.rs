@@ -169,6 +169,12 @@ pub struct BakeToml {
     pub shaft_res: Option<u32>,
     /// Comma-separated variants or `"none"`.
     pub shaft_variants: Option<String>,
+    /// BRDF table size.
+    pub brdf_lut_res: Option<u32>,
+    /// Shadow map size.
+    pub shadow_res: Option<u32>,
+    /// Light-visibility volume resolution.
+    pub media_volume_res: Option<u32>,
 }
 
 impl Sidecar {
@@ -318,7 +324,10 @@ fn convert_light(l: &LightToml, i: usize) -> Result<Light, String> {
     };
     match l.kind {
         LightKindToml::Point => light.position = need(l.position, "position")?,
-        LightKindToml::Directional => light.direction = unit(need(l.direction, "direction")?, "direction")?,
+        LightKindToml::Directional => {
+            light.kind = LightKind::Directional;
+            light.direction = unit(need(l.direction, "direction")?, "direction")?;
+        }
         LightKindToml::Spot => {
             light.position = need(l.position, "position")?;
             light.direction = unit(need(l.direction, "direction")?, "direction")?;

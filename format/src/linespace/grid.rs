@@ -16,8 +16,12 @@ impl Variants {
     pub const CANDIDATES: u32 = 1 << 1;
     /// Front and back hit records of each filled shaft's midpoint ray.
     pub const PNMT: u32 = 1 << 2;
+    /// Front and back radiance of each filled shaft under the static lights.
+    pub const PREILLUM: u32 = 1 << 3;
     /// Every defined bit.
-    pub const ALL: u32 = Self::BINARY | Self::CANDIDATES | Self::PNMT;
+    pub const ALL: u32 = Self::BINARY | Self::CANDIDATES | Self::PNMT | Self::PREILLUM;
+    /// What the compiler bakes by default for a lit scene (within its size budget).
+    pub const DEFAULT: u32 = Self::BINARY | Self::CANDIDATES | Self::PNMT;
 }
 
 /// Header of the voxel grid and line space (section `VGRD`, one element). 96 bytes.

@@ -23,7 +23,7 @@ pub use query::{PnmtQueryHit, ShaftLookup};
 use crate::error::{FormatError, Result};
 use crate::read::KilnFile;
 use crate::sections::{
-    CANDIDATE_OFFSETS, CANDIDATES, GRID, PNMT, SHAFT_BITS, SHAFT_RANKS, SHAFT_SLOTS, VOXEL_OFFSETS,
+    CANDIDATE_OFFSETS, CANDIDATES, GRID, PNMT, PREILLUM, SHAFT_BITS, SHAFT_RANKS, SHAFT_SLOTS, VOXEL_OFFSETS,
     VOXEL_TRIANGLES,
 };
 use index::{MAX_SHAFT_RES, shafts_per_voxel};
@@ -82,6 +82,9 @@ pub struct LineSpace<'a> {
     pub candidates: &'a [u32],
     /// PNMT records, 2 per filled shaft (empty without PNMT).
     pub pnmt: &'a [PnmtRecord],
+    /// Pre-illuminated radiance per filled shaft: front RGB, 0, back RGB, 0 as binary16
+    /// (empty without the variant).
+    pub preillum: &'a [[u16; 8]],
     /// Words per slot.
     pub words_per_slot: usize,
 }
@@ -126,6 +129,7 @@ impl<'a> LineSpace<'a> {
             candidate_offsets: get(CANDIDATE_OFFSETS)?,
             candidates: get(CANDIDATES)?,
             pnmt: file.pod::<PnmtRecord>(PNMT, 0)?.unwrap_or(&[]),
+            preillum: file.pod::<[u16; 8]>(PREILLUM, 0)?.unwrap_or(&[]),
             words_per_slot: if h.shaft_res == 0 { 0 } else { words_per_slot(h.shaft_res.min(MAX_SHAFT_RES)) },
         };
         ls.check(triangles, materials)?;
@@ -276,6 +280,21 @@ impl<'a> LineSpace<'a> {
             }
         } else if !self.pnmt.is_empty() {
             return Err(bad("PNMT records present but not in the header's variants".into()));
+        }
+        if has(Variants::PREILLUM) {
+            if self.preillum.len() as u64 != h.filled {
+                return Err(bad(format!(
+                    "{} pre-illuminated records for {} filled shafts",
+                    self.preillum.len(),
+                    h.filled
+                )));
+            }
+            // binary16 exponent all ones: infinity or NaN, which no radiance may be.
+            if self.preillum.iter().flatten().any(|&x| x & 0x7c00 == 0x7c00) {
+                return Err(bad("a pre-illuminated radiance is infinite or NaN".into()));
+            }
+        } else if !self.preillum.is_empty() {
+            return Err(bad("pre-illuminated records present but not in the header's variants".into()));
         }
         Ok(())
     }

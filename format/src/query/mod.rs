@@ -87,3 +87,21 @@ pub fn closest_hit_brute_force(tris: &(impl TriangleSource + ?Sized), ray: &Ray)
 pub fn any_hit_brute_force(tris: &(impl TriangleSource + ?Sized), ray: &Ray) -> bool {
     (0..tris.len()).any(|i| intersect_triangle(ray, tris.corners(i), ray.tmax).is_some())
 }
+
+/// Moves a ray origin `p` off the surface with geometric normal `n` by a few units in the last
+/// place of each coordinate, proportional to the coordinate's magnitude (Wächter and Binder,
+/// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6): robust at
+/// every scale, unlike a fixed epsilon. `n` must point to the side the ray leaves into.
+pub fn offset_origin(p: Vec3, n: Vec3) -> Vec3 {
+    const ORIGIN: f32 = 1.0 / 32.0;
+    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
+    const INT_SCALE: f32 = 256.0;
+    let of = (n * INT_SCALE).to_array().map(|x| x as i32);
+    let pi: [f32; 3] = std::array::from_fn(|a| {
+        let bits = p[a].to_bits() as i32;
+        f32::from_bits(bits.wrapping_add(if p[a] < 0.0 { -of[a] } else { of[a] }) as u32)
+    });
+    Vec3::from(std::array::from_fn::<f32, 3, _>(|a| {
+        if p[a].abs() < ORIGIN { p[a] + FLOAT_SCALE * n[a] } else { pi[a] }
+    }))
+}

@@ -49,6 +49,16 @@ pub const CANDIDATES: SectionKind = SectionKind(*b"LSCE");
 /// PNMT records ([`crate::linespace::PnmtRecord`]), front and back per filled shaft.
 pub const PNMT: SectionKind = SectionKind(*b"LSPN");
 
+/// Pre-illuminated line space: front and back radiance per filled shaft (`[u16; 4]` binary16
+/// RGB + zero, twice).
+pub const PREILLUM: SectionKind = SectionKind(*b"LSPI");
+/// BRDF lookup table: `[u16; 2]` unorm16 (R scale, G bias) per texel.
+pub const BRDF_LUT: SectionKind = SectionKind(*b"BRDF");
+/// One shadow map: f32 depths; index = shadow map number.
+pub const SHADOW_MAP: SectionKind = SectionKind(*b"SHDW");
+/// Light-visibility volume of one light: u8 per cell; index = position in the manifest's list.
+pub const MEDIA_VISIBILITY: SectionKind = SectionKind(*b"MVIS");
+
 /// What the format knows of a section kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct KindInfo {
@@ -142,6 +152,25 @@ pub const KNOWN: &[KindInfo] = &[
         indexed: false,
         description: "compressed wide BVH (8-ary) nodes",
     },
+    pod_kind(BRDF_LUT, "brdf-lut", 4, "split-sum BRDF table (unorm16 scale, bias)"),
+    KindInfo {
+        kind: SHADOW_MAP,
+        name: "shadow-map",
+        version: 1,
+        element_size: 4,
+        required: false,
+        indexed: true,
+        description: "shadow map depths (f32)",
+    },
+    KindInfo {
+        kind: MEDIA_VISIBILITY,
+        name: "media-visibility",
+        version: 1,
+        element_size: 1,
+        required: false,
+        indexed: true,
+        description: "light visibility per medium cell (unorm8)",
+    },
     pod_kind(GRID, "voxel-grid", 96, "voxel grid and line-space header"),
     pod_kind(VOXEL_OFFSETS, "voxel-offsets", 4, "voxel triangle list offsets"),
     pod_kind(VOXEL_TRIANGLES, "voxel-triangles", 4, "voxel triangle lists"),
@@ -151,6 +180,7 @@ pub const KNOWN: &[KindInfo] = &[
     pod_kind(CANDIDATE_OFFSETS, "candidate-offsets", 4, "candidate list offsets per filled shaft"),
     pod_kind(CANDIDATES, "candidates", 4, "exact candidate lists per filled shaft"),
     pod_kind(PNMT, "pnmt", 16, "front and back hit records per filled shaft"),
+    pod_kind(PREILLUM, "preillum", 16, "front and back radiance per filled shaft"),
 ];
 
 /// A non-indexed, optional POD kind at version 1.

@@ -12,7 +12,7 @@ use kiln_format::manifest::Bounds;
 use kiln_format::sections::Vertex;
 use rayon::prelude::*;
 
-pub use shafts::HitAttributes;
+pub use shafts::{HitAttributes, Shade};
 
 use crate::exit::{CliError, CliResult};
 use crate::progress::Progress;
@@ -38,6 +38,8 @@ pub struct BakedLineSpace {
     pub candidates: Vec<u32>,
     /// PNMT records.
     pub pnmt: Vec<PnmtRecord>,
+    /// Pre-illuminated radiance per filled shaft.
+    pub preillum: Vec<[u16; 8]>,
     /// Shaft–triangle overlap tests run.
     pub tests: u64,
     /// Filled shafts whose PNMT sample rays all missed (no record).
@@ -92,6 +94,7 @@ pub fn bake(
     res: u32,
     n: u32,
     variants: u32,
+    shade: Option<&Shade<'_>>,
     progress: &Progress,
 ) -> CliResult<BakedLineSpace> {
     let start = std::time::Instant::now();
@@ -118,6 +121,13 @@ pub fn bake(
     }
     let candidates = variants & Variants::CANDIDATES != 0;
     let pnmt = variants & Variants::PNMT != 0;
+    let shade = if variants & Variants::PREILLUM != 0 {
+        Some(shade.ok_or_else(|| {
+            CliError::input("the pre-illuminated line space needs the scene's lights and BVH")
+        })?)
+    } else {
+        None
+    };
     if candidates && header.max_cell_triangles > MAX_CANDIDATE_CELL_TRIANGLES {
         return Err(CliError::input(format!(
             "a cell holds {} triangles, more than the {MAX_CANDIDATE_CELL_TRIANGLES} candidate lists can address; raise --voxel-res",
@@ -151,6 +161,7 @@ pub fn bake(
                 candidates,
                 pnmt,
                 attrs,
+                shade,
                 scratch,
             );
             let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -182,6 +193,9 @@ pub fn bake(
     if pnmt {
         out.pnmt.reserve_exact(2 * rank as usize);
     }
+    if shade.is_some() {
+        out.preillum.reserve_exact(rank as usize);
+    }
     // Consume the cells one by one, so that their memory is freed as it is copied.
     for cell in per_cell {
         for list in cell.lists {
@@ -192,6 +206,7 @@ pub fn bake(
             out.pnmt_missing += (!r[0].is_some() || !r[1].is_some()) as u64;
             out.pnmt.extend_from_slice(&r);
         }
+        out.preillum.extend_from_slice(&cell.preillum);
     }
     header.entries = out.candidates.len() as u64;
     out.header = header;

@@ -20,6 +20,8 @@ pub struct CellShafts {
     pub lists: Vec<Vec<u32>>,
     /// Front and back records of each filled shaft, in shaft order (empty without PNMT).
     pub pnmt: Vec<[PnmtRecord; 2]>,
+    /// Front and back radiance (binary16 RGB, 0) of each filled shaft (empty without it).
+    pub preillum: Vec<[u16; 8]>,
     /// Overlap tests run (for the bake report).
     pub tests: u64,
 }
@@ -300,15 +302,17 @@ pub fn bake_cell(
     candidates: bool,
     pnmt: bool,
     attrs: &dyn HitAttributes,
+    shade: Option<&Shade<'_>>,
     scratch: &mut Scratch,
 ) -> CellShafts {
+    let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
     let Scratch { stack, hits, sorted, counts, ends, polys } = scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
     ends.clear();
-    if pnmt {
+    if records_needed {
         ends.resize(shafts, [NO_END; 2]);
     }
     polys.clear();
@@ -333,7 +337,7 @@ pub fn bake_cell(
         let v = local[t as usize].map(|p| p - cell_min);
         let prep = Prepared::new(v);
         let poly = clip_to_box(v, lo_box, hi_box);
-        let seg = if pnmt { SegmentTest::new(attrs.corners(t)) } else { SegmentTest::new([Vec3::ZERO; 3]) };
+        let seg = SegmentTest::new(if records_needed { attrs.corners(t) } else { [Vec3::ZERO; 3] });
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let w = outward(fb) - outward(fa);
@@ -352,7 +356,7 @@ pub fn bake_cell(
                 if candidates {
                     hits.push((shaft, qmin as u8, qmax as u8, li as u16));
                 }
-                if pnmt {
+                if records_needed {
                     let (_, pa, _, pb) = shaft_parts(shaft, n);
                     let (o, e) = (centres[fa as usize][pa as usize], centres[fb as usize][pb as usize]);
                     let end = &mut ends[shaft as usize];
@@ -414,7 +418,7 @@ pub fn bake_cell(
             );
         }
     }
-    if pnmt {
+    if records_needed {
         for (shaft, end) in ends.iter().enumerate() {
             if out.bits[shaft / 32] & (1 << (shaft % 32)) == 0 {
                 continue;
@@ -455,11 +459,37 @@ pub fn bake_cell(
                     cell,
                 )
             };
-            out.pnmt.push([record(&end[0], true), record(&end[1], false)]);
+            let pair_records = [record(&end[0], true), record(&end[1], false)];
+            if let Some(shade) = shade {
+                let (_, pa, _, pb) = shaft_parts(shaft as u32, n);
+                let mut rgb = [0u16; 8];
+                for (k, r) in pair_records.iter().enumerate() {
+                    let Some(hit) = r.decode(world_cell_min, cell) else { continue };
+                    // The viewer of the front record is at the front patch, of the back one at the back.
+                    let eye = if k == 0 {
+                        centres[fa as usize][pa as usize]
+                    } else {
+                        centres[fb as usize][pb as usize]
+                    };
+                    let v = (eye.as_dvec3() - hit.position).as_vec3().normalize_or(hit.normal);
+                    let radiance = shade(hit.position, hit.normal, v, hit.material, hit.uv);
+                    for c in 0..3 {
+                        rgb[4 * k + c] = half::f16::from_f32(radiance[c].min(65504.0)).to_bits();
+                    }
+                }
+                out.preillum.push(rgb);
+            }
+            if pnmt {
+                out.pnmt.push(pair_records);
+            }
         }
     }
     out
 }
+
+/// Radiance leaving a decoded record: (position, normal, direction to the viewer, material,
+/// texture coordinates) → linear RGB.
+pub type Shade<'a> = dyn Fn(DVec3, Vec3, Vec3, u16, glam::Vec2) -> Vec3 + Sync + 'a;
 
 /// A segment–triangle test for midpoint segments (PNMT records need the nearest hit, not a
 /// watertight one): plane crossing, then three edge functions.

@@ -1,0 +1,520 @@
+//! Lighting bakes: the BRDF table against an independent quadrature, shadow maps against brute
+//! force, the light-visibility volume against brute-force visibility, and pre-illuminated
+//! radiance against an independent evaluation of the same shading.
+
+mod util;
+
+use kiln_compiler::bake::brdf_lut;
+
+/// Gauss–Legendre nodes and weights on [−1, 1], 5 points.
+const GL5: [(f64, f64); 5] = [
+    (0.0, 0.568_888_888_888_888_9),
+    (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+];
+
+/// Composite Gauss–Legendre integral of f over [a, b] with `panels` panels.
+fn quad(a: f64, b: f64, panels: usize, f: &mut dyn FnMut(f64) -> f64) -> f64 {
+    let h = (b - a) / panels as f64;
+    let mut sum = 0.0;
+    for p in 0..panels {
+        let m = a + (p as f64 + 0.5) * h;
+        for &(x, w) in &GL5 {
+            sum += w * f(m + 0.5 * h * x);
+        }
+    }
+    sum * 0.5 * h
+}
+
+/// An independent evaluation of the split-sum integrals: f64 tensor-product Gauss–Legendre
+/// quadratures (not sampling estimates), with the height-correlated G₂ in its closed form rather
+/// than through Λ. Near-normal views integrate over the half vector distributed by D(h)(n·h)
+/// (θ through the GGX CDF), where the integrand is smooth when the view is steep; grazing views
+/// integrate over the disk that parametrises the distribution of visible normals, where the
+/// integrand G₂/G₁ stays bounded.
+fn reference(n_v: f64, roughness: f64) -> (f64, f64) {
+    let a = (roughness * roughness).max(1e-6);
+    let a2 = a * a;
+    let v = [((1.0 - n_v * n_v).max(0.0)).sqrt(), 0.0, n_v];
+    let g2 = |nv: f64, nl: f64| {
+        2.0 * nl * nv / (nv * (a2 + (1.0 - a2) * nl * nl).sqrt() + nl * (a2 + (1.0 - a2) * nv * nv).sqrt())
+    };
+    let g1 = 2.0 * n_v / (n_v + (a2 + (1.0 - a2) * n_v * n_v).sqrt());
+    // Contribution of half vector h: (weight without F, v·h), or None below the horizon.
+    let split = |h: [f64; 3], weight: f64| -> (f64, f64) {
+        let v_h = v[0] * h[0] + v[2] * h[2];
+        let n_l = 2.0 * v_h * h[2] - v[2];
+        if n_l <= 0.0 || v_h <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let fc = (1.0 - v_h).powi(5);
+        let w = weight * g2(n_v, n_l);
+        ((1.0 - fc) * w, fc * w)
+    };
+    let mut total = (0.0, 0.0);
+    if n_v >= 0.5 {
+        // ∫ f (n·l) dl = ∫∫ G₂ (v·h) / ((n·v)(n·h)) dx dφ / 2π, cos²θ_h = (1 − x) / (1 + (α² − 1) x).
+        for which in 0..2 {
+            let r = quad(0.0, 1.0, 200, &mut |x| {
+                let c = ((1.0 - x) / (1.0 + (a2 - 1.0) * x)).sqrt();
+                let s = (1.0 - c * c).max(0.0).sqrt();
+                quad(0.0, std::f64::consts::PI, 100, &mut |phi| {
+                    let h = [s * phi.cos(), s * phi.sin(), c];
+                    let v_h = v[0] * h[0] + v[2] * h[2];
+                    let (r, g) = split(h, v_h / (n_v * c));
+                    if which == 0 { r } else { g }
+                }) / std::f64::consts::PI
+            });
+            if which == 0 { total.0 = r } else { total.1 = r }
+        }
+        return total;
+    }
+    // Visible normals: h from the disk point (r, u2) (Heitz 2018), weight G₂ / G₁.
+    let len = (a2 * v[0] * v[0] + v[2] * v[2]).sqrt();
+    let vh = [a * v[0] / len, 0.0, v[2] / len];
+    let t2 = [-vh[2], 0.0, vh[0]];
+    for which in 0..2 {
+        // u1 = r² (the square root's infinite slope at 0 would stall the quadrature): du1 = 2r dr.
+        let r = quad(0.0, 1.0, 200, &mut |r| {
+            2.0 * r
+                * quad(0.0, 1.0, 100, &mut |u2| {
+                    let phi = std::f64::consts::TAU * u2;
+                    let p1 = r * phi.cos();
+                    let s = 0.5 * (1.0 + vh[2]);
+                    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+                    let p3 = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+                    let nh = [p2 * t2[0] + p3 * vh[0], p1, p2 * t2[2] + p3 * vh[2]];
+                    let ne = [a * nh[0], a * nh[1], nh[2].max(0.0)];
+                    let l = (ne[0] * ne[0] + ne[1] * ne[1] + ne[2] * ne[2]).sqrt();
+                    let (r, g) = split([ne[0] / l, ne[1] / l, ne[2] / l], 1.0 / g1);
+                    if which == 0 { r } else { g }
+                })
+        });
+        if which == 0 { total.0 = r } else { total.1 = r }
+    }
+    total
+}
+
+#[test]
+fn brdf_table_matches_an_independent_quadrature() {
+    let res = brdf_lut::DEFAULT_RESOLUTION;
+    let table = brdf_lut::bake(res, brdf_lut::SAMPLES);
+    let mut worst = (0.0f64, 0, 0);
+    // Every 16th texel in each direction plus the first and last rows and columns.
+    let picks: Vec<u32> = (0..res).filter(|i| i % 16 == 7 || *i == 0 || *i == res - 1).collect();
+    for &j in &picks {
+        for &i in &picks {
+            let (r, g) = reference((i as f64 + 0.5) / res as f64, (j as f64 + 0.5) / res as f64);
+            let t = table[(j * res + i) as usize];
+            let err = ((t[0] as f64 / 65535.0 - r).abs()).max((t[1] as f64 / 65535.0 - g).abs());
+            if err > worst.0 {
+                worst = (err, i, j);
+            }
+        }
+    }
+    eprintln!(
+        "BRDF table: max abs error {:.2e} at texel {:?} ({} texels checked)",
+        worst.0,
+        (worst.1, worst.2),
+        picks.len() * picks.len()
+    );
+    assert!(worst.0 <= 1e-3, "max abs error {:.2e} at texel ({}, {})", worst.0, worst.1, worst.2);
+}
+
+#[test]
+fn brdf_table_has_the_known_limits() {
+    // Smooth and head-on: R + G → 1 (all energy reflected), G → F_c(1) = 0.
+    let (r, g) = reference(0.999, 0.02);
+    assert!((r + g - 1.0).abs() < 1e-2 && g < 1e-3, "{r} {g}");
+    // Rough surfaces lose energy to single scattering: R + G < 1.
+    let (r, g) = reference(0.5, 1.0);
+    assert!(r + g < 0.9, "{r} {g}");
+}
+
+use glam::{Mat4, Vec3};
+use kiln_compiler::bake::shadow;
+use kiln_compiler::ir::{Material, Scene};
+use kiln_compiler::progress::Progress;
+use kiln_compiler::settings::Settings;
+use kiln_format::linespace::{LineSpace, Variants};
+use kiln_format::manifest::{Bounds, Light, LightKind, Medium, ShadowProjection};
+use kiln_format::query::{BruteForce, IndexedTriangles, Ray, offset_origin};
+use kiln_format::sections::{self, Vertex};
+use kiln_format::{Checksums, KilnFile, SceneView};
+
+fn light(kind: LightKind, position: [f32; 3], direction: [f32; 3], intensity: f32) -> Light {
+    Light {
+        name: "l".into(),
+        kind,
+        position,
+        direction,
+        right: [1.0, 0.0, 0.0],
+        color: [1.0; 3],
+        intensity,
+        range: 0.0,
+        casts_shadows: true,
+    }
+}
+
+fn compile(scene: Scene, settings: Settings) -> Vec<u8> {
+    let loaded =
+        kiln_compiler::pipeline::finish(scene, settings, "test", false, true, std::time::Instant::now())
+            .expect("valid");
+    let baked = kiln_compiler::bake::bake(
+        &loaded.scene,
+        &loaded.settings,
+        &loaded.plan,
+        Vec::new(),
+        &Progress::hidden(),
+    )
+    .expect("bake");
+    kiln_compiler::bake::to_bytes(&baked).expect("write")
+}
+
+/// The ray of a texel reconstructed from the manifest record alone, by the documented
+/// conventions (not by the compiler's own layout code).
+fn texel_ray(info: &kiln_format::manifest::ShadowMapInfo, k: usize) -> Ray {
+    let n = info.resolution as usize;
+    let (face, rest) = (k / (n * n), k % (n * n));
+    let (x, y) = ((rest % n) as f32 + 0.5, (rest / n) as f32 + 0.5);
+    let origin = Vec3::from(info.origin);
+    match info.projection {
+        ShadowProjection::Cube => {
+            let (sc, tc) = (2.0 * x / n as f32 - 1.0, 2.0 * y / n as f32 - 1.0);
+            let d = [
+                Vec3::new(1.0, -tc, -sc),
+                Vec3::new(-1.0, -tc, sc),
+                Vec3::new(sc, 1.0, tc),
+                Vec3::new(sc, -1.0, -tc),
+                Vec3::new(sc, -tc, 1.0),
+                Vec3::new(-sc, -tc, -1.0),
+            ][face];
+            Ray::new(origin, d.normalize(), 0.0, f32::INFINITY)
+        }
+        _ => {
+            let inv = Mat4::from_cols_array(&info.view_proj).inverse();
+            let (ndc_x, ndc_y) = (2.0 * x / n as f32 - 1.0, 1.0 - 2.0 * y / n as f32);
+            let near = inv.project_point3(Vec3::new(ndc_x, ndc_y, 0.0));
+            let far = inv.project_point3(Vec3::new(ndc_x, ndc_y, 1.0));
+            let d = (far - near).normalize();
+            let o = if info.projection == ShadowProjection::Orthographic { near } else { origin };
+            Ray::new(o, d, 0.0, f32::INFINITY)
+        }
+    }
+}
+
+#[test]
+fn shadow_maps_agree_with_brute_force_ray_casts() {
+    let mut scene = kiln_compiler::import::demo::cornell_box();
+    scene.lights = vec![
+        light(LightKind::Directional, [0.0; 3], [-0.3, -1.0, -0.2], 2.0),
+        light(LightKind::Spot { inner_cone: 0.4, outer_cone: 0.6 }, [0.3, 1.8, 0.4], [0.0, -1.0, 0.1], 5.0),
+        light(LightKind::Point, [0.0, 1.5, 0.0], [0.0, -1.0, 0.0], 5.0),
+        light(LightKind::Rect { width: 0.5, height: 0.4 }, [0.0, 1.98, 0.0], [0.0, -1.0, 0.0], 10.0),
+    ];
+    let bytes = compile(scene, Settings { shadow_res: 64, shaft_variants: Some(0), ..Default::default() });
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let tris = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
+    let brute = BruteForce::new(&tris);
+    let kinds: Vec<ShadowProjection> = view.manifest.shadow_maps.iter().map(|m| m.projection).collect();
+    assert_eq!(
+        kinds,
+        [
+            ShadowProjection::Orthographic,
+            ShadowProjection::Perspective,
+            ShadowProjection::Cube,
+            ShadowProjection::Cube
+        ]
+    );
+    let mut rng = kiln_compiler::raycheck::Rng::new(3);
+    for (i, info) in view.manifest.shadow_maps.iter().enumerate() {
+        let depths: &[f32] = file.pod(sections::SHADOW_MAP, i as u32).unwrap().unwrap();
+        for _ in 0..1500 {
+            let k = rng.below(depths.len());
+            let want = brute.closest_hit(&texel_ray(info, k)).map_or(shadow::NO_OCCLUDER, |h| h.t);
+            let got = depths[k];
+            let tol = if want == shadow::NO_OCCLUDER { 0.0 } else { 1e-5 * want.max(1.0) };
+            assert!((got - want).abs() <= tol, "map {i} texel {k}: stored {got}, brute force {want}");
+        }
+    }
+}
+
+#[test]
+fn lights_that_see_nothing_and_lights_inside_geometry() {
+    let mut scene = kiln_compiler::import::demo::cornell_box();
+    // A spot pointing away from the scene sees nothing; a point light inside the tall block
+    // sees the block's inside in every direction (closed on 5 sides: the floor closes it).
+    scene.lights = vec![
+        light(LightKind::Spot { inner_cone: 0.2, outer_cone: 0.3 }, [0.0, 5.0, 0.0], [0.0, 1.0, 0.0], 1.0),
+        light(LightKind::Point, [-0.35, 0.6, -0.3], [0.0, -1.0, 0.0], 1.0),
+    ];
+    let bytes = compile(scene, Settings { shadow_res: 32, shaft_variants: Some(0), ..Default::default() });
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let away: &[f32] = file.pod(sections::SHADOW_MAP, 0).unwrap().unwrap();
+    assert!(away.iter().all(|&d| d == shadow::NO_OCCLUDER));
+    let inside: &[f32] = file.pod(sections::SHADOW_MAP, 1).unwrap().unwrap();
+    assert!(
+        inside.iter().all(|&d| d < 1.0),
+        "a ray escaped the block: {:?}",
+        inside.iter().cloned().fold(0.0f32, f32::max)
+    );
+}
+
+fn floor_and_blocker() -> Scene {
+    let mut s = Scene { name: "floor".into(), ..Default::default() };
+    s.materials.push(Material {
+        name: "grey".into(),
+        gpu: kiln_compiler::import::demo::lambert_material([0.5, 0.5, 0.5]),
+    });
+    let mut quad = |c: [Vec3; 4]| {
+        let n = (c[1] - c[0]).cross(c[2] - c[0]).normalize();
+        let b = s.vertices.len() as u32;
+        for p in c {
+            s.vertices.push(Vertex { position: p.to_array(), normal: n.to_array() });
+            s.uvs.push([0.0; 2]);
+        }
+        s.triangles.extend([[b, b + 1, b + 2], [b, b + 2, b + 3]]);
+        s.triangle_materials.extend([0, 0]);
+    };
+    quad([
+        Vec3::new(-1.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, -1.0),
+        Vec3::new(-1.0, 0.0, -1.0),
+    ]);
+    // A small blocker above the floor, facing down.
+    quad([
+        Vec3::new(-0.2, 0.5, -0.2),
+        Vec3::new(0.2, 0.5, -0.2),
+        Vec3::new(0.2, 0.5, 0.2),
+        Vec3::new(-0.2, 0.5, 0.2),
+    ]);
+    s.lights.push(light(LightKind::Point, [0.1, 1.5, 0.05], [0.0, -1.0, 0.0], 3.0));
+    s.cameras.push(kiln_format::manifest::Camera {
+        name: "c".into(),
+        position: [0.0, 1.0, 3.0],
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        vfov_degrees: 45.0,
+        znear: 0.01,
+        zfar: 0.0,
+    });
+    s
+}
+
+/// Pre-illuminated radiance against an independent evaluation: Lambert (albedo / π) times the
+/// point light's I cos θ / d², zero where a brute-force shadow ray is blocked.
+#[test]
+fn preilluminated_radiance_matches_direct_evaluation() {
+    let bytes = compile(
+        floor_and_blocker(),
+        Settings {
+            voxel_res: kiln_compiler::settings::VoxelRes::Cells(4),
+            shaft_res: 3,
+            shaft_variants: Some(Variants::PNMT | Variants::PREILLUM),
+            ..Default::default()
+        },
+    );
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().unwrap();
+    let tris = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
+    let brute = BruteForce::new(&tris);
+    let h = &ls.header;
+    let light_pos = Vec3::new(0.1, 1.5, 0.05);
+    let (mut checked, mut lit, mut shadowed) = (0, 0, 0);
+    let wps = kiln_format::linespace::words_per_slot(h.shaft_res);
+    for (c, &slot) in ls.slots.iter().enumerate() {
+        if slot == kiln_format::linespace::NO_SLOT {
+            continue;
+        }
+        let cmin = h.cell_min(h.cell_coords(c));
+        for w in 0..wps {
+            let word = ls.bits[slot as usize * wps + w];
+            for bit in 0..32 {
+                if word & (1 << bit) == 0 {
+                    continue;
+                }
+                let shaft = (w * 32 + bit) as u32;
+                let rank = ls.rank(slot, shaft).unwrap();
+                let Some(hit) = ls.pnmt[2 * rank].decode(cmin, h.cell) else { continue };
+                // The viewer of a front record is the centre of the shaft's front patch.
+                let (fa, pa, _, _) = kiln_format::linespace::index::shaft_parts(shaft, h.shaft_res);
+                let (ua, va) = kiln_format::linespace::index::face_uv_axes(fa);
+                let mut eye = glam::DVec3::ZERO;
+                eye[(fa / 2) as usize] = (fa % 2) as f64;
+                eye[ua] = ((pa / h.shaft_res) as f64 + 0.5) / h.shaft_res as f64;
+                eye[va] = ((pa % h.shaft_res) as f64 + 0.5) / h.shaft_res as f64;
+                let eye = (cmin + eye * h.cell).as_vec3();
+                let p = hit.position.as_vec3();
+                // Only records on the floor's upper side (normal +y) are checked.
+                if hit.normal.y < 0.99 || p.y.abs() > 1e-3 {
+                    continue;
+                }
+                let to = light_pos - p;
+                let d = to.length();
+                let origin = offset_origin(p, Vec3::Y);
+                let blocked = eye.y > p.y
+                    && brute.closest_hit(&Ray::new(origin, to / d, 0.0, d * (1.0 - 1e-5))).is_some();
+                // Seen from below, the floor's underside faces away from the light.
+                let from_above = eye.y > p.y;
+                let expected = if blocked || !from_above {
+                    0.0
+                } else {
+                    0.5 / std::f32::consts::PI * 3.0 * (to.y / d) / (d * d)
+                };
+                let got = half::f16::from_bits(ls.preillum[rank][0]).to_f32();
+                assert!(
+                    (got - expected).abs() <= 2e-3 * expected.max(1e-3) + 1e-5,
+                    "record at {p:?}: stored {got}, expected {expected}"
+                );
+                checked += 1;
+                if blocked { shadowed += 1 } else { lit += 1 }
+            }
+        }
+    }
+    assert!(checked > 200 && lit > 50 && shadowed > 5, "checked {checked}: {lit} lit, {shadowed} shadowed");
+}
+
+#[test]
+fn light_visibility_volume_matches_brute_force() {
+    let mut scene = floor_and_blocker();
+    scene.media.push(Medium {
+        bounds: Bounds { min: [-1.0, 0.0, -1.0], max: [1.0, 1.4, 1.0] },
+        sigma_a: [0.01; 3],
+        sigma_s: [0.1; 3],
+        g: 0.3,
+    });
+    scene.lights.push(light(LightKind::Directional, [0.0; 3], [0.2, -1.0, 0.1], 1.0));
+    let bytes =
+        compile(scene, Settings { media_volume_res: 16, shaft_variants: Some(0), ..Default::default() });
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let info = view.manifest.media_visibility.clone().expect("volume baked");
+    assert_eq!(info.lights, [0, 1]);
+    let tris = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
+    let brute = BruteForce::new(&tris);
+    let medium = &view.manifest.media[0];
+    let mut rng = kiln_compiler::raycheck::Rng::new(5);
+    let mut under_blocker = 0;
+    for (i, &l) in info.lights.iter().enumerate() {
+        let cells: &[u8] = file.pod(sections::MEDIA_VISIBILITY, i as u32).unwrap().unwrap();
+        let light = &view.manifest.lights[l as usize];
+        for _ in 0..400 {
+            let c = [
+                rng.below(info.dims[0] as usize) as u32,
+                rng.below(info.dims[1] as usize) as u32,
+                rng.below(info.dims[2] as usize) as u32,
+            ];
+            let seen = (0..info.samples)
+                .filter(|&k| {
+                    let p = kiln_compiler::bake::media::sample_point(medium, info.dims, c, k);
+                    let (d, tmax) = match light.kind {
+                        LightKind::Directional => (-Vec3::from(light.direction).normalize(), f32::INFINITY),
+                        _ => {
+                            let to = Vec3::from(light.position) - p;
+                            (to.normalize(), to.length() * (1.0 - 1e-5))
+                        }
+                    };
+                    brute.closest_hit(&Ray::new(p, d, 0.0, tmax)).is_none()
+                })
+                .count();
+            let want = (seen as f32 / info.samples as f32 * 255.0).round() as u8;
+            let got = cells[(c[0] + info.dims[0] * (c[1] + info.dims[1] * c[2])) as usize];
+            assert_eq!(got, want, "light {l}, cell {c:?}");
+            under_blocker += (got < 255) as u32;
+        }
+    }
+    assert!(under_blocker > 0, "no sampled cell was in a shadow");
+}
+
+#[test]
+fn plan_skips_each_lighting_bake_with_its_reason() {
+    let plan = |scene: Scene| {
+        let loaded = kiln_compiler::pipeline::finish(
+            scene,
+            Settings::default(),
+            "t",
+            false,
+            true,
+            std::time::Instant::now(),
+        )
+        .unwrap();
+        loaded.plan.stages.iter().map(|d| (d.stage.name(), d.run, d.reason.clone())).collect::<Vec<_>>()
+    };
+    fn find(p: &[(&'static str, bool, String)], n: &str) -> (&'static str, bool, String) {
+        p.iter().find(|d| d.0 == n).cloned().unwrap()
+    }
+    // The demo: all Lambertian, no medium, one shadow-casting light.
+    let p = plan(kiln_compiler::import::demo::cornell_box());
+    assert_eq!(
+        find(&p, "brdf-lut"),
+        ("brdf-lut", false, "every material is pure Lambertian: no specular lobe to pre-integrate".into())
+    );
+    assert!(find(&p, "shadow-maps").1);
+    assert_eq!(find(&p, "media-visibility").2, "the scene has no participating medium");
+    // No shadow casters.
+    let mut s = floor_and_blocker();
+    s.lights[0].casts_shadows = false;
+    s.media.push(Medium {
+        bounds: Bounds { min: [-1.0; 3], max: [1.0; 3] },
+        sigma_a: [0.0; 3],
+        sigma_s: [0.1; 3],
+        g: 0.0,
+    });
+    let p = plan(s);
+    assert_eq!(find(&p, "shadow-maps").2, "no light casts shadows");
+    assert!(!find(&p, "media-visibility").1);
+    // No lights at all.
+    let mut s = floor_and_blocker();
+    s.lights.clear();
+    let p = plan(s);
+    assert_eq!(find(&p, "shadow-maps").2, "the scene has no analytic lights");
+    assert!(!find(&p, "line-space").1);
+    // A glossy material needs the table.
+    let mut s = floor_and_blocker();
+    s.materials[0].gpu.flags = 0;
+    assert!(find(&plan(s), "brdf-lut").1);
+}
+
+#[test]
+fn export_writes_readable_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = floor_and_blocker();
+    scene.materials[0].gpu.flags = 0;
+    std::fs::write(
+        dir.path().join("s.kiln"),
+        compile(
+            scene,
+            Settings { shadow_res: 32, brdf_lut_res: 16, shaft_variants: Some(0), ..Default::default() },
+        ),
+    )
+    .unwrap();
+    for (section, out) in [
+        ("brdf-lut", "lut.pfm"),
+        ("brdf-lut", "lut.png"),
+        ("brdf-lut", "lut.exr"),
+        ("shadow-map:0", "sm.pfm"),
+        ("shadow-map", "sm.png"),
+    ] {
+        util::kiln(dir.path(), &["export", "s.kiln", section, "-o", out]).expect(0);
+    }
+    // PFM: header, then little-endian floats, bottom row first.
+    let pfm = std::fs::read(dir.path().join("sm.pfm")).unwrap();
+    assert!(pfm.starts_with(b"Pf\n16 96\n-1.0\n"), "{:?}", String::from_utf8_lossy(&pfm[..16]));
+    assert_eq!(pfm.len(), 14 + 16 * 96 * 4);
+    let lut = image::open(dir.path().join("lut.png")).unwrap();
+    assert_eq!((lut.width(), lut.height()), (16, 16));
+    let exr = image::open(dir.path().join("lut.exr")).unwrap().into_rgba32f();
+    assert!(exr.pixels().all(|p| p[0] + p[1] <= 1.0 + 1e-4 && p[0] >= 0.0));
+    util::kiln(dir.path(), &["export", "s.kiln", "shadow-map:7", "-o", "x.pfm"])
+        .expect(1)
+        .says("no shadow-map:7");
+    util::kiln(dir.path(), &["export", "s.kiln", "bvh", "-o", "x.pfm"]).expect(2).says("exportable");
+    util::kiln(dir.path(), &["export", "s.kiln", "brdf-lut", "-o", "x.bmp"])
+        .expect(2)
+        .says("unknown image type");
+}
