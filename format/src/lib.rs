@@ -20,6 +20,7 @@ compile_error!("kiln-format reads sections zero-copy and supports little-endian 
 
 pub mod checksum;
 pub mod error;
+pub mod gpu;
 pub mod header;
 pub mod linespace;
 pub mod manifest;

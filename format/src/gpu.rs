@@ -1,0 +1,285 @@
+//! Layouts the player's shaders read, defined once here. Each struct is declared with the GLSL
+//! type of every field; `glsl_layout()` emits the matching GLSL declarations, which the player's
+//! `shaders/common/layout.glsl` must equal (a test fails on drift), and a test checks every Rust
+//! offset against the std430/std140 offsets GLSL assigns.
+
+use bytemuck::{Pod, Zeroable};
+
+/// A struct shared with GLSL: its fields as (name, GLSL type, Rust offset, Rust size).
+pub trait GlslStruct {
+    /// Struct name in both languages.
+    const NAME: &'static str;
+    /// Fields in declaration order.
+    fn fields() -> Vec<(&'static str, &'static str, usize, usize)>;
+    /// Size in bytes.
+    fn size() -> usize;
+}
+
+macro_rules! gpu_struct {
+    ($(#[$m:meta])* pub struct $name:ident { $($(#[$fm:meta])* pub $field:ident : $ty:ty => $glsl:literal,)* }) => {
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+        #[repr(C)]
+        pub struct $name {
+            $($(#[$fm])* pub $field: $ty,)*
+        }
+
+        impl GlslStruct for $name {
+            const NAME: &'static str = stringify!($name);
+            fn fields() -> Vec<(&'static str, &'static str, usize, usize)> {
+                vec![$((stringify!($field), $glsl, core::mem::offset_of!($name, $field), size_of::<$ty>()),)*]
+            }
+            fn size() -> usize {
+                size_of::<$name>()
+            }
+        }
+    };
+}
+
+/// Light kinds in [`GpuLight::kind`].
+#[derive(Debug)]
+pub struct LightKinds;
+
+impl LightKinds {
+    /// Point light.
+    pub const POINT: u32 = 0;
+    /// Spot light.
+    pub const SPOT: u32 = 1;
+    /// Directional light.
+    pub const DIRECTIONAL: u32 = 2;
+    /// One-sided rectangle.
+    pub const RECT: u32 = 3;
+}
+
+/// Shadow projections in [`GpuShadow::projection`].
+#[derive(Debug)]
+pub struct ShadowKinds;
+
+impl ShadowKinds {
+    /// Orthographic (2D map).
+    pub const ORTHOGRAPHIC: u32 = 0;
+    /// Perspective (2D map).
+    pub const PERSPECTIVE: u32 = 1;
+    /// Cube map.
+    pub const CUBE: u32 = 2;
+}
+
+gpu_struct! {
+    /// One analytic light, as the direct-light pass reads it (std430, 80 bytes). Units as in the
+    /// manifest: `intensity × color` is W/sr (point, spot), W/m² (directional) or W/(sr·m²) (rect).
+    pub struct GpuLight {
+        /// Position (point, spot, rect centre).
+        pub position: [f32; 3] => "vec3",
+        /// [`LightKinds`].
+        pub kind: u32 => "uint",
+        /// Unit direction the light travels (directional, spot) or faces (rect).
+        pub direction: [f32; 3] => "vec3",
+        /// Cut-off distance, 0 = none.
+        pub range: f32 => "float",
+        /// Linear RGB colour times intensity.
+        pub radiance: [f32; 3] => "vec3",
+        /// Index into the shadow records, −1 without a shadow map.
+        pub shadow: i32 => "int",
+        /// Rect: unit vector along the width.
+        pub right: [f32; 3] => "vec3",
+        /// Spot: cosine of the inner cone half-angle.
+        pub cos_inner: f32 => "float",
+        /// Spot: cosine of the outer cone half-angle.
+        pub cos_outer: f32 => "float",
+        /// Rect: width.
+        pub width: f32 => "float",
+        /// Rect: height.
+        pub height: f32 => "float",
+        /// Zero.
+        pub reserved: f32 => "float",
+    }
+}
+
+gpu_struct! {
+    /// One shadow map's parameters (std430, 112 bytes); see FORMAT.md ("`SHDW`").
+    pub struct GpuShadow {
+        /// World to clip, column-major (2D maps).
+        pub view_proj: [f32; 16] => "mat4",
+        /// Ray origin: light position, or near-plane centre (orthographic).
+        pub origin: [f32; 3] => "vec3",
+        /// [`ShadowKinds`].
+        pub projection: u32 => "uint",
+        /// View axis.
+        pub direction: [f32; 3] => "vec3",
+        /// Texel footprint: world size (orthographic) or radians.
+        pub texel: f32 => "float",
+        /// Farthest distance.
+        pub far: f32 => "float",
+        /// Index into the 2D or the cube map array.
+        pub slot: u32 => "uint",
+        /// Texels per side.
+        pub resolution: u32 => "uint",
+        /// Zero.
+        pub reserved: u32 => "uint",
+    }
+}
+
+gpu_struct! {
+    /// Per-frame constants (std140 uniform block, 208 bytes).
+    pub struct FrameConstants {
+        /// World to clip, column-major.
+        pub view_proj: [f32; 16] => "mat4",
+        /// Clip to world.
+        pub inv_view_proj: [f32; 16] => "mat4",
+        /// Camera position, w unused.
+        pub camera: [f32; 4] => "vec4",
+        /// Sky radiance, w unused.
+        pub sky: [f32; 4] => "vec4",
+        /// Image width, height, light count, flags.
+        pub size: [u32; 4] => "uvec4",
+        /// Exposure multiplier, BRDF table resolution (0: none), frame number, unused.
+        pub params: [f32; 4] => "vec4",
+    }
+}
+
+/// Bits of `FrameConstants::size.w`.
+#[derive(Debug)]
+pub struct FrameFlags;
+
+impl FrameFlags {
+    /// Shadows from the baked shadow maps.
+    pub const SHADOW_MAPS: u32 = 1 << 0;
+}
+
+/// Alignment and size of a GLSL type under std430 (std140 differs only for arrays and structs,
+/// which these layouts do not nest).
+fn glsl_align_size(ty: &str) -> (usize, usize) {
+    match ty {
+        "float" | "uint" | "int" => (4, 4),
+        "vec2" | "uvec2" | "ivec2" => (8, 8),
+        "vec3" | "uvec3" | "ivec3" => (16, 12),
+        "vec4" | "uvec4" | "ivec4" => (16, 16),
+        "mat4" => (16, 64),
+        other => panic!("GLSL type {other} has no layout rule here"),
+    }
+}
+
+/// Offsets GLSL assigns to the fields of `T` (std430 / std140), and the struct size rounded to
+/// its alignment.
+pub fn glsl_offsets<T: GlslStruct>() -> (Vec<usize>, usize) {
+    let mut offset = 0usize;
+    let mut align_max = 4usize;
+    let mut out = Vec::new();
+    for (_, ty, _, _) in T::fields() {
+        let (align, size) = glsl_align_size(ty);
+        offset = offset.div_ceil(align) * align;
+        out.push(offset);
+        offset += size;
+        align_max = align_max.max(align);
+    }
+    (out, offset.div_ceil(align_max) * align_max)
+}
+
+fn declare<T: GlslStruct>(out: &mut String) {
+    out.push_str(&format!("struct {} {{\n", T::NAME));
+    for (name, ty, offset, _) in T::fields() {
+        out.push_str(&format!("    {ty} {name}; // offset {offset}\n"));
+    }
+    out.push_str(&format!("}}; // {} bytes\n\n", T::size()));
+}
+
+/// The GLSL declarations of every shared layout.
+pub fn glsl_layout() -> String {
+    let mut s = String::from(
+        "// Generated by kiln_format::gpu::glsl_layout(); do not edit.\n// Layouts shared with kiln-format (format/src/gpu.rs, format/src/sections).\n#ifndef KILN_LAYOUT_GLSL\n#define KILN_LAYOUT_GLSL\n\n",
+    );
+    declare::<GpuLight>(&mut s);
+    declare::<GpuShadow>(&mut s);
+    declare::<FrameConstants>(&mut s);
+    declare::<GpuMaterialLayout>(&mut s);
+    for (name, v) in [
+        ("LIGHT_POINT", LightKinds::POINT),
+        ("LIGHT_SPOT", LightKinds::SPOT),
+        ("LIGHT_DIRECTIONAL", LightKinds::DIRECTIONAL),
+        ("LIGHT_RECT", LightKinds::RECT),
+        ("SHADOW_ORTHOGRAPHIC", ShadowKinds::ORTHOGRAPHIC),
+        ("SHADOW_PERSPECTIVE", ShadowKinds::PERSPECTIVE),
+        ("SHADOW_CUBE", ShadowKinds::CUBE),
+        ("FRAME_SHADOW_MAPS", FrameFlags::SHADOW_MAPS),
+        ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
+        ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
+        ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),
+        ("NO_TEXTURE", crate::sections::NO_TEXTURE),
+    ] {
+        s.push_str(&format!("const uint {name} = {v}u;\n"));
+    }
+    s.push_str("\n#endif\n");
+    s
+}
+
+gpu_struct! {
+    /// The GLSL view of [`crate::sections::GpuMaterial`] (same bytes; std430, 80 bytes).
+    pub struct GpuMaterialLayout {
+        /// See `GpuMaterial`.
+        pub base_color: [f32; 4] => "vec4",
+        /// See `GpuMaterial`.
+        pub emission: [f32; 3] => "vec3",
+        /// See `GpuMaterial`.
+        pub metallic: f32 => "float",
+        /// See `GpuMaterial`.
+        pub roughness: f32 => "float",
+        /// See `GpuMaterial`.
+        pub alpha_cutoff: f32 => "float",
+        /// See `GpuMaterial`.
+        pub normal_scale: f32 => "float",
+        /// See `GpuMaterial`.
+        pub occlusion_strength: f32 => "float",
+        /// See `GpuMaterial`.
+        pub base_color_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub metallic_roughness_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub normal_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub occlusion_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub emissive_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub flags: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub reserved: [u32; 2] => "uvec2",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check<T: GlslStruct>() {
+        let (offsets, size) = glsl_offsets::<T>();
+        for ((name, ty, rust, _), glsl) in T::fields().into_iter().zip(offsets) {
+            assert_eq!(rust, glsl, "{}.{name} ({ty}): Rust offset {rust}, GLSL offset {glsl}", T::NAME);
+        }
+        assert_eq!(T::size(), size, "{}: Rust size {}, GLSL size {size}", T::NAME, T::size());
+    }
+
+    #[test]
+    fn rust_and_glsl_layouts_agree() {
+        check::<GpuLight>();
+        check::<GpuShadow>();
+        check::<FrameConstants>();
+        check::<GpuMaterialLayout>();
+        // The material section and its GLSL view are the same bytes.
+        let m = crate::sections::GpuMaterial { base_color_texture: 3, flags: 5, metallic: 0.25, ..Default::default() };
+        let v: GpuMaterialLayout = bytemuck::cast(m);
+        assert_eq!((v.base_color_texture, v.flags, v.metallic), (3, 5, 0.25));
+    }
+
+    /// `shaders/common/layout.glsl` must be exactly the generated text
+    /// (`KILN_BLESS=1 cargo test -p kiln-format layout` regenerates it).
+    #[test]
+    fn committed_glsl_layout_is_generated() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders/common/layout.glsl");
+        let text = glsl_layout();
+        if std::env::var_os("KILN_BLESS").is_some() {
+            std::fs::write(&path, &text).expect("write layout.glsl");
+        }
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(committed == text, "{} differs from the generated layout; run KILN_BLESS=1 cargo test -p kiln-format layout", path.display());
+    }
+}

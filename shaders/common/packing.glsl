@@ -1,0 +1,29 @@
+// Octahedral normal encoding (Meyer et al. 2010), as in format/src/linespace/pnmt.rs.
+#ifndef KILN_PACKING_GLSL
+#define KILN_PACKING_GLSL
+
+vec2 oct_encode(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 p = n.xy;
+    if (n.z < 0.0) {
+        p = (1.0 - abs(p.yx)) * vec2(p.x >= 0.0 ? 1.0 : -1.0, p.y >= 0.0 ? 1.0 : -1.0);
+    }
+    return p;
+}
+
+vec3 oct_decode(vec2 e) {
+    float z = 1.0 - abs(e.x) - abs(e.y);
+    float t = max(-z, 0.0);
+    return normalize(vec3(e.x - t * (e.x >= 0.0 ? 1.0 : -1.0), e.y - t * (e.y >= 0.0 ? 1.0 : -1.0), z));
+}
+
+vec3 srgb_to_linear(vec3 c) {
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+vec3 linear_to_srgb(vec3 l) {
+    l = clamp(l, 0.0, 1.0);
+    return mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, greaterThan(l, vec3(0.0031308)));
+}
+
+#endif

@@ -1,0 +1,82 @@
+#version 460
+// G-buffer pass: material evaluation into four targets.
+//   0 normal    RG16_SNORM  octahedral shading normal (normal map applied), world space
+//   1 albedo    RGBA8_SRGB  base colour
+//   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag, occlusion
+//   3 emission  RGBA16F     emitted radiance
+#include "../common/layout.glsl"
+#include "../common/packing.glsl"
+
+layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
+layout(set = 1, binding = 0) uniform sampler2D base_color_tex;
+layout(set = 1, binding = 1) uniform sampler2D metallic_roughness_tex;
+layout(set = 1, binding = 2) uniform sampler2D normal_tex;
+layout(set = 1, binding = 3) uniform sampler2D occlusion_tex;
+layout(set = 1, binding = 4) uniform sampler2D emissive_tex;
+layout(push_constant) uniform Material { GpuMaterialLayout material; };
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+
+layout(location = 0) out vec2 out_normal;
+layout(location = 1) out vec4 out_albedo;
+layout(location = 2) out vec4 out_material;
+layout(location = 3) out vec4 out_emission;
+
+// Perturbs the normal with a tangent-space normal map through the screen-space cotangent frame
+// (Schüler 2013): no stored tangents needed.
+vec3 apply_normal_map(vec3 n, vec3 p, vec2 uv, vec3 sample_ts) {
+    vec3 dp1 = dFdx(p), dp2 = dFdy(p);
+    vec2 duv1 = dFdx(uv), duv2 = dFdy(uv);
+    vec3 dp2perp = cross(dp2, n);
+    vec3 dp1perp = cross(n, dp1);
+    vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+    vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+    float invmax = inversesqrt(max(max(dot(t, t), dot(b, b)), 1e-20));
+    vec3 m = vec3(sample_ts.xy * material.normal_scale, sample_ts.z);
+    // glTF uv runs down the image; its tangent-space y (green) points up: flip the bitangent.
+    return normalize(mat3(t * invmax, -b * invmax, n) * m);
+}
+
+void main() {
+    vec4 base = material.base_color;
+    if (material.base_color_texture != NO_TEXTURE) {
+        base *= texture(base_color_tex, in_uv);
+    }
+    uint alpha_mode = (material.flags >> MATERIAL_ALPHA_SHIFT) & 3u;
+    if (alpha_mode == 1u && base.a < material.alpha_cutoff) {
+        discard;
+    }
+    bool double_sided = (material.flags & MATERIAL_DOUBLE_SIDED) != 0u;
+    if (!double_sided && !gl_FrontFacing) {
+        discard;
+    }
+    vec3 n = normalize(in_normal);
+    if (!gl_FrontFacing) {
+        n = -n;
+    }
+    if (material.normal_texture != NO_TEXTURE) {
+        n = apply_normal_map(n, in_position, in_uv, texture(normal_tex, in_uv).xyz * 2.0 - 1.0);
+    }
+    float metallic = material.metallic;
+    float roughness = material.roughness;
+    if (material.metallic_roughness_texture != NO_TEXTURE) {
+        vec4 mr = texture(metallic_roughness_tex, in_uv);
+        metallic *= mr.b;
+        roughness *= mr.g;
+    }
+    float occlusion = 1.0;
+    if (material.occlusion_texture != NO_TEXTURE) {
+        occlusion = mix(1.0, texture(occlusion_tex, in_uv).r, material.occlusion_strength);
+    }
+    vec3 emission = material.emission;
+    if (material.emissive_texture != NO_TEXTURE) {
+        emission *= texture(emissive_tex, in_uv).rgb;
+    }
+    bool diffuse_only = (material.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    out_normal = oct_encode(n);
+    out_albedo = vec4(base.rgb, 1.0);
+    out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), diffuse_only ? 1.0 : 0.0, occlusion);
+    out_emission = vec4(emission, 1.0);
+}

@@ -1,0 +1,216 @@
+#version 460
+// Direct light: every analytic light over the G-buffer, shadowed by the baked shadow maps
+// (PCF; PCSS for rect lights), plus the constant sky through the split-sum table and emission.
+// Output: linear scene radiance (before exposure and tone mapping).
+#include "../common/layout.glsl"
+#include "../common/packing.glsl"
+#include "../common/brdf.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+const uint MAX_SHADOW_2D = 8u;
+const uint MAX_SHADOW_CUBE = 8u;
+
+layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Lights { GpuLight lights[]; };
+layout(set = 0, binding = 2, std430) readonly buffer Shadows { GpuShadow shadows[]; };
+layout(set = 0, binding = 3) uniform sampler2D brdf_lut;
+layout(set = 0, binding = 4) uniform sampler2D shadow_2d[MAX_SHADOW_2D];
+layout(set = 0, binding = 5) uniform samplerCube shadow_cube[MAX_SHADOW_CUBE];
+layout(set = 0, binding = 6) uniform sampler2D g_depth;
+layout(set = 0, binding = 7) uniform sampler2D g_normal;
+layout(set = 0, binding = 8) uniform sampler2D g_albedo;
+layout(set = 0, binding = 9) uniform sampler2D g_material;
+layout(set = 0, binding = 10) uniform sampler2D g_emission;
+layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D radiance_out;
+
+// A Vogel spiral of 16 taps in the unit disk.
+vec2 tap(int i, float angle) {
+    float r = sqrt((float(i) + 0.5) / 16.0);
+    float theta = float(i) * 2.39996323 + angle;
+    return r * vec2(cos(theta), sin(theta));
+}
+
+float hash(uvec2 p) {
+    uint h = p.x * 1664525u + p.y * 1013904223u;
+    h ^= h >> 16; h *= 0x7feb352du; h ^= h >> 15;
+    return float(h) / 4294967296.0;
+}
+
+// Recommended bias (FORMAT.md, "SHDW"): 1.5 footprints plus one per unit of slope tangent.
+float shadow_bias(float footprint, float cos_theta) {
+    float tan_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / max(cos_theta, 1e-3);
+    return footprint * (1.5 + min(tan_theta, 10.0));
+}
+
+// Orthographic or perspective map: 16-tap PCF over a 1.5-texel radius.
+float shadow_2d_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float angle) {
+    vec3 to = p - s.origin;
+    float d = s.projection == SHADOW_ORTHOGRAPHIC ? dot(to, s.direction) : length(to);
+    float footprint = s.projection == SHADOW_ORTHOGRAPHIC ? s.texel : d * s.texel;
+    vec3 q = p + n * footprint;
+    vec4 clip = s.view_proj * vec4(q, 1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    if (clip.w <= 0.0 || any(greaterThan(abs(ndc.xy), vec2(1.0)))) {
+        return 1.0;
+    }
+    vec2 uv = vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    float dq = s.projection == SHADOW_ORTHOGRAPHIC ? dot(q - s.origin, s.direction) : length(q - s.origin);
+    float bias = shadow_bias(footprint, max(dot(n, l), 0.0));
+    float lit = 0.0;
+    for (int i = 0; i < 16; i++) {
+        vec2 t = uv + tap(i, angle) * (1.5 / float(s.resolution));
+        ivec2 texel = clamp(ivec2(t * float(s.resolution)), ivec2(0), ivec2(int(s.resolution) - 1));
+        float stored = texelFetch(shadow_2d[s.slot], texel, 0).r;
+        lit += dq <= stored + bias ? 1.0 : 0.0;
+    }
+    return lit / 16.0;
+}
+
+// Cube map (point and rect lights). Point lights: 16-tap PCF over 1.5 texels. Rect lights: PCSS,
+// a blocker search over the light's extent, then PCF over the penumbra it implies.
+float shadow_cube_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float light_radius, float angle) {
+    vec3 to = p - s.origin;
+    float d = length(to);
+    float footprint = d * s.texel;
+    vec3 q = p + n * footprint;
+    vec3 dir = q - s.origin;
+    float dq = length(dir);
+    dir /= dq;
+    vec3 u = normalize(abs(dir.y) < 0.9 ? cross(dir, vec3(0.0, 1.0, 0.0)) : cross(dir, vec3(1.0, 0.0, 0.0)));
+    vec3 w = cross(dir, u);
+    float bias = shadow_bias(footprint, max(dot(n, l), 0.0));
+    float radius = 1.5 * s.texel;
+    if (light_radius > 0.0) {
+        // Blocker search: directions within the light's apparent size seen from the receiver.
+        float search = light_radius / dq;
+        float blockers = 0.0, sum = 0.0;
+        for (int i = 0; i < 16; i++) {
+            vec2 t = tap(i, angle) * search;
+            float stored = texture(shadow_cube[s.slot], dir + u * t.x + w * t.y).r;
+            if (stored + bias < dq) {
+                blockers += 1.0;
+                sum += stored;
+            }
+        }
+        if (blockers == 0.0) {
+            return 1.0;
+        }
+        float db = sum / blockers;
+        float penumbra = light_radius * (dq - db) / max(db, 1e-4);
+        radius = max(radius, penumbra / dq);
+    }
+    float lit = 0.0;
+    for (int i = 0; i < 16; i++) {
+        vec2 t = tap(i, angle) * radius;
+        float stored = texture(shadow_cube[s.slot], dir + u * t.x + w * t.y).r;
+        lit += dq <= stored + bias ? 1.0 : 0.0;
+    }
+    return lit / 16.0;
+}
+
+float shadow_factor(GpuLight light, vec3 p, vec3 n, vec3 l, float angle) {
+    if ((frame.size.w & FRAME_SHADOW_MAPS) == 0u || light.shadow < 0) {
+        return 1.0;
+    }
+    GpuShadow s = shadows[light.shadow];
+    if (s.projection == SHADOW_CUBE) {
+        float radius = light.kind == LIGHT_RECT ? 0.5 * length(vec2(light.width, light.height)) : 0.0;
+        return shadow_cube_factor(s, p, n, l, radius, angle);
+    }
+    return shadow_2d_factor(s, p, n, l, angle);
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    uvec2 size = frame.size.xy;
+    if (any(greaterThanEqual(uvec2(pixel), size))) {
+        return;
+    }
+    float depth = texelFetch(g_depth, pixel, 0).r;
+    if (depth >= 1.0) {
+        imageStore(radiance_out, pixel, vec4(frame.sky.rgb, 1.0));
+        return;
+    }
+    vec2 ndc = vec2((float(pixel.x) + 0.5) / float(size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + 0.5) / float(size.y) * 2.0);
+    vec4 world = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+    vec3 p = world.xyz / world.w;
+    vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
+    vec4 mat = texelFetch(g_material, pixel, 0);
+    Surface s = Surface(texelFetch(g_albedo, pixel, 0).rgb, mat.r, mat.g, mat.b > 0.5);
+    vec3 v = normalize(frame.camera.xyz - p);
+    if (dot(n, v) < 0.0) {
+        n = -n;
+    }
+    float n_v = clamp(dot(n, v), 1e-4, 1.0);
+    float lut_res = frame.params.y;
+    float e_albedo = s.diffuse_only ? 1.0 : directional_albedo(brdf_lut, lut_res, n_v, s.roughness);
+    float angle = 6.2831853 * hash(uvec2(pixel));
+
+    vec3 radiance = texelFetch(g_emission, pixel, 0).rgb;
+    // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.
+    vec3 ambient;
+    if (s.diffuse_only) {
+        ambient = s.base;
+    } else {
+        vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, s.roughness)).rg : vec2(1.0, 0.0);
+        vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
+        vec3 specular = (f0 * rg.r + rg.g) * (vec3(1.0) + f0 * (1.0 / e_albedo - 1.0));
+        ambient = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - s.metallic) * s.base + specular;
+    }
+    radiance += ambient * frame.sky.rgb * mat.a;
+
+    for (uint i = 0u; i < frame.size.z; i++) {
+        GpuLight light = lights[i];
+        vec3 contribution = vec3(0.0);
+        vec3 shadow_dir;
+        if (light.kind == LIGHT_DIRECTIONAL) {
+            vec3 l = -light.direction;
+            shadow_dir = l;
+            float n_l = dot(n, l);
+            if (n_l > 0.0) {
+                contribution = brdf(s, n, v, l, e_albedo) * light.radiance * n_l;
+            }
+        } else if (light.kind == LIGHT_RECT) {
+            vec3 up = cross(light.direction, light.right);
+            float area = light.width * light.height;
+            shadow_dir = normalize(light.position - p);
+            for (int a = 0; a < 4; a++) {
+                for (int b = 0; b < 4; b++) {
+                    vec3 q = light.position + light.right * ((float(a) + 0.5) / 4.0 - 0.5) * light.width
+                        + up * ((float(b) + 0.5) / 4.0 - 0.5) * light.height;
+                    vec3 to = q - p;
+                    float d = length(to);
+                    if (d <= 0.0 || (light.range > 0.0 && d > light.range)) {
+                        continue;
+                    }
+                    vec3 l = to / d;
+                    float cos_light = dot(-l, light.direction);
+                    float n_l = dot(n, l);
+                    if (cos_light <= 0.0 || n_l <= 0.0) {
+                        continue;
+                    }
+                    contribution += brdf(s, n, v, l, e_albedo) * light.radiance * (cos_light * area / (16.0 * d * d)) * n_l;
+                }
+            }
+        } else {
+            vec3 to = light.position - p;
+            float d = length(to);
+            vec3 l = to / max(d, 1e-12);
+            shadow_dir = l;
+            float n_l = dot(n, l);
+            if (d > 0.0 && n_l > 0.0 && (light.range <= 0.0 || d <= light.range)) {
+                float cone = 1.0;
+                if (light.kind == LIGHT_SPOT) {
+                    cone = smoothstep(light.cos_outer, light.cos_inner, dot(-l, light.direction));
+                }
+                contribution = brdf(s, n, v, l, e_albedo) * light.radiance * (cone / (d * d)) * n_l;
+            }
+        }
+        if (any(greaterThan(contribution, vec3(0.0)))) {
+            contribution *= shadow_factor(light, p, n, shadow_dir, angle);
+        }
+        radiance += contribution;
+    }
+    imageStore(radiance_out, pixel, vec4(radiance, 1.0));
+}
