@@ -120,7 +120,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Per-frame constants (std140 uniform block, 208 bytes).
+    /// Per-frame constants (std140 uniform block, 192 bytes).
     pub struct FrameConstants {
         /// World to clip, column-major.
         pub view_proj: [f32; 16] => "mat4",
@@ -265,7 +265,12 @@ mod tests {
         check::<FrameConstants>();
         check::<GpuMaterialLayout>();
         // The material section and its GLSL view are the same bytes.
-        let m = crate::sections::GpuMaterial { base_color_texture: 3, flags: 5, metallic: 0.25, ..Default::default() };
+        let m = crate::sections::GpuMaterial {
+            base_color_texture: 3,
+            flags: 5,
+            metallic: 0.25,
+            ..Default::default()
+        };
         let v: GpuMaterialLayout = bytemuck::cast(m);
         assert_eq!((v.base_color_texture, v.flags, v.metallic), (3, 5, 0.25));
     }
@@ -280,6 +285,10 @@ mod tests {
             std::fs::write(&path, &text).expect("write layout.glsl");
         }
         let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(committed == text, "{} differs from the generated layout; run KILN_BLESS=1 cargo test -p kiln-format layout", path.display());
+        assert!(
+            committed == text,
+            "{} differs from the generated layout; run KILN_BLESS=1 cargo test -p kiln-format layout",
+            path.display()
+        );
     }
 }

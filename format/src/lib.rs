@@ -24,6 +24,7 @@ pub mod gpu;
 pub mod header;
 pub mod linespace;
 pub mod manifest;
+pub mod projection;
 pub mod query;
 pub mod read;
 pub mod scene;

@@ -1,30 +1,19 @@
-//! `kiln-play`: the Vulkan player. This release carries the command-line skeleton only.
+//! `kiln-play`: the Vulkan player (see `kiln-play --help`).
+
+use std::process::ExitCode;
+use std::time::Instant;
 
 use clap::Parser;
+use kiln_player::cli::{Args, run};
 
-/// kiln-play renders .kiln files with Vulkan, headless or in a window.
-#[derive(Debug, Parser)]
-#[command(name = "kiln-play", version, about)]
-struct Args {
-    /// The .kiln file to play.
-    file: Option<std::path::PathBuf>,
-}
-
-fn main() -> std::process::ExitCode {
+fn main() -> ExitCode {
+    let start = Instant::now();
     let args = Args::parse();
-    match args.file {
-        None => {
-            println!(
-                "kiln-play {} (format {}.{})",
-                env!("CARGO_PKG_VERSION"),
-                kiln_format::header::VERSION_MAJOR,
-                kiln_format::header::VERSION_MINOR
-            );
-            std::process::ExitCode::SUCCESS
-        }
-        Some(path) => {
-            eprintln!("error: {}: rendering is not available in this build of kiln-play yet", path.display());
-            std::process::ExitCode::from(3)
+    match run(args, start) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit as u8)
         }
     }
 }

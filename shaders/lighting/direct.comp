@@ -1,4 +1,5 @@
 #version 460
+#extension GL_EXT_control_flow_attributes : require
 // Direct light: every analytic light over the G-buffer, shadowed by the baked shadow maps
 // (PCF; PCSS for rect lights), plus the constant sky through the split-sum table and emission.
 // Output: linear scene radiance (before exposure and tone mapping).
@@ -8,6 +9,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// The shadow tap loops are [[dont_unroll]]: each tap samples through a dynamically indexed
+// sampler array, which CPU drivers (lavapipe) expand into one sampling routine per array element;
+// unrolling multiplied that by 16 and took lavapipe 26 s to compile.
 const uint MAX_SHADOW_2D = 8u;
 const uint MAX_SHADOW_CUBE = 8u;
 
@@ -58,7 +62,7 @@ float shadow_2d_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float angle) {
     float dq = s.projection == SHADOW_ORTHOGRAPHIC ? dot(q - s.origin, s.direction) : length(q - s.origin);
     float bias = shadow_bias(footprint, max(dot(n, l), 0.0));
     float lit = 0.0;
-    for (int i = 0; i < 16; i++) {
+    [[dont_unroll]] for (int i = 0; i < 16; i++) {
         vec2 t = uv + tap(i, angle) * (1.5 / float(s.resolution));
         ivec2 texel = clamp(ivec2(t * float(s.resolution)), ivec2(0), ivec2(int(s.resolution) - 1));
         float stored = texelFetch(shadow_2d[s.slot], texel, 0).r;
@@ -85,7 +89,7 @@ float shadow_cube_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float light_radius
         // Blocker search: directions within the light's apparent size seen from the receiver.
         float search = light_radius / dq;
         float blockers = 0.0, sum = 0.0;
-        for (int i = 0; i < 16; i++) {
+        [[dont_unroll]] for (int i = 0; i < 16; i++) {
             vec2 t = tap(i, angle) * search;
             float stored = texture(shadow_cube[s.slot], dir + u * t.x + w * t.y).r;
             if (stored + bias < dq) {
@@ -101,7 +105,7 @@ float shadow_cube_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float light_radius
         radius = max(radius, penumbra / dq);
     }
     float lit = 0.0;
-    for (int i = 0; i < 16; i++) {
+    [[dont_unroll]] for (int i = 0; i < 16; i++) {
         vec2 t = tap(i, angle) * radius;
         float stored = texture(shadow_cube[s.slot], dir + u * t.x + w * t.y).r;
         lit += dq <= stored + bias ? 1.0 : 0.0;
@@ -128,7 +132,8 @@ void main() {
         return;
     }
     float depth = texelFetch(g_depth, pixel, 0).r;
-    if (depth >= 1.0) {
+    // Reversed Z: the far plane (cleared, nothing drawn) is depth 0.
+    if (depth <= 0.0) {
         imageStore(radiance_out, pixel, vec4(frame.sky.rgb, 1.0));
         return;
     }
@@ -202,7 +207,9 @@ void main() {
             if (d > 0.0 && n_l > 0.0 && (light.range <= 0.0 || d <= light.range)) {
                 float cone = 1.0;
                 if (light.kind == LIGHT_SPOT) {
-                    cone = smoothstep(light.cos_outer, light.cos_inner, dot(-l, light.direction));
+                    // smoothstep, written out: GLSL leaves smoothstep undefined for equal edges.
+                    float t = clamp((dot(-l, light.direction) - light.cos_outer) / max(light.cos_inner - light.cos_outer, 1e-6), 0.0, 1.0);
+                    cone = t * t * (3.0 - 2.0 * t);
                 }
                 contribution = brdf(s, n, v, l, e_albedo) * light.radiance * (cone / (d * d)) * n_l;
             }

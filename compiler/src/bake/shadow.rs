@@ -17,6 +17,7 @@
 
 use glam::{Mat4, Vec3};
 use kiln_format::manifest::{Bounds, Light, LightKind, ShadowMapInfo, ShadowProjection};
+use kiln_format::projection::{look_to_rh, orthographic_rh, perspective_rh};
 use kiln_format::query::{BvhQuery, Ray, TriangleSource};
 use kiln_format::sections::CwbvhNode;
 use rayon::prelude::*;
@@ -41,42 +42,6 @@ pub fn cube_direction(face: u32, x: u32, y: u32, n: u32) -> Vec3 {
         _ => Vec3::new(-sc, -tc, -1.0),
     };
     d.normalize()
-}
-
-/// Right-handed view matrix looking from `eye` along `dir` (view space: x right, y up, −z
-/// forward).
-pub fn look_to_rh(eye: Vec3, dir: Vec3, up: Vec3) -> Mat4 {
-    let f = dir.normalize();
-    let s = f.cross(up).normalize();
-    let u = s.cross(f);
-    Mat4::from_cols(
-        glam::Vec4::new(s.x, u.x, -f.x, 0.0),
-        glam::Vec4::new(s.y, u.y, -f.y, 0.0),
-        glam::Vec4::new(s.z, u.z, -f.z, 0.0),
-        glam::Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
-    )
-}
-
-/// Orthographic projection of view-space [l, r] × [b, t] × [−near, −far] to x, y in [−1, 1] and
-/// z in [0, 1].
-pub fn orthographic_rh(l: f32, r: f32, b: f32, t: f32, near: f32, far: f32) -> Mat4 {
-    Mat4::from_cols(
-        glam::Vec4::new(2.0 / (r - l), 0.0, 0.0, 0.0),
-        glam::Vec4::new(0.0, 2.0 / (t - b), 0.0, 0.0),
-        glam::Vec4::new(0.0, 0.0, -1.0 / (far - near), 0.0),
-        glam::Vec4::new(-(r + l) / (r - l), -(t + b) / (t - b), -near / (far - near), 1.0),
-    )
-}
-
-/// Perspective projection with vertical field of view `fov`, z in [0, 1] from near to far.
-pub fn perspective_rh(fov: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
-    let f = 1.0 / (fov * 0.5).tan();
-    Mat4::from_cols(
-        glam::Vec4::new(f / aspect, 0.0, 0.0, 0.0),
-        glam::Vec4::new(0.0, f, 0.0, 0.0),
-        glam::Vec4::new(0.0, 0.0, far / (near - far), -1.0),
-        glam::Vec4::new(0.0, 0.0, near * far / (near - far), 0.0),
-    )
 }
 
 /// A vector perpendicular to `d` (unit).
@@ -128,12 +93,19 @@ pub fn layout(light: &Light, index: u32, bounds: &Bounds, res: u32) -> Option<La
             let pad = diag * 0.01;
             let (lo, hi) = (lo - pad, hi + pad);
             let centre = right * (lo.x + hi.x) * 0.5 + up * (lo.y + hi.y) * 0.5 + dir * lo.z;
-            let view = look_to_rh(centre, dir, up);
+            let view = look_to_rh(centre.as_dvec3(), dir.as_dvec3(), up.as_dvec3());
             let (w, h) = (hi.x - lo.x, hi.y - lo.y);
-            let proj = orthographic_rh(-w * 0.5, w * 0.5, -h * 0.5, h * 0.5, 0.0, hi.z - lo.z);
+            let proj = orthographic_rh(
+                -w as f64 * 0.5,
+                w as f64 * 0.5,
+                -h as f64 * 0.5,
+                h as f64 * 0.5,
+                0.0,
+                (hi.z - lo.z) as f64,
+            );
             (
                 ShadowProjection::Orthographic,
-                proj * view,
+                (proj * view).as_mat4(),
                 centre,
                 0.0,
                 hi.z - lo.z,
@@ -145,9 +117,9 @@ pub fn layout(light: &Light, index: u32, bounds: &Bounds, res: u32) -> Option<La
             let fov = (2.0 * outer_cone).clamp(1e-3, 170f32.to_radians());
             let near = diag * 1e-4;
             let far = far_from(pos);
-            let view = look_to_rh(pos, dir, perpendicular(dir));
-            let proj = perspective_rh(fov, 1.0, near, far);
-            (ShadowProjection::Perspective, proj * view, pos, near, far, fov / res as f32, res)
+            let view = look_to_rh(pos.as_dvec3(), dir.as_dvec3(), perpendicular(dir).as_dvec3());
+            let proj = perspective_rh(fov as f64, 1.0, near as f64, far as f64);
+            (ShadowProjection::Perspective, (proj * view).as_mat4(), pos, near, far, fov / res as f32, res)
         }
         LightKind::Point | LightKind::Rect { .. } => {
             let n = (res / 2).max(1);

@@ -1,0 +1,235 @@
+//! The view: where it starts (the file's camera, a `--camera` override, or a view of the scene
+//! bounds), its matrices (reversed-Z, computed in f64), and the fly controls of the window.
+
+use glam::{DMat4, DVec3, Vec3};
+use kiln_format::manifest::{Bounds, Camera as FileCamera};
+use kiln_format::projection::{look_to_rh, perspective_infinite_reverse_rh, perspective_rh};
+
+use crate::error::{Exit, PlayError, PlayResult};
+
+/// A perspective camera looking from `position` along `forward`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: DVec3,
+    /// Unit view direction.
+    pub forward: DVec3,
+    /// Up hint.
+    pub up: DVec3,
+    /// Vertical field of view, degrees.
+    pub vfov_degrees: f64,
+    /// Near plane distance.
+    pub znear: f64,
+    /// Far plane distance; 0 or infinite for an infinite far plane.
+    pub zfar: f64,
+}
+
+/// A `--camera` override: position, target and optionally the vertical field of view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraOverride {
+    /// Eye.
+    pub position: [f64; 3],
+    /// Point looked at.
+    pub target: [f64; 3],
+    /// Vertical field of view, degrees.
+    pub vfov_degrees: Option<f64>,
+}
+
+impl std::str::FromStr for CameraOverride {
+    type Err = String;
+
+    /// `px,py,pz,tx,ty,tz[,vfov]`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|t| t.trim().parse::<f64>().map_err(|_| format!("'{t}' is not a number")))
+            .collect::<Result<_, _>>()?;
+        if !(v.len() == 6 || v.len() == 7) {
+            return Err(format!(
+                "expected 6 or 7 comma-separated numbers (px,py,pz,tx,ty,tz[,vfov]), got {}",
+                v.len()
+            ));
+        }
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err("every number must be finite".into());
+        }
+        let position = [v[0], v[1], v[2]];
+        let target = [v[3], v[4], v[5]];
+        if position == target {
+            return Err("position and target must differ".into());
+        }
+        let vfov_degrees = v.get(6).copied();
+        if let Some(f) = vfov_degrees
+            && !(f > 0.0 && f < 180.0)
+        {
+            return Err(format!("vfov {f} must be in (0, 180) degrees"));
+        }
+        Ok(CameraOverride { position, target, vfov_degrees })
+    }
+}
+
+fn d3(v: [f32; 3]) -> DVec3 {
+    Vec3::from_array(v).as_dvec3()
+}
+
+impl Camera {
+    /// The camera to start with: the override applied to the file's first camera, or to a view of
+    /// the bounds from above and in front when the file has none.
+    pub fn initial(
+        cameras: &[FileCamera],
+        bounds: &Bounds,
+        over: Option<CameraOverride>,
+    ) -> PlayResult<Camera> {
+        let lo = d3(bounds.min);
+        let hi = d3(bounds.max);
+        let valid = lo.is_finite() && hi.is_finite() && lo.cmple(hi).all();
+        let (centre, radius) =
+            if valid { ((lo + hi) * 0.5, ((hi - lo).length() * 0.5).max(1e-3)) } else { (DVec3::ZERO, 1.0) };
+        let mut cam = match cameras.first() {
+            Some(c) => Camera {
+                position: d3(c.position),
+                forward: (d3(c.target) - d3(c.position)).normalize_or(DVec3::NEG_Z),
+                up: d3(c.up).normalize_or(DVec3::Y),
+                vfov_degrees: c.vfov_degrees as f64,
+                znear: c.znear as f64,
+                zfar: c.zfar as f64,
+            },
+            None => {
+                let vfov = 45.0f64;
+                let distance = radius / (vfov.to_radians() * 0.5).sin();
+                let dir = DVec3::new(0.0, 0.35, 1.0).normalize();
+                Camera {
+                    position: centre + dir * distance,
+                    forward: -dir,
+                    up: DVec3::Y,
+                    vfov_degrees: vfov,
+                    znear: 0.0,
+                    zfar: 0.0,
+                }
+            }
+        };
+        if let Some(o) = over {
+            cam.position = DVec3::from_array(o.position);
+            cam.forward = (DVec3::from_array(o.target) - cam.position).normalize();
+            if let Some(f) = o.vfov_degrees {
+                cam.vfov_degrees = f;
+            }
+        }
+        if !(cam.znear > 0.0) {
+            // Reversed-Z float depth keeps precision over the whole range, so a small near plane
+            // costs nothing: 1/10000 of the scene diagonal (as the compiler's default).
+            cam.znear = (2.0 * radius) * 1e-4;
+        }
+        let usable = cam.position.is_finite()
+            && cam.forward.is_finite()
+            && cam.vfov_degrees > 0.0
+            && cam.vfov_degrees < 180.0;
+        if !usable {
+            return Err(PlayError::new(
+                Exit::BadInput,
+                "the camera is not finite or its field of view is outside (0, 180) degrees",
+            ));
+        }
+        Ok(cam)
+    }
+
+    /// World to view.
+    pub fn view(&self) -> DMat4 {
+        let up = if self.forward.cross(self.up).length_squared() < 1e-12 { DVec3::Z } else { self.up };
+        look_to_rh(self.position, self.forward, up)
+    }
+
+    /// View to clip with reversed Z (near → 1, far → 0) and Vulkan's [0, 1] depth; clip y up (the
+    /// viewport flips it).
+    pub fn projection(&self, aspect: f64) -> DMat4 {
+        let fov = self.vfov_degrees.to_radians();
+        if self.zfar > self.znear && self.zfar.is_finite() {
+            perspective_rh(fov, aspect, self.zfar, self.znear)
+        } else {
+            perspective_infinite_reverse_rh(fov, aspect, self.znear)
+        }
+    }
+
+    /// World to clip and its inverse, as f32 column-major arrays.
+    pub fn matrices(&self, width: u32, height: u32) -> ([f32; 16], [f32; 16]) {
+        let aspect = width.max(1) as f64 / height.max(1) as f64;
+        let vp = self.projection(aspect) * self.view();
+        (vp.as_mat4().to_cols_array(), vp.inverse().as_mat4().to_cols_array())
+    }
+
+    /// Turns the view by yaw (about world up) and pitch, in radians; pitch stops short of the poles.
+    pub fn turn(&mut self, yaw: f64, pitch: f64) {
+        let up = DVec3::Y;
+        let current_pitch = self.forward.dot(up).clamp(-1.0, 1.0).asin();
+        let new_pitch = (current_pitch + pitch).clamp(-1.5, 1.5);
+        let flat = DVec3::new(self.forward.x, 0.0, self.forward.z).normalize_or(DVec3::NEG_Z);
+        let (s, c) = (-yaw).sin_cos();
+        let flat = DVec3::new(flat.x * c - flat.z * s, 0.0, flat.x * s + flat.z * c);
+        self.forward = (flat * new_pitch.cos() + up * new_pitch.sin()).normalize();
+        self.up = up;
+    }
+
+    /// Moves by `local` (x right, y up, z forward) scaled by `distance`.
+    pub fn fly(&mut self, local: DVec3, distance: f64) {
+        let right = self.forward.cross(DVec3::Y).normalize_or(DVec3::X);
+        self.position += (right * local.x + DVec3::Y * local.y + self.forward * local.z) * distance;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bounds() -> Bounds {
+        Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] }
+    }
+
+    #[test]
+    fn override_parses_and_rejects() {
+        let o: CameraOverride = "1,2,3,0,0,0,60".parse().unwrap();
+        assert_eq!(o.position, [1.0, 2.0, 3.0]);
+        assert_eq!(o.vfov_degrees, Some(60.0));
+        assert!("1,2,3".parse::<CameraOverride>().is_err());
+        assert!("1,2,3,1,2,3".parse::<CameraOverride>().is_err());
+        assert!("1,2,3,0,0,0,200".parse::<CameraOverride>().is_err());
+        assert!("1,2,x,0,0,0".parse::<CameraOverride>().is_err());
+    }
+
+    #[test]
+    fn reversed_depth_maps_near_to_one_and_far_towards_zero() {
+        let cam = Camera::initial(&[], &bounds(), Some("0,0,5,0,0,0,60".parse().unwrap())).unwrap();
+        let (vp, inv) = cam.matrices(100, 100);
+        let vp = glam::Mat4::from_cols_array(&vp);
+        let near = vp * glam::Vec4::new(0.0, 0.0, 5.0 - cam.znear as f32, 1.0);
+        assert!((near.z / near.w - 1.0).abs() < 1e-4);
+        let far = vp * glam::Vec4::new(0.0, 0.0, -1000.0, 1.0);
+        assert!(far.z / far.w > 0.0 && far.z / far.w < 1e-5);
+        // The inverse recovers a world point from its clip position.
+        let p = glam::Vec4::new(0.3, -0.2, 0.5, 1.0);
+        let clip = vp * p;
+        let back = glam::Mat4::from_cols_array(&inv) * (clip / clip.w);
+        assert!((back.truncate() / back.w - p.truncate()).length() < 1e-4);
+    }
+
+    #[test]
+    fn default_view_sees_the_bounds() {
+        let cam = Camera::initial(&[], &bounds(), None).unwrap();
+        let (vp, _) = cam.matrices(64, 64);
+        let vp = glam::Mat4::from_cols_array(&vp);
+        for corner in [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0], [1.0, -1.0, 1.0], [-1.0, 1.0, -1.0]] {
+            let c = vp * glam::Vec3::from_array(corner).extend(1.0);
+            let ndc = c.truncate() / c.w;
+            assert!(c.w > 0.0 && ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{corner:?} → {ndc}");
+        }
+    }
+
+    #[test]
+    fn turning_keeps_a_unit_forward_below_the_pole() {
+        let mut cam = Camera::initial(&[], &bounds(), None).unwrap();
+        for _ in 0..100 {
+            cam.turn(0.1, 0.1);
+        }
+        assert!((cam.forward.length() - 1.0).abs() < 1e-9);
+        assert!(cam.forward.y < 1.0);
+    }
+}

@@ -1,0 +1,225 @@
+//! Command line of `kiln-play`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Parser, ValueEnum};
+
+use crate::bench;
+use crate::camera::CameraOverride;
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{GpuOptions, default_cache_path, list_devices};
+use crate::headless;
+use crate::render::RenderSettings;
+use crate::session::SessionOptions;
+use crate::window;
+
+const AFTER_HELP: &str = "\
+Examples:
+  kiln-play scene.kiln                                 open a window (WASD/QE fly, drag to look, Shift faster, Esc quits)
+  kiln-play scene.kiln --headless --size 800x450 -o out.png
+  kiln-play scene.kiln --headless -o radiance.exr       linear radiance, before exposure and tone mapping
+  kiln-play scene.kiln --bench --json --size 1600x900  per-pass GPU times and the load breakdown
+
+Tone mapping: display = sRGB(ACES(2^exposure * radiance)), ACES being Narkowicz's fit
+x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14) of the ACES filmic curve, per channel.
+
+Exit codes: 0 success, 1 invalid or damaged .kiln file, 2 usage error, 3 unsupported (no Vulkan
+loader, no suitable device, missing feature), 4 I/O error, 5 GPU failure or validation errors
+(with --validate).";
+
+/// Image size `WxH`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Size {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+}
+
+impl std::str::FromStr for Size {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Size, String> {
+        let (w, h) =
+            s.split_once(['x', 'X']).ok_or_else(|| format!("'{s}' is not WIDTHxHEIGHT (e.g. 1280x720)"))?;
+        let parse = |t: &str| t.trim().parse::<u32>().map_err(|_| format!("'{t}' is not a whole number"));
+        let (width, height) = (parse(w)?, parse(h)?);
+        if !(1..=16384).contains(&width) || !(1..=16384).contains(&height) {
+            return Err(format!("{width}x{height}: each side must be 1..=16384"));
+        }
+        Ok(Size { width, height })
+    }
+}
+
+/// `--shadows`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Shadows {
+    /// No shadows.
+    None,
+    /// The compiler's baked shadow maps (PCF; PCSS for rect lights).
+    Shadowmap,
+}
+
+/// A technique switch whose techniques come with later passes; `none` for now.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum NotYet {
+    /// Off.
+    None,
+}
+
+/// kiln-play renders .kiln files with Vulkan 1.3: in a window, headless to PNG or EXR, or as a
+/// benchmark.
+#[derive(Debug, Parser)]
+#[command(name = "kiln-play", version, about, after_help = AFTER_HELP)]
+pub struct Args {
+    /// The .kiln file to play (`kiln compile` or `kiln demo` make one).
+    pub file: Option<PathBuf>,
+    /// Render without a window (no display server needed).
+    #[arg(long)]
+    pub headless: bool,
+    /// Image size; the window's initial size.
+    #[arg(long, value_name = "WxH", default_value = "1280x720")]
+    pub size: Size,
+    /// Frames to render headless (the last is written), or to measure with --bench [1 | 100].
+    #[arg(long, value_name = "N")]
+    pub frames: Option<u32>,
+    /// Headless output: .png (tone-mapped sRGB) or .exr (linear radiance).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Measure per-pass GPU times and the load breakdown (headless).
+    #[arg(long)]
+    pub bench: bool,
+    /// With --bench: print JSON instead of a table.
+    #[arg(long, requires = "bench")]
+    pub json: bool,
+    /// With --bench: frames rendered before measuring.
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    pub warmup: u32,
+    /// Enable the Khronos validation layer; errors make the exit code 5.
+    #[arg(long)]
+    pub validate: bool,
+    /// Use the first device whose name contains NAME (see --list-devices); default: a discrete
+    /// GPU, else any, lavapipe last.
+    #[arg(long, value_name = "NAME")]
+    pub device: Option<String>,
+    /// List the Vulkan devices and exit.
+    #[arg(long)]
+    pub list_devices: bool,
+    /// Camera override: position, target and optionally the vertical field of view in degrees.
+    #[arg(long, value_name = "PX,PY,PZ,TX,TY,TZ[,VFOV]", allow_hyphen_values = true)]
+    pub camera: Option<CameraOverride>,
+    /// Exposure in stops (radiance × 2^EV before tone mapping; PNG and window only).
+    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f32,
+    /// Shadows technique.
+    #[arg(long, value_enum, default_value = "shadowmap")]
+    pub shadows: Shadows,
+    /// Ambient occlusion technique (later passes add techniques).
+    #[arg(long, value_enum, default_value = "none")]
+    pub ao: NotYet,
+    /// Reflections technique (later passes add techniques).
+    #[arg(long, value_enum, default_value = "none")]
+    pub reflections: NotYet,
+    /// Global illumination technique (later passes add techniques).
+    #[arg(long, value_enum, default_value = "none")]
+    pub gi: NotYet,
+    /// Participating media technique (later passes add techniques).
+    #[arg(long, value_enum, default_value = "none")]
+    pub media: NotYet,
+    /// Do not read or write the pipeline cache (~/.cache/kiln/pipelines.bin).
+    #[arg(long)]
+    pub no_pipeline_cache: bool,
+}
+
+impl Args {
+    fn session(&self, file: PathBuf) -> PlayResult<SessionOptions> {
+        if !self.exposure.is_finite() {
+            return Err(PlayError::new(Exit::Usage, "--exposure must be finite"));
+        }
+        Ok(SessionOptions {
+            file,
+            gpu: GpuOptions {
+                validate: self.validate,
+                device: self.device.clone(),
+                surface_extensions: Vec::new(),
+                pipeline_cache: if self.no_pipeline_cache { None } else { default_cache_path() },
+            },
+            render: RenderSettings {
+                shadow_maps: self.shadows == Shadows::Shadowmap,
+                exposure: self.exposure,
+            },
+            width: self.size.width,
+            height: self.size.height,
+            camera: self.camera,
+        })
+    }
+}
+
+fn validation_verdict(errors: u32) -> PlayResult {
+    if errors > 0 {
+        return Err(PlayError::new(Exit::Gpu, format!("the validation layer reported {errors} error(s)")));
+    }
+    Ok(())
+}
+
+/// Runs the command line; `start` is the process start.
+pub fn run(args: Args, start: Instant) -> PlayResult {
+    if args.list_devices {
+        for (name, kind, version) in list_devices()? {
+            println!("{name}  ({kind}, Vulkan {version})");
+        }
+        return Ok(());
+    }
+    let Some(file) = args.file.clone() else {
+        println!(
+            "kiln-play {} (format {}.{}): give a .kiln file to play; --help explains",
+            env!("CARGO_PKG_VERSION"),
+            kiln_format::header::VERSION_MAJOR,
+            kiln_format::header::VERSION_MINOR
+        );
+        return Ok(());
+    };
+    let options = args.session(file)?;
+    if args.bench {
+        if args.output.is_some() {
+            return Err(PlayError::new(Exit::Usage, "--bench writes no image; drop -o"));
+        }
+        let report = bench::run(&options, args.warmup, args.frames.unwrap_or(100), start)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
+        } else {
+            print!("{}", report.table());
+        }
+        return validation_verdict(report.validation_errors);
+    }
+    if args.headless || args.output.is_some() {
+        if args.output.is_none() {
+            eprintln!("note: no -o given; rendering without writing an image");
+        }
+        let result = headless::run(&options, args.frames.unwrap_or(1), args.output.as_deref(), start)?;
+        let s = &result.session;
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
+        }
+        if let Some(out) = &args.output {
+            eprintln!(
+                "wrote {} ({}x{}, {}) in {:.0} ms (first frame {:.0} ms after start; device {})",
+                out.display(),
+                options.width,
+                options.height,
+                s.scene.manifest.scene_name,
+                s.since_start_ms(),
+                s.times.first_frame_since_start_ms,
+                s.gpu.name
+            );
+        }
+        if result.non_finite > 0 {
+            return Err(PlayError::new(
+                Exit::Gpu,
+                format!("{} pixel(s) of the frame are NaN or infinite", result.non_finite),
+            ));
+        }
+        return validation_verdict(s.validation_errors());
+    }
+    window::run(options, start)
+}

@@ -1,0 +1,20 @@
+//! kiln-play: streams a `.kiln` file to the GPU and renders it with Vulkan, headless or in a
+//! window.
+//!
+//! Layers, bottom up: [`gpu`] (the only module that speaks raw Vulkan), [`scene`] (streaming
+//! upload of a file's sections), [`render`] (passes and their targets), and the front ends
+//! [`headless`], [`window`] and [`bench`], driven by [`cli`].
+
+pub mod bench;
+pub mod camera;
+pub mod cli;
+pub mod error;
+pub mod gpu;
+pub mod headless;
+pub mod image_out;
+pub mod render;
+pub mod scene;
+pub mod session;
+pub mod window;
+
+pub use error::{Exit, PlayError, PlayResult};

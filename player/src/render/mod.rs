@@ -1,0 +1,474 @@
+//! The frame: G-buffer raster, direct light in compute, tone mapping. Pipelines are built
+//! without the scene (so they compile while it uploads); [`Renderer::new`] then binds the scene.
+
+pub mod lights;
+pub mod targets;
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use kiln_format::gpu::{FrameConstants, FrameFlags, GpuMaterialLayout};
+use kiln_format::sections::NO_TEXTURE;
+
+use crate::camera::Camera;
+use crate::error::PlayResult;
+use crate::gpu::{
+    Binding, BindingKind, Buffer, ComputePipeline, Gpu, GraphicsDesc, GraphicsPipeline, Image, Recorder,
+    SetLayout, TimestampPool, Use, Write,
+};
+use crate::scene::upload::Uploader;
+use crate::scene::{GpuScene, sampled_desc};
+use targets::{DEPTH_FORMAT, GBUFFER_FORMATS, Targets};
+
+/// SPIR-V of the passes, built from `shaders/` by `shaders/build.sh` (checked by a test).
+pub mod spirv {
+    /// G-buffer vertex shader.
+    pub const GBUFFER_VERT: &[u8] = include_bytes!("../../../shaders/spirv/gbuffer.vert.spv");
+    /// G-buffer fragment shader.
+    pub const GBUFFER_FRAG: &[u8] = include_bytes!("../../../shaders/spirv/gbuffer.frag.spv");
+    /// Direct light.
+    pub const DIRECT: &[u8] = include_bytes!("../../../shaders/spirv/direct.comp.spv");
+    /// Tone mapping.
+    pub const TONEMAP: &[u8] = include_bytes!("../../../shaders/spirv/tonemap.comp.spv");
+    /// (source under `shaders/`, embedded bytes) of every shader.
+    pub const ALL: [(&str, &[u8]); 4] = [
+        ("gbuffer/gbuffer.vert", GBUFFER_VERT),
+        ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
+        ("lighting/direct.comp", DIRECT),
+        ("post/tonemap.comp", TONEMAP),
+    ];
+}
+
+/// Shadow maps of each kind the direct-light pass can bind (`MAX_SHADOW_2D`, `MAX_SHADOW_CUBE`
+/// in `shaders/lighting/direct.comp`).
+pub const MAX_SHADOW_MAPS: usize = 8;
+
+/// Passes timed with timestamps, in order.
+pub const PASSES: [&str; 3] = ["gbuffer", "direct", "tonemap"];
+
+/// How to render.
+#[derive(Debug, Clone, Copy)]
+pub struct RenderSettings {
+    /// Shadows from the baked shadow maps.
+    pub shadow_maps: bool,
+    /// Exposure in stops (the radiance is multiplied by 2^exposure before tone mapping).
+    pub exposure: f32,
+}
+
+/// Layouts and pipelines (independent of the scene).
+#[derive(Debug)]
+pub struct Pipelines {
+    frame_layout: SetLayout,
+    material_layout: SetLayout,
+    direct_layout: SetLayout,
+    tonemap_layout: SetLayout,
+    gbuffer: GraphicsPipeline,
+    direct: ComputePipeline,
+    tonemap: ComputePipeline,
+}
+
+fn b(kind: BindingKind) -> Binding {
+    Binding { kind, count: 1 }
+}
+
+impl Pipelines {
+    /// Builds every pipeline (through the pipeline cache).
+    pub fn new(gpu: &Gpu) -> PlayResult<Pipelines> {
+        use BindingKind::*;
+        let frame_layout = SetLayout::new(gpu, &[b(Uniform)], 1)?;
+        let material_layout = SetLayout::new(gpu, &[b(Sampled); 5], 64)?;
+        let mut direct_bindings = vec![b(Uniform), b(Storage), b(Storage), b(Sampled)];
+        direct_bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
+        direct_bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
+        direct_bindings.extend([b(Sampled); 5]);
+        direct_bindings.push(b(StorageImage));
+        let direct_layout = SetLayout::new(gpu, &direct_bindings, 1)?;
+        let tonemap_layout = SetLayout::new(gpu, &[b(Uniform), b(StorageImage), b(StorageImage)], 1)?;
+        let gbuffer = GraphicsPipeline::new(
+            gpu,
+            &GraphicsDesc {
+                vertex: spirv::GBUFFER_VERT,
+                fragment: spirv::GBUFFER_FRAG,
+                vertex_strides: &[24, 8],
+                attributes: &[
+                    (0, 0, vk::Format::R32G32B32_SFLOAT, 0),
+                    (1, 0, vk::Format::R32G32B32_SFLOAT, 12),
+                    (2, 1, vk::Format::R32G32_SFLOAT, 0),
+                ],
+                colors: &GBUFFER_FORMATS,
+                depth: DEPTH_FORMAT,
+                sets: &[&frame_layout, &material_layout],
+                push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
+            },
+        )?;
+        let direct = ComputePipeline::new(gpu, spirv::DIRECT, &[&direct_layout], 0)?;
+        let tonemap = ComputePipeline::new(gpu, spirv::TONEMAP, &[&tonemap_layout], 0)?;
+        Ok(Pipelines {
+            frame_layout,
+            material_layout,
+            direct_layout,
+            tonemap_layout,
+            gbuffer,
+            direct,
+            tonemap,
+        })
+    }
+
+    /// Releases layouts and pipelines.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.gbuffer.destroy(gpu);
+        self.direct.destroy(gpu);
+        self.tonemap.destroy(gpu);
+        for l in [
+            &mut self.frame_layout,
+            &mut self.material_layout,
+            &mut self.direct_layout,
+            &mut self.tonemap_layout,
+        ] {
+            l.destroy(gpu);
+        }
+    }
+}
+
+/// Placeholder images for descriptors that must be valid but are never read.
+#[derive(Debug)]
+pub struct Dummies {
+    /// 1 × 1 white RGBA8 (absent textures, absent BRDF table).
+    pub white: Image,
+    /// 1 × 1 R32F at f32::MAX (unused 2D shadow slots).
+    pub shadow_2d: Image,
+    /// 1 × 1 × 6 R32F cube at f32::MAX (unused cube slots).
+    pub shadow_cube: Image,
+}
+
+impl Dummies {
+    /// Creates and uploads the placeholders.
+    pub fn new(gpu: &Gpu, up: &mut Uploader) -> PlayResult<Dummies> {
+        let white = Image::new(gpu, "white", sampled_desc(vk::Format::R8G8B8A8_UNORM, 1, 1, 1, 1, false))?;
+        up.image(&white, 4, &[(0, 0, 1, 1, &[255u8; 4])])?;
+        let far = f32::MAX.to_le_bytes();
+        let shadow_2d =
+            Image::new(gpu, "no shadow 2d", sampled_desc(vk::Format::R32_SFLOAT, 1, 1, 1, 1, false))?;
+        up.image(&shadow_2d, 4, &[(0, 0, 1, 1, &far)])?;
+        let shadow_cube =
+            Image::new(gpu, "no shadow cube", sampled_desc(vk::Format::R32_SFLOAT, 1, 1, 1, 6, true))?;
+        let faces: Vec<(u32, u32, u32, u32, &[u8])> = (0..6).map(|f| (0, f, 1, 1, &far[..])).collect();
+        up.image(&shadow_cube, 4, &faces)?;
+        Ok(Dummies { white, shadow_2d, shadow_cube })
+    }
+
+    /// Releases the images.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.white.destroy(gpu);
+        self.shadow_2d.destroy(gpu);
+        self.shadow_cube.destroy(gpu);
+    }
+}
+
+/// GPU times of one frame's passes, in milliseconds (order of [`PASSES`]).
+pub type PassTimes = [f64; 3];
+
+/// Renders a resident scene.
+pub struct Renderer {
+    pipelines: Pipelines,
+    dummies: Dummies,
+    /// The images of the current size.
+    pub targets: Targets,
+    frame_ubo: Buffer,
+    lights: Buffer,
+    shadows: Buffer,
+    frame_set: vk::DescriptorSet,
+    material_sets: Vec<vk::DescriptorSet>,
+    direct_set: vk::DescriptorSet,
+    tonemap_set: vk::DescriptorSet,
+    /// Materials as pushed, with texture numbers of absent textures cleared.
+    materials: Vec<GpuMaterialLayout>,
+    light_count: u32,
+    slots_2d: Vec<usize>,
+    slots_cube: Vec<usize>,
+    flags: u32,
+    lut_resolution: u32,
+    sky: [f32; 3],
+    settings: RenderSettings,
+    timestamps: TimestampPool,
+    /// Frames rendered.
+    pub frame: u64,
+    /// Notes for the user (e.g. lights left unshadowed).
+    pub warnings: Vec<String>,
+}
+
+impl std::fmt::Debug for Renderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Renderer").field("size", &(self.targets.width, self.targets.height)).finish()
+    }
+}
+
+fn host_buffer(gpu: &Gpu, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags) -> PlayResult<Buffer> {
+    let mut buf = Buffer::new(gpu, name, bytes.len() as u64, usage, MemoryLocation::CpuToGpu)?;
+    buf.write(bytes)?;
+    Ok(buf)
+}
+
+impl Renderer {
+    /// Binds `scene` to `pipelines` for images of `width` × `height`.
+    pub fn new(
+        gpu: &Gpu,
+        mut pipelines: Pipelines,
+        dummies: Dummies,
+        scene: &GpuScene,
+        settings: RenderSettings,
+        width: u32,
+        height: u32,
+    ) -> PlayResult<Renderer> {
+        let targets = Targets::new(gpu, width, height)?;
+        let plan = lights::plan(&scene.manifest, &scene.shadow_maps, settings.shadow_maps);
+        let lights = host_buffer(
+            gpu,
+            "lights",
+            bytemuck::cast_slice(&plan.lights),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let shadows = host_buffer(
+            gpu,
+            "shadows",
+            bytemuck::cast_slice(&plan.shadows),
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )?;
+        let frame_ubo = Buffer::new(
+            gpu,
+            "frame",
+            std::mem::size_of::<FrameConstants>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let frame_set = pipelines.frame_layout.allocate(gpu)?;
+        pipelines.frame_layout.write(gpu, frame_set, &[Write::Buffer(0, &frame_ubo)]);
+
+        let white = (dummies.white.view, scene.linear_clamp);
+        let texture = |t: u32| -> (vk::ImageView, vk::Sampler) {
+            match scene.textures.get(t as usize) {
+                Some(img) if t != NO_TEXTURE => (img.view, scene.texture_samplers[t as usize]),
+                _ => white,
+            }
+        };
+        let mut material_sets = Vec::with_capacity(scene.materials.len());
+        let mut materials = Vec::with_capacity(scene.materials.len());
+        for m in &scene.materials {
+            let set = pipelines.material_layout.allocate(gpu)?;
+            let writes: Vec<Write> = m
+                .textures()
+                .iter()
+                .enumerate()
+                .map(|(i, &t)| Write::Sampled(i as u32, vec![texture(t)]))
+                .collect();
+            pipelines.material_layout.write(gpu, set, &writes);
+            material_sets.push(set);
+            let mut layout: GpuMaterialLayout = bytemuck::cast(*m);
+            // Textures the scene did not upload (textures off) read as absent.
+            for t in [
+                &mut layout.base_color_texture,
+                &mut layout.metallic_roughness_texture,
+                &mut layout.normal_texture,
+                &mut layout.occlusion_texture,
+                &mut layout.emissive_texture,
+            ] {
+                if *t as usize >= scene.textures.len() {
+                    *t = NO_TEXTURE;
+                }
+            }
+            materials.push(layout);
+        }
+        let direct_set = pipelines.direct_layout.allocate(gpu)?;
+        let tonemap_set = pipelines.tonemap_layout.allocate(gpu)?;
+        let mut renderer = Renderer {
+            pipelines,
+            dummies,
+            targets,
+            frame_ubo,
+            lights,
+            shadows,
+            frame_set,
+            material_sets,
+            direct_set,
+            tonemap_set,
+            materials,
+            light_count: plan.lights_used,
+            slots_2d: plan.slots_2d,
+            slots_cube: plan.slots_cube,
+            flags: if plan.shadows_bound { FrameFlags::SHADOW_MAPS } else { 0 },
+            lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
+            sky: scene.manifest.sky.radiance,
+            settings,
+            timestamps: TimestampPool::new(gpu, 4)?,
+            frame: 0,
+            warnings: plan.warnings,
+        };
+        renderer.write_frame_sets(gpu, scene);
+        Ok(renderer)
+    }
+
+    /// Points the direct-light and tone-mapping sets at the current targets and the scene.
+    fn write_frame_sets(&mut self, gpu: &Gpu, scene: &GpuScene) {
+        let near = scene.nearest_clamp;
+        let lut = scene
+            .brdf_lut
+            .as_ref()
+            .map_or((self.dummies.white.view, scene.linear_clamp), |i| (i.view, scene.linear_clamp));
+        let mut maps_2d = vec![(self.dummies.shadow_2d.view, near); MAX_SHADOW_MAPS];
+        let mut maps_cube = vec![(self.dummies.shadow_cube.view, near); MAX_SHADOW_MAPS];
+        for (slot, &i) in self.slots_2d.iter().enumerate() {
+            maps_2d[slot] = (scene.shadow_maps[i].image.view, near);
+        }
+        for (slot, &i) in self.slots_cube.iter().enumerate() {
+            maps_cube[slot] = (scene.shadow_maps[i].image.view, near);
+        }
+        let t = &self.targets;
+        let g = |i: usize| vec![(t.gbuffer[i].view, near)];
+        self.pipelines.direct_layout.write(
+            gpu,
+            self.direct_set,
+            &[
+                Write::Buffer(0, &self.frame_ubo),
+                Write::Buffer(1, &self.lights),
+                Write::Buffer(2, &self.shadows),
+                Write::Sampled(3, vec![lut]),
+                Write::Sampled(4, maps_2d),
+                Write::Sampled(5, maps_cube),
+                Write::Sampled(6, vec![(t.depth.view, near)]),
+                Write::Sampled(7, g(0)),
+                Write::Sampled(8, g(1)),
+                Write::Sampled(9, g(2)),
+                Write::Sampled(10, g(3)),
+                Write::StorageImage(11, t.radiance.view),
+            ],
+        );
+        self.pipelines.tonemap_layout.write(
+            gpu,
+            self.tonemap_set,
+            &[
+                Write::Buffer(0, &self.frame_ubo),
+                Write::StorageImage(1, t.radiance.view),
+                Write::StorageImage(2, t.display.view),
+            ],
+        );
+    }
+
+    /// Recreates the targets for a new size (the GPU must be idle).
+    pub fn resize(&mut self, gpu: &Gpu, scene: &GpuScene, width: u32, height: u32) -> PlayResult {
+        self.targets.destroy(gpu);
+        self.targets = Targets::new(gpu, width.max(1), height.max(1))?;
+        self.write_frame_sets(gpu, scene);
+        Ok(())
+    }
+
+    /// Writes the frame constants for `camera` (the previous frame must have finished).
+    pub fn update(&mut self, camera: &Camera) -> PlayResult {
+        let (w, h) = (self.targets.width, self.targets.height);
+        let (view_proj, inv_view_proj) = camera.matrices(w, h);
+        let p = camera.position.as_vec3();
+        let constants = FrameConstants {
+            view_proj,
+            inv_view_proj,
+            camera: [p.x, p.y, p.z, 0.0],
+            sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
+            size: [w, h, self.light_count, self.flags],
+            params: [2f32.powf(self.settings.exposure), self.lut_resolution as f32, self.frame as f32, 0.0],
+        };
+        self.frame_ubo.write(bytemuck::bytes_of(&constants))
+    }
+
+    /// Records one frame: G-buffer, direct light, tone mapping. Leaves `radiance` and `display`
+    /// in GENERAL layout (storage).
+    pub fn record(&mut self, rec: &Recorder, scene: &GpuScene) {
+        let t = &self.targets;
+        rec.reset_timestamps(&self.timestamps);
+        rec.timestamp(&self.timestamps, 0);
+        for img in &t.gbuffer {
+            rec.transition(img, Use::DISCARD, Use::COLOR);
+        }
+        rec.transition(&t.depth, Use::DISCARD, Use::DEPTH);
+        let colors: Vec<&Image> = t.gbuffer.iter().collect();
+        rec.begin_rendering(&colors, &t.depth);
+        let p = &self.pipelines.gbuffer;
+        rec.bind_graphics(p, &[self.frame_set]);
+        if !scene.draws.is_empty() {
+            rec.bind_geometry(&[&scene.vertices, &scene.uvs], &scene.indices);
+            for d in &scene.draws {
+                rec.bind_graphics_set(p, 1, self.material_sets[d.material as usize]);
+                rec.push_graphics(p, bytemuck::bytes_of(&self.materials[d.material as usize]));
+                rec.draw_indexed(d.count, d.first);
+            }
+        }
+        rec.end_rendering();
+        rec.timestamp(&self.timestamps, 1);
+        for img in &t.gbuffer {
+            rec.transition(img, Use::COLOR, Use::SAMPLED);
+        }
+        rec.transition(&t.depth, Use::DEPTH, Use::SAMPLED);
+        rec.transition(&t.radiance, Use::DISCARD, Use::STORAGE);
+        rec.dispatch_2d(&self.pipelines.direct, &[self.direct_set], t.width, t.height);
+        rec.timestamp(&self.timestamps, 2);
+        rec.transition(&t.radiance, Use::STORAGE, Use::STORAGE);
+        rec.transition(&t.display, Use::DISCARD, Use::STORAGE);
+        rec.dispatch_2d(&self.pipelines.tonemap, &[self.tonemap_set], t.width, t.height);
+        rec.timestamp(&self.timestamps, 3);
+        self.frame += 1;
+    }
+
+    /// GPU milliseconds of each pass of the last completed frame.
+    pub fn pass_times(&self, gpu: &Gpu) -> PlayResult<PassTimes> {
+        let ns = self.timestamps.read_ns(gpu)?;
+        Ok([(ns[1] - ns[0]) * 1e-6, (ns[2] - ns[1]) * 1e-6, (ns[3] - ns[2]) * 1e-6])
+    }
+
+    /// Releases everything the renderer owns (the GPU must be idle).
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.targets.destroy(gpu);
+        self.dummies.destroy(gpu);
+        self.frame_ubo.destroy(gpu);
+        self.lights.destroy(gpu);
+        self.shadows.destroy(gpu);
+        self.timestamps.destroy(gpu);
+        self.pipelines.destroy(gpu);
+    }
+}
+
+/// Host-visible copies of a frame's display and radiance images.
+#[derive(Debug)]
+pub struct Readback {
+    /// Tone-mapped RGBA8.
+    pub display: Buffer,
+    /// Linear RGBA32F.
+    pub radiance: Buffer,
+}
+
+impl Readback {
+    /// Buffers for targets of `width` × `height`.
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> PlayResult<Readback> {
+        let px = width as u64 * height as u64;
+        let dst = vk::BufferUsageFlags::TRANSFER_DST;
+        Ok(Readback {
+            display: Buffer::new(gpu, "display readback", px * 4, dst, MemoryLocation::GpuToCpu)?,
+            radiance: Buffer::new(gpu, "radiance readback", px * 16, dst, MemoryLocation::GpuToCpu)?,
+        })
+    }
+
+    /// Records copies of both images (in STORAGE use) into the buffers.
+    pub fn record(&self, rec: &Recorder, targets: &Targets) {
+        for (img, buf) in [(&targets.display, &self.display), (&targets.radiance, &self.radiance)] {
+            rec.transition(img, Use::STORAGE, Use::TRANSFER_SRC);
+            rec.copy_from_image(img, buf);
+        }
+        rec.memory_barrier(
+            vk::PipelineStageFlags2::TRANSFER,
+            vk::AccessFlags2::TRANSFER_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+    }
+
+    /// Releases the buffers.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.display.destroy(gpu);
+        self.radiance.destroy(gpu);
+    }
+}

@@ -1,0 +1,393 @@
+//! A `.kiln` file made resident on the GPU: its sections uploaded in file order through the
+//! staging ring, only those the enabled passes read. The rest are skipped and listed.
+
+pub mod upload;
+
+use std::collections::HashMap;
+
+use ash::vk;
+use kiln_format::manifest::{ColorSpace, Manifest, ShadowProjection, Wrap};
+use kiln_format::read::KilnFile;
+use kiln_format::scene::SceneView;
+use kiln_format::sections::{self, GpuMaterial};
+
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey};
+use upload::Uploader;
+
+/// What the enabled passes read, beyond geometry and materials.
+#[derive(Debug, Clone, Copy)]
+pub struct Needs {
+    /// Material textures.
+    pub textures: bool,
+    /// The split-sum BRDF table.
+    pub brdf_lut: bool,
+    /// Shadow maps.
+    pub shadow_maps: bool,
+}
+
+/// One draw: the triangles of one material, contiguous in the index buffer.
+#[derive(Debug, Clone, Copy)]
+pub struct Draw {
+    /// Material index.
+    pub material: u32,
+    /// First index.
+    pub first: u32,
+    /// Index count.
+    pub count: u32,
+}
+
+/// A resident shadow map.
+#[derive(Debug)]
+pub struct ShadowImage {
+    /// Index in `manifest.shadow_maps`.
+    pub map: usize,
+    /// The depths (R32F; six layers for cube maps).
+    pub image: Image,
+}
+
+/// A section and what happened to it.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SectionFate {
+    /// Kind and index, as `inspect` names them.
+    pub section: String,
+    /// Bytes in the file.
+    pub bytes: u64,
+    /// Uploaded, or why not.
+    pub uploaded: bool,
+    /// Why it was skipped (empty when uploaded or read on the CPU).
+    pub reason: String,
+}
+
+/// The scene on the GPU.
+pub struct GpuScene {
+    /// The file's manifest.
+    pub manifest: Manifest,
+    /// Positions and normals (24-byte `Vertex`).
+    pub vertices: Buffer,
+    /// Texture coordinates (zeros when the file has none).
+    pub uvs: Buffer,
+    /// Triangle indices sorted by material.
+    pub indices: Buffer,
+    /// One draw per material with triangles.
+    pub draws: Vec<Draw>,
+    /// Materials (pushed as constants per draw).
+    pub materials: Vec<GpuMaterial>,
+    /// Material textures (empty when textures are not needed).
+    pub textures: Vec<Image>,
+    /// The sampler of each texture.
+    pub texture_samplers: Vec<vk::Sampler>,
+    /// The BRDF table, when the file has one and a pass needs it.
+    pub brdf_lut: Option<Image>,
+    /// Linear clamp sampler (BRDF table).
+    pub linear_clamp: vk::Sampler,
+    /// Nearest clamp sampler (shadow maps, G-buffer reads).
+    pub nearest_clamp: vk::Sampler,
+    /// Shadow maps, when needed.
+    pub shadow_maps: Vec<ShadowImage>,
+    /// Every section of the file and its fate.
+    pub sections: Vec<SectionFate>,
+    /// Bytes uploaded.
+    pub uploaded_bytes: u64,
+    samplers: HashMap<SamplerKey, Sampler>,
+}
+
+impl std::fmt::Debug for GpuScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuScene")
+            .field("scene", &self.manifest.scene_name)
+            .field("draws", &self.draws.len())
+            .finish()
+    }
+}
+
+fn bad(e: kiln_format::error::FormatError) -> PlayError {
+    PlayError::new(Exit::BadInput, format!("invalid .kiln file: {e}"))
+}
+
+fn wrap_mode(w: Wrap) -> vk::SamplerAddressMode {
+    match w {
+        Wrap::Repeat => vk::SamplerAddressMode::REPEAT,
+        Wrap::MirroredRepeat => vk::SamplerAddressMode::MIRRORED_REPEAT,
+        Wrap::ClampToEdge => vk::SamplerAddressMode::CLAMP_TO_EDGE,
+    }
+}
+
+/// Sorts triangle indices by material (a counting sort, stable within a material); returns the
+/// flat index list and one draw per material that has triangles.
+pub fn sort_by_material(
+    triangles: &[[u32; 3]],
+    triangle_materials: &[u32],
+    materials: usize,
+) -> (Vec<u32>, Vec<Draw>) {
+    let mut counts = vec![0u32; materials];
+    for &m in triangle_materials {
+        counts[m as usize] += 1;
+    }
+    let mut starts = vec![0u32; materials];
+    let mut draws = Vec::new();
+    let mut sum = 0u32;
+    for (m, &c) in counts.iter().enumerate() {
+        starts[m] = sum;
+        if c > 0 {
+            draws.push(Draw { material: m as u32, first: sum * 3, count: c * 3 });
+        }
+        sum += c;
+    }
+    let mut indices = vec![0u32; triangles.len() * 3];
+    for (t, &m) in triangles.iter().zip(triangle_materials) {
+        let at = starts[m as usize] as usize * 3;
+        indices[at..at + 3].copy_from_slice(t);
+        starts[m as usize] += 1;
+    }
+    (indices, draws)
+}
+
+impl GpuScene {
+    /// Validates `file` and uploads what `needs` asks for through `up`. Returns when everything
+    /// is recorded; the caller flushes the uploader and waits on its timeline before drawing.
+    pub fn load(gpu: &Gpu, file: &KilnFile, needs: Needs, up: &mut Uploader) -> PlayResult<GpuScene> {
+        let view = SceneView::new(file).map_err(bad)?;
+        let sampler = |key| Sampler::new(gpu, key);
+        let clamp = vk::SamplerAddressMode::CLAMP_TO_EDGE;
+        let mut samplers = HashMap::new();
+        let linear_key = SamplerKey { linear: true, mipmaps: false, wrap_u: clamp, wrap_v: clamp };
+        let nearest_key = SamplerKey { linear: false, mipmaps: false, wrap_u: clamp, wrap_v: clamp };
+        samplers.insert(linear_key, sampler(linear_key)?);
+        samplers.insert(nearest_key, sampler(nearest_key)?);
+        let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
+        let vertices =
+            Buffer::uploaded(gpu, "vertices", std::mem::size_of_val(view.vertices) as u64, vertex_usage)?;
+        let uvs = Buffer::uploaded(
+            gpu,
+            "uvs",
+            (view.vertices.len() * 8) as u64,
+            vertex_usage | vk::BufferUsageFlags::TRANSFER_DST,
+        )?;
+        let (index_data, draws) =
+            sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
+        let indices = Buffer::uploaded(
+            gpu,
+            "indices",
+            (index_data.len() * 4) as u64,
+            vk::BufferUsageFlags::INDEX_BUFFER,
+        )?;
+        let mut scene = GpuScene {
+            manifest: view.manifest.clone(),
+            vertices,
+            uvs,
+            indices,
+            draws,
+            materials: view.materials.to_vec(),
+            textures: Vec::new(),
+            texture_samplers: Vec::new(),
+            brdf_lut: None,
+            linear_clamp: samplers[&linear_key].raw,
+            nearest_clamp: samplers[&nearest_key].raw,
+            shadow_maps: Vec::new(),
+            sections: Vec::new(),
+            uploaded_bytes: 0,
+            samplers,
+        };
+        match scene.upload_sections(gpu, file, &view, needs, up, &index_data) {
+            Ok(()) => {
+                scene.uploaded_bytes = up.bytes;
+                Ok(scene)
+            }
+            Err(e) => {
+                // The uploader may still reference these resources; wait for it before freeing.
+                let _ = up.flush();
+                let _ = gpu.wait_idle();
+                scene.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+
+    fn upload_sections(
+        &mut self,
+        gpu: &Gpu,
+        file: &KilnFile,
+        view: &SceneView,
+        needs: Needs,
+        up: &mut Uploader,
+        index_data: &[u32],
+    ) -> PlayResult {
+        let mut uvs_uploaded = false;
+        for s in file.sections() {
+            let kind = s.entry.kind;
+            let index = s.entry.index;
+            let name = match s.known {
+                Some(k) if k.indexed => format!("{}#{index}", k.name),
+                Some(k) => k.name.to_string(),
+                None => format!("{kind} (unknown to this player)"),
+            };
+            let mut fate =
+                SectionFate { section: name, bytes: s.entry.raw_size, uploaded: true, reason: String::new() };
+            if s.known.is_none() {
+                fate.uploaded = false;
+                fate.reason = "unknown kind or newer version".into();
+            } else if kind == sections::MANIFEST
+                || kind == sections::MATERIALS
+                || kind == sections::TRIANGLE_MATERIALS
+            {
+                fate.uploaded = false;
+                fate.reason = "read on the CPU".into();
+            } else if kind == sections::VERTICES {
+                up.buffer(&self.vertices, 0, bytemuck::cast_slice(view.vertices))?;
+            } else if kind == sections::UVS {
+                up.buffer(&self.uvs, 0, bytemuck::cast_slice(view.uvs))?;
+                uvs_uploaded = true;
+            } else if kind == sections::TRIANGLES {
+                // Uploaded re-sorted by material, so that each material is one draw.
+                up.buffer(&self.indices, 0, bytemuck::cast_slice(index_data))?;
+            } else if kind == sections::TEXTURE && needs.textures {
+                self.upload_texture(gpu, view, index as usize, up)?;
+            } else if kind == sections::BRDF_LUT && needs.brdf_lut {
+                let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
+                let texels: &[[u16; 2]] = file.pod(sections::BRDF_LUT, 0).map_err(bad)?.unwrap_or(&[]);
+                let image = Image::new(
+                    gpu,
+                    "brdf lut",
+                    sampled_desc(vk::Format::R16G16_UNORM, res, res, 1, 1, false),
+                )?;
+                up.image(&image, 4, &[(0, 0, res, res, bytemuck::cast_slice(texels))])?;
+                self.brdf_lut = Some(image);
+            } else if kind == sections::SHADOW_MAP && needs.shadow_maps {
+                let info = &view.manifest.shadow_maps[index as usize];
+                let depths: &[f32] = file.pod(sections::SHADOW_MAP, index).map_err(bad)?.unwrap_or(&[]);
+                let n = info.resolution;
+                let cube = info.projection == ShadowProjection::Cube;
+                let faces = if cube { 6 } else { 1 };
+                let image = Image::new(
+                    gpu,
+                    "shadow map",
+                    sampled_desc(vk::Format::R32_SFLOAT, n, n, 1, faces, cube),
+                )?;
+                let face_bytes = n as usize * n as usize * 4;
+                let bytes: &[u8] = bytemuck::cast_slice(depths);
+                let levels: Vec<(u32, u32, u32, u32, &[u8])> = (0..faces)
+                    .map(|f| (0, f, n, n, &bytes[f as usize * face_bytes..(f as usize + 1) * face_bytes]))
+                    .collect();
+                up.image(&image, 4, &levels)?;
+                self.shadow_maps.push(ShadowImage { map: index as usize, image });
+            } else {
+                fate.uploaded = false;
+                fate.reason = if kind == sections::TEXTURE {
+                    "textures off".into()
+                } else if kind == sections::BRDF_LUT {
+                    "no pass reads the BRDF table".into()
+                } else if kind == sections::SHADOW_MAP {
+                    "--shadows is not shadowmap".into()
+                } else {
+                    "no enabled pass reads it".into()
+                };
+            }
+            self.sections.push(fate);
+        }
+        if !uvs_uploaded {
+            up.zero(&self.uvs)?;
+        }
+        Ok(())
+    }
+
+    fn upload_texture(&mut self, gpu: &Gpu, view: &SceneView, i: usize, up: &mut Uploader) -> PlayResult {
+        let info = &view.manifest.textures[i];
+        let bytes = view.texture(i).map_err(bad)?;
+        let format = match info.color_space {
+            ColorSpace::Srgb => vk::Format::R8G8B8A8_SRGB,
+            ColorSpace::Linear => vk::Format::R8G8B8A8_UNORM,
+        };
+        let image = Image::new(
+            gpu,
+            &info.name,
+            sampled_desc(format, info.width, info.height, info.mip_levels, 1, false),
+        )?;
+        let mut levels = Vec::with_capacity(info.mip_levels as usize);
+        let mut offset = 0usize;
+        for mip in 0..info.mip_levels {
+            let (w, h) = ((info.width >> mip).max(1), (info.height >> mip).max(1));
+            let n = w as usize * h as usize * 4;
+            levels.push((mip, 0, w, h, &bytes[offset..offset + n]));
+            offset += n;
+        }
+        up.image(&image, 4, &levels)?;
+        let key = SamplerKey {
+            linear: info.mag_linear,
+            mipmaps: info.mip_levels > 1,
+            wrap_u: wrap_mode(info.wrap_u),
+            wrap_v: wrap_mode(info.wrap_v),
+        };
+        let raw = match self.samplers.get(&key) {
+            Some(s) => s.raw,
+            None => {
+                let s = Sampler::new(gpu, key)?;
+                let raw = s.raw;
+                self.samplers.insert(key, s);
+                raw
+            }
+        };
+        // Textures arrive in index order (file order), so position == texture number.
+        debug_assert_eq!(self.textures.len(), i);
+        self.textures.push(image);
+        self.texture_samplers.push(raw);
+        Ok(())
+    }
+
+    /// Releases every resource (the GPU must be idle).
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.vertices.destroy(gpu);
+        self.uvs.destroy(gpu);
+        self.indices.destroy(gpu);
+        for t in &mut self.textures {
+            t.destroy(gpu);
+        }
+        if let Some(b) = &mut self.brdf_lut {
+            b.destroy(gpu);
+        }
+        for s in &mut self.shadow_maps {
+            s.image.destroy(gpu);
+        }
+        for s in self.samplers.values_mut() {
+            s.destroy(gpu);
+        }
+        self.samplers.clear();
+    }
+}
+
+/// A sampled, uploaded image.
+pub fn sampled_desc(
+    format: vk::Format,
+    width: u32,
+    height: u32,
+    mips: u32,
+    layers: u32,
+    cube: bool,
+) -> ImageDesc {
+    ImageDesc {
+        format,
+        width,
+        height,
+        mips,
+        layers,
+        cube,
+        usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
+        uploaded: true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sorting_by_material_keeps_every_triangle_once() {
+        let tris = [[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]];
+        let mats = [2, 0, 2, 0];
+        let (idx, draws) = sort_by_material(&tris, &mats, 3);
+        assert_eq!(idx, vec![3, 4, 5, 9, 10, 11, 0, 1, 2, 6, 7, 8]);
+        assert_eq!(draws.len(), 2);
+        assert_eq!((draws[0].material, draws[0].first, draws[0].count), (0, 0, 6));
+        assert_eq!((draws[1].material, draws[1].first, draws[1].count), (2, 6, 6));
+    }
+}

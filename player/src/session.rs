@@ -1,0 +1,293 @@
+//! Opening a file for playback: device, pipelines and upload (the last two in parallel), then
+//! frames. Every front end goes through here, and so does the load-time breakdown.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use ash::vk;
+use kiln_format::error::ErrorKind;
+use kiln_format::read::{Checksums, KilnFile};
+
+use crate::camera::{Camera, CameraOverride};
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
+use crate::render::{Dummies, PassTimes, Pipelines, Readback, RenderSettings, Renderer};
+use crate::scene::upload::Uploader;
+use crate::scene::{GpuScene, Needs};
+
+/// What to open and how.
+#[derive(Debug, Clone)]
+pub struct SessionOptions {
+    /// The `.kiln` file.
+    pub file: PathBuf,
+    /// Device options.
+    pub gpu: GpuOptions,
+    /// Rendering options.
+    pub render: RenderSettings,
+    /// Image size.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Camera override.
+    pub camera: Option<CameraOverride>,
+}
+
+/// Milliseconds spent in each step of loading (wall clock, this process).
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct LoadTimes {
+    /// Loader, instance and device creation.
+    pub instance_and_device_ms: f64,
+    /// Mapping the file and validating header, table and manifest.
+    pub open_file_ms: f64,
+    /// Building pipelines (parallel with the upload).
+    pub pipelines_ms: f64,
+    /// Recording and submitting every upload, until the GPU finished them.
+    pub upload_ms: f64,
+    /// Bytes uploaded.
+    pub upload_bytes: u64,
+    /// Sections uploaded / skipped.
+    pub sections_uploaded: usize,
+    /// Sections not uploaded (no enabled pass reads them).
+    pub sections_skipped: usize,
+    /// Rendering the first frame (submit to done).
+    pub first_frame_gpu_ms: f64,
+    /// From process start until everything the passes read was resident.
+    pub resident_since_start_ms: f64,
+    /// From process start until the first frame finished on the GPU.
+    pub first_frame_since_start_ms: f64,
+    /// From process start until the first frame's output was written (headless).
+    pub first_output_since_start_ms: f64,
+}
+
+/// An open file, ready to render.
+pub struct Session {
+    /// Camera used by the next frame.
+    pub camera: Camera,
+    /// Load breakdown.
+    pub times: LoadTimes,
+    /// Notes for the user.
+    pub warnings: Vec<String>,
+    /// The scene.
+    pub scene: GpuScene,
+    /// The renderer.
+    pub renderer: Renderer,
+    pool: CommandPool,
+    timeline: vk::Semaphore,
+    ready: u64,
+    waited: bool,
+    _file: KilnFile,
+    start: Instant,
+    /// The device (dropped last).
+    pub gpu: Gpu,
+}
+
+impl std::fmt::Debug for Session {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session").field("gpu", &self.gpu.name).field("scene", &self.scene).finish()
+    }
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// Opens a `.kiln` file, mapping format errors to exit codes with the path in the message.
+pub fn open_file(path: &Path) -> PlayResult<KilnFile> {
+    KilnFile::open(path, Checksums::OnAccess).map_err(|e| {
+        let exit = match e.kind {
+            ErrorKind::Io(_) | ErrorKind::NotAFile => Exit::Io,
+            _ => Exit::BadInput,
+        };
+        PlayError::new(exit, format!("{}: {e}", path.display()))
+    })
+}
+
+impl Session {
+    /// Opens `options.file` on a new device. `start` is the process start (for the breakdown).
+    pub fn open(options: &SessionOptions, start: Instant) -> PlayResult<Session> {
+        let mut times = LoadTimes::default();
+        let t = Instant::now();
+        let file = open_file(&options.file)?;
+        times.open_file_ms = ms(t);
+        let t = Instant::now();
+        let gpu = Gpu::new(&options.gpu)?;
+        times.instance_and_device_ms = ms(t);
+        let needs = Needs { textures: true, brdf_lut: true, shadow_maps: options.render.shadow_maps };
+        let timeline = gpu.timeline_semaphore()?;
+        let upload_start = Instant::now();
+        // Pipelines compile on one thread while the other streams the file to the GPU.
+        let (pipelines, loaded) = std::thread::scope(|s| {
+            let pipes = s.spawn(|| {
+                let t = Instant::now();
+                Pipelines::new(&gpu).map(|p| (p, ms(t)))
+            });
+            let loaded = (|| -> PlayResult<(GpuScene, Dummies, u64, u64)> {
+                let ring = if gpu.is_cpu() { 8 << 20 } else { 32 << 20 };
+                let mut up = Uploader::new(&gpu, ring, timeline)?;
+                let result = (|| {
+                    let dummies = Dummies::new(&gpu, &mut up)?;
+                    match GpuScene::load(&gpu, &file, needs, &mut up) {
+                        Ok(scene) => Ok((scene, dummies)),
+                        Err(e) => {
+                            let mut d = dummies;
+                            let _ = up.flush();
+                            let _ = gpu.wait_idle();
+                            d.destroy(&gpu);
+                            Err(e)
+                        }
+                    }
+                })();
+                let flushed = up.flush();
+                let bytes = up.bytes;
+                let destroyed = up.destroy();
+                let (scene, dummies) = result?;
+                let value = flushed?;
+                destroyed?;
+                Ok((scene, dummies, value, bytes))
+            })();
+            let pipes =
+                pipes.join().unwrap_or_else(|_| Err(PlayError::new(Exit::Gpu, "pipeline creation panicked")));
+            (pipes, loaded)
+        });
+        let cleanup = |gpu: &Gpu| gpu.destroy_semaphore(timeline);
+        let (scene, dummies, ready, bytes) = match loaded {
+            Ok(l) => l,
+            Err(e) => {
+                if let Ok((mut p, _)) = pipelines {
+                    p.destroy(&gpu);
+                }
+                cleanup(&gpu);
+                return Err(e);
+            }
+        };
+        times.upload_ms = ms(upload_start);
+        times.upload_bytes = bytes;
+        times.sections_uploaded = scene.sections.iter().filter(|s| s.uploaded).count();
+        times.sections_skipped = scene.sections.len() - times.sections_uploaded;
+        times.resident_since_start_ms = ms(start);
+        let mut scene = scene;
+        let (pipelines, pipelines_ms) = match pipelines {
+            Ok(p) => p,
+            Err(e) => {
+                let mut d = dummies;
+                d.destroy(&gpu);
+                scene.destroy(&gpu);
+                cleanup(&gpu);
+                return Err(e);
+            }
+        };
+        times.pipelines_ms = pipelines_ms;
+        let camera = match Camera::initial(&scene.manifest.cameras, &scene.manifest.bounds, options.camera) {
+            Ok(c) => c,
+            Err(e) => {
+                let (mut p, mut d) = (pipelines, dummies);
+                p.destroy(&gpu);
+                d.destroy(&gpu);
+                scene.destroy(&gpu);
+                cleanup(&gpu);
+                return Err(e);
+            }
+        };
+        let renderer =
+            Renderer::new(&gpu, pipelines, dummies, &scene, options.render, options.width, options.height)?;
+        let pool = CommandPool::new(&gpu, gpu.family)?;
+        let mut warnings = renderer.warnings.clone();
+        if options.render.shadow_maps
+            && scene.manifest.shadow_maps.is_empty()
+            && !scene.manifest.lights.is_empty()
+        {
+            warnings.push("--shadows shadowmap: the file has no shadow maps (compiled with shadows skipped); lights are unshadowed".into());
+        }
+        Ok(Session {
+            camera,
+            times,
+            warnings,
+            scene,
+            renderer,
+            pool,
+            timeline,
+            ready,
+            waited: false,
+            _file: file,
+            start,
+            gpu,
+        })
+    }
+
+    /// Renders one frame and waits for it; with `readback`, copies its images there. Returns
+    /// the passes' GPU times.
+    pub fn frame(&mut self, readback: Option<&Readback>) -> PlayResult<PassTimes> {
+        let t = Instant::now();
+        self.record_and_submit(
+            |rec, renderer| {
+                if let Some(r) = readback {
+                    r.record(rec, &renderer.targets);
+                }
+            },
+            &[],
+            &[],
+        )?;
+        self.pool.wait(&self.gpu)?;
+        if self.times.first_frame_gpu_ms == 0.0 {
+            self.times.first_frame_gpu_ms = ms(t);
+            self.times.first_frame_since_start_ms = ms(self.start);
+        }
+        self.renderer.pass_times(&self.gpu)
+    }
+
+    /// Records a frame plus `extra` commands and submits it with extra semaphores (the window
+    /// adds its swapchain's); the first frame also waits for the upload.
+    pub fn record_and_submit(
+        &mut self,
+        extra: impl FnOnce(&Recorder, &Renderer),
+        wait: &[SemaphoreOp],
+        signal: &[SemaphoreOp],
+    ) -> PlayResult {
+        let rec = self.pool.begin(&self.gpu)?;
+        self.renderer.update(&self.camera)?;
+        self.renderer.record(&rec, &self.scene);
+        extra(&rec, &self.renderer);
+        let mut waits = wait.to_vec();
+        if !self.waited {
+            waits.push(SemaphoreOp::timeline(self.timeline, self.ready));
+            self.waited = true;
+        }
+        self.pool.submit(&self.gpu, &waits, signal)
+    }
+
+    /// Waits for the last submitted frame.
+    pub fn wait(&self) -> PlayResult {
+        self.pool.wait(&self.gpu)
+    }
+
+    /// GPU times of the last finished frame.
+    pub fn pass_times(&self) -> PlayResult<PassTimes> {
+        self.renderer.pass_times(&self.gpu)
+    }
+
+    /// Milliseconds since process start.
+    pub fn since_start_ms(&self) -> f64 {
+        ms(self.start)
+    }
+
+    /// Changes the image size (waits for the GPU).
+    pub fn resize(&mut self, width: u32, height: u32) -> PlayResult {
+        self.gpu.wait_idle()?;
+        self.renderer.resize(&self.gpu, &self.scene, width, height)
+    }
+
+    /// Validation-layer errors so far.
+    pub fn validation_errors(&self) -> u32 {
+        self.gpu.validation_errors()
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        let _ = self.gpu.wait_idle();
+        self.pool.destroy(&self.gpu);
+        self.renderer.destroy(&self.gpu);
+        self.scene.destroy(&self.gpu);
+        self.gpu.destroy_semaphore(self.timeline);
+    }
+}
