@@ -198,12 +198,13 @@ mod tests {
     #[test]
     fn reversed_depth_maps_near_to_one_and_far_towards_zero() {
         let cam = Camera::initial(&[], &bounds(), Some("0,0,5,0,0,0,60".parse().unwrap())).unwrap();
+        let exact = cam.projection(1.0) * cam.view();
+        let near = exact * glam::DVec4::new(0.0, 0.0, 5.0 - cam.znear, 1.0);
+        assert!((near.z / near.w - 1.0).abs() < 1e-9);
+        let far = exact * glam::DVec4::new(0.0, 0.0, -1000.0, 1.0);
+        assert!(far.z / far.w > 0.0 && far.z / far.w < 1e-6);
         let (vp, inv) = cam.matrices(100, 100);
         let vp = glam::Mat4::from_cols_array(&vp);
-        let near = vp * glam::Vec4::new(0.0, 0.0, 5.0 - cam.znear as f32, 1.0);
-        assert!((near.z / near.w - 1.0).abs() < 1e-4);
-        let far = vp * glam::Vec4::new(0.0, 0.0, -1000.0, 1.0);
-        assert!(far.z / far.w > 0.0 && far.z / far.w < 1e-5);
         // The inverse recovers a world point from its clip position.
         let p = glam::Vec4::new(0.3, -0.2, 0.5, 1.0);
         let clip = vp * p;

@@ -1,0 +1,460 @@
+//! kiln-play on lavapipe: analytic direct-light checks pixel by pixel, the demo and PICA PICA
+//! scenes with the validation layer on, and damaged or minimal files.
+//!
+//! Every test needs a Vulkan 1.3 device; without one they print why and pass, unless
+//! `KILN_REQUIRE_VULKAN` is set (as `.ci/run` does), when they fail.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::{DVec3, Vec3};
+use kiln_compiler::import::demo::{cornell_box, lambert_material};
+use kiln_compiler::settings::Settings;
+use kiln_format::manifest::{Camera, Light, LightKind, Sky};
+use kiln_player::camera::CameraOverride;
+use kiln_player::error::Exit;
+use kiln_player::gpu::GpuOptions;
+use kiln_player::headless::{self, HeadlessResult};
+use kiln_player::image_out::read_exr;
+use kiln_player::render::RenderSettings;
+use kiln_player::session::SessionOptions;
+use kiln_tests::{compile, scene_of, shared_scenes};
+
+/// Whether a Vulkan device and the validation layer are here; panics when they are required.
+fn vulkan() -> bool {
+    match kiln_player::gpu::list_devices() {
+        Ok(d) if !d.is_empty() => true,
+        other => {
+            let why = format!("no Vulkan device ({other:?})");
+            assert!(
+                std::env::var_os("KILN_REQUIRE_VULKAN").is_none(),
+                "{why}, but KILN_REQUIRE_VULKAN is set"
+            );
+            eprintln!("skipping: {why}");
+            false
+        }
+    }
+}
+
+fn options(
+    file: &Path,
+    width: u32,
+    height: u32,
+    camera: Option<CameraOverride>,
+    shadows: bool,
+) -> SessionOptions {
+    SessionOptions {
+        file: file.to_path_buf(),
+        gpu: GpuOptions {
+            validate: true,
+            device: None,
+            surface_extensions: Vec::new(),
+            pipeline_cache: None,
+        },
+        render: RenderSettings { shadow_maps: shadows, exposure: 0.0 },
+        width,
+        height,
+        camera,
+    }
+}
+
+/// Renders `bytes` headless to an EXR; returns the RGB radiance, asserting a clean run.
+fn render(
+    dir: &Path,
+    name: &str,
+    bytes: &[u8],
+    opts: impl Fn(&Path) -> SessionOptions,
+) -> (Vec<f32>, HeadlessResult) {
+    let file = dir.join(format!("{name}.kiln"));
+    std::fs::write(&file, bytes).unwrap();
+    let exr = dir.join(format!("{name}.exr"));
+    let o = opts(&file);
+    let result = headless::run(&o, 1, Some(&exr), Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(result.session.validation_errors(), 0, "{name}: validation errors");
+    assert_eq!(result.non_finite, 0, "{name}: NaN or Inf in the frame");
+    let (w, h, rgb) = read_exr(&exr).unwrap();
+    assert_eq!((w, h), (o.width, o.height));
+    assert!(rgb.iter().all(|v| v.is_finite()), "{name}: the EXR holds NaN or Inf");
+    (rgb, result)
+}
+
+/// The linear value an 8-bit sRGB code decodes to (so that the G-buffer stores it exactly).
+fn srgb8(code: u8) -> f32 {
+    let c = code as f32 / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// A pinhole camera computed here, independently of the player: pixel (x, y), row 0 at the
+/// top, looks through NDC (2(x+½)/W − 1, 1 − 2(y+½)/H).
+struct Pinhole {
+    eye: DVec3,
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    tan_half: f64,
+    aspect: f64,
+}
+
+impl Pinhole {
+    fn new(eye: [f64; 3], target: [f64; 3], up: [f64; 3], vfov_degrees: f64, w: u32, h: u32) -> Pinhole {
+        let eye = DVec3::from_array(eye);
+        let forward = (DVec3::from_array(target) - eye).normalize();
+        let right = forward.cross(DVec3::from_array(up)).normalize();
+        Pinhole {
+            eye,
+            forward,
+            right,
+            up: right.cross(forward),
+            tan_half: (vfov_degrees.to_radians() * 0.5).tan(),
+            aspect: w as f64 / h as f64,
+        }
+    }
+
+    fn ray(&self, x: u32, y: u32, w: u32, h: u32) -> DVec3 {
+        let nx = 2.0 * (x as f64 + 0.5) / w as f64 - 1.0;
+        let ny = 1.0 - 2.0 * (y as f64 + 0.5) / h as f64;
+        (self.forward + self.right * nx * self.tan_half * self.aspect + self.up * ny * self.tan_half)
+            .normalize()
+    }
+
+    fn file_camera(&self) -> Camera {
+        let t = self.eye + self.forward;
+        Camera {
+            name: "test".into(),
+            position: self.eye.as_vec3().to_array(),
+            target: t.as_vec3().to_array(),
+            up: self.up.as_vec3().to_array(),
+            vfov_degrees: (self.tan_half.atan() * 2.0).to_degrees() as f32,
+            znear: 0.0,
+            zfar: 0.0,
+        }
+    }
+}
+
+/// A square of half-size `s` in the plane y = `y`, facing up, as two triangles.
+fn square(y: f32, s: f32) -> [[Vec3; 3]; 2] {
+    let p = |x: f32, z: f32| Vec3::new(x, y, z);
+    [[p(-s, -s), p(-s, s), p(s, s)], [p(-s, -s), p(s, s), p(s, -s)]]
+}
+
+fn light(kind: LightKind, position: [f32; 3], direction: [f32; 3], intensity: f32) -> Light {
+    Light {
+        name: "l".into(),
+        kind,
+        position,
+        direction,
+        right: [1.0, 0.0, 0.0],
+        color: [1.0; 3],
+        intensity,
+        range: 0.0,
+        casts_shadows: true,
+    }
+}
+
+fn fast_settings() -> Settings {
+    Settings { shaft_variants: Some(0), shadow_res: 512, ..Default::default() }
+}
+
+const ALBEDO: [u8; 3] = [188, 150, 120];
+const W: u32 = 96;
+const H: u32 = 72;
+
+/// Compares every pixel whose camera ray meets the plane y = 0 inside |x|, |z| < `inside`
+/// (and passes `keep`) with `expected(point)`; returns the pixels compared.
+fn compare_plane(
+    rgb: &[f32],
+    cam: &Pinhole,
+    inside: f64,
+    keep: impl Fn(DVec3, DVec3) -> bool,
+    expected: impl Fn(DVec3) -> [f64; 3],
+    tolerance: f64,
+) -> usize {
+    let mut compared = 0;
+    let mut worst = (0.0f64, 0u32, 0u32);
+    for y in 0..H {
+        for x in 0..W {
+            let d = cam.ray(x, y, W, H);
+            if d.y >= -1e-6 {
+                continue;
+            }
+            let p = cam.eye + d * (-cam.eye.y / d.y);
+            if p.x.abs() >= inside || p.z.abs() >= inside || !keep(p, d) {
+                continue;
+            }
+            let e = expected(p);
+            let i = ((y * W + x) * 3) as usize;
+            for c in 0..3 {
+                let got = rgb[i + c] as f64;
+                let rel = (got - e[c]).abs() / e[c].max(1e-6);
+                if rel > worst.0 {
+                    worst = (rel, x, y);
+                }
+                assert!(
+                    rel <= tolerance,
+                    "pixel ({x}, {y}) channel {c}: {got} vs analytic {} ({:.3}% off)",
+                    e[c],
+                    rel * 100.0
+                );
+            }
+            compared += 1;
+        }
+    }
+    eprintln!(
+        "{compared} pixels compared, worst relative error {:.4}% at ({}, {})",
+        worst.0 * 100.0,
+        worst.1,
+        worst.2
+    );
+    compared
+}
+
+fn albedo() -> [f64; 3] {
+    ALBEDO.map(|c| srgb8(c) as f64)
+}
+
+/// Relative tolerance of the analytic checks, 1 %. The albedo is an sRGB code, which the
+/// G-buffer's RGBA8_SRGB target stores exactly on GPUs; lavapipe's sRGB conversion is
+/// approximate (measured: −0.14 %, +0.11 %, +0.46 % on codes 188, 150, 120). The normal is 16-bit
+/// octahedral (≤ 0.003°), the position rebuilt from 32-bit reversed depth.
+const TOLERANCE: f64 = 0.01;
+
+#[test]
+fn point_light_on_a_diffuse_plane_matches_albedo_over_pi_times_i_cos_over_d2() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
+    let mut scene = scene_of(&square(0.0, 10.0));
+    scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
+    let lp = [1.0f32, 3.0, -0.5];
+    let intensity = 10.0;
+    scene.lights.push(light(LightKind::Point, lp, [0.0, -1.0, 0.0], intensity));
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    let (rgb, _) = render(dir.path(), "point", &bytes, |f| options(f, W, H, None, true));
+    let a = albedo();
+    let l = DVec3::from_array(lp.map(f64::from));
+    let n = compare_plane(
+        &rgb,
+        &cam,
+        9.5,
+        |_, _| true,
+        |p| {
+            let to = l - p;
+            let d2 = to.length_squared();
+            let cos = to.y / d2.sqrt();
+            a.map(|k| k / std::f64::consts::PI * intensity as f64 * cos / d2)
+        },
+        TOLERANCE,
+    );
+    assert!(n > (W * H / 2) as usize, "only {n} pixels compared");
+}
+
+#[test]
+fn directional_light_on_a_diffuse_plane_is_albedo_over_pi_times_e_cos() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cam = Pinhole::new([3.0, 6.0, 5.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
+    let mut scene = scene_of(&square(0.0, 10.0));
+    scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
+    let travel = Vec3::new(-0.3, -1.0, 0.2).normalize();
+    let irradiance = 3.0;
+    scene.lights.push(light(LightKind::Directional, [0.0; 3], travel.to_array(), irradiance));
+    scene.sky = Sky { radiance: [0.0; 3] };
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    let (rgb, _) = render(dir.path(), "directional", &bytes, |f| options(f, W, H, None, true));
+    let a = albedo();
+    let cos = -travel.y as f64;
+    let n = compare_plane(
+        &rgb,
+        &cam,
+        9.5,
+        |_, _| true,
+        |_| a.map(|k| k / std::f64::consts::PI * irradiance as f64 * cos),
+        TOLERANCE,
+    );
+    assert!(n > (W * H / 3) as usize, "only {n} pixels compared");
+}
+
+#[test]
+fn an_occluder_casts_the_shadow_its_geometry_implies() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A 2 × 2 square at height 1 under a point light at height 4: its umbra on the floor is the
+    // square scaled by 4 / (4 − 1), |x|, |z| < 4/3.
+    let cam = Pinhole::new([5.0, 9.0, 6.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 45.0, W, H);
+    let mut tris: Vec<[Vec3; 3]> = square(0.0, 10.0).to_vec();
+    tris.extend(square(1.0, 1.0));
+    let mut scene = scene_of(&tris);
+    scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
+    let lp = [0.0f32, 4.0, 0.0];
+    let intensity = 20.0;
+    scene.lights.push(light(LightKind::Point, lp, [0.0, -1.0, 0.0], intensity));
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    let (rgb, _) = render(dir.path(), "occluder", &bytes, |f| options(f, W, H, None, true));
+    let a = albedo();
+    let l = DVec3::from_array(lp.map(f64::from));
+    let edge = 4.0 / 3.0;
+    // Pixels whose view of the floor the occluder hides are skipped.
+    let visible = |p: DVec3, d: DVec3| {
+        let t = (1.0 - cam.eye.y) / d.y;
+        let q = cam.eye + d * t;
+        let _ = p;
+        !(q.x.abs() <= 1.05 && q.z.abs() <= 1.05)
+    };
+    let lit = |p: DVec3| {
+        let to = l - p;
+        let d2 = to.length_squared();
+        a.map(|k| k / std::f64::consts::PI * intensity as f64 * (to.y / d2.sqrt()) / d2)
+    };
+    // Outside the umbra (beyond the PCF footprint) the floor is fully lit...
+    let margin = 0.15;
+    let outside =
+        |p: DVec3, d: DVec3| visible(p, d) && (p.x.abs() > edge + margin || p.z.abs() > edge + margin);
+    let n_lit = compare_plane(&rgb, &cam, 6.0, outside, lit, TOLERANCE);
+    // ...and inside it, black.
+    let inside = |p: DVec3, d: DVec3| visible(p, d) && p.x.abs() < edge - margin && p.z.abs() < edge - margin;
+    let mut n_dark = 0;
+    for y in 0..H {
+        for x in 0..W {
+            let d = cam.ray(x, y, W, H);
+            let p = cam.eye + d * (-cam.eye.y / d.y);
+            if d.y < 0.0 && inside(p, d) {
+                let i = ((y * W + x) * 3) as usize;
+                let unshadowed = lit(p);
+                for c in 0..3 {
+                    assert!(
+                        (rgb[i + c] as f64) < 1e-3 * unshadowed[c],
+                        "pixel ({x}, {y}) at {p} should be in the umbra: {}",
+                        rgb[i + c]
+                    );
+                }
+                n_dark += 1;
+            }
+        }
+    }
+    eprintln!("{n_lit} lit and {n_dark} shadowed floor pixels checked");
+    assert!(
+        n_lit > 500 && n_dark > 30,
+        "{n_lit} lit, {n_dark} shadowed pixels: the view does not test the shadow"
+    );
+
+    // With --shadows none the umbra is lit like the rest.
+    let (unshadowed, _) = render(dir.path(), "occluder-none", &bytes, |f| options(f, W, H, None, false));
+    let n = compare_plane(&unshadowed, &cam, 6.0, inside, lit, TOLERANCE);
+    assert!(n == n_dark);
+}
+
+#[test]
+fn demo_scene_renders_clean_in_png_and_exr_with_a_camera_override() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = compile(cornell_box(), fast_settings());
+    let (rgb, result) = render(dir.path(), "demo", &bytes, |f| options(f, 64, 48, None, true));
+    assert!(rgb.iter().any(|&v| v > 0.0), "the demo frame is black");
+    assert!(result.session.times.first_frame_since_start_ms > 0.0);
+    drop(result);
+    // PNG through the same path, and a camera override that looks away from the box (sky only).
+    let file = dir.path().join("demo.kiln");
+    let png = dir.path().join("demo.png");
+    headless::run(&options(&file, 64, 48, None, true), 2, Some(&png), Instant::now()).unwrap();
+    let img = image::open(&png).unwrap().into_rgb8();
+    assert_eq!(img.dimensions(), (64, 48));
+    let away: CameraOverride = "0,1,3.9,0,1,100,40".parse().unwrap();
+    let (sky, _) = render(dir.path(), "demo", &bytes, |f| options(f, 16, 16, Some(away), true));
+    assert!(sky.iter().all(|&v| v == 0.0), "looking away from the box should see the black sky");
+}
+
+#[test]
+fn pica_pica_renders_clean_with_three_lights_and_its_shadow_maps() {
+    if !vulkan() {
+        return;
+    }
+    let Some(scenes) = shared_scenes() else {
+        eprintln!("skipping: ../shared/scenes is not here");
+        return;
+    };
+    let mut inputs = Vec::new();
+    let mut scene = kiln_compiler::import::import(&scenes.join("pica_pica/scene.gltf")).unwrap();
+    let side = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/pica_pica.toml");
+    kiln_compiler::import::sidecar::Sidecar::load(&side, &mut inputs)
+        .unwrap()
+        .apply(&mut scene, "pica_pica.toml")
+        .unwrap();
+    let bytes = compile(scene, Settings { shaft_variants: Some(0), shadow_res: 256, ..Default::default() });
+    let dir = tempfile::tempdir().unwrap();
+    let (rgb, result) = render(dir.path(), "pica", &bytes, |f| options(f, 160, 90, None, true));
+    let s = &result.session;
+    assert_eq!(s.scene.manifest.lights.len(), 3);
+    assert_eq!(s.scene.shadow_maps.len(), 3, "every light's shadow map is resident");
+    assert_eq!(s.scene.textures.len(), s.scene.manifest.textures.len());
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    let lit = rgb.chunks_exact(3).filter(|p| p.iter().sum::<f32>() > 0.05).count();
+    assert!(lit > rgb.len() / 3 / 4, "only {lit} pixels are lit");
+}
+
+#[test]
+fn damaged_files_fail_cleanly_and_minimal_files_render() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let good = compile(cornell_box(), fast_settings());
+    let file = kiln_format::read::KilnFile::from_bytes(&good, Default::default()).unwrap();
+    let vert = file.find(kiln_format::sections::VERTICES, 0).unwrap().entry;
+    let cases: Vec<(&str, Vec<u8>)> = vec![
+        ("truncated", good[..good.len() / 2].to_vec()),
+        ("flipped vertex byte", {
+            let mut b = good.clone();
+            b[vert.offset as usize + 5] ^= 0x40;
+            b
+        }),
+        ("not a kiln file", b"glTF binary, not kiln".repeat(10)),
+        ("empty", Vec::new()),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.path().join(format!("{}.kiln", name.replace(' ', "-")));
+        std::fs::write(&path, &bytes).unwrap();
+        let err = headless::run(
+            &options(&path, 32, 32, None, true),
+            1,
+            Some(&dir.path().join("x.png")),
+            Instant::now(),
+        )
+        .unwrap_err();
+        assert_eq!(err.exit, Exit::BadInput, "{name}: {}", err.message);
+        assert!(
+            err.message.contains(path.to_str().unwrap()) || err.message.contains("invalid"),
+            "{name}: {}",
+            err.message
+        );
+    }
+    let missing = dir.path().join("missing.kiln");
+    let err = headless::run(&options(&missing, 32, 32, None, true), 1, None, Instant::now()).unwrap_err();
+    assert_eq!(err.exit, Exit::Io, "{}", err.message);
+
+    // No lights: no shadow maps, no BRDF table, no textures. It renders emission and sky only.
+    let mut scene = scene_of(&square(0.0, 1.0));
+    scene.materials[0].gpu = lambert_material([0.0; 3]);
+    scene.materials[0].gpu.emission = [0.5, 0.25, 0.125];
+    scene.sky = Sky { radiance: [0.1, 0.2, 0.3] };
+    let bytes = compile(scene, fast_settings());
+    let (rgb, result) = render(dir.path(), "minimal", &bytes, |f| {
+        options(f, 32, 32, Some("0,3,0.01,0,0,0,90".parse().unwrap()), true)
+    });
+    assert!(result.session.scene.shadow_maps.is_empty() && result.session.scene.brdf_lut.is_none());
+    assert!(rgb.chunks_exact(3).any(|p| p == [0.5, 0.25, 0.125]), "emission is written as is");
+    assert!(rgb.chunks_exact(3).any(|p| p == [0.1, 0.2, 0.3]), "the sky is written as is");
+    let skipped: Vec<_> =
+        result.session.scene.sections.iter().filter(|s| !s.uploaded).map(|s| s.section.clone()).collect();
+    assert!(skipped.iter().any(|s| s == "bvh"), "the BVH is not uploaded: no pass traces rays ({skipped:?})");
+}
