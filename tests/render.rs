@@ -55,6 +55,7 @@ fn options(
         width,
         height,
         camera,
+        readback: None,
     }
 }
 

@@ -78,12 +78,12 @@ fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
 pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -> PlayResult<BenchReport> {
     let mut session = Session::open(options, start)?;
     for _ in 0..warmup.max(1) {
-        session.frame(None)?;
+        session.frame(false)?;
     }
     let frames = frames.max(1);
     let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len() + 1];
     for _ in 0..frames {
-        let t = session.frame(None)?;
+        let t = session.frame(false)?;
         for (i, ms) in t.iter().enumerate() {
             per_pass[i].push(*ms);
         }
@@ -131,9 +131,10 @@ impl BenchReport {
         }
         let l = &self.load;
         s.push_str(&format!(
-            "\nload (wall clock ms)\n  open file            {:>8.1}\n  instance + device    {:>8.1}\n  pipelines (parallel) {:>8.1}\n  upload               {:>8.1}  ({:.1} MiB, {} sections uploaded, {} skipped)\n  first frame on GPU   {:>8.1}\n  resident after start {:>8.1}\n  first frame after start {:>5.1}\n",
+            "\nload (wall clock ms)\n  open file            {:>8.1}\n  instance + device    {:>8.1}\n  validate (parallel)  {:>8.1}\n  pipelines (parallel) {:>8.1}\n  upload               {:>8.1}  ({:.1} MiB, {} sections uploaded, {} skipped)\n  first frame on GPU   {:>8.1}\n  resident after start {:>8.1}\n  first frame after start {:>5.1}\n",
             l.open_file_ms,
             l.instance_and_device_ms,
+            l.prepare_ms,
             l.pipelines_ms,
             l.upload_ms,
             l.upload_bytes as f64 / (1 << 20) as f64,

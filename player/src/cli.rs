@@ -151,6 +151,7 @@ impl Args {
             width: self.size.width,
             height: self.size.height,
             camera: self.camera,
+            readback: None,
         })
     }
 }

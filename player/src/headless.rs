@@ -3,9 +3,9 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::error::PlayResult;
+use crate::error::{Exit, PlayError, PlayResult};
 use crate::image_out::{OutputKind, write_exr, write_png};
-use crate::render::Readback;
+use crate::render::Readable;
 use crate::session::{Session, SessionOptions};
 
 /// What a headless run produced.
@@ -18,44 +18,33 @@ pub struct HeadlessResult {
 }
 
 /// Renders `frames` frames (at least one) and writes the last to `output`, if given.
-pub fn run(
-    options: &SessionOptions,
-    frames: u32,
-    output: Option<&Path>,
-    start: Instant,
-) -> PlayResult<HeadlessResult> {
+pub fn run(options: &SessionOptions, frames: u32, output: Option<&Path>, start: Instant) -> PlayResult<HeadlessResult> {
     let kind = output.map(OutputKind::of).transpose()?;
-    let mut session = Session::open(options, start)?;
-    let mut readback = Readback::new(&session.gpu, options.width, options.height)?;
-    let result = (|| -> PlayResult<usize> {
-        let frames = frames.max(1);
-        for f in 0..frames {
-            let last = f + 1 == frames;
-            session.frame(if last && output.is_some() { Some(&readback) } else { None })?;
+    let mut options = options.clone();
+    options.readback = kind.map(|k| if k == OutputKind::Exr { Readable::Radiance } else { Readable::Display });
+    let mut session = Session::open(&options, start)?;
+    let frames = frames.max(1);
+    for f in 0..frames {
+        session.frame(f + 1 == frames && output.is_some())?;
+    }
+    let (Some(path), Some(kind)) = (output, kind) else { return Ok(HeadlessResult { session, non_finite: 0 }) };
+    let (w, h) = (options.width, options.height);
+    let texel = if kind == OutputKind::Exr { 16 } else { 4 };
+    let bytes = session
+        .readback
+        .as_mut()
+        .and_then(|r| r.buffer.mapped())
+        .map(|m| m[..(w as usize * h as usize * texel)].to_vec())
+        .ok_or_else(|| PlayError::new(Exit::Gpu, "the readback buffer is not host-visible"))?;
+    let mut non_finite = 0;
+    match kind {
+        OutputKind::Png => write_png(path, w, h, &bytes)?,
+        OutputKind::Exr => {
+            let px: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
+            non_finite = px.chunks_exact(4).filter(|p| p[..3].iter().any(|v| !v.is_finite())).count();
+            write_exr(path, w, h, &px)?;
         }
-        let (Some(path), Some(kind)) = (output, kind) else { return Ok(0) };
-        let (w, h) = (options.width, options.height);
-        let mut non_finite = 0;
-        match kind {
-            OutputKind::Png => {
-                let px =
-                    readback.display.mapped().map(|m| m[..(w * h * 4) as usize].to_vec()).unwrap_or_default();
-                write_png(path, w, h, &px)?;
-            }
-            OutputKind::Exr => {
-                let bytes = readback
-                    .radiance
-                    .mapped()
-                    .map(|m| m[..(w * h * 16) as usize].to_vec())
-                    .unwrap_or_default();
-                let px: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
-                non_finite = px.chunks_exact(4).filter(|p| p[..3].iter().any(|v| !v.is_finite())).count();
-                write_exr(path, w, h, &px)?;
-            }
-        }
-        session.times.first_output_since_start_ms = session.since_start_ms();
-        Ok(non_finite)
-    })();
-    readback.destroy(&session.gpu);
-    Ok(HeadlessResult { non_finite: result?, session })
+    }
+    session.times.first_output_since_start_ms = session.since_start_ms();
+    Ok(HeadlessResult { session, non_finite })
 }

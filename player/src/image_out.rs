@@ -2,6 +2,10 @@
 //! float RGB). Files are written to a temporary name and renamed, so a reader never sees half.
 
 use std::io::Cursor;
+
+use image::ImageEncoder;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use image::ExtendedColorType;
 use std::path::Path;
 
 use crate::error::{Exit, PlayError, PlayResult};
@@ -46,12 +50,14 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> PlayResult {
 /// Writes RGBA8 pixels (alpha ignored) as an RGB PNG.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> PlayResult {
     let rgb: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-    let img = image::RgbImage::from_raw(width, height, rgb)
-        .ok_or_else(|| PlayError::new(Exit::Gpu, "readback size mismatch"))?;
-    let mut out = Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png)
-        .map_err(|e| PlayError::new(Exit::Io, format!("encoding PNG: {e}")))?;
-    write_atomic(path, &out.into_inner())
+    if rgb.len() as u64 != width as u64 * height as u64 * 3 {
+        return Err(PlayError::new(Exit::Gpu, "readback size mismatch"));
+    }
+    let mut out = Vec::new();
+    // Fast compression: the output is written on the first frame's critical path.
+    let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
+    encoder.write_image(&rgb, width, height, ExtendedColorType::Rgb8).map_err(|e| PlayError::new(Exit::Io, format!("encoding PNG: {e}")))?;
+    write_atomic(path, &out)
 }
 
 /// Writes RGBA32F pixels (alpha ignored) as a float RGB OpenEXR file.

@@ -11,9 +11,10 @@ use kiln_format::read::{Checksums, KilnFile};
 use crate::camera::{Camera, CameraOverride};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
-use crate::render::{Dummies, PassTimes, Pipelines, Readback, RenderSettings, Renderer};
+use crate::render::targets::Targets;
+use crate::render::{Dummies, PassTimes, Pipelines, Readable, Readback, RenderSettings, Renderer};
 use crate::scene::upload::Uploader;
-use crate::scene::{GpuScene, Needs};
+use crate::scene::{GpuScene, Needs, Prepared};
 
 /// What to open and how.
 #[derive(Debug, Clone)]
@@ -30,6 +31,8 @@ pub struct SessionOptions {
     pub height: u32,
     /// Camera override.
     pub camera: Option<CameraOverride>,
+    /// The image frames can be copied back from (headless output).
+    pub readback: Option<Readable>,
 }
 
 /// Milliseconds spent in each step of loading (wall clock, this process).
@@ -39,7 +42,10 @@ pub struct LoadTimes {
     pub instance_and_device_ms: f64,
     /// Mapping the file and validating header, table and manifest.
     pub open_file_ms: f64,
-    /// Building pipelines (parallel with the upload).
+    /// Validating the file, verifying the checksums of what is uploaded, sorting indices
+    /// (parallel with instance and device creation).
+    pub prepare_ms: f64,
+    /// Building pipelines and allocating the frame's targets (parallel with the upload).
     pub pipelines_ms: f64,
     /// Recording and submitting every upload, until the GPU finished them.
     pub upload_ms: f64,
@@ -71,6 +77,8 @@ pub struct Session {
     pub scene: GpuScene,
     /// The renderer.
     pub renderer: Renderer,
+    /// Where [`Session::frame`] copies the frame when asked to.
+    pub readback: Option<Readback>,
     pool: CommandPool,
     timeline: vk::Semaphore,
     ready: u64,
@@ -109,24 +117,56 @@ impl Session {
         let t = Instant::now();
         let file = open_file(&options.file)?;
         times.open_file_ms = ms(t);
-        let t = Instant::now();
-        let gpu = Gpu::new(&options.gpu)?;
-        times.instance_and_device_ms = ms(t);
         let needs = Needs { textures: true, brdf_lut: true, shadow_maps: options.render.shadow_maps };
+        // The CPU side of loading (validation, checksums, index sorting) runs while the driver
+        // creates the device, which on some drivers takes well over 100 ms.
+        let (gpu, prepared) = std::thread::scope(|s| {
+            let prep = s.spawn(|| {
+                let t = Instant::now();
+                Prepared::new(&file, needs).map(|p| (p, ms(t)))
+            });
+            let t = Instant::now();
+            let gpu = Gpu::new(&options.gpu).map(|g| (g, ms(t)));
+            let prepared = prep.join().unwrap_or_else(|_| Err(PlayError::new(Exit::BadInput, "validating the file panicked")));
+            (gpu, prepared)
+        });
+        let (gpu, device_ms) = gpu?;
+        times.instance_and_device_ms = device_ms;
+        let (prepared, prepare_ms) = prepared?;
+        times.prepare_ms = prepare_ms;
         let timeline = gpu.timeline_semaphore()?;
         let upload_start = Instant::now();
         // Pipelines compile on one thread while the other streams the file to the GPU.
+        let (width, height, readback) = (options.width, options.height, options.readback);
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
-                Pipelines::new(&gpu).map(|p| (p, ms(t)))
+                // The frame's targets too: allocating them costs milliseconds on some drivers.
+                let pipelines = Pipelines::new(&gpu)?;
+                let rest = Targets::new(&gpu, width, height).and_then(|mut targets| {
+                    match readback.map(|r| Readback::new(&gpu, r, width, height)).transpose() {
+                        Ok(rb) => Ok((targets, rb)),
+                        Err(e) => {
+                            targets.destroy(&gpu);
+                            Err(e)
+                        }
+                    }
+                });
+                match rest {
+                    Ok((targets, rb)) => Ok((pipelines, targets, rb, ms(t))),
+                    Err(e) => {
+                        let mut p = pipelines;
+                        p.destroy(&gpu);
+                        Err(e)
+                    }
+                }
             });
             let loaded = (|| -> PlayResult<(GpuScene, Dummies, u64, u64)> {
-                let ring = if gpu.is_cpu() { 8 << 20 } else { 32 << 20 };
+                let ring = if gpu.is_cpu() { 8 << 20 } else { 16 << 20 };
                 let mut up = Uploader::new(&gpu, ring, timeline)?;
                 let result = (|| {
                     let dummies = Dummies::new(&gpu, &mut up)?;
-                    match GpuScene::load(&gpu, &file, needs, &mut up) {
+                    match GpuScene::load(&gpu, &file, &prepared, &mut up) {
                         Ok(scene) => Ok((scene, dummies)),
                         Err(e) => {
                             let mut d = dummies;
@@ -153,8 +193,12 @@ impl Session {
         let (scene, dummies, ready, bytes) = match loaded {
             Ok(l) => l,
             Err(e) => {
-                if let Ok((mut p, _)) = pipelines {
+                if let Ok((mut p, mut t, rb, _)) = pipelines {
                     p.destroy(&gpu);
+                    t.destroy(&gpu);
+                    if let Some(mut rb) = rb {
+                        rb.destroy(&gpu);
+                    }
                 }
                 cleanup(&gpu);
                 return Err(e);
@@ -166,7 +210,7 @@ impl Session {
         times.sections_skipped = scene.sections.len() - times.sections_uploaded;
         times.resident_since_start_ms = ms(start);
         let mut scene = scene;
-        let (pipelines, pipelines_ms) = match pipelines {
+        let (pipelines, targets, readback, pipelines_ms) = match pipelines {
             Ok(p) => p,
             Err(e) => {
                 let mut d = dummies;
@@ -180,8 +224,12 @@ impl Session {
         let camera = match Camera::initial(&scene.manifest.cameras, &scene.manifest.bounds, options.camera) {
             Ok(c) => c,
             Err(e) => {
-                let (mut p, mut d) = (pipelines, dummies);
+                let (mut p, mut d, mut t) = (pipelines, dummies, targets);
                 p.destroy(&gpu);
+                t.destroy(&gpu);
+                if let Some(mut rb) = readback {
+                    rb.destroy(&gpu);
+                }
                 d.destroy(&gpu);
                 scene.destroy(&gpu);
                 cleanup(&gpu);
@@ -189,7 +237,7 @@ impl Session {
             }
         };
         let renderer =
-            Renderer::new(&gpu, pipelines, dummies, &scene, options.render, options.width, options.height)?;
+            Renderer::new(&gpu, pipelines, dummies, targets, &scene, options.render)?;
         let pool = CommandPool::new(&gpu, gpu.family)?;
         let mut warnings = renderer.warnings.clone();
         if options.render.shadow_maps
@@ -204,6 +252,7 @@ impl Session {
             warnings,
             scene,
             renderer,
+            readback,
             pool,
             timeline,
             ready,
@@ -214,19 +263,24 @@ impl Session {
         })
     }
 
-    /// Renders one frame and waits for it; with `readback`, copies its images there. Returns
-    /// the passes' GPU times.
-    pub fn frame(&mut self, readback: Option<&Readback>) -> PlayResult<PassTimes> {
+    /// Renders one frame and waits for it; with `read`, copies it into [`Session::readback`].
+    /// Returns the passes' GPU times.
+    pub fn frame(&mut self, read: bool) -> PlayResult<PassTimes> {
         let t = Instant::now();
-        self.record_and_submit(
+        let readback = if read { self.readback.take() } else { None };
+        let submitted = self.record_and_submit(
             |rec, renderer| {
-                if let Some(r) = readback {
+                if let Some(r) = &readback {
                     r.record(rec, &renderer.targets);
                 }
             },
             &[],
             &[],
-        )?;
+        );
+        if readback.is_some() {
+            self.readback = readback;
+        }
+        submitted?;
         self.pool.wait(&self.gpu)?;
         if self.times.first_frame_gpu_ms == 0.0 {
             self.times.first_frame_gpu_ms = ms(t);
@@ -286,6 +340,9 @@ impl Drop for Session {
     fn drop(&mut self) {
         let _ = self.gpu.wait_idle();
         self.pool.destroy(&self.gpu);
+        if let Some(r) = &mut self.readback {
+            r.destroy(&self.gpu);
+        }
         self.renderer.destroy(&self.gpu);
         self.scene.destroy(&self.gpu);
         self.gpu.destroy_semaphore(self.timeline);

@@ -209,17 +209,15 @@ fn host_buffer(gpu: &Gpu, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags)
 }
 
 impl Renderer {
-    /// Binds `scene` to `pipelines` for images of `width` × `height`.
+    /// Binds `scene` to `pipelines`, rendering into `targets`.
     pub fn new(
         gpu: &Gpu,
         mut pipelines: Pipelines,
         dummies: Dummies,
+        targets: Targets,
         scene: &GpuScene,
         settings: RenderSettings,
-        width: u32,
-        height: u32,
     ) -> PlayResult<Renderer> {
-        let targets = Targets::new(gpu, width, height)?;
         let plan = lights::plan(&scene.manifest, &scene.shadow_maps, settings.shadow_maps);
         let lights = host_buffer(
             gpu,
@@ -432,32 +430,38 @@ impl Renderer {
     }
 }
 
-/// Host-visible copies of a frame's display and radiance images.
+/// Which image of a frame to read back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Readable {
+    /// The tone-mapped RGBA8 image.
+    Display,
+    /// The linear RGBA32F radiance.
+    Radiance,
+}
+
+/// A host-visible copy of one of a frame's images.
 #[derive(Debug)]
 pub struct Readback {
-    /// Tone-mapped RGBA8.
-    pub display: Buffer,
-    /// Linear RGBA32F.
-    pub radiance: Buffer,
+    /// The pixels, tightly packed.
+    pub buffer: Buffer,
+    /// Which image.
+    pub image: Readable,
 }
 
 impl Readback {
-    /// Buffers for targets of `width` × `height`.
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> PlayResult<Readback> {
-        let px = width as u64 * height as u64;
-        let dst = vk::BufferUsageFlags::TRANSFER_DST;
-        Ok(Readback {
-            display: Buffer::new(gpu, "display readback", px * 4, dst, MemoryLocation::GpuToCpu)?,
-            radiance: Buffer::new(gpu, "radiance readback", px * 16, dst, MemoryLocation::GpuToCpu)?,
-        })
+    /// A buffer for `image` of targets of `width` × `height`.
+    pub fn new(gpu: &Gpu, image: Readable, width: u32, height: u32) -> PlayResult<Readback> {
+        let texel = if image == Readable::Display { 4 } else { 16 };
+        let size = width as u64 * height as u64 * texel;
+        let buffer = Buffer::new(gpu, "readback", size, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        Ok(Readback { buffer, image })
     }
 
-    /// Records copies of both images (in STORAGE use) into the buffers.
+    /// Records the copy of the image (in STORAGE use) into the buffer.
     pub fn record(&self, rec: &Recorder, targets: &Targets) {
-        for (img, buf) in [(&targets.display, &self.display), (&targets.radiance, &self.radiance)] {
-            rec.transition(img, Use::STORAGE, Use::TRANSFER_SRC);
-            rec.copy_from_image(img, buf);
-        }
+        let img = if self.image == Readable::Display { &targets.display } else { &targets.radiance };
+        rec.transition(img, Use::STORAGE, Use::TRANSFER_SRC);
+        rec.copy_from_image(img, &self.buffer);
         rec.memory_barrier(
             vk::PipelineStageFlags2::TRANSFER,
             vk::AccessFlags2::TRANSFER_WRITE,
@@ -466,9 +470,8 @@ impl Readback {
         );
     }
 
-    /// Releases the buffers.
+    /// Releases the buffer.
     pub fn destroy(&mut self, gpu: &Gpu) {
-        self.display.destroy(gpu);
-        self.radiance.destroy(gpu);
+        self.buffer.destroy(gpu);
     }
 }

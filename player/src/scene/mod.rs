@@ -59,6 +59,46 @@ pub struct SectionFate {
     pub reason: String,
 }
 
+/// The CPU side of loading, done while the device is being created: the file validated, the
+/// checksums of every section to upload verified (which also pages them in), and the index
+/// buffer sorted by material.
+pub struct Prepared<'f> {
+    view: SceneView<'f>,
+    needs: Needs,
+    indices: Vec<u32>,
+    draws: Vec<Draw>,
+}
+
+impl std::fmt::Debug for Prepared<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Prepared").field("draws", &self.draws.len()).finish()
+    }
+}
+
+/// Whether a section of `kind` is uploaded under `needs` (geometry always).
+fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
+    kind == sections::VERTICES
+        || kind == sections::UVS
+        || kind == sections::TRIANGLES
+        || (kind == sections::TEXTURE && needs.textures)
+        || (kind == sections::BRDF_LUT && needs.brdf_lut)
+        || (kind == sections::SHADOW_MAP && needs.shadow_maps)
+}
+
+impl<'f> Prepared<'f> {
+    /// Validates `file` and prepares what the upload copies.
+    pub fn new(file: &'f KilnFile, needs: Needs) -> PlayResult<Prepared<'f>> {
+        let view = SceneView::new(file).map_err(bad)?;
+        for s in file.sections() {
+            if s.known.is_some() && uploads(s.entry.kind, needs) {
+                file.verify_section(s.position).map_err(bad)?;
+            }
+        }
+        let (indices, draws) = sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
+        Ok(Prepared { view, needs, indices, draws })
+    }
+}
+
 /// The scene on the GPU.
 pub struct GpuScene {
     /// The file's manifest.
@@ -144,10 +184,10 @@ pub fn sort_by_material(
 }
 
 impl GpuScene {
-    /// Validates `file` and uploads what `needs` asks for through `up`. Returns when everything
-    /// is recorded; the caller flushes the uploader and waits on its timeline before drawing.
-    pub fn load(gpu: &Gpu, file: &KilnFile, needs: Needs, up: &mut Uploader) -> PlayResult<GpuScene> {
-        let view = SceneView::new(file).map_err(bad)?;
+    /// Uploads what `prepared` needs through `up`. Returns when everything is recorded; the
+    /// caller flushes the uploader and waits on its timeline before drawing.
+    pub fn load(gpu: &Gpu, file: &KilnFile, prepared: &Prepared, up: &mut Uploader) -> PlayResult<GpuScene> {
+        let view = &prepared.view;
         let sampler = |key| Sampler::new(gpu, key);
         let clamp = vk::SamplerAddressMode::CLAMP_TO_EDGE;
         let mut samplers = HashMap::new();
@@ -156,28 +196,15 @@ impl GpuScene {
         samplers.insert(linear_key, sampler(linear_key)?);
         samplers.insert(nearest_key, sampler(nearest_key)?);
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
-        let vertices =
-            Buffer::uploaded(gpu, "vertices", std::mem::size_of_val(view.vertices) as u64, vertex_usage)?;
-        let uvs = Buffer::uploaded(
-            gpu,
-            "uvs",
-            (view.vertices.len() * 8) as u64,
-            vertex_usage | vk::BufferUsageFlags::TRANSFER_DST,
-        )?;
-        let (index_data, draws) =
-            sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
-        let indices = Buffer::uploaded(
-            gpu,
-            "indices",
-            (index_data.len() * 4) as u64,
-            vk::BufferUsageFlags::INDEX_BUFFER,
-        )?;
+        let vertices = Buffer::uploaded(gpu, "vertices", std::mem::size_of_val(view.vertices) as u64, vertex_usage)?;
+        let uvs = Buffer::uploaded(gpu, "uvs", (view.vertices.len() * 8) as u64, vertex_usage)?;
+        let indices = Buffer::uploaded(gpu, "indices", (prepared.indices.len() * 4) as u64, vk::BufferUsageFlags::INDEX_BUFFER)?;
         let mut scene = GpuScene {
             manifest: view.manifest.clone(),
             vertices,
             uvs,
             indices,
-            draws,
+            draws: prepared.draws.clone(),
             materials: view.materials.to_vec(),
             textures: Vec::new(),
             texture_samplers: Vec::new(),
@@ -189,7 +216,7 @@ impl GpuScene {
             uploaded_bytes: 0,
             samplers,
         };
-        match scene.upload_sections(gpu, file, &view, needs, up, &index_data) {
+        match scene.upload_sections(gpu, file, prepared, up) {
             Ok(()) => {
                 scene.uploaded_bytes = up.bytes;
                 Ok(scene)
@@ -204,15 +231,8 @@ impl GpuScene {
         }
     }
 
-    fn upload_sections(
-        &mut self,
-        gpu: &Gpu,
-        file: &KilnFile,
-        view: &SceneView,
-        needs: Needs,
-        up: &mut Uploader,
-        index_data: &[u32],
-    ) -> PlayResult {
+    fn upload_sections(&mut self, gpu: &Gpu, file: &KilnFile, prepared: &Prepared, up: &mut Uploader) -> PlayResult {
+        let (view, needs) = (&prepared.view, prepared.needs);
         let mut uvs_uploaded = false;
         for s in file.sections() {
             let kind = s.entry.kind;
@@ -240,7 +260,7 @@ impl GpuScene {
                 uvs_uploaded = true;
             } else if kind == sections::TRIANGLES {
                 // Uploaded re-sorted by material, so that each material is one draw.
-                up.buffer(&self.indices, 0, bytemuck::cast_slice(index_data))?;
+                up.buffer(&self.indices, 0, bytemuck::cast_slice(&prepared.indices))?;
             } else if kind == sections::TEXTURE && needs.textures {
                 self.upload_texture(gpu, view, index as usize, up)?;
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
