@@ -10,9 +10,15 @@ use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_tests::{compile, scene_of};
 use proptest::prelude::*;
 
+/// Settings that bake geometry and BVH only: these tests query the BVH, and baking line space
+/// for every generated case made them several times slower.
+fn geometry_only() -> Settings {
+    Settings { shaft_variants: Some(0), ..Default::default() }
+}
+
 /// Compiles `tris`, then checks `rays` rays of every class: BVH against brute force.
 fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<(), String> {
-    let bytes = compile(scene_of(tris), Settings { bvh_preset: preset, ..Default::default() });
+    let bytes = compile(scene_of(tris), Settings { bvh_preset: preset, ..geometry_only() });
     let file = KilnFile::from_bytes(&bytes, Checksums::Eager).map_err(|e| e.to_string())?;
     let view = SceneView::new(&file).map_err(|e| e.to_string())?;
     let t = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
@@ -148,7 +154,7 @@ fn closed_mesh_is_watertight() {
             }
         }
     }
-    let bytes = compile(scene_of(&tris), Settings::default());
+    let bytes = compile(scene_of(&tris), geometry_only());
     let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
     let view = SceneView::new(&file).unwrap();
     let t = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };

@@ -80,7 +80,8 @@ pub struct Args {
     /// Image size; the window's initial size.
     #[arg(long, value_name = "WxH", default_value = "1280x720")]
     pub size: Size,
-    /// Frames to render headless (the last is written), or to measure with --bench [1 | 100].
+    /// Frames to render headless (the last is written; default 1), to measure with --bench
+    /// (default 100), or to show before closing the window (default: until closed).
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
     /// Headless output: .png (tone-mapped sRGB) or .exr (linear radiance).
@@ -222,5 +223,5 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
         }
         return validation_verdict(s.validation_errors());
     }
-    window::run(options, start)
+    window::run(options, args.frames, start)
 }

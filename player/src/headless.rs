@@ -18,16 +18,24 @@ pub struct HeadlessResult {
 }
 
 /// Renders `frames` frames (at least one) and writes the last to `output`, if given.
-pub fn run(options: &SessionOptions, frames: u32, output: Option<&Path>, start: Instant) -> PlayResult<HeadlessResult> {
+pub fn run(
+    options: &SessionOptions,
+    frames: u32,
+    output: Option<&Path>,
+    start: Instant,
+) -> PlayResult<HeadlessResult> {
     let kind = output.map(OutputKind::of).transpose()?;
     let mut options = options.clone();
-    options.readback = kind.map(|k| if k == OutputKind::Exr { Readable::Radiance } else { Readable::Display });
+    options.readback =
+        kind.map(|k| if k == OutputKind::Exr { Readable::Radiance } else { Readable::Display });
     let mut session = Session::open(&options, start)?;
     let frames = frames.max(1);
     for f in 0..frames {
         session.frame(f + 1 == frames && output.is_some())?;
     }
-    let (Some(path), Some(kind)) = (output, kind) else { return Ok(HeadlessResult { session, non_finite: 0 }) };
+    let (Some(path), Some(kind)) = (output, kind) else {
+        return Ok(HeadlessResult { session, non_finite: 0 });
+    };
     let (w, h) = (options.width, options.height);
     let texel = if kind == OutputKind::Exr { 16 } else { 4 };
     let bytes = session

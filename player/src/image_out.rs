@@ -3,9 +3,9 @@
 
 use std::io::Cursor;
 
+use image::ExtendedColorType;
 use image::ImageEncoder;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-use image::ExtendedColorType;
 use std::path::Path;
 
 use crate::error::{Exit, PlayError, PlayResult};
@@ -56,7 +56,9 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> PlayResul
     let mut out = Vec::new();
     // Fast compression: the output is written on the first frame's critical path.
     let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
-    encoder.write_image(&rgb, width, height, ExtendedColorType::Rgb8).map_err(|e| PlayError::new(Exit::Io, format!("encoding PNG: {e}")))?;
+    encoder
+        .write_image(&rgb, width, height, ExtendedColorType::Rgb8)
+        .map_err(|e| PlayError::new(Exit::Io, format!("encoding PNG: {e}")))?;
     write_atomic(path, &out)
 }
 

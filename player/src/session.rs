@@ -127,7 +127,9 @@ impl Session {
             });
             let t = Instant::now();
             let gpu = Gpu::new(&options.gpu).map(|g| (g, ms(t)));
-            let prepared = prep.join().unwrap_or_else(|_| Err(PlayError::new(Exit::BadInput, "validating the file panicked")));
+            let prepared = prep
+                .join()
+                .unwrap_or_else(|_| Err(PlayError::new(Exit::BadInput, "validating the file panicked")));
             (gpu, prepared)
         });
         let (gpu, device_ms) = gpu?;
@@ -236,8 +238,7 @@ impl Session {
                 return Err(e);
             }
         };
-        let renderer =
-            Renderer::new(&gpu, pipelines, dummies, targets, &scene, options.render)?;
+        let renderer = Renderer::new(&gpu, pipelines, dummies, targets, &scene, options.render)?;
         let pool = CommandPool::new(&gpu, gpu.family)?;
         let mut warnings = renderer.warnings.clone();
         if options.render.shadow_maps

@@ -45,10 +45,11 @@ struct App {
     title_at: Instant,
     frame_ms: f64,
     speed: f64,
+    frames_left: Option<u32>,
 }
 
-/// Opens the window and plays until it is closed.
-pub fn run(options: SessionOptions, start: Instant) -> PlayResult {
+/// Opens the window and plays until it is closed, or for `frames` frames.
+pub fn run(options: SessionOptions, frames: Option<u32>, start: Instant) -> PlayResult {
     let event_loop = EventLoop::new().map_err(|e| {
         PlayError::new(
             Exit::Unsupported,
@@ -68,6 +69,7 @@ pub fn run(options: SessionOptions, start: Instant) -> PlayResult {
         title_at: Instant::now(),
         frame_ms: 0.0,
         speed: 1.0,
+        frames_left: frames,
     };
     event_loop
         .run_app(&mut app)
@@ -252,6 +254,12 @@ impl ApplicationHandler for App {
             WindowEvent::RedrawRequested => {
                 if let Err(e) = self.draw() {
                     self.fail(event_loop, e);
+                }
+                if let Some(n) = &mut self.frames_left {
+                    *n = n.saturating_sub(1);
+                    if *n == 0 {
+                        event_loop.exit();
+                    }
                 }
             }
             _ => {}

@@ -9,7 +9,7 @@ use kiln_compiler::bake;
 use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::progress::Progress;
 use kiln_compiler::settings::Settings;
-use kiln_format::sections::{GpuMaterial, Vertex};
+use kiln_format::sections::Vertex;
 
 /// The shared scene folder (`../shared/scenes` beside the checkout), if present.
 pub fn shared_scenes() -> Option<PathBuf> {
@@ -17,10 +17,12 @@ pub fn shared_scenes() -> Option<PathBuf> {
     dir.is_dir().then_some(dir)
 }
 
-/// A scene of the given triangles (one material, flat normals).
+/// A scene of the given triangles (one grey Lambertian material, flat normals; a Lambertian
+/// scene needs no BRDF table, which keeps compiling thousands of test scenes quick).
 pub fn scene_of(tris: &[[Vec3; 3]]) -> Scene {
     let mut s = Scene { name: "test".into(), ..Default::default() };
-    s.materials.push(Material { name: "m".into(), gpu: GpuMaterial::default() });
+    s.materials
+        .push(Material { name: "m".into(), gpu: kiln_compiler::import::demo::lambert_material([0.5; 3]) });
     for t in tris {
         let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or(Vec3::Z);
         let base = s.vertices.len() as u32;

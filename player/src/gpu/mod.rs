@@ -246,7 +246,8 @@ impl Gpu {
             buffer_device_address: true,
             // Host-visible blocks are pinned and zeroed by the driver, which costs milliseconds per
             // 64 MiB (the default): small blocks, and large host buffers get their own.
-            allocation_sizes: gpu_allocator::AllocationSizes::new(64 << 20, 4 << 20).with_max_device_memblock_size(256 << 20),
+            allocation_sizes: gpu_allocator::AllocationSizes::new(64 << 20, 4 << 20)
+                .with_max_device_memblock_size(256 << 20),
         })
         .map_err(|e| PlayError::new(Exit::Gpu, format!("creating the memory allocator failed: {e}")))?;
         let cache_data =

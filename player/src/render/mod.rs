@@ -453,7 +453,8 @@ impl Readback {
     pub fn new(gpu: &Gpu, image: Readable, width: u32, height: u32) -> PlayResult<Readback> {
         let texel = if image == Readable::Display { 4 } else { 16 };
         let size = width as u64 * height as u64 * texel;
-        let buffer = Buffer::new(gpu, "readback", size, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
+        let buffer =
+            Buffer::new(gpu, "readback", size, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?;
         Ok(Readback { buffer, image })
     }
 

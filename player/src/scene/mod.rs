@@ -94,7 +94,8 @@ impl<'f> Prepared<'f> {
                 file.verify_section(s.position).map_err(bad)?;
             }
         }
-        let (indices, draws) = sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
+        let (indices, draws) =
+            sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
         Ok(Prepared { view, needs, indices, draws })
     }
 }
@@ -196,9 +197,15 @@ impl GpuScene {
         samplers.insert(linear_key, sampler(linear_key)?);
         samplers.insert(nearest_key, sampler(nearest_key)?);
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
-        let vertices = Buffer::uploaded(gpu, "vertices", std::mem::size_of_val(view.vertices) as u64, vertex_usage)?;
+        let vertices =
+            Buffer::uploaded(gpu, "vertices", std::mem::size_of_val(view.vertices) as u64, vertex_usage)?;
         let uvs = Buffer::uploaded(gpu, "uvs", (view.vertices.len() * 8) as u64, vertex_usage)?;
-        let indices = Buffer::uploaded(gpu, "indices", (prepared.indices.len() * 4) as u64, vk::BufferUsageFlags::INDEX_BUFFER)?;
+        let indices = Buffer::uploaded(
+            gpu,
+            "indices",
+            (prepared.indices.len() * 4) as u64,
+            vk::BufferUsageFlags::INDEX_BUFFER,
+        )?;
         let mut scene = GpuScene {
             manifest: view.manifest.clone(),
             vertices,
@@ -231,7 +238,13 @@ impl GpuScene {
         }
     }
 
-    fn upload_sections(&mut self, gpu: &Gpu, file: &KilnFile, prepared: &Prepared, up: &mut Uploader) -> PlayResult {
+    fn upload_sections(
+        &mut self,
+        gpu: &Gpu,
+        file: &KilnFile,
+        prepared: &Prepared,
+        up: &mut Uploader,
+    ) -> PlayResult {
         let (view, needs) = (&prepared.view, prepared.needs);
         let mut uvs_uploaded = false;
         for s in file.sections() {
