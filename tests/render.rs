@@ -72,6 +72,9 @@ fn render(
     let o = opts(&file);
     let result = headless::run(&o, 1, Some(&exr), Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(result.session.validation_errors(), 0, "{name}: validation errors");
+    // Close a second session on the same file, counting what the layer reports at teardown.
+    let again = headless::run(&o, 1, None, Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(again.session.close(), 0, "{name}: validation errors at teardown (leaked objects?)");
     assert_eq!(result.non_finite, 0, "{name}: NaN or Inf in the frame");
     let (w, h, rgb) = read_exr(&exr).unwrap();
     assert_eq!((w, h), (o.width, o.height));

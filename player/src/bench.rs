@@ -91,7 +91,7 @@ pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -
     }
     let names = PASSES.iter().copied().chain(["total"]);
     let passes = names.zip(per_pass).map(|(n, v)| stats(n, v)).collect();
-    Ok(BenchReport {
+    let mut report = BenchReport {
         device: session.gpu.name.clone(),
         scene: session.scene.manifest.scene_name.clone(),
         width: options.width,
@@ -101,8 +101,10 @@ pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -
         passes,
         load: session.times.clone(),
         sections: session.scene.sections.clone(),
-        validation_errors: session.validation_errors(),
-    })
+        validation_errors: 0,
+    };
+    report.validation_errors = session.close();
+    Ok(report)
 }
 
 impl BenchReport {

@@ -335,6 +335,14 @@ impl Session {
     pub fn validation_errors(&self) -> u32 {
         self.gpu.validation_errors()
     }
+
+    /// Releases everything and returns the validation errors, including those the layer reports
+    /// while the device is destroyed (objects never freed).
+    pub fn close(self) -> u32 {
+        let counts = self.gpu.validation.clone();
+        drop(self);
+        counts.errors.load(std::sync::atomic::Ordering::Relaxed)
+    }
 }
 
 impl Drop for Session {

@@ -74,8 +74,9 @@ pub fn run(options: SessionOptions, frames: Option<u32>, start: Instant) -> Play
     event_loop
         .run_app(&mut app)
         .map_err(|e| PlayError::new(Exit::Gpu, format!("window event loop failed: {e}")))?;
-    let errors = app.running.as_ref().map_or(0, |r| r.session.validation_errors());
+    let counts = app.running.as_ref().map(|r| r.session.gpu.validation.clone());
     drop(app.running.take());
+    let errors = counts.map_or(0, |c| c.errors.load(std::sync::atomic::Ordering::Relaxed));
     if let Some(e) = app.error {
         return Err(e);
     }

@@ -72,7 +72,9 @@ pub struct Gpu {
     allocator: ManuallyDrop<Mutex<Allocator>>,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     /// Validation message counts (boxed: the messenger holds a pointer to it).
-    pub validation: Box<ValidationCounts>,
+    /// Shared, so that messages sent while the device is destroyed (leaked objects) can still be
+    /// counted by whoever holds a clone.
+    pub validation: std::sync::Arc<ValidationCounts>,
     /// Pipeline cache.
     pub pipeline_cache: vk::PipelineCache,
     cache_path: Option<PathBuf>,
@@ -151,7 +153,7 @@ impl Gpu {
         }
         let app_name = CString::new("kiln-play").unwrap_or_default();
         let app = vk::ApplicationInfo::default().application_name(&app_name).api_version(vk::API_VERSION_1_3);
-        let validation = Box::new(ValidationCounts::default());
+        let validation = std::sync::Arc::new(ValidationCounts::default());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(
                 vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
@@ -162,7 +164,7 @@ impl Gpu {
                     | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
             )
             .pfn_user_callback(Some(debug_callback))
-            .user_data(&*validation as *const ValidationCounts as *mut c_void);
+            .user_data(std::sync::Arc::as_ptr(&validation) as *mut c_void);
         let mut info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layers)
@@ -171,8 +173,12 @@ impl Gpu {
             info = info.push_next(&mut messenger_info);
         }
         // SAFETY: all pointers in `info` live until the call returns.
-        let instance = unsafe { entry.create_instance(&info, None) }
-            .map_err(|e| vk_err("creating the Vulkan instance", e))?;
+        let instance = unsafe { entry.create_instance(&info, None) }.map_err(|e| match e {
+            vk::Result::ERROR_INCOMPATIBLE_DRIVER => unsupported(
+                "no Vulkan driver found: install your GPU's driver, or Mesa's CPU driver lavapipe (Debian: mesa-vulkan-drivers)",
+            ),
+            e => vk_err("creating the Vulkan instance", e),
+        })?;
         let debug = if options.validate {
             let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let messenger = unsafe { utils.create_debug_utils_messenger(&messenger_info, None) }
