@@ -8,6 +8,7 @@ use kiln_compiler::raycheck::{Rng, check_line_space};
 use kiln_compiler::settings::{Settings, VoxelRes};
 use kiln_format::linespace::{LineSpace, Variants};
 use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile, SceneView, sections};
+use kiln_tests::shapes::{height_grid, soup};
 use kiln_tests::{compile, scene_of};
 use proptest::prelude::*;
 
@@ -43,26 +44,6 @@ fn check(tris: &[[Vec3; 3]], res: u32, n: u32, rays: u64, seed: u64) -> Result<u
     Ok(c.pnmt.map_or(0, |p| p.hit_disagreements))
 }
 
-fn soup(rng: &mut Rng, n: usize, size: f32) -> Vec<[Vec3; 3]> {
-    (0..n)
-        .map(|_| {
-            let c = rng.in_box(Vec3::splat(-1.0), Vec3::splat(1.0));
-            [c, c + rng.direction() * size * rng.f32(), c + rng.direction() * size * rng.f32()]
-        })
-        .collect()
-}
-
-fn grid_mesh(n: usize, rng: &mut Rng) -> Vec<[Vec3; 3]> {
-    let h: Vec<f32> = (0..(n + 1) * (n + 1)).map(|_| rng.f32() * 0.3).collect();
-    let p = |i: usize, j: usize| Vec3::new(i as f32 / n as f32, h[i * (n + 1) + j], j as f32 / n as f32);
-    (0..n * n)
-        .flat_map(|k| {
-            let (i, j) = (k / n, k % n);
-            [[p(i, j), p(i + 1, j), p(i + 1, j + 1)], [p(i, j), p(i + 1, j + 1), p(i, j + 1)]]
-        })
-        .collect()
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(20))]
 
@@ -77,7 +58,7 @@ proptest! {
 #[test]
 fn far_tiny_and_huge_scenes() {
     let mut rng = Rng::new(3);
-    let base = grid_mesh(12, &mut rng);
+    let base = height_grid(12, 0.3, &mut rng);
     for (scale, offset) in [
         (1.0, Vec3::ZERO),
         (1e-3, Vec3::ZERO),

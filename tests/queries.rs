@@ -7,6 +7,7 @@ use kiln_compiler::raycheck::{Agreement, RaySample, Rng, compare, generate};
 use kiln_compiler::settings::{BvhPreset, Settings};
 use kiln_format::query::{BruteForce, BvhQuery, IndexedTriangles, Ray, closest_hit_brute_force};
 use kiln_format::{Checksums, KilnFile, SceneView};
+use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
 use kiln_tests::{compile, scene_of};
 use proptest::prelude::*;
 
@@ -46,40 +47,13 @@ fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<
     Ok(())
 }
 
-fn random_soup(rng: &mut Rng, n: usize, size: f32) -> Vec<[Vec3; 3]> {
-    (0..n)
-        .map(|_| {
-            let c = rng.in_box(Vec3::splat(-1.0), Vec3::splat(1.0));
-            [c, c + rng.direction() * size * rng.f32(), c + rng.direction() * size * rng.f32()]
-        })
-        .collect()
-}
-
-/// A height field of `n × n` quads sharing edges and vertices.
-fn grid(n: usize, rng: &mut Rng) -> Vec<[Vec3; 3]> {
-    let h: Vec<f32> = (0..(n + 1) * (n + 1)).map(|_| rng.f32() * 0.2).collect();
-    let p = |i: usize, j: usize| Vec3::new(i as f32 / n as f32, h[i * (n + 1) + j], j as f32 / n as f32);
-    let mut t = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            t.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
-            t.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
-        }
-    }
-    t
-}
-
-fn transformed(tris: &[[Vec3; 3]], scale: f32, offset: Vec3) -> Vec<[Vec3; 3]> {
-    tris.iter().map(|t| t.map(|p| p * scale + offset)).collect()
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     #[test]
     fn soups_match_brute_force(seed in any::<u64>(), n in 1usize..400, size in 0.01f32..1.0) {
         let mut rng = Rng::new(seed);
-        let tris = random_soup(&mut rng, n, size);
+        let tris = soup(&mut rng, n, size);
         prop_assert_eq!(check(&tris, BvhPreset::Medium, 300, seed), Ok(()));
     }
 
@@ -87,7 +61,7 @@ proptest! {
     fn grids_match_brute_force_at_every_scale(seed in any::<u64>(), n in 1usize..24, which in 0usize..4) {
         let mut rng = Rng::new(seed);
         let (scale, offset) = [(1.0, Vec3::ZERO), (1e-3, Vec3::ZERO), (1e3, Vec3::ZERO), (1.0, Vec3::splat(1e5))][which];
-        let tris = transformed(&grid(n, &mut rng), scale, offset);
+        let tris = transformed(&height_grid(n, 0.2, &mut rng), scale, offset);
         prop_assert_eq!(check(&tris, BvhPreset::Fast, 300, seed), Ok(()));
     }
 }
@@ -95,7 +69,7 @@ proptest! {
 #[test]
 fn every_preset_matches_brute_force() {
     let mut rng = Rng::new(7);
-    let tris = random_soup(&mut rng, 3000, 0.1);
+    let tris = soup(&mut rng, 3000, 0.1);
     for preset in [BvhPreset::Fast, BvhPreset::Medium, BvhPreset::Slow] {
         check(&tris, preset, 3000, 7).unwrap();
     }
@@ -121,7 +95,7 @@ fn slivers_and_coplanar_overlaps() {
 fn one_triangle_and_huge_triangle_scenes() {
     check(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], BvhPreset::Medium, 2000, 1).unwrap();
     let mut rng = Rng::new(5);
-    let mut tris = random_soup(&mut rng, 200, 0.05);
+    let mut tris = soup(&mut rng, 200, 0.05);
     tris.push([Vec3::new(-1e4, -1.0, -1e4), Vec3::new(1e4, -1.0, -1e4), Vec3::new(0.0, -1.0, 1e4)]);
     check(&tris, BvhPreset::Medium, 3000, 5).unwrap();
 }
@@ -130,30 +104,7 @@ fn one_triangle_and_huge_triangle_scenes() {
 /// go, including straight at vertices and edges (a leak would be a miss).
 #[test]
 fn closed_mesh_is_watertight() {
-    let (nu, nv) = (48, 24);
-    let p = |i: usize, j: usize| {
-        let (u, v) =
-            (i as f32 / nu as f32 * std::f32::consts::TAU, j as f32 / nv as f32 * std::f32::consts::PI);
-        if j == 0 {
-            Vec3::Y
-        } else if j == nv {
-            Vec3::NEG_Y
-        } else {
-            Vec3::new(v.sin() * u.cos(), v.cos(), v.sin() * u.sin())
-        }
-    };
-    let mut tris = Vec::new();
-    for i in 0..nu {
-        for j in 0..nv {
-            let (a, b, c, d) = (p(i, j), p((i + 1) % nu, j), p((i + 1) % nu, j + 1), p(i, j + 1));
-            if j != 0 {
-                tris.push([a, b, d]);
-            }
-            if j != nv - 1 {
-                tris.push([b, c, d]);
-            }
-        }
-    }
+    let tris = sphere(48, 24);
     let bytes = compile(scene_of(&tris), geometry_only());
     let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
     let view = SceneView::new(&file).unwrap();

@@ -147,6 +147,7 @@ impl Args {
             },
             render: RenderSettings {
                 shadow_maps: self.shadows == Shadows::Shadowmap,
+                rays: false,
                 exposure: self.exposure,
             },
             width: self.size.width,

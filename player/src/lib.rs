@@ -15,6 +15,7 @@ pub mod image_out;
 pub mod render;
 pub mod scene;
 pub mod session;
+pub mod trace;
 pub mod window;
 
 pub use error::{Exit, PlayError, PlayResult};

@@ -117,7 +117,12 @@ impl Session {
         let t = Instant::now();
         let file = open_file(&options.file)?;
         times.open_file_ms = ms(t);
-        let needs = Needs { textures: true, brdf_lut: true, shadow_maps: options.render.shadow_maps };
+        let needs = Needs {
+            textures: true,
+            brdf_lut: true,
+            shadow_maps: options.render.shadow_maps,
+            bvh: options.render.rays,
+        };
         // The CPU side of loading (validation, checksums, index sorting) runs while the driver
         // creates the device, which on some drivers takes well over 100 ms.
         let (gpu, prepared) = std::thread::scope(|s| {

@@ -44,3 +44,65 @@ pub fn compile(scene: Scene, settings: Settings) -> Vec<u8> {
         bake::bake(&loaded.scene, &loaded.settings, plan, Vec::new(), &Progress::hidden()).expect("bake");
     bake::to_bytes(&baked).expect("write")
 }
+
+/// Shapes the query tests share.
+pub mod shapes {
+    use glam::Vec3;
+    use kiln_compiler::raycheck::Rng;
+
+    /// `n` random triangles of edge up to `size` in [−1, 1]³.
+    pub fn soup(rng: &mut Rng, n: usize, size: f32) -> Vec<[Vec3; 3]> {
+        (0..n)
+            .map(|_| {
+                let c = rng.in_box(Vec3::splat(-1.0), Vec3::splat(1.0));
+                [c, c + rng.direction() * size * rng.f32(), c + rng.direction() * size * rng.f32()]
+            })
+            .collect()
+    }
+
+    /// A height field of `n × n` quads over [0, 1]² sharing edges and vertices, heights up to
+    /// `amplitude`.
+    pub fn height_grid(n: usize, amplitude: f32, rng: &mut Rng) -> Vec<[Vec3; 3]> {
+        let h: Vec<f32> = (0..(n + 1) * (n + 1)).map(|_| rng.f32() * amplitude).collect();
+        let p = |i: usize, j: usize| Vec3::new(i as f32 / n as f32, h[i * (n + 1) + j], j as f32 / n as f32);
+        (0..n * n)
+            .flat_map(|k| {
+                let (i, j) = (k / n, k % n);
+                [[p(i, j), p(i + 1, j), p(i + 1, j + 1)], [p(i, j), p(i + 1, j + 1), p(i, j + 1)]]
+            })
+            .collect()
+    }
+
+    /// Scaled and moved copies.
+    pub fn transformed(tris: &[[Vec3; 3]], scale: f32, offset: Vec3) -> Vec<[Vec3; 3]> {
+        tris.iter().map(|t| t.map(|p| p * scale + offset)).collect()
+    }
+
+    /// A closed unit sphere of `nu` × `nv` quads (triangles at the poles).
+    pub fn sphere(nu: usize, nv: usize) -> Vec<[Vec3; 3]> {
+        let p = |i: usize, j: usize| {
+            let (u, v) =
+                (i as f32 / nu as f32 * std::f32::consts::TAU, j as f32 / nv as f32 * std::f32::consts::PI);
+            if j == 0 {
+                Vec3::Y
+            } else if j == nv {
+                Vec3::NEG_Y
+            } else {
+                Vec3::new(v.sin() * u.cos(), v.cos(), v.sin() * u.sin())
+            }
+        };
+        let mut tris = Vec::new();
+        for i in 0..nu {
+            for j in 0..nv {
+                let (a, b, c, d) = (p(i, j), p((i + 1) % nu, j), p((i + 1) % nu, j + 1), p(i, j + 1));
+                if j != 0 {
+                    tris.push([a, b, d]);
+                }
+                if j != nv - 1 {
+                    tris.push([b, c, d]);
+                }
+            }
+        }
+        tris
+    }
+}

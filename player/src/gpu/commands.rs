@@ -483,6 +483,25 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// Binds a compute pipeline, its sets and push constants, and dispatches `groups`.
+    pub fn dispatch(&self, p: &ComputePipeline, sets: &[vk::DescriptorSet], push: &[u8], groups: [u32; 3]) {
+        unsafe {
+            self.gpu.device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, p.raw);
+            self.gpu.device.cmd_bind_descriptor_sets(
+                self.cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                p.layout,
+                0,
+                sets,
+                &[],
+            );
+            if !push.is_empty() {
+                self.gpu.device.cmd_push_constants(self.cmd, p.layout, vk::ShaderStageFlags::ALL, 0, push);
+            }
+            self.gpu.device.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
+        }
+    }
+
     /// Resets a query range (before its timestamps are written).
     pub fn reset_timestamps(&self, pool: &TimestampPool) {
         unsafe { self.gpu.device.cmd_reset_query_pool(self.cmd, pool.raw, 0, pool.count) };

@@ -228,7 +228,8 @@ impl Gpu {
             .dynamic_rendering(true)
             .synchronization2(true)
             .maintenance4(true);
-        let features = vk::PhysicalDeviceFeatures::default();
+        // Doubles for the watertight triangle test's edge fallback in ray queries.
+        let features = vk::PhysicalDeviceFeatures::default().shader_float64(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_extensions)
@@ -424,10 +425,12 @@ fn pick_device(
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut f13);
         unsafe { instance.get_physical_device_features2(d, &mut f2) };
+        let f10 = f2.features;
         let missing: Vec<&str> = [
             ("dynamicRendering", f13.dynamic_rendering),
             ("synchronization2", f13.synchronization2),
             ("maintenance4", f13.maintenance4),
+            ("shaderFloat64", f10.shader_float64),
             ("timelineSemaphore", f12.timeline_semaphore),
             ("bufferDeviceAddress", f12.buffer_device_address),
             ("scalarBlockLayout", f12.scalar_block_layout),

@@ -29,12 +29,15 @@ pub mod spirv {
     pub const DIRECT: &[u8] = include_bytes!("../../../shaders/spirv/direct.comp.spv");
     /// Tone mapping.
     pub const TONEMAP: &[u8] = include_bytes!("../../../shaders/spirv/tonemap.comp.spv");
+    /// Ray queries from a buffer.
+    pub const TRACE_RAYS: &[u8] = include_bytes!("../../../shaders/spirv/rays.comp.spv");
     /// (source under `shaders/`, embedded bytes) of every shader.
-    pub const ALL: [(&str, &[u8]); 4] = [
+    pub const ALL: [(&str, &[u8]); 5] = [
         ("gbuffer/gbuffer.vert", GBUFFER_VERT),
         ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
         ("lighting/direct.comp", DIRECT),
         ("post/tonemap.comp", TONEMAP),
+        ("trace/rays.comp", TRACE_RAYS),
     ];
 }
 
@@ -50,6 +53,8 @@ pub const PASSES: [&str; 3] = ["gbuffer", "direct", "tonemap"];
 pub struct RenderSettings {
     /// Shadows from the baked shadow maps.
     pub shadow_maps: bool,
+    /// Upload the BVH for ray queries (ray-traced passes, the reference path tracer, `RayQuery`).
+    pub rays: bool,
     /// Exposure in stops (the radiance is multiplied by 2^exposure before tone mapping).
     pub exposure: f32,
 }

@@ -9,7 +9,7 @@ use ash::vk;
 use kiln_format::manifest::{ColorSpace, Manifest, ShadowProjection, Wrap};
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
-use kiln_format::sections::{self, GpuMaterial};
+use kiln_format::sections::{self, GpuMaterial, Vertex};
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey};
@@ -24,6 +24,8 @@ pub struct Needs {
     pub brdf_lut: bool,
     /// Shadow maps.
     pub shadow_maps: bool,
+    /// The BVH and its triangles, for ray queries.
+    pub bvh: bool,
 }
 
 /// One draw: the triangles of one material, contiguous in the index buffer.
@@ -67,6 +69,8 @@ pub struct Prepared<'f> {
     needs: Needs,
     indices: Vec<u32>,
     draws: Vec<Draw>,
+    /// Triangle corners in leaf order, (x, y, z, 0) each, when the BVH is needed.
+    bvh_triangles: Vec<[f32; 4]>,
 }
 
 impl std::fmt::Debug for Prepared<'_> {
@@ -83,6 +87,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::TEXTURE && needs.textures)
         || (kind == sections::BRDF_LUT && needs.brdf_lut)
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
+        || (kind == sections::BVH_NODES && needs.bvh)
 }
 
 impl<'f> Prepared<'f> {
@@ -96,8 +101,37 @@ impl<'f> Prepared<'f> {
         }
         let (indices, draws) =
             sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
-        Ok(Prepared { view, needs, indices, draws })
+        let bvh_triangles =
+            if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
+        Ok(Prepared { view, needs, indices, draws, bvh_triangles })
     }
+}
+
+/// Triangle corners in leaf (file) order as `vec4`s, three per triangle: what the GPU traversal
+/// reads (one load per corner instead of an index and a vertex fetch).
+pub fn triangle_corners(vertices: &[Vertex], triangles: &[[u32; 3]]) -> Vec<[f32; 4]> {
+    triangles
+        .iter()
+        .flat_map(|t| {
+            t.map(|i| {
+                let p = vertices[i as usize].position;
+                [p[0], p[1], p[2], 0.0]
+            })
+        })
+        .collect()
+}
+
+/// The BVH on the GPU: nodes as in the file and triangle corners in leaf order.
+#[derive(Debug)]
+pub struct BvhBuffers {
+    /// `CwbvhNode`s (80 bytes each).
+    pub nodes: Buffer,
+    /// Three `vec4` corners per triangle.
+    pub triangles: Buffer,
+    /// Node count.
+    pub node_count: u32,
+    /// Triangle count.
+    pub triangle_count: u32,
 }
 
 /// The scene on the GPU.
@@ -126,6 +160,8 @@ pub struct GpuScene {
     pub nearest_clamp: vk::Sampler,
     /// Shadow maps, when needed.
     pub shadow_maps: Vec<ShadowImage>,
+    /// The BVH, when ray queries are needed and the file has one.
+    pub bvh: Option<BvhBuffers>,
     /// Every section of the file and its fate.
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
@@ -219,6 +255,7 @@ impl GpuScene {
             linear_clamp: samplers[&linear_key].raw,
             nearest_clamp: samplers[&nearest_key].raw,
             shadow_maps: Vec::new(),
+            bvh: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
             samplers,
@@ -274,6 +311,30 @@ impl GpuScene {
             } else if kind == sections::TRIANGLES {
                 // Uploaded re-sorted by material, so that each material is one draw.
                 up.buffer(&self.indices, 0, bytemuck::cast_slice(&prepared.indices))?;
+            } else if kind == sections::BVH_NODES && needs.bvh && !view.bvh.is_empty() {
+                let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+                let nodes =
+                    Buffer::uploaded(gpu, "bvh nodes", std::mem::size_of_val(view.bvh) as u64, storage)?;
+                let corners: &[u8] = bytemuck::cast_slice(&prepared.bvh_triangles);
+                let triangles = match Buffer::uploaded(gpu, "bvh triangles", corners.len() as u64, storage) {
+                    Ok(t) => t,
+                    Err(e) => {
+                        let mut n = nodes;
+                        n.destroy(gpu);
+                        return Err(e);
+                    }
+                };
+                let bvh = BvhBuffers {
+                    nodes,
+                    triangles,
+                    node_count: view.bvh.len() as u32,
+                    triangle_count: view.triangles.len() as u32,
+                };
+                let uploaded = up
+                    .buffer(&bvh.nodes, 0, bytemuck::cast_slice(view.bvh))
+                    .and_then(|()| up.buffer(&bvh.triangles, 0, corners));
+                self.bvh = Some(bvh);
+                uploaded?;
             } else if kind == sections::TEXTURE && needs.textures {
                 self.upload_texture(gpu, view, index as usize, up)?;
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
@@ -380,6 +441,10 @@ impl GpuScene {
         }
         for s in &mut self.shadow_maps {
             s.image.destroy(gpu);
+        }
+        if let Some(b) = &mut self.bvh {
+            b.nodes.destroy(gpu);
+            b.triangles.destroy(gpu);
         }
         for s in self.samplers.values_mut() {
             s.destroy(gpu);

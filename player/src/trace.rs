@@ -1,0 +1,158 @@
+//! Ray queries on the GPU: a buffer of rays traced through the resident BVH by the compute
+//! traversal (`shaders/common/traverse.glsl`), closest or any hit each, timed with timestamps.
+//! Tests hold it to the CPU query of `kiln-format`; benchmarks report its rays per second.
+
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use gpu_allocator::MemoryLocation;
+
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{
+    Binding, BindingKind, Buffer, CommandPool, ComputePipeline, Gpu, SetLayout, TimestampPool, Write,
+};
+use crate::render::spirv;
+use crate::scene::BvhBuffers;
+
+/// A ray as the GPU reads it (32 bytes).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuRay {
+    /// Origin.
+    pub origin: [f32; 3],
+    /// Start of the interval.
+    pub tmin: f32,
+    /// Direction (not necessarily unit).
+    pub direction: [f32; 3],
+    /// End of the interval.
+    pub tmax: f32,
+}
+
+/// A hit as the GPU writes it (16 bytes); `t == NO_HIT` for a miss.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuHit {
+    /// Ray parameter, or [`NO_HIT`].
+    pub t: f32,
+    /// Triangle in leaf order.
+    pub triangle: u32,
+    /// Barycentric weight of corner 1.
+    pub u: f32,
+    /// Barycentric weight of corner 2.
+    pub v: f32,
+}
+
+/// `t` of a miss (`NO_HIT` in the shader).
+pub const NO_HIT: f32 = 3.402823e38;
+
+/// The compute traversal, bound to one scene's BVH.
+pub struct RayQuery {
+    layout: SetLayout,
+    pipeline: ComputePipeline,
+    pool: CommandPool,
+    timestamps: TimestampPool,
+}
+
+impl std::fmt::Debug for RayQuery {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RayQuery").finish()
+    }
+}
+
+impl RayQuery {
+    /// Builds the pipeline.
+    pub fn new(gpu: &Gpu) -> PlayResult<RayQuery> {
+        let storage = Binding { kind: BindingKind::Storage, count: 1 };
+        let layout = SetLayout::new(gpu, &[storage; 4], 4)?;
+        let pipeline = ComputePipeline::new(gpu, spirv::TRACE_RAYS, &[&layout], 8)?;
+        Ok(RayQuery {
+            layout,
+            pipeline,
+            pool: CommandPool::new(gpu, gpu.family)?,
+            timestamps: TimestampPool::new(gpu, 2)?,
+        })
+    }
+
+    /// Traces `rays` through `bvh`; returns one hit per ray and the GPU milliseconds of the
+    /// traversal alone.
+    pub fn trace(
+        &mut self,
+        gpu: &Gpu,
+        bvh: &BvhBuffers,
+        rays: &[GpuRay],
+        any_hit: bool,
+    ) -> PlayResult<(Vec<GpuHit>, f64)> {
+        if rays.is_empty() {
+            return Ok((Vec::new(), 0.0));
+        }
+        let bytes: &[u8] = bytemuck::cast_slice(rays);
+        let count = u32::try_from(rays.len())
+            .map_err(|_| PlayError::new(Exit::Usage, "too many rays in one batch"))?;
+        let mut input = Buffer::new(
+            gpu,
+            "rays",
+            bytes.len() as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let out_size = rays.len() as u64 * 16;
+        let output = Buffer::new(
+            gpu,
+            "hits",
+            out_size,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+            MemoryLocation::GpuToCpu,
+        );
+        let mut output = match output {
+            Ok(o) => o,
+            Err(e) => {
+                input.destroy(gpu);
+                return Err(e);
+            }
+        };
+        let result = (|| -> PlayResult<(Vec<GpuHit>, f64)> {
+            input.write(bytes)?;
+            let set = self.layout.allocate(gpu)?;
+            self.layout.write(
+                gpu,
+                set,
+                &[
+                    Write::Buffer(0, &bvh.nodes),
+                    Write::Buffer(1, &bvh.triangles),
+                    Write::Buffer(2, &input),
+                    Write::Buffer(3, &output),
+                ],
+            );
+            let rec = self.pool.begin(gpu)?;
+            rec.reset_timestamps(&self.timestamps);
+            rec.timestamp(&self.timestamps, 0);
+            let push: [u32; 2] = [count, any_hit as u32];
+            rec.dispatch(&self.pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
+            rec.timestamp(&self.timestamps, 1);
+            rec.memory_barrier(
+                vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_STORAGE_WRITE,
+                vk::PipelineStageFlags2::HOST,
+                vk::AccessFlags2::HOST_READ,
+            );
+            self.pool.submit(gpu, &[], &[])?;
+            self.pool.wait(gpu)?;
+            let ns = self.timestamps.read_ns(gpu)?;
+            let hits: Vec<GpuHit> = output
+                .mapped()
+                .map(|m| bytemuck::pod_collect_to_vec(&m[..out_size as usize]))
+                .ok_or_else(|| PlayError::new(Exit::Gpu, "the hit buffer is not host-visible"))?;
+            Ok((hits, (ns[1] - ns[0]) * 1e-6))
+        })();
+        input.destroy(gpu);
+        output.destroy(gpu);
+        result
+    }
+
+    /// Releases the pipeline and its pools.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.pool.destroy(gpu);
+        self.timestamps.destroy(gpu);
+        self.pipeline.destroy(gpu);
+        self.layout.destroy(gpu);
+    }
+}
