@@ -51,7 +51,7 @@ fn options(
             surface_extensions: Vec::new(),
             pipeline_cache: None,
         },
-        render: RenderSettings { shadow_maps: shadows, rays: false, exposure: 0.0 },
+        render: RenderSettings { shadow_maps: shadows, rays: false, reference: false, exposure: 0.0 },
         width,
         height,
         camera,

@@ -46,7 +46,7 @@ fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
             surface_extensions: Vec::new(),
             pipeline_cache: None,
         },
-        render: RenderSettings { shadow_maps: false, rays: true, exposure: 0.0 },
+        render: RenderSettings { shadow_maps: false, rays: true, reference: false, exposure: 0.0 },
         width: 8,
         height: 8,
         camera: None,

@@ -137,6 +137,83 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// Constants of the reference path tracer (std140 uniform block, 112 bytes).
+    pub struct ReferenceConstants {
+        /// Camera position, w = tan(vfov / 2).
+        pub eye: [f32; 4] => "vec4",
+        /// Unit right vector, w = aspect ratio (width / height).
+        pub right: [f32; 4] => "vec4",
+        /// Unit up vector, w unused.
+        pub up: [f32; 4] => "vec4",
+        /// Unit forward vector, w unused.
+        pub forward: [f32; 4] => "vec4",
+        /// Sky radiance, w unused.
+        pub sky: [f32; 4] => "vec4",
+        /// Image width, height, samples per pixel requested, emitter count (the index of the
+        /// sample being taken is a push constant).
+        pub size: [u32; 4] => "uvec4",
+        /// Light count, maximum path length, seed, unused.
+        pub params: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// One entry of the reference path tracer's emitter table (std430, 16 bytes): emitters are
+    /// chosen with probability proportional to their power.
+    pub struct GpuEmitter {
+        /// [`EmitterKinds`].
+        pub kind: u32 => "uint",
+        /// Light index (analytic) or triangle (leaf order).
+        pub index: u32 => "uint",
+        /// Cumulative selection probability up to and including this entry.
+        pub cdf: f32 => "float",
+        /// Selection probability of this entry.
+        pub pdf: f32 => "float",
+    }
+}
+
+/// Kinds in [`GpuEmitter::kind`].
+#[derive(Debug)]
+pub struct EmitterKinds;
+
+impl EmitterKinds {
+    /// An analytic light of the manifest.
+    pub const LIGHT: u32 = 0;
+    /// An emissive triangle.
+    pub const TRIANGLE: u32 = 1;
+}
+
+gpu_struct! {
+    /// A texture in the reference path tracer's texel buffer (std430, 16 bytes): mip 0 as packed
+    /// RGBA8 words from `offset`.
+    pub struct GpuTexture {
+        /// First texel (in words).
+        pub offset: u32 => "uint",
+        /// Width.
+        pub width: u32 => "uint",
+        /// Height.
+        pub height: u32 => "uint",
+        /// [`TextureFlags`].
+        pub flags: u32 => "uint",
+    }
+}
+
+/// Bits of [`GpuTexture::flags`].
+#[derive(Debug)]
+pub struct TextureFlags;
+
+impl TextureFlags {
+    /// Wrap mode along u in bits 0–1 (0 repeat, 1 mirrored repeat, 2 clamp).
+    pub const WRAP_U_SHIFT: u32 = 0;
+    /// Wrap mode along v in bits 2–3.
+    pub const WRAP_V_SHIFT: u32 = 2;
+    /// Texels are sRGB-encoded.
+    pub const SRGB: u32 = 1 << 4;
+    /// Bilinear filtering (else nearest).
+    pub const LINEAR: u32 = 1 << 5;
+}
+
 /// Bits of `FrameConstants::size.w`.
 #[derive(Debug)]
 pub struct FrameFlags;
@@ -192,6 +269,9 @@ pub fn glsl_layout() -> String {
     declare::<GpuShadow>(&mut s);
     declare::<FrameConstants>(&mut s);
     declare::<GpuMaterialLayout>(&mut s);
+    declare::<ReferenceConstants>(&mut s);
+    declare::<GpuEmitter>(&mut s);
+    declare::<GpuTexture>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -205,6 +285,12 @@ pub fn glsl_layout() -> String {
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),
         ("NO_TEXTURE", crate::sections::NO_TEXTURE),
+        ("EMITTER_LIGHT", EmitterKinds::LIGHT),
+        ("EMITTER_TRIANGLE", EmitterKinds::TRIANGLE),
+        ("TEXTURE_WRAP_U_SHIFT", TextureFlags::WRAP_U_SHIFT),
+        ("TEXTURE_WRAP_V_SHIFT", TextureFlags::WRAP_V_SHIFT),
+        ("TEXTURE_SRGB", TextureFlags::SRGB),
+        ("TEXTURE_LINEAR", TextureFlags::LINEAR),
     ] {
         s.push_str(&format!("const uint {name} = {v}u;\n"));
     }
@@ -264,6 +350,9 @@ mod tests {
         check::<GpuShadow>();
         check::<FrameConstants>();
         check::<GpuMaterialLayout>();
+        check::<ReferenceConstants>();
+        check::<GpuEmitter>();
+        check::<GpuTexture>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {
             base_color_texture: 3,

@@ -127,6 +127,12 @@ pub struct Args {
     /// Participating media technique (later passes add techniques).
     #[arg(long, value_enum, default_value = "none")]
     pub media: NotYet,
+    /// Render the unbiased reference path tracer instead (headless, needs -o OUT.exr).
+    #[arg(long)]
+    pub reference: bool,
+    /// With --reference: samples per pixel.
+    #[arg(long, value_name = "N", default_value_t = 256)]
+    pub spp: u32,
     /// Do not read or write the pipeline cache (~/.cache/kiln/pipelines.bin).
     #[arg(long)]
     pub no_pipeline_cache: bool,
@@ -148,6 +154,7 @@ impl Args {
             render: RenderSettings {
                 shadow_maps: self.shadows == Shadows::Shadowmap,
                 rays: false,
+                reference: self.reference,
                 exposure: self.exposure,
             },
             width: self.size.width,
@@ -156,6 +163,30 @@ impl Args {
             readback: None,
         })
     }
+}
+
+fn run_reference(args: &Args, options: &SessionOptions, start: Instant) -> PlayResult {
+    let output =
+        args.output.as_ref().ok_or_else(|| PlayError::new(Exit::Usage, "--reference needs -o OUT.exr"))?;
+    if crate::image_out::OutputKind::of(output)? != crate::image_out::OutputKind::Exr {
+        return Err(PlayError::new(Exit::Usage, "--reference writes linear radiance: give -o OUT.exr"));
+    }
+    let (report, rgb) = crate::reference::render(options, args.spp, start)?;
+    if rgb.iter().any(|v| !v.is_finite()) {
+        return Err(PlayError::new(Exit::Gpu, "the reference image holds NaN or infinite values"));
+    }
+    crate::reference::write_exr(output, report.width, report.height, &rgb, report.spp)?;
+    eprintln!(
+        "wrote {} ({}x{}, {} spp) in {:.1} s: {:.2} M samples/s on {}",
+        output.display(),
+        report.width,
+        report.height,
+        report.spp,
+        report.seconds,
+        report.samples_per_second * 1e-6,
+        report.device
+    );
+    Ok(())
 }
 
 fn validation_verdict(errors: u32) -> PlayResult {
@@ -183,6 +214,9 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
         return Ok(());
     };
     let options = args.session(file)?;
+    if args.reference {
+        return run_reference(&args, &options, start);
+    }
     if args.bench {
         if args.output.is_some() {
             return Err(PlayError::new(Exit::Usage, "--bench writes no image; drop -o"));

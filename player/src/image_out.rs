@@ -36,7 +36,8 @@ impl OutputKind {
     }
 }
 
-fn write_atomic(path: &Path, bytes: &[u8]) -> PlayResult {
+/// Writes `bytes` to a temporary file beside `path` and renames it into place.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> PlayResult {
     let io = |e: std::io::Error| PlayError::new(Exit::Io, format!("{}: {e}", path.display()));
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));

@@ -121,7 +121,8 @@ impl Session {
             textures: true,
             brdf_lut: true,
             shadow_maps: options.render.shadow_maps,
-            bvh: options.render.rays,
+            bvh: options.render.rays || options.render.reference,
+            reference: options.render.reference,
         };
         // The CPU side of loading (validation, checksums, index sorting) runs while the driver
         // creates the device, which on some drivers takes well over 100 ms.

@@ -56,6 +56,30 @@ struct GpuMaterialLayout {
     uvec2 reserved; // offset 72
 }; // 80 bytes
 
+struct ReferenceConstants {
+    vec4 eye; // offset 0
+    vec4 right; // offset 16
+    vec4 up; // offset 32
+    vec4 forward; // offset 48
+    vec4 sky; // offset 64
+    uvec4 size; // offset 80
+    uvec4 params; // offset 96
+}; // 112 bytes
+
+struct GpuEmitter {
+    uint kind; // offset 0
+    uint index; // offset 4
+    float cdf; // offset 8
+    float pdf; // offset 12
+}; // 16 bytes
+
+struct GpuTexture {
+    uint offset; // offset 0
+    uint width; // offset 4
+    uint height; // offset 8
+    uint flags; // offset 12
+}; // 16 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;
@@ -68,5 +92,11 @@ const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;
 const uint NO_TEXTURE = 4294967295u;
+const uint EMITTER_LIGHT = 0u;
+const uint EMITTER_TRIANGLE = 1u;
+const uint TEXTURE_WRAP_U_SHIFT = 0u;
+const uint TEXTURE_WRAP_V_SHIFT = 2u;
+const uint TEXTURE_SRGB = 16u;
+const uint TEXTURE_LINEAR = 32u;
 
 #endif

@@ -8,11 +8,11 @@
 // The includer declares, before including this file:
 //   layout(std430) readonly buffer BvhNodes { uvec4 bvh_nodes[]; };   // 5 uvec4 per node
 //   layout(std430) readonly buffer BvhTriangles { vec4 bvh_tris[]; }; // 3 vec4 per triangle, leaf order
-// and defines BVH_STACK (stack entries; the reader rejects trees deeper than 32).
+// and defines BVH_STACK (stack entries; the reader rejects trees deeper than 32). Defining
+// BVH_ALPHA_TEST before the include makes traversal call `bool bvh_alpha_test(uint triangle,
+// float u, float v)` on every candidate hit and skip it when that returns false (alpha masks).
 #ifndef KILN_TRAVERSE_GLSL
 #define KILN_TRAVERSE_GLSL
-
-#extension GL_ARB_gpu_shader_fp64 : require
 
 #ifndef BVH_STACK
 #define BVH_STACK 32
@@ -64,6 +64,18 @@ TraceRay make_ray(vec3 origin, vec3 direction, float tmin, float tmax) {
     float dz = direction[kz];
     r.shear = vec3(direction[kx] / dz, direction[ky] / dz, 1.0 / dz);
     return r;
+}
+
+// Moves a hit point off its surface along the geometric normal n (pointing to the side the new
+// ray leaves into) by a few ulps of each coordinate (Wächter and Binder, Ray Tracing Gems ch. 6),
+// as format/src/query/mod.rs's offset_origin: robust at every scale, unlike a fixed epsilon.
+vec3 offset_ray_origin(vec3 p, vec3 n) {
+    const float ORIGIN = 1.0 / 32.0;
+    const float FLOAT_SCALE = 1.0 / 65536.0;
+    const float INT_SCALE = 256.0;
+    ivec3 of = ivec3(n * INT_SCALE);
+    vec3 pi = intBitsToFloat(floatBitsToInt(p) + mix(of, -of, lessThan(p, vec3(0.0))));
+    return mix(pi, p + FLOAT_SCALE * n, lessThan(abs(p), vec3(ORIGIN)));
 }
 
 // Watertight ray–triangle test; accepts tmin <= t < tmax. Both faces are hit.
@@ -196,6 +208,11 @@ TraceHit trace(TraceRay r, bool any) {
             uint tri = triangle_group.x + bit;
             vec3 tuv;
             if (intersect_triangle(r, bvh_tris[tri * 3u].xyz, bvh_tris[tri * 3u + 1u].xyz, bvh_tris[tri * 3u + 2u].xyz, tmax, tuv)) {
+#ifdef BVH_ALPHA_TEST
+                if (!bvh_alpha_test(tri, tuv.y, tuv.z)) {
+                    continue;
+                }
+#endif
                 best = TraceHit(tuv.x, tri, tuv.y, tuv.z);
                 tmax = tuv.x;
                 if (any) {

@@ -31,13 +31,16 @@ pub mod spirv {
     pub const TONEMAP: &[u8] = include_bytes!("../../../shaders/spirv/tonemap.comp.spv");
     /// Ray queries from a buffer.
     pub const TRACE_RAYS: &[u8] = include_bytes!("../../../shaders/spirv/rays.comp.spv");
+    /// The reference path tracer.
+    pub const PATHTRACE: &[u8] = include_bytes!("../../../shaders/spirv/pathtrace.comp.spv");
     /// (source under `shaders/`, embedded bytes) of every shader.
-    pub const ALL: [(&str, &[u8]); 5] = [
+    pub const ALL: [(&str, &[u8]); 6] = [
         ("gbuffer/gbuffer.vert", GBUFFER_VERT),
         ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
         ("lighting/direct.comp", DIRECT),
         ("post/tonemap.comp", TONEMAP),
         ("trace/rays.comp", TRACE_RAYS),
+        ("reference/pathtrace.comp", PATHTRACE),
     ];
 }
 
@@ -53,8 +56,10 @@ pub const PASSES: [&str; 3] = ["gbuffer", "direct", "tonemap"];
 pub struct RenderSettings {
     /// Shadows from the baked shadow maps.
     pub shadow_maps: bool,
-    /// Upload the BVH for ray queries (ray-traced passes, the reference path tracer, `RayQuery`).
+    /// Upload the BVH for ray queries (ray-traced passes, `RayQuery`).
     pub rays: bool,
+    /// Upload what the reference path tracer reads (implies `rays`).
+    pub reference: bool,
     /// Exposure in stops (the radiance is multiplied by 2^exposure before tone mapping).
     pub exposure: f32,
 }

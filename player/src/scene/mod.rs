@@ -1,6 +1,7 @@
 //! A `.kiln` file made resident on the GPU: its sections uploaded in file order through the
 //! staging ring, only those the enabled passes read. The rest are skipped and listed.
 
+pub mod reference;
 pub mod upload;
 
 use std::collections::HashMap;
@@ -26,6 +27,8 @@ pub struct Needs {
     pub shadow_maps: bool,
     /// The BVH and its triangles, for ray queries.
     pub bvh: bool,
+    /// What the reference path tracer reads (implies `bvh`).
+    pub reference: bool,
 }
 
 /// One draw: the triangles of one material, contiguous in the index buffer.
@@ -71,6 +74,8 @@ pub struct Prepared<'f> {
     draws: Vec<Draw>,
     /// Triangle corners in leaf order, (x, y, z, 0) each, when the BVH is needed.
     bvh_triangles: Vec<[f32; 4]>,
+    /// Emitter and texture tables of the reference path tracer.
+    reference: Option<reference::ReferenceTables>,
 }
 
 impl std::fmt::Debug for Prepared<'_> {
@@ -88,6 +93,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::BRDF_LUT && needs.brdf_lut)
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
+        || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.reference)
 }
 
 impl<'f> Prepared<'f> {
@@ -103,7 +109,16 @@ impl<'f> Prepared<'f> {
             sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
         let bvh_triangles =
             if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
-        Ok(Prepared { view, needs, indices, draws, bvh_triangles })
+        let reference = needs.reference.then(|| {
+            reference::tables(
+                &view.manifest,
+                view.vertices,
+                view.triangles,
+                view.triangle_materials,
+                view.materials,
+            )
+        });
+        Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference })
     }
 }
 
@@ -134,6 +149,43 @@ pub struct BvhBuffers {
     pub triangle_count: u32,
 }
 
+/// What the reference path tracer reads beyond the BVH, each a storage buffer.
+#[derive(Debug)]
+pub struct ReferenceBuffers {
+    /// Vertex indices in leaf order (the file's `TRIS`).
+    pub indices: Buffer,
+    /// Material per triangle (`TMAT`).
+    pub triangle_materials: Buffer,
+    /// Materials (`MATL`).
+    pub materials: Buffer,
+    /// `GpuEmitter` table.
+    pub emitters: Buffer,
+    /// Emitter of each triangle (i32, −1 for none).
+    pub triangle_emitter: Buffer,
+    /// Mip 0 of every texture, RGBA8 words.
+    pub texels: Buffer,
+    /// `GpuTexture` table.
+    pub textures: Buffer,
+    /// Entries in `emitters`.
+    pub emitter_count: u32,
+}
+
+impl ReferenceBuffers {
+    fn destroy(&mut self, gpu: &Gpu) {
+        for b in [
+            &mut self.indices,
+            &mut self.triangle_materials,
+            &mut self.materials,
+            &mut self.emitters,
+            &mut self.triangle_emitter,
+            &mut self.texels,
+            &mut self.textures,
+        ] {
+            b.destroy(gpu);
+        }
+    }
+}
+
 /// The scene on the GPU.
 pub struct GpuScene {
     /// The file's manifest.
@@ -162,6 +214,8 @@ pub struct GpuScene {
     pub shadow_maps: Vec<ShadowImage>,
     /// The BVH, when ray queries are needed and the file has one.
     pub bvh: Option<BvhBuffers>,
+    /// The reference path tracer's buffers, when asked for.
+    pub reference: Option<ReferenceBuffers>,
     /// Every section of the file and its fate.
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
@@ -256,6 +310,7 @@ impl GpuScene {
             nearest_clamp: samplers[&nearest_key].raw,
             shadow_maps: Vec::new(),
             bvh: None,
+            reference: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
             samplers,
@@ -284,6 +339,9 @@ impl GpuScene {
     ) -> PlayResult {
         let (view, needs) = (&prepared.view, prepared.needs);
         let mut uvs_uploaded = false;
+        if let Some(tables) = &prepared.reference {
+            self.reference = Some(reference_buffers(gpu, view, tables)?);
+        }
         for s in file.sections() {
             let kind = s.entry.kind;
             let index = s.entry.index;
@@ -297,6 +355,10 @@ impl GpuScene {
             if s.known.is_none() {
                 fate.uploaded = false;
                 fate.reason = "unknown kind or newer version".into();
+            } else if let (Some(r), true) = (&self.reference, kind == sections::MATERIALS) {
+                up.buffer(&r.materials, 0, bytemuck::cast_slice(view.materials))?;
+            } else if let (Some(r), true) = (&self.reference, kind == sections::TRIANGLE_MATERIALS) {
+                up.buffer(&r.triangle_materials, 0, bytemuck::cast_slice(view.triangle_materials))?;
             } else if kind == sections::MANIFEST
                 || kind == sections::MATERIALS
                 || kind == sections::TRIANGLE_MATERIALS
@@ -311,6 +373,9 @@ impl GpuScene {
             } else if kind == sections::TRIANGLES {
                 // Uploaded re-sorted by material, so that each material is one draw.
                 up.buffer(&self.indices, 0, bytemuck::cast_slice(&prepared.indices))?;
+                if let Some(r) = &self.reference {
+                    up.buffer(&r.indices, 0, bytemuck::cast_slice(view.triangles))?;
+                }
             } else if kind == sections::BVH_NODES && needs.bvh && !view.bvh.is_empty() {
                 let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
                 let nodes =
@@ -337,6 +402,15 @@ impl GpuScene {
                 uploaded?;
             } else if kind == sections::TEXTURE && needs.textures {
                 self.upload_texture(gpu, view, index as usize, up)?;
+                if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
+                    let t = tables.textures[index as usize];
+                    let level0 = t.width as usize * t.height as usize * 4;
+                    up.buffer(
+                        &r.texels,
+                        t.offset as u64 * 4,
+                        &view.texture(index as usize).map_err(bad)?[..level0],
+                    )?;
+                }
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
                 let texels: &[[u16; 2]] = file.pod(sections::BRDF_LUT, 0).map_err(bad)?.unwrap_or(&[]);
@@ -381,6 +455,11 @@ impl GpuScene {
         }
         if !uvs_uploaded {
             up.zero(&self.uvs)?;
+        }
+        if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
+            up.buffer(&r.emitters, 0, bytemuck::cast_slice(&tables.emitters))?;
+            up.buffer(&r.triangle_emitter, 0, bytemuck::cast_slice(&tables.triangle_emitter))?;
+            up.buffer(&r.textures, 0, bytemuck::cast_slice(&tables.textures))?;
         }
         Ok(())
     }
@@ -446,11 +525,55 @@ impl GpuScene {
             b.nodes.destroy(gpu);
             b.triangles.destroy(gpu);
         }
+        if let Some(r) = &mut self.reference {
+            r.destroy(gpu);
+        }
         for s in self.samplers.values_mut() {
             s.destroy(gpu);
         }
         self.samplers.clear();
     }
+}
+
+/// Allocates the reference path tracer's buffers (filled as their sections stream past).
+fn reference_buffers(
+    gpu: &Gpu,
+    view: &SceneView,
+    tables: &reference::ReferenceTables,
+) -> PlayResult<ReferenceBuffers> {
+    let sizes = [
+        ("leaf indices", std::mem::size_of_val(view.triangles)),
+        ("triangle materials", std::mem::size_of_val(view.triangle_materials)),
+        ("materials", std::mem::size_of_val(view.materials)),
+        ("emitters", std::mem::size_of_val(tables.emitters.as_slice())),
+        ("triangle emitters", std::mem::size_of_val(tables.triangle_emitter.as_slice())),
+        ("texels", tables.texel_words as usize * 4),
+        ("texture table", std::mem::size_of_val(tables.textures.as_slice())),
+    ];
+    let mut made: Vec<Buffer> = Vec::new();
+    for (name, size) in sizes {
+        match Buffer::uploaded(gpu, name, size as u64, vk::BufferUsageFlags::STORAGE_BUFFER) {
+            Ok(b) => made.push(b),
+            Err(e) => {
+                for mut b in made {
+                    b.destroy(gpu);
+                }
+                return Err(e);
+            }
+        }
+    }
+    let mut it = made.into_iter();
+    let mut next = || it.next().expect("one buffer per size");
+    Ok(ReferenceBuffers {
+        indices: next(),
+        triangle_materials: next(),
+        materials: next(),
+        emitters: next(),
+        triangle_emitter: next(),
+        texels: next(),
+        textures: next(),
+        emitter_count: tables.emitters.len() as u32,
+    })
 }
 
 /// A sampled, uploaded image.

@@ -1,0 +1,149 @@
+//! Tables the reference path tracer reads besides the file's sections: emitters chosen in
+//! proportion to their power, the emitter of each triangle, and the layout of the texel buffer.
+
+use glam::Vec3;
+use kiln_format::gpu::{EmitterKinds, GpuEmitter, GpuTexture, TextureFlags};
+use kiln_format::manifest::{ColorSpace, LightKind, Manifest, Wrap};
+use kiln_format::sections::{GpuMaterial, Vertex};
+
+/// The derived tables.
+#[derive(Debug, Default)]
+pub struct ReferenceTables {
+    /// Emitters with cumulative selection probabilities (empty when nothing emits).
+    pub emitters: Vec<GpuEmitter>,
+    /// Per triangle (leaf order): its index in `emitters`, or −1.
+    pub triangle_emitter: Vec<i32>,
+    /// Per texture: where its mip 0 lies in the texel buffer.
+    pub textures: Vec<GpuTexture>,
+    /// Words (texels) in the texel buffer.
+    pub texel_words: u64,
+}
+
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+fn wrap_bits(w: Wrap) -> u32 {
+    match w {
+        Wrap::Repeat => 0,
+        Wrap::MirroredRepeat => 1,
+        Wrap::ClampToEdge => 2,
+    }
+}
+
+/// Emitted power (up to a common constant) of each analytic light: what selection is
+/// proportional to. Directional lights count over the disk of the scene's bounding sphere.
+fn light_power(l: &kiln_format::manifest::Light, scene_radius: f32) -> f32 {
+    let i = l.intensity * luminance(l.color);
+    let p = match l.kind {
+        LightKind::Point => 4.0 * std::f32::consts::PI * i,
+        LightKind::Spot { inner_cone, outer_cone } => {
+            2.0 * std::f32::consts::PI * (1.0 - 0.5 * (inner_cone.cos() + outer_cone.cos())) * i
+        }
+        LightKind::Directional => std::f32::consts::PI * scene_radius * scene_radius * i,
+        LightKind::Rect { width, height } => std::f32::consts::PI * width * height * i,
+    };
+    if p.is_finite() { p.max(0.0) } else { 0.0 }
+}
+
+/// Builds the tables of a validated scene.
+pub fn tables(
+    manifest: &Manifest,
+    vertices: &[Vertex],
+    triangles: &[[u32; 3]],
+    triangle_materials: &[u32],
+    materials: &[GpuMaterial],
+) -> ReferenceTables {
+    let b = &manifest.bounds;
+    let radius = (Vec3::from(b.max) - Vec3::from(b.min)).length() * 0.5;
+    let radius = if radius.is_finite() { radius } else { 0.0 };
+    let mut power: Vec<(u32, u32, f32)> = manifest
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (EmitterKinds::LIGHT, i as u32, light_power(l, radius)))
+        .collect();
+    for (t, (tri, &m)) in triangles.iter().zip(triangle_materials).enumerate() {
+        let e = luminance(materials[m as usize].emission);
+        if e > 0.0 {
+            let p = tri.map(|v| Vec3::from(vertices[v as usize].position));
+            let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+            power.push((EmitterKinds::TRIANGLE, t as u32, std::f32::consts::PI * e * area));
+        }
+    }
+    power.retain(|p| p.2 > 0.0 && p.2.is_finite());
+    let total: f64 = power.iter().map(|p| p.2 as f64).sum();
+    let mut tables = ReferenceTables { triangle_emitter: vec![-1; triangles.len()], ..Default::default() };
+    let mut cumulative = 0.0f64;
+    for (i, &(kind, index, p)) in power.iter().enumerate() {
+        cumulative += p as f64;
+        let last = i + 1 == power.len();
+        tables.emitters.push(GpuEmitter {
+            kind,
+            index,
+            // The last entry is exactly 1 so that every draw in [0, 1) finds an emitter.
+            cdf: if last { 1.0 } else { (cumulative / total) as f32 },
+            pdf: (p as f64 / total) as f32,
+        });
+        if kind == EmitterKinds::TRIANGLE {
+            tables.triangle_emitter[index as usize] = i as i32;
+        }
+    }
+    for t in &manifest.textures {
+        let mut flags = wrap_bits(t.wrap_u) << TextureFlags::WRAP_U_SHIFT
+            | wrap_bits(t.wrap_v) << TextureFlags::WRAP_V_SHIFT;
+        if t.color_space == ColorSpace::Srgb {
+            flags |= TextureFlags::SRGB;
+        }
+        if t.mag_linear {
+            flags |= TextureFlags::LINEAR;
+        }
+        tables.textures.push(GpuTexture {
+            offset: tables.texel_words as u32,
+            width: t.width,
+            height: t.height,
+            flags,
+        });
+        tables.texel_words += t.width as u64 * t.height as u64;
+    }
+    tables
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kiln_format::manifest::Light;
+
+    fn light(kind: LightKind, intensity: f32) -> Light {
+        Light {
+            name: "l".into(),
+            kind,
+            position: [0.0; 3],
+            direction: [0.0, -1.0, 0.0],
+            right: [1.0, 0.0, 0.0],
+            color: [1.0; 3],
+            intensity,
+            range: 0.0,
+            casts_shadows: true,
+        }
+    }
+
+    #[test]
+    fn selection_is_proportional_to_power_and_covers_emissive_triangles() {
+        let mut manifest = Manifest::default();
+        manifest.bounds.max = [1.0; 3];
+        manifest.lights =
+            vec![light(LightKind::Point, 1.0), light(LightKind::Point, 3.0), light(LightKind::Point, 0.0)];
+        let v = |x: f32, z: f32| Vertex { position: [x, 0.0, z], normal: [0.0, 1.0, 0.0] };
+        let vertices = vec![v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
+        let glow = GpuMaterial { emission: [1.0; 3], ..Default::default() };
+        let t =
+            tables(&manifest, &vertices, &[[0, 1, 2], [0, 2, 1]], &[0, 1], &[GpuMaterial::default(), glow]);
+        assert_eq!(t.emitters.len(), 3, "the dark light is dropped");
+        let p: Vec<f32> = t.emitters.iter().map(|e| e.pdf).collect();
+        assert!((p[1] / p[0] - 3.0).abs() < 1e-5);
+        assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        assert_eq!(t.emitters[2].cdf, 1.0);
+        assert_eq!(t.triangle_emitter, vec![-1, 2]);
+    }
+}
