@@ -16,7 +16,7 @@ use kiln_player::error::Exit;
 use kiln_player::gpu::GpuOptions;
 use kiln_player::headless::{self, HeadlessResult};
 use kiln_player::image_out::read_exr;
-use kiln_player::render::RenderSettings;
+use kiln_player::render::{ReflectionRes, RenderSettings, RtSettings};
 use kiln_player::session::SessionOptions;
 use kiln_tests::{compile, scene_of, shared_scenes};
 
@@ -51,12 +51,25 @@ fn options(
             surface_extensions: Vec::new(),
             pipeline_cache: None,
         },
-        render: RenderSettings { shadow_maps: shadows, rays: false, reference: false, exposure: 0.0 },
+        render: RenderSettings {
+            shadow_maps: shadows,
+            rays: false,
+            reference: false,
+            exposure: 0.0,
+            rt: RtSettings::OFF,
+        },
         width,
         height,
         camera,
         readback: None,
     }
+}
+
+/// Options with the given ray-traced passes (no shadow maps).
+fn rt_options(file: &Path, width: u32, height: u32, rt: RtSettings) -> SessionOptions {
+    let mut o = options(file, width, height, None, false);
+    o.render.rt = rt;
+    o
 }
 
 /// Renders `bytes` headless to an EXR; returns the RGB radiance, asserting a clean run.
@@ -66,11 +79,23 @@ fn render(
     bytes: &[u8],
     opts: impl Fn(&Path) -> SessionOptions,
 ) -> (Vec<f32>, HeadlessResult) {
+    render_frames(dir, name, bytes, 1, opts)
+}
+
+/// [`render`] writing the last of `frames` frames (the ray-traced passes average them).
+fn render_frames(
+    dir: &Path,
+    name: &str,
+    bytes: &[u8],
+    frames: u32,
+    opts: impl Fn(&Path) -> SessionOptions,
+) -> (Vec<f32>, HeadlessResult) {
     let file = dir.join(format!("{name}.kiln"));
     std::fs::write(&file, bytes).unwrap();
     let exr = dir.join(format!("{name}.exr"));
     let o = opts(&file);
-    let result = headless::run(&o, 1, Some(&exr), Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let result =
+        headless::run(&o, frames, Some(&exr), Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(result.session.validation_errors(), 0, "{name}: validation errors");
     // Close a second session on the same file, counting what the layer reports at teardown.
     let again = headless::run(&o, 1, None, Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -289,6 +314,23 @@ fn an_occluder_casts_the_shadow_its_geometry_implies() {
     if !vulkan() {
         return;
     }
+    // Shadow maps: PCF blurs the edge over a few texels.
+    occluder_case("occluder", 0.15, |f| options(f, W, H, None, true));
+}
+
+#[test]
+fn ray_traced_hard_shadows_are_exact_up_to_the_pixel_at_the_umbra_edge() {
+    if !vulkan() {
+        return;
+    }
+    // A point light of radius 0: one ray per pixel decides exactly, so only pixels whose
+    // footprint straddles the edge (about 0.06 units here) are left out.
+    occluder_case("occluder-rt", 0.04, |f| {
+        rt_options(f, W, H, RtSettings { shadows: true, ..RtSettings::OFF })
+    });
+}
+
+fn occluder_case(name: &str, margin: f64, shadowed: impl Fn(&Path) -> SessionOptions) {
     let dir = tempfile::tempdir().unwrap();
     // A 2 × 2 square at height 1 under a point light at height 4: its umbra on the floor is the
     // square scaled by 4 / (4 − 1), |x|, |z| < 4/3.
@@ -302,7 +344,7 @@ fn an_occluder_casts_the_shadow_its_geometry_implies() {
     scene.lights.push(light(LightKind::Point, lp, [0.0, -1.0, 0.0], intensity));
     scene.cameras.push(cam.file_camera());
     let bytes = compile(scene, fast_settings());
-    let (rgb, _) = render(dir.path(), "occluder", &bytes, |f| options(f, W, H, None, true));
+    let (rgb, _) = render(dir.path(), name, &bytes, shadowed);
     let a = albedo();
     let l = DVec3::from_array(lp.map(f64::from));
     let edge = 4.0 / 3.0;
@@ -319,7 +361,6 @@ fn an_occluder_casts_the_shadow_its_geometry_implies() {
         a.map(|k| k / std::f64::consts::PI * intensity as f64 * (to.y / d2.sqrt()) / d2)
     };
     // Outside the umbra (beyond the PCF footprint) the floor is fully lit...
-    let margin = 0.15;
     let outside =
         |p: DVec3, d: DVec3| visible(p, d) && (p.x.abs() > edge + margin || p.z.abs() > edge + margin);
     let n_lit = compare_plane(&rgb, &cam, 6.0, outside, lit, TOLERANCE);
@@ -404,6 +445,26 @@ fn pica_pica_renders_clean_with_three_lights_and_its_shadow_maps() {
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
     let lit = rgb.chunks_exact(3).filter(|p| p.iter().sum::<f32>() > 0.05).count();
     assert!(lit > rgb.len() / 3 / 4, "only {lit} pixels are lit");
+
+    // The hybrid pipeline: every ray-traced pass, both reflection resolutions, validation clean
+    // (render asserts it), finite, and close to the shadow-mapped frame on average.
+    for res in [ReflectionRes::Full, ReflectionRes::Half] {
+        let rt = RtSettings {
+            shadows: true,
+            ao: true,
+            reflections: Some(res),
+            light_radius: 0.05,
+            sun_degrees: 0.53,
+            ..RtSettings::OFF
+        };
+        let (traced, result) =
+            render_frames(dir.path(), "pica-rt", &bytes, 2, |f| rt_options(f, 160, 90, rt));
+        assert!(result.session.warnings.is_empty(), "{:?}", result.session.warnings);
+        let mean = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+        let (a, b) = (mean(&rgb), mean(&traced));
+        eprintln!("pica_pica mean radiance: shadow maps {a:.4}, ray traced ({res:?}) {b:.4}");
+        assert!((b / a - 1.0).abs() < 0.25, "{res:?}: mean radiance {b} vs {a} with shadow maps");
+    }
 }
 
 #[test]
@@ -461,4 +522,207 @@ fn damaged_files_fail_cleanly_and_minimal_files_render() {
     let skipped: Vec<_> =
         result.session.scene.sections.iter().filter(|s| !s.uploaded).map(|s| s.section.clone()).collect();
     assert!(skipped.iter().any(|s| s == "bvh"), "the BVH is not uploaded: no pass traces rays ({skipped:?})");
+}
+
+/// Floor pixels of `rgb` (plane y = 0 seen by `cam`, inside |x|, |z| < `inside`) with the
+/// point they show.
+fn floor_pixels(cam: &Pinhole, inside: f64) -> Vec<(usize, DVec3, DVec3)> {
+    let mut out = Vec::new();
+    for y in 0..H {
+        for x in 0..W {
+            let d = cam.ray(x, y, W, H);
+            if d.y >= -1e-6 {
+                continue;
+            }
+            let p = cam.eye + d * (-cam.eye.y / d.y);
+            if p.x.abs() < inside && p.z.abs() < inside {
+                out.push((((y * W + x) * 3) as usize, p, d));
+            }
+        }
+    }
+    out
+}
+
+/// Mean over `pixels` of got / expected (one channel: the scenes are grey), and the spread
+/// (standard deviation) of that ratio.
+fn ratio_stats(
+    rgb: &[f32],
+    pixels: &[(usize, DVec3, DVec3)],
+    expected: impl Fn(DVec3, DVec3) -> f64,
+) -> (f64, f64) {
+    let r: Vec<f64> = pixels.iter().map(|&(i, p, d)| rgb[i] as f64 / expected(p, d)).collect();
+    let mean = r.iter().sum::<f64>() / r.len() as f64;
+    let var = r.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / r.len() as f64;
+    (mean, var.sqrt())
+}
+
+#[test]
+fn ray_traced_ao_under_a_ceiling_matches_the_analytic_openness_and_converges() {
+    if !vulkan() {
+        return;
+    }
+    // A floor under a ceiling at height h, sky radiance S, AO radius R > h. With cosine-weighted
+    // rays u = cos²θ is uniform; a ray hits the ceiling at t = h / cosθ, contributing (t/R)²
+    // when t < R and 1 otherwise, so the openness is k (1 + ln(1/k)) with k = (h/R)², and a
+    // diffuse floor shows albedo · S · openness.
+    let dir = tempfile::tempdir().unwrap();
+    let (h, r, sky) = (1.0f64, 2.0f64, 2.0f32);
+    // An albedo the sRGB G-buffer stores exactly.
+    let albedo = srgb8(188);
+    let cam = Pinhole::new([0.0, 0.9, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 90.0, W, H);
+    let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
+    // The ceiling faces down (its front towards the floor).
+    tris.extend(square(h as f32, 20.0).map(|t| [t[0], t[2], t[1]]));
+    let mut scene = scene_of(&tris);
+    scene.materials[0].gpu = lambert_material([albedo; 3]);
+    scene.sky = Sky { radiance: [sky; 3] };
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    let k = (h / r) * (h / r);
+    let openness = k * (1.0 + (1.0 / k).ln());
+    let expected = |_: DVec3, _: DVec3| albedo as f64 * sky as f64 * openness;
+    let pixels = floor_pixels(&cam, 19.0);
+    let rt = RtSettings { ao: true, ao_radius: Some(r as f32), ..RtSettings::OFF };
+    let (one, _) = render(dir.path(), "ao-1", &bytes, |f| rt_options(f, W, H, rt));
+    let (many, _) = render_frames(dir.path(), "ao-32", &bytes, 32, |f| rt_options(f, W, H, rt));
+    let (m1, s1) = ratio_stats(&one, &pixels, expected);
+    let (m32, s32) = ratio_stats(&many, &pixels, expected);
+    eprintln!(
+        "AO openness {openness:.4}: 1 frame mean ratio {m1:.4} (spread {s1:.3}), 32 frames {m32:.4} (spread {s32:.3}) over {} pixels",
+        pixels.len()
+    );
+    assert!(pixels.len() > 2000);
+    assert!((m32 - 1.0).abs() < 0.01, "32 frames: mean ratio {m32} to the analytic AO");
+    assert!((m1 - 1.0).abs() < 0.02, "1 frame: mean ratio {m1} to the analytic AO");
+    // Averaging 32 frames divides the noise by about √32 ≈ 5.7.
+    assert!(s32 < s1 / 4.0, "accumulation did not reduce the noise: {s1} → {s32}");
+    // Without AO the floor sees the whole sky.
+    let (off, _) = render(dir.path(), "ao-off", &bytes, |f| options(f, W, H, None, false));
+    let (m_off, _) = ratio_stats(&off, &pixels, |_, _| albedo as f64 * sky as f64);
+    assert!((m_off - 1.0).abs() < 0.01, "without AO: {m_off}");
+}
+
+#[test]
+fn ray_traced_reflections_of_a_mirror_floor_show_the_sky_and_an_emitter_at_the_fresnel_weight() {
+    if !vulkan() {
+        return;
+    }
+    // A smooth metal floor (F0 = base) under an emissive panel covering x in [−1, 1] at height
+    // 2, facing down, in a sky of radiance S. A pixel's mirror ray sees the panel (radiance E)
+    // or the sky; it shows F · L with Schlick's F at the view angle (α = 10⁻³: G2/G1 = 1 and
+    // the lobe is a mirror to within a pixel). The split-sum fallback cannot see the panel.
+    let dir = tempfile::tempdir().unwrap();
+    let (sky, emitted, base) = (1.0f32, 4.0f32, 0.8f32);
+    let cam = Pinhole::new([0.0, 1.0, 6.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 60.0, W, H);
+    let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
+    let panel = [
+        Vec3::new(-1.0, 2.0, -8.0),
+        Vec3::new(1.0, 2.0, -8.0),
+        Vec3::new(1.0, 2.0, 8.0),
+        Vec3::new(-1.0, 2.0, 8.0),
+    ];
+    tris.push([panel[0], panel[1], panel[2]]);
+    tris.push([panel[0], panel[2], panel[3]]);
+    let mut scene = scene_of(&tris);
+    let mut metal = lambert_material([base; 3]);
+    metal.flags &= !kiln_format::sections::MaterialFlags::DIFFUSE_ONLY;
+    metal.metallic = 1.0;
+    metal.roughness = 0.0;
+    scene.materials[0].gpu = metal;
+    let mut light = lambert_material([0.0; 3]);
+    light.emission = [emitted; 3];
+    scene.materials.push(kiln_compiler::ir::Material { name: "panel".into(), gpu: light });
+    let n = scene.triangle_materials.len();
+    scene.triangle_materials[n - 2..].fill(1);
+    scene.sky = Sky { radiance: [sky; 3] };
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    // Where the mirror ray goes, and Schlick's F for the view angle.
+    let sees = |p: DVec3, d: DVec3| -> Option<bool> {
+        let m = DVec3::new(d.x, -d.y, d.z);
+        let q = p + m * ((2.0 - p.y) / m.y);
+        let x = q.x.abs();
+        if (x - 1.0).abs() < 0.08 || q.z.abs() > 7.5 {
+            return None;
+        }
+        Some(x < 1.0)
+    };
+    let fresnel = |d: DVec3| {
+        let c = -d.normalize().y;
+        base as f64 + (1.0 - base as f64) * (1.0 - c).powi(5)
+    };
+    let pixels: Vec<_> =
+        floor_pixels(&cam, 15.0).into_iter().filter(|&(_, p, d)| sees(p, d).is_some()).collect();
+    let expected = |p: DVec3, d: DVec3| {
+        let l = if sees(p, d) == Some(true) { emitted } else { sky } as f64;
+        fresnel(d) * l
+    };
+    for res in [ReflectionRes::Full, ReflectionRes::Half] {
+        let rt = RtSettings { reflections: Some(res), ..RtSettings::OFF };
+        let name = format!("mirror-{res:?}");
+        let (rgb, _) = render_frames(dir.path(), &name, &bytes, 4, |f| rt_options(f, W, H, rt));
+        let on_panel: Vec<_> = pixels.iter().copied().filter(|&(_, p, d)| sees(p, d) == Some(true)).collect();
+        let (m_panel, _) = ratio_stats(&rgb, &on_panel, expected);
+        let (m_all, spread) = ratio_stats(&rgb, &pixels, expected);
+        eprintln!(
+            "{res:?}: {} floor pixels ({} see the panel): mean ratio {m_all:.4} (spread {spread:.4}), panel {m_panel:.4}",
+            pixels.len(),
+            on_panel.len()
+        );
+        assert!(on_panel.len() > 100 && pixels.len() > on_panel.len() + 500);
+        // The split-sum compensation from the baked table adds up to about a percent.
+        assert!((m_all - 1.0).abs() < 0.02 && (m_panel - 1.0).abs() < 0.02, "{res:?}");
+        // Half resolution blends up to a full-resolution pixel across the reflected panel's
+        // edge (which is no edge of the floor): pixels within two of it are left out.
+        let (tolerance, reach) = if res == ReflectionRes::Full { (0.03, 0) } else { (0.03, 2) };
+        let sees_at = |x: i64, y: i64| {
+            let d = cam.ray(x.clamp(0, W as i64 - 1) as u32, y.clamp(0, H as i64 - 1) as u32, W, H);
+            (d.y < -1e-6).then(|| sees(cam.eye + d * (-cam.eye.y / d.y), d)).flatten()
+        };
+        for &(i, p, d) in &pixels {
+            let (x, y) = (((i / 3) as u32 % W) as i64, ((i / 3) as u32 / W) as i64);
+            let here = sees_at(x, y);
+            if (-reach..=reach).any(|dy| (-reach..=reach).any(|dx| sees_at(x + dx, y + dy) != here)) {
+                continue;
+            }
+            let rel = (rgb[i] as f64 / expected(p, d) - 1.0).abs();
+            assert!(rel < tolerance, "{res:?}: floor at {p}: {} vs {} ({rel})", rgb[i], expected(p, d));
+        }
+    }
+    let (split, _) = render(dir.path(), "mirror-off", &bytes, |f| options(f, W, H, None, false));
+    let on_panel: Vec<_> = pixels.iter().copied().filter(|&(_, p, d)| sees(p, d) == Some(true)).collect();
+    let (m_split, _) = ratio_stats(&split, &on_panel, |_, d| fresnel(d) * sky as f64);
+    assert!((m_split - 1.0).abs() < 0.03, "the split sum shows the sky everywhere: {m_split}");
+}
+
+#[test]
+fn accumulation_restarts_when_the_camera_moves_and_every_pass_is_clean_on_pica_pica() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("demo.kiln");
+    std::fs::write(&file, compile(cornell_box(), fast_settings())).unwrap();
+    let all = RtSettings {
+        shadows: true,
+        ao: true,
+        reflections: Some(ReflectionRes::Half),
+        light_radius: 0.05,
+        ..RtSettings::OFF
+    };
+    let mut session =
+        kiln_player::session::Session::open(&rt_options(&file, 64, 48, all), Instant::now()).unwrap();
+    for _ in 0..3 {
+        session.frame(false).unwrap();
+    }
+    assert_eq!(session.renderer.accumulated(), 3);
+    session.camera.turn(0.1, 0.0);
+    session.frame(false).unwrap();
+    assert_eq!(session.renderer.accumulated(), 1, "a camera move restarts the average");
+    session.frame(false).unwrap();
+    assert_eq!(session.renderer.accumulated(), 2);
+    session.resize(40, 30).unwrap();
+    session.frame(false).unwrap();
+    assert_eq!(session.renderer.accumulated(), 1, "a resize restarts the average");
+    assert_eq!(session.close(), 0, "validation errors");
 }

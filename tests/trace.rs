@@ -15,7 +15,7 @@ use kiln_compiler::settings::Settings;
 use kiln_format::query::{BvhQuery, IndexedTriangles, Ray, intersect_triangle};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::gpu::GpuOptions;
-use kiln_player::render::RenderSettings;
+use kiln_player::render::{RenderSettings, RtSettings};
 use kiln_player::session::{Session, SessionOptions};
 use kiln_player::trace::{GpuRay, NO_HIT, RayQuery};
 use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
@@ -46,7 +46,13 @@ fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
             surface_extensions: Vec::new(),
             pipeline_cache: None,
         },
-        render: RenderSettings { shadow_maps: false, rays: true, reference: false, exposure: 0.0 },
+        render: RenderSettings {
+            shadow_maps: false,
+            rays: true,
+            reference: false,
+            exposure: 0.0,
+            rt: RtSettings::OFF,
+        },
         width: 8,
         height: 8,
         camera: None,

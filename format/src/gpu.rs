@@ -90,8 +90,9 @@ gpu_struct! {
         pub width: f32 => "float",
         /// Rect: height.
         pub height: f32 => "float",
-        /// Zero.
-        pub reserved: f32 => "float",
+        /// Extent the ray-traced soft shadows sample (a player setting, not in the file): sphere
+        /// radius of point and spot lights, angular radius in radians of directional lights.
+        pub radius: f32 => "float",
     }
 }
 
@@ -120,7 +121,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Per-frame constants (std140 uniform block, 192 bytes).
+    /// Per-frame constants (std140 uniform block, 240 bytes).
     pub struct FrameConstants {
         /// World to clip, column-major.
         pub view_proj: [f32; 16] => "mat4",
@@ -134,6 +135,13 @@ gpu_struct! {
         pub size: [u32; 4] => "uvec4",
         /// Exposure multiplier, BRDF table resolution (0: none), frame number, unused.
         pub params: [f32; 4] => "vec4",
+        /// Unit right vector, w = tan(vfov / 2) · aspect: the camera ray through NDC (x, y) is
+        /// forward + right · x · right.w + up · y · up.w (the projection's own mapping).
+        pub camera_right: [f32; 4] => "vec4",
+        /// Unit up vector, w = tan(vfov / 2).
+        pub camera_up: [f32; 4] => "vec4",
+        /// Unit forward vector, w unused.
+        pub camera_forward: [f32; 4] => "vec4",
     }
 }
 
@@ -155,6 +163,27 @@ gpu_struct! {
         pub size: [u32; 4] => "uvec4",
         /// Light count, maximum path length, seed, unused.
         pub params: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 32 bytes).
+    pub struct RtConstants {
+        /// Frames already averaged into the accumulation images at this camera (0: this frame
+        /// replaces them).
+        pub accumulated: u32 => "uint",
+        /// Per-frame random seed.
+        pub seed: u32 => "uint",
+        /// Ambient-occlusion ray length (world units).
+        pub ao_radius: f32 => "float",
+        /// Reflections: surfaces rougher than this are left to the split-sum ambient.
+        pub max_roughness: f32 => "float",
+        /// Lights with a ray-traced shadow layer (the first ones of the light buffer).
+        pub shadow_lights: u32 => "uint",
+        /// Pixels per reflection sample along each axis: 1 full resolution, 2 half.
+        pub reflection_step: u32 => "uint",
+        /// Zero.
+        pub reserved: [u32; 2] => "uvec2",
     }
 }
 
@@ -221,6 +250,14 @@ pub struct FrameFlags;
 impl FrameFlags {
     /// Shadows from the baked shadow maps.
     pub const SHADOW_MAPS: u32 = 1 << 0;
+    /// Shadows from the ray-traced visibility image (one layer per light).
+    pub const RT_SHADOWS: u32 = 1 << 1;
+    /// Ambient occlusion from the ray-traced AO image.
+    pub const RT_AO: u32 = 1 << 2;
+    /// Glossy reflections from the ray-traced reflection image.
+    pub const RT_REFLECTIONS: u32 = 1 << 3;
+    /// The reflection image has half the width and height.
+    pub const REFLECTIONS_HALF: u32 = 1 << 4;
 }
 
 /// Alignment and size of a GLSL type under std430 (std140 differs only for arrays and structs,
@@ -272,6 +309,7 @@ pub fn glsl_layout() -> String {
     declare::<ReferenceConstants>(&mut s);
     declare::<GpuEmitter>(&mut s);
     declare::<GpuTexture>(&mut s);
+    declare::<RtConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -281,6 +319,10 @@ pub fn glsl_layout() -> String {
         ("SHADOW_PERSPECTIVE", ShadowKinds::PERSPECTIVE),
         ("SHADOW_CUBE", ShadowKinds::CUBE),
         ("FRAME_SHADOW_MAPS", FrameFlags::SHADOW_MAPS),
+        ("FRAME_RT_SHADOWS", FrameFlags::RT_SHADOWS),
+        ("FRAME_RT_AO", FrameFlags::RT_AO),
+        ("FRAME_RT_REFLECTIONS", FrameFlags::RT_REFLECTIONS),
+        ("FRAME_REFLECTIONS_HALF", FrameFlags::REFLECTIONS_HALF),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),

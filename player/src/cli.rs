@@ -10,7 +10,7 @@ use crate::camera::CameraOverride;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
-use crate::render::RenderSettings;
+use crate::render::{ReflectionRes, RenderSettings, RtSettings};
 use crate::session::SessionOptions;
 use crate::window;
 
@@ -20,6 +20,10 @@ Examples:
   kiln-play scene.kiln --headless --size 800x450 -o out.png
   kiln-play scene.kiln --headless -o radiance.exr       linear radiance, before exposure and tone mapping
   kiln-play scene.kiln --bench --json --size 1600x900  per-pass GPU times and the load breakdown
+  kiln-play scene.kiln --bench --size 1600x900 --shadows rt --ao rt --reflections rt --light-radius 0.1
+                                                       the hybrid ray-traced frame (seed 001)
+  kiln-play scene.kiln --bench-rays --size 1600x900    traversal Mrays/s: primary, shadow, diffuse rays
+  kiln-play scene.kiln --reference --spp 1024 -o ref.exr   the unbiased path-traced reference
 
 Tone mapping: display = sRGB(ACES(2^exposure * radiance)), ACES being Narkowicz's fit
 x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14) of the ACES filmic curve, per channel.
@@ -58,6 +62,37 @@ pub enum Shadows {
     None,
     /// The compiler's baked shadow maps (PCF; PCSS for rect lights).
     Shadowmap,
+    /// Ray-traced soft shadows: one ray per light per pixel per frame, averaged while the
+    /// camera is still (see --light-radius, --sun-angle).
+    Rt,
+}
+
+/// `--ao`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Ao {
+    /// No ambient occlusion (the material's occlusion texture still applies).
+    None,
+    /// Ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius.
+    Rt,
+}
+
+/// `--reflections`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Reflections {
+    /// Split-sum ambient specular only.
+    None,
+    /// Ray-traced glossy reflections (GGX visible-normal samples, one per pixel per frame at
+    /// --reflection-res).
+    Rt,
+}
+
+/// `--reflection-res`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ReflectionResArg {
+    /// One ray per pixel.
+    Full,
+    /// One ray per 2 × 2 pixels, upsampled with edge-aware weights.
+    Half,
 }
 
 /// A technique switch whose techniques come with later passes; `none` for now.
@@ -90,8 +125,12 @@ pub struct Args {
     /// Measure per-pass GPU times and the load breakdown (headless).
     #[arg(long)]
     pub bench: bool,
-    /// With --bench: print JSON instead of a table.
-    #[arg(long, requires = "bench")]
+    /// Measure the compute traversal's throughput (Mrays/s) on primary, shadow and diffuse
+    /// rays at --size from the file's camera, each set traced --frames times (default 20).
+    #[arg(long, conflicts_with_all = ["bench", "reference", "output"])]
+    pub bench_rays: bool,
+    /// With --bench or --bench-rays: print JSON instead of a table.
+    #[arg(long)]
     pub json: bool,
     /// With --bench: frames rendered before measuring.
     #[arg(long, value_name = "N", default_value_t = 10)]
@@ -115,12 +154,31 @@ pub struct Args {
     /// Shadows technique.
     #[arg(long, value_enum, default_value = "shadowmap")]
     pub shadows: Shadows,
-    /// Ambient occlusion technique (later passes add techniques).
+    /// Ambient occlusion technique.
     #[arg(long, value_enum, default_value = "none")]
-    pub ao: NotYet,
-    /// Reflections technique (later passes add techniques).
+    pub ao: Ao,
+    /// With --ao rt: ray length in scene units (default: a tenth of the scene's diagonal).
+    #[arg(long, value_name = "R")]
+    pub ao_radius: Option<f32>,
+    /// Reflections technique.
     #[arg(long, value_enum, default_value = "none")]
-    pub reflections: NotYet,
+    pub reflections: Reflections,
+    /// With --reflections rt: resolution of the traced reflections.
+    #[arg(long, value_enum, default_value = "full")]
+    pub reflection_res: ReflectionResArg,
+    /// With --reflections rt: surfaces rougher than this keep the split-sum ambient.
+    #[arg(long, value_name = "ROUGHNESS", default_value_t = 1.0)]
+    pub reflection_max_roughness: f32,
+    /// With --shadows rt: sphere radius of point and spot lights in scene units (0: hard
+    /// shadows, as the file's punctual lights imply).
+    #[arg(long, value_name = "R", default_value_t = 0.0)]
+    pub light_radius: f32,
+    /// With --shadows rt: angular diameter of directional lights in degrees (the sun: 0.53).
+    #[arg(long, value_name = "DEGREES", default_value_t = 0.0)]
+    pub sun_angle: f32,
+    /// Do not average the ray-traced passes over frames (every frame shows one sample).
+    #[arg(long)]
+    pub no_accumulate: bool,
     /// Global illumination technique (later passes add techniques).
     #[arg(long, value_enum, default_value = "none")]
     pub gi: NotYet,
@@ -143,6 +201,38 @@ impl Args {
         if !self.exposure.is_finite() {
             return Err(PlayError::new(Exit::Usage, "--exposure must be finite"));
         }
+        let non_negative = |name: &str, v: f32| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(PlayError::new(Exit::Usage, format!("{name} must be a finite number ≥ 0, not {v}")))
+            }
+        };
+        non_negative("--light-radius", self.light_radius)?;
+        non_negative("--sun-angle", self.sun_angle)?;
+        non_negative("--reflection-max-roughness", self.reflection_max_roughness)?;
+        if let Some(r) = self.ao_radius {
+            non_negative("--ao-radius", r)?;
+            if r == 0.0 {
+                return Err(PlayError::new(Exit::Usage, "--ao-radius must be greater than 0"));
+            }
+        }
+        if self.sun_angle >= 180.0 {
+            return Err(PlayError::new(Exit::Usage, "--sun-angle must be below 180 degrees"));
+        }
+        let rt = RtSettings {
+            shadows: self.shadows == Shadows::Rt,
+            ao: self.ao == Ao::Rt,
+            reflections: (self.reflections == Reflections::Rt).then_some(match self.reflection_res {
+                ReflectionResArg::Full => ReflectionRes::Full,
+                ReflectionResArg::Half => ReflectionRes::Half,
+            }),
+            light_radius: self.light_radius,
+            sun_degrees: self.sun_angle,
+            ao_radius: self.ao_radius,
+            max_roughness: self.reflection_max_roughness,
+            accumulate: !self.no_accumulate,
+        };
         Ok(SessionOptions {
             file,
             gpu: GpuOptions {
@@ -156,6 +246,7 @@ impl Args {
                 rays: false,
                 reference: self.reference,
                 exposure: self.exposure,
+                rt,
             },
             width: self.size.width,
             height: self.size.height,
@@ -216,6 +307,18 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
     let options = args.session(file)?;
     if args.reference {
         return run_reference(&args, &options, start);
+    }
+    if args.json && !args.bench && !args.bench_rays {
+        return Err(PlayError::new(Exit::Usage, "--json goes with --bench or --bench-rays"));
+    }
+    if args.bench_rays {
+        let report = crate::raybench::run(&options, args.frames.unwrap_or(20), start)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
+        } else {
+            print!("{}", report.table());
+        }
+        return Ok(());
     }
     if args.bench {
         if args.output.is_some() {

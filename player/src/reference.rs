@@ -110,6 +110,7 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
             mips: 1,
             layers: 1,
             cube: false,
+            array: false,
             usage,
             uploaded: false,
         };

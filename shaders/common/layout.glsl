@@ -15,7 +15,7 @@ struct GpuLight {
     float cos_outer; // offset 64
     float width; // offset 68
     float height; // offset 72
-    float reserved; // offset 76
+    float radius; // offset 76
 }; // 80 bytes
 
 struct GpuShadow {
@@ -37,7 +37,10 @@ struct FrameConstants {
     vec4 sky; // offset 144
     uvec4 size; // offset 160
     vec4 params; // offset 176
-}; // 192 bytes
+    vec4 camera_right; // offset 192
+    vec4 camera_up; // offset 208
+    vec4 camera_forward; // offset 224
+}; // 240 bytes
 
 struct GpuMaterialLayout {
     vec4 base_color; // offset 0
@@ -80,6 +83,16 @@ struct GpuTexture {
     uint flags; // offset 12
 }; // 16 bytes
 
+struct RtConstants {
+    uint accumulated; // offset 0
+    uint seed; // offset 4
+    float ao_radius; // offset 8
+    float max_roughness; // offset 12
+    uint shadow_lights; // offset 16
+    uint reflection_step; // offset 20
+    uvec2 reserved; // offset 24
+}; // 32 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;
@@ -88,6 +101,10 @@ const uint SHADOW_ORTHOGRAPHIC = 0u;
 const uint SHADOW_PERSPECTIVE = 1u;
 const uint SHADOW_CUBE = 2u;
 const uint FRAME_SHADOW_MAPS = 1u;
+const uint FRAME_RT_SHADOWS = 2u;
+const uint FRAME_RT_AO = 4u;
+const uint FRAME_RT_REFLECTIONS = 8u;
+const uint FRAME_REFLECTIONS_HALF = 16u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;

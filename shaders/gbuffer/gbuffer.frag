@@ -4,6 +4,8 @@
 //   1 albedo    RGBA8_SRGB  base colour
 //   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag, occlusion
 //   3 emission  RGBA16F     emitted radiance
+//   4 triangle  R32_UINT    1 + the triangle's index in the index buffer (0: nothing drawn); the
+//                           ray-traced passes rebuild the exact surface point from it
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 
@@ -18,11 +20,13 @@ layout(push_constant) uniform Material { GpuMaterialLayout material; };
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_first_triangle;
 
 layout(location = 0) out vec2 out_normal;
 layout(location = 1) out vec4 out_albedo;
 layout(location = 2) out vec4 out_material;
 layout(location = 3) out vec4 out_emission;
+layout(location = 4) out uint out_triangle;
 
 // Perturbs the normal with a tangent-space normal map through the screen-space cotangent frame
 // (Schüler 2013): no stored tangents needed.
@@ -79,4 +83,5 @@ void main() {
     out_albedo = vec4(base.rgb, 1.0);
     out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), diffuse_only ? 1.0 : 0.0, occlusion);
     out_emission = vec4(emission, 1.0);
+    out_triangle = in_first_triangle + uint(gl_PrimitiveID) + 1u;
 }

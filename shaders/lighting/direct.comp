@@ -1,7 +1,9 @@
 #version 460
 #extension GL_EXT_control_flow_attributes : require
-// Direct light: every analytic light over the G-buffer, shadowed by the baked shadow maps
-// (PCF; PCSS for rect lights), plus the constant sky through the split-sum table and emission.
+// Direct light and composition: every analytic light over the G-buffer, shadowed by the baked
+// shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, plus the constant sky
+// through the split-sum table (its diffuse part times the ray-traced AO; its specular part
+// replaced by the ray-traced reflections where they were traced) and emission.
 // Output: linear scene radiance (before exposure and tone mapping).
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
@@ -27,6 +29,9 @@ layout(set = 0, binding = 8) uniform sampler2D g_albedo;
 layout(set = 0, binding = 9) uniform sampler2D g_material;
 layout(set = 0, binding = 10) uniform sampler2D g_emission;
 layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D radiance_out;
+layout(set = 0, binding = 12, r32f) uniform readonly image2DArray rt_shadows;
+layout(set = 0, binding = 13, r32f) uniform readonly image2D rt_ao;
+layout(set = 0, binding = 14, rgba32f) uniform readonly image2D rt_reflections;
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -113,7 +118,11 @@ float shadow_cube_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float light_radius
     return lit / 16.0;
 }
 
-float shadow_factor(GpuLight light, vec3 p, vec3 n, vec3 l, float angle) {
+float shadow_factor(uint index, GpuLight light, vec3 p, vec3 n, vec3 l, float angle) {
+    if ((frame.size.w & FRAME_RT_SHADOWS) != 0u) {
+        ivec3 at = ivec3(gl_GlobalInvocationID.xy, int(index));
+        return index < uint(imageSize(rt_shadows).z) ? imageLoad(rt_shadows, at).r : 1.0;
+    }
     if ((frame.size.w & FRAME_SHADOW_MAPS) == 0u || light.shadow < 0) {
         return 1.0;
     }
@@ -123,6 +132,46 @@ float shadow_factor(GpuLight light, vec3 p, vec3 n, vec3 l, float angle) {
         return shadow_cube_factor(s, p, n, l, radius, angle);
     }
     return shadow_2d_factor(s, p, n, l, angle);
+}
+
+// The ray-traced reflection at a pixel (rgb, a > 0 where traced). Half resolution: the four
+// nearest traced pixels (each block's top-left), bilinear weights times how well their surface
+// matches this pixel's (normal and plane distance), so that reflections do not bleed across
+// edges as plain bilinear upsampling does.
+vec4 reflection_at(ivec2 pixel, vec3 p, vec3 n) {
+    if ((frame.size.w & FRAME_REFLECTIONS_HALF) == 0u) {
+        vec4 r = imageLoad(rt_reflections, pixel);
+        return r.a > 0.0 ? vec4(r.rgb, 1.0) : vec4(0.0);
+    }
+    ivec2 cells = imageSize(rt_reflections);
+    vec2 x = vec2(pixel) * 0.5;
+    ivec2 c0 = ivec2(floor(x));
+    vec2 f = x - vec2(c0);
+    float scale = max(length(frame.camera.xyz - p), 1e-6);
+    vec3 sum = vec3(0.0);
+    float weight = 0.0;
+    for (int j = 0; j < 2; j++) {
+        for (int i = 0; i < 2; i++) {
+            ivec2 c = min(c0 + ivec2(i, j), cells - 1);
+            ivec2 src = min(c * 2, ivec2(frame.size.xy) - 1);
+            float depth = texelFetch(g_depth, src, 0).r;
+            if (depth <= 0.0) {
+                continue;
+            }
+            vec2 ndc = vec2((float(src.x) + 0.5) / float(frame.size.x) * 2.0 - 1.0, 1.0 - (float(src.y) + 0.5) / float(frame.size.y) * 2.0);
+            vec4 w4 = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+            vec3 q = w4.xyz / w4.w;
+            vec3 nq = oct_decode(texelFetch(g_normal, src, 0).rg);
+            float bilinear = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
+            float normal_match = pow(max(dot(nq, n), 0.0), 16.0);
+            float plane_match = exp(-abs(dot(q - p, n)) / (0.01 * scale));
+            vec4 r = imageLoad(rt_reflections, c);
+            float w = (bilinear + 1e-3) * normal_match * plane_match * r.a;
+            sum += r.rgb * w;
+            weight += w;
+        }
+    }
+    return weight > 1e-6 ? vec4(sum / weight, 1.0) : vec4(0.0);
 }
 
 void main() {
@@ -153,17 +202,28 @@ void main() {
     float angle = 6.2831853 * hash(uvec2(pixel));
 
     vec3 radiance = texelFetch(g_emission, pixel, 0).rgb;
+    float occlusion = mat.a;
+    if ((frame.size.w & FRAME_RT_AO) != 0u) {
+        occlusion *= imageLoad(rt_ao, pixel).r;
+    }
+    vec4 traced = vec4(0.0);
+    if ((frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !s.diffuse_only) {
+        traced = reflection_at(pixel, p, n);
+    }
     // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.
-    vec3 ambient;
     if (s.diffuse_only) {
-        ambient = s.base;
+        radiance += s.base * frame.sky.rgb * occlusion;
     } else {
         vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, s.roughness)).rg : vec2(1.0, 0.0);
         vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
-        vec3 specular = (f0 * rg.r + rg.g) * (vec3(1.0) + f0 * (1.0 / e_albedo - 1.0));
-        ambient = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - s.metallic) * s.base + specular;
+        vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
+        vec3 diffuse = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - s.metallic) * s.base;
+        radiance += diffuse * frame.sky.rgb * occlusion;
+        // The traced reflection estimates the single-scattering lobe; the same multiple-
+        // scattering compensation as the split sum applies.
+        vec3 split_sum = (f0 * rg.r + rg.g) * frame.sky.rgb * occlusion;
+        radiance += compensation * (traced.a > 0.0 ? traced.rgb / traced.a : split_sum);
     }
-    radiance += ambient * frame.sky.rgb * mat.a;
 
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight light = lights[i];
@@ -215,7 +275,7 @@ void main() {
             }
         }
         if (any(greaterThan(contribution, vec3(0.0)))) {
-            contribution *= shadow_factor(light, p, n, shadow_dir, angle);
+            contribution *= shadow_factor(i, light, p, n, shadow_dir, angle);
         }
         radiance += contribution;
     }

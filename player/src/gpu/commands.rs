@@ -464,7 +464,8 @@ impl<'a> Recorder<'a> {
 
     /// Draws `count` indices from `first`.
     pub fn draw_indexed(&self, count: u32, first: u32) {
-        unsafe { self.gpu.device.cmd_draw_indexed(self.cmd, count, 1, first, 0, 0) };
+        // The first instance carries the first triangle (gl_InstanceIndex in the G-buffer pass).
+        unsafe { self.gpu.device.cmd_draw_indexed(self.cmd, count, 1, first, 0, first / 3) };
     }
 
     /// Binds a compute pipeline with its sets and dispatches enough 8 × 8 groups for w × h.

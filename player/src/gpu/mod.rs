@@ -229,7 +229,9 @@ impl Gpu {
             .synchronization2(true)
             .maintenance4(true);
         // Doubles for the watertight triangle test's edge fallback in ray queries.
-        let features = vk::PhysicalDeviceFeatures::default().shader_float64(true);
+        // geometryShader: the G-buffer's fragment shader reads gl_PrimitiveID (SPIR-V declares the
+        // Geometry capability for it); no geometry shader is used.
+        let features = vk::PhysicalDeviceFeatures::default().shader_float64(true).geometry_shader(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_extensions)
@@ -431,6 +433,7 @@ fn pick_device(
             ("synchronization2", f13.synchronization2),
             ("maintenance4", f13.maintenance4),
             ("shaderFloat64", f10.shader_float64),
+            ("geometryShader", f10.geometry_shader),
             ("timelineSemaphore", f12.timeline_semaphore),
             ("bufferDeviceAddress", f12.buffer_device_address),
             ("scalarBlockLayout", f12.scalar_block_layout),

@@ -119,6 +119,8 @@ pub struct ImageDesc {
     pub layers: u32,
     /// Cube compatible.
     pub cube: bool,
+    /// Viewed as a 2D array (even with one layer); otherwise 2D or cube.
+    pub array: bool,
     /// Usage.
     pub usage: vk::ImageUsageFlags,
     /// Filled by uploads: shared with the transfer queue when there is one.
@@ -180,7 +182,13 @@ impl Image {
         let aspect = aspect_of(desc.format);
         let view_info = vk::ImageViewCreateInfo::default()
             .image(raw)
-            .view_type(if desc.cube { vk::ImageViewType::CUBE } else { vk::ImageViewType::TYPE_2D })
+            .view_type(if desc.cube {
+                vk::ImageViewType::CUBE
+            } else if desc.array {
+                vk::ImageViewType::TYPE_2D_ARRAY
+            } else {
+                vk::ImageViewType::TYPE_2D
+            })
             .format(desc.format)
             .subresource_range(vk::ImageSubresourceRange {
                 aspect_mask: aspect,

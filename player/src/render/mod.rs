@@ -1,12 +1,18 @@
-//! The frame: G-buffer raster, direct light in compute, tone mapping. Pipelines are built
-//! without the scene (so they compile while it uploads); [`Renderer::new`] then binds the scene.
+//! The frame: G-buffer raster, the ray-traced shadows, AO and reflections of the hybrid pipeline
+//! (each optional, compute traversal of the baked BVH), direct light and composition in compute,
+//! tone mapping. Pipelines are built without the scene (so they compile while it uploads);
+//! [`Renderer::new`] then binds the scene.
+//!
+//! The ray-traced passes take one sample per pixel per frame and average frames while the
+//! camera is still (a running mean); any change of the view or projection restarts the average
+//! (no reprojection: a moving camera sees the one-sample image).
 
 pub mod lights;
 pub mod targets;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
-use kiln_format::gpu::{FrameConstants, FrameFlags, GpuMaterialLayout};
+use kiln_format::gpu::{FrameConstants, FrameFlags, GpuMaterialLayout, LightKinds, RtConstants};
 use kiln_format::sections::NO_TEXTURE;
 
 use crate::camera::Camera;
@@ -17,7 +23,7 @@ use crate::gpu::{
 };
 use crate::scene::upload::Uploader;
 use crate::scene::{GpuScene, sampled_desc};
-use targets::{DEPTH_FORMAT, GBUFFER_FORMATS, Targets};
+use targets::{DEPTH_FORMAT, GBUFFER_FORMATS, RtShape, Targets};
 
 /// SPIR-V of the passes, built from `shaders/` by `shaders/build.sh` (checked by a test).
 pub mod spirv {
@@ -33,14 +39,23 @@ pub mod spirv {
     pub const TRACE_RAYS: &[u8] = include_bytes!("../../../shaders/spirv/rays.comp.spv");
     /// The reference path tracer.
     pub const PATHTRACE: &[u8] = include_bytes!("../../../shaders/spirv/pathtrace.comp.spv");
+    /// Ray-traced soft shadows.
+    pub const RT_SHADOWS: &[u8] = include_bytes!("../../../shaders/spirv/shadows.comp.spv");
+    /// Ray-traced ambient occlusion.
+    pub const RT_AO: &[u8] = include_bytes!("../../../shaders/spirv/ao.comp.spv");
+    /// Ray-traced glossy reflections.
+    pub const RT_REFLECTIONS: &[u8] = include_bytes!("../../../shaders/spirv/reflections.comp.spv");
     /// (source under `shaders/`, embedded bytes) of every shader.
-    pub const ALL: [(&str, &[u8]); 6] = [
+    pub const ALL: [(&str, &[u8]); 9] = [
         ("gbuffer/gbuffer.vert", GBUFFER_VERT),
         ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
         ("lighting/direct.comp", DIRECT),
         ("post/tonemap.comp", TONEMAP),
         ("trace/rays.comp", TRACE_RAYS),
         ("reference/pathtrace.comp", PATHTRACE),
+        ("rt/shadows.comp", RT_SHADOWS),
+        ("rt/ao.comp", RT_AO),
+        ("rt/reflections.comp", RT_REFLECTIONS),
     ];
 }
 
@@ -48,8 +63,11 @@ pub mod spirv {
 /// in `shaders/lighting/direct.comp`).
 pub const MAX_SHADOW_MAPS: usize = 8;
 
-/// Passes timed with timestamps, in order.
-pub const PASSES: [&str; 3] = ["gbuffer", "direct", "tonemap"];
+/// Lights that can have a ray-traced shadow layer; further lights are drawn unshadowed.
+pub const MAX_RT_SHADOW_LIGHTS: usize = 16;
+
+/// Passes timed with timestamps, in order (a pass that is off takes 0 ms).
+pub const PASSES: [&str; 6] = ["gbuffer", "shadows", "ao", "reflections", "direct", "tonemap"];
 
 /// How to render.
 #[derive(Debug, Clone, Copy)]
@@ -62,6 +80,70 @@ pub struct RenderSettings {
     pub reference: bool,
     /// Exposure in stops (the radiance is multiplied by 2^exposure before tone mapping).
     pub exposure: f32,
+    /// The ray-traced passes.
+    pub rt: RtSettings,
+}
+
+/// Resolution of the ray-traced reflections.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReflectionRes {
+    /// One ray per pixel.
+    Full,
+    /// One ray per 2 × 2 pixels, upsampled with normal- and plane-aware weights.
+    Half,
+}
+
+/// The hybrid pipeline's ray-traced passes and their parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RtSettings {
+    /// Ray-traced soft shadows (replace the shadow maps).
+    pub shadows: bool,
+    /// Ray-traced ambient occlusion.
+    pub ao: bool,
+    /// Ray-traced glossy reflections.
+    pub reflections: Option<ReflectionRes>,
+    /// Sphere radius of point and spot lights for soft shadows (0: hard).
+    pub light_radius: f32,
+    /// Angular diameter of directional lights in degrees (0: hard).
+    pub sun_degrees: f32,
+    /// AO ray length; `None`: a tenth of the scene's bounding-box diagonal.
+    pub ao_radius: Option<f32>,
+    /// Surfaces rougher than this get the split-sum ambient instead of traced reflections.
+    pub max_roughness: f32,
+    /// Average frames while the camera is still.
+    pub accumulate: bool,
+}
+
+impl RtSettings {
+    /// Every ray-traced pass off.
+    pub const OFF: RtSettings = RtSettings {
+        shadows: false,
+        ao: false,
+        reflections: None,
+        light_radius: 0.0,
+        sun_degrees: 0.0,
+        ao_radius: None,
+        max_roughness: 1.0,
+        accumulate: true,
+    };
+
+    /// Whether any ray-traced pass is on.
+    pub fn any(&self) -> bool {
+        self.shadows || self.ao || self.reflections.is_some()
+    }
+
+    /// The accumulation images these settings need for a scene of `lights` lights.
+    pub fn shape(&self, lights: usize) -> RtShape {
+        RtShape {
+            shadow_layers: if self.shadows { lights.clamp(1, MAX_RT_SHADOW_LIGHTS) as u32 } else { 0 },
+            ao: self.ao,
+            reflection_step: match self.reflections {
+                None => 0,
+                Some(ReflectionRes::Full) => 1,
+                Some(ReflectionRes::Half) => 2,
+            },
+        }
+    }
 }
 
 /// Layouts and pipelines (independent of the scene).
@@ -74,6 +156,16 @@ pub struct Pipelines {
     gbuffer: GraphicsPipeline,
     direct: ComputePipeline,
     tonemap: ComputePipeline,
+    rt: Option<RtPipelines>,
+}
+
+/// The ray-traced passes (one set layout for all three).
+#[derive(Debug)]
+struct RtPipelines {
+    layout: SetLayout,
+    shadows: ComputePipeline,
+    ao: ComputePipeline,
+    reflections: ComputePipeline,
 }
 
 fn b(kind: BindingKind) -> Binding {
@@ -81,8 +173,8 @@ fn b(kind: BindingKind) -> Binding {
 }
 
 impl Pipelines {
-    /// Builds every pipeline (through the pipeline cache).
-    pub fn new(gpu: &Gpu) -> PlayResult<Pipelines> {
+    /// Builds every pipeline (through the pipeline cache); the ray-traced ones when `rt`.
+    pub fn new(gpu: &Gpu, rt: bool) -> PlayResult<Pipelines> {
         use BindingKind::*;
         let frame_layout = SetLayout::new(gpu, &[b(Uniform)], 1)?;
         let material_layout = SetLayout::new(gpu, &[b(Sampled); 5], 64)?;
@@ -90,7 +182,7 @@ impl Pipelines {
         direct_bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
         direct_bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
         direct_bindings.extend([b(Sampled); 5]);
-        direct_bindings.push(b(StorageImage));
+        direct_bindings.extend([b(StorageImage); 4]);
         let direct_layout = SetLayout::new(gpu, &direct_bindings, 1)?;
         let tonemap_layout = SetLayout::new(gpu, &[b(Uniform), b(StorageImage), b(StorageImage)], 1)?;
         let gbuffer = GraphicsPipeline::new(
@@ -112,6 +204,22 @@ impl Pipelines {
         )?;
         let direct = ComputePipeline::new(gpu, spirv::DIRECT, &[&direct_layout], 0)?;
         let tonemap = ComputePipeline::new(gpu, spirv::TONEMAP, &[&tonemap_layout], 0)?;
+        let rt = if rt {
+            let mut bindings = vec![b(Uniform)];
+            bindings.extend([b(Storage); 11]);
+            bindings.extend([b(Sampled); 4]);
+            bindings.extend([b(StorageImage); 3]);
+            let layout = SetLayout::new(gpu, &bindings, 1)?;
+            let push = std::mem::size_of::<RtConstants>() as u32;
+            Some(RtPipelines {
+                shadows: ComputePipeline::new(gpu, spirv::RT_SHADOWS, &[&layout], push)?,
+                ao: ComputePipeline::new(gpu, spirv::RT_AO, &[&layout], push)?,
+                reflections: ComputePipeline::new(gpu, spirv::RT_REFLECTIONS, &[&layout], push)?,
+                layout,
+            })
+        } else {
+            None
+        };
         Ok(Pipelines {
             frame_layout,
             material_layout,
@@ -120,6 +228,7 @@ impl Pipelines {
             gbuffer,
             direct,
             tonemap,
+            rt,
         })
     }
 
@@ -128,6 +237,12 @@ impl Pipelines {
         self.gbuffer.destroy(gpu);
         self.direct.destroy(gpu);
         self.tonemap.destroy(gpu);
+        if let Some(rt) = &mut self.rt {
+            rt.shadows.destroy(gpu);
+            rt.ao.destroy(gpu);
+            rt.reflections.destroy(gpu);
+            rt.layout.destroy(gpu);
+        }
         for l in [
             &mut self.frame_layout,
             &mut self.material_layout,
@@ -175,7 +290,7 @@ impl Dummies {
 }
 
 /// GPU times of one frame's passes, in milliseconds (order of [`PASSES`]).
-pub type PassTimes = [f64; 3];
+pub type PassTimes = [f64; 6];
 
 /// Renders a resident scene.
 pub struct Renderer {
@@ -190,6 +305,11 @@ pub struct Renderer {
     material_sets: Vec<vk::DescriptorSet>,
     direct_set: vk::DescriptorSet,
     tonemap_set: vk::DescriptorSet,
+    rt_set: vk::DescriptorSet,
+    rt_constants: RtConstants,
+    /// Frames averaged at the current camera.
+    accumulated: u32,
+    last_view_proj: Option<[f32; 16]>,
     /// Materials as pushed, with texture numbers of absent textures cleared.
     materials: Vec<GpuMaterialLayout>,
     light_count: u32,
@@ -228,7 +348,25 @@ impl Renderer {
         scene: &GpuScene,
         settings: RenderSettings,
     ) -> PlayResult<Renderer> {
-        let plan = lights::plan(&scene.manifest, &scene.shadow_maps, settings.shadow_maps);
+        let mut settings = settings;
+        let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, settings.shadow_maps);
+        if settings.rt.any() && (scene.bvh.is_none() || scene.reference.is_none()) {
+            plan.warnings.push("the ray-traced passes are off: the file has no BVH".into());
+            settings.rt = RtSettings::OFF;
+        }
+        if settings.rt.shadows && plan.lights_used as usize > MAX_RT_SHADOW_LIGHTS {
+            plan.warnings.push(format!(
+                "{} light(s) are drawn without ray-traced shadows: at most {MAX_RT_SHADOW_LIGHTS} have them",
+                plan.lights_used as usize - MAX_RT_SHADOW_LIGHTS
+            ));
+        }
+        for l in &mut plan.lights {
+            l.radius = match l.kind {
+                LightKinds::POINT | LightKinds::SPOT => settings.rt.light_radius.max(0.0),
+                LightKinds::DIRECTIONAL => (settings.rt.sun_degrees.max(0.0) * 0.5).to_radians(),
+                _ => 0.0,
+            };
+        }
         let lights = host_buffer(
             gpu,
             "lights",
@@ -287,6 +425,35 @@ impl Renderer {
         }
         let direct_set = pipelines.direct_layout.allocate(gpu)?;
         let tonemap_set = pipelines.tonemap_layout.allocate(gpu)?;
+        let rt_set = match &mut pipelines.rt {
+            Some(rt) if settings.rt.any() => rt.layout.allocate(gpu)?,
+            _ => vk::DescriptorSet::null(),
+        };
+        let bounds = scene.manifest.bounds;
+        let diagonal = glam::Vec3::from(bounds.max).distance(glam::Vec3::from(bounds.min));
+        let rt_constants = RtConstants {
+            ao_radius: settings.rt.ao_radius.unwrap_or(0.1 * diagonal).max(1e-6),
+            max_roughness: settings.rt.max_roughness,
+            shadow_lights: if settings.rt.shadows {
+                (plan.lights_used as usize).min(MAX_RT_SHADOW_LIGHTS) as u32
+            } else {
+                0
+            },
+            reflection_step: settings.rt.shape(0).reflection_step.max(1),
+            ..Default::default()
+        };
+        let mut flags = if plan.shadows_bound && !settings.rt.shadows { FrameFlags::SHADOW_MAPS } else { 0 };
+        if settings.rt.shadows {
+            flags |= FrameFlags::RT_SHADOWS;
+        }
+        if settings.rt.ao {
+            flags |= FrameFlags::RT_AO;
+        }
+        match settings.rt.reflections {
+            Some(ReflectionRes::Full) => flags |= FrameFlags::RT_REFLECTIONS,
+            Some(ReflectionRes::Half) => flags |= FrameFlags::RT_REFLECTIONS | FrameFlags::REFLECTIONS_HALF,
+            None => {}
+        }
         let mut renderer = Renderer {
             pipelines,
             dummies,
@@ -298,15 +465,19 @@ impl Renderer {
             material_sets,
             direct_set,
             tonemap_set,
+            rt_set,
+            rt_constants,
+            accumulated: 0,
+            last_view_proj: None,
             materials,
             light_count: plan.lights_used,
             slots_2d: plan.slots_2d,
             slots_cube: plan.slots_cube,
-            flags: if plan.shadows_bound { FrameFlags::SHADOW_MAPS } else { 0 },
+            flags,
             lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
             sky: scene.manifest.sky.radiance,
             settings,
-            timestamps: TimestampPool::new(gpu, 4)?,
+            timestamps: TimestampPool::new(gpu, PASSES.len() as u32 + 1)?,
             frame: 0,
             warnings: plan.warnings,
         };
@@ -347,8 +518,40 @@ impl Renderer {
                 Write::Sampled(9, g(2)),
                 Write::Sampled(10, g(3)),
                 Write::StorageImage(11, t.radiance.view),
+                Write::StorageImage(12, t.rt_shadows.view),
+                Write::StorageImage(13, t.rt_ao.view),
+                Write::StorageImage(14, t.rt_reflections.view),
             ],
         );
+        if let (Some(rt), Some(bvh), Some(r)) = (&self.pipelines.rt, &scene.bvh, &scene.reference)
+            && self.rt_set != vk::DescriptorSet::null()
+        {
+            rt.layout.write(
+                gpu,
+                self.rt_set,
+                &[
+                    Write::Buffer(0, &self.frame_ubo),
+                    Write::Buffer(1, &bvh.nodes),
+                    Write::Buffer(2, &bvh.triangles),
+                    Write::Buffer(3, &scene.vertices),
+                    Write::Buffer(4, &scene.uvs),
+                    Write::Buffer(5, &r.indices),
+                    Write::Buffer(6, &r.triangle_materials),
+                    Write::Buffer(7, &r.materials),
+                    Write::Buffer(8, &self.lights),
+                    Write::Buffer(9, &r.texels),
+                    Write::Buffer(10, &r.textures),
+                    Write::Buffer(11, &scene.indices),
+                    Write::Sampled(12, g(4)),
+                    Write::Sampled(13, g(0)),
+                    Write::Sampled(14, g(1)),
+                    Write::Sampled(15, g(2)),
+                    Write::StorageImage(16, t.rt_shadows.view),
+                    Write::StorageImage(17, t.rt_ao.view),
+                    Write::StorageImage(18, t.rt_reflections.view),
+                ],
+            );
+        }
         self.pipelines.tonemap_layout.write(
             gpu,
             self.tonemap_set,
@@ -362,8 +565,10 @@ impl Renderer {
 
     /// Recreates the targets for a new size (the GPU must be idle).
     pub fn resize(&mut self, gpu: &Gpu, scene: &GpuScene, width: u32, height: u32) -> PlayResult {
+        let shape = self.targets.rt;
         self.targets.destroy(gpu);
-        self.targets = Targets::new(gpu, width.max(1), height.max(1))?;
+        self.targets = Targets::new(gpu, width.max(1), height.max(1), shape)?;
+        self.accumulated = 0;
         self.write_frame_sets(gpu, scene);
         Ok(())
     }
@@ -372,7 +577,16 @@ impl Renderer {
     pub fn update(&mut self, camera: &Camera) -> PlayResult {
         let (w, h) = (self.targets.width, self.targets.height);
         let (view_proj, inv_view_proj) = camera.matrices(w, h);
+        if !self.settings.rt.accumulate || self.last_view_proj != Some(view_proj) {
+            self.accumulated = 0;
+        }
+        self.last_view_proj = Some(view_proj);
         let p = camera.position.as_vec3();
+        let right = camera.forward.cross(camera.up).normalize_or(glam::DVec3::X);
+        let up = right.cross(camera.forward);
+        let tan_half = (camera.vfov_degrees.to_radians() * 0.5).tan();
+        let aspect = w as f64 / h as f64;
+        let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
         let constants = FrameConstants {
             view_proj,
             inv_view_proj,
@@ -380,6 +594,9 @@ impl Renderer {
             sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
             size: [w, h, self.light_count, self.flags],
             params: [2f32.powf(self.settings.exposure), self.lut_resolution as f32, self.frame as f32, 0.0],
+            camera_right: v4(right, tan_half * aspect),
+            camera_up: v4(up, tan_half),
+            camera_forward: v4(camera.forward, 0.0),
         };
         self.frame_ubo.write(bytemuck::bytes_of(&constants))
     }
@@ -412,20 +629,58 @@ impl Renderer {
             rec.transition(img, Use::COLOR, Use::SAMPLED);
         }
         rec.transition(&t.depth, Use::DEPTH, Use::SAMPLED);
+        let rt_images = [&t.rt_shadows, &t.rt_ao, &t.rt_reflections];
+        for img in rt_images {
+            // Fresh images are discarded once; after that they carry the running average.
+            let from = if t.rt_fresh { Use::DISCARD } else { Use::STORAGE };
+            rec.transition(img, from, Use::STORAGE);
+        }
+        self.rt_constants.accumulated = self.accumulated;
+        self.rt_constants.seed = self.frame as u32;
+        let push = bytemuck::bytes_of(&self.rt_constants);
+        let step = self.rt_constants.reflection_step;
+        let rt = self.pipelines.rt.as_ref().filter(|_| self.rt_set != vk::DescriptorSet::null());
+        let passes: [(Option<&ComputePipeline>, u32, u32); 3] = [
+            (rt.filter(|_| self.settings.rt.shadows).map(|r| &r.shadows), t.width, t.height),
+            (rt.filter(|_| self.settings.rt.ao).map(|r| &r.ao), t.width, t.height),
+            (
+                rt.filter(|_| self.settings.rt.reflections.is_some()).map(|r| &r.reflections),
+                t.width.div_ceil(step),
+                t.height.div_ceil(step),
+            ),
+        ];
+        for (i, (pipeline, w, h)) in passes.into_iter().enumerate() {
+            if let Some(p) = pipeline {
+                rec.dispatch(p, &[self.rt_set], push, [w.div_ceil(8), h.div_ceil(8), 1]);
+            }
+            rec.timestamp(&self.timestamps, 2 + i as u32);
+        }
+        for img in rt_images {
+            rec.transition(img, Use::STORAGE, Use::STORAGE);
+        }
+        self.targets.rt_fresh = false;
+        let t = &self.targets;
         rec.transition(&t.radiance, Use::DISCARD, Use::STORAGE);
         rec.dispatch_2d(&self.pipelines.direct, &[self.direct_set], t.width, t.height);
-        rec.timestamp(&self.timestamps, 2);
+        rec.timestamp(&self.timestamps, 5);
         rec.transition(&t.radiance, Use::STORAGE, Use::STORAGE);
         rec.transition(&t.display, Use::DISCARD, Use::STORAGE);
         rec.dispatch_2d(&self.pipelines.tonemap, &[self.tonemap_set], t.width, t.height);
-        rec.timestamp(&self.timestamps, 3);
+        rec.timestamp(&self.timestamps, 6);
         self.frame += 1;
+        self.accumulated = (self.accumulated + 1).min(1 << 24);
+    }
+
+    /// Frames averaged into the ray-traced images at the current camera (after the last
+    /// recorded frame).
+    pub fn accumulated(&self) -> u32 {
+        self.accumulated
     }
 
     /// GPU milliseconds of each pass of the last completed frame.
     pub fn pass_times(&self, gpu: &Gpu) -> PlayResult<PassTimes> {
         let ns = self.timestamps.read_ns(gpu)?;
-        Ok([(ns[1] - ns[0]) * 1e-6, (ns[2] - ns[1]) * 1e-6, (ns[3] - ns[2]) * 1e-6])
+        Ok(std::array::from_fn(|i| (ns[i + 1] - ns[i]) * 1e-6))
     }
 
     /// Releases everything the renderer owns (the GPU must be idle).

@@ -6,11 +6,12 @@ use crate::error::PlayResult;
 use crate::gpu::{Gpu, Image, ImageDesc};
 
 /// G-buffer formats, in attachment order (see `shaders/gbuffer/gbuffer.frag`).
-pub const GBUFFER_FORMATS: [vk::Format; 4] = [
+pub const GBUFFER_FORMATS: [vk::Format; 5] = [
     vk::Format::R16G16_SNORM,
     vk::Format::R8G8B8A8_SRGB,
     vk::Format::R8G8B8A8_UNORM,
     vk::Format::R16G16B16A16_SFLOAT,
+    vk::Format::R32_UINT,
 ];
 /// Depth format.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
@@ -26,7 +27,7 @@ pub struct Targets {
     pub width: u32,
     /// Height.
     pub height: u32,
-    /// Normal, albedo, material, emission.
+    /// Normal, albedo, material, emission, triangle.
     pub gbuffer: Vec<Image>,
     /// Depth (reversed Z).
     pub depth: Image,
@@ -34,15 +35,36 @@ pub struct Targets {
     pub radiance: Image,
     /// Tone-mapped result.
     pub display: Image,
+    /// Ray-traced shadow visibility, one layer per light (1 × 1 when the pass is off).
+    pub rt_shadows: Image,
+    /// Ray-traced ambient openness (1 × 1 when off).
+    pub rt_ao: Image,
+    /// Ray-traced reflections, full or half size (1 × 1 when off).
+    pub rt_reflections: Image,
+    /// What the ray-traced images were made for.
+    pub rt: RtShape,
+    /// The ray-traced images hold nothing yet (their first use discards).
+    pub rt_fresh: bool,
+}
+
+/// Sizes of the ray-traced passes' accumulation images.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RtShape {
+    /// Lights with a ray-traced shadow layer (0: the pass is off).
+    pub shadow_layers: u32,
+    /// The AO pass is on.
+    pub ao: bool,
+    /// Pixels per reflection sample along each axis (0: the pass is off).
+    pub reflection_step: u32,
 }
 
 fn desc(format: vk::Format, width: u32, height: u32, usage: vk::ImageUsageFlags) -> ImageDesc {
-    ImageDesc { format, width, height, mips: 1, layers: 1, cube: false, usage, uploaded: false }
+    ImageDesc { format, width, height, mips: 1, layers: 1, cube: false, array: false, usage, uploaded: false }
 }
 
 impl Targets {
     /// Targets of `width` × `height`.
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> PlayResult<Targets> {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, rt: RtShape) -> PlayResult<Targets> {
         let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
         let mut gbuffer = Vec::new();
         for (i, f) in GBUFFER_FORMATS.iter().enumerate() {
@@ -61,7 +83,46 @@ impl Targets {
         let storage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC;
         let radiance = Image::new(gpu, "radiance", desc(RADIANCE_FORMAT, width, height, storage))?;
         let display = Image::new(gpu, "display", desc(DISPLAY_FORMAT, width, height, storage))?;
-        Ok(Targets { width, height, gbuffer, depth, radiance, display })
+        let accumulation = vk::ImageUsageFlags::STORAGE;
+        let on = |yes: bool, n: u32| if yes { n } else { 1 };
+        let mut shadows = desc(
+            vk::Format::R32_SFLOAT,
+            on(rt.shadow_layers > 0, width),
+            on(rt.shadow_layers > 0, height),
+            accumulation,
+        );
+        shadows.layers = rt.shadow_layers.max(1);
+        shadows.array = true;
+        let rt_shadows = Image::new(gpu, "rt shadows", shadows)?;
+        let rt_ao = Image::new(
+            gpu,
+            "rt ao",
+            desc(vk::Format::R32_SFLOAT, on(rt.ao, width), on(rt.ao, height), accumulation),
+        )?;
+        let step = rt.reflection_step.max(1);
+        let rt_reflections = Image::new(
+            gpu,
+            "rt reflections",
+            desc(
+                vk::Format::R32G32B32A32_SFLOAT,
+                on(rt.reflection_step > 0, width.div_ceil(step)),
+                on(rt.reflection_step > 0, height.div_ceil(step)),
+                accumulation,
+            ),
+        )?;
+        Ok(Targets {
+            width,
+            height,
+            gbuffer,
+            depth,
+            radiance,
+            display,
+            rt_shadows,
+            rt_ao,
+            rt_reflections,
+            rt,
+            rt_fresh: true,
+        })
     }
 
     /// Releases the images.
@@ -72,5 +133,8 @@ impl Targets {
         self.depth.destroy(gpu);
         self.radiance.destroy(gpu);
         self.display.destroy(gpu);
+        self.rt_shadows.destroy(gpu);
+        self.rt_ao.destroy(gpu);
+        self.rt_reflections.destroy(gpu);
     }
 }

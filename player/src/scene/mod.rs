@@ -122,6 +122,13 @@ impl<'f> Prepared<'f> {
     }
 }
 
+impl Prepared<'_> {
+    /// The file's manifest.
+    pub fn manifest(&self) -> &kiln_format::Manifest {
+        &self.view.manifest
+    }
+}
+
 /// Triangle corners in leaf (file) order as `vec4`s, three per triangle: what the GPU traversal
 /// reads (one load per corner instead of an index and a vertex fetch).
 pub fn triangle_corners(vertices: &[Vertex], triangles: &[[u32; 3]]) -> Vec<[f32; 4]> {
@@ -294,7 +301,8 @@ impl GpuScene {
             gpu,
             "indices",
             (prepared.indices.len() * 4) as u64,
-            vk::BufferUsageFlags::INDEX_BUFFER,
+            // Storage too: the ray-traced passes rebuild surface points from the G-buffer's triangle.
+            vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
         )?;
         let mut scene = GpuScene {
             manifest: view.manifest.clone(),
@@ -592,6 +600,7 @@ pub fn sampled_desc(
         mips,
         layers,
         cube,
+        array: false,
         usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
         uploaded: true,
     }

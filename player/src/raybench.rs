@@ -1,0 +1,216 @@
+//! `--bench-rays`: throughput of the compute traversal (`shaders/common/traverse.glsl`) on the
+//! three ray sets of a frame of the hybrid pipeline, at the requested size from the file's camera:
+//! primary camera rays through pixel centres (closest hit), shadow rays from the primary hits to
+//! the first light (any hit) and diffuse bounces from them (cosine-weighted, closest hit). Rays
+//! stay in pixel order, as a frame traces them. Times are GPU timestamps around the dispatch.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use kiln_format::SceneView;
+use kiln_format::manifest::LightKind;
+use kiln_format::query::offset_origin;
+use serde::Serialize;
+
+use crate::bench::quantile;
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::session::{Session, SessionOptions, open_file};
+use crate::trace::{GpuRay, NO_HIT, RayQuery};
+
+/// One ray set's figures.
+#[derive(Debug, Clone, Serialize)]
+pub struct RaySetStats {
+    /// "primary", "shadow" or "diffuse".
+    pub set: String,
+    /// Rays in the set.
+    pub rays: usize,
+    /// Rays that hit something.
+    pub hits: usize,
+    /// Median GPU milliseconds per trace of the whole set.
+    pub median_ms: f64,
+    /// 10th percentile.
+    pub p10_ms: f64,
+    /// 90th percentile.
+    pub p90_ms: f64,
+    /// Million rays per second at the median.
+    pub mrays_per_s: f64,
+}
+
+/// The report.
+#[derive(Debug, Clone, Serialize)]
+pub struct RayBenchReport {
+    /// Device name.
+    pub device: String,
+    /// Scene name.
+    pub scene: String,
+    /// Image width (primary rays per row).
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Traces of each set measured.
+    pub repeats: u32,
+    /// Per set.
+    pub sets: Vec<RaySetStats>,
+}
+
+impl RayBenchReport {
+    /// A human-readable table.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "{} on {}, {}x{}, median of {} traces per set\n{:<8} {:>10} {:>10} {:>10} {:>10}\n",
+            self.scene,
+            self.device,
+            self.width,
+            self.height,
+            self.repeats,
+            "set",
+            "rays",
+            "hits",
+            "ms",
+            "Mrays/s"
+        );
+        for r in &self.sets {
+            s.push_str(&format!(
+                "{:<8} {:>10} {:>10} {:>10.3} {:>10.1}\n",
+                r.set, r.rays, r.hits, r.median_ms, r.mrays_per_s
+            ));
+        }
+        s
+    }
+}
+
+/// A small deterministic generator for the bounce directions.
+fn unit(i: u32, salt: u32) -> f32 {
+    let mut x = i.wrapping_mul(0x9e37_79b9) ^ salt.wrapping_mul(0x85eb_ca6b);
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    (x >> 8) as f32 / 16_777_216.0
+}
+
+/// Runs the benchmark.
+pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult<RayBenchReport> {
+    let mut o = options.clone();
+    o.render.rays = true;
+    o.readback = None;
+    let session = Session::open(&o, start)?;
+    let mut query = RayQuery::new(&session.gpu)?;
+    let result = measure(&session, &mut query, &o, repeats.max(1));
+    query.destroy(&session.gpu);
+    let errors = session.close();
+    let report = result?;
+    if errors > 0 {
+        return Err(PlayError::new(Exit::Gpu, format!("the validation layer reported {errors} error(s)")));
+    }
+    Ok(report)
+}
+
+fn measure(
+    session: &Session,
+    query: &mut RayQuery,
+    o: &SessionOptions,
+    repeats: u32,
+) -> PlayResult<RayBenchReport> {
+    let gpu = &session.gpu;
+    let bvh = session
+        .scene
+        .bvh
+        .as_ref()
+        .ok_or_else(|| PlayError::new(Exit::BadInput, "the file has no BVH: nothing to trace"))?;
+    let file = open_file(&o.file)?;
+    let view = SceneView::new(&file)
+        .map_err(|e| PlayError::new(Exit::BadInput, format!("invalid .kiln file: {e}")))?;
+    let (w, h) = (o.width, o.height);
+    let cam = &session.camera;
+    let right = cam.forward.cross(cam.up).normalize_or(glam::DVec3::X);
+    let up = right.cross(cam.forward);
+    let tan = (cam.vfov_degrees.to_radians() * 0.5).tan();
+    let aspect = w as f64 / h as f64;
+    let eye = cam.position.as_vec3();
+    let mut primary = Vec::with_capacity(w as usize * h as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let nx = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
+            let ny = 1.0 - (y as f64 + 0.5) / h as f64 * 2.0;
+            let d = (cam.forward + right * nx * tan * aspect + up * ny * tan).normalize().as_vec3();
+            primary.push(GpuRay {
+                origin: eye.to_array(),
+                tmin: 0.0,
+                direction: d.to_array(),
+                tmax: f32::MAX,
+            });
+        }
+    }
+    let (hits, _) = query.trace(gpu, bvh, &primary, false)?;
+    let light = view.manifest.lights.first();
+    let mut shadow = Vec::new();
+    let mut diffuse = Vec::new();
+    for (i, (r, hit)) in primary.iter().zip(&hits).enumerate() {
+        if hit.t == NO_HIT {
+            continue;
+        }
+        let Some(tri) = view.triangles.get(hit.triangle as usize) else {
+            return Err(PlayError::new(Exit::Gpu, "the traversal returned a triangle out of range"));
+        };
+        let c = tri.map(|v| Vec3::from(view.vertices[v as usize].position));
+        let d = Vec3::from(r.direction);
+        let p = c[0] * (1.0 - hit.u - hit.v) + c[1] * hit.u + c[2] * hit.v;
+        let mut n = (c[1] - c[0]).cross(c[2] - c[0]).normalize_or_zero();
+        if n.dot(d) > 0.0 {
+            n = -n;
+        }
+        let origin = offset_origin(p, n).to_array();
+        if let Some(l) = light {
+            let (dir, tmax) = match l.kind {
+                LightKind::Directional => (-Vec3::from(l.direction), f32::MAX),
+                _ => {
+                    let to = Vec3::from(l.position) - p;
+                    (to.normalize_or_zero(), to.length() * (1.0 - 1e-5))
+                }
+            };
+            shadow.push(GpuRay { origin, tmin: 0.0, direction: dir.to_array(), tmax });
+        }
+        let (u1, u2) = (unit(i as u32, 1), unit(i as u32, 2));
+        let (s, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+        let t = if n.z.abs() < 0.999 { Vec3::Z.cross(n).normalize() } else { Vec3::X.cross(n).normalize() };
+        let b = n.cross(t);
+        let dir = t * (s * phi.cos()) + b * (s * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
+        diffuse.push(GpuRay { origin, tmin: 0.0, direction: dir.to_array(), tmax: f32::MAX });
+    }
+    let mut sets = Vec::new();
+    for (name, rays, any) in
+        [("primary", &primary, false), ("shadow", &shadow, true), ("diffuse", &diffuse, false)]
+    {
+        if rays.is_empty() {
+            continue;
+        }
+        let mut ms = Vec::with_capacity(repeats as usize);
+        let mut hit_count = 0;
+        for _ in 0..repeats {
+            let (hits, t) = query.trace(gpu, bvh, rays, any)?;
+            hit_count = hits.iter().filter(|h| h.t != NO_HIT).count();
+            ms.push(t);
+        }
+        ms.sort_by(f64::total_cmp);
+        let median = quantile(&ms, 0.5);
+        sets.push(RaySetStats {
+            set: name.into(),
+            rays: rays.len(),
+            hits: hit_count,
+            median_ms: median,
+            p10_ms: quantile(&ms, 0.1),
+            p90_ms: quantile(&ms, 0.9),
+            mrays_per_s: rays.len() as f64 / (median * 1e3),
+        });
+    }
+    Ok(RayBenchReport {
+        device: gpu.name.clone(),
+        scene: view.manifest.scene_name.clone(),
+        width: w,
+        height: h,
+        repeats,
+        sets,
+    })
+}

@@ -1,0 +1,270 @@
+// The scene as the ray-traced passes see it: textures from a texel buffer, alpha-masked
+// traversal, surfaces at hits (shading frame, material) and the glTF metallic-roughness BRDF
+// with its sampling. Shared by the reference path tracer and the hybrid passes so that both
+// shade a hit identically.
+//
+// The includer declares these storage buffers (see shaders/reference/pathtrace.comp):
+//   bvh_nodes, bvh_tris (traverse.glsl), vertex_data (6 floats per vertex), uvs, indices (leaf
+//   order), tri_materials, materials, texels, textures
+// and includes random.glsl, layout.glsl and packing.glsl first.
+#ifndef KILN_SCENE_GLSL
+#define KILN_SCENE_GLSL
+
+const float PI = 3.14159265358979;
+
+// ---------------------------------------------------------------- textures
+int wrap(int i, int n, uint mode) {
+    if (mode == 2u) {
+        return clamp(i, 0, n - 1);
+    }
+    if (mode == 1u) {
+        int m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return m < n ? m : 2 * n - 1 - m;
+    }
+    return ((i % n) + n) % n;
+}
+
+vec4 texel(GpuTexture t, int x, int y) {
+    x = wrap(x, int(t.width), (t.flags >> TEXTURE_WRAP_U_SHIFT) & 3u);
+    y = wrap(y, int(t.height), (t.flags >> TEXTURE_WRAP_V_SHIFT) & 3u);
+    vec4 c = unpackUnorm4x8(texels[t.offset + uint(y) * t.width + uint(x)]);
+    if ((t.flags & TEXTURE_SRGB) != 0u) {
+        c.rgb = srgb_to_linear(c.rgb);
+    }
+    return c;
+}
+
+vec4 sample_texture(uint index, vec2 uv) {
+    GpuTexture t = textures[index];
+    vec2 x = uv * vec2(t.width, t.height);
+    if ((t.flags & TEXTURE_LINEAR) == 0u) {
+        return texel(t, int(floor(x.x)), int(floor(x.y)));
+    }
+    x -= 0.5;
+    ivec2 i = ivec2(floor(x));
+    vec2 f = x - vec2(i);
+    return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x), mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
+}
+
+vec2 triangle_uv(uint tri, float u, float v) {
+    uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
+    return (1.0 - u - v) * uvs[idx.x] + u * uvs[idx.y] + v * uvs[idx.z];
+}
+
+// Alpha-masked materials are cut out during traversal.
+bool bvh_alpha_test(uint tri, float u, float v) {
+    GpuMaterialLayout m = materials[tri_materials[tri]];
+    if (((m.flags >> MATERIAL_ALPHA_SHIFT) & 3u) != 1u) {
+        return true;
+    }
+    float a = m.base_color.a;
+    if (m.base_color_texture != NO_TEXTURE) {
+        a *= sample_texture(m.base_color_texture, triangle_uv(tri, u, v)).a;
+    }
+    return a >= m.alpha_cutoff;
+}
+#define BVH_ALPHA_TEST
+#include "../common/traverse.glsl"
+
+// ---------------------------------------------------------------- surfaces
+struct Surface {
+    vec3 p;
+    vec3 ng;        // geometric normal, facing the incoming ray
+    vec3 ns;        // shading normal, same side as ng
+    bool front;     // the ray hit the triangle's front (counter-clockwise) face
+    vec3 base;
+    float metallic;
+    float roughness;
+    bool diffuse_only;
+    vec3 emission;  // emitted radiance towards the ray (zero from a back face of a one-sided material)
+};
+
+vec3 vertex_normal(uint i) {
+    return vec3(vertex_data[6u * i + 3u], vertex_data[6u * i + 4u], vertex_data[6u * i + 5u]);
+}
+
+Surface surface_at(TraceRay r, TraceHit h) {
+    Surface s;
+    uint tri = h.triangle;
+    vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
+    float w0 = 1.0 - h.u - h.v;
+    s.p = w0 * p0 + h.u * p1 + h.v * p2;
+    vec3 ng = normalize(cross(p1 - p0, p2 - p0));
+    uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
+    vec3 ns = w0 * vertex_normal(idx.x) + h.u * vertex_normal(idx.y) + h.v * vertex_normal(idx.z);
+    ns = dot(ns, ns) > 0.0 ? normalize(ns) : ng;
+    GpuMaterialLayout m = materials[tri_materials[tri]];
+    vec2 uv = vec2(0.0);
+    bool textured = m.base_color_texture != NO_TEXTURE || m.metallic_roughness_texture != NO_TEXTURE || m.normal_texture != NO_TEXTURE
+        || m.emissive_texture != NO_TEXTURE || m.occlusion_texture != NO_TEXTURE;
+    if (textured) {
+        uv = triangle_uv(tri, h.u, h.v);
+    }
+    if (m.normal_texture != NO_TEXTURE) {
+        // Tangent frame of the triangle's texture mapping (glTF: v runs down the image, the
+        // map's green axis up, hence the minus on the bitangent).
+        vec2 t0 = uvs[idx.x], t1 = uvs[idx.y], t2 = uvs[idx.z];
+        vec3 e1 = p1 - p0, e2 = p2 - p0;
+        vec2 d1 = t1 - t0, d2 = t2 - t0;
+        float det = d1.x * d2.y - d1.y * d2.x;
+        if (abs(det) > 1e-20) {
+            vec3 tangent = (e1 * d2.y - e2 * d1.y) / det;
+            vec3 bitangent = (e2 * d1.x - e1 * d2.x) / det;
+            tangent = normalize(tangent - ns * dot(ns, tangent));
+            bitangent = cross(ns, tangent) * (dot(cross(ns, tangent), bitangent) < 0.0 ? -1.0 : 1.0);
+            vec3 mtex = sample_texture(m.normal_texture, uv).xyz * 2.0 - 1.0;
+            vec3 mapped = tangent * mtex.x * m.normal_scale - bitangent * mtex.y * m.normal_scale + ns * mtex.z;
+            if (dot(mapped, mapped) > 0.0) {
+                ns = normalize(mapped);
+            }
+        }
+    }
+    s.front = dot(ng, r.direction) < 0.0;
+    if (!s.front) {
+        ng = -ng;
+        ns = -ns;
+    }
+    // A shading normal on the far side of the surface would light the wrong hemisphere.
+    if (dot(ns, ng) <= 0.0) {
+        ns = ng;
+    }
+    s.ng = ng;
+    s.ns = ns;
+    vec4 base = m.base_color;
+    if (m.base_color_texture != NO_TEXTURE) {
+        base *= sample_texture(m.base_color_texture, uv);
+    }
+    s.base = base.rgb;
+    s.metallic = m.metallic;
+    s.roughness = m.roughness;
+    if (m.metallic_roughness_texture != NO_TEXTURE) {
+        vec4 mr = sample_texture(m.metallic_roughness_texture, uv);
+        s.metallic *= mr.b;
+        s.roughness *= mr.g;
+    }
+    s.metallic = clamp(s.metallic, 0.0, 1.0);
+    s.roughness = clamp(s.roughness, 0.0, 1.0);
+    s.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    vec3 e = m.emission;
+    if (m.emissive_texture != NO_TEXTURE && any(greaterThan(e, vec3(0.0)))) {
+        e *= sample_texture(m.emissive_texture, uv).rgb;
+    }
+    bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
+    s.emission = (s.front || double_sided) ? e : vec3(0.0);
+    return s;
+}
+
+// ---------------------------------------------------------------- BRDF
+float luminance(vec3 c) {
+    return dot(c, vec3(0.2126, 0.7152, 0.0722));
+}
+
+float ggx_d(float n_h, float a2) {
+    float d = n_h * n_h * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+float smith_g1(float n_x, float a2) {
+    return 2.0 * n_x / (n_x + sqrt(a2 + (1.0 - a2) * n_x * n_x));
+}
+
+float alpha_of(Surface s) {
+    return max(s.roughness * s.roughness, 1e-3);
+}
+
+// f(wo, wi) · |n·wi|, zero below the geometric surface.
+vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
+    if (dot(s.ng, wi) <= 0.0) {
+        return vec3(0.0);
+    }
+    float n_l = dot(s.ns, wi);
+    float n_v = dot(s.ns, wo);
+    if (n_l <= 0.0 || n_v <= 0.0) {
+        return vec3(0.0);
+    }
+    if (s.diffuse_only) {
+        return s.base / PI * n_l;
+    }
+    vec3 h = normalize(wo + wi);
+    float a = alpha_of(s);
+    float a2 = a * a;
+    float d = ggx_d(max(dot(s.ns, h), 0.0), a2);
+    float vis = 0.5 / (n_l * sqrt(n_v * n_v * (1.0 - a2) + a2) + n_v * sqrt(n_l * n_l * (1.0 - a2) + a2));
+    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
+    vec3 f = f0 + (1.0 - f0) * pow(1.0 - max(dot(wo, h), 0.0), 5.0);
+    return ((1.0 - f) * (1.0 - s.metallic) * s.base / PI + f * d * vis) * n_l;
+}
+
+// Probability of choosing the specular lobe.
+float specular_probability(Surface s, vec3 wo) {
+    if (s.diffuse_only) {
+        return 0.0;
+    }
+    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
+    float fresnel = luminance(f0 + (1.0 - f0) * pow(1.0 - clamp(dot(s.ns, wo), 0.0, 1.0), 5.0));
+    float diffuse = luminance(s.base) * (1.0 - s.metallic) * (1.0 - fresnel);
+    return clamp(fresnel / max(fresnel + diffuse, 1e-6), 0.05, 0.95);
+}
+
+mat3 basis(vec3 n) {
+    vec3 t = abs(n.z) < 0.999 ? normalize(cross(vec3(0.0, 0.0, 1.0), n)) : normalize(cross(vec3(1.0, 0.0, 0.0), n));
+    return mat3(t, cross(n, t), n);
+}
+
+// Solid-angle density of sampling wi with `sample_brdf`.
+float brdf_pdf(Surface s, vec3 wo, vec3 wi) {
+    float n_l = dot(s.ns, wi);
+    if (n_l <= 0.0 || dot(s.ng, wi) <= 0.0) {
+        return 0.0;
+    }
+    float diffuse = n_l / PI;
+    float ps = specular_probability(s, wo);
+    if (ps == 0.0) {
+        return diffuse;
+    }
+    float n_v = max(dot(s.ns, wo), 1e-6);
+    vec3 h = normalize(wo + wi);
+    float a = alpha_of(s);
+    float a2 = a * a;
+    float specular = smith_g1(n_v, a2) * ggx_d(max(dot(s.ns, h), 0.0), a2) / (4.0 * n_v);
+    return ps * specular + (1.0 - ps) * diffuse;
+}
+
+// GGX visible-normal sampling (Heitz 2018) in the local frame where the normal is +z.
+vec3 sample_vndf(vec3 v, float a, vec2 xi) {
+    vec3 vh = normalize(vec3(a * v.x, a * v.y, v.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(lensq) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float r = sqrt(xi.x);
+    float phi = 2.0 * PI * xi.y;
+    float p1 = r * cos(phi);
+    float p2 = r * sin(phi);
+    float s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * p2;
+    vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+    return normalize(vec3(a * nh.x, a * nh.y, max(nh.z, 0.0)));
+}
+
+vec3 sample_brdf(Surface s, vec3 wo) {
+    mat3 f = basis(s.ns);
+    float ps = specular_probability(s, wo);
+    vec2 xi = vec2(rnd(), rnd());
+    if (rnd() < ps) {
+        vec3 v = transpose(f) * wo;
+        vec3 h = f * sample_vndf(v, alpha_of(s), xi);
+        return reflect(-wo, h);
+    }
+    float r = sqrt(xi.x);
+    float phi = 2.0 * PI * xi.y;
+    return f * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - xi.x)));
+}
+
+// Whether anything blocks the segment from a surface point (offset off its geometric normal
+// `n`) along `dir` for `dist`.
+bool occluded(vec3 from, vec3 n, vec3 dir, float dist) {
+    TraceRay r = make_ray(offset_ray_origin(from, n), dir, 0.0, dist * (1.0 - 1e-5));
+    return trace(r, true).t != NO_HIT;
+}
+
+#endif

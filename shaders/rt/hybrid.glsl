@@ -1,0 +1,112 @@
+// What the hybrid ray-traced passes share (seed 001's shadows, AO and reflections over the
+// G-buffer, with kiln's compute traversal instead of a ray-tracing pipeline): one descriptor set,
+// the exact surface point under a pixel, and progressive accumulation.
+//
+// Surface points are not reconstructed from depth: the G-buffer stores the triangle under each
+// pixel, and the point is the pixel-centre camera ray's barycentric point on that triangle. It
+// lies on the triangle within a few ulps of its corners, which is the error bound that
+// `offset_ray_origin` (Wächter and Binder 2019) is built for; a depth-reconstructed point can be
+// off the surface by far more (depth quantisation, the inverse projection), which is what forces
+// fixed epsilons.
+#ifndef KILN_HYBRID_GLSL
+#define KILN_HYBRID_GLSL
+
+#include "../common/layout.glsl"
+#include "../common/packing.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
+layout(set = 0, binding = 1, std430) readonly buffer BvhNodes { uvec4 bvh_nodes[]; };
+layout(set = 0, binding = 2, std430) readonly buffer BvhTriangles { vec4 bvh_tris[]; };
+layout(set = 0, binding = 3, std430) readonly buffer Vertices { float vertex_data[]; };   // 6 floats each
+layout(set = 0, binding = 4, std430) readonly buffer Uvs { vec2 uvs[]; };
+layout(set = 0, binding = 5, std430) readonly buffer Indices { uint indices[]; };        // leaf order
+layout(set = 0, binding = 6, std430) readonly buffer TriMaterials { uint tri_materials[]; };
+layout(set = 0, binding = 7, std430) readonly buffer Materials { GpuMaterialLayout materials[]; };
+layout(set = 0, binding = 8, std430) readonly buffer Lights { GpuLight lights[]; };
+layout(set = 0, binding = 9, std430) readonly buffer Texels { uint texels[]; };
+layout(set = 0, binding = 10, std430) readonly buffer Textures { GpuTexture textures[]; };
+layout(set = 0, binding = 11, std430) readonly buffer RasterIndices { uint raster_indices[]; }; // draw order
+layout(set = 0, binding = 12) uniform usampler2D g_triangle;
+layout(set = 0, binding = 13) uniform sampler2D g_normal;
+layout(set = 0, binding = 14) uniform sampler2D g_albedo;
+layout(set = 0, binding = 15) uniform sampler2D g_material;
+layout(set = 0, binding = 16, r32f) uniform image2DArray rt_shadows;   // one layer per light
+layout(set = 0, binding = 17, r32f) uniform image2D rt_ao;
+layout(set = 0, binding = 18, rgba32f) uniform image2D rt_reflections;  // rgb, a = 1 where traced
+layout(push_constant) uniform Params { RtConstants rt; };
+
+#include "../common/random.glsl"
+#include "../common/scene.glsl"
+
+// The visible surface under a pixel.
+struct Primary {
+    vec3 p;     // on the triangle
+    vec3 ng;    // geometric normal, towards the camera
+    vec3 n;     // shading normal from the G-buffer, on the camera's side of the surface
+    vec3 v;     // unit vector towards the camera
+};
+
+bool primary_at(ivec2 pixel, out Primary s) {
+    uint id = texelFetch(g_triangle, pixel, 0).r;
+    if (id == 0u) {
+        return false;
+    }
+    uint t = id - 1u;
+    uvec3 idx = uvec3(raster_indices[3u * t], raster_indices[3u * t + 1u], raster_indices[3u * t + 2u]);
+    vec3 p0 = vec3(vertex_data[6u * idx.x], vertex_data[6u * idx.x + 1u], vertex_data[6u * idx.x + 2u]);
+    vec3 p1 = vec3(vertex_data[6u * idx.y], vertex_data[6u * idx.y + 1u], vertex_data[6u * idx.y + 2u]);
+    vec3 p2 = vec3(vertex_data[6u * idx.z], vertex_data[6u * idx.z + 1u], vertex_data[6u * idx.z + 2u]);
+    vec2 ndc = vec2((float(pixel.x) + 0.5) / float(frame.size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + 0.5) / float(frame.size.y) * 2.0);
+    vec3 dir = frame.camera_forward.xyz + frame.camera_right.xyz * (ndc.x * frame.camera_right.w)
+        + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
+    // Möller–Trumbore barycentrics of the pixel-centre ray, clamped onto the triangle (the
+    // rasteriser's sample may lie a hair outside the triangle that won it).
+    vec3 e1 = p1 - p0, e2 = p2 - p0;
+    vec3 pv = cross(dir, e2);
+    float det = dot(e1, pv);
+    vec3 tv = frame.camera.xyz - p0;
+    float u = 0.0, w = 0.0;
+    if (abs(det) > 0.0) {
+        u = dot(tv, pv) / det;
+        w = dot(dir, cross(tv, e1)) / det;
+    }
+    u = clamp(u, 0.0, 1.0);
+    w = clamp(w, 0.0, 1.0 - u);
+    s.p = p0 + u * e1 + w * e2;
+    vec3 ng = cross(e1, e2);
+    ng = dot(ng, ng) > 0.0 ? normalize(ng) : -normalize(dir);
+    if (dot(ng, dir) > 0.0) {
+        ng = -ng;
+    }
+    s.ng = ng;
+    vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
+    s.n = dot(n, ng) < 0.0 ? -n : n;
+    s.v = -normalize(dir);
+    return true;
+}
+
+// Seeds the generator for this pixel, pass and frame.
+void seed_rng(ivec2 pixel, uint pass) {
+    rng = hash(uint(pixel.x) + 65536u * uint(pixel.y)) ^ hash(rt.seed * 0x9e3779b9u + pass * 0x85ebca6bu);
+}
+
+// The running mean over frames: the new sample weighs 1 / (n + 1) after n accumulated frames.
+float accumulate(float old, float value) {
+    return rt.accumulated == 0u ? value : old + (value - old) / float(rt.accumulated + 1u);
+}
+
+vec4 accumulate(vec4 old, vec4 value) {
+    return rt.accumulated == 0u ? value : old + (value - old) / float(rt.accumulated + 1u);
+}
+
+// A direction uniformly distributed in the cone of half-angle acos(cos_max) around `axis`.
+vec3 sample_cone(vec3 axis, float cos_max) {
+    float c = 1.0 - rnd() * (1.0 - cos_max);
+    float s = sqrt(max(1.0 - c * c, 0.0));
+    float phi = 2.0 * PI * rnd();
+    return basis(axis) * vec3(s * cos(phi), s * sin(phi), c);
+}
+
+#endif

@@ -1,0 +1,104 @@
+#version 460
+// Ray-traced glossy reflections (seed 001 §1.5) at full resolution or one ray per 2 × 2 pixels.
+// Per traced pixel one GGX visible-normal sample (Heitz 2018) of the specular lobe; the stored
+// value is F(v·h) · G2 / G1(v) · L(wi), the unbiased one-sample estimate of the lobe's reflected
+// radiance (the composition adds it in place of the split-sum ambient specular). At the hit:
+// emission, every light with one hard shadow ray to its centre (as in the thesis), and the sky as
+// unshadowed ambient; a miss sees the sky.
+//
+// Fixes of the thesis's code: surfaces that are too *rough* are skipped (its test was inverted
+// and skipped the smooth ones), a sample below the surface contributes zero instead of being
+// re-rolled in an unbounded loop (re-rolling biases the estimate), the weight includes the
+// masking term and the pdf (it used Fresnel alone), and diffuse-only materials are not traced.
+#include "hybrid.glsl"
+
+// Smith Λ of GGX for a direction at cosine c to the normal.
+float smith_lambda(float c, float a2) {
+    float c2 = max(c * c, 1e-12);
+    return 0.5 * (sqrt(1.0 + a2 * (1.0 - c2) / c2) - 1.0);
+}
+
+// Radiance leaving the hit towards -dir.
+vec3 shade_hit(TraceRay r, TraceHit h) {
+    Surface s = surface_at(r, h);
+    vec3 wo = -normalize(r.direction);
+    vec3 sum = s.emission;
+    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
+    vec3 diffuse = s.diffuse_only ? s.base : s.base * (1.0 - s.metallic);
+    sum += frame.sky.rgb * (s.diffuse_only ? diffuse : diffuse + f0);
+    for (uint i = 0u; i < frame.size.z; i++) {
+        GpuLight l = lights[i];
+        vec3 wi;
+        float dist;
+        vec3 li;
+        if (l.kind == LIGHT_DIRECTIONAL) {
+            wi = -l.direction;
+            dist = 3.4e38;
+            li = l.radiance;
+        } else {
+            vec3 to = l.position - s.p;
+            dist = length(to);
+            wi = to / max(dist, 1e-30);
+            if (dist <= 0.0 || (l.range > 0.0 && dist > l.range)) {
+                continue;
+            }
+            li = l.radiance / (dist * dist);
+            if (l.kind == LIGHT_SPOT) {
+                float t = clamp((dot(-wi, l.direction) - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-6), 0.0, 1.0);
+                li *= t * t * (3.0 - 2.0 * t);
+            } else if (l.kind == LIGHT_RECT) {
+                // The rectangle seen from the hit as one point at its centre.
+                li *= max(dot(-wi, l.direction), 0.0) * l.width * l.height;
+            }
+        }
+        vec3 f = brdf_cos(s, wo, wi);
+        if (any(greaterThan(f * li, vec3(0.0))) && !occluded(s.p, s.ng, wi, dist)) {
+            sum += f * li;
+        }
+    }
+    return sum;
+}
+
+void main() {
+    uvec2 cell = gl_GlobalInvocationID.xy;
+    uvec2 cells = (frame.size.xy + rt.reflection_step - 1u) / rt.reflection_step;
+    if (any(greaterThanEqual(cell, cells))) {
+        return;
+    }
+    // Half resolution traces the top-left pixel of each 2 × 2 block; the composition upsamples
+    // with weights that respect that pixel's surface.
+    ivec2 pixel = ivec2(cell * rt.reflection_step);
+    vec4 value = vec4(0.0);
+    Primary s;
+    if (primary_at(pixel, s)) {
+        vec4 mat = texelFetch(g_material, pixel, 0);
+        float roughness = mat.g;
+        if (mat.b < 0.5 && roughness <= rt.max_roughness) {
+            seed_rng(pixel, 3u);
+            vec3 base = texelFetch(g_albedo, pixel, 0).rgb;
+            vec3 f0 = mix(vec3(0.04), base, mat.r);
+            float a = max(roughness * roughness, 1e-3);
+            float a2 = a * a;
+            mat3 f = basis(s.n);
+            vec3 h = f * sample_vndf(transpose(f) * s.v, a, vec2(rnd(), rnd()));
+            vec3 wi = reflect(-s.v, h);
+            vec3 radiance = vec3(0.0);
+            float n_l = dot(s.n, wi);
+            if (n_l > 0.0 && dot(wi, s.ng) > 0.0) {
+                float n_v = max(dot(s.n, s.v), 1e-4);
+                float lv = smith_lambda(n_v, a2);
+                float weight = (1.0 + lv) / (1.0 + lv + smith_lambda(n_l, a2));
+                vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(s.v, h), 0.0, 1.0), 5.0);
+                TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, 3.4e38);
+                TraceHit hit = trace(r, false);
+                vec3 l = hit.t == NO_HIT ? frame.sky.rgb : shade_hit(r, hit);
+                radiance = fresnel * weight * l;
+            }
+            if (any(isnan(radiance)) || any(isinf(radiance))) {
+                radiance = vec3(0.0);
+            }
+            value = vec4(radiance, 1.0);
+        }
+    }
+    imageStore(rt_reflections, ivec2(cell), accumulate(imageLoad(rt_reflections, ivec2(cell)), value));
+}
