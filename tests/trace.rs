@@ -15,7 +15,7 @@ use kiln_compiler::settings::Settings;
 use kiln_format::query::{BvhQuery, IndexedTriangles, Ray, intersect_triangle};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::gpu::GpuOptions;
-use kiln_player::render::{RenderSettings, RtSettings};
+use kiln_player::render::{GBufferMode, RenderSettings, RtSettings};
 use kiln_player::session::{Session, SessionOptions};
 use kiln_player::trace::{GpuRay, NO_HIT, RayQuery};
 use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
@@ -52,6 +52,7 @@ fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
             reference: false,
             exposure: 0.0,
             rt: RtSettings::OFF,
+            gbuffer: GBufferMode::Raster,
         },
         width: 8,
         height: 8,

@@ -214,8 +214,8 @@ impl EmitterKinds {
 }
 
 gpu_struct! {
-    /// A texture in the reference path tracer's texel buffer (std430, 16 bytes): mip 0 as packed
-    /// RGBA8 words from `offset`.
+    /// A texture in the texel buffer of the ray-traced passes (std430, 16 bytes): its mip chain
+    /// as packed RGBA8 words from `offset`.
     pub struct GpuTexture {
         /// First texel (in words).
         pub offset: u32 => "uint",
@@ -241,6 +241,8 @@ impl TextureFlags {
     pub const SRGB: u32 = 1 << 4;
     /// Bilinear filtering (else nearest).
     pub const LINEAR: u32 = 1 << 5;
+    /// Mip levels stored from `offset` (level after level, each `max(1, size >> l)`) in bits 8–12.
+    pub const LEVELS_SHIFT: u32 = 8;
 }
 
 /// Bits of `FrameConstants::size.w`.
@@ -333,6 +335,7 @@ pub fn glsl_layout() -> String {
         ("TEXTURE_WRAP_V_SHIFT", TextureFlags::WRAP_V_SHIFT),
         ("TEXTURE_SRGB", TextureFlags::SRGB),
         ("TEXTURE_LINEAR", TextureFlags::LINEAR),
+        ("TEXTURE_LEVELS_SHIFT", TextureFlags::LEVELS_SHIFT),
     ] {
         s.push_str(&format!("const uint {name} = {v}u;\n"));
     }

@@ -10,7 +10,7 @@ use crate::camera::CameraOverride;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
-use crate::render::{ReflectionRes, RenderSettings, RtSettings};
+use crate::render::{GBufferMode, ReflectionRes, RenderSettings, RtSettings};
 use crate::session::SessionOptions;
 use crate::window;
 
@@ -65,6 +65,16 @@ pub enum Shadows {
     /// Ray-traced soft shadows: one ray per light per pixel per frame, averaged while the
     /// camera is still (see --light-radius, --sun-angle).
     Rt,
+}
+
+/// `--gbuffer`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GBufferArg {
+    /// Rasterise every material attribute (five targets).
+    Raster,
+    /// Rasterise a visibility buffer (triangle per pixel), evaluate materials in compute:
+    /// faster on GPUs with little raster hardware (e.g. NVIDIA H100/H200).
+    Visibility,
 }
 
 /// `--ao`.
@@ -151,6 +161,9 @@ pub struct Args {
     /// Exposure in stops (radiance × 2^EV before tone mapping; PNG and window only).
     #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
+    /// How the G-buffer is made.
+    #[arg(long, value_enum, default_value = "raster")]
+    pub gbuffer: GBufferArg,
     /// Shadows technique.
     #[arg(long, value_enum, default_value = "shadowmap")]
     pub shadows: Shadows,
@@ -247,6 +260,10 @@ impl Args {
                 reference: self.reference,
                 exposure: self.exposure,
                 rt,
+                gbuffer: match self.gbuffer {
+                    GBufferArg::Raster => GBufferMode::Raster,
+                    GBufferArg::Visibility => GBufferMode::Visibility,
+                },
             },
             width: self.size.width,
             height: self.size.height,

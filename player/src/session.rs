@@ -122,7 +122,7 @@ impl Session {
             brdf_lut: true,
             shadow_maps: options.render.shadow_maps,
             bvh: options.render.rays || options.render.reference || options.render.rt.any(),
-            reference: options.render.reference || options.render.rt.any(),
+            reference: options.render.needs_scene_buffers(),
         };
         // The CPU side of loading (validation, checksums, index sorting) runs while the driver
         // creates the device, which on some drivers takes well over 100 ms.
@@ -147,12 +147,13 @@ impl Session {
         // Pipelines compile on one thread while the other streams the file to the GPU.
         let (width, height, readback) = (options.width, options.height, options.readback);
         let rt = options.render.rt;
+        let gbuffer = options.render.gbuffer;
         let rt_shape = rt.shape(prepared.manifest().lights.len());
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
                 // The frame's targets too: allocating them costs milliseconds on some drivers.
-                let pipelines = Pipelines::new(&gpu, rt.any())?;
+                let pipelines = Pipelines::new(&gpu, rt.any(), gbuffer)?;
                 let rest = Targets::new(&gpu, width, height, rt_shape).and_then(|mut targets| match readback
                     .map(|r| Readback::new(&gpu, r, width, height))
                     .transpose()

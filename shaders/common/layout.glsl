@@ -115,5 +115,6 @@ const uint TEXTURE_WRAP_U_SHIFT = 0u;
 const uint TEXTURE_WRAP_V_SHIFT = 2u;
 const uint TEXTURE_SRGB = 16u;
 const uint TEXTURE_LINEAR = 32u;
+const uint TEXTURE_LEVELS_SHIFT = 8u;
 
 #endif

@@ -12,39 +12,7 @@
 
 const float PI = 3.14159265358979;
 
-// ---------------------------------------------------------------- textures
-int wrap(int i, int n, uint mode) {
-    if (mode == 2u) {
-        return clamp(i, 0, n - 1);
-    }
-    if (mode == 1u) {
-        int m = ((i % (2 * n)) + 2 * n) % (2 * n);
-        return m < n ? m : 2 * n - 1 - m;
-    }
-    return ((i % n) + n) % n;
-}
-
-vec4 texel(GpuTexture t, int x, int y) {
-    x = wrap(x, int(t.width), (t.flags >> TEXTURE_WRAP_U_SHIFT) & 3u);
-    y = wrap(y, int(t.height), (t.flags >> TEXTURE_WRAP_V_SHIFT) & 3u);
-    vec4 c = unpackUnorm4x8(texels[t.offset + uint(y) * t.width + uint(x)]);
-    if ((t.flags & TEXTURE_SRGB) != 0u) {
-        c.rgb = srgb_to_linear(c.rgb);
-    }
-    return c;
-}
-
-vec4 sample_texture(uint index, vec2 uv) {
-    GpuTexture t = textures[index];
-    vec2 x = uv * vec2(t.width, t.height);
-    if ((t.flags & TEXTURE_LINEAR) == 0u) {
-        return texel(t, int(floor(x.x)), int(floor(x.y)));
-    }
-    x -= 0.5;
-    ivec2 i = ivec2(floor(x));
-    vec2 f = x - vec2(i);
-    return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x), mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
-}
+#include "textures.glsl"
 
 vec2 triangle_uv(uint tri, float u, float v) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);

@@ -1,13 +1,15 @@
 #version 460
 // G-buffer pass: material evaluation into four targets.
 //   0 normal    RG16_SNORM  octahedral shading normal (normal map applied), world space
-//   1 albedo    RGBA8_SRGB  base colour
+//   1 albedo    RGBA8_UNORM base colour, sRGB-encoded here (an SRGB format cannot be a storage
+//                           image, and the visibility-buffer resolve writes the same targets)
 //   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag, occlusion
 //   3 emission  RGBA16F     emitted radiance
 //   4 triangle  R32_UINT    1 + the triangle's index in the index buffer (0: nothing drawn); the
 //                           ray-traced passes rebuild the exact surface point from it
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
+#include "../common/normalmap.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 1, binding = 0) uniform sampler2D base_color_tex;
@@ -28,21 +30,6 @@ layout(location = 2) out vec4 out_material;
 layout(location = 3) out vec4 out_emission;
 layout(location = 4) out uint out_triangle;
 
-// Perturbs the normal with a tangent-space normal map through the screen-space cotangent frame
-// (Schüler 2013): no stored tangents needed.
-vec3 apply_normal_map(vec3 n, vec3 p, vec2 uv, vec3 sample_ts) {
-    vec3 dp1 = dFdx(p), dp2 = dFdy(p);
-    vec2 duv1 = dFdx(uv), duv2 = dFdy(uv);
-    vec3 dp2perp = cross(dp2, n);
-    vec3 dp1perp = cross(n, dp1);
-    vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
-    vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
-    float invmax = inversesqrt(max(max(dot(t, t), dot(b, b)), 1e-20));
-    vec3 m = vec3(sample_ts.xy * material.normal_scale, sample_ts.z);
-    // glTF uv runs down the image; its tangent-space y (green) points up: flip the bitangent.
-    return normalize(mat3(t * invmax, -b * invmax, n) * m);
-}
-
 void main() {
     vec4 base = material.base_color;
     if (material.base_color_texture != NO_TEXTURE) {
@@ -61,7 +48,8 @@ void main() {
         n = -n;
     }
     if (material.normal_texture != NO_TEXTURE) {
-        n = apply_normal_map(n, in_position, in_uv, texture(normal_tex, in_uv).xyz * 2.0 - 1.0);
+        n = normal_mapped(n, dFdx(in_position), dFdy(in_position), dFdx(in_uv), dFdy(in_uv),
+            texture(normal_tex, in_uv).xyz * 2.0 - 1.0, material.normal_scale);
     }
     float metallic = material.metallic;
     float roughness = material.roughness;
@@ -80,7 +68,7 @@ void main() {
     }
     bool diffuse_only = (material.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     out_normal = oct_encode(n);
-    out_albedo = vec4(base.rgb, 1.0);
+    out_albedo = vec4(linear_to_srgb(base.rgb), 1.0);
     out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), diffuse_only ? 1.0 : 0.0, occlusion);
     out_emission = vec4(emission, 1.0);
     out_triangle = in_first_triangle + uint(gl_PrimitiveID) + 1u;

@@ -191,7 +191,7 @@ void main() {
     vec3 p = world.xyz / world.w;
     vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
     vec4 mat = texelFetch(g_material, pixel, 0);
-    Surface s = Surface(texelFetch(g_albedo, pixel, 0).rgb, mat.r, mat.g, mat.b > 0.5);
+    Surface s = Surface(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
     vec3 v = normalize(frame.camera.xyz - p);
     if (dot(n, v) < 0.0) {
         n = -n;

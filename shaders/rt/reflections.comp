@@ -75,7 +75,7 @@ void main() {
         float roughness = mat.g;
         if (mat.b < 0.5 && roughness <= rt.max_roughness) {
             seed_rng(pixel, 3u);
-            vec3 base = texelFetch(g_albedo, pixel, 0).rgb;
+            vec3 base = srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb);
             vec3 f0 = mix(vec3(0.04), base, mat.r);
             float a = max(roughness * roughness, 1e-3);
             float a2 = a * a;

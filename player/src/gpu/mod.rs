@@ -231,7 +231,11 @@ impl Gpu {
         // Doubles for the watertight triangle test's edge fallback in ray queries.
         // geometryShader: the G-buffer's fragment shader reads gl_PrimitiveID (SPIR-V declares the
         // Geometry capability for it); no geometry shader is used.
-        let features = vk::PhysicalDeviceFeatures::default().shader_float64(true).geometry_shader(true);
+        // shaderStorageImageExtendedFormats: the visibility-buffer resolve writes RG16_SNORM.
+        let features = vk::PhysicalDeviceFeatures::default()
+            .shader_float64(true)
+            .geometry_shader(true)
+            .shader_storage_image_extended_formats(true);
         let device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_extensions)
@@ -434,6 +438,7 @@ fn pick_device(
             ("maintenance4", f13.maintenance4),
             ("shaderFloat64", f10.shader_float64),
             ("geometryShader", f10.geometry_shader),
+            ("shaderStorageImageExtendedFormats", f10.shader_storage_image_extended_formats),
             ("timelineSemaphore", f12.timeline_semaphore),
             ("bufferDeviceAddress", f12.buffer_device_address),
             ("scalarBlockLayout", f12.scalar_block_layout),

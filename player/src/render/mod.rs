@@ -23,7 +23,7 @@ use crate::gpu::{
 };
 use crate::scene::upload::Uploader;
 use crate::scene::{GpuScene, sampled_desc};
-use targets::{DEPTH_FORMAT, GBUFFER_FORMATS, RtShape, Targets};
+use targets::{DEPTH_FORMAT, GBUFFER_FORMATS, RtShape, TRIANGLE_TARGET, Targets};
 
 /// SPIR-V of the passes, built from `shaders/` by `shaders/build.sh` (checked by a test).
 pub mod spirv {
@@ -37,6 +37,10 @@ pub mod spirv {
     pub const TONEMAP: &[u8] = include_bytes!("../../../shaders/spirv/tonemap.comp.spv");
     /// Ray queries from a buffer.
     pub const TRACE_RAYS: &[u8] = include_bytes!("../../../shaders/spirv/rays.comp.spv");
+    /// Visibility-buffer raster pass.
+    pub const VISIBILITY_FRAG: &[u8] = include_bytes!("../../../shaders/spirv/visibility.frag.spv");
+    /// Visibility-buffer resolve.
+    pub const RESOLVE: &[u8] = include_bytes!("../../../shaders/spirv/resolve.comp.spv");
     /// The reference path tracer.
     pub const PATHTRACE: &[u8] = include_bytes!("../../../shaders/spirv/pathtrace.comp.spv");
     /// Ray-traced soft shadows.
@@ -46,7 +50,7 @@ pub mod spirv {
     /// Ray-traced glossy reflections.
     pub const RT_REFLECTIONS: &[u8] = include_bytes!("../../../shaders/spirv/reflections.comp.spv");
     /// (source under `shaders/`, embedded bytes) of every shader.
-    pub const ALL: [(&str, &[u8]); 9] = [
+    pub const ALL: [(&str, &[u8]); 11] = [
         ("gbuffer/gbuffer.vert", GBUFFER_VERT),
         ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
         ("lighting/direct.comp", DIRECT),
@@ -56,6 +60,8 @@ pub mod spirv {
         ("rt/shadows.comp", RT_SHADOWS),
         ("rt/ao.comp", RT_AO),
         ("rt/reflections.comp", RT_REFLECTIONS),
+        ("gbuffer/visibility.frag", VISIBILITY_FRAG),
+        ("gbuffer/resolve.comp", RESOLVE),
     ];
 }
 
@@ -82,6 +88,26 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// The ray-traced passes.
     pub rt: RtSettings,
+    /// How the G-buffer is made.
+    pub gbuffer: GBufferMode,
+}
+
+/// How the G-buffer is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GBufferMode {
+    /// Rasterised with every material evaluated per fragment (five targets).
+    #[default]
+    Raster,
+    /// A visibility buffer (the triangle under each pixel) rasterised, the materials evaluated in
+    /// compute: far cheaper where raster throughput is small next to compute (datacenter GPUs).
+    Visibility,
+}
+
+impl RenderSettings {
+    /// Whether the passes read the scene's buffers beyond geometry (texel buffer, materials).
+    pub fn needs_scene_buffers(&self) -> bool {
+        self.reference || self.rt.any() || self.gbuffer == GBufferMode::Visibility
+    }
 }
 
 /// Resolution of the ray-traced reflections.
@@ -157,6 +183,15 @@ pub struct Pipelines {
     direct: ComputePipeline,
     tonemap: ComputePipeline,
     rt: Option<RtPipelines>,
+    visibility: Option<VisibilityPipelines>,
+}
+
+/// The visibility-buffer G-buffer: raster pass and compute resolve.
+#[derive(Debug)]
+struct VisibilityPipelines {
+    raster: GraphicsPipeline,
+    layout: SetLayout,
+    resolve: ComputePipeline,
 }
 
 /// The ray-traced passes (one set layout for all three).
@@ -174,7 +209,7 @@ fn b(kind: BindingKind) -> Binding {
 
 impl Pipelines {
     /// Builds every pipeline (through the pipeline cache); the ray-traced ones when `rt`.
-    pub fn new(gpu: &Gpu, rt: bool) -> PlayResult<Pipelines> {
+    pub fn new(gpu: &Gpu, rt: bool, mode: GBufferMode) -> PlayResult<Pipelines> {
         use BindingKind::*;
         let frame_layout = SetLayout::new(gpu, &[b(Uniform)], 1)?;
         let material_layout = SetLayout::new(gpu, &[b(Sampled); 5], 64)?;
@@ -202,6 +237,34 @@ impl Pipelines {
                 push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
             },
         )?;
+        let visibility = if mode == GBufferMode::Visibility {
+            let raster = GraphicsPipeline::new(
+                gpu,
+                &GraphicsDesc {
+                    vertex: spirv::GBUFFER_VERT,
+                    fragment: spirv::VISIBILITY_FRAG,
+                    vertex_strides: &[24, 8],
+                    attributes: &[
+                        (0, 0, vk::Format::R32G32B32_SFLOAT, 0),
+                        (1, 0, vk::Format::R32G32B32_SFLOAT, 12),
+                        (2, 1, vk::Format::R32G32_SFLOAT, 0),
+                    ],
+                    colors: &[GBUFFER_FORMATS[TRIANGLE_TARGET]],
+                    depth: DEPTH_FORMAT,
+                    sets: &[&frame_layout, &material_layout],
+                    push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
+                },
+            )?;
+            let mut bindings = vec![b(Uniform)];
+            bindings.extend([b(Storage); 7]);
+            bindings.push(b(Sampled));
+            bindings.extend([b(StorageImage); 4]);
+            let layout = SetLayout::new(gpu, &bindings, 1)?;
+            let resolve = ComputePipeline::new(gpu, spirv::RESOLVE, &[&layout], 0)?;
+            Some(VisibilityPipelines { raster, layout, resolve })
+        } else {
+            None
+        };
         let direct = ComputePipeline::new(gpu, spirv::DIRECT, &[&direct_layout], 0)?;
         let tonemap = ComputePipeline::new(gpu, spirv::TONEMAP, &[&tonemap_layout], 0)?;
         let rt = if rt {
@@ -229,6 +292,7 @@ impl Pipelines {
             direct,
             tonemap,
             rt,
+            visibility,
         })
     }
 
@@ -237,6 +301,11 @@ impl Pipelines {
         self.gbuffer.destroy(gpu);
         self.direct.destroy(gpu);
         self.tonemap.destroy(gpu);
+        if let Some(v) = &mut self.visibility {
+            v.raster.destroy(gpu);
+            v.resolve.destroy(gpu);
+            v.layout.destroy(gpu);
+        }
         if let Some(rt) = &mut self.rt {
             rt.shadows.destroy(gpu);
             rt.ao.destroy(gpu);
@@ -306,6 +375,7 @@ pub struct Renderer {
     direct_set: vk::DescriptorSet,
     tonemap_set: vk::DescriptorSet,
     rt_set: vk::DescriptorSet,
+    resolve_set: vk::DescriptorSet,
     rt_constants: RtConstants,
     /// Frames averaged at the current camera.
     accumulated: u32,
@@ -429,6 +499,14 @@ impl Renderer {
             Some(rt) if settings.rt.any() => rt.layout.allocate(gpu)?,
             _ => vk::DescriptorSet::null(),
         };
+        if settings.gbuffer == GBufferMode::Visibility && scene.reference.is_none() {
+            plan.warnings.push("the visibility-buffer G-buffer needs the scene buffers: rasterising".into());
+            settings.gbuffer = GBufferMode::Raster;
+        }
+        let resolve_set = match &mut pipelines.visibility {
+            Some(v) if settings.gbuffer == GBufferMode::Visibility => v.layout.allocate(gpu)?,
+            _ => vk::DescriptorSet::null(),
+        };
         let bounds = scene.manifest.bounds;
         let diagonal = glam::Vec3::from(bounds.max).distance(glam::Vec3::from(bounds.min));
         let rt_constants = RtConstants {
@@ -466,6 +544,7 @@ impl Renderer {
             direct_set,
             tonemap_set,
             rt_set,
+            resolve_set,
             rt_constants,
             accumulated: 0,
             last_view_proj: None,
@@ -523,6 +602,29 @@ impl Renderer {
                 Write::StorageImage(14, t.rt_reflections.view),
             ],
         );
+        if let (Some(v), Some(r)) = (&self.pipelines.visibility, &scene.reference)
+            && self.resolve_set != vk::DescriptorSet::null()
+        {
+            v.layout.write(
+                gpu,
+                self.resolve_set,
+                &[
+                    Write::Buffer(0, &self.frame_ubo),
+                    Write::Buffer(1, &scene.vertices),
+                    Write::Buffer(2, &scene.uvs),
+                    Write::Buffer(3, &scene.indices),
+                    Write::Buffer(4, &r.raster_materials),
+                    Write::Buffer(5, &r.materials),
+                    Write::Buffer(6, &r.texels),
+                    Write::Buffer(7, &r.textures),
+                    Write::Sampled(8, g(TRIANGLE_TARGET)),
+                    Write::StorageImage(9, t.gbuffer[0].view),
+                    Write::StorageImage(10, t.gbuffer[1].view),
+                    Write::StorageImage(11, t.gbuffer[2].view),
+                    Write::StorageImage(12, t.gbuffer[3].view),
+                ],
+            );
+        }
         if let (Some(rt), Some(bvh), Some(r)) = (&self.pipelines.rt, &scene.bvh, &scene.reference)
             && self.rt_set != vk::DescriptorSet::null()
         {
@@ -607,13 +709,18 @@ impl Renderer {
         let t = &self.targets;
         rec.reset_timestamps(&self.timestamps);
         rec.timestamp(&self.timestamps, 0);
-        for img in &t.gbuffer {
+        let visibility =
+            self.pipelines.visibility.as_ref().filter(|_| self.resolve_set != vk::DescriptorSet::null());
+        let colors: Vec<&Image> = match visibility {
+            Some(_) => vec![&t.gbuffer[TRIANGLE_TARGET]],
+            None => t.gbuffer.iter().collect(),
+        };
+        for img in &colors {
             rec.transition(img, Use::DISCARD, Use::COLOR);
         }
         rec.transition(&t.depth, Use::DISCARD, Use::DEPTH);
-        let colors: Vec<&Image> = t.gbuffer.iter().collect();
         rec.begin_rendering(&colors, &t.depth);
-        let p = &self.pipelines.gbuffer;
+        let p = visibility.map_or(&self.pipelines.gbuffer, |v| &v.raster);
         rec.bind_graphics(p, &[self.frame_set]);
         if !scene.draws.is_empty() {
             rec.bind_geometry(&[&scene.vertices, &scene.uvs], &scene.indices);
@@ -624,10 +731,19 @@ impl Renderer {
             }
         }
         rec.end_rendering();
-        rec.timestamp(&self.timestamps, 1);
-        for img in &t.gbuffer {
+        for img in &colors {
             rec.transition(img, Use::COLOR, Use::SAMPLED);
         }
+        if let Some(v) = visibility {
+            for img in &t.gbuffer[..TRIANGLE_TARGET] {
+                rec.transition(img, Use::DISCARD, Use::STORAGE);
+            }
+            rec.dispatch_2d(&v.resolve, &[self.resolve_set], t.width, t.height);
+            for img in &t.gbuffer[..TRIANGLE_TARGET] {
+                rec.transition(img, Use::STORAGE, Use::SAMPLED);
+            }
+        }
+        rec.timestamp(&self.timestamps, 1);
         rec.transition(&t.depth, Use::DEPTH, Use::SAMPLED);
         let rt_images = [&t.rt_shadows, &t.rt_ao, &t.rt_reflections];
         for img in rt_images {

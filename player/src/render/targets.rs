@@ -8,11 +8,13 @@ use crate::gpu::{Gpu, Image, ImageDesc};
 /// G-buffer formats, in attachment order (see `shaders/gbuffer/gbuffer.frag`).
 pub const GBUFFER_FORMATS: [vk::Format; 5] = [
     vk::Format::R16G16_SNORM,
-    vk::Format::R8G8B8A8_SRGB,
+    vk::Format::R8G8B8A8_UNORM,
     vk::Format::R8G8B8A8_UNORM,
     vk::Format::R16G16B16A16_SFLOAT,
     vk::Format::R32_UINT,
 ];
+/// Index of the triangle target in [`GBUFFER_FORMATS`] (the visibility buffer).
+pub const TRIANGLE_TARGET: usize = 4;
 /// Depth format.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 /// Linear radiance format (what `-o x.exr` writes).
@@ -65,7 +67,10 @@ fn desc(format: vk::Format, width: u32, height: u32, usage: vk::ImageUsageFlags)
 impl Targets {
     /// Targets of `width` × `height`.
     pub fn new(gpu: &Gpu, width: u32, height: u32, rt: RtShape) -> PlayResult<Targets> {
-        let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        // Storage too: the visibility-buffer resolve writes the material targets in compute.
+        let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT
+            | vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::STORAGE;
         let mut gbuffer = Vec::new();
         for (i, f) in GBUFFER_FORMATS.iter().enumerate() {
             gbuffer.push(Image::new(gpu, &format!("gbuffer {i}"), desc(*f, width, height, attach))?);

@@ -173,6 +173,8 @@ pub struct ReferenceBuffers {
     pub texels: Buffer,
     /// `GpuTexture` table.
     pub textures: Buffer,
+    /// Material of each triangle in draw order (the G-buffer's triangle target).
+    pub raster_materials: Buffer,
     /// Entries in `emitters`.
     pub emitter_count: u32,
 }
@@ -187,6 +189,7 @@ impl ReferenceBuffers {
             &mut self.triangle_emitter,
             &mut self.texels,
             &mut self.textures,
+            &mut self.raster_materials,
         ] {
             b.destroy(gpu);
         }
@@ -412,12 +415,7 @@ impl GpuScene {
                 self.upload_texture(gpu, view, index as usize, up)?;
                 if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
                     let t = tables.textures[index as usize];
-                    let level0 = t.width as usize * t.height as usize * 4;
-                    up.buffer(
-                        &r.texels,
-                        t.offset as u64 * 4,
-                        &view.texture(index as usize).map_err(bad)?[..level0],
-                    )?;
+                    up.buffer(&r.texels, t.offset as u64 * 4, view.texture(index as usize).map_err(bad)?)?;
                 }
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
@@ -468,6 +466,7 @@ impl GpuScene {
             up.buffer(&r.emitters, 0, bytemuck::cast_slice(&tables.emitters))?;
             up.buffer(&r.triangle_emitter, 0, bytemuck::cast_slice(&tables.triangle_emitter))?;
             up.buffer(&r.textures, 0, bytemuck::cast_slice(&tables.textures))?;
+            up.buffer(&r.raster_materials, 0, bytemuck::cast_slice(&raster_materials(&prepared.draws)))?;
         }
         Ok(())
     }
@@ -543,6 +542,11 @@ impl GpuScene {
     }
 }
 
+/// The material of each triangle in draw (index buffer) order.
+fn raster_materials(draws: &[Draw]) -> Vec<u32> {
+    draws.iter().flat_map(|d| std::iter::repeat_n(d.material, d.count as usize / 3)).collect()
+}
+
 /// Allocates the reference path tracer's buffers (filled as their sections stream past).
 fn reference_buffers(
     gpu: &Gpu,
@@ -557,6 +561,7 @@ fn reference_buffers(
         ("triangle emitters", std::mem::size_of_val(tables.triangle_emitter.as_slice())),
         ("texels", tables.texel_words as usize * 4),
         ("texture table", std::mem::size_of_val(tables.textures.as_slice())),
+        ("raster materials", view.triangles.len() * 4),
     ];
     let mut made: Vec<Buffer> = Vec::new();
     for (name, size) in sizes {
@@ -580,6 +585,7 @@ fn reference_buffers(
         triangle_emitter: next(),
         texels: next(),
         textures: next(),
+        raster_materials: next(),
         emitter_count: tables.emitters.len() as u32,
     })
 }

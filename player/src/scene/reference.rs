@@ -13,7 +13,7 @@ pub struct ReferenceTables {
     pub emitters: Vec<GpuEmitter>,
     /// Per triangle (leaf order): its index in `emitters`, or −1.
     pub triangle_emitter: Vec<i32>,
-    /// Per texture: where its mip 0 lies in the texel buffer.
+    /// Per texture: where its mip chain lies in the texel buffer.
     pub textures: Vec<GpuTexture>,
     /// Words (texels) in the texel buffer.
     pub texel_words: u64,
@@ -98,13 +98,16 @@ pub fn tables(
         if t.mag_linear {
             flags |= TextureFlags::LINEAR;
         }
+        flags |= t.mip_levels.min(31) << TextureFlags::LEVELS_SHIFT;
         tables.textures.push(GpuTexture {
             offset: tables.texel_words as u32,
             width: t.width,
             height: t.height,
             flags,
         });
-        tables.texel_words += t.width as u64 * t.height as u64;
+        // The manifest's level count was validated against the size when the file was opened.
+        tables.texel_words +=
+            kiln_format::scene::mip_chain_bytes(t.width, t.height, t.mip_levels).unwrap_or(0) / 4;
     }
     tables
 }

@@ -1,0 +1,19 @@
+// Tangent-space normal mapping through the cotangent frame of the surface's position and uv
+// differentials across the pixel (Schüler 2013): no stored tangents needed. The raster G-buffer
+// passes dFdx/dFdy; the visibility-buffer resolve passes the differentials of the neighbouring
+// pixels' rays on the same triangle, so both give the same frame.
+#ifndef KILN_NORMALMAP_GLSL
+#define KILN_NORMALMAP_GLSL
+
+vec3 normal_mapped(vec3 n, vec3 dp1, vec3 dp2, vec2 duv1, vec2 duv2, vec3 sample_ts, float scale) {
+    vec3 dp2perp = cross(dp2, n);
+    vec3 dp1perp = cross(n, dp1);
+    vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
+    vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+    float invmax = inversesqrt(max(max(dot(t, t), dot(b, b)), 1e-20));
+    vec3 m = vec3(sample_ts.xy * scale, sample_ts.z);
+    // glTF uv runs down the image; its tangent-space y (green) points up: flip the bitangent.
+    return normalize(mat3(t * invmax, -b * invmax, n) * m);
+}
+
+#endif

@@ -1,0 +1,123 @@
+#version 460
+// Visibility-buffer resolve: the G-buffer targets of `gbuffer.frag`, written in compute from the
+// triangle under each pixel. The surface point is the pixel-centre ray's barycentric point on
+// that triangle; the rays through the next pixel in x and y, met with the same triangle's plane,
+// give the uv and position differentials that hardware derivatives give the raster pass
+// (texture level of detail and the normal map's cotangent frame). Textures are filtered
+// trilinearly from the texel buffer's mip chains, like the raster pass's samplers.
+#include "../common/layout.glsl"
+#include "../common/packing.glsl"
+#include "../common/normalmap.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
+layout(set = 0, binding = 1, std430) readonly buffer Vertices { float vertex_data[]; };   // 6 floats each
+layout(set = 0, binding = 2, std430) readonly buffer Uvs { vec2 uvs[]; };
+layout(set = 0, binding = 3, std430) readonly buffer RasterIndices { uint raster_indices[]; };
+layout(set = 0, binding = 4, std430) readonly buffer RasterMaterials { uint raster_materials[]; };
+layout(set = 0, binding = 5, std430) readonly buffer Materials { GpuMaterialLayout materials[]; };
+layout(set = 0, binding = 6, std430) readonly buffer Texels { uint texels[]; };
+layout(set = 0, binding = 7, std430) readonly buffer Textures { GpuTexture textures[]; };
+layout(set = 0, binding = 8) uniform usampler2D g_triangle;
+layout(set = 0, binding = 9, rg16_snorm) uniform writeonly image2D out_normal;
+layout(set = 0, binding = 10, rgba8) uniform writeonly image2D out_albedo;
+layout(set = 0, binding = 11, rgba8) uniform writeonly image2D out_material;
+layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D out_emission;
+
+#include "../common/textures.glsl"
+
+vec3 position(uint v) {
+    return vec3(vertex_data[6u * v], vertex_data[6u * v + 1u], vertex_data[6u * v + 2u]);
+}
+
+vec3 vertex_normal(uint v) {
+    return vec3(vertex_data[6u * v + 3u], vertex_data[6u * v + 4u], vertex_data[6u * v + 5u]);
+}
+
+vec3 pixel_ray(vec2 at) {
+    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
+    return frame.camera_forward.xyz + frame.camera_right.xyz * (ndc.x * frame.camera_right.w)
+        + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
+}
+
+// Barycentrics (of corners 1 and 2) where the ray from the camera along `dir` meets the
+// triangle's plane.
+vec2 barycentrics(vec3 dir, vec3 p0, vec3 e1, vec3 e2) {
+    vec3 pv = cross(dir, e2);
+    float det = dot(e1, pv);
+    if (abs(det) <= 0.0) {
+        return vec2(0.0);
+    }
+    vec3 tv = frame.camera.xyz - p0;
+    return vec2(dot(tv, pv), dot(dir, cross(tv, e1))) / det;
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(uvec2(pixel), frame.size.xy))) {
+        return;
+    }
+    uint id = texelFetch(g_triangle, pixel, 0).r;
+    if (id == 0u) {
+        // Nothing drawn: the direct pass shows the sky (depth 0) without reading these.
+        imageStore(out_normal, pixel, vec4(0.0));
+        imageStore(out_albedo, pixel, vec4(0.0));
+        imageStore(out_material, pixel, vec4(0.0));
+        imageStore(out_emission, pixel, vec4(0.0));
+        return;
+    }
+    uint t = id - 1u;
+    uvec3 idx = uvec3(raster_indices[3u * t], raster_indices[3u * t + 1u], raster_indices[3u * t + 2u]);
+    vec3 p0 = position(idx.x), p1 = position(idx.y), p2 = position(idx.z);
+    vec3 e1 = p1 - p0, e2 = p2 - p0;
+    vec2 centre = vec2(pixel) + 0.5;
+    vec3 dir = pixel_ray(centre);
+    vec2 b = barycentrics(dir, p0, e1, e2);
+    vec2 bx = barycentrics(pixel_ray(centre + vec2(1.0, 0.0)), p0, e1, e2);
+    vec2 by = barycentrics(pixel_ray(centre + vec2(0.0, 1.0)), p0, e1, e2);
+    GpuMaterialLayout m = materials[raster_materials[t]];
+    vec2 t0 = uvs[idx.x], t1 = uvs[idx.y], t2 = uvs[idx.z];
+    vec2 uv = t0 + b.x * (t1 - t0) + b.y * (t2 - t0);
+    vec2 duv_dx = (bx.x - b.x) * (t1 - t0) + (bx.y - b.y) * (t2 - t0);
+    vec2 duv_dy = (by.x - b.x) * (t1 - t0) + (by.y - b.y) * (t2 - t0);
+
+    vec3 n = (1.0 - b.x - b.y) * vertex_normal(idx.x) + b.x * vertex_normal(idx.y) + b.y * vertex_normal(idx.z);
+    n = dot(n, n) > 0.0 ? normalize(n) : normalize(cross(e1, e2));
+    // The rasteriser's front face is counter-clockwise on screen: the corners' normal faces the
+    // camera. Back faces (drawn only for double-sided materials) flip the normal.
+    bool front = dot(cross(e1, e2), dir) < 0.0;
+    if (!front) {
+        n = -n;
+    }
+    if (m.normal_texture != NO_TEXTURE) {
+        vec3 dp_dx = (bx.x - b.x) * e1 + (bx.y - b.y) * e2;
+        vec3 dp_dy = (by.x - b.x) * e1 + (by.y - b.y) * e2;
+        vec3 ts = sample_texture_grad(m.normal_texture, uv, duv_dx, duv_dy).xyz * 2.0 - 1.0;
+        n = normal_mapped(n, dp_dx, dp_dy, duv_dx, duv_dy, ts, m.normal_scale);
+    }
+    vec4 base = m.base_color;
+    if (m.base_color_texture != NO_TEXTURE) {
+        base *= sample_texture_grad(m.base_color_texture, uv, duv_dx, duv_dy);
+    }
+    float metallic = m.metallic;
+    float roughness = m.roughness;
+    if (m.metallic_roughness_texture != NO_TEXTURE) {
+        vec4 mr = sample_texture_grad(m.metallic_roughness_texture, uv, duv_dx, duv_dy);
+        metallic *= mr.b;
+        roughness *= mr.g;
+    }
+    float occlusion = 1.0;
+    if (m.occlusion_texture != NO_TEXTURE) {
+        occlusion = mix(1.0, sample_texture_grad(m.occlusion_texture, uv, duv_dx, duv_dy).r, m.occlusion_strength);
+    }
+    vec3 emission = m.emission;
+    if (m.emissive_texture != NO_TEXTURE) {
+        emission *= sample_texture_grad(m.emissive_texture, uv, duv_dx, duv_dy).rgb;
+    }
+    bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    imageStore(out_normal, pixel, vec4(oct_encode(n), 0.0, 0.0));
+    imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), 1.0));
+    imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), diffuse_only ? 1.0 : 0.0, occlusion));
+    imageStore(out_emission, pixel, vec4(emission, 1.0));
+}
