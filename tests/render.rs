@@ -50,6 +50,7 @@ fn options(
             device: None,
             surface_extensions: Vec::new(),
             pipeline_cache: None,
+            ray_tracing_pipeline: false,
         },
         render: RenderSettings {
             shadow_maps: shadows,

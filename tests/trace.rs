@@ -45,6 +45,7 @@ fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
             device: None,
             surface_extensions: Vec::new(),
             pipeline_cache: None,
+            ray_tracing_pipeline: false,
         },
         render: RenderSettings {
             shadow_maps: false,

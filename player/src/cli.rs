@@ -253,6 +253,8 @@ impl Args {
                 device: self.device.clone(),
                 surface_extensions: Vec::new(),
                 pipeline_cache: if self.no_pipeline_cache { None } else { default_cache_path() },
+                // Only the ray benchmark traces through the driver's pipeline.
+                ray_tracing_pipeline: self.bench_rays,
             },
             render: RenderSettings {
                 shadow_maps: self.shadows == Shadows::Shadowmap,

@@ -12,6 +12,7 @@ pub mod error;
 pub mod gpu;
 pub mod headless;
 pub mod image_out;
+pub mod peer;
 pub mod raybench;
 pub mod reference;
 pub mod render;

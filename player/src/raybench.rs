@@ -1,8 +1,11 @@
 //! `--bench-rays`: throughput of the compute traversal (`shaders/common/traverse.glsl`) on the
-//! three ray sets of a frame of the hybrid pipeline, at the requested size from the file's camera:
+//! ray sets of a frame of the hybrid pipeline, at the requested size from the file's camera:
 //! primary camera rays through pixel centres (closest hit), shadow rays from the primary hits to
-//! the first light (any hit) and diffuse bounces from them (cosine-weighted, closest hit). Rays
-//! stay in pixel order, as a frame traces them. Times are GPU timestamps around the dispatch.
+//! the first light (any hit), AO rays (cosine-weighted, closest hit within a tenth of the scene
+//! diagonal) and unbounded diffuse bounces. Rays stay in pixel order, as a frame traces them.
+//! Times are GPU timestamps around the dispatch. Where the device has a ray-tracing pipeline, the
+//! same rays go through it too ([`crate::peer`]), traces of the two interleaved, and the hits are
+//! compared.
 
 use std::time::Instant;
 
@@ -15,7 +18,7 @@ use serde::Serialize;
 use crate::bench::quantile;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::session::{Session, SessionOptions, open_file};
-use crate::trace::{GpuRay, NO_HIT, RayQuery};
+use crate::trace::{GpuHit, GpuRay, NO_HIT, RayQuery};
 
 /// One ray set's figures.
 #[derive(Debug, Clone, Serialize)]
@@ -34,6 +37,22 @@ pub struct RaySetStats {
     pub p90_ms: f64,
     /// Million rays per second at the median.
     pub mrays_per_s: f64,
+    /// The driver's ray-tracing pipeline on the same rays, when present.
+    pub peer: Option<PeerStats>,
+}
+
+/// The ray-tracing pipeline's figures for one set.
+#[derive(Debug, Clone, Serialize)]
+pub struct PeerStats {
+    /// Median GPU milliseconds per trace.
+    pub median_ms: f64,
+    /// Million rays per second at the median.
+    pub mrays_per_s: f64,
+    /// kiln's Mrays/s over the pipeline's.
+    pub ratio: f64,
+    /// Rays on which both agree: both miss, or both hit (any-hit sets), or the same triangle or
+    /// a distance within 1e-4 relative (closest-hit sets; ties on shared edges differ).
+    pub agreeing: usize,
 }
 
 /// The report.
@@ -51,13 +70,15 @@ pub struct RayBenchReport {
     pub repeats: u32,
     /// Per set.
     pub sets: Vec<RaySetStats>,
+    /// GPU milliseconds the driver took to build its acceleration structures (with a peer).
+    pub peer_build_ms: Option<f64>,
 }
 
 impl RayBenchReport {
     /// A human-readable table.
     pub fn table(&self) -> String {
         let mut s = format!(
-            "{} on {}, {}x{}, median of {} traces per set\n{:<8} {:>10} {:>10} {:>10} {:>10}\n",
+            "{} on {}, {}x{}, median of {} traces per set\n{:<8} {:>10} {:>10} {:>10} {:>10} {:>12} {:>10} {:>8}\n",
             self.scene,
             self.device,
             self.width,
@@ -67,13 +88,29 @@ impl RayBenchReport {
             "rays",
             "hits",
             "ms",
-            "Mrays/s"
+            "Mrays/s",
+            "RT pipe Mr/s",
+            "ratio",
+            "agree %"
         );
         for r in &self.sets {
             s.push_str(&format!(
-                "{:<8} {:>10} {:>10} {:>10.3} {:>10.1}\n",
+                "{:<8} {:>10} {:>10} {:>10.3} {:>10.1}",
                 r.set, r.rays, r.hits, r.median_ms, r.mrays_per_s
             ));
+            match &r.peer {
+                Some(p) => s.push_str(&format!(
+                    " {:>12.1} {:>10.3} {:>8.3}\n",
+                    p.mrays_per_s,
+                    p.ratio,
+                    100.0 * p.agreeing as f64 / r.rays as f64
+                )),
+                None => s.push_str("            -          -        -\n"),
+            }
+        }
+        match self.peer_build_ms {
+            Some(ms) => s.push_str(&format!("driver acceleration structures built in {ms:.3} ms (GPU)\n")),
+            None => s.push_str("no ray-tracing pipeline on this device: kiln's traversal only\n"),
         }
         s
     }
@@ -146,7 +183,10 @@ fn measure(
     let (hits, _) = query.trace(gpu, bvh, &primary, false)?;
     let light = view.manifest.lights.first();
     let mut shadow = Vec::new();
+    let mut ao = Vec::new();
     let mut diffuse = Vec::new();
+    let bounds = view.manifest.bounds;
+    let ao_radius = 0.1 * Vec3::from(bounds.max).distance(Vec3::from(bounds.min));
     for (i, (r, hit)) in primary.iter().zip(&hits).enumerate() {
         if hit.t == NO_HIT {
             continue;
@@ -178,32 +218,25 @@ fn measure(
         let b = n.cross(t);
         let dir = t * (s * phi.cos()) + b * (s * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
         diffuse.push(GpuRay { origin, tmin: 0.0, direction: dir.to_array(), tmax: f32::MAX });
+        let (u1, u2) = (unit(i as u32, 3), unit(i as u32, 4));
+        let (s, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+        let dir = t * (s * phi.cos()) + b * (s * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt();
+        ao.push(GpuRay { origin, tmin: 0.0, direction: dir.to_array(), tmax: ao_radius });
     }
-    let mut sets = Vec::new();
-    for (name, rays, any) in
-        [("primary", &primary, false), ("shadow", &shadow, true), ("diffuse", &diffuse, false)]
-    {
-        if rays.is_empty() {
-            continue;
-        }
-        let mut ms = Vec::with_capacity(repeats as usize);
-        let mut hit_count = 0;
-        for _ in 0..repeats {
-            let (hits, t) = query.trace(gpu, bvh, rays, any)?;
-            hit_count = hits.iter().filter(|h| h.t != NO_HIT).count();
-            ms.push(t);
-        }
-        ms.sort_by(f64::total_cmp);
-        let median = quantile(&ms, 0.5);
-        sets.push(RaySetStats {
-            set: name.into(),
-            rays: rays.len(),
-            hits: hit_count,
-            median_ms: median,
-            p10_ms: quantile(&ms, 0.1),
-            p90_ms: quantile(&ms, 0.9),
-            mrays_per_s: rays.len() as f64 / (median * 1e3),
-        });
+    let corners: Vec<[f32; 3]> =
+        view.triangles.iter().flat_map(|t| t.map(|v| view.vertices[v as usize].position)).collect();
+    let mut peer = crate::peer::RtPipelinePeer::new(gpu, &corners)?;
+    let sets = [
+        ("primary", &primary, false),
+        ("shadow", &shadow, true),
+        ("ao", &ao, false),
+        ("diffuse", &diffuse, false),
+    ];
+    let result = trace_sets(gpu, bvh, query, peer.as_mut(), repeats, sets);
+    let peer_build_ms = peer.as_ref().map(|p| p.build_ms);
+    if let Some(p) = &mut peer {
+        let _ = gpu.wait_idle();
+        p.destroy(gpu);
     }
     Ok(RayBenchReport {
         device: gpu.name.clone(),
@@ -211,6 +244,73 @@ fn measure(
         width: w,
         height: h,
         repeats,
-        sets,
+        sets: result?,
+        peer_build_ms,
     })
+}
+
+/// Whether two hits of the same ray agree (see [`PeerStats::agreeing`]).
+fn agree(a: &GpuHit, b: &GpuHit, any_hit: bool) -> bool {
+    let (ha, hb) = (a.t != NO_HIT, b.t != NO_HIT);
+    if ha != hb {
+        return false;
+    }
+    !ha || any_hit || a.triangle == b.triangle || (a.t - b.t).abs() <= 1e-4 * a.t.abs().max(b.t.abs())
+}
+
+/// Traces each set `repeats` times through kiln's traversal and, interleaved (so that clocks and
+/// temperature treat both alike), through the peer.
+fn trace_sets(
+    gpu: &crate::gpu::Gpu,
+    bvh: &crate::scene::BvhBuffers,
+    query: &mut RayQuery,
+    mut peer: Option<&mut crate::peer::RtPipelinePeer>,
+    repeats: u32,
+    sets: [(&str, &Vec<GpuRay>, bool); 4],
+) -> PlayResult<Vec<RaySetStats>> {
+    let mut out = Vec::new();
+    for (name, rays, any) in sets {
+        if rays.is_empty() {
+            continue;
+        }
+        let mut ms = Vec::with_capacity(repeats as usize);
+        let mut peer_ms = Vec::with_capacity(repeats as usize);
+        let mut hits = Vec::new();
+        let mut peer_hits = Vec::new();
+        for _ in 0..repeats {
+            let (h, t) = query.trace(gpu, bvh, rays, any)?;
+            hits = h;
+            ms.push(t);
+            if let Some(p) = peer.as_deref_mut() {
+                let (h, t) = p.trace(gpu, rays, any)?;
+                peer_hits = h;
+                peer_ms.push(t);
+            }
+        }
+        ms.sort_by(f64::total_cmp);
+        peer_ms.sort_by(f64::total_cmp);
+        let median = quantile(&ms, 0.5);
+        let mrays = rays.len() as f64 / (median * 1e3);
+        let peer = (!peer_ms.is_empty()).then(|| {
+            let m = quantile(&peer_ms, 0.5);
+            let p_mrays = rays.len() as f64 / (m * 1e3);
+            PeerStats {
+                median_ms: m,
+                mrays_per_s: p_mrays,
+                ratio: mrays / p_mrays,
+                agreeing: hits.iter().zip(&peer_hits).filter(|(a, b)| agree(a, b, any)).count(),
+            }
+        });
+        out.push(RaySetStats {
+            set: name.into(),
+            rays: rays.len(),
+            hits: hits.iter().filter(|h| h.t != NO_HIT).count(),
+            median_ms: median,
+            p10_ms: quantile(&ms, 0.1),
+            p90_ms: quantile(&ms, 0.9),
+            mrays_per_s: mrays,
+            peer,
+        });
+    }
+    Ok(out)
 }

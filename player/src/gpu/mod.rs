@@ -38,6 +38,9 @@ pub struct GpuOptions {
     pub surface_extensions: Vec<*const std::ffi::c_char>,
     /// Keep the pipeline cache in this file.
     pub pipeline_cache: Option<PathBuf>,
+    /// Enable the driver's ray-tracing pipeline and acceleration structures when the device has
+    /// them (the peer of the compute traversal in `--bench-rays`).
+    pub ray_tracing_pipeline: bool,
 }
 
 /// Counts of validation messages (errors are what tests require to be zero).
@@ -78,7 +81,16 @@ pub struct Gpu {
     /// Pipeline cache.
     pub pipeline_cache: vk::PipelineCache,
     cache_path: Option<PathBuf>,
+    /// Whether VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure are enabled.
+    pub ray_tracing_pipeline: bool,
 }
+
+/// Device extensions the ray-tracing-pipeline peer needs.
+const RT_PIPELINE_EXTENSIONS: [&std::ffi::CStr; 3] = [
+    ash::khr::acceleration_structure::NAME,
+    ash::khr::ray_tracing_pipeline::NAME,
+    ash::khr::deferred_host_operations::NAME,
+];
 
 impl std::fmt::Debug for Gpu {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -228,20 +240,47 @@ impl Gpu {
             .dynamic_rendering(true)
             .synchronization2(true)
             .maintenance4(true);
+        let available: Vec<std::ffi::CString> =
+            unsafe { instance.enumerate_device_extension_properties(physical) }
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|e| e.extension_name_as_c_str().ok().map(|c| c.to_owned()))
+                .collect();
+        let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+        let mut rtp = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default();
+        let ray_tracing_pipeline = options.ray_tracing_pipeline
+            && RT_PIPELINE_EXTENSIONS.iter().all(|x| available.iter().any(|a| a.as_c_str() == *x))
+            && {
+                let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut accel).push_next(&mut rtp);
+                unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+                let int64 = f2.features.shader_int64 == vk::TRUE;
+                int64 && accel.acceleration_structure == vk::TRUE && rtp.ray_tracing_pipeline == vk::TRUE
+            };
         // Doubles for the watertight triangle test's edge fallback in ray queries.
         // geometryShader: the G-buffer's fragment shader reads gl_PrimitiveID (SPIR-V declares the
         // Geometry capability for it); no geometry shader is used.
         // shaderStorageImageExtendedFormats: the visibility-buffer resolve writes RG16_SNORM.
+        // shaderInt64: the ray-tracing peer's shaders take 64-bit device addresses.
         let features = vk::PhysicalDeviceFeatures::default()
             .shader_float64(true)
             .geometry_shader(true)
-            .shader_storage_image_extended_formats(true);
-        let device_info = vk::DeviceCreateInfo::default()
+            .shader_storage_image_extended_formats(true)
+            .shader_int64(ray_tracing_pipeline);
+        let mut accel =
+            vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
+        let mut rtp = vk::PhysicalDeviceRayTracingPipelineFeaturesKHR::default().ray_tracing_pipeline(true);
+        if ray_tracing_pipeline {
+            device_extensions.extend(RT_PIPELINE_EXTENSIONS.iter().map(|x| x.as_ptr()));
+        }
+        let mut device_info = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_infos)
             .enabled_extension_names(&device_extensions)
             .enabled_features(&features)
             .push_next(&mut f12)
             .push_next(&mut f13);
+        if ray_tracing_pipeline {
+            device_info = device_info.push_next(&mut accel).push_next(&mut rtp);
+        }
         let device = match unsafe { instance.create_device(physical, &device_info, None) } {
             Ok(d) => d,
             Err(e) => {
@@ -287,6 +326,7 @@ impl Gpu {
             validation,
             pipeline_cache,
             cache_path: options.pipeline_cache.clone(),
+            ray_tracing_pipeline,
         })
     }
 

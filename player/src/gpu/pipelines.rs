@@ -241,6 +241,9 @@ pub struct GraphicsDesc<'a> {
     pub sets: &'a [&'a SetLayout],
     /// Push constant bytes.
     pub push_bytes: u32,
+    /// Cull back (clockwise) faces in hardware; otherwise nothing is culled and the fragment
+    /// shader decides facing.
+    pub cull_back: bool,
 }
 
 /// A graphics pipeline for dynamic rendering.
@@ -253,7 +256,7 @@ pub struct GraphicsPipeline {
 }
 
 impl GraphicsPipeline {
-    /// A triangle-list pipeline with a reversed-Z depth test, no culling (materials decide facing), dynamic
+    /// A triangle-list pipeline with a reversed-Z depth test, optional back-face culling, dynamic
     /// viewport and scissor.
     pub fn new(gpu: &Gpu, d: &GraphicsDesc) -> PlayResult<GraphicsPipeline> {
         let vs = shader_module(gpu, d.vertex)?;
@@ -297,7 +300,7 @@ impl GraphicsPipeline {
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::NONE)
+            .cull_mode(if d.cull_back { vk::CullModeFlags::BACK } else { vk::CullModeFlags::NONE })
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()

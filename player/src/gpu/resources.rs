@@ -83,6 +83,12 @@ impl Buffer {
         Ok(Buffer { raw, size, allocation: Some(allocation) })
     }
 
+    /// The buffer's device address (it must have been created with SHADER_DEVICE_ADDRESS usage).
+    pub fn address(&self, gpu: &Gpu) -> u64 {
+        let info = vk::BufferDeviceAddressInfo::default().buffer(self.raw);
+        unsafe { gpu.device.get_buffer_device_address(&info) }
+    }
+
     /// The mapped bytes of a host-visible buffer.
     pub fn mapped(&mut self) -> Option<&mut [u8]> {
         self.allocation.as_mut().and_then(|a| a.mapped_slice_mut())

@@ -13,7 +13,7 @@ pub mod targets;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use kiln_format::gpu::{FrameConstants, FrameFlags, GpuMaterialLayout, LightKinds, RtConstants};
-use kiln_format::sections::NO_TEXTURE;
+use kiln_format::sections::{MaterialFlags, NO_TEXTURE};
 
 use crate::camera::Camera;
 use crate::error::PlayResult;
@@ -39,6 +39,9 @@ pub mod spirv {
     pub const TRACE_RAYS: &[u8] = include_bytes!("../../../shaders/spirv/rays.comp.spv");
     /// Visibility-buffer raster pass.
     pub const VISIBILITY_FRAG: &[u8] = include_bytes!("../../../shaders/spirv/visibility.frag.spv");
+    /// Visibility-buffer raster pass for opaque one-sided materials.
+    pub const VISIBILITY_OPAQUE_FRAG: &[u8] =
+        include_bytes!("../../../shaders/spirv/visibility_opaque.frag.spv");
     /// Visibility-buffer resolve.
     pub const RESOLVE: &[u8] = include_bytes!("../../../shaders/spirv/resolve.comp.spv");
     /// The reference path tracer.
@@ -50,7 +53,7 @@ pub mod spirv {
     /// Ray-traced glossy reflections.
     pub const RT_REFLECTIONS: &[u8] = include_bytes!("../../../shaders/spirv/reflections.comp.spv");
     /// (source under `shaders/`, embedded bytes) of every shader.
-    pub const ALL: [(&str, &[u8]); 11] = [
+    pub const ALL: [(&str, &[u8]); 12] = [
         ("gbuffer/gbuffer.vert", GBUFFER_VERT),
         ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
         ("lighting/direct.comp", DIRECT),
@@ -61,6 +64,7 @@ pub mod spirv {
         ("rt/ao.comp", RT_AO),
         ("rt/reflections.comp", RT_REFLECTIONS),
         ("gbuffer/visibility.frag", VISIBILITY_FRAG),
+        ("gbuffer/visibility_opaque.frag", VISIBILITY_OPAQUE_FRAG),
         ("gbuffer/resolve.comp", RESOLVE),
     ];
 }
@@ -190,6 +194,7 @@ pub struct Pipelines {
 #[derive(Debug)]
 struct VisibilityPipelines {
     raster: GraphicsPipeline,
+    opaque: GraphicsPipeline,
     layout: SetLayout,
     resolve: ComputePipeline,
 }
@@ -235,33 +240,41 @@ impl Pipelines {
                 depth: DEPTH_FORMAT,
                 sets: &[&frame_layout, &material_layout],
                 push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
+                cull_back: false,
             },
         )?;
         let visibility = if mode == GBufferMode::Visibility {
-            let raster = GraphicsPipeline::new(
-                gpu,
-                &GraphicsDesc {
-                    vertex: spirv::GBUFFER_VERT,
-                    fragment: spirv::VISIBILITY_FRAG,
-                    vertex_strides: &[24, 8],
-                    attributes: &[
-                        (0, 0, vk::Format::R32G32B32_SFLOAT, 0),
-                        (1, 0, vk::Format::R32G32B32_SFLOAT, 12),
-                        (2, 1, vk::Format::R32G32_SFLOAT, 0),
-                    ],
-                    colors: &[GBUFFER_FORMATS[TRIANGLE_TARGET]],
-                    depth: DEPTH_FORMAT,
-                    sets: &[&frame_layout, &material_layout],
-                    push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
-                },
-            )?;
+            let raster = |fragment: &[u8], cull_back: bool| {
+                GraphicsPipeline::new(
+                    gpu,
+                    &GraphicsDesc {
+                        vertex: spirv::GBUFFER_VERT,
+                        fragment,
+                        vertex_strides: &[24, 8],
+                        attributes: &[
+                            (0, 0, vk::Format::R32G32B32_SFLOAT, 0),
+                            (1, 0, vk::Format::R32G32B32_SFLOAT, 12),
+                            (2, 1, vk::Format::R32G32_SFLOAT, 0),
+                        ],
+                        colors: &[GBUFFER_FORMATS[TRIANGLE_TARGET]],
+                        depth: DEPTH_FORMAT,
+                        sets: &[&frame_layout, &material_layout],
+                        push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
+                        cull_back,
+                    },
+                )
+            };
+            // Opaque one-sided materials: culled in hardware and a shader without `discard`, so
+            // the depth test runs before shading; masked or double-sided ones decide in the shader.
+            let opaque = raster(spirv::VISIBILITY_OPAQUE_FRAG, true)?;
+            let raster = raster(spirv::VISIBILITY_FRAG, false)?;
             let mut bindings = vec![b(Uniform)];
             bindings.extend([b(Storage); 7]);
             bindings.push(b(Sampled));
             bindings.extend([b(StorageImage); 4]);
             let layout = SetLayout::new(gpu, &bindings, 1)?;
             let resolve = ComputePipeline::new(gpu, spirv::RESOLVE, &[&layout], 0)?;
-            Some(VisibilityPipelines { raster, layout, resolve })
+            Some(VisibilityPipelines { raster, opaque, layout, resolve })
         } else {
             None
         };
@@ -303,6 +316,7 @@ impl Pipelines {
         self.tonemap.destroy(gpu);
         if let Some(v) = &mut self.visibility {
             v.raster.destroy(gpu);
+            v.opaque.destroy(gpu);
             v.resolve.destroy(gpu);
             v.layout.destroy(gpu);
         }
@@ -720,11 +734,22 @@ impl Renderer {
         }
         rec.transition(&t.depth, Use::DISCARD, Use::DEPTH);
         rec.begin_rendering(&colors, &t.depth);
-        let p = visibility.map_or(&self.pipelines.gbuffer, |v| &v.raster);
-        rec.bind_graphics(p, &[self.frame_set]);
         if !scene.draws.is_empty() {
             rec.bind_geometry(&[&scene.vertices, &scene.uvs], &scene.indices);
+            let mut bound: Option<&GraphicsPipeline> = None;
             for d in &scene.draws {
+                let m = &self.materials[d.material as usize];
+                let opaque_one_sided = m.flags & MaterialFlags::DOUBLE_SIDED == 0
+                    && (m.flags >> MaterialFlags::ALPHA_MODE_SHIFT) & 3 != 1;
+                let p = match visibility {
+                    Some(v) if opaque_one_sided => &v.opaque,
+                    Some(v) => &v.raster,
+                    None => &self.pipelines.gbuffer,
+                };
+                if bound.is_none_or(|b| !std::ptr::eq(b, p)) {
+                    rec.bind_graphics(p, &[self.frame_set]);
+                    bound = Some(p);
+                }
                 rec.bind_graphics_set(p, 1, self.material_sets[d.material as usize]);
                 rec.push_graphics(p, bytemuck::bytes_of(&self.materials[d.material as usize]));
                 rec.draw_indexed(d.count, d.first);
