@@ -190,13 +190,18 @@ impl App {
         if self.title_at.elapsed().as_secs_f64() > 0.5 {
             self.title_at = Instant::now();
             if let Ok(p) = r.session.pass_times() {
+                // Passes that ran (more than a microsecond), by name.
+                let passes: Vec<String> = crate::render::PASSES
+                    .iter()
+                    .zip(p)
+                    .filter(|(_, ms)| *ms > 1e-3)
+                    .map(|(name, ms)| format!("{name} {ms:.2}"))
+                    .collect();
                 r.window.set_title(&format!(
-                    "kiln-play — {} — GPU {:.2} ms (gbuffer {:.2}, direct {:.2}, tonemap {:.2})",
+                    "kiln-play — {} — GPU {:.2} ms ({})",
                     r.session.scene.manifest.scene_name,
                     p.iter().sum::<f64>(),
-                    p[0],
-                    p[1],
-                    p[2]
+                    passes.join(", ")
                 ));
             }
         }

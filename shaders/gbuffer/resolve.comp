@@ -19,11 +19,14 @@ layout(set = 0, binding = 4, std430) readonly buffer RasterMaterials { uint rast
 layout(set = 0, binding = 5, std430) readonly buffer Materials { GpuMaterialLayout materials[]; };
 layout(set = 0, binding = 6, std430) readonly buffer Texels { uint texels[]; };
 layout(set = 0, binding = 7, std430) readonly buffer Textures { GpuTexture textures[]; };
-layout(set = 0, binding = 8) uniform usampler2D g_triangle;
+// Written by the raster pass where something was drawn, undefined elsewhere (not cleared):
+// pixels at the far plane are set to 0 here.
+layout(set = 0, binding = 8, r32ui) uniform uimage2D g_triangle;
 layout(set = 0, binding = 9, rg16_snorm) uniform writeonly image2D out_normal;
 layout(set = 0, binding = 10, rgba8) uniform writeonly image2D out_albedo;
 layout(set = 0, binding = 11, rgba8) uniform writeonly image2D out_material;
 layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D out_emission;
+layout(set = 0, binding = 13) uniform sampler2D g_depth;
 
 #include "../common/textures.glsl"
 
@@ -58,8 +61,11 @@ void main() {
     if (any(greaterThanEqual(uvec2(pixel), frame.size.xy))) {
         return;
     }
-    uint id = texelFetch(g_triangle, pixel, 0).r;
+    // Reversed Z: nothing drawn leaves the cleared depth 0.
+    bool drawn = texelFetch(g_depth, pixel, 0).r > 0.0;
+    uint id = drawn ? imageLoad(g_triangle, pixel).r : 0u;
     if (id == 0u) {
+        imageStore(g_triangle, pixel, uvec4(0u));
         // Nothing drawn: the direct pass shows the sky (depth 0) without reading these.
         imageStore(out_normal, pixel, vec4(0.0));
         imageStore(out_albedo, pixel, vec4(0.0));

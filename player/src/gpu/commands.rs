@@ -361,16 +361,20 @@ impl<'a> Recorder<'a> {
         unsafe { self.gpu.device.cmd_blit_image2(self.cmd, &info) };
     }
 
-    /// Begins dynamic rendering into colour targets (cleared to zero) and a depth target
-    /// (cleared to 0: reversed Z).
-    pub fn begin_rendering(&self, colors: &[&Image], depth: &Image) {
+    /// Begins dynamic rendering into colour targets (cleared to zero when `clear_colors`, else
+    /// left undefined where nothing is drawn) and a depth target (cleared to 0: reversed Z).
+    pub fn begin_rendering(&self, colors: &[&Image], depth: &Image, clear_colors: bool) {
         let color_infos: Vec<vk::RenderingAttachmentInfo> = colors
             .iter()
             .map(|c| {
                 vk::RenderingAttachmentInfo::default()
                     .image_view(c.view)
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .load_op(if clear_colors {
+                        vk::AttachmentLoadOp::CLEAR
+                    } else {
+                        vk::AttachmentLoadOp::DONT_CARE
+                    })
                     .store_op(vk::AttachmentStoreOp::STORE)
                     .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })
             })

@@ -77,7 +77,7 @@ pub const MAX_SHADOW_MAPS: usize = 8;
 pub const MAX_RT_SHADOW_LIGHTS: usize = 16;
 
 /// Passes timed with timestamps, in order (a pass that is off takes 0 ms).
-pub const PASSES: [&str; 6] = ["gbuffer", "shadows", "ao", "reflections", "direct", "tonemap"];
+pub const PASSES: [&str; 7] = ["gbuffer", "resolve", "shadows", "ao", "reflections", "direct", "tonemap"];
 
 /// How to render.
 #[derive(Debug, Clone, Copy)]
@@ -270,8 +270,8 @@ impl Pipelines {
             let raster = raster(spirv::VISIBILITY_FRAG, false)?;
             let mut bindings = vec![b(Uniform)];
             bindings.extend([b(Storage); 7]);
+            bindings.extend([b(StorageImage); 5]);
             bindings.push(b(Sampled));
-            bindings.extend([b(StorageImage); 4]);
             let layout = SetLayout::new(gpu, &bindings, 1)?;
             let resolve = ComputePipeline::new(gpu, spirv::RESOLVE, &[&layout], 0)?;
             Some(VisibilityPipelines { raster, opaque, layout, resolve })
@@ -373,7 +373,7 @@ impl Dummies {
 }
 
 /// GPU times of one frame's passes, in milliseconds (order of [`PASSES`]).
-pub type PassTimes = [f64; 6];
+pub type PassTimes = [f64; 7];
 
 /// Renders a resident scene.
 pub struct Renderer {
@@ -631,11 +631,12 @@ impl Renderer {
                     Write::Buffer(5, &r.materials),
                     Write::Buffer(6, &r.texels),
                     Write::Buffer(7, &r.textures),
-                    Write::Sampled(8, g(TRIANGLE_TARGET)),
+                    Write::StorageImage(8, t.gbuffer[TRIANGLE_TARGET].view),
                     Write::StorageImage(9, t.gbuffer[0].view),
                     Write::StorageImage(10, t.gbuffer[1].view),
                     Write::StorageImage(11, t.gbuffer[2].view),
                     Write::StorageImage(12, t.gbuffer[3].view),
+                    Write::Sampled(13, vec![(t.depth.view, scene.nearest_clamp)]),
                 ],
             );
         }
@@ -733,7 +734,9 @@ impl Renderer {
             rec.transition(img, Use::DISCARD, Use::COLOR);
         }
         rec.transition(&t.depth, Use::DISCARD, Use::DEPTH);
-        rec.begin_rendering(&colors, &t.depth);
+        // The visibility buffer is not cleared (a full-screen clear costs as much as a target's
+        // writes on GPUs with few raster units): the resolve marks pixels at the far plane empty.
+        rec.begin_rendering(&colors, &t.depth, visibility.is_none());
         if !scene.draws.is_empty() {
             rec.bind_geometry(&[&scene.vertices, &scene.uvs], &scene.indices);
             let mut bound: Option<&GraphicsPipeline> = None;
@@ -756,20 +759,26 @@ impl Renderer {
             }
         }
         rec.end_rendering();
-        for img in &colors {
-            rec.transition(img, Use::COLOR, Use::SAMPLED);
-        }
-        if let Some(v) = visibility {
-            for img in &t.gbuffer[..TRIANGLE_TARGET] {
-                rec.transition(img, Use::DISCARD, Use::STORAGE);
-            }
-            rec.dispatch_2d(&v.resolve, &[self.resolve_set], t.width, t.height);
-            for img in &t.gbuffer[..TRIANGLE_TARGET] {
-                rec.transition(img, Use::STORAGE, Use::SAMPLED);
-            }
-        }
-        rec.timestamp(&self.timestamps, 1);
         rec.transition(&t.depth, Use::DEPTH, Use::SAMPLED);
+        rec.timestamp(&self.timestamps, 1);
+        match visibility {
+            Some(v) => {
+                rec.transition(&t.gbuffer[TRIANGLE_TARGET], Use::COLOR, Use::STORAGE);
+                for img in &t.gbuffer[..TRIANGLE_TARGET] {
+                    rec.transition(img, Use::DISCARD, Use::STORAGE);
+                }
+                rec.dispatch_2d(&v.resolve, &[self.resolve_set], t.width, t.height);
+                for img in &t.gbuffer {
+                    rec.transition(img, Use::STORAGE, Use::SAMPLED);
+                }
+            }
+            None => {
+                for img in &colors {
+                    rec.transition(img, Use::COLOR, Use::SAMPLED);
+                }
+            }
+        }
+        rec.timestamp(&self.timestamps, 2);
         let rt_images = [&t.rt_shadows, &t.rt_ao, &t.rt_reflections];
         for img in rt_images {
             // Fresh images are discarded once; after that they carry the running average.
@@ -794,7 +803,7 @@ impl Renderer {
             if let Some(p) = pipeline {
                 rec.dispatch(p, &[self.rt_set], push, [w.div_ceil(8), h.div_ceil(8), 1]);
             }
-            rec.timestamp(&self.timestamps, 2 + i as u32);
+            rec.timestamp(&self.timestamps, 3 + i as u32);
         }
         for img in rt_images {
             rec.transition(img, Use::STORAGE, Use::STORAGE);
@@ -803,11 +812,11 @@ impl Renderer {
         let t = &self.targets;
         rec.transition(&t.radiance, Use::DISCARD, Use::STORAGE);
         rec.dispatch_2d(&self.pipelines.direct, &[self.direct_set], t.width, t.height);
-        rec.timestamp(&self.timestamps, 5);
+        rec.timestamp(&self.timestamps, 6);
         rec.transition(&t.radiance, Use::STORAGE, Use::STORAGE);
         rec.transition(&t.display, Use::DISCARD, Use::STORAGE);
         rec.dispatch_2d(&self.pipelines.tonemap, &[self.tonemap_set], t.width, t.height);
-        rec.timestamp(&self.timestamps, 6);
+        rec.timestamp(&self.timestamps, 7);
         self.frame += 1;
         self.accumulated = (self.accumulated + 1).min(1 << 24);
     }
