@@ -306,9 +306,26 @@ float power_heuristic(float a, float b) {
     return a2 / max(a2 + b * b, 1e-30);
 }
 
-bool occluded(vec3 from, vec3 n, vec3 dir, float dist) {
-    TraceRay r = make_ray(offset_ray_origin(from, n), dir, 0.0, dist * (1.0 - 1e-5));
+// Whether something blocks the segment from `from`, on a surface of geometric normal `n` (the
+// side the segment leaves by), to `to`. The length is measured from the offset origin: measured
+// from `from`, a segment to a point on an emissive triangle reached that triangle (and was
+// blocked by it) wherever the offset exceeded the 1e-5 relative margin, e.g. on surfaces facing
+// the emitter at coordinates >= 0.5 from the origin. Emitter points are offset off their own
+// surface towards `from` by the caller.
+bool occluded(vec3 from, vec3 n, vec3 to) {
+    vec3 o = offset_ray_origin(from, n);
+    vec3 d = to - o;
+    float dist = length(d);
+    if (!(dist > 0.0)) {
+        return false;
+    }
+    TraceRay r = make_ray(o, d / dist, 0.0, dist * (1.0 - 1e-5));
     return trace(r, true).t != NO_HIT;
+}
+
+// Whether something blocks the ray from `from` (as for `occluded`) in direction `dir`, unbounded.
+bool occluded_ray(vec3 from, vec3 n, vec3 dir) {
+    return trace(make_ray(offset_ray_origin(from, n), dir, 0.0, 3.4e38), true).t != NO_HIT;
 }
 
 uint choose_emitter(float xi) {
@@ -353,7 +370,10 @@ vec3 sample_emitter(Surface s, vec3 wo) {
             return vec3(0.0);
         }
         vec3 f = brdf_cos(s, wo, wi);
-        if (all(equal(f, vec3(0.0))) || occluded(origin, s.ng, wi, d)) {
+        // The sampled point, moved off the emitter towards the shading point: the shadow ray
+        // must not reach the emitter's own surface.
+        vec3 q_off = offset_ray_origin(q, dot(nl, wi) < 0.0 ? nl : -nl);
+        if (all(equal(f, vec3(0.0))) || occluded(origin, s.ng, q_off)) {
             return vec3(0.0);
         }
         vec3 le = m.emission;
@@ -365,17 +385,20 @@ vec3 sample_emitter(Surface s, vec3 wo) {
     }
     GpuLight l = lights[e.index];
     vec3 wi;
+    vec3 target;  // the point the shadow ray ends at (directional lights: none)
     float dist;
     vec3 li;
     float pdf_light = e.pdf;
     bool delta = true;
     if (l.kind == LIGHT_DIRECTIONAL) {
         wi = -l.direction;
+        target = vec3(0.0);
         dist = 3.4e38;
         li = l.radiance;
     } else if (l.kind == LIGHT_RECT) {
         vec3 up = cross(l.direction, l.right);
         vec3 q = l.position + l.right * (rnd() - 0.5) * l.width + up * (rnd() - 0.5) * l.height;
+        target = q;
         vec3 to = q - origin;
         float d2 = dot(to, to);
         dist = sqrt(d2);
@@ -389,6 +412,7 @@ vec3 sample_emitter(Surface s, vec3 wo) {
         pdf_light = e.pdf * d2 / (cos_l * area);
         delta = false;
     } else {
+        target = l.position;
         vec3 to = l.position - origin;
         float d2 = dot(to, to);
         dist = sqrt(d2);
@@ -404,7 +428,10 @@ vec3 sample_emitter(Surface s, vec3 wo) {
         li = l.radiance * cone / d2;
     }
     vec3 f = brdf_cos(s, wo, wi);
-    if (all(equal(f, vec3(0.0))) || all(equal(li, vec3(0.0))) || occluded(origin, s.ng, wi, dist)) {
+    if (all(equal(f, vec3(0.0))) || all(equal(li, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    if (l.kind == LIGHT_DIRECTIONAL ? occluded_ray(origin, s.ng, wi) : occluded(origin, s.ng, target)) {
         return vec3(0.0);
     }
     float weight = delta ? 1.0 : power_heuristic(pdf_light, brdf_pdf(s, wo, wi));
