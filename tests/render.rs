@@ -44,26 +44,10 @@ fn options(
     shadows: bool,
 ) -> SessionOptions {
     SessionOptions {
-        file: file.to_path_buf(),
-        gpu: GpuOptions {
-            validate: true,
-            device: None,
-            surface_extensions: Vec::new(),
-            pipeline_cache: None,
-            ray_tracing_pipeline: false,
-        },
-        render: RenderSettings {
-            shadow_maps: shadows,
-            rays: false,
-            reference: false,
-            exposure: 0.0,
-            rt: RtSettings::OFF,
-            gbuffer: GBufferMode::Raster,
-        },
-        width,
-        height,
+        gpu: GpuOptions { validate: true, ..Default::default() },
+        render: RenderSettings { shadow_maps: shadows, ..Default::default() },
         camera,
-        readback: None,
+        ..SessionOptions::new(file, width, height)
     }
 }
 

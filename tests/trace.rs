@@ -15,7 +15,7 @@ use kiln_compiler::settings::Settings;
 use kiln_format::query::{BvhQuery, IndexedTriangles, Ray, intersect_triangle};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::gpu::GpuOptions;
-use kiln_player::render::{GBufferMode, RenderSettings, RtSettings};
+use kiln_player::render::RenderSettings;
 use kiln_player::session::{Session, SessionOptions};
 use kiln_player::trace::{GpuRay, NO_HIT, RayQuery};
 use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
@@ -39,26 +39,9 @@ fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
     let file = dir.join("scene.kiln");
     std::fs::write(&file, bytes).unwrap();
     let options = SessionOptions {
-        file,
-        gpu: GpuOptions {
-            validate: true,
-            device: None,
-            surface_extensions: Vec::new(),
-            pipeline_cache: None,
-            ray_tracing_pipeline: false,
-        },
-        render: RenderSettings {
-            shadow_maps: false,
-            rays: true,
-            reference: false,
-            exposure: 0.0,
-            rt: RtSettings::OFF,
-            gbuffer: GBufferMode::Raster,
-        },
-        width: 8,
-        height: 8,
-        camera: None,
-        readback: None,
+        gpu: GpuOptions { validate: true, ..Default::default() },
+        render: RenderSettings { shadow_maps: false, rays: true, ..Default::default() },
+        ..SessionOptions::new(file, 8, 8)
     };
     Session::open(&options, Instant::now()).unwrap()
 }

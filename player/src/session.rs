@@ -35,6 +35,21 @@ pub struct SessionOptions {
     pub readback: Option<Readable>,
 }
 
+impl SessionOptions {
+    /// `file` at `width` × `height` with the default device and render settings.
+    pub fn new(file: impl Into<PathBuf>, width: u32, height: u32) -> SessionOptions {
+        SessionOptions {
+            file: file.into(),
+            gpu: GpuOptions::default(),
+            render: RenderSettings::default(),
+            width,
+            height,
+            camera: None,
+            readback: None,
+        }
+    }
+}
+
 /// Milliseconds spent in each step of loading (wall clock, this process).
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct LoadTimes {

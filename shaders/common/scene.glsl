@@ -228,11 +228,26 @@ vec3 sample_brdf(Surface s, vec3 wo) {
     return f * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - xi.x)));
 }
 
-// Whether anything blocks the segment from a surface point (offset off its geometric normal
-// `n`) along `dir` for `dist`.
-bool occluded(vec3 from, vec3 n, vec3 dir, float dist) {
-    TraceRay r = make_ray(offset_ray_origin(from, n), dir, 0.0, dist * (1.0 - 1e-5));
+// Whether something blocks the segment from `from`, on a surface of geometric normal `n` (the
+// side the segment leaves by), to `to`. The length is measured from the offset origin: measured
+// from `from`, a segment to a point on an emissive triangle reached that triangle (and was
+// blocked by it) wherever the offset exceeded the 1e-5 relative margin, e.g. on surfaces facing
+// the emitter at coordinates >= 0.5 from the origin. Emitter points are offset off their own
+// surface towards `from` by the caller.
+bool occluded(vec3 from, vec3 n, vec3 to) {
+    vec3 o = offset_ray_origin(from, n);
+    vec3 d = to - o;
+    float dist = length(d);
+    if (!(dist > 0.0)) {
+        return false;
+    }
+    TraceRay r = make_ray(o, d / dist, 0.0, dist * (1.0 - 1e-5));
     return trace(r, true).t != NO_HIT;
+}
+
+// Whether something blocks the ray from `from` (as for `occluded`) in direction `dir`, unbounded.
+bool occluded_ray(vec3 from, vec3 n, vec3 dir) {
+    return trace(make_ray(offset_ray_origin(from, n), dir, 0.0, 3.4e38), true).t != NO_HIT;
 }
 
 #endif

@@ -85,7 +85,10 @@ vec3 sample_emitter(Surface s, vec3 wo) {
             return vec3(0.0);
         }
         vec3 f = brdf_cos(s, wo, wi);
-        if (all(equal(f, vec3(0.0))) || occluded(origin, s.ng, wi, d)) {
+        // The sampled point, moved off the emitter towards the shading point: the shadow ray
+        // must not reach the emitter's own surface.
+        vec3 q_off = offset_ray_origin(q, dot(nl, wi) < 0.0 ? nl : -nl);
+        if (all(equal(f, vec3(0.0))) || occluded(origin, s.ng, q_off)) {
             return vec3(0.0);
         }
         vec3 le = m.emission;
@@ -97,17 +100,20 @@ vec3 sample_emitter(Surface s, vec3 wo) {
     }
     GpuLight l = lights[e.index];
     vec3 wi;
+    vec3 target;  // the point the shadow ray ends at (directional lights: none)
     float dist;
     vec3 li;
     float pdf_light = e.pdf;
     bool delta = true;
     if (l.kind == LIGHT_DIRECTIONAL) {
         wi = -l.direction;
+        target = vec3(0.0);
         dist = 3.4e38;
         li = l.radiance;
     } else if (l.kind == LIGHT_RECT) {
         vec3 up = cross(l.direction, l.right);
         vec3 q = l.position + l.right * (rnd() - 0.5) * l.width + up * (rnd() - 0.5) * l.height;
+        target = q;
         vec3 to = q - origin;
         float d2 = dot(to, to);
         dist = sqrt(d2);
@@ -121,6 +127,7 @@ vec3 sample_emitter(Surface s, vec3 wo) {
         pdf_light = e.pdf * d2 / (cos_l * area);
         delta = false;
     } else {
+        target = l.position;
         vec3 to = l.position - origin;
         float d2 = dot(to, to);
         dist = sqrt(d2);
@@ -136,7 +143,10 @@ vec3 sample_emitter(Surface s, vec3 wo) {
         li = l.radiance * cone / d2;
     }
     vec3 f = brdf_cos(s, wo, wi);
-    if (all(equal(f, vec3(0.0))) || all(equal(li, vec3(0.0))) || occluded(origin, s.ng, wi, dist)) {
+    if (all(equal(f, vec3(0.0))) || all(equal(li, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    if (l.kind == LIGHT_DIRECTIONAL ? occluded_ray(origin, s.ng, wi) : occluded(origin, s.ng, target)) {
         return vec3(0.0);
     }
     float weight = delta ? 1.0 : power_heuristic(pdf_light, brdf_pdf(s, wo, wi));

@@ -52,7 +52,10 @@ vec3 shade_hit(TraceRay r, TraceHit h) {
             }
         }
         vec3 f = brdf_cos(s, wo, wi);
-        if (any(greaterThan(f * li, vec3(0.0))) && !occluded(s.p, s.ng, wi, dist)) {
+        if (!any(greaterThan(f * li, vec3(0.0)))) {
+            continue;
+        }
+        if (!(l.kind == LIGHT_DIRECTIONAL ? occluded_ray(s.p, s.ng, wi) : occluded(s.p, s.ng, l.position))) {
             sum += f * li;
         }
     }

@@ -41,7 +41,10 @@ float visibility(Primary s, GpuLight l) {
     if (dot(wi, s.ng) <= 0.0 || dist <= 0.0) {
         return 0.0;
     }
-    return occluded(s.p, s.ng, wi, dist) ? 0.0 : 1.0;
+    if (l.kind == LIGHT_DIRECTIONAL) {
+        return occluded_ray(s.p, s.ng, wi) ? 0.0 : 1.0;
+    }
+    return occluded(s.p, s.ng, s.p + wi * dist) ? 0.0 : 1.0;
 }
 
 void main() {

@@ -107,6 +107,20 @@ pub enum GBufferMode {
     Visibility,
 }
 
+impl Default for RenderSettings {
+    /// What `kiln-play` does without options: shadow maps, no ray-traced passes, raster G-buffer.
+    fn default() -> RenderSettings {
+        RenderSettings {
+            shadow_maps: true,
+            rays: false,
+            reference: false,
+            exposure: 0.0,
+            rt: RtSettings::OFF,
+            gbuffer: GBufferMode::Raster,
+        }
+    }
+}
+
 impl RenderSettings {
     /// Whether the passes read the scene's buffers beyond geometry (texel buffer, materials).
     pub fn needs_scene_buffers(&self) -> bool {

@@ -1,0 +1,354 @@
+//! kiln's reference path tracer (`kiln-play --reference`) against Mitsuba 3, an independent
+//! renderer: the diffuse Cornell box rendered by both from the same geometry, albedos, light and
+//! camera, compared with HDR-FLIP and relative MSE.
+//!
+//! Two cases cover both kinds of emitter kiln's next-event estimation handles: the demo box with
+//! its analytic rect light, and the same box with the light replaced by an emissive quad (one-sided
+//! emissive triangles). Mitsuba renders many more samples per pixel than kiln and serves as the
+//! reference; the mean HDR-FLIP of kiln's image against it must be at most 0.05. For scale, the
+//! tests also print the error of Mitsuba's own image at kiln's sample count (another seed): what
+//! noise alone gives. An unbiased kiln comes close to it.
+//!
+//! The scene goes to Mitsuba as JSON (`tests/mitsuba/render.py` documents the mapping of
+//! kiln's conventions onto Mitsuba's), rendered with the `scalar_rgb` variant on the CPU. The
+//! comparison runs in the same script with `flip_evaluator`, the FLIP authors' implementation.
+//!
+//! Needs a Vulkan device and a Python with `mitsuba`, `flip-evaluator` and `numpy`: the virtual
+//! environment `.venv-mitsuba` at the workspace root, or the interpreter `KILN_MITSUBA_PYTHON`
+//! names. Without either the tests say why and pass, unless `KILN_REQUIRE_VULKAN` or
+//! `KILN_REQUIRE_MITSUBA` is set (as `.ci/run` does), when they fail. `KILN_MITSUBA_OUT=DIR`
+//! keeps the scene and both images (`.npy`, linear RGB) there.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Mutex;
+use std::time::Instant;
+
+use glam::Vec3;
+use kiln_compiler::import::demo::{cornell_box, lambert_material};
+use kiln_compiler::ir::{Material, Scene};
+use kiln_compiler::settings::Settings;
+use kiln_format::manifest::LightKind;
+use kiln_format::sections::{MaterialFlags, NO_TEXTURE, Vertex};
+use kiln_player::gpu::GpuOptions;
+use kiln_player::render::RenderSettings;
+use kiln_player::session::SessionOptions;
+use kiln_tests::compile;
+
+/// Image size: small, as kiln samples about 0.06 M paths/s on lavapipe with two cores.
+const W: u32 = 64;
+const H: u32 = 48;
+/// kiln's samples per pixel (about 28 s per case on lavapipe with two cores).
+const KILN_SPP: u32 = 512;
+/// Mitsuba's, for the reference (about 1.4 M paths/s on two cores): at 8192 its own noise is
+/// small beside kiln's (measured against 65536 spp: mean FLIP 0.011 at 16384 spp, 0.034 at 512).
+const MITSUBA_SPP: u32 = 8192;
+/// The bound on mean HDR-FLIP of kiln's image against Mitsuba's.
+const MAX_MEAN_FLIP: f64 = 0.05;
+
+const INSTALL: &str = "run .ci/run or python3 -m venv .venv-mitsuba && \
+                       .venv-mitsuba/bin/pip install mitsuba flip-evaluator numpy";
+
+/// Skips (printing why) or, when `require` is set in the environment, fails.
+fn skip(require: &str, why: String) -> bool {
+    assert!(std::env::var_os(require).is_none(), "{why}, but {require} is set");
+    eprintln!("skipping: {why}");
+    false
+}
+
+/// Whether a Vulkan device and the validation layer are here.
+fn vulkan() -> bool {
+    match kiln_player::gpu::list_devices() {
+        Ok(d) if !d.is_empty() => true,
+        other => skip("KILN_REQUIRE_VULKAN", format!("no Vulkan device ({other:?})")),
+    }
+}
+
+/// The Python that has Mitsuba and FLIP, if any.
+fn mitsuba_python() -> Option<PathBuf> {
+    let (python, origin) = match std::env::var_os("KILN_MITSUBA_PYTHON") {
+        Some(p) => (PathBuf::from(p), "KILN_MITSUBA_PYTHON"),
+        None => (workspace().join(".venv-mitsuba/bin/python"), ".venv-mitsuba"),
+    };
+    if !python.exists() {
+        skip(
+            "KILN_REQUIRE_MITSUBA",
+            format!("Mitsuba not installed ({origin} missing: {}; {INSTALL})", python.display()),
+        );
+        return None;
+    }
+    let probe = Command::new(&python)
+        .args(["-c", "import mitsuba, flip_evaluator, numpy; mitsuba.set_variant('scalar_rgb')"])
+        .output();
+    match probe {
+        Ok(o) if o.status.success() => Some(python),
+        Ok(o) => {
+            let why = String::from_utf8_lossy(&o.stderr).trim().lines().last().unwrap_or("").to_string();
+            skip(
+                "KILN_REQUIRE_MITSUBA",
+                format!(
+                    "{} cannot import mitsuba (scalar_rgb), flip_evaluator and numpy: {why}; {INSTALL}",
+                    python.display()
+                ),
+            );
+            None
+        }
+        Err(e) => {
+            skip("KILN_REQUIRE_MITSUBA", format!("cannot run {}: {e}", python.display()));
+            None
+        }
+    }
+}
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The renderers take turns, so that each has the machine's cores and its time is its own.
+static MACHINE: Mutex<()> = Mutex::new(());
+
+/// The scene as `render.py` reads it: camera, triangles grouped by material, rect lights.
+fn scene_json(s: &Scene) -> String {
+    let list = |v: &mut dyn Iterator<Item = String>| v.collect::<Vec<_>>().join(",");
+    let num = |x: f32| {
+        assert!(x.is_finite());
+        format!("{x}")
+    };
+    let vec3 = |v: [f32; 3]| format!("[{}]", list(&mut v.iter().map(|&x| num(x))));
+    assert_eq!(s.sky.radiance, [0.0; 3], "the Mitsuba scene has no sky");
+    let cam = &s.cameras[0];
+    let mut meshes = Vec::new();
+    for (m, material) in s.materials.iter().enumerate() {
+        let g = &material.gpu;
+        assert!(
+            g.flags & MaterialFlags::DIFFUSE_ONLY != 0 && g.base_color_texture == NO_TEXTURE,
+            "{}: only untextured Lambertian materials map onto Mitsuba's diffuse here",
+            material.name
+        );
+        assert!(
+            g.emission == [0.0; 3] || g.flags & MaterialFlags::DOUBLE_SIDED == 0,
+            "{}: Mitsuba's area emitters are one-sided",
+            material.name
+        );
+        let mut remap = vec![u32::MAX; s.vertices.len()];
+        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+        for (t, _) in s.triangles.iter().zip(&s.triangle_materials).filter(|(_, tm)| **tm as usize == m) {
+            for &i in t {
+                if remap[i as usize] == u32::MAX {
+                    remap[i as usize] = (positions.len() / 3) as u32;
+                    positions.extend(s.vertices[i as usize].position);
+                }
+                triangles.push(remap[i as usize]);
+            }
+        }
+        if triangles.is_empty() {
+            continue;
+        }
+        let b = g.base_color;
+        meshes.push(format!(
+            r#"{{"name":"{}","albedo":{},"emission":{},"positions":[{}],"triangles":[{}]}}"#,
+            material.name,
+            vec3([b[0], b[1], b[2]]),
+            vec3(g.emission),
+            list(&mut positions.iter().map(|&x| num(x))),
+            list(&mut triangles.iter().map(u32::to_string)),
+        ));
+    }
+    let mut rects = Vec::new();
+    for l in &s.lights {
+        let LightKind::Rect { width, height } = l.kind else {
+            panic!("light {}: only rect lights are mapped onto Mitsuba here", l.name)
+        };
+        assert!(l.range == 0.0, "light {}: a range has no Mitsuba equivalent", l.name);
+        rects.push(format!(
+            r#"{{"position":{},"direction":{},"right":{},"width":{},"height":{},"radiance":{}}}"#,
+            vec3(l.position),
+            vec3(l.direction),
+            vec3(l.right),
+            num(width),
+            num(height),
+            vec3(l.color.map(|c| c * l.intensity)),
+        ));
+    }
+    format!(
+        r#"{{"camera":{{"position":{},"target":{},"up":{},"vfov_degrees":{}}},"meshes":[{}],"rect_lights":[{}]}}"#,
+        vec3(cam.position),
+        vec3(cam.target),
+        vec3(cam.up),
+        num(cam.vfov_degrees),
+        meshes.join(","),
+        rects.join(","),
+    )
+}
+
+/// Writes linear RGB (row 0 at the top) as a NumPy float32 array of shape (height, width, 3).
+fn write_npy(path: &Path, w: u32, h: u32, rgb: &[f32]) {
+    assert_eq!(rgb.len(), (w * h * 3) as usize);
+    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({h}, {w}, 3), }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((header.len() as u16).to_le_bytes());
+    bytes.extend(header.as_bytes());
+    for v in rgb {
+        bytes.extend(v.to_le_bytes());
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// Runs `render.py` with `args`; returns its last line of output, parsed.
+fn python(python: &Path, args: &[&str]) -> serde_json::Value {
+    let script = workspace().join("tests/mitsuba/render.py");
+    let out = Command::new(python).arg(&script).args(args).output().expect("running Python");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "render.py {}: {}\n{stdout}{}",
+        args.join(" "),
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(stdout.trim().lines().last().unwrap_or("")).expect("a JSON line from render.py")
+}
+
+/// Red left, green right: the red wall must be on the left in both images (none is mirrored).
+fn assert_red_left(name: &str, rgb: &[f32]) {
+    let side = |x0: u32, x1: u32| {
+        let mut s = [0.0f64; 3];
+        for y in 0..H {
+            for x in x0..x1 {
+                let i = ((y * W + x) * 3) as usize;
+                for c in 0..3 {
+                    s[c] += rgb[i + c] as f64;
+                }
+            }
+        }
+        s
+    };
+    let (left, right) = (side(0, W / 4), side(W - W / 4, W));
+    assert!(
+        left[0] > left[1] && right[1] > right[0],
+        "{name}: red wall not on the left ({left:?}, {right:?})"
+    );
+}
+
+/// Renders `scene` with both, compares, and asserts the bound on mean FLIP.
+fn check(case: &str, scene: Scene) {
+    if !vulkan() {
+        return;
+    }
+    let Some(py) = mitsuba_python() else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = match std::env::var_os("KILN_MITSUBA_OUT") {
+        Some(d) => {
+            let d = PathBuf::from(d);
+            std::fs::create_dir_all(&d).unwrap();
+            d
+        }
+        None => tmp.path().to_path_buf(),
+    };
+    let at = |name: &str| dir.join(format!("{case}-{name}"));
+    std::fs::write(at("scene.json"), scene_json(&scene)).unwrap();
+    let file = at("scene.kiln");
+    std::fs::write(
+        &file,
+        compile(scene, Settings { shaft_variants: Some(0), shadow_res: 64, ..Default::default() }),
+    )
+    .unwrap();
+
+    let options = SessionOptions {
+        gpu: GpuOptions { validate: true, ..Default::default() },
+        render: RenderSettings { shadow_maps: false, reference: true, ..Default::default() },
+        ..SessionOptions::new(file, W, H)
+    };
+    let lock = MACHINE.lock().unwrap_or_else(|e| e.into_inner());
+    let (report, rgb) = kiln_player::reference::render(&options, KILN_SPP, Instant::now())
+        .unwrap_or_else(|e| panic!("{case}: kiln reference render: {e}"));
+    assert_eq!(rgb.len(), (W * H * 3) as usize);
+    assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0), "{case}: kiln's image holds NaN, Inf or < 0");
+    write_npy(&at("kiln.npy"), W, H, &rgb);
+    let size = format!("{W}x{H}");
+    let spp = MITSUBA_SPP.to_string();
+    let (scene_path, mitsuba_path) = (at("scene.json"), at("mitsuba.npy"));
+    let m =
+        python(&py, &["render", &scene_path.to_string_lossy(), &mitsuba_path.to_string_lossy(), &spp, &size]);
+    // The noise floor: Mitsuba at kiln's sample count, another seed.
+    let control = at("mitsuba-control.npy");
+    let kiln_spp = KILN_SPP.to_string();
+    python(
+        &py,
+        &["render", &scene_path.to_string_lossy(), &control.to_string_lossy(), &kiln_spp, &size, "1"],
+    );
+    drop(lock);
+    let c = python(&py, &["compare", &mitsuba_path.to_string_lossy(), &at("kiln.npy").to_string_lossy()]);
+    let n = python(&py, &["compare", &mitsuba_path.to_string_lossy(), &control.to_string_lossy()]);
+    let (flip, rel_mse) = (c["mean_flip"].as_f64().unwrap(), c["rel_mse"].as_f64().unwrap());
+    let mut ratio = String::new();
+    for r in c["mean_ratio"].as_array().unwrap() {
+        let _ = write!(ratio, " {:.4}", r.as_f64().unwrap());
+    }
+    eprintln!(
+        "mitsuba check {case}: mean FLIP {flip:.4}, relMSE {rel_mse:.5}, kiln/mitsuba mean radiance (RGB){ratio}; \
+         {W}x{H}, kiln {KILN_SPP} spp in {:.1} s, mitsuba {MITSUBA_SPP} spp in {:.1} s; \
+         noise floor (mitsuba {KILN_SPP} spp, another seed): mean FLIP {:.4}, relMSE {:.5}",
+        report.seconds,
+        m["seconds"].as_f64().unwrap(),
+        n["mean_flip"].as_f64().unwrap(),
+        n["rel_mse"].as_f64().unwrap(),
+    );
+    assert_red_left(&format!("{case} (kiln)"), &rgb);
+    let mitsuba = read_npy(&mitsuba_path);
+    assert_red_left(&format!("{case} (mitsuba)"), &mitsuba);
+    assert!(flip <= MAX_MEAN_FLIP, "{case}: mean FLIP {flip:.4} > {MAX_MEAN_FLIP} (relMSE {rel_mse:.5})");
+}
+
+/// Reads the float32 (height, width, 3) array `render.py` wrote.
+fn read_npy(path: &Path) -> Vec<f32> {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+    let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = String::from_utf8_lossy(&bytes[10..10 + len]);
+    assert!(header.contains("'<f4'") && header.contains(&format!("({H}, {W}, 3)")), "{header}");
+    bytes[10 + len..].chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
+}
+
+#[test]
+fn cornell_box_with_a_rect_light_matches_mitsuba() {
+    let scene = cornell_box();
+    assert!(matches!(scene.lights[..], [ref l] if matches!(l.kind, LightKind::Rect { .. })));
+    check("rect", scene);
+}
+
+#[test]
+fn cornell_box_with_an_emissive_quad_matches_mitsuba() {
+    let mut scene = cornell_box();
+    // The rect light becomes two one-sided emissive triangles of the same size, place and
+    // radiance, their front faces (counter-clockwise) down, a black Lambertian surface.
+    let l = scene.lights.pop().unwrap();
+    let LightKind::Rect { width, height } = l.kind else { panic!("the demo's light is a rect light") };
+    let (p, d, r) = (Vec3::from(l.position), Vec3::from(l.direction), Vec3::from(l.right));
+    let (r, u) = (r * 0.5 * width, d.cross(r) * 0.5 * height);
+    let mut gpu = lambert_material([0.0; 3]);
+    gpu.emission = l.color.map(|c| c * l.intensity);
+    scene.materials.push(Material { name: "emitter".into(), gpu });
+    let material = scene.materials.len() as u32 - 1;
+    // Counter-clockwise seen from below (from `d`'s side): the normal (c1 − c0) × (c2 − c0) is d.
+    let corners = [p - r - u, p + r - u, p + r + u, p - r + u];
+    let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize();
+    assert!(n.dot(d) > 0.999, "the emissive quad must face the way the light did");
+    let base = scene.vertices.len() as u32;
+    for c in corners {
+        scene.vertices.push(Vertex { position: c.to_array(), normal: n.to_array() });
+        if !scene.uvs.is_empty() {
+            scene.uvs.push([0.0; 2]);
+        }
+    }
+    scene.triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    scene.triangle_materials.extend([material; 2]);
+    check("emissive", scene);
+}

@@ -1,0 +1,163 @@
+"""Renders a kiln test scene with Mitsuba 3 (variant scalar_rgb) and compares images with FLIP.
+
+    render.py render SCENE.json OUT.npy SPP WIDTHxHEIGHT [SEED]
+        Renders the scene that tests/mitsuba.rs wrote and saves linear RGB radiance as float32
+        (height, width, 3), row 0 at the top. Prints one JSON line: {"spp", "seconds"}.
+
+    render.py compare REFERENCE.npy TEST.npy [FLIP_MAP.npy]
+        Prints one JSON line: mean HDR-FLIP of TEST against REFERENCE, relative MSE, and the
+        ratio of the images' mean radiance per channel (TEST / REFERENCE); optionally saves the
+        per-pixel FLIP error.
+
+The scene JSON (written by tests/mitsuba.rs) holds the camera, triangle meshes grouped by
+material (positions, vertex indices with front faces counter-clockwise, Lambertian albedo,
+emitted radiance) and one-sided rectangular lights. The conventions are kiln's reference path
+tracer's (shaders/reference/pathtrace.comp), mapped to Mitsuba's:
+
+- Lambertian surfaces reflect on both sides in kiln: `twosided(diffuse)`.
+- Emissive triangles emit from the front face only (as Mitsuba's `area` emitter does); flat
+  face normals (`face_normals`), as the kiln scenes' quads have.
+- A kiln rect light is no geometry (rays pass through it, it casts no shadow) and emits its
+  radiance from the side its `direction` points to: a `rectangle` with an `area` emitter and the
+  `null` BSDF (paths go straight through it), `to_world` mapping Mitsuba's [-1, 1]² (normal +z)
+  onto `right` × width, `direction × right` × height, normal `direction`.
+- Pinhole camera, vertical field of view, box filter over the pixel: `perspective` with
+  `fov_axis: y` and `rfilter: box` (kiln jitters uniformly over the pixel; a box of radius 0.5
+  gives each sample to its own pixel).
+- Unbiased path tracing of unlimited length: `path` with `max_depth: -1`.
+
+FLIP: HDR-FLIP (Andersson et al. 2021, `flip_evaluator`), the variant for linear radiance: it
+tonemaps both images over the range of exposures the reference needs and reports the mean error
+over exposures and pixels, in [0, 1]. Relative MSE: mean over pixels and channels of
+(test - ref)^2 / (ref^2 + 0.01).
+"""
+
+import json
+import os
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+
+def write_ply(path, positions, triangles):
+    positions = np.asarray(positions, dtype="<f4").reshape(-1, 3)
+    triangles = np.asarray(triangles, dtype="<u4").reshape(-1, 3)
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {len(positions)}\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        f"element face {len(triangles)}\n"
+        "property list uchar uint vertex_indices\nend_header\n"
+    )
+    faces = np.zeros(len(triangles), dtype=[("n", "u1"), ("i", "<u4", 3)])
+    faces["n"] = 3
+    faces["i"] = triangles
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        f.write(positions.tobytes())
+        f.write(faces.tobytes())
+
+
+def rgb(value):
+    return {"type": "rgb", "value": [float(v) for v in value]}
+
+
+def scene_dict(mi, desc, tmp, width, height, spp, seed):
+    cam = desc["camera"]
+    scene = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5, "hide_emitters": False},
+        "sensor": {
+            "type": "perspective",
+            "fov_axis": "y",
+            "fov": float(cam["vfov_degrees"]),
+            "near_clip": 1e-3,
+            "far_clip": 1e4,
+            "to_world": mi.ScalarTransform4f().look_at(
+                origin=cam["position"], target=cam["target"], up=cam["up"]
+            ),
+            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+            "film": {
+                "type": "hdrfilm",
+                "width": width,
+                "height": height,
+                "rfilter": {"type": "box"},
+                "pixel_format": "rgb",
+                "component_format": "float32",
+            },
+        },
+    }
+    for i, m in enumerate(desc["meshes"]):
+        path = os.path.join(tmp, f"mesh{i}.ply")
+        write_ply(path, m["positions"], m["triangles"])
+        shape = {
+            "type": "ply",
+            "filename": path,
+            "face_normals": True,
+            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(m["albedo"])}},
+        }
+        if any(v > 0.0 for v in m["emission"]):
+            shape["emitter"] = {"type": "area", "radiance": rgb(m["emission"])}
+        scene[f"mesh{i}"] = shape
+    for i, l in enumerate(desc["rect_lights"]):
+        d = np.asarray(l["direction"], dtype=float)
+        r = np.asarray(l["right"], dtype=float)
+        u = np.cross(d, r)
+        m = np.identity(4)
+        m[:3, 0] = r * 0.5 * l["width"]
+        m[:3, 1] = u * 0.5 * l["height"]
+        m[:3, 2] = d
+        m[:3, 3] = l["position"]
+        scene[f"rect{i}"] = {
+            "type": "rectangle",
+            "to_world": mi.ScalarTransform4f(m.tolist()),
+            "bsdf": {"type": "null"},
+            "emitter": {"type": "area", "radiance": rgb(l["radiance"])},
+        }
+    return scene
+
+
+def render(scene_path, out_path, spp, size, seed):
+    import mitsuba as mi
+
+    mi.set_variant("scalar_rgb")
+    width, height = (int(v) for v in size.split("x"))
+    with open(scene_path) as f:
+        desc = json.load(f)
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = mi.load_dict(scene_dict(mi, desc, tmp, width, height, spp, seed))
+    t0 = time.perf_counter()
+    image = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float32)
+    seconds = time.perf_counter() - t0
+    assert image.shape == (height, width, 3), image.shape
+    np.save(out_path, image)
+    print(json.dumps({"spp": spp, "seconds": seconds}))
+
+
+def compare(reference_path, test_path, flip_map=None):
+    import flip_evaluator
+
+    ref = np.load(reference_path).astype(np.float32)
+    test = np.load(test_path).astype(np.float32)
+    assert ref.shape == test.shape, (ref.shape, test.shape)
+    assert np.isfinite(ref).all() and np.isfinite(test).all(), "non-finite pixels"
+    error_map, mean_flip, _ = flip_evaluator.evaluate(
+        np.ascontiguousarray(ref), np.ascontiguousarray(test), "HDR", applyMagma=False
+    )
+    rel_mse = float(np.mean((test - ref) ** 2 / (ref**2 + 1e-2)))
+    ratio = (test.reshape(-1, 3).mean(axis=0) / np.maximum(ref.reshape(-1, 3).mean(axis=0), 1e-30)).tolist()
+    if flip_map is not None:
+        np.save(flip_map, np.asarray(error_map, dtype=np.float32))
+    print(json.dumps({"mean_flip": float(mean_flip), "rel_mse": rel_mse, "mean_ratio": ratio}))
+
+
+if __name__ == "__main__":
+    args = sys.argv[1:]
+    if len(args) in (5, 6) and args[0] == "render":
+        render(args[1], args[2], int(args[3]), args[4], int(args[5]) if len(args) == 6 else 0)
+    elif len(args) in (3, 4) and args[0] == "compare":
+        compare(*args[1:])
+    else:
+        sys.exit(__doc__)
