@@ -9,9 +9,9 @@
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use crate::error::{Exit, PlayError, PlayResult, vk as vk_err};
+use crate::error::{PlayResult, vk as vk_err};
 use crate::gpu::{Buffer, CommandPool, Gpu, TimestampPool};
-use crate::trace::{GpuHit, GpuRay};
+use crate::trace::{GpuHit, GpuRay, timed_trace};
 
 /// SPIR-V of the peer's shaders.
 pub mod spirv {
@@ -380,83 +380,37 @@ impl RtPipelinePeer {
     /// Traces `rays` (closest hit, or any hit); returns one hit per ray and the GPU milliseconds
     /// of the trace alone.
     pub fn trace(&mut self, gpu: &Gpu, rays: &[GpuRay], any_hit: bool) -> PlayResult<(Vec<GpuHit>, f64)> {
-        if rays.is_empty() {
-            return Ok((Vec::new(), 0.0));
-        }
-        let count = u32::try_from(rays.len())
-            .map_err(|_| PlayError::new(Exit::Usage, "too many rays in one batch"))?;
-        let mut input = Buffer::new(
-            gpu,
-            "peer rays",
-            (rays.len() * 32) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER | ADDRESS,
-            MemoryLocation::CpuToGpu,
-        )?;
-        let output = Buffer::new(
-            gpu,
-            "peer hits",
-            (rays.len() * 16) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER | ADDRESS,
-            MemoryLocation::GpuToCpu,
-        );
-        let mut output = match output {
-            Ok(o) => o,
-            Err(e) => {
-                input.destroy(gpu);
-                return Err(e);
-            }
-        };
-        let result = (|| -> PlayResult<(Vec<GpuHit>, f64)> {
-            input.write(bytemuck::cast_slice(rays))?;
+        let this = &*self;
+        timed_trace(gpu, &this.pool, &this.timestamps, rays, ADDRESS, |rec, input, output, count| {
             let push = Push {
-                tlas: self.tlas_address,
+                tlas: this.tlas_address,
                 rays: input.address(gpu),
                 hits: output.address(gpu),
                 count,
                 any_hit: any_hit as u32,
             };
-            let rec = self.pool.begin(gpu)?;
-            rec.reset_timestamps(&self.timestamps);
-            rec.timestamp(&self.timestamps, 0);
             unsafe {
-                gpu.device.cmd_bind_pipeline(rec.cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, self.pipeline);
+                gpu.device.cmd_bind_pipeline(rec.cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, this.pipeline);
                 gpu.device.cmd_push_constants(
                     rec.cmd,
-                    self.layout,
+                    this.layout,
                     vk::ShaderStageFlags::RAYGEN_KHR,
                     0,
                     bytemuck::bytes_of(&push),
                 );
-                self.rtp.cmd_trace_rays(
+                this.rtp.cmd_trace_rays(
                     rec.cmd,
-                    &self.regions[0],
-                    &self.regions[1],
-                    &self.regions[2],
+                    &this.regions[0],
+                    &this.regions[1],
+                    &this.regions[2],
                     &vk::StridedDeviceAddressRegionKHR::default(),
                     count,
                     1,
                     1,
                 );
             }
-            rec.timestamp(&self.timestamps, 1);
-            rec.memory_barrier(
-                vk::PipelineStageFlags2::RAY_TRACING_SHADER_KHR,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::HOST,
-                vk::AccessFlags2::HOST_READ,
-            );
-            self.pool.submit(gpu, &[], &[])?;
-            self.pool.wait(gpu)?;
-            let ns = self.timestamps.read_ns(gpu)?;
-            let hits: Vec<GpuHit> = output
-                .mapped()
-                .map(|m| bytemuck::pod_collect_to_vec(&m[..rays.len() * 16]))
-                .ok_or_else(|| PlayError::new(Exit::Gpu, "the hit buffer is not host-visible"))?;
-            Ok((hits, (ns[1] - ns[0]) * 1e-6))
-        })();
-        input.destroy(gpu);
-        output.destroy(gpu);
-        result
+            vk::PipelineStageFlags2::RAY_TRACING_SHADER_KHR
+        })
     }
 
     /// Releases everything (the GPU must be idle).

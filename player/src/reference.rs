@@ -59,7 +59,7 @@ pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<
 fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)> {
     let gpu = &session.gpu;
     let scene = &session.scene;
-    let (Some(bvh), Some(r)) = (&scene.bvh, &scene.reference) else {
+    let (Some(common), Some(r)) = (scene.ray_writes(), &scene.reference) else {
         return Err(PlayError::new(
             Exit::BadInput,
             "the file has no BVH (no triangles?): nothing to path trace",
@@ -135,26 +135,17 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
             owned.lights.as_ref().expect("set"),
             owned.image.as_ref().expect("set"),
         );
-        layout.write(
-            gpu,
-            set,
-            &[
-                Write::Buffer(0, ubo),
-                Write::Buffer(1, &bvh.nodes),
-                Write::Buffer(2, &bvh.triangles),
-                Write::Buffer(3, &scene.vertices),
-                Write::Buffer(4, &scene.uvs),
-                Write::Buffer(5, &r.indices),
-                Write::Buffer(6, &r.triangle_materials),
-                Write::Buffer(7, &r.materials),
-                Write::Buffer(8, lights),
-                Write::Buffer(9, &r.emitters),
-                Write::Buffer(10, &r.triangle_emitter),
-                Write::Buffer(11, &r.texels),
-                Write::Buffer(12, &r.textures),
-                Write::StorageImage(13, image.view),
-            ],
-        );
+        let mut writes = vec![Write::Buffer(0, ubo)];
+        writes.extend(common);
+        writes.extend([
+            Write::Buffer(8, lights),
+            Write::Buffer(9, &r.emitters),
+            Write::Buffer(10, &r.triangle_emitter),
+            Write::Buffer(11, &r.texels),
+            Write::Buffer(12, &r.textures),
+            Write::StorageImage(13, image.view),
+        ]);
+        layout.write(gpu, set, &writes);
         let pipeline = owned.pipeline.as_ref().expect("set");
         let pool = crate::gpu::CommandPool::new(gpu, gpu.family)?;
         owned.pool = Some(pool);

@@ -8,7 +8,8 @@ use gpu_allocator::MemoryLocation;
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{
-    Binding, BindingKind, Buffer, CommandPool, ComputePipeline, Gpu, SetLayout, TimestampPool, Write,
+    Binding, BindingKind, Buffer, CommandPool, ComputePipeline, Gpu, Recorder, SetLayout, TimestampPool,
+    Write,
 };
 use crate::render::spirv;
 use crate::scene::BvhBuffers;
@@ -81,71 +82,24 @@ impl RayQuery {
         rays: &[GpuRay],
         any_hit: bool,
     ) -> PlayResult<(Vec<GpuHit>, f64)> {
-        if rays.is_empty() {
-            return Ok((Vec::new(), 0.0));
-        }
-        let bytes: &[u8] = bytemuck::cast_slice(rays);
-        let count = u32::try_from(rays.len())
-            .map_err(|_| PlayError::new(Exit::Usage, "too many rays in one batch"))?;
-        let mut input = Buffer::new(
-            gpu,
-            "rays",
-            bytes.len() as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::CpuToGpu,
-        )?;
-        let out_size = rays.len() as u64 * 16;
-        let output = Buffer::new(
-            gpu,
-            "hits",
-            out_size,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuToCpu,
-        );
-        let mut output = match output {
-            Ok(o) => o,
-            Err(e) => {
-                input.destroy(gpu);
-                return Err(e);
-            }
-        };
-        let result = (|| -> PlayResult<(Vec<GpuHit>, f64)> {
-            input.write(bytes)?;
-            let set = self.layout.allocate(gpu)?;
-            self.layout.write(
+        let set = self.layout.allocate(gpu)?;
+        let (layout, pipeline) = (&self.layout, &self.pipeline);
+        let usage = vk::BufferUsageFlags::empty();
+        timed_trace(gpu, &self.pool, &self.timestamps, rays, usage, |rec, input, output, count| {
+            layout.write(
                 gpu,
                 set,
                 &[
                     Write::Buffer(0, &bvh.nodes),
                     Write::Buffer(1, &bvh.triangles),
-                    Write::Buffer(2, &input),
-                    Write::Buffer(3, &output),
+                    Write::Buffer(2, input),
+                    Write::Buffer(3, output),
                 ],
             );
-            let rec = self.pool.begin(gpu)?;
-            rec.reset_timestamps(&self.timestamps);
-            rec.timestamp(&self.timestamps, 0);
             let push: [u32; 2] = [count, any_hit as u32];
-            rec.dispatch(&self.pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
-            rec.timestamp(&self.timestamps, 1);
-            rec.memory_barrier(
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                vk::PipelineStageFlags2::HOST,
-                vk::AccessFlags2::HOST_READ,
-            );
-            self.pool.submit(gpu, &[], &[])?;
-            self.pool.wait(gpu)?;
-            let ns = self.timestamps.read_ns(gpu)?;
-            let hits: Vec<GpuHit> = output
-                .mapped()
-                .map(|m| bytemuck::pod_collect_to_vec(&m[..out_size as usize]))
-                .ok_or_else(|| PlayError::new(Exit::Gpu, "the hit buffer is not host-visible"))?;
-            Ok((hits, (ns[1] - ns[0]) * 1e-6))
-        })();
-        input.destroy(gpu);
-        output.destroy(gpu);
-        result
+            rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
+            vk::PipelineStageFlags2::COMPUTE_SHADER
+        })
     }
 
     /// Releases the pipeline and its pools.
@@ -155,4 +109,59 @@ impl RayQuery {
         self.pipeline.destroy(gpu);
         self.layout.destroy(gpu);
     }
+}
+
+/// Runs one timed trace of `rays`: fills a host-visible ray buffer, records `record` (given the
+/// ray and hit buffers, created with storage plus `usage`, and the ray count; it returns the
+/// stage that writes the hits) between two timestamps, waits, and returns the hits and the GPU
+/// milliseconds between the timestamps. Shared by the compute traversal and its peer.
+pub(crate) fn timed_trace(
+    gpu: &Gpu,
+    pool: &CommandPool,
+    timestamps: &TimestampPool,
+    rays: &[GpuRay],
+    usage: vk::BufferUsageFlags,
+    record: impl FnOnce(&Recorder, &Buffer, &Buffer, u32) -> vk::PipelineStageFlags2,
+) -> PlayResult<(Vec<GpuHit>, f64)> {
+    if rays.is_empty() {
+        return Ok((Vec::new(), 0.0));
+    }
+    let count =
+        u32::try_from(rays.len()).map_err(|_| PlayError::new(Exit::Usage, "too many rays in one batch"))?;
+    let bytes: &[u8] = bytemuck::cast_slice(rays);
+    let usage = usage | vk::BufferUsageFlags::STORAGE_BUFFER;
+    let mut input = Buffer::new(gpu, "rays", bytes.len() as u64, usage, MemoryLocation::CpuToGpu)?;
+    let out_size = rays.len() * 16;
+    let mut output = match Buffer::new(gpu, "hits", out_size as u64, usage, MemoryLocation::GpuToCpu) {
+        Ok(o) => o,
+        Err(e) => {
+            input.destroy(gpu);
+            return Err(e);
+        }
+    };
+    let result = (|| -> PlayResult<(Vec<GpuHit>, f64)> {
+        input.write(bytes)?;
+        let rec = pool.begin(gpu)?;
+        rec.reset_timestamps(timestamps);
+        rec.timestamp(timestamps, 0);
+        let stage = record(&rec, &input, &output, count);
+        rec.timestamp(timestamps, 1);
+        rec.memory_barrier(
+            stage,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::HOST,
+            vk::AccessFlags2::HOST_READ,
+        );
+        pool.submit(gpu, &[], &[])?;
+        pool.wait(gpu)?;
+        let ns = timestamps.read_ns(gpu)?;
+        let hits: Vec<GpuHit> = output
+            .mapped()
+            .map(|m| bytemuck::pod_collect_to_vec(&m[..out_size]))
+            .ok_or_else(|| PlayError::new(Exit::Gpu, "the hit buffer is not host-visible"))?;
+        Ok((hits, (ns[1] - ns[0]) * 1e-6))
+    })();
+    input.destroy(gpu);
+    output.destroy(gpu);
+    result
 }

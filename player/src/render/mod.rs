@@ -654,34 +654,25 @@ impl Renderer {
                 ],
             );
         }
-        if let (Some(rt), Some(bvh), Some(r)) = (&self.pipelines.rt, &scene.bvh, &scene.reference)
+        if let (Some(rt), Some(common), Some(r)) = (&self.pipelines.rt, scene.ray_writes(), &scene.reference)
             && self.rt_set != vk::DescriptorSet::null()
         {
-            rt.layout.write(
-                gpu,
-                self.rt_set,
-                &[
-                    Write::Buffer(0, &self.frame_ubo),
-                    Write::Buffer(1, &bvh.nodes),
-                    Write::Buffer(2, &bvh.triangles),
-                    Write::Buffer(3, &scene.vertices),
-                    Write::Buffer(4, &scene.uvs),
-                    Write::Buffer(5, &r.indices),
-                    Write::Buffer(6, &r.triangle_materials),
-                    Write::Buffer(7, &r.materials),
-                    Write::Buffer(8, &self.lights),
-                    Write::Buffer(9, &r.texels),
-                    Write::Buffer(10, &r.textures),
-                    Write::Buffer(11, &scene.indices),
-                    Write::Sampled(12, g(4)),
-                    Write::Sampled(13, g(0)),
-                    Write::Sampled(14, g(1)),
-                    Write::Sampled(15, g(2)),
-                    Write::StorageImage(16, t.rt_shadows.view),
-                    Write::StorageImage(17, t.rt_ao.view),
-                    Write::StorageImage(18, t.rt_reflections.view),
-                ],
-            );
+            let mut writes = vec![Write::Buffer(0, &self.frame_ubo)];
+            writes.extend(common);
+            writes.extend([
+                Write::Buffer(8, &self.lights),
+                Write::Buffer(9, &r.texels),
+                Write::Buffer(10, &r.textures),
+                Write::Buffer(11, &scene.indices),
+                Write::Sampled(12, g(4)),
+                Write::Sampled(13, g(0)),
+                Write::Sampled(14, g(1)),
+                Write::Sampled(15, g(2)),
+                Write::StorageImage(16, t.rt_shadows.view),
+                Write::StorageImage(17, t.rt_ao.view),
+                Write::StorageImage(18, t.rt_reflections.view),
+            ]);
+            rt.layout.write(gpu, self.rt_set, &writes);
         }
         self.pipelines.tonemap_layout.write(
             gpu,

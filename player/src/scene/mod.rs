@@ -13,7 +13,7 @@ use kiln_format::scene::SceneView;
 use kiln_format::sections::{self, GpuMaterial, Vertex};
 
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey};
+use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, Write};
 use upload::Uploader;
 
 /// What the enabled passes read, beyond geometry and materials.
@@ -119,6 +119,25 @@ impl<'f> Prepared<'f> {
             )
         });
         Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference })
+    }
+}
+
+impl GpuScene {
+    /// Descriptor writes of what every ray-traced pass reads, at bindings 1 to 7 (the shaders'
+    /// common prefix after the constants at 0): BVH nodes, triangle corners, vertices, uvs,
+    /// leaf-order indices, triangle materials, materials. `None` without the BVH or the scene
+    /// buffers.
+    pub fn ray_writes(&self) -> Option<Vec<Write<'_>>> {
+        let (bvh, r) = (self.bvh.as_ref()?, self.reference.as_ref()?);
+        Some(vec![
+            Write::Buffer(1, &bvh.nodes),
+            Write::Buffer(2, &bvh.triangles),
+            Write::Buffer(3, &self.vertices),
+            Write::Buffer(4, &self.uvs),
+            Write::Buffer(5, &r.indices),
+            Write::Buffer(6, &r.triangle_materials),
+            Write::Buffer(7, &r.materials),
+        ])
     }
 }
 
