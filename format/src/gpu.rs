@@ -182,8 +182,11 @@ gpu_struct! {
         pub shadow_lights: u32 => "uint",
         /// Pixels per reflection sample along each axis: 1 full resolution, 2 half.
         pub reflection_step: u32 => "uint",
+        /// Lights whose shadow rays at reflection hits are traced in the separate, lean
+        /// reflection-shadow pass (the first ones; any further ones are traced inline).
+        pub reflection_lights: u32 => "uint",
         /// Zero.
-        pub reserved: [u32; 2] => "uvec2",
+        pub reserved: u32 => "uint",
     }
 }
 

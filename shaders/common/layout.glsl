@@ -90,7 +90,8 @@ struct RtConstants {
     float max_roughness; // offset 12
     uint shadow_lights; // offset 16
     uint reflection_step; // offset 20
-    uvec2 reserved; // offset 24
+    uint reflection_lights; // offset 24
+    uint reserved; // offset 28
 }; // 32 bytes
 
 const uint LIGHT_POINT = 0u;

@@ -228,14 +228,13 @@ vec3 sample_brdf(Surface s, vec3 wo) {
     return f * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - xi.x)));
 }
 
-// Whether something blocks the segment from `from`, on a surface of geometric normal `n` (the
-// side the segment leaves by), to `to`. The length is measured from the offset origin: measured
-// from `from`, a segment to a point on an emissive triangle reached that triangle (and was
-// blocked by it) wherever the offset exceeded the 1e-5 relative margin, e.g. on surfaces facing
-// the emitter at coordinates >= 0.5 from the origin. Emitter points are offset off their own
-// surface towards `from` by the caller.
-bool occluded(vec3 from, vec3 n, vec3 to) {
-    vec3 o = offset_ray_origin(from, n);
+// Whether something blocks the segment from `o`, a ray origin already offset off its surface,
+// to `to`. The length is measured from the offset origin: measured from the surface point, a
+// segment to a point on an emissive triangle reached that triangle (and was blocked by it)
+// wherever the offset exceeded the 1e-5 relative margin, e.g. on surfaces facing the emitter at
+// coordinates >= 0.5 from the origin. Emitter points are offset off their own surface towards
+// the origin by the caller.
+bool occluded_from(vec3 o, vec3 to) {
     vec3 d = to - o;
     float dist = length(d);
     if (!(dist > 0.0)) {
@@ -245,9 +244,20 @@ bool occluded(vec3 from, vec3 n, vec3 to) {
     return trace(r, true).t != NO_HIT;
 }
 
-// Whether something blocks the ray from `from` (as for `occluded`) in direction `dir`, unbounded.
+// `occluded_from` for the point `from` on a surface of geometric normal `n` (the side the
+// segment leaves by).
+bool occluded(vec3 from, vec3 n, vec3 to) {
+    return occluded_from(offset_ray_origin(from, n), to);
+}
+
+// Whether something blocks the unbounded ray from the offset origin `o` along `dir`.
+bool occluded_ray_from(vec3 o, vec3 dir) {
+    return trace(make_ray(o, dir, 0.0, 3.4e38), true).t != NO_HIT;
+}
+
+// `occluded_ray_from` for the point `from` on a surface of geometric normal `n`.
 bool occluded_ray(vec3 from, vec3 n, vec3 dir) {
-    return trace(make_ray(offset_ray_origin(from, n), dir, 0.0, 3.4e38), true).t != NO_HIT;
+    return occluded_ray_from(offset_ray_origin(from, n), dir);
 }
 
 #endif

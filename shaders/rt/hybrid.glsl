@@ -35,6 +35,12 @@ layout(set = 0, binding = 15) uniform sampler2D g_material;
 layout(set = 0, binding = 16, r32f) uniform image2DArray rt_shadows;   // one layer per light
 layout(set = 0, binding = 17, r32f) uniform image2D rt_ao;
 layout(set = 0, binding = 18, rgba32f) uniform image2D rt_reflections;  // rgb, a = 1 where traced
+// Between the two reflection passes, per reflection sample: the radiance without the lights'
+// shadowed terms (a = 1 where traced), the hit's offset origin (w = 1 on a hit), and each
+// light's unshadowed term, which the lean shadow pass adds where the light is visible.
+layout(set = 0, binding = 19, rgba32f) uniform image2D refl_partial;
+layout(set = 0, binding = 20, rgba32f) uniform image2D refl_origin;
+layout(set = 0, binding = 21, rgba32f) uniform image2DArray refl_lights;
 layout(push_constant) uniform Params { RtConstants rt; };
 
 #include "../common/random.glsl"

@@ -6,6 +6,11 @@
 // emission, every light with one hard shadow ray to its centre (as in the thesis), and the sky as
 // unshadowed ambient; a miss sees the sky.
 //
+// The shadow rays at the hits are not traced here: this pass stores each light's unshadowed
+// term and the hit's ray origin, and `reflection_shadows.comp`, a small kernel, traces them and
+// accumulates. Traced inside this large kernel (low occupancy) they took 72 % of its time on an
+// H200; traversal is latency-bound and wants many rays in flight.
+//
 // Fixes of the thesis's code: surfaces that are too *rough* are skipped (its test was inverted
 // and skipped the smooth ones), a sample below the surface contributes zero instead of being
 // re-rolled in an unbounded loop (re-rolling biases the estimate), the weight includes the
@@ -18,9 +23,12 @@ float smith_lambda(float c, float a2) {
     return 0.5 * (sqrt(1.0 + a2 * (1.0 - c2) / c2) - 1.0);
 }
 
-// Radiance leaving the hit towards -dir.
-vec3 shade_hit(TraceRay r, TraceHit h) {
+// Radiance leaving the hit towards -dir, without the shadowed terms of the lights that the
+// shadow pass handles (stored, scaled by `scale`, in their `refl_lights` layers); the hit's
+// offset origin goes to `origin`.
+vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, out vec3 origin) {
     Surface s = surface_at(r, h);
+    origin = offset_ray_origin(s.p, s.ng);
     vec3 wo = -normalize(r.direction);
     vec3 sum = s.emission;
     vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
@@ -29,34 +37,32 @@ vec3 shade_hit(TraceRay r, TraceHit h) {
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight l = lights[i];
         vec3 wi;
-        float dist;
-        vec3 li;
+        vec3 li = vec3(0.0);
         if (l.kind == LIGHT_DIRECTIONAL) {
             wi = -l.direction;
-            dist = 3.4e38;
             li = l.radiance;
         } else {
             vec3 to = l.position - s.p;
-            dist = length(to);
+            float dist = length(to);
             wi = to / max(dist, 1e-30);
-            if (dist <= 0.0 || (l.range > 0.0 && dist > l.range)) {
-                continue;
-            }
-            li = l.radiance / (dist * dist);
-            if (l.kind == LIGHT_SPOT) {
-                float t = clamp((dot(-wi, l.direction) - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-6), 0.0, 1.0);
-                li *= t * t * (3.0 - 2.0 * t);
-            } else if (l.kind == LIGHT_RECT) {
-                // The rectangle seen from the hit as one point at its centre.
-                li *= max(dot(-wi, l.direction), 0.0) * l.width * l.height;
+            if (dist > 0.0 && (l.range <= 0.0 || dist <= l.range)) {
+                li = l.radiance / (dist * dist);
+                if (l.kind == LIGHT_SPOT) {
+                    float t = clamp((dot(-wi, l.direction) - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-6), 0.0, 1.0);
+                    li *= t * t * (3.0 - 2.0 * t);
+                } else if (l.kind == LIGHT_RECT) {
+                    // The rectangle seen from the hit as one point at its centre.
+                    li *= max(dot(-wi, l.direction), 0.0) * l.width * l.height;
+                }
             }
         }
-        vec3 f = brdf_cos(s, wo, wi);
-        if (!any(greaterThan(f * li, vec3(0.0)))) {
-            continue;
-        }
-        if (!(l.kind == LIGHT_DIRECTIONAL ? occluded_ray(s.p, s.ng, wi) : occluded(s.p, s.ng, l.position))) {
-            sum += f * li;
+        vec3 term = any(greaterThan(li, vec3(0.0))) ? brdf_cos(s, wo, wi) * li : vec3(0.0);
+        if (i < rt.reflection_lights) {
+            // Every layer is written for every hit: the shadow pass reads them all.
+            imageStore(refl_lights, ivec3(cell, int(i)), vec4(term * scale, 0.0));
+        } else if (any(greaterThan(term, vec3(0.0)))
+            && !(l.kind == LIGHT_DIRECTIONAL ? occluded_ray_from(origin, wi) : occluded_from(origin, l.position))) {
+            sum += term;
         }
     }
     return sum;
@@ -72,6 +78,7 @@ void main() {
     // with weights that respect that pixel's surface.
     ivec2 pixel = ivec2(cell * rt.reflection_step);
     vec4 value = vec4(0.0);
+    vec4 origin = vec4(0.0);
     Primary s;
     if (primary_at(pixel, s)) {
         vec4 mat = texelFetch(g_material, pixel, 0);
@@ -94,8 +101,14 @@ void main() {
                 vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(s.v, h), 0.0, 1.0), 5.0);
                 TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, 3.4e38);
                 TraceHit hit = trace(r, false);
-                vec3 l = hit.t == NO_HIT ? frame.sky.rgb : shade_hit(r, hit);
-                radiance = fresnel * weight * l;
+                vec3 scale = fresnel * weight;
+                if (hit.t == NO_HIT) {
+                    radiance = scale * frame.sky.rgb;
+                } else {
+                    vec3 o;
+                    radiance = scale * shade_hit(r, hit, ivec2(cell), scale, o);
+                    origin = vec4(o, 1.0);
+                }
             }
             if (any(isnan(radiance)) || any(isinf(radiance))) {
                 radiance = vec3(0.0);
@@ -103,5 +116,6 @@ void main() {
             value = vec4(radiance, 1.0);
         }
     }
-    imageStore(rt_reflections, ivec2(cell), accumulate(imageLoad(rt_reflections, ivec2(cell)), value));
+    imageStore(refl_partial, ivec2(cell), value);
+    imageStore(refl_origin, ivec2(cell), origin);
 }

@@ -52,8 +52,11 @@ pub mod spirv {
     pub const RT_AO: &[u8] = include_bytes!("../../../shaders/spirv/ao.comp.spv");
     /// Ray-traced glossy reflections.
     pub const RT_REFLECTIONS: &[u8] = include_bytes!("../../../shaders/spirv/reflections.comp.spv");
+    /// Shadow rays at the reflection hits.
+    pub const RT_REFLECTION_SHADOWS: &[u8] =
+        include_bytes!("../../../shaders/spirv/reflection_shadows.comp.spv");
     /// (source under `shaders/`, embedded bytes) of every shader.
-    pub const ALL: [(&str, &[u8]); 12] = [
+    pub const ALL: [(&str, &[u8]); 13] = [
         ("gbuffer/gbuffer.vert", GBUFFER_VERT),
         ("gbuffer/gbuffer.frag", GBUFFER_FRAG),
         ("lighting/direct.comp", DIRECT),
@@ -63,6 +66,7 @@ pub mod spirv {
         ("rt/shadows.comp", RT_SHADOWS),
         ("rt/ao.comp", RT_AO),
         ("rt/reflections.comp", RT_REFLECTIONS),
+        ("rt/reflection_shadows.comp", RT_REFLECTION_SHADOWS),
         ("gbuffer/visibility.frag", VISIBILITY_FRAG),
         ("gbuffer/visibility_opaque.frag", VISIBILITY_OPAQUE_FRAG),
         ("gbuffer/resolve.comp", RESOLVE),
@@ -186,6 +190,11 @@ impl RtSettings {
                 Some(ReflectionRes::Full) => 1,
                 Some(ReflectionRes::Half) => 2,
             },
+            reflection_lights: if self.reflections.is_some() {
+                lights.min(MAX_RT_SHADOW_LIGHTS) as u32
+            } else {
+                0
+            },
         }
     }
 }
@@ -220,6 +229,7 @@ struct RtPipelines {
     shadows: ComputePipeline,
     ao: ComputePipeline,
     reflections: ComputePipeline,
+    reflection_shadows: ComputePipeline,
 }
 
 fn b(kind: BindingKind) -> Binding {
@@ -298,13 +308,19 @@ impl Pipelines {
             let mut bindings = vec![b(Uniform)];
             bindings.extend([b(Storage); 11]);
             bindings.extend([b(Sampled); 4]);
-            bindings.extend([b(StorageImage); 3]);
+            bindings.extend([b(StorageImage); 6]);
             let layout = SetLayout::new(gpu, &bindings, 1)?;
             let push = std::mem::size_of::<RtConstants>() as u32;
             Some(RtPipelines {
                 shadows: ComputePipeline::new(gpu, spirv::RT_SHADOWS, &[&layout], push)?,
                 ao: ComputePipeline::new(gpu, spirv::RT_AO, &[&layout], push)?,
                 reflections: ComputePipeline::new(gpu, spirv::RT_REFLECTIONS, &[&layout], push)?,
+                reflection_shadows: ComputePipeline::new(
+                    gpu,
+                    spirv::RT_REFLECTION_SHADOWS,
+                    &[&layout],
+                    push,
+                )?,
                 layout,
             })
         } else {
@@ -338,6 +354,7 @@ impl Pipelines {
             rt.shadows.destroy(gpu);
             rt.ao.destroy(gpu);
             rt.reflections.destroy(gpu);
+            rt.reflection_shadows.destroy(gpu);
             rt.layout.destroy(gpu);
         }
         for l in [
@@ -546,6 +563,7 @@ impl Renderer {
                 0
             },
             reflection_step: settings.rt.shape(0).reflection_step.max(1),
+            reflection_lights: settings.rt.shape(plan.lights_used as usize).reflection_lights,
             ..Default::default()
         };
         let mut flags = if plan.shadows_bound && !settings.rt.shadows { FrameFlags::SHADOW_MAPS } else { 0 };
@@ -671,6 +689,9 @@ impl Renderer {
                 Write::StorageImage(16, t.rt_shadows.view),
                 Write::StorageImage(17, t.rt_ao.view),
                 Write::StorageImage(18, t.rt_reflections.view),
+                Write::StorageImage(19, t.refl_partial.view),
+                Write::StorageImage(20, t.refl_origin.view),
+                Write::StorageImage(21, t.refl_lights.view),
             ]);
             rt.layout.write(gpu, self.rt_set, &writes);
         }
@@ -784,7 +805,8 @@ impl Renderer {
             }
         }
         rec.timestamp(&self.timestamps, 2);
-        let rt_images = [&t.rt_shadows, &t.rt_ao, &t.rt_reflections];
+        let rt_images =
+            [&t.rt_shadows, &t.rt_ao, &t.rt_reflections, &t.refl_partial, &t.refl_origin, &t.refl_lights];
         for img in rt_images {
             // Fresh images are discarded once; after that they carry the running average.
             let from = if t.rt_fresh { Use::DISCARD } else { Use::STORAGE };
@@ -807,6 +829,18 @@ impl Renderer {
         for (i, (pipeline, w, h)) in passes.into_iter().enumerate() {
             if let Some(p) = pipeline {
                 rec.dispatch(p, &[self.rt_set], push, [w.div_ceil(8), h.div_ceil(8), 1]);
+                if let (2, Some(rt)) = (i, rt) {
+                    // The reflection hits' shadow rays, in their own small kernel.
+                    for img in [&t.refl_partial, &t.refl_origin, &t.refl_lights] {
+                        rec.transition(img, Use::STORAGE, Use::STORAGE);
+                    }
+                    rec.dispatch(
+                        &rt.reflection_shadows,
+                        &[self.rt_set],
+                        push,
+                        [w.div_ceil(8), h.div_ceil(8), 1],
+                    );
+                }
             }
             rec.timestamp(&self.timestamps, 3 + i as u32);
         }

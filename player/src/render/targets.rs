@@ -43,6 +43,12 @@ pub struct Targets {
     pub rt_ao: Image,
     /// Ray-traced reflections, full or half size (1 × 1 when off).
     pub rt_reflections: Image,
+    /// Between the reflection passes: radiance without the lights' shadowed terms.
+    pub refl_partial: Image,
+    /// Between the reflection passes: the hits' offset ray origins.
+    pub refl_origin: Image,
+    /// Between the reflection passes: each light's unshadowed term (one layer per light).
+    pub refl_lights: Image,
     /// What the ray-traced images were made for.
     pub rt: RtShape,
     /// The ray-traced images hold nothing yet (their first use discards).
@@ -58,6 +64,8 @@ pub struct RtShape {
     pub ao: bool,
     /// Pixels per reflection sample along each axis (0: the pass is off).
     pub reflection_step: u32,
+    /// Lights whose reflection-hit shadow rays the separate shadow pass traces.
+    pub reflection_lights: u32,
 }
 
 fn desc(format: vk::Format, width: u32, height: u32, usage: vk::ImageUsageFlags) -> ImageDesc {
@@ -115,6 +123,16 @@ impl Targets {
                 accumulation,
             ),
         )?;
+        let refl_size = |yes: bool| (on(yes, width.div_ceil(step)), on(yes, height.div_ceil(step)));
+        let (rw, rh) = refl_size(rt.reflection_step > 0);
+        let refl =
+            |name: &str| Image::new(gpu, name, desc(vk::Format::R32G32B32A32_SFLOAT, rw, rh, accumulation));
+        let refl_partial = refl("reflection partial")?;
+        let refl_origin = refl("reflection origins")?;
+        let mut lights = desc(vk::Format::R32G32B32A32_SFLOAT, rw, rh, accumulation);
+        lights.layers = rt.reflection_lights.max(1);
+        lights.array = true;
+        let refl_lights = Image::new(gpu, "reflection light terms", lights)?;
         Ok(Targets {
             width,
             height,
@@ -125,6 +143,9 @@ impl Targets {
             rt_shadows,
             rt_ao,
             rt_reflections,
+            refl_partial,
+            refl_origin,
+            refl_lights,
             rt,
             rt_fresh: true,
         })
@@ -141,5 +162,8 @@ impl Targets {
         self.rt_shadows.destroy(gpu);
         self.rt_ao.destroy(gpu);
         self.rt_reflections.destroy(gpu);
+        self.refl_partial.destroy(gpu);
+        self.refl_origin.destroy(gpu);
+        self.refl_lights.destroy(gpu);
     }
 }

@@ -1,0 +1,35 @@
+#version 460
+// Shadow rays at the reflection hits (see reflections.comp): for each light with a stored
+// unshadowed term, one hard shadow ray from the hit towards the light's centre (or along a
+// directional light); visible terms are added to the partial radiance, and the sample is
+// averaged into the reflection image over frames.
+#include "hybrid.glsl"
+
+void main() {
+    uvec2 cell = gl_GlobalInvocationID.xy;
+    uvec2 cells = (frame.size.xy + rt.reflection_step - 1u) / rt.reflection_step;
+    if (any(greaterThanEqual(cell, cells))) {
+        return;
+    }
+    ivec2 c = ivec2(cell);
+    vec4 value = imageLoad(refl_partial, c);
+    vec4 origin = imageLoad(refl_origin, c);
+    if (origin.w > 0.0) {
+        for (uint i = 0u; i < rt.reflection_lights; i++) {
+            vec3 term = imageLoad(refl_lights, ivec3(c, int(i))).rgb;
+            if (!any(greaterThan(term, vec3(0.0)))) {
+                continue;
+            }
+            GpuLight l = lights[i];
+            bool blocked = l.kind == LIGHT_DIRECTIONAL ? occluded_ray_from(origin.xyz, -l.direction)
+                                                       : occluded_from(origin.xyz, l.position);
+            if (!blocked) {
+                value.rgb += term;
+            }
+        }
+    }
+    if (any(isnan(value)) || any(isinf(value))) {
+        value = vec4(0.0, 0.0, 0.0, value.a > 0.0 ? 1.0 : 0.0);
+    }
+    imageStore(rt_reflections, c, accumulate(imageLoad(rt_reflections, c), value));
+}
