@@ -453,9 +453,12 @@ fn pica_pica_renders_clean_with_three_lights_and_its_shadow_maps() {
     );
     assert!(close as f64 >= 0.98 * rgb.len() as f64, "{close} of {} channels agree", rgb.len());
 
-    // The hybrid pipeline: every ray-traced pass, both reflection resolutions, validation clean
-    // (render asserts it), finite, and close to the shadow-mapped frame on average.
-    for res in [ReflectionRes::Full, ReflectionRes::Half] {
+    // The hybrid pipeline: every ray-traced pass, both reflection resolutions and both
+    // G-buffers, validation clean (render asserts it), finite, and close to the shadow-mapped
+    // frame on average.
+    for (res, gbuffer) in
+        [(ReflectionRes::Full, GBufferMode::Raster), (ReflectionRes::Half, GBufferMode::Visibility)]
+    {
         let rt = RtSettings {
             shadows: true,
             ao: true,
@@ -464,8 +467,11 @@ fn pica_pica_renders_clean_with_three_lights_and_its_shadow_maps() {
             sun_degrees: 0.53,
             ..RtSettings::OFF
         };
-        let (traced, result) =
-            render_frames(dir.path(), "pica-rt", &bytes, 2, |f| rt_options(f, 160, 90, rt));
+        let (traced, result) = render_frames(dir.path(), "pica-rt", &bytes, 2, |f| {
+            let mut o = rt_options(f, 160, 90, rt);
+            o.render.gbuffer = gbuffer;
+            o
+        });
         assert!(result.session.warnings.is_empty(), "{:?}", result.session.warnings);
         let mean = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
         let (a, b) = (mean(&rgb), mean(&traced));
