@@ -32,13 +32,18 @@ fn window_presents_frames_and_exits_cleanly_under_xvfb() {
         file.to_str().unwrap(),
     ]);
     kiln_compiler::commands::run(cli).unwrap();
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_kiln-play")])
-        .arg(&file)
-        .args(["--frames", "12", "--validate", "--no-pipeline-cache", "--size", "200x150"])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "kiln-play in a window failed ({:?}): {stderr}", out.status);
-    assert!(!stderr.contains("validation error"), "{stderr}");
+    // The default frame, and the hybrid one (every ray-traced pass, the visibility buffer).
+    let hybrid = ["--shadows", "rt", "--ao", "rt", "--reflections", "rt", "--gbuffer", "visibility"];
+    for extra in [&[][..], &hybrid[..]] {
+        let out = Command::new("xvfb-run")
+            .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_kiln-play")])
+            .arg(&file)
+            .args(["--frames", "12", "--validate", "--no-pipeline-cache", "--size", "200x150"])
+            .args(extra)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "kiln-play {extra:?} in a window failed ({:?}): {stderr}", out.status);
+        assert!(!stderr.contains("validation error"), "{stderr}");
+    }
 }
