@@ -18,6 +18,10 @@ float visibility(Primary s, GpuLight l) {
         wi = l.radius > 0.0 ? sample_cone(-l.direction, cos(l.radius)) : -l.direction;
         dist = 3.4e38;
     } else if (l.kind == LIGHT_RECT) {
+        // Behind a one-sided rect light's plane nothing arrives.
+        if (dot(s.p - l.position, l.direction) <= 0.0) {
+            return 1.0;
+        }
         vec3 up = cross(l.direction, l.right);
         vec3 q = l.position + l.right * (rnd() - 0.5) * l.width + up * (rnd() - 0.5) * l.height;
         vec3 to = q - s.p;
@@ -27,6 +31,11 @@ float visibility(Primary s, GpuLight l) {
         vec3 to = l.position - s.p;
         float d = length(to);
         vec3 axis = to / max(d, 1e-30);
+        // Where the light contributes nothing (outside a spot's cone, beyond its range) the
+        // composition multiplies zero by the visibility: no ray is traced.
+        if ((l.kind == LIGHT_SPOT && dot(-axis, l.direction) <= l.cos_outer) || (l.range > 0.0 && d > l.range)) {
+            return 1.0;
+        }
         if (l.radius > 0.0 && d > l.radius) {
             float sin2 = (l.radius * l.radius) / (d * d);
             wi = sample_cone(axis, sqrt(max(1.0 - sin2, 0.0)));
