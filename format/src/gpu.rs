@@ -133,7 +133,8 @@ gpu_struct! {
         pub sky: [f32; 4] => "vec4",
         /// Image width, height, light count, flags.
         pub size: [u32; 4] => "uvec4",
-        /// Exposure multiplier, BRDF table resolution (0: none), frame number, unused.
+        /// Exposure multiplier, BRDF table resolution (0: none), frame number, the roughness up
+        /// to which ray-traced reflections replace the split-sum specular.
         pub params: [f32; 4] => "vec4",
         /// Unit right vector, w = tan(vfov / 2) · aspect: the camera ray through NDC (x, y) is
         /// forward + right · x · right.w + up · y · up.w (the projection's own mapping).

@@ -48,6 +48,8 @@ pub const NO_HIT: f32 = 3.402823e38;
 /// The compute traversal, bound to one scene's BVH.
 pub struct RayQuery {
     layout: SetLayout,
+    /// One set, rewritten by every trace (the previous trace has finished by then).
+    set: vk::DescriptorSet,
     pipeline: ComputePipeline,
     pool: CommandPool,
     timestamps: TimestampPool,
@@ -63,10 +65,12 @@ impl RayQuery {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<RayQuery> {
         let storage = Binding { kind: BindingKind::Storage, count: 1 };
-        let layout = SetLayout::new(gpu, &[storage; 4], 4)?;
+        let mut layout = SetLayout::new(gpu, &[storage; 4], 1)?;
         let pipeline = ComputePipeline::new(gpu, spirv::TRACE_RAYS, &[&layout], 8)?;
+        let set = layout.allocate(gpu)?;
         Ok(RayQuery {
             layout,
+            set,
             pipeline,
             pool: CommandPool::new(gpu, gpu.family)?,
             timestamps: TimestampPool::new(gpu, 2)?,
@@ -82,8 +86,7 @@ impl RayQuery {
         rays: &[GpuRay],
         any_hit: bool,
     ) -> PlayResult<(Vec<GpuHit>, f64)> {
-        let set = self.layout.allocate(gpu)?;
-        let (layout, pipeline) = (&self.layout, &self.pipeline);
+        let (layout, pipeline, set) = (&self.layout, &self.pipeline, self.set);
         let usage = vk::BufferUsageFlags::empty();
         // The set points at this trace's buffers; it is written once, before its first use (the
         // trace is recorded several times, and writing a bound set invalidates the recording).

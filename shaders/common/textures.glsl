@@ -68,12 +68,14 @@ vec4 sample_texture_grad(uint index, vec2 uv, vec2 dx, vec2 dy) {
     GpuTexture t = textures[index];
     vec2 size = vec2(t.width, t.height);
     float footprint = max(length(dx * size), length(dy * size));
+    // A degenerate pixel footprint (NaN, infinite) takes the coarsest level.
+    footprint = isnan(footprint) || isinf(footprint) ? 1e30 : footprint;
     float levels = float((t.flags >> TEXTURE_LEVELS_SHIFT) & 31u);
     float lod = clamp(log2(max(footprint, 1e-8)), 0.0, max(levels - 1.0, 0.0));
     if (lod <= 0.0) {
         return sample_texture(index, uv);
     }
-    uint l0 = uint(floor(lod));
+    uint l0 = min(uint(floor(lod)), uint(max(levels - 1.0, 0.0)));
     vec4 a = bilinear_level(t, l0, uv);
     float f = lod - float(l0);
     return f > 0.0 ? mix(a, bilinear_level(t, min(l0 + 1u, uint(levels) - 1u), uv), f) : a;

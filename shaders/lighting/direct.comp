@@ -207,7 +207,9 @@ void main() {
         occlusion *= imageLoad(rt_ao, pixel).r;
     }
     vec4 traced = vec4(0.0);
-    if ((frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !s.diffuse_only) {
+    // Surfaces rougher than the limit keep the split sum, also where half-resolution upsampling
+    // would borrow a smoother neighbour's traced reflection.
+    if ((frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !s.diffuse_only && s.roughness <= frame.params.w) {
         traced = reflection_at(pixel, p, n);
     }
     // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.

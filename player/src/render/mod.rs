@@ -465,6 +465,10 @@ impl Renderer {
     ) -> PlayResult<Renderer> {
         let mut settings = settings;
         let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, settings.shadow_maps);
+        if settings.rt.any() && pipelines.rt.is_none() {
+            plan.warnings.push("the ray-traced passes are off: their pipelines were not built".into());
+            settings.rt = RtSettings::OFF;
+        }
         if settings.rt.any() && (scene.bvh.is_none() || scene.reference.is_none()) {
             plan.warnings.push("the ray-traced passes are off: the file has no BVH".into());
             settings.rt = RtSettings::OFF;
@@ -736,7 +740,12 @@ impl Renderer {
             camera: [p.x, p.y, p.z, 0.0],
             sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
             size: [w, h, self.light_count, self.flags],
-            params: [2f32.powf(self.settings.exposure), self.lut_resolution as f32, self.frame as f32, 0.0],
+            params: [
+                2f32.powf(self.settings.exposure),
+                self.lut_resolution as f32,
+                self.frame as f32,
+                self.settings.rt.max_roughness,
+            ],
             camera_right: v4(right, tan_half * aspect),
             camera_up: v4(up, tan_half),
             camera_forward: v4(camera.forward, 0.0),
