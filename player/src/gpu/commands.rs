@@ -11,7 +11,10 @@ pub struct CommandPool {
     pool: vk::CommandPool,
     /// The command buffer.
     pub cmd: vk::CommandBuffer,
-    fence: vk::Fence,
+    /// Signalled when the last submission finished (or when nothing was submitted): it is reset
+    /// only just before a submission, and replaced by a signalled one if that submission fails,
+    /// so that no wait can hang on work that never reached the queue.
+    fence: std::cell::Cell<vk::Fence>,
     family: u32,
 }
 
@@ -34,14 +37,13 @@ impl CommandPool {
                 .create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
         }
         .map_err(|e| vk_err("creating a fence", e))?;
-        Ok(CommandPool { pool, cmd, fence, family })
+        Ok(CommandPool { pool, cmd, fence: std::cell::Cell::new(fence), family })
     }
 
     /// Waits for the previous submission, then starts recording.
     pub fn begin<'a>(&self, gpu: &'a Gpu) -> PlayResult<Recorder<'a>> {
         self.wait(gpu)?;
         unsafe {
-            gpu.device.reset_fences(&[self.fence]).map_err(|e| vk_err("resetting a fence", e))?;
             gpu.device
                 .reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty())
                 .map_err(|e| vk_err("resetting a command buffer", e))?;
@@ -76,26 +78,36 @@ impl CommandPool {
             .command_buffer_infos(&cmds)
             .wait_semaphore_infos(&waits)
             .signal_semaphore_infos(&signals);
-        unsafe { gpu.device.queue_submit2(queue, &[info], self.fence) }
-            .map_err(|e| vk_err("submitting commands", e))
+        let fence = self.fence.get();
+        unsafe { gpu.device.reset_fences(&[fence]) }.map_err(|e| vk_err("resetting a fence", e))?;
+        let submitted = unsafe { gpu.device.queue_submit2(queue, &[info], fence) };
+        if let Err(e) = submitted {
+            let signalled = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+            if let Ok(replacement) = unsafe { gpu.device.create_fence(&signalled, None) } {
+                unsafe { gpu.device.destroy_fence(fence, None) };
+                self.fence.set(replacement);
+            }
+            return Err(vk_err("submitting commands", e));
+        }
+        Ok(())
     }
 
     /// Waits until the last submission finished.
     pub fn wait(&self, gpu: &Gpu) -> PlayResult {
-        unsafe { gpu.device.wait_for_fences(&[self.fence], true, u64::MAX) }
+        unsafe { gpu.device.wait_for_fences(&[self.fence.get()], true, u64::MAX) }
             .map_err(|e| vk_err("waiting for the GPU", e))
     }
 
     /// Whether the last submission finished.
     pub fn done(&self, gpu: &Gpu) -> bool {
-        unsafe { gpu.device.get_fence_status(self.fence) }.unwrap_or(false)
+        unsafe { gpu.device.get_fence_status(self.fence.get()) }.unwrap_or(false)
     }
 
     /// Releases the pool.
     pub fn destroy(&mut self, gpu: &Gpu) {
         unsafe {
-            let _ = gpu.device.wait_for_fences(&[self.fence], true, u64::MAX);
-            gpu.device.destroy_fence(self.fence, None);
+            let _ = gpu.device.wait_for_fences(&[self.fence.get()], true, u64::MAX);
+            gpu.device.destroy_fence(self.fence.get(), None);
             gpu.device.destroy_command_pool(self.pool, None);
         }
     }
