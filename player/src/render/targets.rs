@@ -73,79 +73,80 @@ fn desc(format: vk::Format, width: u32, height: u32, usage: vk::ImageUsageFlags)
 }
 
 impl Targets {
-    /// Targets of `width` × `height`.
+    /// Targets of `width` × `height`. On failure the images already made are released.
     pub fn new(gpu: &Gpu, width: u32, height: u32, rt: RtShape) -> PlayResult<Targets> {
         // Storage too: the visibility-buffer resolve writes the material targets in compute.
         let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT
             | vk::ImageUsageFlags::SAMPLED
             | vk::ImageUsageFlags::STORAGE;
-        let mut gbuffer = Vec::new();
-        for (i, f) in GBUFFER_FORMATS.iter().enumerate() {
-            gbuffer.push(Image::new(gpu, &format!("gbuffer {i}"), desc(*f, width, height, attach))?);
-        }
-        let depth = Image::new(
-            gpu,
-            "depth",
-            desc(
-                DEPTH_FORMAT,
-                width,
-                height,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
-            ),
-        )?;
         let storage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC;
-        let radiance = Image::new(gpu, "radiance", desc(RADIANCE_FORMAT, width, height, storage))?;
-        let display = Image::new(gpu, "display", desc(DISPLAY_FORMAT, width, height, storage))?;
         let accumulation = vk::ImageUsageFlags::STORAGE;
         let on = |yes: bool, n: u32| if yes { n } else { 1 };
-        let mut shadows = desc(
-            vk::Format::R32_SFLOAT,
-            on(rt.shadow_layers > 0, width),
-            on(rt.shadow_layers > 0, height),
-            accumulation,
-        );
-        shadows.layers = rt.shadow_layers.max(1);
-        shadows.array = true;
-        let rt_shadows = Image::new(gpu, "rt shadows", shadows)?;
-        let rt_ao = Image::new(
-            gpu,
-            "rt ao",
-            desc(vk::Format::R32_SFLOAT, on(rt.ao, width), on(rt.ao, height), accumulation),
-        )?;
         let step = rt.reflection_step.max(1);
-        let rt_reflections = Image::new(
-            gpu,
-            "rt reflections",
-            desc(
-                vk::Format::R32G32B32A32_SFLOAT,
-                on(rt.reflection_step > 0, width.div_ceil(step)),
-                on(rt.reflection_step > 0, height.div_ceil(step)),
-                accumulation,
+        let (rw, rh) = (
+            on(rt.reflection_step > 0, width.div_ceil(step)),
+            on(rt.reflection_step > 0, height.div_ceil(step)),
+        );
+        let array = |mut d: ImageDesc, layers: u32| {
+            d.layers = layers.max(1);
+            d.array = true;
+            d
+        };
+        // In field order: the G-buffer, depth, radiance, display, then the ray-traced images.
+        let mut wanted: Vec<(String, ImageDesc)> = GBUFFER_FORMATS
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (format!("gbuffer {i}"), desc(*f, width, height, attach)))
+            .collect();
+        let depth_usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let r32 = vk::Format::R32_SFLOAT;
+        let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
+        let shadow_size = |n: u32| on(rt.shadow_layers > 0, n);
+        wanted.extend([
+            ("depth".into(), desc(DEPTH_FORMAT, width, height, depth_usage)),
+            ("radiance".into(), desc(RADIANCE_FORMAT, width, height, storage)),
+            ("display".into(), desc(DISPLAY_FORMAT, width, height, storage)),
+            (
+                "rt shadows".into(),
+                array(desc(r32, shadow_size(width), shadow_size(height), accumulation), rt.shadow_layers),
             ),
-        )?;
-        let refl_size = |yes: bool| (on(yes, width.div_ceil(step)), on(yes, height.div_ceil(step)));
-        let (rw, rh) = refl_size(rt.reflection_step > 0);
-        let refl =
-            |name: &str| Image::new(gpu, name, desc(vk::Format::R32G32B32A32_SFLOAT, rw, rh, accumulation));
-        let refl_partial = refl("reflection partial")?;
-        let refl_origin = refl("reflection origins")?;
-        let mut lights = desc(vk::Format::R32G32B32A32_SFLOAT, rw, rh, accumulation);
-        lights.layers = rt.reflection_lights.max(1);
-        lights.array = true;
-        let refl_lights = Image::new(gpu, "reflection light terms", lights)?;
+            ("rt ao".into(), desc(r32, on(rt.ao, width), on(rt.ao, height), accumulation)),
+            ("rt reflections".into(), desc(rgba32, rw, rh, accumulation)),
+            ("reflection partial".into(), desc(rgba32, rw, rh, accumulation)),
+            ("reflection origins".into(), desc(rgba32, rw, rh, accumulation)),
+            (
+                "reflection light terms".into(),
+                array(desc(rgba32, rw, rh, accumulation), rt.reflection_lights),
+            ),
+        ]);
+        let mut made = Vec::with_capacity(wanted.len());
+        for (name, d) in wanted {
+            match Image::new(gpu, &name, d) {
+                Ok(image) => made.push(image),
+                Err(e) => {
+                    for mut image in made {
+                        image.destroy(gpu);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        let mut it = made.into_iter();
+        let mut next = || it.next().expect("one image per description");
+        let gbuffer = (0..GBUFFER_FORMATS.len()).map(|_| next()).collect();
         Ok(Targets {
             width,
             height,
             gbuffer,
-            depth,
-            radiance,
-            display,
-            rt_shadows,
-            rt_ao,
-            rt_reflections,
-            refl_partial,
-            refl_origin,
-            refl_lights,
+            depth: next(),
+            radiance: next(),
+            display: next(),
+            rt_shadows: next(),
+            rt_ao: next(),
+            rt_reflections: next(),
+            refl_partial: next(),
+            refl_origin: next(),
+            refl_lights: next(),
             rt,
             rt_fresh: true,
         })
