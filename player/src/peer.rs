@@ -67,6 +67,14 @@ impl RtPipelinePeer {
         }
         let accel = ash::khr::acceleration_structure::Device::new(&gpu.instance, &gpu.device);
         let rtp = ash::khr::ray_tracing_pipeline::Device::new(&gpu.instance, &gpu.device);
+        let mut pool = CommandPool::new(gpu, gpu.family)?;
+        let timestamps = match TimestampPool::new(gpu, 2) {
+            Ok(t) => t,
+            Err(e) => {
+                pool.destroy(gpu);
+                return Err(e);
+            }
+        };
         let mut peer = RtPipelinePeer {
             accel,
             rtp,
@@ -76,8 +84,8 @@ impl RtPipelinePeer {
             layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             regions: [vk::StridedDeviceAddressRegionKHR::default(); 3],
-            pool: CommandPool::new(gpu, gpu.family)?,
-            timestamps: TimestampPool::new(gpu, 2)?,
+            pool,
+            timestamps,
             build_ms: 0.0,
         };
         match peer.build(gpu, corners).and_then(|()| peer.make_pipeline(gpu)) {
