@@ -709,7 +709,7 @@ fn ray_traced_reflections_of_a_mirror_floor_show_the_sky_and_an_emitter_at_the_f
 }
 
 #[test]
-fn accumulation_restarts_when_the_camera_moves_and_every_pass_is_clean_on_pica_pica() {
+fn accumulation_restarts_when_the_camera_moves_or_the_size_changes() {
     if !vulkan() {
         return;
     }
