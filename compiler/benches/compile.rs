@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use kiln_compiler::bake::bvh;
-use kiln_compiler::cli::{OutputArgs, SceneArgs};
+use kiln_compiler::cli::{BakeArgs, OutputArgs, SceneArgs};
 use kiln_compiler::pipeline;
 use kiln_compiler::settings::BvhPreset;
 use kiln_format::{Checksums, KilnFile, SceneView};
@@ -42,10 +42,7 @@ fn main() {
         bvh_preset: Some(BvhPreset::Medium),
         voxel_res: None,
         shaft_res: None,
-        shaft_variants: Some(0),
-        brdf_lut_res: None,
-        shadow_res: None,
-        media_volume_res: None,
+        bake: BakeArgs { shaft_variants: Some(0), ..BakeArgs::default() },
         strict: false,
     };
     let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };

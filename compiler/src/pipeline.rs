@@ -53,18 +53,7 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some(n) = args.shaft_res {
         settings.shaft_res = n;
     }
-    if let Some(v) = args.shaft_variants {
-        settings.shaft_variants = Some(v);
-    }
-    if let Some(n) = args.brdf_lut_res {
-        settings.brdf_lut_res = n;
-    }
-    if let Some(n) = args.shadow_res {
-        settings.shadow_res = n;
-    }
-    if let Some(n) = args.media_volume_res {
-        settings.media_volume_res = n;
-    }
+    args.bake.apply(&mut settings);
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
 }
 

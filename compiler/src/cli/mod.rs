@@ -84,6 +84,19 @@ pub struct SceneArgs {
     /// Shaft resolution N: patches per voxel face edge, 15·N⁴ shafts per voxel, 1..=8 [default: 4].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), help_heading = "Voxel grid and line space")]
     pub shaft_res: Option<u32>,
+    /// Line-space variants and lighting-bake sizes.
+    #[command(flatten)]
+    pub bake: BakeArgs,
+    /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
+    /// an error.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// Line-space variants and lighting-bake sizes, shared by `compile`, `plan` and `demo`; each
+/// overrides the sidecar's or the default setting when given.
+#[derive(Debug, Args, Clone, Default)]
+pub struct BakeArgs {
     /// Line-space variants to bake, comma-separated: binary (one bit per shaft), candidates
     /// (exact triangle lists), pnmt (front/back hit records), preillum (front/back radiance under
     /// the static lights), or none [default: chosen by the plan].
@@ -98,10 +111,24 @@ pub struct SceneArgs {
     /// Light-visibility volume cells along the medium's longest axis, 2..=512 [default: 64].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=512), help_heading = "Lighting bakes")]
     pub media_volume_res: Option<u32>,
-    /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
-    /// an error.
-    #[arg(long)]
-    pub strict: bool,
+}
+
+impl BakeArgs {
+    /// Applies the options given to `settings`.
+    pub fn apply(&self, settings: &mut crate::settings::Settings) {
+        if let Some(v) = self.shaft_variants {
+            settings.shaft_variants = Some(v);
+        }
+        if let Some(n) = self.brdf_lut_res {
+            settings.brdf_lut_res = n;
+        }
+        if let Some(n) = self.shadow_res {
+            settings.shadow_res = n;
+        }
+        if let Some(n) = self.media_volume_res {
+            settings.media_volume_res = n;
+        }
+    }
 }
 
 /// Options of commands that write a file.
@@ -177,18 +204,9 @@ pub struct DemoArgs {
     /// Shaft resolution N (1..=8).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), default_value_t = DEFAULT_SHAFT_RES, help_heading = "Voxel grid and line space")]
     pub shaft_res: u32,
-    /// Line-space variants (binary, candidates, pnmt, preillum, none) [default: chosen by the plan].
-    #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
-    pub shaft_variants: Option<u32>,
-    /// BRDF lookup table size N (N × N texels, 8..=1024) [default: 128].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(8..=1024), help_heading = "Lighting bakes")]
-    pub brdf_lut_res: Option<u32>,
-    /// Shadow map size N (N × N for directional and spot lights; cube faces of N/2), 16..=8192 [default: 1024].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=8192), help_heading = "Lighting bakes")]
-    pub shadow_res: Option<u32>,
-    /// Light-visibility volume cells along the medium's longest axis, 2..=512 [default: 64].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=512), help_heading = "Lighting bakes")]
-    pub media_volume_res: Option<u32>,
+    /// Line-space variants and lighting-bake sizes.
+    #[command(flatten)]
+    pub bake: BakeArgs,
     /// Report, depfile, threads.
     #[command(flatten)]
     pub out: OutputArgs,

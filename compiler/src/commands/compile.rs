@@ -29,22 +29,14 @@ pub fn run(args: &CompileArgs) -> CliResult {
 pub fn demo(args: &DemoArgs) -> CliResult {
     let start = Instant::now();
     let scene = crate::import::demo::cornell_box();
-    let loaded = pipeline::finish(
-        scene,
-        Settings {
-            bvh_preset: args.bvh_preset,
-            voxel_res: args.voxel_res,
-            shaft_res: args.shaft_res,
-            shaft_variants: args.shaft_variants,
-            brdf_lut_res: args.brdf_lut_res.unwrap_or(crate::bake::brdf_lut::DEFAULT_RESOLUTION),
-            shadow_res: args.shadow_res.unwrap_or(crate::bake::shadow::DEFAULT_RESOLUTION),
-            media_volume_res: args.media_volume_res.unwrap_or(crate::bake::media::DEFAULT_RESOLUTION),
-        },
-        "demo",
-        false,
-        args.out.quiet,
-        start,
-    )?;
+    let mut settings = Settings {
+        bvh_preset: args.bvh_preset,
+        voxel_res: args.voxel_res,
+        shaft_res: args.shaft_res,
+        ..Settings::default()
+    };
+    args.bake.apply(&mut settings);
+    let loaded = pipeline::finish(scene, settings, "demo", false, args.out.quiet, start)?;
     let report = pipeline::compile(&loaded, "demo", &args.output, &args.out)?;
     if !args.out.quiet {
         summary(&report);
