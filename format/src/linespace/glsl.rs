@@ -85,17 +85,7 @@ mod tests {
     /// `KILN_BLESS=1 cargo test -p kiln-format glsl`.
     #[test]
     fn committed_glsl_include_is_generated() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders/common/shaft.glsl");
-        let text = shaft_include();
-        if std::env::var_os("KILN_BLESS").is_some() {
-            std::fs::write(&path, &text).expect("write shaft.glsl");
-        }
-        let committed = std::fs::read_to_string(&path).unwrap_or_default();
-        assert!(
-            committed == text,
-            "{} differs from the generated include; run KILN_BLESS=1 cargo test -p kiln-format glsl",
-            path.display()
-        );
+        crate::gpu::assert_committed("shaders/common/shaft.glsl", &shaft_include(), "glsl");
     }
 
     /// The tables in the include reproduce the Rust mapping.
