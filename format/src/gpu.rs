@@ -381,6 +381,23 @@ gpu_struct! {
     }
 }
 
+/// Asserts that the committed file at `path` (relative to the workspace root) is exactly `text`,
+/// a GLSL mirror generated from this crate; with `KILN_BLESS` set it writes `text` there first.
+/// `filter` is the test-name filter the message suggests for regenerating.
+#[cfg(test)]
+pub(crate) fn assert_committed(path: &str, text: &str, filter: &str) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path);
+    if std::env::var_os("KILN_BLESS").is_some() {
+        std::fs::write(&path, text).expect("write the generated file");
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == text,
+        "{} differs from the generated text; run KILN_BLESS=1 cargo test -p kiln-format {filter}",
+        path.display()
+    );
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -419,21 +436,4 @@ mod tests {
     fn committed_glsl_layout_is_generated() {
         assert_committed("shaders/common/layout.glsl", &glsl_layout(), "layout");
     }
-}
-
-/// Asserts that the committed file at `path` (relative to the workspace root) is exactly `text`,
-/// a GLSL mirror generated from this crate; with `KILN_BLESS` set it writes `text` there first.
-/// `filter` is the test-name filter the message suggests for regenerating.
-#[cfg(test)]
-pub(crate) fn assert_committed(path: &str, text: &str, filter: &str) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path);
-    if std::env::var_os("KILN_BLESS").is_some() {
-        std::fs::write(&path, text).expect("write the generated file");
-    }
-    let committed = std::fs::read_to_string(&path).unwrap_or_default();
-    assert!(
-        committed == text,
-        "{} differs from the generated text; run KILN_BLESS=1 cargo test -p kiln-format {filter}",
-        path.display()
-    );
 }
