@@ -23,17 +23,7 @@ fn compile(scene: Scene, res: u32, n: u32) -> Vec<u8> {
         shaft_variants: Some(Variants::ALL),
         ..Default::default()
     };
-    let loaded = kiln_compiler::pipeline::finish(scene, settings, "bench", false, true, Instant::now())
-        .expect("valid");
-    let baked = kiln_compiler::bake::bake(
-        &loaded.scene,
-        &loaded.settings,
-        &loaded.plan,
-        Vec::new(),
-        &kiln_compiler::progress::Progress::hidden(),
-    )
-    .expect("bake");
-    kiln_compiler::bake::to_bytes(&baked).expect("write")
+    kiln_compiler::pipeline::compile_to_bytes(scene, settings, "bench").expect("bakes")
 }
 
 fn rays(tris: &IndexedTriangles, lo: Vec3, hi: Vec3, n: usize) -> Vec<(Ray, Option<Vec3>)> {

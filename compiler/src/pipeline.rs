@@ -122,6 +122,15 @@ pub fn finish(
     Ok(Loaded { scene, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
 }
 
+/// Validates, plans and bakes `scene` in memory, quietly and on the calling thread's pool, with no
+/// input files recorded: the bytes `kiln compile` would write (tests and benchmarks build their
+/// scenes in code).
+pub fn compile_to_bytes(scene: Scene, settings: Settings, source: &str) -> CliResult<Vec<u8>> {
+    let loaded = finish(scene, settings, source, false, true, Instant::now())?;
+    let baked = bake::bake(&loaded.scene, &loaded.settings, &loaded.plan, Vec::new(), &Progress::hidden())?;
+    bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))
+}
+
 /// Reads and hashes every input file for the manifest.
 pub fn hash_inputs(paths: &[PathBuf]) -> CliResult<Vec<InputFile>> {
     paths

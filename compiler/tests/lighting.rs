@@ -136,7 +136,6 @@ fn brdf_table_has_the_known_limits() {
 use glam::{Mat4, Vec3};
 use kiln_compiler::bake::shadow;
 use kiln_compiler::ir::{Material, Scene};
-use kiln_compiler::progress::Progress;
 use kiln_compiler::settings::Settings;
 use kiln_format::linespace::{LineSpace, Variants};
 use kiln_format::manifest::{Bounds, Light, LightKind, Medium, ShadowProjection};
@@ -159,18 +158,7 @@ fn light(kind: LightKind, position: [f32; 3], direction: [f32; 3], intensity: f3
 }
 
 fn compile(scene: Scene, settings: Settings) -> Vec<u8> {
-    let loaded =
-        kiln_compiler::pipeline::finish(scene, settings, "test", false, true, std::time::Instant::now())
-            .expect("valid");
-    let baked = kiln_compiler::bake::bake(
-        &loaded.scene,
-        &loaded.settings,
-        &loaded.plan,
-        Vec::new(),
-        &Progress::hidden(),
-    )
-    .expect("bake");
-    kiln_compiler::bake::to_bytes(&baked).expect("write")
+    kiln_compiler::pipeline::compile_to_bytes(scene, settings, "test").expect("bakes")
 }
 
 /// The ray of a texel reconstructed from the manifest record alone, by the documented

@@ -1,13 +1,9 @@
 //! Shared helpers of the workspace-level tests: scenes built in code and compiled in memory.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use glam::Vec3;
-use kiln_compiler::analyze::plan::Plan;
-use kiln_compiler::bake;
 use kiln_compiler::ir::{Material, Scene};
-use kiln_compiler::progress::Progress;
 use kiln_compiler::settings::Settings;
 use kiln_format::sections::Vertex;
 
@@ -37,12 +33,7 @@ pub fn scene_of(tris: &[[Vec3; 3]]) -> Scene {
 
 /// Compiles a scene in memory (as `kiln compile` would) and returns the file's bytes.
 pub fn compile(scene: Scene, settings: Settings) -> Vec<u8> {
-    let loaded = kiln_compiler::pipeline::finish(scene, settings, "test", false, true, Instant::now())
-        .expect("valid scene");
-    let plan: &Plan = &loaded.plan;
-    let baked =
-        bake::bake(&loaded.scene, &loaded.settings, plan, Vec::new(), &Progress::hidden()).expect("bake");
-    bake::to_bytes(&baked).expect("write")
+    kiln_compiler::pipeline::compile_to_bytes(scene, settings, "test").expect("valid scene")
 }
 
 /// Shapes the query tests share.
