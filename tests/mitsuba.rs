@@ -34,7 +34,7 @@ use kiln_format::sections::{MaterialFlags, NO_TEXTURE, Vertex};
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::RenderSettings;
 use kiln_player::session::SessionOptions;
-use kiln_tests::compile;
+use kiln_tests::{compile, skip, vulkan};
 
 /// Image size: small, as kiln samples about 0.06 M paths/s on lavapipe with two cores.
 const W: u32 = 64;
@@ -49,21 +49,6 @@ const MAX_MEAN_FLIP: f64 = 0.05;
 
 const INSTALL: &str = "run .ci/run or python3 -m venv .venv-mitsuba && \
                        .venv-mitsuba/bin/pip install mitsuba flip-evaluator numpy";
-
-/// Skips (printing why) or, when `require` is set in the environment, fails.
-fn skip(require: &str, why: String) -> bool {
-    assert!(std::env::var_os(require).is_none(), "{why}, but {require} is set");
-    eprintln!("skipping: {why}");
-    false
-}
-
-/// Whether a Vulkan device and the validation layer are here.
-fn vulkan() -> bool {
-    match kiln_player::gpu::list_devices() {
-        Ok(d) if !d.is_empty() => true,
-        other => skip("KILN_REQUIRE_VULKAN", format!("no Vulkan device ({other:?})")),
-    }
-}
 
 /// The Python that has Mitsuba and FLIP, if any.
 fn mitsuba_python() -> Option<PathBuf> {

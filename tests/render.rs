@@ -18,23 +18,7 @@ use kiln_player::headless::{self, HeadlessResult};
 use kiln_player::image_out::read_exr;
 use kiln_player::render::{GBufferMode, ReflectionRes, RenderSettings, RtSettings};
 use kiln_player::session::SessionOptions;
-use kiln_tests::{compile, scene_of, shared_scenes};
-
-/// Whether a Vulkan device and the validation layer are here; panics when they are required.
-fn vulkan() -> bool {
-    match kiln_player::gpu::list_devices() {
-        Ok(d) if !d.is_empty() => true,
-        other => {
-            let why = format!("no Vulkan device ({other:?})");
-            assert!(
-                std::env::var_os("KILN_REQUIRE_VULKAN").is_none(),
-                "{why}, but KILN_REQUIRE_VULKAN is set"
-            );
-            eprintln!("skipping: {why}");
-            false
-        }
-    }
-}
+use kiln_tests::{compile, scene_of, shared_scenes, vulkan};
 
 fn options(
     file: &Path,

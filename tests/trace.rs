@@ -19,21 +19,7 @@ use kiln_player::render::RenderSettings;
 use kiln_player::session::{Session, SessionOptions};
 use kiln_player::trace::{GpuRay, NO_HIT, RayQuery};
 use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
-use kiln_tests::{compile, scene_of, shared_scenes};
-
-fn vulkan() -> bool {
-    match kiln_player::gpu::list_devices() {
-        Ok(d) if !d.is_empty() => true,
-        other => {
-            assert!(
-                std::env::var_os("KILN_REQUIRE_VULKAN").is_none(),
-                "no Vulkan device ({other:?}) but KILN_REQUIRE_VULKAN is set"
-            );
-            eprintln!("skipping: no Vulkan device ({other:?})");
-            false
-        }
-    }
-}
+use kiln_tests::{compile, scene_of, shared_scenes, vulkan};
 
 fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
     let file = dir.join("scene.kiln");
