@@ -558,16 +558,14 @@ impl Renderer {
         };
         let bounds = scene.manifest.bounds;
         let diagonal = glam::Vec3::from(bounds.max).distance(glam::Vec3::from(bounds.min));
+        // The same shape the targets were made with (one layer at least, even without lights).
+        let shape = settings.rt.shape(plan.lights_used as usize);
         let rt_constants = RtConstants {
             ao_radius: settings.rt.ao_radius.unwrap_or(0.1 * diagonal).max(1e-6),
             max_roughness: settings.rt.max_roughness,
-            shadow_lights: if settings.rt.shadows {
-                (plan.lights_used as usize).min(MAX_RT_SHADOW_LIGHTS) as u32
-            } else {
-                0
-            },
-            reflection_step: settings.rt.shape(0).reflection_step.max(1),
-            reflection_lights: settings.rt.shape(plan.lights_used as usize).reflection_lights,
+            shadow_lights: shape.shadow_layers.min(plan.lights_used),
+            reflection_step: shape.reflection_step.max(1),
+            reflection_lights: shape.reflection_lights,
             ..Default::default()
         };
         let mut flags = if plan.shadows_bound && !settings.rt.shadows { FrameFlags::SHADOW_MAPS } else { 0 };
