@@ -29,18 +29,6 @@ vec4 texel(GpuTexture t, int x, int y) {
     return level_texel(t, uvec3(t.width, t.height, t.offset), x, y);
 }
 
-vec4 sample_texture(uint index, vec2 uv) {
-    GpuTexture t = textures[index];
-    vec2 x = uv * vec2(t.width, t.height);
-    if ((t.flags & TEXTURE_LINEAR) == 0u) {
-        return texel(t, int(floor(x.x)), int(floor(x.y)));
-    }
-    x -= 0.5;
-    ivec2 i = ivec2(floor(x));
-    vec2 f = x - vec2(i);
-    return mix(mix(texel(t, i.x, i.y), texel(t, i.x + 1, i.y), f.x), mix(texel(t, i.x, i.y + 1), texel(t, i.x + 1, i.y + 1), f.x), f.y);
-}
-
 // Mip level `level` of a texture: its size and first word.
 uvec3 texture_level(GpuTexture t, uint level) {
     uint w = t.width, h = t.height, offset = t.offset;
@@ -59,6 +47,16 @@ vec4 bilinear_level(GpuTexture t, uint level, vec2 uv) {
     vec2 f = x - vec2(i);
     return mix(mix(level_texel(t, l, i.x, i.y), level_texel(t, l, i.x + 1, i.y), f.x),
         mix(level_texel(t, l, i.x, i.y + 1), level_texel(t, l, i.x + 1, i.y + 1), f.x), f.y);
+}
+
+// Mip 0, bilinear or nearest as the texture's filter says (what the path tracer samples).
+vec4 sample_texture(uint index, vec2 uv) {
+    GpuTexture t = textures[index];
+    if ((t.flags & TEXTURE_LINEAR) == 0u) {
+        vec2 x = uv * vec2(t.width, t.height);
+        return texel(t, int(floor(x.x)), int(floor(x.y)));
+    }
+    return bilinear_level(t, 0u, uv);
 }
 
 // Trilinear filtering with the level chosen from the uv footprint of a pixel (the larger of its
