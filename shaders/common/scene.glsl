@@ -13,6 +13,7 @@
 const float PI = 3.14159265358979;
 
 #include "textures.glsl"
+#include "vertices.glsl"
 
 vec2 triangle_uv(uint tri, float u, float v) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
@@ -46,10 +47,6 @@ struct Surface {
     bool diffuse_only;
     vec3 emission;  // emitted radiance towards the ray (zero from a back face of a one-sided material)
 };
-
-vec3 vertex_normal(uint i) {
-    return vec3(vertex_data[6u * i + 3u], vertex_data[6u * i + 4u], vertex_data[6u * i + 5u]);
-}
 
 Surface surface_at(TraceRay r, TraceHit h) {
     Surface s;

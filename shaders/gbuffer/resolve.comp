@@ -29,32 +29,8 @@ layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D out_emission;
 layout(set = 0, binding = 13) uniform sampler2D g_depth;
 
 #include "../common/textures.glsl"
-
-vec3 position(uint v) {
-    return vec3(vertex_data[6u * v], vertex_data[6u * v + 1u], vertex_data[6u * v + 2u]);
-}
-
-vec3 vertex_normal(uint v) {
-    return vec3(vertex_data[6u * v + 3u], vertex_data[6u * v + 4u], vertex_data[6u * v + 5u]);
-}
-
-vec3 pixel_ray(vec2 at) {
-    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
-    return frame.camera_forward.xyz + frame.camera_right.xyz * (ndc.x * frame.camera_right.w)
-        + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
-}
-
-// Barycentrics (of corners 1 and 2) where the ray from the camera along `dir` meets the
-// triangle's plane.
-vec2 barycentrics(vec3 dir, vec3 p0, vec3 e1, vec3 e2) {
-    vec3 pv = cross(dir, e2);
-    float det = dot(e1, pv);
-    if (abs(det) <= 0.0) {
-        return vec2(0.0);
-    }
-    vec3 tv = frame.camera.xyz - p0;
-    return vec2(dot(tv, pv), dot(dir, cross(tv, e1))) / det;
-}
+#include "../common/vertices.glsl"
+#include "../common/pixel.glsl"
 
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -75,7 +51,7 @@ void main() {
     }
     uint t = id - 1u;
     uvec3 idx = uvec3(raster_indices[3u * t], raster_indices[3u * t + 1u], raster_indices[3u * t + 2u]);
-    vec3 p0 = position(idx.x), p1 = position(idx.y), p2 = position(idx.z);
+    vec3 p0 = vertex_position(idx.x), p1 = vertex_position(idx.y), p2 = vertex_position(idx.z);
     vec3 e1 = p1 - p0, e2 = p2 - p0;
     vec2 centre = vec2(pixel) + 0.5;
     vec3 dir = pixel_ray(centre);

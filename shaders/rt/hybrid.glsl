@@ -45,6 +45,7 @@ layout(push_constant) uniform Params { RtConstants rt; };
 
 #include "../common/random.glsl"
 #include "../common/scene.glsl"
+#include "../common/pixel.glsl"
 
 // The visible surface under a pixel.
 struct Primary {
@@ -61,25 +62,14 @@ bool primary_at(ivec2 pixel, out Primary s) {
     }
     uint t = id - 1u;
     uvec3 idx = uvec3(raster_indices[3u * t], raster_indices[3u * t + 1u], raster_indices[3u * t + 2u]);
-    vec3 p0 = vec3(vertex_data[6u * idx.x], vertex_data[6u * idx.x + 1u], vertex_data[6u * idx.x + 2u]);
-    vec3 p1 = vec3(vertex_data[6u * idx.y], vertex_data[6u * idx.y + 1u], vertex_data[6u * idx.y + 2u]);
-    vec3 p2 = vec3(vertex_data[6u * idx.z], vertex_data[6u * idx.z + 1u], vertex_data[6u * idx.z + 2u]);
-    vec2 ndc = vec2((float(pixel.x) + 0.5) / float(frame.size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + 0.5) / float(frame.size.y) * 2.0);
-    vec3 dir = frame.camera_forward.xyz + frame.camera_right.xyz * (ndc.x * frame.camera_right.w)
-        + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
-    // Möller–Trumbore barycentrics of the pixel-centre ray, clamped onto the triangle (the
-    // rasteriser's sample may lie a hair outside the triangle that won it).
+    vec3 p0 = vertex_position(idx.x), p1 = vertex_position(idx.y), p2 = vertex_position(idx.z);
+    vec3 dir = pixel_ray(vec2(pixel) + 0.5);
+    // Barycentrics of the pixel-centre ray, clamped onto the triangle (the rasteriser's sample
+    // may lie a hair outside the triangle that won it).
     vec3 e1 = p1 - p0, e2 = p2 - p0;
-    vec3 pv = cross(dir, e2);
-    float det = dot(e1, pv);
-    vec3 tv = frame.camera.xyz - p0;
-    float u = 0.0, w = 0.0;
-    if (abs(det) > 0.0) {
-        u = dot(tv, pv) / det;
-        w = dot(dir, cross(tv, e1)) / det;
-    }
-    u = clamp(u, 0.0, 1.0);
-    w = clamp(w, 0.0, 1.0 - u);
+    vec2 b = barycentrics(dir, p0, e1, e2);
+    float u = clamp(b.x, 0.0, 1.0);
+    float w = clamp(b.y, 0.0, 1.0 - u);
     s.p = p0 + u * e1 + w * e2;
     vec3 ng = cross(e1, e2);
     ng = dot(ng, ng) > 0.0 ? normalize(ng) : -normalize(dir);
