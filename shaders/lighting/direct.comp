@@ -134,6 +134,13 @@ float shadow_factor(uint index, GpuLight light, vec3 p, vec3 n, vec3 l, float an
     return shadow_2d_factor(s, p, n, l, angle);
 }
 
+// The world position of a pixel's centre at the given (reversed-Z) depth.
+vec3 world_at(ivec2 pixel, float depth) {
+    vec2 ndc = vec2((float(pixel.x) + 0.5) / float(frame.size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + 0.5) / float(frame.size.y) * 2.0);
+    vec4 world = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+    return world.xyz / world.w;
+}
+
 // The ray-traced reflection at a pixel (rgb, a > 0 where traced). Half resolution: the four
 // nearest traced pixels (each block's top-left), bilinear weights times how well their surface
 // matches this pixel's (normal and plane distance), so that reflections do not bleed across
@@ -158,9 +165,7 @@ vec4 reflection_at(ivec2 pixel, vec3 p, vec3 n) {
             if (depth <= 0.0) {
                 continue;
             }
-            vec2 ndc = vec2((float(src.x) + 0.5) / float(frame.size.x) * 2.0 - 1.0, 1.0 - (float(src.y) + 0.5) / float(frame.size.y) * 2.0);
-            vec4 w4 = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-            vec3 q = w4.xyz / w4.w;
+            vec3 q = world_at(src, depth);
             vec3 nq = oct_decode(texelFetch(g_normal, src, 0).rg);
             float bilinear = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
             float normal_match = pow(max(dot(nq, n), 0.0), 16.0);
@@ -186,9 +191,7 @@ void main() {
         imageStore(radiance_out, pixel, vec4(frame.sky.rgb, 1.0));
         return;
     }
-    vec2 ndc = vec2((float(pixel.x) + 0.5) / float(size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + 0.5) / float(size.y) * 2.0);
-    vec4 world = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-    vec3 p = world.xyz / world.w;
+    vec3 p = world_at(pixel, depth);
     vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
     vec4 mat = texelFetch(g_material, pixel, 0);
     Surface s = Surface(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
