@@ -48,6 +48,8 @@ pub struct RtPipelinePeer {
     timestamps: TimestampPool,
     /// GPU milliseconds of the acceleration-structure build.
     pub build_ms: f64,
+    /// Untimed traces recorded before each timed one (see [`crate::trace::WARMUP_TRACES`]).
+    pub warmup: u32,
 }
 
 impl std::fmt::Debug for RtPipelinePeer {
@@ -87,6 +89,7 @@ impl RtPipelinePeer {
             pool,
             timestamps,
             build_ms: 0.0,
+            warmup: 0,
         };
         match peer.build(gpu, corners).and_then(|()| peer.make_pipeline(gpu)) {
             Ok(()) => Ok(Some(peer)),
@@ -389,36 +392,48 @@ impl RtPipelinePeer {
     /// of the trace alone.
     pub fn trace(&mut self, gpu: &Gpu, rays: &[GpuRay], any_hit: bool) -> PlayResult<(Vec<GpuHit>, f64)> {
         let this = &*self;
-        timed_trace(gpu, &this.pool, &this.timestamps, rays, ADDRESS, |rec, input, output, count| {
-            let push = Push {
-                tlas: this.tlas_address,
-                rays: input.address(gpu),
-                hits: output.address(gpu),
-                count,
-                any_hit: any_hit as u32,
-            };
-            unsafe {
-                gpu.device.cmd_bind_pipeline(rec.cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, this.pipeline);
-                gpu.device.cmd_push_constants(
-                    rec.cmd,
-                    this.layout,
-                    vk::ShaderStageFlags::RAYGEN_KHR,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
-                this.rtp.cmd_trace_rays(
-                    rec.cmd,
-                    &this.regions[0],
-                    &this.regions[1],
-                    &this.regions[2],
-                    &vk::StridedDeviceAddressRegionKHR::default(),
+        timed_trace(
+            gpu,
+            &this.pool,
+            &this.timestamps,
+            rays,
+            ADDRESS,
+            this.warmup,
+            |rec, input, output, count| {
+                let push = Push {
+                    tlas: this.tlas_address,
+                    rays: input.address(gpu),
+                    hits: output.address(gpu),
                     count,
-                    1,
-                    1,
-                );
-            }
-            vk::PipelineStageFlags2::RAY_TRACING_SHADER_KHR
-        })
+                    any_hit: any_hit as u32,
+                };
+                unsafe {
+                    gpu.device.cmd_bind_pipeline(
+                        rec.cmd,
+                        vk::PipelineBindPoint::RAY_TRACING_KHR,
+                        this.pipeline,
+                    );
+                    gpu.device.cmd_push_constants(
+                        rec.cmd,
+                        this.layout,
+                        vk::ShaderStageFlags::RAYGEN_KHR,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                    this.rtp.cmd_trace_rays(
+                        rec.cmd,
+                        &this.regions[0],
+                        &this.regions[1],
+                        &this.regions[2],
+                        &vk::StridedDeviceAddressRegionKHR::default(),
+                        count,
+                        1,
+                        1,
+                    );
+                }
+                vk::PipelineStageFlags2::RAY_TRACING_SHADER_KHR
+            },
+        )
     }
 
     /// Releases everything (the GPU must be idle).

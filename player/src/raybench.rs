@@ -18,7 +18,7 @@ use serde::Serialize;
 use crate::bench::quantile;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::session::{Session, SessionOptions, open_file};
-use crate::trace::{GpuHit, GpuRay, NO_HIT, RayQuery};
+use crate::trace::{GpuHit, GpuRay, NO_HIT, RayQuery, WARMUP_TRACES};
 
 /// One ray set's figures.
 #[derive(Debug, Clone, Serialize)]
@@ -134,6 +134,7 @@ pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult
     o.readback = None;
     let session = Session::open(&o, start)?;
     let mut query = RayQuery::new(&session.gpu)?;
+    query.warmup = WARMUP_TRACES;
     let result = measure(&session, &mut query, &o, repeats.max(1));
     query.destroy(&session.gpu);
     let errors = session.close();
@@ -226,6 +227,9 @@ fn measure(
     let corners: Vec<[f32; 3]> =
         view.triangles.iter().flat_map(|t| t.map(|v| view.vertices[v as usize].position)).collect();
     let mut peer = crate::peer::RtPipelinePeer::new(gpu, &corners)?;
+    if let Some(p) = &mut peer {
+        p.warmup = WARMUP_TRACES;
+    }
     let sets = [
         ("primary", &primary, false),
         ("shadow", &shadow, true),

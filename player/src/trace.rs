@@ -53,6 +53,8 @@ pub struct RayQuery {
     pipeline: ComputePipeline,
     pool: CommandPool,
     timestamps: TimestampPool,
+    /// Untimed traces recorded before each timed one (0; benchmarks set [`WARMUP_TRACES`]).
+    pub warmup: u32,
 }
 
 impl std::fmt::Debug for RayQuery {
@@ -74,6 +76,7 @@ impl RayQuery {
             pipeline,
             pool: CommandPool::new(gpu, gpu.family)?,
             timestamps: TimestampPool::new(gpu, 2)?,
+            warmup: 0,
         })
     }
 
@@ -91,23 +94,31 @@ impl RayQuery {
         // The set points at this trace's buffers; it is written once, before its first use (the
         // trace is recorded several times, and writing a bound set invalidates the recording).
         let written = std::cell::Cell::new(false);
-        timed_trace(gpu, &self.pool, &self.timestamps, rays, usage, |rec, input, output, count| {
-            if !written.replace(true) {
-                layout.write(
-                    gpu,
-                    set,
-                    &[
-                        Write::Buffer(0, &bvh.nodes),
-                        Write::Buffer(1, &bvh.triangles),
-                        Write::Buffer(2, input),
-                        Write::Buffer(3, output),
-                    ],
-                );
-            }
-            let push: [u32; 2] = [count, any_hit as u32];
-            rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
-            vk::PipelineStageFlags2::COMPUTE_SHADER
-        })
+        timed_trace(
+            gpu,
+            &self.pool,
+            &self.timestamps,
+            rays,
+            usage,
+            self.warmup,
+            |rec, input, output, count| {
+                if !written.replace(true) {
+                    layout.write(
+                        gpu,
+                        set,
+                        &[
+                            Write::Buffer(0, &bvh.nodes),
+                            Write::Buffer(1, &bvh.triangles),
+                            Write::Buffer(2, input),
+                            Write::Buffer(3, output),
+                        ],
+                    );
+                }
+                let push: [u32; 2] = [count, any_hit as u32];
+                rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
+                vk::PipelineStageFlags2::COMPUTE_SHADER
+            },
+        )
     }
 
     /// Releases the pipeline and its pools.
@@ -119,23 +130,24 @@ impl RayQuery {
     }
 }
 
+/// Untimed traces a benchmark records before each timed one (see [`timed_trace`]).
+pub const WARMUP_TRACES: u32 = 3;
+
 /// Runs one timed trace of `rays`: fills a host-visible ray buffer, records `record` (given the
 /// ray and hit buffers, created with storage plus `usage`, and the ray count; it returns the
 /// stage that writes the hits) between two timestamps, waits, and returns the hits and the GPU
 /// milliseconds between the timestamps. Shared by the compute traversal and its peer.
 ///
-/// The same trace is recorded [`WARMUP_TRACES`] times before the timed one, in the same
+/// Benchmarks record the same trace `warmup` times before the timed one, in the same
 /// submission: a lone sub-millisecond dispatch after the host's work on the buffers ran at
 /// whatever clock the idle GPU had dropped to (on an H200, 2–7× slower on later ray sets).
-/// Untimed traces recorded before each timed one (see [`timed_trace`]).
-pub const WARMUP_TRACES: u32 = 3;
-
 pub(crate) fn timed_trace(
     gpu: &Gpu,
     pool: &CommandPool,
     timestamps: &TimestampPool,
     rays: &[GpuRay],
     usage: vk::BufferUsageFlags,
+    warmup: u32,
     record: impl Fn(&Recorder, &Buffer, &Buffer, u32) -> vk::PipelineStageFlags2,
 ) -> PlayResult<(Vec<GpuHit>, f64)> {
     if rays.is_empty() {
@@ -158,7 +170,7 @@ pub(crate) fn timed_trace(
         input.write(bytes)?;
         let rec = pool.begin(gpu)?;
         rec.reset_timestamps(timestamps);
-        for _ in 0..WARMUP_TRACES {
+        for _ in 0..warmup {
             let stage = record(&rec, &input, &output, count);
             // The next trace overwrites the same hits.
             rec.memory_barrier(
