@@ -11,17 +11,8 @@ use gpu_allocator::MemoryLocation;
 
 use crate::error::{PlayResult, vk as vk_err};
 use crate::gpu::{Buffer, CommandPool, Gpu, TimestampPool};
+use crate::render::spirv;
 use crate::trace::{GpuHit, GpuRay, timed_trace};
-
-/// SPIR-V of the peer's shaders.
-pub mod spirv {
-    /// Ray generation: one ray of the buffer per launch index.
-    pub const RGEN: &[u8] = include_bytes!("../../shaders/spirv/trace.rgen.spv");
-    /// Miss: no hit.
-    pub const RMISS: &[u8] = include_bytes!("../../shaders/spirv/trace.rmiss.spv");
-    /// Closest hit: distance, primitive, barycentrics.
-    pub const RCHIT: &[u8] = include_bytes!("../../shaders/spirv/trace.rchit.spv");
-}
 
 /// Push constants of `shaders/peer/trace.rgen`.
 #[repr(C)]
@@ -279,7 +270,7 @@ impl RtPipelinePeer {
         }
         .map_err(|e| vk_err("creating the ray-tracing pipeline layout", e))?;
         let mut modules = Vec::new();
-        for code in [spirv::RGEN, spirv::RMISS, spirv::RCHIT] {
+        for code in [spirv::PEER_RGEN, spirv::PEER_RMISS, spirv::PEER_RCHIT] {
             let words: Vec<u32> =
                 code.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
             match unsafe {

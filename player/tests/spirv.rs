@@ -63,7 +63,10 @@ fn every_shader_source_is_built_and_embedded() {
         }
         for f in std::fs::read_dir(&folder).unwrap() {
             let f = f.unwrap().path();
-            if matches!(f.extension().and_then(|e| e.to_str()), Some("vert" | "frag" | "comp")) {
+            if matches!(
+                f.extension().and_then(|e| e.to_str()),
+                Some("vert" | "frag" | "comp" | "rgen" | "rmiss" | "rchit")
+            ) {
                 let rel = format!(
                     "{}/{}",
                     folder.file_name().unwrap().to_str().unwrap(),
