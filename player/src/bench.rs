@@ -6,7 +6,6 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::error::PlayResult;
-use crate::render::PASSES;
 use crate::scene::SectionFate;
 use crate::session::{LoadTimes, Session, SessionOptions};
 
@@ -81,16 +80,16 @@ pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -
         session.frame(false)?;
     }
     let frames = frames.max(1);
-    let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len() + 1];
+    let names: Vec<&str> = session.renderer.pass_names().into_iter().chain(["total"]).collect();
+    let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
     for _ in 0..frames {
         let t = session.frame(false)?;
-        for (i, ms) in t.iter().enumerate() {
+        for (i, (_, ms)) in t.iter().enumerate() {
             per_pass[i].push(*ms);
         }
-        per_pass[PASSES.len()].push(t.iter().sum());
+        per_pass[names.len() - 1].push(t.iter().map(|(_, ms)| ms).sum());
     }
-    let names = PASSES.iter().copied().chain(["total"]);
-    let passes = names.zip(per_pass).map(|(n, v)| stats(n, v)).collect();
+    let passes = names.into_iter().zip(per_pass).map(|(n, v)| stats(n, v)).collect();
     let mut report = BenchReport {
         device: session.gpu.name.clone(),
         scene: session.scene.manifest.scene_name.clone(),

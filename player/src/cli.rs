@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use clap::builder::{PossibleValue, PossibleValuesParser};
 use clap::{Parser, ValueEnum};
 
 use crate::bench;
@@ -10,7 +11,8 @@ use crate::camera::CameraOverride;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
-use crate::render::{GBufferMode, ReflectionRes, RenderSettings, RtSettings};
+use crate::render::technique::{Effect, KnobValue, Techniques, catalogue, techniques_of};
+use crate::render::{Aa, Purpose, RenderSettings};
 use crate::session::SessionOptions;
 use crate::window;
 
@@ -55,45 +57,9 @@ impl std::str::FromStr for Size {
     }
 }
 
-/// `--shadows`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Shadows {
-    /// No shadows.
-    None,
-    /// The compiler's baked shadow maps (PCF; PCSS for rect lights).
-    Shadowmap,
-    /// Ray-traced soft shadows: one ray per light per pixel per frame, averaged while the
-    /// camera is still (see --light-radius, --sun-angle).
-    Rt,
-}
-
-/// `--gbuffer`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum GBufferArg {
-    /// Rasterise every material attribute (five targets).
-    Raster,
-    /// Rasterise a visibility buffer (triangle per pixel), evaluate materials in compute:
-    /// faster on GPUs with little raster hardware (e.g. NVIDIA H100/H200).
-    Visibility,
-}
-
-/// `--ao`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Ao {
-    /// No ambient occlusion (the material's occlusion texture still applies).
-    None,
-    /// Ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius.
-    Rt,
-}
-
-/// `--reflections`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Reflections {
-    /// Split-sum ambient specular only.
-    None,
-    /// Ray-traced glossy reflections (GGX visible-normal samples, one per pixel per frame at
-    /// --reflection-res).
-    Rt,
+/// The values `--EFFECT` takes: the catalogue's techniques of that effect, with their help.
+fn techniques(effect: Effect) -> PossibleValuesParser {
+    PossibleValuesParser::new(techniques_of(effect).map(|t| PossibleValue::new(t.name).help(t.help)))
 }
 
 /// `--reflection-res`.
@@ -105,17 +71,10 @@ pub enum ReflectionResArg {
     Half,
 }
 
-/// A technique switch whose techniques come with later passes; `none` for now.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum NotYet {
-    /// Off.
-    None,
-}
-
 /// kiln-play renders .kiln files with Vulkan 1.3: in a window, headless to PNG or EXR, or as a
 /// benchmark.
 #[derive(Debug, Parser)]
-#[command(name = "kiln-play", version, about, after_help = AFTER_HELP)]
+#[command(name = "kiln-play", version, about, after_help = AFTER_HELP, args_override_self = true)]
 pub struct Args {
     /// The .kiln file to play (`kiln compile` or `kiln demo` make one).
     pub file: Option<PathBuf>,
@@ -133,7 +92,7 @@ pub struct Args {
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Measure per-pass GPU times and the load breakdown (headless).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "output")]
     pub bench: bool,
     /// Measure the compute traversal's throughput (Mrays/s) on primary, shadow and diffuse
     /// rays at --size from the file's camera, each set traced --frames times (default 20).
@@ -162,20 +121,20 @@ pub struct Args {
     #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
     /// How the G-buffer is made.
-    #[arg(long, value_enum, default_value = "raster")]
-    pub gbuffer: GBufferArg,
+    #[arg(long, value_parser = techniques(Effect::GBuffer), default_value = "raster")]
+    pub gbuffer: String,
     /// Shadows technique.
-    #[arg(long, value_enum, default_value = "shadowmap")]
-    pub shadows: Shadows,
+    #[arg(long, value_parser = techniques(Effect::Shadows), default_value = "shadowmap")]
+    pub shadows: String,
     /// Ambient occlusion technique.
-    #[arg(long, value_enum, default_value = "none")]
-    pub ao: Ao,
+    #[arg(long, value_parser = techniques(Effect::Ao), default_value = "none")]
+    pub ao: String,
     /// With --ao rt: ray length in scene units (default: a tenth of the scene's diagonal).
     #[arg(long, value_name = "R")]
     pub ao_radius: Option<f32>,
     /// Reflections technique.
-    #[arg(long, value_enum, default_value = "none")]
-    pub reflections: Reflections,
+    #[arg(long, value_parser = techniques(Effect::Reflections), default_value = "none")]
+    pub reflections: String,
     /// With --reflections rt: resolution of the traced reflections.
     #[arg(long, value_enum, default_value = "full")]
     pub reflection_res: ReflectionResArg,
@@ -193,13 +152,13 @@ pub struct Args {
     #[arg(long)]
     pub no_accumulate: bool,
     /// Global illumination technique (later passes add techniques).
-    #[arg(long, value_enum, default_value = "none")]
-    pub gi: NotYet,
+    #[arg(long, value_parser = techniques(Effect::Gi), default_value = "none")]
+    pub gi: String,
     /// Participating media technique (later passes add techniques).
-    #[arg(long, value_enum, default_value = "none")]
-    pub media: NotYet,
+    #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
+    pub media: String,
     /// Render the unbiased reference path tracer instead (headless, needs -o OUT.exr).
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["bench", "bench_rays"])]
     pub reference: bool,
     /// With --reference: samples per pixel.
     #[arg(long, value_name = "N", default_value_t = 256)]
@@ -210,42 +169,57 @@ pub struct Args {
 }
 
 impl Args {
+    /// The value the command line gives a knob (flags named as the catalogue's knobs).
+    fn knob(&self, name: &str) -> Option<KnobValue> {
+        match name {
+            "light-radius" => Some(KnobValue::Number(self.light_radius)),
+            "sun-angle" => Some(KnobValue::Number(self.sun_angle)),
+            "ao-radius" => self.ao_radius.map(KnobValue::Number),
+            "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
+            "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
+            _ => None,
+        }
+    }
+
+    /// The techniques the flags choose, each with the knobs the command line sets.
+    fn techniques(&self) -> PlayResult<Techniques> {
+        let usage = |e: String| PlayError::new(Exit::Usage, e);
+        // Every knob flag is checked, whether or not its technique was chosen.
+        for info in catalogue() {
+            for k in info.knobs {
+                if let Some(v) = self.knob(k.name) {
+                    k.check(v).map_err(|e| usage(format!("--{e}")))?;
+                }
+            }
+        }
+        let mut t = Techniques::default();
+        let chosen = [
+            (Effect::GBuffer, &self.gbuffer),
+            (Effect::Shadows, &self.shadows),
+            (Effect::Ao, &self.ao),
+            (Effect::Reflections, &self.reflections),
+            (Effect::Gi, &self.gi),
+            (Effect::Media, &self.media),
+        ];
+        for (effect, name) in chosen {
+            let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
+                .find(|i| i.name == name.as_str())
+                .map(|i| i.knobs.iter().filter_map(|k| self.knob(k.name).map(|v| (k.name, v))).collect())
+                .unwrap_or_default();
+            t.set(effect, name, &knobs).map_err(usage)?;
+        }
+        t.aa = if self.no_accumulate { Aa::None } else { Aa::Accumulate };
+        Ok(t)
+    }
+
     fn session(&self, file: PathBuf) -> PlayResult<SessionOptions> {
         if !self.exposure.is_finite() {
             return Err(PlayError::new(Exit::Usage, "--exposure must be finite"));
         }
-        let non_negative = |name: &str, v: f32| {
-            if v.is_finite() && v >= 0.0 {
-                Ok(())
-            } else {
-                Err(PlayError::new(Exit::Usage, format!("{name} must be a finite number ≥ 0, not {v}")))
-            }
-        };
-        non_negative("--light-radius", self.light_radius)?;
-        non_negative("--sun-angle", self.sun_angle)?;
-        non_negative("--reflection-max-roughness", self.reflection_max_roughness)?;
-        if let Some(r) = self.ao_radius {
-            non_negative("--ao-radius", r)?;
-            if r == 0.0 {
-                return Err(PlayError::new(Exit::Usage, "--ao-radius must be greater than 0"));
-            }
+        if self.ao_radius == Some(0.0) {
+            return Err(PlayError::new(Exit::Usage, "--ao-radius must be greater than 0"));
         }
-        if self.sun_angle >= 180.0 {
-            return Err(PlayError::new(Exit::Usage, "--sun-angle must be below 180 degrees"));
-        }
-        let rt = RtSettings {
-            shadows: self.shadows == Shadows::Rt,
-            ao: self.ao == Ao::Rt,
-            reflections: (self.reflections == Reflections::Rt).then_some(match self.reflection_res {
-                ReflectionResArg::Full => ReflectionRes::Full,
-                ReflectionResArg::Half => ReflectionRes::Half,
-            }),
-            light_radius: self.light_radius,
-            sun_degrees: self.sun_angle,
-            ao_radius: self.ao_radius,
-            max_roughness: self.reflection_max_roughness,
-            accumulate: !self.no_accumulate,
-        };
+        let techniques = self.techniques()?;
         Ok(SessionOptions {
             file,
             gpu: GpuOptions {
@@ -257,15 +231,9 @@ impl Args {
                 ray_tracing_pipeline: self.bench_rays,
             },
             render: RenderSettings {
-                shadow_maps: self.shadows == Shadows::Shadowmap,
-                rays: false,
-                reference: self.reference,
+                techniques,
                 exposure: self.exposure,
-                rt,
-                gbuffer: match self.gbuffer {
-                    GBufferArg::Raster => GBufferMode::Raster,
-                    GBufferArg::Visibility => GBufferMode::Visibility,
-                },
+                purpose: if self.reference { Purpose::Reference } else { Purpose::Frames },
             },
             width: self.size.width,
             height: self.size.height,
@@ -340,9 +308,6 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
         return Ok(());
     }
     if args.bench {
-        if args.output.is_some() {
-            return Err(PlayError::new(Exit::Usage, "--bench writes no image; drop -o"));
-        }
         let report = bench::run(&options, args.warmup, args.frames.unwrap_or(100), start)?;
         if args.json {
             println!("{}", serde_json::to_string_pretty(&report).unwrap_or_default());
@@ -381,4 +346,80 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
         return validation_verdict(s.validation_errors());
     }
     window::run(options, args.frames, start)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::{Ao, GBuffer, ReflectionRes, Reflections, Shadows};
+
+    fn parse(args: &[&str]) -> Result<Args, clap::Error> {
+        Args::try_parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))
+    }
+
+    fn techniques(args: &[&str]) -> Techniques {
+        parse(args).unwrap().techniques().unwrap()
+    }
+
+    #[test]
+    fn flags_set_technique_values_with_their_knobs() {
+        let t = techniques(&[
+            "f.kiln",
+            "--gbuffer",
+            "visibility",
+            "--shadows",
+            "rt",
+            "--light-radius",
+            "1",
+            "--sun-angle",
+            "0.53",
+            "--ao",
+            "rt",
+            "--ao-radius",
+            "0.5",
+            "--reflections",
+            "rt",
+            "--reflection-res",
+            "half",
+            "--reflection-max-roughness",
+            "0.4",
+            "--no-accumulate",
+        ]);
+        assert_eq!(t.gbuffer, GBuffer::Visibility);
+        assert_eq!(t.shadows, Shadows::Rt { light_radius: 1.0, sun_degrees: 0.53 });
+        assert_eq!(t.ao, Ao::Rt { radius: Some(0.5) });
+        assert_eq!(t.reflections, Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 });
+        assert_eq!(t.aa, Aa::None);
+        let d = techniques(&["f.kiln"]);
+        assert_eq!(d, Techniques::default());
+        assert_eq!(d.shadows, Shadows::ShadowMap);
+    }
+
+    #[test]
+    fn the_last_flag_wins() {
+        assert_eq!(techniques(&["f.kiln", "--shadows", "rt", "--shadows", "none"]).shadows, Shadows::None);
+        let t = techniques(&["f.kiln", "--ao", "rt", "--ao-radius", "2", "--ao-radius", "3"]);
+        assert_eq!(t.ao, Ao::Rt { radius: Some(3.0) });
+    }
+
+    #[test]
+    fn contradictory_modes_are_refused_naming_both_flags() {
+        for (a, b) in
+            [("--reference", "--bench"), ("--bench", "--bench-rays"), ("--reference", "--bench-rays")]
+        {
+            let e = parse(&["f.kiln", a, b]).unwrap_err().to_string();
+            assert!(e.contains(a) && e.contains(b), "{a} {b}: {e}");
+        }
+        let e = parse(&["f.kiln", "--bench", "-o", "x.png"]).unwrap_err().to_string();
+        assert!(e.contains("--bench") && e.contains("--output"), "{e}");
+    }
+
+    #[test]
+    fn bad_values_are_usage_errors_naming_the_flag() {
+        let e = parse(&["f.kiln", "--light-radius=-1"]).unwrap().techniques().unwrap_err();
+        assert_eq!(e.exit, Exit::Usage);
+        assert!(e.message.contains("--light-radius"), "{}", e.message);
+        let e = parse(&["f.kiln", "--shadows", "raytraced"]).unwrap_err().to_string();
+        assert!(e.contains("shadowmap") && e.contains("rt"), "{e}");
+    }
 }

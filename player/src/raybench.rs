@@ -130,7 +130,7 @@ fn unit(i: u32, salt: u32) -> f32 {
 /// Runs the benchmark.
 pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult<RayBenchReport> {
     let mut o = options.clone();
-    o.render.rays = true;
+    o.render.purpose = crate::render::Purpose::RayQueries;
     o.readback = None;
     let session = Session::open(&o, start)?;
     let mut query = RayQuery::new(&session.gpu)?;

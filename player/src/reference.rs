@@ -44,7 +44,7 @@ pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<
         return Err(PlayError::new(Exit::Usage, "--spp must be at least 1"));
     }
     let mut options = options.clone();
-    options.render.reference = true;
+    options.render.purpose = crate::render::Purpose::Reference;
     options.readback = None;
     let session = Session::open(&options, start)?;
     let result = sample(&session, spp);
@@ -65,7 +65,7 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
             "the file has no BVH (no triangles?): nothing to path trace",
         ));
     };
-    let (w, h) = (session.renderer.targets.width, session.renderer.targets.height);
+    let (w, h) = (session.renderer.images().width, session.renderer.images().height);
     let cam = &session.camera;
     let right = cam.forward.cross(cam.up).normalize_or(glam::DVec3::X);
     let up = right.cross(cam.forward);
@@ -138,7 +138,7 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
         let mut writes = vec![Write::Buffer(0, ubo)];
         writes.extend(common);
         writes.extend([
-            Write::Buffer(8, lights),
+            Write::Buffer(crate::scene::bindings::LIGHTS.binding, lights),
             Write::Buffer(9, &r.emitters),
             Write::Buffer(10, &r.triangle_emitter),
             Write::Buffer(11, &r.texels),

@@ -11,10 +11,10 @@ use kiln_format::read::{Checksums, KilnFile};
 use crate::camera::{Camera, CameraOverride};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
-use crate::render::targets::Targets;
-use crate::render::{Dummies, PassTimes, Pipelines, Readable, Readback, RenderSettings, Renderer};
+use crate::render::frame::Frame;
+use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer};
 use crate::scene::upload::Uploader;
-use crate::scene::{GpuScene, Needs, Prepared};
+use crate::scene::{GpuScene, Prepared};
 
 /// What to open and how.
 #[derive(Debug, Clone)]
@@ -132,13 +132,8 @@ impl Session {
         let t = Instant::now();
         let file = open_file(&options.file)?;
         times.open_file_ms = ms(t);
-        let needs = Needs {
-            textures: true,
-            brdf_lut: true,
-            shadow_maps: options.render.shadow_maps,
-            bvh: options.render.rays || options.render.reference || options.render.rt.any(),
-            reference: options.render.needs_scene_buffers(),
-        };
+        let mut render = options.render;
+        let needs = render.needs();
         // The CPU side of loading (validation, checksums, index sorting) runs while the driver
         // creates the device, which on some drivers takes well over 100 ms.
         let (gpu, prepared) = std::thread::scope(|s| {
@@ -161,29 +156,22 @@ impl Session {
         let upload_start = Instant::now();
         // Pipelines compile on one thread while the other streams the file to the GPU.
         let (width, height, readback) = (options.width, options.height, options.readback);
-        let rt = options.render.rt;
-        let gbuffer = options.render.gbuffer;
-        let rt_shape = rt.shape(prepared.manifest().lights.len());
+        let mut warnings = Vec::new();
+        if render.techniques.ray_traced() && !prepared.has_bvh() {
+            warnings.push("the ray-traced passes are off: the file has no BVH".to_string());
+            render.techniques = render.techniques.without_rays();
+        }
+        let techniques = render.techniques;
+        let lights = prepared.manifest().lights.len();
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
                 // The frame's targets too: allocating them costs milliseconds on some drivers.
-                let pipelines = Pipelines::new(&gpu, rt.any(), gbuffer)?;
-                let rest = Targets::new(&gpu, width, height, rt_shape).and_then(|mut targets| match readback
-                    .map(|r| Readback::new(&gpu, r, width, height))
-                    .transpose()
-                {
-                    Ok(rb) => Ok((targets, rb)),
+                let mut frame = Frame::new(&gpu, &techniques, lights, width, height)?;
+                match readback.map(|r| Readback::new(&gpu, r, width, height)).transpose() {
+                    Ok(rb) => Ok((frame, rb, ms(t))),
                     Err(e) => {
-                        targets.destroy(&gpu);
-                        Err(e)
-                    }
-                });
-                match rest {
-                    Ok((targets, rb)) => Ok((pipelines, targets, rb, ms(t))),
-                    Err(e) => {
-                        let mut p = pipelines;
-                        p.destroy(&gpu);
+                        frame.destroy(&gpu);
                         Err(e)
                     }
                 }
@@ -220,9 +208,8 @@ impl Session {
         let (scene, dummies, ready, bytes) = match loaded {
             Ok(l) => l,
             Err(e) => {
-                if let Ok((mut p, mut t, rb, _)) = pipelines {
-                    p.destroy(&gpu);
-                    t.destroy(&gpu);
+                if let Ok((mut f, rb, _)) = pipelines {
+                    f.destroy(&gpu);
                     if let Some(mut rb) = rb {
                         rb.destroy(&gpu);
                     }
@@ -237,7 +224,7 @@ impl Session {
         times.sections_skipped = scene.sections.len() - times.sections_uploaded;
         times.resident_since_start_ms = ms(start);
         let mut scene = scene;
-        let (pipelines, targets, readback, pipelines_ms) = match pipelines {
+        let (frame, readback, pipelines_ms) = match pipelines {
             Ok(p) => p,
             Err(e) => {
                 let mut d = dummies;
@@ -251,9 +238,8 @@ impl Session {
         let camera = match Camera::initial(&scene.manifest.cameras, &scene.manifest.bounds, options.camera) {
             Ok(c) => c,
             Err(e) => {
-                let (mut p, mut d, mut t) = (pipelines, dummies, targets);
-                p.destroy(&gpu);
-                t.destroy(&gpu);
+                let (mut f, mut d) = (frame, dummies);
+                f.destroy(&gpu);
                 if let Some(mut rb) = readback {
                     rb.destroy(&gpu);
                 }
@@ -263,10 +249,20 @@ impl Session {
                 return Err(e);
             }
         };
-        let renderer = Renderer::new(&gpu, pipelines, dummies, targets, &scene, options.render)?;
+        let renderer = match Renderer::new(&gpu, frame, dummies, &scene, render) {
+            Ok(r) => r,
+            Err(e) => {
+                if let Some(mut rb) = readback {
+                    rb.destroy(&gpu);
+                }
+                scene.destroy(&gpu);
+                cleanup(&gpu);
+                return Err(e);
+            }
+        };
         let pool = CommandPool::new(&gpu, gpu.family)?;
-        let mut warnings = renderer.warnings.clone();
-        if options.render.shadow_maps
+        warnings.extend(renderer.warnings.iter().cloned());
+        if render.techniques.shadows == crate::render::Shadows::ShadowMap
             && scene.manifest.shadow_maps.is_empty()
             && !scene.manifest.lights.is_empty()
         {
@@ -297,7 +293,7 @@ impl Session {
         let submitted = self.record_and_submit(
             |rec, renderer| {
                 if let Some(r) = &readback {
-                    r.record(rec, &renderer.targets);
+                    r.record(rec, renderer);
                 }
             },
             &[],
@@ -319,14 +315,14 @@ impl Session {
     /// adds its swapchain's); the first frame also waits for the upload.
     pub fn record_and_submit(
         &mut self,
-        extra: impl FnOnce(&Recorder, &Renderer),
+        extra: impl FnOnce(&Recorder, &mut Renderer),
         wait: &[SemaphoreOp],
         signal: &[SemaphoreOp],
     ) -> PlayResult {
         let rec = self.pool.begin(&self.gpu)?;
         self.renderer.update(&self.camera)?;
         self.renderer.record(&rec, &self.scene);
-        extra(&rec, &self.renderer);
+        extra(&rec, &mut self.renderer);
         let mut waits = wait.to_vec();
         if !self.waited {
             waits.push(SemaphoreOp::timeline(self.timeline, self.ready));

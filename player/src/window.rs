@@ -17,6 +17,7 @@ use winit::window::{Window, WindowId};
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{SemaphoreOp, Swapchain, Use, surface_extensions};
+use crate::render::Readable;
 use crate::session::{Session, SessionOptions};
 
 struct Running {
@@ -171,8 +172,7 @@ impl App {
         let t = Instant::now();
         r.session.record_and_submit(
             |rec, renderer| {
-                let display = &renderer.targets.display;
-                rec.transition(display, Use::STORAGE, Use::TRANSFER_SRC);
+                let display = renderer.copy_source(rec, Readable::Display);
                 rec.transition_raw(image, range, Use::DISCARD, Use::TRANSFER_DST);
                 rec.blit(display, image, extent.width, extent.height);
                 rec.transition_raw(image, range, Use::TRANSFER_DST, Use::PRESENT);
@@ -191,16 +191,11 @@ impl App {
             self.title_at = Instant::now();
             if let Ok(p) = r.session.pass_times() {
                 // Passes that ran (more than a microsecond), by name.
-                let passes: Vec<String> = crate::render::PASSES
-                    .iter()
-                    .zip(p)
-                    .filter(|(_, ms)| *ms > 1e-3)
-                    .map(|(name, ms)| format!("{name} {ms:.2}"))
-                    .collect();
+                let passes: Vec<String> = p.iter().map(|(name, ms)| format!("{name} {ms:.2}")).collect();
                 r.window.set_title(&format!(
                     "kiln-play — {} — GPU {:.2} ms ({})",
                     r.session.scene.manifest.scene_name,
-                    p.iter().sum::<f64>(),
+                    p.iter().map(|(_, ms)| ms).sum::<f64>(),
                     passes.join(", ")
                 ));
             }

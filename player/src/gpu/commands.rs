@@ -265,6 +265,29 @@ impl<'a> Recorder<'a> {
         self.transition_raw(image.raw, image.range(), from, to);
     }
 
+    /// Transitions whole images, in one barrier command (nothing when `list` is empty).
+    pub fn transitions(&self, list: &[(&Image, Use, Use)]) {
+        if list.is_empty() {
+            return;
+        }
+        let barriers: Vec<vk::ImageMemoryBarrier2> = list
+            .iter()
+            .map(|(image, from, to)| {
+                vk::ImageMemoryBarrier2::default()
+                    .image(image.raw)
+                    .subresource_range(image.range())
+                    .old_layout(from.layout)
+                    .new_layout(to.layout)
+                    .src_stage_mask(from.stage)
+                    .src_access_mask(from.access)
+                    .dst_stage_mask(to.stage)
+                    .dst_access_mask(to.access)
+            })
+            .collect();
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        unsafe { self.gpu.device.cmd_pipeline_barrier2(self.cmd, &dep) };
+    }
+
     /// A global memory barrier.
     pub fn memory_barrier(
         &self,

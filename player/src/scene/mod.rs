@@ -1,6 +1,7 @@
 //! A `.kiln` file made resident on the GPU: its sections uploaded in file order through the
 //! staging ring, only those the enabled passes read. The rest are skipped and listed.
 
+pub mod bindings;
 pub mod reference;
 pub mod upload;
 
@@ -14,22 +15,8 @@ use kiln_format::sections::{self, GpuMaterial, Vertex};
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, Write};
+use crate::render::Needs;
 use upload::Uploader;
-
-/// What the enabled passes read, beyond geometry and materials.
-#[derive(Debug, Clone, Copy)]
-pub struct Needs {
-    /// Material textures.
-    pub textures: bool,
-    /// The split-sum BRDF table.
-    pub brdf_lut: bool,
-    /// Shadow maps.
-    pub shadow_maps: bool,
-    /// The BVH and its triangles, for ray queries.
-    pub bvh: bool,
-    /// What the reference path tracer reads (implies `bvh`).
-    pub reference: bool,
-}
 
 /// One draw: the triangles of one material, contiguous in the index buffer.
 #[derive(Debug, Clone, Copy)]
@@ -93,7 +80,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::BRDF_LUT && needs.brdf_lut)
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
-        || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.reference)
+        || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
 impl<'f> Prepared<'f> {
@@ -109,7 +96,7 @@ impl<'f> Prepared<'f> {
             sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
         let bvh_triangles =
             if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
-        let reference = needs.reference.then(|| {
+        let reference = needs.scene_buffers.then(|| {
             reference::tables(
                 &view.manifest,
                 view.vertices,
@@ -123,20 +110,18 @@ impl<'f> Prepared<'f> {
 }
 
 impl GpuScene {
-    /// Descriptor writes of what every ray-traced pass reads, at bindings 1 to 7 (the shaders'
-    /// common prefix after the constants at 0): BVH nodes, triangle corners, vertices, uvs,
-    /// leaf-order indices, triangle materials, materials. `None` without the BVH or the scene
-    /// buffers.
+    /// Descriptor writes of what every ray-traced pass reads ([`bindings::TABLE`] but the
+    /// lights, which the pass writes). `None` without the BVH or the scene buffers.
     pub fn ray_writes(&self) -> Option<Vec<Write<'_>>> {
         let (bvh, r) = (self.bvh.as_ref()?, self.reference.as_ref()?);
         Some(vec![
-            Write::Buffer(1, &bvh.nodes),
-            Write::Buffer(2, &bvh.triangles),
-            Write::Buffer(3, &self.vertices),
-            Write::Buffer(4, &self.uvs),
-            Write::Buffer(5, &r.indices),
-            Write::Buffer(6, &r.triangle_materials),
-            Write::Buffer(7, &r.materials),
+            Write::Buffer(bindings::BVH_NODES.binding, &bvh.nodes),
+            Write::Buffer(bindings::BVH_TRIANGLES.binding, &bvh.triangles),
+            Write::Buffer(bindings::VERTICES.binding, &self.vertices),
+            Write::Buffer(bindings::UVS.binding, &self.uvs),
+            Write::Buffer(bindings::LEAF_INDICES.binding, &r.indices),
+            Write::Buffer(bindings::TRIANGLE_MATERIALS.binding, &r.triangle_materials),
+            Write::Buffer(bindings::MATERIALS.binding, &r.materials),
         ])
     }
 }
@@ -145,6 +130,11 @@ impl Prepared<'_> {
     /// The file's manifest.
     pub fn manifest(&self) -> &kiln_format::Manifest {
         &self.view.manifest
+    }
+
+    /// Whether the file has a BVH to trace rays through.
+    pub fn has_bvh(&self) -> bool {
+        !self.view.bvh.is_empty()
     }
 }
 
@@ -471,7 +461,7 @@ impl GpuScene {
                 } else if kind == sections::BRDF_LUT {
                     "no pass reads the BRDF table".into()
                 } else if kind == sections::SHADOW_MAP {
-                    "--shadows is not shadowmap".into()
+                    "no pass reads shadow maps (--shadows is not shadowmap)".into()
                 } else {
                     "no enabled pass reads it".into()
                 };

@@ -1,0 +1,105 @@
+//! Wires the passes of a run: which passes the chosen techniques need, in frame order, and the
+//! images they make and bind.
+//!
+//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
+//! reflections (each when chosen) → direct light and composition → tone mapping.
+
+use super::graph::{FrameImages, TargetDecl};
+use super::passes::Pass;
+use super::passes::direct::DirectPass;
+use super::passes::gbuffer::GBufferPass;
+use super::passes::resolve::ResolvePass;
+use super::passes::rt_ao::RtAoPass;
+use super::passes::rt_reflections::RtReflectionsPass;
+use super::passes::rt_shadows::RtShadowsPass;
+use super::passes::tonemap::TonemapPass;
+use super::passes::visibility::VisibilityPass;
+use super::technique::{Ao, GBuffer, Reflections, Shadows, Techniques};
+use crate::error::PlayResult;
+use crate::gpu::{Gpu, ImageDesc};
+
+/// The passes of a run and the images of the current size.
+#[derive(Debug)]
+pub struct Frame {
+    /// The passes, in order.
+    pub passes: Vec<Box<dyn Pass>>,
+    /// Their images.
+    pub images: FrameImages,
+}
+
+/// Builds the passes `techniques` need, in frame order, for a scene of `lights` lights.
+fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<Box<dyn Pass>>> {
+    let mut made: Vec<Box<dyn Pass>> = Vec::new();
+    let built = (|| -> PlayResult {
+        match techniques.gbuffer {
+            GBuffer::Raster => made.push(Box::new(GBufferPass::new(gpu)?)),
+            GBuffer::Visibility => {
+                made.push(Box::new(VisibilityPass::new(gpu)?));
+                made.push(Box::new(ResolvePass::new(gpu)?));
+            }
+        }
+        if let Shadows::Rt { .. } = techniques.shadows {
+            made.push(Box::new(RtShadowsPass::new(gpu, lights)?));
+        }
+        if let Ao::Rt { .. } = techniques.ao {
+            made.push(Box::new(RtAoPass::new(gpu)?));
+        }
+        if let Reflections::Rt { resolution, .. } = techniques.reflections {
+            made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights)?));
+        }
+        made.push(Box::new(DirectPass::new(gpu)?));
+        made.push(Box::new(TonemapPass::new(gpu)?));
+        Ok(())
+    })();
+    if let Err(e) = built {
+        for p in &mut made {
+            p.destroy(gpu);
+        }
+        return Err(e);
+    }
+    Ok(made)
+}
+
+fn make_images(gpu: &Gpu, passes: &[Box<dyn Pass>], width: u32, height: u32) -> PlayResult<FrameImages> {
+    let made: Vec<(TargetDecl, ImageDesc)> = passes.iter().flat_map(|p| p.targets(width, height)).collect();
+    let bound: Vec<TargetDecl> = passes.iter().flat_map(|p| p.binds()).collect();
+    FrameImages::new(gpu, width, height, &made, &bound)
+}
+
+impl Frame {
+    /// The passes of `techniques` and their images at `width` × `height` (scene-independent:
+    /// built while the scene uploads). On failure everything made is released.
+    pub fn new(
+        gpu: &Gpu,
+        techniques: &Techniques,
+        lights: usize,
+        width: u32,
+        height: u32,
+    ) -> PlayResult<Frame> {
+        let mut passes = passes(gpu, techniques, lights)?;
+        match make_images(gpu, &passes, width, height) {
+            Ok(images) => Ok(Frame { passes, images }),
+            Err(e) => {
+                for p in &mut passes {
+                    p.destroy(gpu);
+                }
+                Err(e)
+            }
+        }
+    }
+
+    /// Remakes the images for a new size (the GPU must be idle); the caller rebinds.
+    pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) -> PlayResult {
+        self.images.destroy(gpu);
+        self.images = make_images(gpu, &self.passes, width, height)?;
+        Ok(())
+    }
+
+    /// Releases passes and images.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        for p in &mut self.passes {
+            p.destroy(gpu);
+        }
+        self.images.destroy(gpu);
+    }
+}

@@ -1,0 +1,121 @@
+//! Direct light and composition (`shaders/lighting/direct.comp`): every analytic light over the
+//! G-buffer (Lambert or Cook–Torrance GGX, multiple-scattering compensation from the baked
+//! table), shadowed by the baked shadow maps (PCF; PCSS for rect lights) or by the ray-traced
+//! layers, the constant sky through the split-sum table, ray-traced AO and reflections
+//! composited where they ran; writes linear radiance.
+
+use ash::vk;
+
+use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
+use super::{FrameCtx, Pass, Shared, one, rt_ao, rt_reflections, rt_shadows};
+use crate::error::PlayResult;
+use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, ImageDesc, SetLayout, Use, Write};
+use crate::render::graph::{Access, TargetDecl};
+use crate::render::{MAX_SHADOW_MAPS, spirv};
+
+/// Linear scene radiance (what `-o x.exr` writes).
+pub const RADIANCE: TargetDecl = TargetDecl {
+    name: "radiance",
+    format: vk::Format::R32G32B32A32_SFLOAT,
+    usage: vk::ImageUsageFlags::from_raw(
+        vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
+    ),
+    array: false,
+};
+
+/// The G-buffer targets it samples, in binding order (6–10).
+const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
+
+/// The ray-traced results it composites, in binding order (12–14).
+const RAY_TRACED: [TargetDecl; 3] = [rt_shadows::SHADOWS, rt_ao::AO, rt_reflections::REFLECTIONS];
+
+/// The direct-light pass.
+#[derive(Debug)]
+pub struct DirectPass {
+    layout: SetLayout,
+    pipeline: ComputePipeline,
+    set: vk::DescriptorSet,
+}
+
+impl DirectPass {
+    /// Builds the pipeline.
+    pub fn new(gpu: &Gpu) -> PlayResult<DirectPass> {
+        use BindingKind::*;
+        let mut bindings = vec![one(Uniform), one(Storage), one(Storage), one(Sampled)];
+        bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
+        bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
+        bindings.extend([one(Sampled); 5]);
+        bindings.extend([one(StorageImage); 4]);
+        let mut layout = SetLayout::new(gpu, &bindings, 1)?;
+        match ComputePipeline::new(gpu, spirv::DIRECT, &[&layout], 0) {
+            Ok(pipeline) => Ok(DirectPass { layout, pipeline, set: vk::DescriptorSet::null() }),
+            Err(e) => {
+                layout.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+}
+
+impl Pass for DirectPass {
+    fn name(&self) -> &'static str {
+        "direct"
+    }
+
+    fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
+        vec![(RADIANCE, RADIANCE.sized(width, height, 1))]
+    }
+
+    fn binds(&self) -> Vec<TargetDecl> {
+        GBUFFER.iter().chain(&RAY_TRACED).copied().collect()
+    }
+
+    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        if self.set == vk::DescriptorSet::null() {
+            self.set = self.layout.allocate(gpu)?;
+        }
+        let (scene, dummies) = (shared.scene, shared.dummies);
+        let near = scene.nearest_clamp;
+        let lut = scene.brdf_lut.as_ref().map_or(dummies.white.view, |i| i.view);
+        let mut maps_2d = vec![(dummies.shadow_2d.view, near); MAX_SHADOW_MAPS];
+        let mut maps_cube = vec![(dummies.shadow_cube.view, near); MAX_SHADOW_MAPS];
+        for (slot, &i) in shared.plan.slots_2d.iter().enumerate() {
+            maps_2d[slot] = (scene.shadow_maps[i].image.view, near);
+        }
+        for (slot, &i) in shared.plan.slots_cube.iter().enumerate() {
+            maps_cube[slot] = (scene.shadow_maps[i].image.view, near);
+        }
+        let img = |t: &TargetDecl| shared.images.get(t).view;
+        let mut writes = vec![
+            Write::Buffer(0, shared.frame_ubo),
+            Write::Buffer(1, shared.lights),
+            Write::Buffer(2, shared.shadows),
+            Write::Sampled(3, vec![(lut, scene.linear_clamp)]),
+            Write::Sampled(4, maps_2d),
+            Write::Sampled(5, maps_cube),
+        ];
+        for (i, t) in GBUFFER.iter().enumerate() {
+            writes.push(Write::Sampled(6 + i as u32, vec![(img(t), near)]));
+        }
+        writes.push(Write::StorageImage(11, img(&RADIANCE)));
+        for (i, t) in RAY_TRACED.iter().enumerate() {
+            writes.push(Write::StorageImage(12 + i as u32, img(t)));
+        }
+        self.layout.write(gpu, self.set, &writes);
+        Ok(())
+    }
+
+    fn record(&mut self, ctx: &mut FrameCtx) {
+        let mut io = super::gbuffer::sampled(&GBUFFER);
+        io.extend(RAY_TRACED.iter().map(|t| (*t, Access::Read(Use::STORAGE))));
+        io.push((RADIANCE, Access::Write(Use::STORAGE)));
+        ctx.images.access(ctx.rec, &io);
+        let (w, h) = (ctx.images.width, ctx.images.height);
+        ctx.rec.dispatch_2d(&self.pipeline, &[self.set], w, h);
+    }
+
+    fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        self.layout.destroy(gpu);
+    }
+}

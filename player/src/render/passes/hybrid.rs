@@ -1,0 +1,97 @@
+//! The binding table every ray-traced pass of the hybrid pipeline shares
+//! (`shaders/rt/hybrid.glsl`): the frame constants, the scene as the traversal and shading read
+//! it, the G-buffer, and every ray-traced target (those of passes that are off are 1 × 1
+//! placeholders). Each pass has its own set of this layout.
+
+use ash::vk;
+use kiln_format::gpu::RtConstants;
+
+use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
+use super::{Shared, one, rt_ao, rt_reflections, rt_shadows};
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{BindingKind, ComputePipeline, Gpu, SetLayout, Write};
+use crate::render::graph::{Access, TargetDecl};
+use crate::scene::bindings as scene_bindings;
+
+/// The G-buffer targets the ray-traced passes sample.
+pub const GBUFFER_READS: [TargetDecl; 4] = [TRIANGLE, NORMAL, ALBEDO, MATERIAL];
+
+/// Every target the table binds.
+pub fn bound() -> Vec<TargetDecl> {
+    let mut t = GBUFFER_READS.to_vec();
+    t.extend([rt_shadows::SHADOWS, rt_ao::AO]);
+    t.extend(rt_reflections::TARGETS);
+    t
+}
+
+/// A set of the shared layout and one or more compute pipelines over it.
+#[derive(Debug)]
+pub struct HybridSet {
+    layout: SetLayout,
+    /// The set (allocated by the first [`HybridSet::bind`]).
+    pub set: vk::DescriptorSet,
+}
+
+impl HybridSet {
+    /// The layout.
+    pub fn new(gpu: &Gpu) -> PlayResult<HybridSet> {
+        use BindingKind::*;
+        let mut bindings = vec![one(Uniform)];
+        bindings.extend([one(Storage); 11]);
+        bindings.extend([one(Sampled); 4]);
+        bindings.extend([one(StorageImage); 6]);
+        Ok(HybridSet { layout: SetLayout::new(gpu, &bindings, 1)?, set: vk::DescriptorSet::null() })
+    }
+
+    /// A compute pipeline over this layout with the ray-traced passes' push constants.
+    pub fn pipeline(&self, gpu: &Gpu, spirv: &[u8]) -> PlayResult<ComputePipeline> {
+        ComputePipeline::new(gpu, spirv, &[&self.layout], std::mem::size_of::<RtConstants>() as u32)
+    }
+
+    /// Allocates (once) and writes the set.
+    pub fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        let scene = shared.scene;
+        let (Some(common), Some(r)) = (scene.ray_writes(), &scene.reference) else {
+            return Err(PlayError::new(
+                Exit::Gpu,
+                "the ray-traced passes need the BVH, which was not uploaded",
+            ));
+        };
+        if self.set == vk::DescriptorSet::null() {
+            self.set = self.layout.allocate(gpu)?;
+        }
+        let img = |t: &TargetDecl| shared.images.get(t).view;
+        let sampled = |t: &TargetDecl| vec![(img(t), scene.nearest_clamp)];
+        let mut writes = vec![Write::Buffer(0, shared.frame_ubo)];
+        writes.extend(common);
+        writes.extend([
+            Write::Buffer(scene_bindings::LIGHTS.binding, shared.lights),
+            Write::Buffer(9, &r.texels),
+            Write::Buffer(10, &r.textures),
+            Write::Buffer(11, &scene.indices),
+            Write::Sampled(12, sampled(&TRIANGLE)),
+            Write::Sampled(13, sampled(&NORMAL)),
+            Write::Sampled(14, sampled(&ALBEDO)),
+            Write::Sampled(15, sampled(&MATERIAL)),
+            Write::StorageImage(16, img(&rt_shadows::SHADOWS)),
+            Write::StorageImage(17, img(&rt_ao::AO)),
+        ]);
+        for (i, t) in rt_reflections::TARGETS.iter().enumerate() {
+            writes.push(Write::StorageImage(18 + i as u32, img(t)));
+        }
+        self.layout.write(gpu, self.set, &writes);
+        Ok(())
+    }
+
+    /// Releases the layout and its set.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.layout.destroy(gpu);
+    }
+}
+
+/// The G-buffer reads of a ray-traced step plus `own` accesses.
+pub fn io(own: &[(TargetDecl, Access)]) -> Vec<(TargetDecl, Access)> {
+    let mut io = super::gbuffer::sampled(&GBUFFER_READS);
+    io.extend_from_slice(own);
+    io
+}

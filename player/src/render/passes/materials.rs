@@ -1,0 +1,156 @@
+//! What both raster passes share: the frame and material set layouts, one material set per
+//! material (its five textures), the materials as pushed, and the draw loop (one draw per
+//! material, pipelines switched only when the material's kind changes).
+
+use ash::vk;
+use kiln_format::gpu::GpuMaterialLayout;
+use kiln_format::sections::NO_TEXTURE;
+
+use super::{Shared, one};
+use crate::error::PlayResult;
+use crate::gpu::{BindingKind, Gpu, GraphicsDesc, GraphicsPipeline, Recorder, SetLayout, Write};
+use crate::scene::GpuScene;
+
+/// Vertex buffer strides of the raster passes: positions + normals, texture coordinates.
+pub const VERTEX_STRIDES: [u32; 2] = [24, 8];
+
+/// (location, binding, format, offset) of the raster passes' vertex attributes.
+pub const ATTRIBUTES: [(u32, u32, vk::Format, u32); 3] = [
+    (0, 0, vk::Format::R32G32B32_SFLOAT, 0),
+    (1, 0, vk::Format::R32G32B32_SFLOAT, 12),
+    (2, 1, vk::Format::R32G32_SFLOAT, 0),
+];
+
+/// Set layouts, sets and pushed materials of a raster pass.
+#[derive(Debug)]
+pub struct SceneDraws {
+    frame_layout: SetLayout,
+    material_layout: SetLayout,
+    frame_set: vk::DescriptorSet,
+    material_sets: Vec<vk::DescriptorSet>,
+    /// Materials as pushed, with texture numbers of absent textures cleared.
+    pub materials: Vec<GpuMaterialLayout>,
+}
+
+impl SceneDraws {
+    /// The layouts (sets are allocated by [`SceneDraws::bind`]).
+    pub fn new(gpu: &Gpu) -> PlayResult<SceneDraws> {
+        let frame_layout = SetLayout::new(gpu, &[one(BindingKind::Uniform)], 1)?;
+        let material_layout = match SetLayout::new(gpu, &[one(BindingKind::Sampled); 5], 64) {
+            Ok(l) => l,
+            Err(e) => {
+                let mut f = frame_layout;
+                f.destroy(gpu);
+                return Err(e);
+            }
+        };
+        Ok(SceneDraws {
+            frame_layout,
+            material_layout,
+            frame_set: vk::DescriptorSet::null(),
+            material_sets: Vec::new(),
+            materials: Vec::new(),
+        })
+    }
+
+    /// A triangle-list pipeline over the scene's vertex layout with these sets, writing
+    /// `colors` and the depth target.
+    pub fn pipeline(
+        &self,
+        gpu: &Gpu,
+        vertex: &[u8],
+        fragment: &[u8],
+        colors: &[vk::Format],
+        depth: vk::Format,
+        cull_back: bool,
+    ) -> PlayResult<GraphicsPipeline> {
+        GraphicsPipeline::new(
+            gpu,
+            &GraphicsDesc {
+                vertex,
+                fragment,
+                vertex_strides: &VERTEX_STRIDES,
+                attributes: &ATTRIBUTES,
+                colors,
+                depth,
+                sets: &[&self.frame_layout, &self.material_layout],
+                push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
+                cull_back,
+            },
+        )
+    }
+
+    /// Allocates and writes the sets the first time (they depend on the scene only).
+    pub fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        if self.frame_set != vk::DescriptorSet::null() {
+            return Ok(());
+        }
+        let scene = shared.scene;
+        self.frame_set = self.frame_layout.allocate(gpu)?;
+        self.frame_layout.write(gpu, self.frame_set, &[Write::Buffer(0, shared.frame_ubo)]);
+        let white = (shared.dummies.white.view, scene.linear_clamp);
+        let texture = |t: u32| -> (vk::ImageView, vk::Sampler) {
+            match scene.textures.get(t as usize) {
+                Some(img) if t != NO_TEXTURE => (img.view, scene.texture_samplers[t as usize]),
+                _ => white,
+            }
+        };
+        for m in &scene.materials {
+            let set = self.material_layout.allocate(gpu)?;
+            let writes: Vec<Write> = m
+                .textures()
+                .iter()
+                .enumerate()
+                .map(|(i, &t)| Write::Sampled(i as u32, vec![texture(t)]))
+                .collect();
+            self.material_layout.write(gpu, set, &writes);
+            self.material_sets.push(set);
+            let mut layout: GpuMaterialLayout = bytemuck::cast(*m);
+            // Textures the scene did not upload (textures off) read as absent.
+            for t in [
+                &mut layout.base_color_texture,
+                &mut layout.metallic_roughness_texture,
+                &mut layout.normal_texture,
+                &mut layout.occlusion_texture,
+                &mut layout.emissive_texture,
+            ] {
+                if *t as usize >= scene.textures.len() {
+                    *t = NO_TEXTURE;
+                }
+            }
+            self.materials.push(layout);
+        }
+        Ok(())
+    }
+
+    /// Records one draw per material, with the pipeline `pick` chooses for its material.
+    pub fn draw<'p>(
+        &self,
+        rec: &Recorder,
+        scene: &GpuScene,
+        pick: impl Fn(&GpuMaterialLayout) -> &'p GraphicsPipeline,
+    ) {
+        if scene.draws.is_empty() {
+            return;
+        }
+        rec.bind_geometry(&[&scene.vertices, &scene.uvs], &scene.indices);
+        let mut bound: Option<&GraphicsPipeline> = None;
+        for d in &scene.draws {
+            let m = &self.materials[d.material as usize];
+            let p = pick(m);
+            if bound.is_none_or(|b| !std::ptr::eq(b, p)) {
+                rec.bind_graphics(p, &[self.frame_set]);
+                bound = Some(p);
+            }
+            rec.bind_graphics_set(p, 1, self.material_sets[d.material as usize]);
+            rec.push_graphics(p, bytemuck::bytes_of(m));
+            rec.draw_indexed(d.count, d.first);
+        }
+    }
+
+    /// Releases the layouts and their sets.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.frame_layout.destroy(gpu);
+        self.material_layout.destroy(gpu);
+    }
+}

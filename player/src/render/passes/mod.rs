@@ -1,0 +1,91 @@
+//! The passes of a frame, one file each. A pass owns its pipelines, set layouts and binding
+//! table, the targets it makes, its timestamp name, and declares the targets each of its steps
+//! reads and writes; [`super::frame`] chooses the passes of a run from the techniques and
+//! [`super::graph`] derives the barriers between them.
+//!
+//! A pass is built in two steps: [`Pass`] values are made with their pipelines before the
+//! scene is resident (pipelines compile while the file uploads), then [`Pass::bind`] points
+//! their descriptor sets at the scene and the frame's images (again after every resize).
+
+pub mod direct;
+pub mod gbuffer;
+pub mod hybrid;
+pub mod materials;
+pub mod resolve;
+pub mod rt_ao;
+pub mod rt_reflections;
+pub mod rt_shadows;
+pub mod tonemap;
+pub mod visibility;
+
+use kiln_format::gpu::RtConstants;
+
+use super::dummies::Dummies;
+use super::graph::{FrameImages, TargetDecl};
+use super::lights::LightPlan;
+use crate::error::PlayResult;
+use crate::gpu::{Buffer, Gpu, ImageDesc, Recorder};
+use crate::scene::GpuScene;
+
+/// What the renderer shares with every pass when binding.
+#[derive(Debug)]
+pub struct Shared<'a> {
+    /// The resident scene.
+    pub scene: &'a GpuScene,
+    /// The frame constants (`FrameConstants`, uniform).
+    pub frame_ubo: &'a Buffer,
+    /// The lights (`GpuLight`s, storage).
+    pub lights: &'a Buffer,
+    /// The bound shadow maps' parameters (`GpuShadow`s, storage).
+    pub shadows: &'a Buffer,
+    /// Which resident shadow map goes in which slot.
+    pub plan: &'a LightPlan,
+    /// Placeholder images.
+    pub dummies: &'a Dummies,
+    /// The frame's images.
+    pub images: &'a FrameImages,
+}
+
+/// What a pass records with.
+#[derive(Debug)]
+pub struct FrameCtx<'a, 'r> {
+    /// The command buffer.
+    pub rec: &'a Recorder<'r>,
+    /// The frame's images (barriers go through [`FrameImages::access`]).
+    pub images: &'a mut FrameImages,
+    /// The resident scene.
+    pub scene: &'a GpuScene,
+    /// This frame's constants of the ray-traced passes (their push constants).
+    pub rt: &'a RtConstants,
+}
+
+/// One pass of the frame.
+pub trait Pass: Send + std::fmt::Debug {
+    /// Timestamp name.
+    fn name(&self) -> &'static str;
+
+    /// The targets this pass makes at `width` × `height`.
+    fn targets(&self, _width: u32, _height: u32) -> Vec<(TargetDecl, ImageDesc)> {
+        Vec::new()
+    }
+
+    /// Targets its descriptor sets bind that other passes make (or that are placeholders when
+    /// none does).
+    fn binds(&self) -> Vec<TargetDecl> {
+        Vec::new()
+    }
+
+    /// Allocates (the first time) and writes its descriptor sets.
+    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult;
+
+    /// Records its work, declaring each step's reads and writes first.
+    fn record(&mut self, ctx: &mut FrameCtx);
+
+    /// Releases what it owns (the GPU must be idle).
+    fn destroy(&mut self, gpu: &Gpu);
+}
+
+/// Binding helper: one binding of `kind`.
+pub(crate) fn one(kind: crate::gpu::BindingKind) -> crate::gpu::Binding {
+    crate::gpu::Binding { kind, count: 1 }
+}

@@ -1,0 +1,77 @@
+//! Ray-traced soft shadows (`shaders/rt/shadows.comp`, seed 001 with its errata fixed): one ray
+//! per light per pixel per frame towards a point sampled on the light, averaged into one layer
+//! per light.
+
+use ash::vk;
+
+use super::hybrid::{self, HybridSet};
+use super::{FrameCtx, Pass, Shared};
+use crate::error::PlayResult;
+use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
+use crate::render::graph::{Access, TargetDecl};
+use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
+
+/// Shadow visibility, one layer per light.
+pub const SHADOWS: TargetDecl = TargetDecl {
+    name: "rt shadows",
+    format: vk::Format::R32_SFLOAT,
+    usage: vk::ImageUsageFlags::STORAGE,
+    array: true,
+};
+
+/// Layers of [`SHADOWS`] for a scene of `lights` lights (one at least).
+pub fn layers(lights: usize) -> u32 {
+    lights.clamp(1, MAX_RT_SHADOW_LIGHTS) as u32
+}
+
+/// The ray-traced shadow pass.
+#[derive(Debug)]
+pub struct RtShadowsPass {
+    set: HybridSet,
+    pipeline: ComputePipeline,
+    layers: u32,
+}
+
+impl RtShadowsPass {
+    /// Builds the pipeline for a scene of `lights` lights.
+    pub fn new(gpu: &Gpu, lights: usize) -> PlayResult<RtShadowsPass> {
+        let mut set = HybridSet::new(gpu)?;
+        match set.pipeline(gpu, spirv::RT_SHADOWS) {
+            Ok(pipeline) => Ok(RtShadowsPass { set, pipeline, layers: layers(lights) }),
+            Err(e) => {
+                set.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+}
+
+impl Pass for RtShadowsPass {
+    fn name(&self) -> &'static str {
+        "shadows"
+    }
+
+    fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
+        vec![(SHADOWS, SHADOWS.sized(width, height, self.layers))]
+    }
+
+    fn binds(&self) -> Vec<TargetDecl> {
+        hybrid::bound()
+    }
+
+    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        self.set.bind(gpu, shared)
+    }
+
+    fn record(&mut self, ctx: &mut FrameCtx) {
+        ctx.images.access(ctx.rec, &hybrid::io(&[(SHADOWS, Access::ReadWrite(Use::STORAGE))]));
+        let (w, h) = (ctx.images.width, ctx.images.height);
+        let push = bytemuck::bytes_of(ctx.rt);
+        ctx.rec.dispatch(&self.pipeline, &[self.set.set], push, [w.div_ceil(8), h.div_ceil(8), 1]);
+    }
+
+    fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        self.set.destroy(gpu);
+    }
+}

@@ -1,0 +1,89 @@
+//! Tone mapping (`shaders/post/tonemap.comp`): display = sRGB(ACES(2^EV · radiance)), with
+//! Narkowicz's fit of the ACES filmic curve, per channel.
+
+use ash::vk;
+
+use super::direct::RADIANCE;
+use super::{FrameCtx, Pass, Shared, one};
+use crate::error::PlayResult;
+use crate::gpu::{BindingKind, ComputePipeline, Gpu, ImageDesc, SetLayout, Use, Write};
+use crate::render::graph::{Access, TargetDecl};
+use crate::render::spirv;
+
+/// The tone-mapped image (sRGB-encoded values in a UNORM image).
+pub const DISPLAY: TargetDecl = TargetDecl {
+    name: "display",
+    format: vk::Format::R8G8B8A8_UNORM,
+    usage: vk::ImageUsageFlags::from_raw(
+        vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
+    ),
+    array: false,
+};
+
+/// The tone-mapping pass.
+#[derive(Debug)]
+pub struct TonemapPass {
+    layout: SetLayout,
+    pipeline: ComputePipeline,
+    set: vk::DescriptorSet,
+}
+
+impl TonemapPass {
+    /// Builds the pipeline.
+    pub fn new(gpu: &Gpu) -> PlayResult<TonemapPass> {
+        use BindingKind::*;
+        let mut layout = SetLayout::new(gpu, &[one(Uniform), one(StorageImage), one(StorageImage)], 1)?;
+        match ComputePipeline::new(gpu, spirv::TONEMAP, &[&layout], 0) {
+            Ok(pipeline) => Ok(TonemapPass { layout, pipeline, set: vk::DescriptorSet::null() }),
+            Err(e) => {
+                layout.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+}
+
+impl Pass for TonemapPass {
+    fn name(&self) -> &'static str {
+        "tonemap"
+    }
+
+    fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
+        vec![(DISPLAY, DISPLAY.sized(width, height, 1))]
+    }
+
+    fn binds(&self) -> Vec<TargetDecl> {
+        vec![RADIANCE]
+    }
+
+    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        if self.set == vk::DescriptorSet::null() {
+            self.set = self.layout.allocate(gpu)?;
+        }
+        let img = |t: &TargetDecl| shared.images.get(t).view;
+        self.layout.write(
+            gpu,
+            self.set,
+            &[
+                Write::Buffer(0, shared.frame_ubo),
+                Write::StorageImage(1, img(&RADIANCE)),
+                Write::StorageImage(2, img(&DISPLAY)),
+            ],
+        );
+        Ok(())
+    }
+
+    fn record(&mut self, ctx: &mut FrameCtx) {
+        ctx.images.access(
+            ctx.rec,
+            &[(RADIANCE, Access::Read(Use::STORAGE)), (DISPLAY, Access::Write(Use::STORAGE))],
+        );
+        let (w, h) = (ctx.images.width, ctx.images.height);
+        ctx.rec.dispatch_2d(&self.pipeline, &[self.set], w, h);
+    }
+
+    fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        self.layout.destroy(gpu);
+    }
+}

@@ -1,0 +1,84 @@
+//! The visibility-buffer raster pass (`shaders/gbuffer/visibility*.frag`): only the triangle
+//! under each pixel and depth are rasterised; [`super::resolve`] evaluates the materials.
+
+use kiln_format::sections::MaterialFlags;
+
+use super::gbuffer::{DEPTH, TRIANGLE};
+use super::materials::SceneDraws;
+use super::{FrameCtx, Pass, Shared};
+use crate::error::PlayResult;
+use crate::gpu::{Gpu, GraphicsPipeline, ImageDesc, Use};
+use crate::render::graph::{Access, TargetDecl};
+use crate::render::spirv;
+
+/// The visibility raster pass.
+#[derive(Debug)]
+pub struct VisibilityPass {
+    draws: SceneDraws,
+    /// Opaque one-sided materials: culled in hardware and a shader without `discard`, so the
+    /// depth test runs before shading.
+    opaque: GraphicsPipeline,
+    /// Masked or double-sided materials: the shader decides.
+    raster: GraphicsPipeline,
+}
+
+impl VisibilityPass {
+    /// Builds the pipelines.
+    pub fn new(gpu: &Gpu) -> PlayResult<VisibilityPass> {
+        let mut draws = SceneDraws::new(gpu)?;
+        let colors = [TRIANGLE.format];
+        let build = |fragment: &[u8], cull: bool| {
+            draws.pipeline(gpu, spirv::GBUFFER_VERT, fragment, &colors, DEPTH.format, cull)
+        };
+        let opaque = match build(spirv::VISIBILITY_OPAQUE_FRAG, true) {
+            Ok(p) => p,
+            Err(e) => {
+                draws.destroy(gpu);
+                return Err(e);
+            }
+        };
+        match build(spirv::VISIBILITY_FRAG, false) {
+            Ok(raster) => Ok(VisibilityPass { draws, opaque, raster }),
+            Err(e) => {
+                let mut o = opaque;
+                o.destroy(gpu);
+                draws.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+}
+
+impl Pass for VisibilityPass {
+    fn name(&self) -> &'static str {
+        "gbuffer"
+    }
+
+    fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
+        [TRIANGLE, DEPTH].iter().map(|t| (*t, t.sized(width, height, 1))).collect()
+    }
+
+    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        self.draws.bind(gpu, shared)
+    }
+
+    fn record(&mut self, ctx: &mut FrameCtx) {
+        ctx.images
+            .access(ctx.rec, &[(TRIANGLE, Access::Write(Use::COLOR)), (DEPTH, Access::Write(Use::DEPTH))]);
+        // The visibility buffer is not cleared (a full-screen clear costs as much as a target's
+        // writes on GPUs with few raster units): the resolve marks pixels at the far plane empty.
+        ctx.rec.begin_rendering(&[ctx.images.get(&TRIANGLE)], ctx.images.get(&DEPTH), false);
+        self.draws.draw(ctx.rec, ctx.scene, |m| {
+            let opaque_one_sided = m.flags & MaterialFlags::DOUBLE_SIDED == 0
+                && (m.flags >> MaterialFlags::ALPHA_MODE_SHIFT) & 3 != 1;
+            if opaque_one_sided { &self.opaque } else { &self.raster }
+        });
+        ctx.rec.end_rendering();
+    }
+
+    fn destroy(&mut self, gpu: &Gpu) {
+        self.opaque.destroy(gpu);
+        self.raster.destroy(gpu);
+        self.draws.destroy(gpu);
+    }
+}

@@ -1,0 +1,619 @@
+//! Techniques as values: one enum per effect, each variant carrying its quality knobs. A
+//! technique knows the passes it runs ([`super::passes`]) and the `.kiln` sections they read
+//! ([`Needs`]); the player uploads exactly the union of those sections.
+//!
+//! [`catalogue`] lists every technique of every effect with its knobs as data, so that a
+//! benchmark can sweep them without knowing any by name, and [`Techniques::set`] builds a
+//! technique from such a description (the command line goes through the same door).
+
+use std::fmt;
+
+/// Resolution of the ray-traced reflections.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReflectionRes {
+    /// One ray per pixel.
+    Full,
+    /// One ray per 2 × 2 pixels, upsampled with normal- and plane-aware weights.
+    Half,
+}
+
+/// How the G-buffer is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GBuffer {
+    /// Rasterised with every material evaluated per fragment (five targets).
+    #[default]
+    Raster,
+    /// A visibility buffer (the triangle under each pixel) rasterised, the materials evaluated in
+    /// compute: far cheaper where raster throughput is small next to compute (datacenter GPUs).
+    Visibility,
+}
+
+/// Shadows of the analytic lights.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Shadows {
+    /// Every light unshadowed.
+    None,
+    /// The compiler's baked shadow maps (PCF; PCSS for rect lights).
+    #[default]
+    ShadowMap,
+    /// One ray per light per pixel per frame towards a point sampled on the light.
+    Rt {
+        /// Sphere radius of point and spot lights in scene units (0: hard shadows).
+        light_radius: f32,
+        /// Angular diameter of directional lights in degrees (0: hard).
+        sun_degrees: f32,
+    },
+}
+
+/// Ambient occlusion.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Ao {
+    /// None (the material's occlusion texture still applies).
+    #[default]
+    None,
+    /// One cosine-weighted ray per pixel per frame; a hit at t weighs (t/R)².
+    Rt {
+        /// Ray length R; `None`: a tenth of the scene's bounding-box diagonal.
+        radius: Option<f32>,
+    },
+}
+
+/// Specular reflections beyond the split-sum ambient.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Reflections {
+    /// The split-sum ambient only.
+    #[default]
+    None,
+    /// One GGX visible-normal sample per pixel (or per 2 × 2) per frame, shaded at the hit.
+    Rt {
+        /// Full or half resolution.
+        resolution: ReflectionRes,
+        /// Surfaces rougher than this keep the split-sum ambient.
+        max_roughness: f32,
+    },
+}
+
+/// Indirect diffuse light (techniques come with later passes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Gi {
+    /// None.
+    #[default]
+    None,
+}
+
+/// Participating media (techniques come with later passes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Media {
+    /// None.
+    #[default]
+    None,
+}
+
+/// What happens to the stochastic passes' samples across frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Aa {
+    /// Every frame shows its own samples.
+    None,
+    /// A running mean while the camera is still; any change of view, projection or size
+    /// restarts it.
+    #[default]
+    Accumulate,
+}
+
+/// One technique per effect: what a frame renders.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Techniques {
+    /// How the G-buffer is made.
+    pub gbuffer: GBuffer,
+    /// Shadows.
+    pub shadows: Shadows,
+    /// Ambient occlusion.
+    pub ao: Ao,
+    /// Reflections.
+    pub reflections: Reflections,
+    /// Global illumination.
+    pub gi: Gi,
+    /// Participating media.
+    pub media: Media,
+    /// Accumulation / anti-aliasing.
+    pub aa: Aa,
+}
+
+/// The sections of a `.kiln` file the chosen passes read (geometry always).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Needs {
+    /// Material textures.
+    pub textures: bool,
+    /// The split-sum BRDF table.
+    pub brdf_lut: bool,
+    /// Shadow maps.
+    pub shadow_maps: bool,
+    /// The BVH and its triangles, for ray queries.
+    pub bvh: bool,
+    /// Materials, per-triangle materials, texels and the emitter table as storage buffers
+    /// (what passes that shade surfaces in compute read).
+    pub scene_buffers: bool,
+}
+
+impl Needs {
+    /// Both sets together.
+    pub fn union(self, o: Needs) -> Needs {
+        Needs {
+            textures: self.textures || o.textures,
+            brdf_lut: self.brdf_lut || o.brdf_lut,
+            shadow_maps: self.shadow_maps || o.shadow_maps,
+            bvh: self.bvh || o.bvh,
+            scene_buffers: self.scene_buffers || o.scene_buffers,
+        }
+    }
+
+    /// What ray queries through the BVH read.
+    pub const RAYS: Needs =
+        Needs { textures: false, brdf_lut: false, shadow_maps: false, bvh: true, scene_buffers: false };
+    /// What the ray-traced passes and the path tracer read: the BVH and the surfaces it hits.
+    pub const TRACED_SURFACES: Needs =
+        Needs { textures: false, brdf_lut: false, shadow_maps: false, bvh: true, scene_buffers: true };
+    /// What the G-buffer and the direct-light pass always read.
+    pub const FRAME: Needs =
+        Needs { textures: true, brdf_lut: true, shadow_maps: false, bvh: false, scene_buffers: false };
+}
+
+impl Techniques {
+    /// The sections these techniques read.
+    pub fn needs(&self) -> Needs {
+        let mut n = Needs::FRAME;
+        if self.gbuffer == GBuffer::Visibility {
+            n.scene_buffers = true;
+        }
+        match self.shadows {
+            Shadows::ShadowMap => n.shadow_maps = true,
+            Shadows::Rt { .. } => n = n.union(Needs::TRACED_SURFACES),
+            Shadows::None => {}
+        }
+        if self.ray_traced() {
+            n = n.union(Needs::TRACED_SURFACES);
+        }
+        n
+    }
+
+    /// Whether any ray-traced pass runs.
+    pub fn ray_traced(&self) -> bool {
+        matches!(self.shadows, Shadows::Rt { .. })
+            || matches!(self.ao, Ao::Rt { .. })
+            || matches!(self.reflections, Reflections::Rt { .. })
+    }
+
+    /// Every ray-traced technique replaced by its effect's default or off (what the frame
+    /// falls back to when the file has no BVH).
+    pub fn without_rays(self) -> Techniques {
+        Techniques {
+            shadows: if matches!(self.shadows, Shadows::Rt { .. }) { Shadows::None } else { self.shadows },
+            ao: Ao::None,
+            reflections: Reflections::None,
+            ..self
+        }
+    }
+
+    /// The technique `name` for `effect` with `knobs` (name, value) set, the others at their
+    /// defaults; errors name the effect, technique or knob and the valid values.
+    pub fn set(&mut self, effect: Effect, name: &str, knobs: &[(&str, KnobValue)]) -> Result<(), String> {
+        let info = catalogue().iter().find(|t| t.effect == effect && t.name == name).ok_or_else(|| {
+            let names: Vec<&str> = techniques_of(effect).map(|t| t.name).collect();
+            format!("{effect}: no technique '{name}' (one of: {})", names.join(", "))
+        })?;
+        let mut values: Vec<KnobValue> = info.knobs.iter().map(|k| k.default).collect();
+        for (knob, value) in knobs {
+            let at = info.knobs.iter().position(|k| k.name == *knob).ok_or_else(|| {
+                let names: Vec<&str> = info.knobs.iter().map(|k| k.name).collect();
+                format!(
+                    "{effect} {name}: no knob '{knob}' ({})",
+                    if names.is_empty() {
+                        "it has none".into()
+                    } else {
+                        format!("it has {}", names.join(", "))
+                    }
+                )
+            })?;
+            info.knobs[at].check(*value).map_err(|e| format!("{effect} {name}: {e}"))?;
+            values[at] = *value;
+        }
+        let v = |i: usize| values[i];
+        match (effect, name) {
+            (Effect::GBuffer, "raster") => self.gbuffer = GBuffer::Raster,
+            (Effect::GBuffer, "visibility") => self.gbuffer = GBuffer::Visibility,
+            (Effect::Shadows, "none") => self.shadows = Shadows::None,
+            (Effect::Shadows, "shadowmap") => self.shadows = Shadows::ShadowMap,
+            (Effect::Shadows, "rt") => {
+                self.shadows = Shadows::Rt { light_radius: v(0).number(), sun_degrees: v(1).number() }
+            }
+            (Effect::Ao, "none") => self.ao = Ao::None,
+            (Effect::Ao, "rt") => {
+                let r = v(0).number();
+                self.ao = Ao::Rt { radius: (r > 0.0).then_some(r) };
+            }
+            (Effect::Reflections, "none") => self.reflections = Reflections::None,
+            (Effect::Reflections, "rt") => {
+                self.reflections = Reflections::Rt {
+                    resolution: if v(0) == KnobValue::Choice(1) {
+                        ReflectionRes::Half
+                    } else {
+                        ReflectionRes::Full
+                    },
+                    max_roughness: v(1).number(),
+                }
+            }
+            (Effect::Gi, "none") => self.gi = Gi::None,
+            (Effect::Media, "none") => self.media = Media::None,
+            (Effect::Aa, "none") => self.aa = Aa::None,
+            (Effect::Aa, "accumulate") => self.aa = Aa::Accumulate,
+            _ => unreachable!("every catalogue entry is matched above (checked by a test)"),
+        }
+        Ok(())
+    }
+
+    /// The technique each effect uses now, by catalogue name.
+    pub fn name_of(&self, effect: Effect) -> &'static str {
+        match effect {
+            Effect::GBuffer => match self.gbuffer {
+                GBuffer::Raster => "raster",
+                GBuffer::Visibility => "visibility",
+            },
+            Effect::Shadows => match self.shadows {
+                Shadows::None => "none",
+                Shadows::ShadowMap => "shadowmap",
+                Shadows::Rt { .. } => "rt",
+            },
+            Effect::Ao => match self.ao {
+                Ao::None => "none",
+                Ao::Rt { .. } => "rt",
+            },
+            Effect::Reflections => match self.reflections {
+                Reflections::None => "none",
+                Reflections::Rt { .. } => "rt",
+            },
+            Effect::Gi => "none",
+            Effect::Media => "none",
+            Effect::Aa => match self.aa {
+                Aa::None => "none",
+                Aa::Accumulate => "accumulate",
+            },
+        }
+    }
+}
+
+/// An effect: something a frame shows, made by one of several techniques.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Effect {
+    /// How surfaces are found per pixel.
+    GBuffer,
+    /// Shadows of analytic lights.
+    Shadows,
+    /// Ambient occlusion.
+    Ao,
+    /// Specular reflections.
+    Reflections,
+    /// Indirect diffuse light.
+    Gi,
+    /// Participating media.
+    Media,
+    /// Accumulation and anti-aliasing.
+    Aa,
+}
+
+impl Effect {
+    /// Every effect, in frame order.
+    pub const ALL: [Effect; 7] = [
+        Effect::GBuffer,
+        Effect::Shadows,
+        Effect::Ao,
+        Effect::Reflections,
+        Effect::Gi,
+        Effect::Media,
+        Effect::Aa,
+    ];
+
+    /// The effect's name (also its command-line flag without `--`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::GBuffer => "gbuffer",
+            Effect::Shadows => "shadows",
+            Effect::Ao => "ao",
+            Effect::Reflections => "reflections",
+            Effect::Gi => "gi",
+            Effect::Media => "media",
+            Effect::Aa => "aa",
+        }
+    }
+}
+
+impl fmt::Display for Effect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A knob's value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum KnobValue {
+    /// A number.
+    Number(f32),
+    /// The index of one of a choice knob's options.
+    Choice(usize),
+}
+
+impl KnobValue {
+    fn number(self) -> f32 {
+        match self {
+            KnobValue::Number(v) => v,
+            KnobValue::Choice(i) => i as f32,
+        }
+    }
+}
+
+/// The values a knob takes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum KnobRange {
+    /// A number in `min..=max` (`max` may be infinite); `sweep` lists the values worth
+    /// measuring.
+    Number {
+        /// Smallest value.
+        min: f32,
+        /// Largest value.
+        max: f32,
+        /// Values a sweep should measure.
+        sweep: &'static [f32],
+    },
+    /// One of the named options.
+    Choice(&'static [&'static str]),
+}
+
+/// A quality knob of a technique.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Knob {
+    /// Name (also the command-line flag without `--`).
+    pub name: &'static str,
+    /// What it does.
+    pub help: &'static str,
+    /// Valid values.
+    pub range: KnobRange,
+    /// The default.
+    pub default: KnobValue,
+}
+
+impl Knob {
+    /// Whether `value` is valid for this knob.
+    pub fn check(&self, value: KnobValue) -> Result<(), String> {
+        match (self.range, value) {
+            (KnobRange::Number { min, max, .. }, KnobValue::Number(v)) => {
+                if v.is_finite() && v >= min && v <= max {
+                    Ok(())
+                } else {
+                    Err(format!("{} must be a number in {min}..={max}, not {v}", self.name))
+                }
+            }
+            (KnobRange::Choice(options), KnobValue::Choice(i)) if i < options.len() => Ok(()),
+            (KnobRange::Choice(options), _) => {
+                Err(format!("{} must be one of {}", self.name, options.join(", ")))
+            }
+            (KnobRange::Number { .. }, KnobValue::Choice(_)) => Err(format!("{} takes a number", self.name)),
+        }
+    }
+}
+
+/// A technique of an effect, as data.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TechniqueInfo {
+    /// The effect.
+    pub effect: Effect,
+    /// Name (the command-line value).
+    pub name: &'static str,
+    /// What it does.
+    pub help: &'static str,
+    /// Its quality knobs.
+    pub knobs: &'static [Knob],
+    /// Whether its result improves with frames accumulated (a sweep varies the frame count).
+    pub stochastic: bool,
+}
+
+const fn number(
+    name: &'static str,
+    help: &'static str,
+    min: f32,
+    max: f32,
+    default: f32,
+    sweep: &'static [f32],
+) -> Knob {
+    Knob { name, help, range: KnobRange::Number { min, max, sweep }, default: KnobValue::Number(default) }
+}
+
+/// The upper end of an open range.
+const UNBOUNDED: f32 = f32::INFINITY;
+
+static CATALOGUE: [TechniqueInfo; 13] = [
+    TechniqueInfo {
+        effect: Effect::GBuffer,
+        name: "raster",
+        help: "rasterise every material attribute (five targets)",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::GBuffer,
+        name: "visibility",
+        help: "rasterise a visibility buffer (triangle per pixel), evaluate materials in compute: \
+               faster on GPUs with little raster hardware (e.g. NVIDIA H100/H200)",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Shadows,
+        name: "none",
+        help: "no shadows",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Shadows,
+        name: "shadowmap",
+        help: "the compiler's baked shadow maps (PCF; PCSS for rect lights)",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Shadows,
+        name: "rt",
+        help: "ray-traced soft shadows: one ray per light per pixel per frame, averaged while the \
+               camera is still (see --light-radius, --sun-angle)",
+        knobs: &[
+            number(
+                "light-radius",
+                "sphere radius of point and spot lights in scene units (0: hard shadows)",
+                0.0,
+                UNBOUNDED,
+                0.0,
+                &[0.0, 0.1, 1.0],
+            ),
+            number(
+                "sun-angle",
+                "angular diameter of directional lights in degrees (the sun: 0.53)",
+                0.0,
+                179.99,
+                0.0,
+                &[0.0, 0.53, 2.0],
+            ),
+        ],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Ao,
+        name: "none",
+        help: "no ambient occlusion (the material's occlusion texture still applies)",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Ao,
+        name: "rt",
+        help: "ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius",
+        knobs: &[number(
+            "ao-radius",
+            "ray length in scene units (0: a tenth of the scene's diagonal)",
+            0.0,
+            UNBOUNDED,
+            0.0,
+            &[0.0],
+        )],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Reflections,
+        name: "none",
+        help: "split-sum ambient specular only",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Reflections,
+        name: "rt",
+        help: "ray-traced glossy reflections (GGX visible-normal samples, one per pixel per frame \
+               at --reflection-res)",
+        knobs: &[
+            Knob {
+                name: "reflection-res",
+                help: "full: one ray per pixel; half: one per 2 × 2 pixels, upsampled with edge-aware weights",
+                range: KnobRange::Choice(&["full", "half"]),
+                default: KnobValue::Choice(0),
+            },
+            number(
+                "reflection-max-roughness",
+                "surfaces rougher than this keep the split-sum ambient",
+                0.0,
+                UNBOUNDED,
+                1.0,
+                &[0.4, 1.0],
+            ),
+        ],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Gi,
+        name: "none",
+        help: "no indirect diffuse light",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Media,
+        name: "none",
+        help: "no participating media",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Aa,
+        name: "none",
+        help: "every frame shows its own samples",
+        knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Aa,
+        name: "accumulate",
+        help: "a running mean of the stochastic passes while the camera is still",
+        knobs: &[],
+        stochastic: false,
+    },
+];
+
+/// Every technique of every effect with its knobs.
+pub fn catalogue() -> &'static [TechniqueInfo] {
+    &CATALOGUE
+}
+
+/// The techniques of one effect, in catalogue order.
+pub fn techniques_of(effect: Effect) -> impl Iterator<Item = &'static TechniqueInfo> {
+    catalogue().iter().filter(move |t| t.effect == effect)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_catalogue_entry_builds_its_technique() {
+        for info in catalogue() {
+            let mut t = Techniques::default();
+            t.set(info.effect, info.name, &[]).unwrap();
+            assert_eq!(t.name_of(info.effect), info.name, "{} {}", info.effect, info.name);
+            for k in info.knobs {
+                k.check(k.default).unwrap();
+            }
+        }
+        for e in Effect::ALL {
+            assert!(techniques_of(e).count() >= 1, "{e} has no technique");
+        }
+    }
+
+    #[test]
+    fn knobs_are_checked_and_named_in_errors() {
+        let mut t = Techniques::default();
+        let e = t.set(Effect::Shadows, "rt", &[("light-radius", KnobValue::Number(-1.0))]).unwrap_err();
+        assert!(e.contains("light-radius"), "{e}");
+        let e = t.set(Effect::Shadows, "rt", &[("radius", KnobValue::Number(1.0))]).unwrap_err();
+        assert!(e.contains("light-radius, sun-angle"), "{e}");
+        let e = t.set(Effect::Ao, "ssao", &[]).unwrap_err();
+        assert!(e.contains("none, rt"), "{e}");
+        t.set(Effect::Reflections, "rt", &[("reflection-res", KnobValue::Choice(1))]).unwrap();
+        assert_eq!(t.reflections, Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 1.0 });
+    }
+
+    #[test]
+    fn needs_follow_the_techniques() {
+        let d = Techniques::default();
+        assert_eq!(d.needs(), Needs { shadow_maps: true, ..Needs::FRAME });
+        let rt = Techniques { ao: Ao::Rt { radius: None }, shadows: Shadows::None, ..d };
+        assert!(rt.needs().bvh && rt.needs().scene_buffers && !rt.needs().shadow_maps);
+        let vis = Techniques { gbuffer: GBuffer::Visibility, ..d };
+        assert!(vis.needs().scene_buffers && !vis.needs().bvh);
+    }
+}
