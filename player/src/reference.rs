@@ -11,8 +11,10 @@ use gpu_allocator::MemoryLocation;
 use kiln_format::gpu::{GpuLight, ReferenceConstants};
 
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Image, ImageDesc, SetLayout, Use, Write};
-use crate::render::{lights, spirv};
+use crate::gpu::{Buffer, Use};
+use crate::render::graph::{Access, FrameImages};
+use crate::render::lights;
+use crate::render::passes::pathtrace::{ACCUMULATION, PathTracePass};
 use crate::session::{Session, SessionOptions};
 
 /// What a reference render measured.
@@ -59,7 +61,7 @@ pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<
 fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)> {
     let gpu = &session.gpu;
     let scene = &session.scene;
-    let (Some(common), Some(r)) = (scene.ray_writes(), &scene.reference) else {
+    let Some(r) = &scene.reference else {
         return Err(PlayError::new(
             Exit::BadInput,
             "the file has no BVH (no triangles?): nothing to path trace",
@@ -102,19 +104,8 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
             bytemuck::cast_slice(&plan),
             vk::BufferUsageFlags::STORAGE_BUFFER,
         )?);
-        let usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_SRC;
-        let desc = ImageDesc {
-            format: vk::Format::R32G32B32A32_SFLOAT,
-            width: w,
-            height: h,
-            mips: 1,
-            layers: 1,
-            cube: false,
-            array: false,
-            usage,
-            uploaded: false,
-        };
-        owned.image = Some(Image::new(gpu, "accumulation", desc)?);
+        owned.images =
+            Some(FrameImages::new(gpu, w, h, &[(ACCUMULATION, ACCUMULATION.sized(w, h, 1))], &[])?);
         owned.readback = Some(Buffer::new(
             gpu,
             "accumulation readback",
@@ -122,31 +113,11 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?);
-        let storage = Binding { kind: BindingKind::Storage, count: 1 };
-        let mut bindings = vec![Binding { kind: BindingKind::Uniform, count: 1 }];
-        bindings.extend([storage; 12]);
-        bindings.push(Binding { kind: BindingKind::StorageImage, count: 1 });
-        owned.layout = Some(SetLayout::new(gpu, &bindings, 1)?);
-        let layout = owned.layout.as_mut().expect("just set");
-        owned.pipeline = Some(ComputePipeline::new(gpu, spirv::PATHTRACE, &[layout], 4)?);
-        let set = layout.allocate(gpu)?;
-        let (ubo, lights, image) = (
-            owned.ubo.as_ref().expect("set"),
-            owned.lights.as_ref().expect("set"),
-            owned.image.as_ref().expect("set"),
-        );
-        let mut writes = vec![Write::Buffer(0, ubo)];
-        writes.extend(common);
-        writes.extend([
-            Write::Buffer(crate::scene::bindings::LIGHTS.binding, lights),
-            Write::Buffer(9, &r.emitters),
-            Write::Buffer(10, &r.triangle_emitter),
-            Write::Buffer(11, &r.texels),
-            Write::Buffer(12, &r.textures),
-            Write::StorageImage(13, image.view),
-        ]);
-        layout.write(gpu, set, &writes);
-        let pipeline = owned.pipeline.as_ref().expect("set");
+        owned.pass = Some(PathTracePass::new(gpu)?);
+        let (ubo, lights) = (owned.ubo.as_ref().expect("set"), owned.lights.as_ref().expect("set"));
+        let images = owned.images.as_mut().expect("set");
+        let pass = owned.pass.as_mut().expect("set");
+        pass.bind(gpu, scene, ubo, lights, images)?;
         let pool = crate::gpu::CommandPool::new(gpu, gpu.family)?;
         owned.pool = Some(pool);
         let pool = owned.pool.as_ref().expect("set");
@@ -156,20 +127,12 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
         // Batches grow until one takes about 50 ms: few submissions, yet no long-running
         // command buffer that a watchdog could take for a hang.
         let mut batch = 1u32;
-        let mut first = true;
         while taken < spp {
             let n = batch.min(spp - taken);
             let started = Instant::now();
             let rec = pool.begin(gpu)?;
             for i in 0..n {
-                if first {
-                    rec.transition(image, Use::DISCARD, Use::STORAGE);
-                    first = false;
-                } else {
-                    rec.transition(image, Use::STORAGE, Use::STORAGE);
-                }
-                let index = taken + i;
-                rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&index), [w.div_ceil(8), h.div_ceil(8), 1]);
+                pass.record(&rec, images, taken + i);
             }
             pool.submit(gpu, &[], &[])?;
             pool.wait(gpu)?;
@@ -190,8 +153,8 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
         let seconds = t0.elapsed().as_secs_f64();
         let readback = owned.readback.as_mut().expect("set");
         let rec = pool.begin(gpu)?;
-        rec.transition(image, Use::STORAGE, Use::TRANSFER_SRC);
-        rec.copy_from_image(image, readback);
+        images.access(&rec, &[(ACCUMULATION, Access::Read(Use::TRANSFER_SRC))]);
+        rec.copy_from_image(images.get(&ACCUMULATION), readback);
         rec.memory_barrier(
             vk::PipelineStageFlags2::TRANSFER,
             vk::AccessFlags2::TRANSFER_WRITE,
@@ -229,10 +192,9 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
 struct Owned {
     ubo: Option<Buffer>,
     lights: Option<Buffer>,
-    image: Option<Image>,
+    images: Option<FrameImages>,
     readback: Option<Buffer>,
-    layout: Option<SetLayout>,
-    pipeline: Option<ComputePipeline>,
+    pass: Option<PathTracePass>,
     pool: Option<crate::gpu::CommandPool>,
 }
 
@@ -243,16 +205,13 @@ impl Owned {
         if let Some(p) = &mut self.pool {
             p.destroy(gpu);
         }
-        if let Some(p) = &mut self.pipeline {
+        if let Some(p) = &mut self.pass {
             p.destroy(gpu);
-        }
-        if let Some(l) = &mut self.layout {
-            l.destroy(gpu);
         }
         for b in [&mut self.ubo, &mut self.lights, &mut self.readback].into_iter().flatten() {
             b.destroy(gpu);
         }
-        if let Some(i) = &mut self.image {
+        if let Some(i) = &mut self.images {
             i.destroy(gpu);
         }
     }

@@ -11,6 +11,7 @@ pub mod direct;
 pub mod gbuffer;
 pub mod hybrid;
 pub mod materials;
+pub mod pathtrace;
 pub mod resolve;
 pub mod rt_ao;
 pub mod rt_reflections;

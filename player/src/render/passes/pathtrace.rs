@@ -1,0 +1,101 @@
+//! The reference path tracer's pass (`shaders/reference/pathtrace.comp`): one unbiased sample
+//! per pixel per dispatch, summed into an accumulation target. [`crate::reference`] drives it
+//! for a fixed sample count and writes the mean.
+
+use ash::vk;
+
+use super::one;
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{BindingKind, Buffer, ComputePipeline, Gpu, SetLayout, Use, Write};
+use crate::render::graph::{Access, FrameImages, TargetDecl};
+use crate::render::spirv;
+use crate::scene::GpuScene;
+use crate::scene::bindings;
+
+/// The sum of the samples so far (rgb; a counts them).
+pub const ACCUMULATION: TargetDecl = TargetDecl {
+    name: "accumulation",
+    format: vk::Format::R32G32B32A32_SFLOAT,
+    usage: vk::ImageUsageFlags::from_raw(
+        vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
+    ),
+    array: false,
+};
+
+/// The path tracer's pipeline and set.
+#[derive(Debug)]
+pub struct PathTracePass {
+    layout: SetLayout,
+    pipeline: ComputePipeline,
+    set: vk::DescriptorSet,
+}
+
+impl PathTracePass {
+    /// Builds the pipeline.
+    pub fn new(gpu: &Gpu) -> PlayResult<PathTracePass> {
+        use BindingKind::*;
+        let mut b = vec![one(Uniform)];
+        b.extend([one(Storage); 12]);
+        b.push(one(StorageImage));
+        let mut layout = SetLayout::new(gpu, &b, 1)?;
+        let push = std::mem::size_of::<u32>() as u32;
+        match ComputePipeline::new(gpu, spirv::PATHTRACE, &[&layout], push) {
+            Ok(pipeline) => Ok(PathTracePass { layout, pipeline, set: vk::DescriptorSet::null() }),
+            Err(e) => {
+                layout.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+
+    /// Allocates and writes the set: `constants` holds `ReferenceConstants`, `lights` the
+    /// lights, `images` the accumulation target.
+    pub fn bind(
+        &mut self,
+        gpu: &Gpu,
+        scene: &GpuScene,
+        constants: &Buffer,
+        lights: &Buffer,
+        images: &FrameImages,
+    ) -> PlayResult {
+        let (Some(common), Some(r)) = (scene.ray_writes(), &scene.reference) else {
+            return Err(PlayError::new(
+                Exit::BadInput,
+                "the file has no BVH (no triangles?): nothing to path trace",
+            ));
+        };
+        if self.set == vk::DescriptorSet::null() {
+            self.set = self.layout.allocate(gpu)?;
+        }
+        let mut writes = vec![Write::Buffer(0, constants)];
+        writes.extend(common);
+        writes.extend([
+            Write::Buffer(bindings::LIGHTS.binding, lights),
+            Write::Buffer(9, &r.emitters),
+            Write::Buffer(10, &r.triangle_emitter),
+            Write::Buffer(11, &r.texels),
+            Write::Buffer(12, &r.textures),
+            Write::StorageImage(13, images.get(&ACCUMULATION).view),
+        ]);
+        self.layout.write(gpu, self.set, &writes);
+        Ok(())
+    }
+
+    /// Records sample `index` (0 overwrites the accumulation, later ones add to it).
+    pub fn record(&self, rec: &crate::gpu::Recorder, images: &mut FrameImages, index: u32) {
+        images.access(rec, &[(ACCUMULATION, Access::ReadWrite(Use::STORAGE))]);
+        let (w, h) = (images.width, images.height);
+        rec.dispatch(
+            &self.pipeline,
+            &[self.set],
+            bytemuck::bytes_of(&index),
+            [w.div_ceil(8), h.div_ceil(8), 1],
+        );
+    }
+
+    /// Releases the pipeline and layout.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        self.layout.destroy(gpu);
+    }
+}
