@@ -88,6 +88,25 @@ struct Slot {
     state: Option<State>,
 }
 
+/// What `access` needs after `state`: the use to transition from (`None`: no barrier) and the
+/// state after it.
+fn step(state: Option<State>, access: Access) -> (Option<Use>, State) {
+    let to = access.target_use();
+    let from = match (state, access) {
+        (None, _) | (_, Access::Write(_)) => Some(Use::DISCARD),
+        (Some(s), _) if s.layout != to.layout || s.wrote || access.writes() => {
+            Some(Use { layout: s.layout, stage: s.stage, access: s.access })
+        }
+        _ => None,
+    };
+    let next = match (from, state) {
+        // Another read in the same layout: a later write must wait for it too.
+        (None, Some(s)) => State { stage: s.stage | to.stage, access: s.access | to.access, ..s },
+        _ => State { layout: to.layout, stage: to.stage, access: to.access, wrote: access.writes() },
+    };
+    (from, next)
+}
+
 /// The images of one frame size and their states.
 #[derive(Debug)]
 pub struct FrameImages {
@@ -152,31 +171,10 @@ impl FrameImages {
         let mut barriers: Vec<(usize, Use, Use)> = Vec::new();
         for &(decl, access) in accesses {
             let i = self.slot(&decl);
-            let to = access.target_use();
-            let from = match (self.slots[i].state, access) {
-                (None, _) | (_, Access::Write(_)) => Some(Use::DISCARD),
-                (Some(s), _) if s.layout != to.layout || s.wrote || access.writes() => {
-                    Some(Use { layout: s.layout, stage: s.stage, access: s.access })
-                }
-                _ => None,
-            };
-            let state = &mut self.slots[i].state;
-            match (from, *state) {
-                (None, Some(s)) => {
-                    // Another read in the same layout: a later write must wait for it too.
-                    *state = Some(State { stage: s.stage | to.stage, access: s.access | to.access, ..s });
-                }
-                _ => {
-                    *state = Some(State {
-                        layout: to.layout,
-                        stage: to.stage,
-                        access: to.access,
-                        wrote: access.writes(),
-                    })
-                }
-            }
+            let (from, state) = step(self.slots[i].state, access);
+            self.slots[i].state = Some(state);
             if let Some(from) = from {
-                barriers.push((i, from, to));
+                barriers.push((i, from, access.target_use()));
             }
         }
         let list: Vec<(&Image, Use, Use)> =
@@ -190,5 +188,78 @@ impl FrameImages {
             s.image.destroy(gpu);
         }
         self.slots.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Runs accesses from a fresh image; returns the `from` layout of each barrier (None: none).
+    fn run(accesses: &[Access]) -> Vec<Option<vk::ImageLayout>> {
+        let mut state = None;
+        accesses
+            .iter()
+            .map(|&a| {
+                let (from, next) = step(state, a);
+                state = Some(next);
+                from.map(|u| u.layout)
+            })
+            .collect()
+    }
+
+    const GENERAL: vk::ImageLayout = vk::ImageLayout::GENERAL;
+    const UNDEFINED: vk::ImageLayout = vk::ImageLayout::UNDEFINED;
+
+    #[test]
+    fn hazards_get_barriers_and_read_after_read_does_not() {
+        use Access::*;
+        let (s, sampled, color) = (Use::STORAGE, Use::SAMPLED, Use::COLOR);
+        // First use and a discarding write come from UNDEFINED.
+        assert_eq!(run(&[Read(s)]), vec![Some(UNDEFINED)]);
+        assert_eq!(run(&[ReadWrite(s), Write(s)]), vec![Some(UNDEFINED), Some(UNDEFINED)]);
+        // Read after write, write after write (running mean), write after read.
+        assert_eq!(run(&[ReadWrite(s), Read(s)]), vec![Some(UNDEFINED), Some(GENERAL)]);
+        assert_eq!(run(&[ReadWrite(s), ReadWrite(s)]), vec![Some(UNDEFINED), Some(GENERAL)]);
+        assert_eq!(
+            run(&[ReadWrite(s), Read(s), ReadWrite(s)]),
+            vec![Some(UNDEFINED), Some(GENERAL), Some(GENERAL)]
+        );
+        // Reads after reads in one layout: one barrier, for the first.
+        assert_eq!(
+            run(&[Write(color), Read(sampled), Read(sampled), Read(sampled)]),
+            vec![Some(UNDEFINED), Some(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL), None, None]
+        );
+        // A layout change after reads needs one.
+        assert_eq!(
+            run(&[Write(s), Read(s), Read(Use::TRANSFER_SRC)]),
+            vec![Some(UNDEFINED), Some(GENERAL), Some(GENERAL)]
+        );
+    }
+
+    #[test]
+    fn a_write_after_several_reads_waits_for_all_of_them() {
+        let reads = [Access::Write(Use::COLOR), Access::Read(Use::SAMPLED), Access::Read(Use::STORAGE)];
+        let mut state = None;
+        for a in reads {
+            state = Some(step(state, a).1);
+        }
+        // SAMPLED and STORAGE reads in GENERAL vs SHADER_READ_ONLY differ in layout, so the
+        // second read already had its own barrier; a write now waits on the last reads' stages.
+        let (from, _) = step(state, Access::ReadWrite(Use::STORAGE));
+        let from = from.expect("a write after reads needs a barrier");
+        assert!(from.stage.contains(Use::STORAGE.stage));
+        let mut s = Some(step(None, Access::Write(Use::STORAGE)).1);
+        s = Some(step(s, Access::Read(Use::STORAGE)).1);
+        s = Some(
+            step(s, Access::Read(Use { stage: vk::PipelineStageFlags2::FRAGMENT_SHADER, ..Use::STORAGE })).1,
+        );
+        let (from, _) = step(s, Access::ReadWrite(Use::STORAGE));
+        let from = from.expect("barrier");
+        assert!(
+            from.stage
+                .contains(vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER)
+        );
+        assert!(from.access.contains(vk::AccessFlags2::SHADER_STORAGE_READ));
     }
 }
