@@ -155,7 +155,7 @@ pub struct ImageRows {
 /// A command buffer being recorded.
 #[derive(Debug)]
 pub struct Recorder<'a> {
-    gpu: &'a Gpu,
+    pub(super) gpu: &'a Gpu,
     /// The command buffer.
     pub cmd: vk::CommandBuffer,
 }

@@ -6,6 +6,7 @@
 
 mod commands;
 mod pipelines;
+mod raytracing;
 mod resources;
 mod swapchain;
 
@@ -13,6 +14,7 @@ pub use commands::{CommandPool, ImageRows, Recorder, SemaphoreOp, TimestampPool,
 pub use pipelines::{
     Binding, BindingKind, ComputePipeline, GraphicsDesc, GraphicsPipeline, SetLayout, Write,
 };
+pub use raytracing::{AccelerationStructures, RayTracingPipeline, RayTracingShaders};
 pub use resources::{Buffer, Image, ImageDesc, Sampler, SamplerKey};
 pub use swapchain::{Swapchain, surface_extensions};
 
