@@ -12,18 +12,16 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// Shadow maps: MAX_SHADOW_MAPS (layout.glsl) of each kind, indexed by `GpuShadow::slot`.
 // The shadow tap loops are [[dont_unroll]]: each tap samples through a dynamically indexed
 // sampler array, which CPU drivers (lavapipe) expand into one sampling routine per array element;
 // unrolling multiplied that by 16 and took lavapipe 26 s to compile.
-const uint MAX_SHADOW_2D = 8u;
-const uint MAX_SHADOW_CUBE = 8u;
-
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Lights { GpuLight lights[]; };
 layout(set = 0, binding = 2, std430) readonly buffer Shadows { GpuShadow shadows[]; };
 layout(set = 0, binding = 3) uniform sampler2D brdf_lut;
-layout(set = 0, binding = 4) uniform sampler2D shadow_2d[MAX_SHADOW_2D];
-layout(set = 0, binding = 5) uniform samplerCube shadow_cube[MAX_SHADOW_CUBE];
+layout(set = 0, binding = 4) uniform sampler2D shadow_2d[MAX_SHADOW_MAPS];
+layout(set = 0, binding = 5) uniform samplerCube shadow_cube[MAX_SHADOW_MAPS];
 layout(set = 0, binding = 6) uniform sampler2D g_depth;
 layout(set = 0, binding = 7) uniform sampler2D g_normal;
 layout(set = 0, binding = 8) uniform sampler2D g_albedo;
