@@ -266,6 +266,15 @@ impl FrameFlags {
     pub const REFLECTIONS_HALF: u32 = 1 << 4;
 }
 
+/// Shadow maps of each kind (2D and cube) the direct-light pass can bind: the length of its
+/// `shadow_2d` and `shadow_cube` sampler arrays (`MAX_SHADOW_MAPS` in `layout.glsl`). Lights
+/// beyond it are drawn without shadow maps.
+pub const MAX_SHADOW_MAPS: usize = 8;
+
+/// Lights that can have a ray-traced shadow layer (and, in the reflections, a shadow-ray layer);
+/// further lights are drawn unshadowed (`MAX_RT_SHADOW_LIGHTS` in `layout.glsl`).
+pub const MAX_RT_SHADOW_LIGHTS: usize = 16;
+
 /// Alignment and size of a GLSL type under std430 (std140 differs only for arrays and structs,
 /// which these layouts do not nest).
 fn glsl_align_size(ty: &str) -> (usize, usize) {
@@ -340,6 +349,8 @@ pub fn glsl_layout() -> String {
         ("TEXTURE_SRGB", TextureFlags::SRGB),
         ("TEXTURE_LINEAR", TextureFlags::LINEAR),
         ("TEXTURE_LEVELS_SHIFT", TextureFlags::LEVELS_SHIFT),
+        ("MAX_SHADOW_MAPS", MAX_SHADOW_MAPS as u32),
+        ("MAX_RT_SHADOW_LIGHTS", MAX_RT_SHADOW_LIGHTS as u32),
     ] {
         s.push_str(&format!("const uint {name} = {v}u;\n"));
     }

@@ -1,16 +1,62 @@
-// kiln's direct-light shading, mirroring compiler/src/shading.rs (the pre-illuminated line space
-// bakes with the same functions). Units: radiance in W/(sr·m²).
+// The glTF metallic-roughness BRDF, once for every pass: GGX normal distribution, height-correlated
+// Smith masking-shadowing, Schlick Fresnel, Lambert diffuse. The direct-light evaluation `brdf`
+// mirrors compiler/src/shading.rs (the pre-illuminated line space bakes with the same
+// functions); the ray-traced passes build their estimators (common/scene.glsl,
+// rt/reflections.comp) from the same pieces. Units: radiance in W/(sr·m²).
 #ifndef KILN_BRDF_GLSL
 #define KILN_BRDF_GLSL
 
 const float PI = 3.14159265358979;
 
-struct Surface {
+// A surface's material as the BRDF sees it.
+struct Material {
     vec3 base;        // linear base colour
     float metallic;
     float roughness;  // perceptual; alpha = roughness²
     bool diffuse_only;
 };
+
+// GGX alpha of a perceptual roughness, kept away from 0 (a perfect mirror's delta lobe).
+float ggx_alpha(float roughness) {
+    return max(roughness * roughness, 1e-3);
+}
+
+// GGX normal distribution D(h) at n·h, for a2 = alpha².
+float ggx_d(float n_h, float a2) {
+    float d = n_h * n_h * (a2 - 1.0) + 1.0;
+    return a2 / (PI * d * d);
+}
+
+// Smith Λ of GGX for a direction at cosine c to the normal.
+float smith_lambda(float c, float a2) {
+    float c2 = max(c * c, 1e-12);
+    return 0.5 * (sqrt(1.0 + a2 * (1.0 - c2) / c2) - 1.0);
+}
+
+// Smith G1 of GGX for a direction at cosine n_x to the normal.
+float smith_g1(float n_x, float a2) {
+    return 2.0 * n_x / (n_x + sqrt(a2 + (1.0 - a2) * n_x * n_x));
+}
+
+// Visibility V = G2 / (4 (n·l)(n·v)) with the height-correlated Smith G2 of GGX.
+float smith_visibility(float n_l, float n_v, float a2) {
+    return 0.5 / (n_l * sqrt(n_v * n_v * (1.0 - a2) + a2) + n_v * sqrt(n_l * n_l * (1.0 - a2) + a2));
+}
+
+// Reflectance at normal incidence: 4 % for dielectrics, the base colour for metals.
+vec3 fresnel_f0(vec3 base, float metallic) {
+    return mix(vec3(0.04), base, metallic);
+}
+
+// Schlick's Fresnel at the cosine `c` between the view (or light) direction and the half vector.
+vec3 fresnel_schlick(vec3 f0, float c) {
+    return f0 + (vec3(1.0) - f0) * pow(1.0 - c, 5.0);
+}
+
+// Lambert: the diffuse BRDF of albedo `base`.
+vec3 lambert(vec3 base) {
+    return base / PI;
+}
 
 // Directional albedo E = R + G of the split-sum table at (n·v, roughness), for multiple-scattering
 // energy compensation; 1 when there is no table.
@@ -25,25 +71,24 @@ float directional_albedo(sampler2D lut, float lut_res, float n_v, float roughnes
 // f(l, v): Lambert for diffuse-only materials; otherwise Cook–Torrance GGX with height-correlated
 // Smith visibility and Schlick Fresnel, F0 = mix(0.04, base, metallic), diffuse (1 − F)(1 − metallic)
 // base / π, specular scaled by 1 + F0 (1 / E − 1).
-vec3 brdf(Surface s, vec3 n, vec3 v, vec3 l, float e_albedo) {
-    vec3 lambert = s.base / PI;
-    if (s.diffuse_only) {
-        return lambert;
+vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
+    vec3 diffuse = lambert(m.base);
+    if (m.diffuse_only) {
+        return diffuse;
     }
     vec3 h = normalize(v + l);
     float n_v = max(dot(n, v), 1e-4);
     float n_l = max(dot(n, l), 1e-4);
     float n_h = max(dot(n, h), 0.0);
     float v_h = max(dot(v, h), 0.0);
-    float alpha = max(s.roughness * s.roughness, 1e-3);
+    float alpha = ggx_alpha(m.roughness);
     float a2 = alpha * alpha;
-    float d_den = n_h * n_h * (a2 - 1.0) + 1.0;
-    float d = a2 / (PI * d_den * d_den);
-    float vis = 0.5 / (n_l * sqrt(n_v * n_v * (1.0 - a2) + a2) + n_v * sqrt(n_l * n_l * (1.0 - a2) + a2));
-    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
-    vec3 f = f0 + (vec3(1.0) - f0) * pow(1.0 - v_h, 5.0);
+    float d = ggx_d(n_h, a2);
+    float vis = smith_visibility(n_l, n_v, a2);
+    vec3 f0 = fresnel_f0(m.base, m.metallic);
+    vec3 f = fresnel_schlick(f0, v_h);
     vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-    return (vec3(1.0) - f) * (1.0 - s.metallic) * lambert + f * (d * vis) * compensation;
+    return (vec3(1.0) - f) * (1.0 - m.metallic) * diffuse + f * (d * vis) * compensation;
 }
 
 #endif

@@ -1,7 +1,7 @@
 // The scene as the ray-traced passes see it: textures from a texel buffer, alpha-masked
-// traversal, surfaces at hits (shading frame, material) and the glTF metallic-roughness BRDF
-// with its sampling. Shared by the reference path tracer and the hybrid passes so that both
-// shade a hit identically.
+// traversal, surfaces at hits (shading frame, material), and the glTF metallic-roughness BRDF
+// (its pieces from brdf.glsl) with its sampling. Shared by the reference path tracer and the
+// hybrid passes so that both shade a hit identically.
 //
 // The includer declares these storage buffers (see shaders/reference/pathtrace.comp):
 //   bvh_nodes, bvh_tris (traverse.glsl), vertex_data (6 floats per vertex), uvs, indices (leaf
@@ -10,8 +10,8 @@
 #ifndef KILN_SCENE_GLSL
 #define KILN_SCENE_GLSL
 
-const float PI = 3.14159265358979;
-
+#include "brdf.glsl"
+#include "lights.glsl"
 #include "textures.glsl"
 #include "vertices.glsl"
 
@@ -41,10 +41,7 @@ struct Surface {
     vec3 ng;        // geometric normal, facing the incoming ray
     vec3 ns;        // shading normal, same side as ng
     bool front;     // the ray hit the triangle's front (counter-clockwise) face
-    vec3 base;
-    float metallic;
-    float roughness;
-    bool diffuse_only;
+    Material mat;
     vec3 emission;  // emitted radiance towards the ray (zero from a back face of a one-sided material)
 };
 
@@ -99,17 +96,17 @@ Surface surface_at(TraceRay r, TraceHit h) {
     if (m.base_color_texture != NO_TEXTURE) {
         base *= sample_texture(m.base_color_texture, uv);
     }
-    s.base = base.rgb;
-    s.metallic = m.metallic;
-    s.roughness = m.roughness;
+    s.mat.base = base.rgb;
+    s.mat.metallic = m.metallic;
+    s.mat.roughness = m.roughness;
     if (m.metallic_roughness_texture != NO_TEXTURE) {
         vec4 mr = sample_texture(m.metallic_roughness_texture, uv);
-        s.metallic *= mr.b;
-        s.roughness *= mr.g;
+        s.mat.metallic *= mr.b;
+        s.mat.roughness *= mr.g;
     }
-    s.metallic = clamp(s.metallic, 0.0, 1.0);
-    s.roughness = clamp(s.roughness, 0.0, 1.0);
-    s.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    s.mat.metallic = clamp(s.mat.metallic, 0.0, 1.0);
+    s.mat.roughness = clamp(s.mat.roughness, 0.0, 1.0);
+    s.mat.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     vec3 e = m.emission;
     if (m.emissive_texture != NO_TEXTURE && any(greaterThan(e, vec3(0.0)))) {
         e *= sample_texture(m.emissive_texture, uv).rgb;
@@ -119,22 +116,9 @@ Surface surface_at(TraceRay r, TraceHit h) {
     return s;
 }
 
-// ---------------------------------------------------------------- BRDF
+// ---------------------------------------------------------------- BRDF sampling
 float luminance(vec3 c) {
     return dot(c, vec3(0.2126, 0.7152, 0.0722));
-}
-
-float ggx_d(float n_h, float a2) {
-    float d = n_h * n_h * (a2 - 1.0) + 1.0;
-    return a2 / (PI * d * d);
-}
-
-float smith_g1(float n_x, float a2) {
-    return 2.0 * n_x / (n_x + sqrt(a2 + (1.0 - a2) * n_x * n_x));
-}
-
-float alpha_of(Surface s) {
-    return max(s.roughness * s.roughness, 1e-3);
 }
 
 // f(wo, wi) · |n·wi|, zero below the geometric surface.
@@ -147,27 +131,27 @@ vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
     if (n_l <= 0.0 || n_v <= 0.0) {
         return vec3(0.0);
     }
-    if (s.diffuse_only) {
-        return s.base / PI * n_l;
+    if (s.mat.diffuse_only) {
+        return lambert(s.mat.base) * n_l;
     }
     vec3 h = normalize(wo + wi);
-    float a = alpha_of(s);
+    float a = ggx_alpha(s.mat.roughness);
     float a2 = a * a;
     float d = ggx_d(max(dot(s.ns, h), 0.0), a2);
-    float vis = 0.5 / (n_l * sqrt(n_v * n_v * (1.0 - a2) + a2) + n_v * sqrt(n_l * n_l * (1.0 - a2) + a2));
-    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
-    vec3 f = f0 + (1.0 - f0) * pow(1.0 - max(dot(wo, h), 0.0), 5.0);
-    return ((1.0 - f) * (1.0 - s.metallic) * s.base / PI + f * d * vis) * n_l;
+    float vis = smith_visibility(n_l, n_v, a2);
+    vec3 f = fresnel_schlick(fresnel_f0(s.mat.base, s.mat.metallic), max(dot(wo, h), 0.0));
+    // Lambert's base / π, divided after the weights (not lambert(base) times them): the order the
+    // reference images were made with; it rounds differently.
+    return ((1.0 - f) * (1.0 - s.mat.metallic) * s.mat.base / PI + f * d * vis) * n_l;
 }
 
 // Probability of choosing the specular lobe.
 float specular_probability(Surface s, vec3 wo) {
-    if (s.diffuse_only) {
+    if (s.mat.diffuse_only) {
         return 0.0;
     }
-    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
-    float fresnel = luminance(f0 + (1.0 - f0) * pow(1.0 - clamp(dot(s.ns, wo), 0.0, 1.0), 5.0));
-    float diffuse = luminance(s.base) * (1.0 - s.metallic) * (1.0 - fresnel);
+    float fresnel = luminance(fresnel_schlick(fresnel_f0(s.mat.base, s.mat.metallic), clamp(dot(s.ns, wo), 0.0, 1.0)));
+    float diffuse = luminance(s.mat.base) * (1.0 - s.mat.metallic) * (1.0 - fresnel);
     return clamp(fresnel / max(fresnel + diffuse, 1e-6), 0.05, 0.95);
 }
 
@@ -189,7 +173,7 @@ float brdf_pdf(Surface s, vec3 wo, vec3 wi) {
     }
     float n_v = max(dot(s.ns, wo), 1e-6);
     vec3 h = normalize(wo + wi);
-    float a = alpha_of(s);
+    float a = ggx_alpha(s.mat.roughness);
     float a2 = a * a;
     float specular = smith_g1(n_v, a2) * ggx_d(max(dot(s.ns, h), 0.0), a2) / (4.0 * n_v);
     return ps * specular + (1.0 - ps) * diffuse;
@@ -217,7 +201,7 @@ vec3 sample_brdf(Surface s, vec3 wo) {
     vec2 xi = vec2(rnd(), rnd());
     if (rnd() < ps) {
         vec3 v = transpose(f) * wo;
-        vec3 h = f * sample_vndf(v, alpha_of(s), xi);
+        vec3 h = f * sample_vndf(v, ggx_alpha(s.mat.roughness), xi);
         return reflect(-wo, h);
     }
     float r = sqrt(xi.x);

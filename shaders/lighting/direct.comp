@@ -8,21 +8,20 @@
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 #include "../common/brdf.glsl"
+#include "../common/lights.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// Shadow maps: MAX_SHADOW_MAPS (layout.glsl) of each kind, indexed by `GpuShadow::slot`.
 // The shadow tap loops are [[dont_unroll]]: each tap samples through a dynamically indexed
 // sampler array, which CPU drivers (lavapipe) expand into one sampling routine per array element;
 // unrolling multiplied that by 16 and took lavapipe 26 s to compile.
-const uint MAX_SHADOW_2D = 8u;
-const uint MAX_SHADOW_CUBE = 8u;
-
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Lights { GpuLight lights[]; };
 layout(set = 0, binding = 2, std430) readonly buffer Shadows { GpuShadow shadows[]; };
 layout(set = 0, binding = 3) uniform sampler2D brdf_lut;
-layout(set = 0, binding = 4) uniform sampler2D shadow_2d[MAX_SHADOW_2D];
-layout(set = 0, binding = 5) uniform samplerCube shadow_cube[MAX_SHADOW_CUBE];
+layout(set = 0, binding = 4) uniform sampler2D shadow_2d[MAX_SHADOW_MAPS];
+layout(set = 0, binding = 5) uniform samplerCube shadow_cube[MAX_SHADOW_MAPS];
 layout(set = 0, binding = 6) uniform sampler2D g_depth;
 layout(set = 0, binding = 7) uniform sampler2D g_normal;
 layout(set = 0, binding = 8) uniform sampler2D g_albedo;
@@ -194,14 +193,14 @@ void main() {
     vec3 p = world_at(pixel, depth);
     vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
     vec4 mat = texelFetch(g_material, pixel, 0);
-    Surface s = Surface(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
+    Material m = Material(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
     vec3 v = normalize(frame.camera.xyz - p);
     if (dot(n, v) < 0.0) {
         n = -n;
     }
     float n_v = clamp(dot(n, v), 1e-4, 1.0);
     float lut_res = frame.params.y;
-    float e_albedo = s.diffuse_only ? 1.0 : directional_albedo(brdf_lut, lut_res, n_v, s.roughness);
+    float e_albedo = m.diffuse_only ? 1.0 : directional_albedo(brdf_lut, lut_res, n_v, m.roughness);
     float angle = 6.2831853 * hash(uvec2(pixel));
 
     vec3 radiance = texelFetch(g_emission, pixel, 0).rgb;
@@ -212,17 +211,17 @@ void main() {
     vec4 traced = vec4(0.0);
     // Surfaces rougher than the limit keep the split sum, also where half-resolution upsampling
     // would borrow a smoother neighbour's traced reflection.
-    if ((frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !s.diffuse_only && s.roughness <= frame.params.w) {
+    if ((frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !m.diffuse_only && m.roughness <= frame.params.w) {
         traced = reflection_at(pixel, p, n);
     }
     // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.
-    if (s.diffuse_only) {
-        radiance += s.base * frame.sky.rgb * occlusion;
+    if (m.diffuse_only) {
+        radiance += m.base * frame.sky.rgb * occlusion;
     } else {
-        vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, s.roughness)).rg : vec2(1.0, 0.0);
-        vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
+        vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.roughness)).rg : vec2(1.0, 0.0);
+        vec3 f0 = fresnel_f0(m.base, m.metallic);
         vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-        vec3 diffuse = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - s.metallic) * s.base;
+        vec3 diffuse = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - m.metallic) * m.base;
         radiance += diffuse * frame.sky.rgb * occlusion;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
@@ -239,7 +238,7 @@ void main() {
             shadow_dir = l;
             float n_l = dot(n, l);
             if (n_l > 0.0) {
-                contribution = brdf(s, n, v, l, e_albedo) * light.radiance * n_l;
+                contribution = brdf(m, n, v, l, e_albedo) * light.radiance * n_l;
             }
         } else if (light.kind == LIGHT_RECT) {
             vec3 up = cross(light.direction, light.right);
@@ -260,7 +259,7 @@ void main() {
                     if (cos_light <= 0.0 || n_l <= 0.0) {
                         continue;
                     }
-                    contribution += brdf(s, n, v, l, e_albedo) * light.radiance * (cos_light * area / (16.0 * d * d)) * n_l;
+                    contribution += brdf(m, n, v, l, e_albedo) * light.radiance * (cos_light * area / (16.0 * d * d)) * n_l;
                 }
             }
         } else {
@@ -272,11 +271,9 @@ void main() {
             if (d > 0.0 && n_l > 0.0 && (light.range <= 0.0 || d <= light.range)) {
                 float cone = 1.0;
                 if (light.kind == LIGHT_SPOT) {
-                    // smoothstep, written out: GLSL leaves smoothstep undefined for equal edges.
-                    float t = clamp((dot(-l, light.direction) - light.cos_outer) / max(light.cos_inner - light.cos_outer, 1e-6), 0.0, 1.0);
-                    cone = t * t * (3.0 - 2.0 * t);
+                    cone = spot_cone(light, l);
                 }
-                contribution = brdf(s, n, v, l, e_albedo) * light.radiance * (cone / (d * d)) * n_l;
+                contribution = brdf(m, n, v, l, e_albedo) * light.radiance * (cone / (d * d)) * n_l;
             }
         }
         if (any(greaterThan(contribution, vec3(0.0)))) {

@@ -2,6 +2,9 @@
 // (VK_KHR_ray_tracing_pipeline) tracing the same ray buffers into the same hit layout as
 // shaders/trace/rays.comp, for throughput comparisons. Everything is reached through buffer
 // device addresses in push constants, so the pipeline needs no descriptor set.
+#ifndef KILN_PEER_COMMON_GLSL
+#define KILN_PEER_COMMON_GLSL
+
 #extension GL_EXT_ray_tracing : require
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
@@ -24,3 +27,5 @@ struct Payload {
 };
 
 const float NO_HIT = 3.402823e38;
+
+#endif

@@ -137,8 +137,7 @@ vec3 sample_emitter(Surface s, vec3 wo) {
         }
         float cone = 1.0;
         if (l.kind == LIGHT_SPOT) {
-            float t = clamp((dot(-wi, l.direction) - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-6), 0.0, 1.0);
-            cone = t * t * (3.0 - 2.0 * t);
+            cone = spot_cone(l, wi);
         }
         li = l.radiance * cone / d2;
     }

@@ -17,12 +17,6 @@
 // masking term and the pdf (it used Fresnel alone), and diffuse-only materials are not traced.
 #include "hybrid.glsl"
 
-// Smith Λ of GGX for a direction at cosine c to the normal.
-float smith_lambda(float c, float a2) {
-    float c2 = max(c * c, 1e-12);
-    return 0.5 * (sqrt(1.0 + a2 * (1.0 - c2) / c2) - 1.0);
-}
-
 // Radiance leaving the hit towards -dir, without the shadowed terms of the lights that the
 // shadow pass handles (stored, scaled by `scale`, in their `refl_lights` layers); the hit's
 // offset origin goes to `origin`.
@@ -31,9 +25,9 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, out vec3 origin) 
     origin = offset_ray_origin(s.p, s.ng);
     vec3 wo = -normalize(r.direction);
     vec3 sum = s.emission;
-    vec3 f0 = mix(vec3(0.04), s.base, s.metallic);
-    vec3 diffuse = s.diffuse_only ? s.base : s.base * (1.0 - s.metallic);
-    sum += frame.sky.rgb * (s.diffuse_only ? diffuse : diffuse + f0);
+    vec3 f0 = fresnel_f0(s.mat.base, s.mat.metallic);
+    vec3 diffuse = s.mat.diffuse_only ? s.mat.base : s.mat.base * (1.0 - s.mat.metallic);
+    sum += frame.sky.rgb * (s.mat.diffuse_only ? diffuse : diffuse + f0);
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight l = lights[i];
         vec3 wi;
@@ -48,8 +42,7 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, out vec3 origin) 
             if (dist > 0.0 && (l.range <= 0.0 || dist <= l.range)) {
                 li = l.radiance / (dist * dist);
                 if (l.kind == LIGHT_SPOT) {
-                    float t = clamp((dot(-wi, l.direction) - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-6), 0.0, 1.0);
-                    li *= t * t * (3.0 - 2.0 * t);
+                    li *= spot_cone(l, wi);
                 } else if (l.kind == LIGHT_RECT) {
                     // The rectangle seen from the hit as one point at its centre.
                     li *= max(dot(-wi, l.direction), 0.0) * l.width * l.height;
@@ -86,8 +79,8 @@ void main() {
         if (mat.b < 0.5 && roughness <= rt.max_roughness) {
             seed_rng(pixel, 3u);
             vec3 base = srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb);
-            vec3 f0 = mix(vec3(0.04), base, mat.r);
-            float a = max(roughness * roughness, 1e-3);
+            vec3 f0 = fresnel_f0(base, mat.r);
+            float a = ggx_alpha(roughness);
             float a2 = a * a;
             mat3 f = basis(s.n);
             vec3 h = f * sample_vndf(transpose(f) * s.v, a, vec2(rnd(), rnd()));
@@ -98,7 +91,7 @@ void main() {
                 float n_v = max(dot(s.n, s.v), 1e-4);
                 float lv = smith_lambda(n_v, a2);
                 float weight = (1.0 + lv) / (1.0 + lv + smith_lambda(n_l, a2));
-                vec3 fresnel = f0 + (1.0 - f0) * pow(1.0 - clamp(dot(s.v, h), 0.0, 1.0), 5.0);
+                vec3 fresnel = fresnel_schlick(f0, clamp(dot(s.v, h), 0.0, 1.0));
                 TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, 3.4e38);
                 TraceHit hit = trace(r, false);
                 vec3 scale = fresnel * weight;

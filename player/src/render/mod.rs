@@ -31,12 +31,9 @@ pub use technique::{
     Aa, Ao, Effect, GBuffer, Gi, Media, Needs, ReflectionRes, Reflections, Shadows, Techniques,
 };
 
-/// Shadow maps of each kind the direct-light pass can bind (`MAX_SHADOW_2D`, `MAX_SHADOW_CUBE`
-/// in `shaders/lighting/direct.comp`).
-pub const MAX_SHADOW_MAPS: usize = 8;
-
-/// Lights that can have a ray-traced shadow layer; further lights are drawn unshadowed.
-pub const MAX_RT_SHADOW_LIGHTS: usize = 16;
+/// Shadow maps of each kind the direct-light pass can bind, and lights with a ray-traced shadow
+/// layer: defined once in `kiln_format::gpu`, which also emits them into the shaders' `layout.glsl`.
+pub use kiln_format::gpu::{MAX_RT_SHADOW_LIGHTS, MAX_SHADOW_MAPS};
 
 /// What a session is opened for, beyond frames.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
