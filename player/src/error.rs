@@ -55,8 +55,8 @@ impl std::error::Error for PlayError {}
 pub type PlayResult<T = ()> = Result<T, PlayError>;
 
 /// Maps a Vulkan error of operation `what` to an exit class.
-pub fn vk(what: &str, e: ash::vk::Result) -> PlayError {
-    use ash::vk::Result as R;
+pub fn vk(what: &str, e: crate::gpu::vk::Result) -> PlayError {
+    use crate::gpu::vk::Result as R;
     let exit = match e {
         R::ERROR_INCOMPATIBLE_DRIVER
         | R::ERROR_EXTENSION_NOT_PRESENT

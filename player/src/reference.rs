@@ -6,7 +6,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
-use ash::vk;
+use crate::gpu::vk;
 use gpu_allocator::MemoryLocation;
 use kiln_format::gpu::{GpuLight, ReferenceConstants};
 

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use ash::vk;
+use crate::gpu::vk;
 use kiln_format::error::ErrorKind;
 use kiln_format::read::{Checksums, KilnFile};
 

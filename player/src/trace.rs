@@ -2,7 +2,7 @@
 //! traversal (`shaders/common/traverse.glsl`), closest or any hit each, timed with timestamps.
 //! Tests hold it to the CPU query of `kiln-format`; benchmarks report its rays per second.
 
-use ash::vk;
+use crate::gpu::vk;
 use bytemuck::{Pod, Zeroable};
 use gpu_allocator::MemoryLocation;
 

@@ -17,14 +17,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
-layout(set = 0, binding = 1, std430) readonly buffer BvhNodes { uvec4 bvh_nodes[]; };
-layout(set = 0, binding = 2, std430) readonly buffer BvhTriangles { vec4 bvh_tris[]; };
-layout(set = 0, binding = 3, std430) readonly buffer Vertices { float vertex_data[]; };   // 6 floats each
-layout(set = 0, binding = 4, std430) readonly buffer Uvs { vec2 uvs[]; };
-layout(set = 0, binding = 5, std430) readonly buffer Indices { uint indices[]; };        // leaf order
-layout(set = 0, binding = 6, std430) readonly buffer TriMaterials { uint tri_materials[]; };
-layout(set = 0, binding = 7, std430) readonly buffer Materials { GpuMaterialLayout materials[]; };
-layout(set = 0, binding = 8, std430) readonly buffer Lights { GpuLight lights[]; };
+#include "../common/scene_bindings.glsl"   // bindings 1-8: the scene, the lights
 layout(set = 0, binding = 9, std430) readonly buffer Texels { uint texels[]; };
 layout(set = 0, binding = 10, std430) readonly buffer Textures { GpuTexture textures[]; };
 layout(set = 0, binding = 11, std430) readonly buffer RasterIndices { uint raster_indices[]; }; // draw order

@@ -1,6 +1,6 @@
 //! Placeholder images for descriptors that must be valid but are never read.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, Image};

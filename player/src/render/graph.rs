@@ -13,7 +13,7 @@
 //! from `UNDEFINED` (and still waits for all earlier work, which orders it after the previous
 //! frame's reads).
 
-use ash::vk;
+use crate::gpu::vk;
 
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, Image, ImageDesc, Recorder, Use};

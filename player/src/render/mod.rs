@@ -15,7 +15,7 @@ pub mod passes;
 pub mod spirv;
 pub mod technique;
 
-use ash::vk;
+use crate::gpu::vk;
 use gpu_allocator::MemoryLocation;
 use kiln_format::gpu::{FrameConstants, FrameFlags, LightKinds, RtConstants};
 

@@ -7,7 +7,7 @@ pub mod upload;
 
 use std::collections::HashMap;
 
-use ash::vk;
+use crate::gpu::vk;
 use kiln_format::manifest::{ColorSpace, Manifest, ShadowProjection, Wrap};
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;

@@ -3,7 +3,7 @@
 //! device has one). Large sections are split at half boundaries: buffers anywhere, images at
 //! row boundaries.
 
-use ash::vk;
+use crate::gpu::vk;
 use gpu_allocator::MemoryLocation;
 
 use crate::error::{Exit, PlayError, PlayResult};

@@ -4,7 +4,7 @@
 //! layers, the constant sky through the split-sum table, ray-traced AO and reflections
 //! composited where they ran; writes linear radiance.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
 use super::{FrameCtx, Pass, Shared, one, rt_ao, rt_reflections, rt_shadows};

@@ -2,7 +2,7 @@
 //! rasterised into five targets and a reversed-Z depth buffer. Also declares the G-buffer
 //! targets every later pass reads, whichever pass makes them.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::materials::SceneDraws;
 use super::{FrameCtx, Pass, Shared};

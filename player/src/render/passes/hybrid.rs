@@ -3,7 +3,7 @@
 //! it, the G-buffer, and every ray-traced target (those of passes that are off are 1 × 1
 //! placeholders). Each pass has its own set of this layout.
 
-use ash::vk;
+use crate::gpu::vk;
 use kiln_format::gpu::RtConstants;
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};

@@ -2,7 +2,7 @@
 //! material (its five textures), the materials as pushed, and the draw loop (one draw per
 //! material, pipelines switched only when the material's kind changes).
 
-use ash::vk;
+use crate::gpu::vk;
 use kiln_format::gpu::GpuMaterialLayout;
 use kiln_format::sections::NO_TEXTURE;
 

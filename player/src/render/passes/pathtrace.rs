@@ -2,7 +2,7 @@
 //! per pixel per dispatch, summed into an accumulation target. [`crate::reference`] drives it
 //! for a fixed sample count and writes the mean.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::one;
 use crate::error::{Exit, PlayError, PlayResult};

@@ -3,7 +3,7 @@
 //! filtering from the texel buffer's mip chains, ray-differential footprints) into the same
 //! targets the raster G-buffer writes.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL, TRIANGLE};
 use super::{FrameCtx, Pass, Shared, one};

@@ -1,7 +1,7 @@
 //! Ray-traced ambient occlusion (`shaders/rt/ao.comp`): one cosine-weighted ray per pixel per
 //! frame within the AO radius, a hit at t weighing (t/R)², averaged.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::hybrid::{self, HybridSet};
 use super::{FrameCtx, Pass, Shared};

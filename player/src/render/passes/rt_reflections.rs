@@ -3,7 +3,7 @@
 //! weighted F·G2/G1, shaded at the hit; the hits' shadow rays are traced by a second, small
 //! kernel (traversal is latency-bound and starves inside the large shading kernel).
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::hybrid::{self, HybridSet};
 use super::{FrameCtx, Pass, Shared};

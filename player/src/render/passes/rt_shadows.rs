@@ -2,7 +2,7 @@
 //! per light per pixel per frame towards a point sampled on the light, averaged into one layer
 //! per light.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::hybrid::{self, HybridSet};
 use super::{FrameCtx, Pass, Shared};

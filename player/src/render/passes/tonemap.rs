@@ -1,7 +1,7 @@
 //! Tone mapping (`shaders/post/tonemap.comp`): display = sRGB(ACES(2^EV · radiance)), with
 //! Narkowicz's fit of the ACES filmic curve, per channel.
 
-use ash::vk;
+use crate::gpu::vk;
 
 use super::direct::RADIANCE;
 use super::{FrameCtx, Pass, Shared, one};
