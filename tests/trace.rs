@@ -158,7 +158,6 @@ fn gpu_traversal_equals_the_cpu_query_on_the_shared_scenes() {
         return;
     }
     let Some(scenes) = shared_scenes() else {
-        eprintln!("skipping: ../shared/scenes is not here");
         return;
     };
     for name in ["cornell_box", "pica_pica"] {

@@ -12,10 +12,15 @@ use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{GBufferMode, ReflectionRes, RtSettings};
 use kiln_player::session::SessionOptions;
 
-/// The shared scene folder (`../shared/scenes` beside the checkout), if present.
+/// The shared scene folder (`../shared/scenes` beside the checkout), if present; if not, says
+/// that the test skips.
 pub fn shared_scenes() -> Option<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes");
-    dir.is_dir().then_some(dir)
+    if !dir.is_dir() {
+        eprintln!("skipping: ../shared/scenes is not here");
+        return None;
+    }
+    Some(dir)
 }
 
 /// Says why a test is skipped and returns false, or fails when the environment variable
