@@ -31,10 +31,7 @@ use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
 use kiln_format::manifest::LightKind;
 use kiln_format::sections::{MaterialFlags, NO_TEXTURE, Vertex};
-use kiln_player::gpu::GpuOptions;
-use kiln_player::render::RenderSettings;
-use kiln_player::session::SessionOptions;
-use kiln_tests::{compile, skip, vulkan};
+use kiln_tests::{Options, compile, skip, vulkan};
 
 /// Image size: small, as kiln samples about 0.06 M paths/s on lavapipe with two cores.
 const W: u32 = 64;
@@ -246,11 +243,7 @@ fn check(case: &str, scene: Scene) {
     )
     .unwrap();
 
-    let options = SessionOptions {
-        gpu: GpuOptions { validate: true, ..Default::default() },
-        render: RenderSettings { shadow_maps: false, reference: true, ..Default::default() },
-        ..SessionOptions::new(file, W, H)
-    };
+    let options = Options::new(file, W, H).unshadowed().reference().build();
     let lock = MACHINE.lock().unwrap_or_else(|e| e.into_inner());
     let (report, rgb) = kiln_player::reference::render(&options, KILN_SPP, Instant::now())
         .unwrap_or_else(|e| panic!("{case}: kiln reference render: {e}"));

@@ -14,22 +14,15 @@ use kiln_compiler::raycheck::{Rng, generate};
 use kiln_compiler::settings::Settings;
 use kiln_format::query::{BvhQuery, IndexedTriangles, Ray, intersect_triangle};
 use kiln_format::{Checksums, KilnFile, SceneView};
-use kiln_player::gpu::GpuOptions;
-use kiln_player::render::RenderSettings;
-use kiln_player::session::{Session, SessionOptions};
+use kiln_player::session::Session;
 use kiln_player::trace::{GpuRay, NO_HIT, RayQuery};
 use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
-use kiln_tests::{compile, scene_of, shared_scenes, vulkan};
+use kiln_tests::{Options, compile, scene_of, shared_scenes, vulkan};
 
 fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
     let file = dir.join("scene.kiln");
     std::fs::write(&file, bytes).unwrap();
-    let options = SessionOptions {
-        gpu: GpuOptions { validate: true, ..Default::default() },
-        render: RenderSettings { shadow_maps: false, rays: true, ..Default::default() },
-        ..SessionOptions::new(file, 8, 8)
-    };
-    Session::open(&options, Instant::now()).unwrap()
+    Session::open(&Options::new(file, 8, 8).unshadowed().rays().build(), Instant::now()).unwrap()
 }
 
 fn gpu_ray(r: &Ray) -> GpuRay {
@@ -165,7 +158,6 @@ fn gpu_traversal_equals_the_cpu_query_on_the_shared_scenes() {
         return;
     }
     let Some(scenes) = shared_scenes() else {
-        eprintln!("skipping: ../shared/scenes is not here");
         return;
     };
     for name in ["cornell_box", "pica_pica"] {

@@ -1,4 +1,5 @@
-//! Shared helpers of the workspace-level tests: scenes built in code and compiled in memory.
+//! Shared helpers of the workspace-level tests: scenes built in code and compiled in memory, and
+//! the player options the tests render with.
 
 use std::path::PathBuf;
 
@@ -6,11 +7,20 @@ use glam::Vec3;
 use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
 use kiln_format::sections::Vertex;
+use kiln_player::camera::CameraOverride;
+use kiln_player::gpu::GpuOptions;
+use kiln_player::render::{GBufferMode, ReflectionRes, RtSettings};
+use kiln_player::session::SessionOptions;
 
-/// The shared scene folder (`../shared/scenes` beside the checkout), if present.
+/// The shared scene folder (`../shared/scenes` beside the checkout), if present; if not, says
+/// that the test skips.
 pub fn shared_scenes() -> Option<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes");
-    dir.is_dir().then_some(dir)
+    if !dir.is_dir() {
+        eprintln!("skipping: ../shared/scenes is not here");
+        return None;
+    }
+    Some(dir)
 }
 
 /// Says why a test is skipped and returns false, or fails when the environment variable
@@ -51,6 +61,103 @@ pub fn scene_of(tris: &[[Vec3; 3]]) -> Scene {
 /// Compiles a scene in memory (as `kiln compile` would) and returns the file's bytes.
 pub fn compile(scene: Scene, settings: Settings) -> Vec<u8> {
     kiln_compiler::pipeline::compile_to_bytes(scene, settings, "test").expect("valid scene")
+}
+
+/// How a G-buffer is made, as the tests name it (see [`Options::gbuffer`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GBuffer {
+    /// Rasterised, every material evaluated per fragment.
+    Raster,
+    /// A visibility buffer resolved in compute.
+    Visibility,
+}
+
+/// The resolution of the ray-traced reflections (see [`Options::rt_reflections`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reflections {
+    /// One ray per pixel.
+    Full,
+    /// One ray per 2 × 2 pixels, upsampled.
+    Half,
+}
+
+/// The player options a test renders with, built from what the test means ("no shadows",
+/// "ray-traced AO of radius r"). This is the one place the tests spell out the player's settings
+/// types: a change to them is made here, not in every test.
+#[derive(Debug, Clone)]
+pub struct Options(SessionOptions);
+
+impl Options {
+    /// `file` at `width` × `height` with the validation layer on, otherwise what `kiln-play` does
+    /// without flags: shadow maps, raster G-buffer, no ray-traced pass.
+    pub fn new(file: impl Into<PathBuf>, width: u32, height: u32) -> Options {
+        Options(SessionOptions {
+            gpu: GpuOptions { validate: true, ..Default::default() },
+            ..SessionOptions::new(file, width, height)
+        })
+    }
+
+    /// No shadow maps (`--shadows none`; with a ray-traced pass, only what that pass gives).
+    pub fn unshadowed(mut self) -> Options {
+        self.0.render.shadow_maps = false;
+        self
+    }
+
+    /// Looks through `camera` instead of the file's.
+    pub fn camera(mut self, camera: CameraOverride) -> Options {
+        self.0.camera = Some(camera);
+        self
+    }
+
+    /// Makes the G-buffer the given way.
+    pub fn gbuffer(mut self, gbuffer: GBuffer) -> Options {
+        self.0.render.gbuffer = match gbuffer {
+            GBuffer::Raster => GBufferMode::Raster,
+            GBuffer::Visibility => GBufferMode::Visibility,
+        };
+        self
+    }
+
+    /// Ray-traced shadows instead of shadow maps, point and spot lights spheres of
+    /// `light_radius`, directional lights `sun_degrees` wide (0 and 0: hard shadows).
+    pub fn rt_shadows(mut self, light_radius: f32, sun_degrees: f32) -> Options {
+        self.0.render.shadow_maps = false;
+        self.0.render.rt = RtSettings { shadows: true, light_radius, sun_degrees, ..self.0.render.rt };
+        self
+    }
+
+    /// Ray-traced ambient occlusion, rays of length `radius` (`None`: the player's default).
+    pub fn rt_ao(mut self, radius: Option<f32>) -> Options {
+        self.0.render.rt = RtSettings { ao: true, ao_radius: radius, ..self.0.render.rt };
+        self
+    }
+
+    /// Ray-traced reflections at the given resolution.
+    pub fn rt_reflections(mut self, res: Reflections) -> Options {
+        let res = match res {
+            Reflections::Full => ReflectionRes::Full,
+            Reflections::Half => ReflectionRes::Half,
+        };
+        self.0.render.rt = RtSettings { reflections: Some(res), ..self.0.render.rt };
+        self
+    }
+
+    /// Uploads the BVH for ray queries (`RayQuery`).
+    pub fn rays(mut self) -> Options {
+        self.0.render.rays = true;
+        self
+    }
+
+    /// Uploads what the reference path tracer reads.
+    pub fn reference(mut self) -> Options {
+        self.0.render.reference = true;
+        self
+    }
+
+    /// The player's options.
+    pub fn build(self) -> SessionOptions {
+        self.0
+    }
 }
 
 /// Shapes the query tests share.

@@ -1,0 +1,17 @@
+//! kiln-play on lavapipe: analytic direct-light checks pixel by pixel, the demo and PICA PICA
+//! scenes with the validation layer on, and damaged or minimal files.
+//!
+//! Every test needs a Vulkan 1.3 device; without one they print why and pass, unless
+//! `KILN_REQUIRE_VULKAN` is set (as `.ci/run` does), when they fail.
+
+// The shared harness: compile a scene, render it headless with the validation layer on, read
+// the image back, and the camera and pixel arithmetic the checks are written in.
+mod harness;
+
+// The tests, by topic.
+mod analytic; // one light on a diffuse plane against its closed form, per pixel
+mod files; // damaged files fail with the right exit code; minimal files render
+mod raytraced; // ray-traced AO and reflections against closed forms, accumulation
+mod reference; // the reference path tracer's GGX in a white furnace
+mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipelines agree
+mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows
