@@ -9,7 +9,9 @@ use kiln_compiler::settings::Settings;
 use kiln_format::sections::Vertex;
 use kiln_player::camera::CameraOverride;
 use kiln_player::gpu::GpuOptions;
-use kiln_player::render::{GBufferMode, ReflectionRes, RtSettings};
+use kiln_player::render::{
+    Ao, GBuffer as GBufferTechnique, Purpose, ReflectionRes, Reflections as ReflectionsTechnique, Shadows,
+};
 use kiln_player::session::SessionOptions;
 
 /// The shared scene folder (`../shared/scenes` beside the checkout), if present; if not, says
@@ -99,7 +101,10 @@ impl Options {
 
     /// No shadow maps (`--shadows none`; with a ray-traced pass, only what that pass gives).
     pub fn unshadowed(mut self) -> Options {
-        self.0.render.shadow_maps = false;
+        let t = &mut self.0.render.techniques;
+        if t.shadows == Shadows::ShadowMap {
+            t.shadows = Shadows::None;
+        }
         self
     }
 
@@ -111,9 +116,9 @@ impl Options {
 
     /// Makes the G-buffer the given way.
     pub fn gbuffer(mut self, gbuffer: GBuffer) -> Options {
-        self.0.render.gbuffer = match gbuffer {
-            GBuffer::Raster => GBufferMode::Raster,
-            GBuffer::Visibility => GBufferMode::Visibility,
+        self.0.render.techniques.gbuffer = match gbuffer {
+            GBuffer::Raster => GBufferTechnique::Raster,
+            GBuffer::Visibility => GBufferTechnique::Visibility,
         };
         self
     }
@@ -121,14 +126,13 @@ impl Options {
     /// Ray-traced shadows instead of shadow maps, point and spot lights spheres of
     /// `light_radius`, directional lights `sun_degrees` wide (0 and 0: hard shadows).
     pub fn rt_shadows(mut self, light_radius: f32, sun_degrees: f32) -> Options {
-        self.0.render.shadow_maps = false;
-        self.0.render.rt = RtSettings { shadows: true, light_radius, sun_degrees, ..self.0.render.rt };
+        self.0.render.techniques.shadows = Shadows::Rt { light_radius, sun_degrees };
         self
     }
 
     /// Ray-traced ambient occlusion, rays of length `radius` (`None`: the player's default).
     pub fn rt_ao(mut self, radius: Option<f32>) -> Options {
-        self.0.render.rt = RtSettings { ao: true, ao_radius: radius, ..self.0.render.rt };
+        self.0.render.techniques.ao = Ao::Rt { radius };
         self
     }
 
@@ -138,19 +142,20 @@ impl Options {
             Reflections::Full => ReflectionRes::Full,
             Reflections::Half => ReflectionRes::Half,
         };
-        self.0.render.rt = RtSettings { reflections: Some(res), ..self.0.render.rt };
+        self.0.render.techniques.reflections =
+            ReflectionsTechnique::Rt { resolution: res, max_roughness: 1.0 };
         self
     }
 
     /// Uploads the BVH for ray queries (`RayQuery`).
     pub fn rays(mut self) -> Options {
-        self.0.render.rays = true;
+        self.0.render.purpose = Purpose::RayQueries;
         self
     }
 
     /// Uploads what the reference path tracer reads.
     pub fn reference(mut self) -> Options {
-        self.0.render.reference = true;
+        self.0.render.purpose = Purpose::Reference;
         self
     }
 
