@@ -7,9 +7,10 @@
 use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
+use super::kernel::{Kernel, many};
 use super::{FrameCtx, Pass, Shared, one, rt_ao, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
-use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, ImageDesc, SetLayout, Use, Write};
+use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::{MAX_SHADOW_MAPS, spirv};
 
@@ -31,29 +32,19 @@ const RAY_TRACED: [TargetDecl; 3] = [rt_shadows::SHADOWS, rt_ao::AO, rt_reflecti
 
 /// The direct-light pass.
 #[derive(Debug)]
-pub struct DirectPass {
-    layout: SetLayout,
-    pipeline: ComputePipeline,
-    set: vk::DescriptorSet,
-}
+pub struct DirectPass(Kernel);
 
 impl DirectPass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<DirectPass> {
         use BindingKind::*;
-        let mut bindings = vec![one(Uniform), one(Storage), one(Storage), one(Sampled)];
-        bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
-        bindings.push(Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 });
-        bindings.extend([one(Sampled); 5]);
-        bindings.extend([one(StorageImage); 4]);
-        let mut layout = SetLayout::new(gpu, &bindings, 1)?;
-        match ComputePipeline::new(gpu, spirv::DIRECT, &[&layout], 0) {
-            Ok(pipeline) => Ok(DirectPass { layout, pipeline, set: vk::DescriptorSet::null() }),
-            Err(e) => {
-                layout.destroy(gpu);
-                Err(e)
-            }
-        }
+        let maps = Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 };
+        let bindings: Vec<Binding> = [one(Uniform), one(Storage), one(Storage), one(Sampled), maps, maps]
+            .into_iter()
+            .chain(many(Sampled, 5))
+            .chain(many(StorageImage, 4))
+            .collect();
+        Ok(DirectPass(Kernel::new(gpu, &bindings, spirv::DIRECT, 0)?))
     }
 }
 
@@ -71,9 +62,6 @@ impl Pass for DirectPass {
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
-        if self.set == vk::DescriptorSet::null() {
-            self.set = self.layout.allocate(gpu)?;
-        }
         let (scene, dummies) = (shared.scene, shared.dummies);
         let near = scene.nearest_clamp;
         let lut = scene.brdf_lut.as_ref().map_or(dummies.white.view, |i| i.view);
@@ -101,8 +89,7 @@ impl Pass for DirectPass {
         for (i, t) in RAY_TRACED.iter().enumerate() {
             writes.push(Write::StorageImage(12 + i as u32, img(t)));
         }
-        self.layout.write(gpu, self.set, &writes);
-        Ok(())
+        self.0.write(gpu, &writes)
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
@@ -110,12 +97,10 @@ impl Pass for DirectPass {
         io.extend(RAY_TRACED.iter().map(|t| (*t, Access::Read(Use::STORAGE))));
         io.push((RADIANCE, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
-        let (w, h) = (ctx.images.width, ctx.images.height);
-        ctx.rec.dispatch_2d(&self.pipeline, &[self.set], w, h);
+        self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
+        self.0.destroy(gpu);
     }
 }

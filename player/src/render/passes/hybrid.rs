@@ -7,7 +7,7 @@ use crate::gpu::vk;
 use kiln_format::gpu::RtConstants;
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
-use super::{Shared, one, rt_ao, rt_reflections, rt_shadows};
+use super::{FrameCtx, Shared, one, rt_ao, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{BindingKind, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -94,4 +94,49 @@ pub fn io(own: &[(TargetDecl, Access)]) -> Vec<(TargetDecl, Access)> {
     let mut io = super::gbuffer::sampled(&GBUFFER_READS);
     io.extend_from_slice(own);
     io
+}
+
+/// One kernel over the shared table, dispatched over the whole frame: what the single-dispatch
+/// ray-traced passes are.
+#[derive(Debug)]
+pub struct HybridKernel {
+    set: HybridSet,
+    pipeline: ComputePipeline,
+}
+
+impl HybridKernel {
+    /// The kernel from SPIR-V; on failure nothing is left behind.
+    pub fn new(gpu: &Gpu, spirv: &[u8]) -> PlayResult<HybridKernel> {
+        let mut set = HybridSet::new(gpu)?;
+        match set.pipeline(gpu, spirv) {
+            Ok(pipeline) => Ok(HybridKernel { set, pipeline }),
+            Err(e) => {
+                set.destroy(gpu);
+                Err(e)
+            }
+        }
+    }
+
+    /// Allocates (once) and writes the set.
+    pub fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        self.set.bind(gpu, shared)
+    }
+
+    /// Declares the G-buffer reads and `own` accesses, then dispatches over the frame.
+    pub fn record(&self, ctx: &mut FrameCtx, own: &[(TargetDecl, Access)]) {
+        ctx.images.access(ctx.rec, &io(own));
+        let (w, h) = (ctx.images.width, ctx.images.height);
+        ctx.rec.dispatch(
+            &self.pipeline,
+            &[self.set.set],
+            bytemuck::bytes_of(ctx.rt),
+            [w.div_ceil(8), h.div_ceil(8), 1],
+        );
+    }
+
+    /// Releases pipeline, layout and set.
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        self.pipeline.destroy(gpu);
+        self.set.destroy(gpu);
+    }
 }

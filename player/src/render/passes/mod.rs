@@ -10,6 +10,7 @@
 pub mod direct;
 pub mod gbuffer;
 pub mod hybrid;
+pub mod kernel;
 pub mod materials;
 pub mod pathtrace;
 pub mod resolve;

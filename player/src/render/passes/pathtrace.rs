@@ -4,9 +4,10 @@
 
 use crate::gpu::vk;
 
+use super::kernel::{Kernel, many};
 use super::one;
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{BindingKind, Buffer, ComputePipeline, Gpu, SetLayout, Use, Write};
+use crate::gpu::{Binding, BindingKind, Buffer, Gpu, Use, Write};
 use crate::render::graph::{Access, FrameImages, TargetDecl};
 use crate::render::spirv;
 use crate::scene::GpuScene;
@@ -24,28 +25,15 @@ pub const ACCUMULATION: TargetDecl = TargetDecl {
 
 /// The path tracer's pipeline and set.
 #[derive(Debug)]
-pub struct PathTracePass {
-    layout: SetLayout,
-    pipeline: ComputePipeline,
-    set: vk::DescriptorSet,
-}
+pub struct PathTracePass(Kernel);
 
 impl PathTracePass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<PathTracePass> {
         use BindingKind::*;
-        let mut b = vec![one(Uniform)];
-        b.extend([one(Storage); 12]);
-        b.push(one(StorageImage));
-        let mut layout = SetLayout::new(gpu, &b, 1)?;
-        let push = std::mem::size_of::<u32>() as u32;
-        match ComputePipeline::new(gpu, spirv::PATHTRACE, &[&layout], push) {
-            Ok(pipeline) => Ok(PathTracePass { layout, pipeline, set: vk::DescriptorSet::null() }),
-            Err(e) => {
-                layout.destroy(gpu);
-                Err(e)
-            }
-        }
+        let bindings: Vec<Binding> =
+            [one(Uniform)].into_iter().chain(many(Storage, 12)).chain([one(StorageImage)]).collect();
+        Ok(PathTracePass(Kernel::new(gpu, &bindings, spirv::PATHTRACE, std::mem::size_of::<u32>() as u32)?))
     }
 
     /// Allocates and writes the set: `constants` holds `ReferenceConstants`, `lights` the
@@ -64,9 +52,6 @@ impl PathTracePass {
                 "the file has no BVH (no triangles?): nothing to path trace",
             ));
         };
-        if self.set == vk::DescriptorSet::null() {
-            self.set = self.layout.allocate(gpu)?;
-        }
         let mut writes = vec![Write::Buffer(0, constants)];
         writes.extend(common);
         writes.extend([
@@ -77,25 +62,17 @@ impl PathTracePass {
             Write::Buffer(12, &r.textures),
             Write::StorageImage(13, images.get(&ACCUMULATION).view),
         ]);
-        self.layout.write(gpu, self.set, &writes);
-        Ok(())
+        self.0.write(gpu, &writes)
     }
 
     /// Records sample `index` (0 overwrites the accumulation, later ones add to it).
     pub fn record(&self, rec: &crate::gpu::Recorder, images: &mut FrameImages, index: u32) {
         images.access(rec, &[(ACCUMULATION, Access::ReadWrite(Use::STORAGE))]);
-        let (w, h) = (images.width, images.height);
-        rec.dispatch(
-            &self.pipeline,
-            &[self.set],
-            bytemuck::bytes_of(&index),
-            [w.div_ceil(8), h.div_ceil(8), 1],
-        );
+        self.0.dispatch(rec, bytemuck::bytes_of(&index), images.width, images.height);
     }
 
     /// Releases the pipeline and layout.
     pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
+        self.0.destroy(gpu);
     }
 }

@@ -3,12 +3,11 @@
 //! filtering from the texel buffer's mip chains, ray-differential footprints) into the same
 //! targets the raster G-buffer writes.
 
-use crate::gpu::vk;
-
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL, TRIANGLE};
+use super::kernel::{Kernel, many};
 use super::{FrameCtx, Pass, Shared, one};
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{BindingKind, ComputePipeline, Gpu, ImageDesc, SetLayout, Use, Write};
+use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -17,28 +16,19 @@ const OUTPUTS: [TargetDecl; 4] = [NORMAL, ALBEDO, MATERIAL, EMISSION];
 
 /// The resolve pass.
 #[derive(Debug)]
-pub struct ResolvePass {
-    layout: SetLayout,
-    pipeline: ComputePipeline,
-    set: vk::DescriptorSet,
-}
+pub struct ResolvePass(Kernel);
 
 impl ResolvePass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<ResolvePass> {
         use BindingKind::*;
-        let mut bindings = vec![one(Uniform)];
-        bindings.extend([one(Storage); 7]);
-        bindings.extend([one(StorageImage); 5]);
-        bindings.push(one(Sampled));
-        let mut layout = SetLayout::new(gpu, &bindings, 1)?;
-        match ComputePipeline::new(gpu, spirv::RESOLVE, &[&layout], 0) {
-            Ok(pipeline) => Ok(ResolvePass { layout, pipeline, set: vk::DescriptorSet::null() }),
-            Err(e) => {
-                layout.destroy(gpu);
-                Err(e)
-            }
-        }
+        let bindings: Vec<Binding> = [one(Uniform)]
+            .into_iter()
+            .chain(many(Storage, 7))
+            .chain(many(StorageImage, 5))
+            .chain([one(Sampled)])
+            .collect();
+        Ok(ResolvePass(Kernel::new(gpu, &bindings, spirv::RESOLVE, 0)?))
     }
 }
 
@@ -63,13 +53,9 @@ impl Pass for ResolvePass {
                 "the visibility resolve needs the scene buffers, which were not uploaded",
             )
         })?;
-        if self.set == vk::DescriptorSet::null() {
-            self.set = self.layout.allocate(gpu)?;
-        }
         let img = |t: &TargetDecl| shared.images.get(t).view;
-        self.layout.write(
+        self.0.write(
             gpu,
-            self.set,
             &[
                 Write::Buffer(0, shared.frame_ubo),
                 Write::Buffer(1, &scene.vertices),
@@ -86,8 +72,7 @@ impl Pass for ResolvePass {
                 Write::StorageImage(12, img(&EMISSION)),
                 Write::Sampled(13, vec![(img(&DEPTH), scene.nearest_clamp)]),
             ],
-        );
-        Ok(())
+        )
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
@@ -96,12 +81,10 @@ impl Pass for ResolvePass {
         io.push((TRIANGLE, Access::ReadWrite(Use::STORAGE)));
         io.push((DEPTH, Access::Read(Use::SAMPLED)));
         ctx.images.access(ctx.rec, &io);
-        let (w, h) = (ctx.images.width, ctx.images.height);
-        ctx.rec.dispatch_2d(&self.pipeline, &[self.set], w, h);
+        self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
+        self.0.destroy(gpu);
     }
 }

@@ -3,10 +3,10 @@
 
 use crate::gpu::vk;
 
-use super::hybrid::{self, HybridSet};
+use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
-use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
+use crate::gpu::{Gpu, ImageDesc, Use};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -20,22 +20,12 @@ pub const AO: TargetDecl = TargetDecl {
 
 /// The ray-traced AO pass.
 #[derive(Debug)]
-pub struct RtAoPass {
-    set: HybridSet,
-    pipeline: ComputePipeline,
-}
+pub struct RtAoPass(HybridKernel);
 
 impl RtAoPass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<RtAoPass> {
-        let mut set = HybridSet::new(gpu)?;
-        match set.pipeline(gpu, spirv::RT_AO) {
-            Ok(pipeline) => Ok(RtAoPass { set, pipeline }),
-            Err(e) => {
-                set.destroy(gpu);
-                Err(e)
-            }
-        }
+        Ok(RtAoPass(HybridKernel::new(gpu, spirv::RT_AO)?))
     }
 }
 
@@ -53,18 +43,14 @@ impl Pass for RtAoPass {
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
-        self.set.bind(gpu, shared)
+        self.0.bind(gpu, shared)
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
-        ctx.images.access(ctx.rec, &hybrid::io(&[(AO, Access::ReadWrite(Use::STORAGE))]));
-        let (w, h) = (ctx.images.width, ctx.images.height);
-        let push = bytemuck::bytes_of(ctx.rt);
-        ctx.rec.dispatch(&self.pipeline, &[self.set.set], push, [w.div_ceil(8), h.div_ceil(8), 1]);
+        self.0.record(ctx, &[(AO, Access::ReadWrite(Use::STORAGE))]);
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
+        self.0.destroy(gpu);
     }
 }

@@ -4,10 +4,10 @@
 
 use crate::gpu::vk;
 
-use super::hybrid::{self, HybridSet};
+use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
-use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
+use crate::gpu::{Gpu, ImageDesc, Use};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
 
@@ -27,22 +27,14 @@ pub fn layers(lights: usize) -> u32 {
 /// The ray-traced shadow pass.
 #[derive(Debug)]
 pub struct RtShadowsPass {
-    set: HybridSet,
-    pipeline: ComputePipeline,
+    kernel: HybridKernel,
     layers: u32,
 }
 
 impl RtShadowsPass {
     /// Builds the pipeline for a scene of `lights` lights.
     pub fn new(gpu: &Gpu, lights: usize) -> PlayResult<RtShadowsPass> {
-        let mut set = HybridSet::new(gpu)?;
-        match set.pipeline(gpu, spirv::RT_SHADOWS) {
-            Ok(pipeline) => Ok(RtShadowsPass { set, pipeline, layers: layers(lights) }),
-            Err(e) => {
-                set.destroy(gpu);
-                Err(e)
-            }
-        }
+        Ok(RtShadowsPass { kernel: HybridKernel::new(gpu, spirv::RT_SHADOWS)?, layers: layers(lights) })
     }
 }
 
@@ -60,18 +52,14 @@ impl Pass for RtShadowsPass {
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
-        self.set.bind(gpu, shared)
+        self.kernel.bind(gpu, shared)
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
-        ctx.images.access(ctx.rec, &hybrid::io(&[(SHADOWS, Access::ReadWrite(Use::STORAGE))]));
-        let (w, h) = (ctx.images.width, ctx.images.height);
-        let push = bytemuck::bytes_of(ctx.rt);
-        ctx.rec.dispatch(&self.pipeline, &[self.set.set], push, [w.div_ceil(8), h.div_ceil(8), 1]);
+        self.kernel.record(ctx, &[(SHADOWS, Access::ReadWrite(Use::STORAGE))]);
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
+        self.kernel.destroy(gpu);
     }
 }

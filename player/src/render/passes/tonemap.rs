@@ -4,9 +4,10 @@
 use crate::gpu::vk;
 
 use super::direct::RADIANCE;
+use super::kernel::Kernel;
 use super::{FrameCtx, Pass, Shared, one};
 use crate::error::PlayResult;
-use crate::gpu::{BindingKind, ComputePipeline, Gpu, ImageDesc, SetLayout, Use, Write};
+use crate::gpu::{BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -22,24 +23,14 @@ pub const DISPLAY: TargetDecl = TargetDecl {
 
 /// The tone-mapping pass.
 #[derive(Debug)]
-pub struct TonemapPass {
-    layout: SetLayout,
-    pipeline: ComputePipeline,
-    set: vk::DescriptorSet,
-}
+pub struct TonemapPass(Kernel);
 
 impl TonemapPass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<TonemapPass> {
         use BindingKind::*;
-        let mut layout = SetLayout::new(gpu, &[one(Uniform), one(StorageImage), one(StorageImage)], 1)?;
-        match ComputePipeline::new(gpu, spirv::TONEMAP, &[&layout], 0) {
-            Ok(pipeline) => Ok(TonemapPass { layout, pipeline, set: vk::DescriptorSet::null() }),
-            Err(e) => {
-                layout.destroy(gpu);
-                Err(e)
-            }
-        }
+        let bindings = [one(Uniform), one(StorageImage), one(StorageImage)];
+        Ok(TonemapPass(Kernel::new(gpu, &bindings, spirv::TONEMAP, 0)?))
     }
 }
 
@@ -57,20 +48,15 @@ impl Pass for TonemapPass {
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
-        if self.set == vk::DescriptorSet::null() {
-            self.set = self.layout.allocate(gpu)?;
-        }
         let img = |t: &TargetDecl| shared.images.get(t).view;
-        self.layout.write(
+        self.0.write(
             gpu,
-            self.set,
             &[
                 Write::Buffer(0, shared.frame_ubo),
                 Write::StorageImage(1, img(&RADIANCE)),
                 Write::StorageImage(2, img(&DISPLAY)),
             ],
-        );
-        Ok(())
+        )
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
@@ -78,12 +64,10 @@ impl Pass for TonemapPass {
             ctx.rec,
             &[(RADIANCE, Access::Read(Use::STORAGE)), (DISPLAY, Access::Write(Use::STORAGE))],
         );
-        let (w, h) = (ctx.images.width, ctx.images.height);
-        ctx.rec.dispatch_2d(&self.pipeline, &[self.set], w, h);
+        self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
+        self.0.destroy(gpu);
     }
 }
