@@ -16,7 +16,7 @@ use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
 use crate::ir::Scene;
 use crate::progress::Progress;
-use crate::settings::{BvhPreset, Settings, VoxelRes};
+use crate::settings::Settings;
 
 /// A scene ready to bake.
 #[derive(Debug)]
@@ -40,62 +40,13 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some(cfg) = &args.config {
         let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
-        apply_bake_table(&sidecar.bake, &mut settings)
+        settings
+            .apply_bake_table(&sidecar.bake)
             .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
     }
     // The command line overrides the sidecar.
-    if let Some(p) = args.bvh_preset {
-        settings.bvh_preset = p;
-    }
-    if let Some(r) = args.voxel_res {
-        settings.voxel_res = r;
-    }
-    if let Some(n) = args.shaft_res {
-        settings.shaft_res = n;
-    }
     args.bake.apply(&mut settings);
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
-}
-
-fn apply_bake_table(b: &crate::import::sidecar::BakeToml, settings: &mut Settings) -> Result<(), String> {
-    if let Some(p) = &b.bvh_preset {
-        settings.bvh_preset =
-            BvhPreset::parse(p).ok_or_else(|| format!("bvh_preset is '{p}'; use fast, medium or slow"))?;
-    }
-    if let Some(v) = &b.voxel_res {
-        let text = match v {
-            toml::Value::String(s) => s.clone(),
-            toml::Value::Integer(i) => i.to_string(),
-            other => other.to_string(),
-        };
-        settings.voxel_res = VoxelRes::parse(&text).map_err(|e| format!("voxel_res: {e}"))?;
-    }
-    if let Some(n) = b.shaft_res {
-        if !(1..=8).contains(&n) {
-            return Err(format!("shaft_res is {n}; use 1..=8"));
-        }
-        settings.shaft_res = n;
-    }
-    let ranged = |name: &str, v: Option<u32>, lo: u32, hi: u32| -> Result<Option<u32>, String> {
-        match v {
-            Some(n) if !(lo..=hi).contains(&n) => Err(format!("{name} is {n}; use {lo}..={hi}")),
-            other => Ok(other),
-        }
-    };
-    if let Some(n) = ranged("brdf_lut_res", b.brdf_lut_res, 8, 1024)? {
-        settings.brdf_lut_res = n;
-    }
-    if let Some(n) = ranged("shadow_res", b.shadow_res, 16, 8192)? {
-        settings.shadow_res = n;
-    }
-    if let Some(n) = ranged("media_volume_res", b.media_volume_res, 2, 512)? {
-        settings.media_volume_res = n;
-    }
-    if let Some(v) = &b.shaft_variants {
-        settings.shaft_variants =
-            Some(crate::settings::parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
-    }
-    Ok(())
 }
 
 /// Validates and plans an imported scene (also the entry point of the demo).

@@ -13,10 +13,6 @@
 //! the estimator of ∫ f₁ (n·l) dl is G₂(v, l) / G₁(v), bounded by 1, which keeps grazing views
 //! (n·v → 0) as accurate as head-on ones.
 
-/// Default table size: the integrals are smooth, so 128 × 128 keeps bilinear interpolation
-/// error far below the 16-bit quantisation step's effect on shading, in 64 KiB.
-pub const DEFAULT_RESOLUTION: u32 = 128;
-
 /// Hammersley samples per texel: enough for a maximum absolute error below 10⁻³ against
 /// a high-order quadrature at every texel centre of the default table (measured by the tests).
 pub const SAMPLES: u32 = 2048;

@@ -10,9 +10,6 @@ use rayon::prelude::*;
 
 use crate::shading::ShadingScene;
 
-/// Default cells along the medium box's longest axis.
-pub const DEFAULT_RESOLUTION: u32 = 64;
-
 /// Shadow rays per cell and light (points on a 2 × 2 × 2 stratified pattern with per-cell
 /// jitter; rect lights are sampled at matching strata).
 pub const SAMPLES: u32 = 8;

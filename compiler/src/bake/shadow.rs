@@ -22,9 +22,6 @@ use kiln_format::query::{BvhQuery, Ray, TriangleSource};
 use kiln_format::sections::CwbvhNode;
 use rayon::prelude::*;
 
-/// Default resolution of 2D maps; cube faces get half of it (each covers 90°).
-pub const DEFAULT_RESOLUTION: u32 = 1024;
-
 /// Depth of texels whose ray hits nothing.
 pub const NO_OCCLUDER: f32 = f32::MAX;
 
