@@ -8,9 +8,10 @@ use kiln_format::ContentHash;
 use kiln_format::manifest::InputFile;
 use serde::Serialize;
 
+use crate::analyze::geometry::SceneGeometry;
 use crate::analyze::plan::Plan;
 use crate::analyze::validate;
-use crate::bake::{self, StageReport};
+use crate::bake::{self, BakeContext, StageReport};
 use crate::cli::{OutputArgs, SceneArgs};
 use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
@@ -23,12 +24,25 @@ use crate::settings::Settings;
 pub struct Loaded {
     /// The validated scene.
     pub scene: Scene,
+    /// Its geometry, shared by the plan and the bake.
+    pub geometry: SceneGeometry,
     /// Settings in effect.
     pub settings: Settings,
     /// The plan.
     pub plan: Plan,
     /// Wall time of import, sidecar and validation, ms.
     pub import_ms: f64,
+}
+
+impl Loaded {
+    /// The bake's context: builds the BVH.
+    pub fn context<'a>(
+        &'a self,
+        inputs: Vec<InputFile>,
+        progress: &'a Progress,
+    ) -> CliResult<BakeContext<'a>> {
+        BakeContext::new(&self.scene, &self.geometry, &self.settings, &self.plan, inputs, progress)
+    }
 }
 
 /// Imports, applies the sidecar, validates and plans. Warnings are printed to stderr unless
@@ -69,8 +83,9 @@ pub fn finish(
     if strict && !scene.warnings.is_empty() {
         return Err(CliError::input(format!("{} warnings and --strict is set", scene.warnings.len())));
     }
-    let plan = Plan::new(&scene, &settings);
-    Ok(Loaded { scene, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
+    let geometry = SceneGeometry::new(&scene);
+    let plan = Plan::new(&scene, &geometry, &settings);
+    Ok(Loaded { scene, geometry, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
 }
 
 /// Validates, plans and bakes `scene` in memory, quietly and on the calling thread's pool, with no
@@ -78,7 +93,8 @@ pub fn finish(
 /// scenes in code).
 pub fn compile_to_bytes(scene: Scene, settings: Settings, source: &str) -> CliResult<Vec<u8>> {
     let loaded = finish(scene, settings, source, false, true, Instant::now())?;
-    let baked = bake::bake(&loaded.scene, &loaded.settings, &loaded.plan, Vec::new(), &Progress::hidden())?;
+    let progress = Progress::hidden();
+    let baked = bake::bake(&loaded.context(Vec::new(), &progress)?)?;
     bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))
 }
 
@@ -156,8 +172,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         .map_err(|e| CliError::io(format!("cannot start {threads} worker threads: {e}")))?;
     let progress = Progress::new(!out.quiet);
     let inputs = hash_inputs(&loaded.scene.inputs)?;
-    let baked =
-        pool.install(|| bake::bake(&loaded.scene, &loaded.settings, &loaded.plan, inputs, &progress))?;
+    let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress)?))?;
     progress.stage("write");
     let t_write = Instant::now();
     let bytes = bake::write(&baked, output).map_err(|e| CliError::io(e.to_string()))?;

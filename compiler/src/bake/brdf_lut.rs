@@ -96,3 +96,19 @@ pub fn bake(res: u32, samples: u32) -> Vec<[u16; 2]> {
         })
         .collect()
 }
+
+/// The BRDF-table stage. Its hash depends on the resolution and sample count alone, not on the
+/// scene, so that every file baked with the same settings shares it.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let res = ctx.settings.brdf_lut_res;
+    let hash = kiln_format::ContentHasher::new()
+        .part("stage", b"brdf-lut")
+        .part("algorithm", super::ALGORITHM_VERSION.as_bytes())
+        .part("res", &res.to_le_bytes())
+        .part("samples", &SAMPLES.to_le_bytes())
+        .finish();
+    let mut out = super::Sections::default();
+    out.push(kiln_format::sections::BRDF_LUT, 0, bytemuck::cast_slice(ctx.lut()).to_vec(), hash);
+    out.brdf_lut = Some(kiln_format::manifest::BrdfLutInfo { resolution: res, samples: SAMPLES });
+    out
+}

@@ -96,3 +96,16 @@ pub fn bake(
         .collect();
     (MediaVisibilityInfo { medium: index, dims, samples: SAMPLES, lights }, volumes)
 }
+
+/// The light-visibility stage: the volume of medium 0, one grid per shadow-casting light.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let res = ctx.settings.media_volume_res;
+    let (info, volumes) = bake(&ctx.shading(), &ctx.scene.media, 0, res);
+    let mut out = super::Sections::default();
+    for (i, v) in volumes.into_iter().enumerate() {
+        let hash = ctx.hash("media-visibility", &[("res", &res.to_string()), ("index", &i.to_string())]);
+        out.push(kiln_format::sections::MEDIA_VISIBILITY, i as u32, v, hash);
+    }
+    out.media_visibility = Some(info);
+    out
+}

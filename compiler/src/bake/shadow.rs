@@ -194,3 +194,27 @@ pub fn render(layout: &Layout, bvh: &[CwbvhNode], tris: &(impl TriangleSource + 
         .map(|k| q.closest_hit(&layout.texel_ray(k)).map_or(NO_OCCLUDER, |h| h.t))
         .collect()
 }
+
+/// The shadow-map stage: one map (or cube map) per shadow-casting light, rendered through the
+/// BVH; section indices count the maps, the records name their lights.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let res = ctx.settings.shadow_res;
+    let triangles = ctx.indexed();
+    let mut out = super::Sections::default();
+    for (i, light) in ctx.scene.lights.iter().enumerate() {
+        let Some(layout) = layout(light, i as u32, &ctx.geometry.bounds, res) else {
+            continue;
+        };
+        ctx.progress.stage(&format!("shadow map of light {i}"));
+        let depths = render(&layout, &ctx.bvh.nodes, &triangles);
+        let hash = ctx.hash("shadow-map", &[("preset", ctx.preset()), ("light", &format!("{i}:{res}"))]);
+        out.push(
+            kiln_format::sections::SHADOW_MAP,
+            out.shadow_maps.len() as u32,
+            bytemuck::cast_slice(&depths).to_vec(),
+            hash,
+        );
+        out.shadow_maps.push(layout.info);
+    }
+    out
+}
