@@ -39,10 +39,11 @@ fn main() {
     let scene_args = SceneArgs {
         input: input.clone(),
         config: Some(root.join("tests/scenes/pica_pica.toml")),
-        bvh_preset: Some(BvhPreset::Medium),
-        voxel_res: None,
-        shaft_res: None,
-        bake: BakeArgs { shaft_variants: Some(0), ..BakeArgs::default() },
+        bake: BakeArgs {
+            bvh_preset: Some(BvhPreset::Medium),
+            shaft_variants: Some(0),
+            ..BakeArgs::default()
+        },
         strict: false,
     };
     let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };

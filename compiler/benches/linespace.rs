@@ -51,24 +51,12 @@ fn attrs_of(scene: &Scene) -> SceneAttributes<'_> {
 }
 
 fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64) {
-    let bounds = kiln_compiler::analyze::validate::bounds(scene);
-    let attrs = SceneAttributes {
-        vertices: &scene.vertices,
-        uvs: &scene.uvs,
-        triangles: &scene.triangles,
-        materials: &scene.triangle_materials,
-    };
     let t = Instant::now();
-    let ls = linespace::bake(
-        &attrs,
-        &bounds,
-        res,
-        n,
-        variants,
-        None,
-        &kiln_compiler::progress::Progress::hidden(),
-    )
-    .expect("bake");
+    let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(scene);
+    let voxels = geometry.voxels(res).clone();
+    let voxel_ms = t.elapsed().as_secs_f64() * 1e3;
+    let progress = kiln_compiler::progress::Progress::hidden();
+    let ls = linespace::bake(&attrs_of(scene), voxels, voxel_ms, n, variants, None, &progress).expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
 }
 

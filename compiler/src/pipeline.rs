@@ -8,27 +8,41 @@ use kiln_format::ContentHash;
 use kiln_format::manifest::InputFile;
 use serde::Serialize;
 
+use crate::analyze::geometry::SceneGeometry;
 use crate::analyze::plan::Plan;
 use crate::analyze::validate;
-use crate::bake::{self, StageReport};
+use crate::bake::{self, BakeContext, StageReport};
 use crate::cli::{OutputArgs, SceneArgs};
 use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
 use crate::ir::Scene;
 use crate::progress::Progress;
-use crate::settings::{BvhPreset, Settings, VoxelRes};
+use crate::settings::Settings;
 
 /// A scene ready to bake.
 #[derive(Debug)]
 pub struct Loaded {
     /// The validated scene.
     pub scene: Scene,
+    /// Its geometry, shared by the plan and the bake.
+    pub geometry: SceneGeometry,
     /// Settings in effect.
     pub settings: Settings,
     /// The plan.
     pub plan: Plan,
     /// Wall time of import, sidecar and validation, ms.
     pub import_ms: f64,
+}
+
+impl Loaded {
+    /// The bake's context: builds the BVH.
+    pub fn context<'a>(
+        &'a self,
+        inputs: Vec<InputFile>,
+        progress: &'a Progress,
+    ) -> CliResult<BakeContext<'a>> {
+        BakeContext::new(&self.scene, &self.geometry, &self.settings, &self.plan, inputs, progress)
+    }
 }
 
 /// Imports, applies the sidecar, validates and plans. Warnings are printed to stderr unless
@@ -40,62 +54,13 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some(cfg) = &args.config {
         let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
-        apply_bake_table(&sidecar.bake, &mut settings)
+        settings
+            .apply_bake_table(&sidecar.bake)
             .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
     }
     // The command line overrides the sidecar.
-    if let Some(p) = args.bvh_preset {
-        settings.bvh_preset = p;
-    }
-    if let Some(r) = args.voxel_res {
-        settings.voxel_res = r;
-    }
-    if let Some(n) = args.shaft_res {
-        settings.shaft_res = n;
-    }
     args.bake.apply(&mut settings);
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
-}
-
-fn apply_bake_table(b: &crate::import::sidecar::BakeToml, settings: &mut Settings) -> Result<(), String> {
-    if let Some(p) = &b.bvh_preset {
-        settings.bvh_preset =
-            BvhPreset::parse(p).ok_or_else(|| format!("bvh_preset is '{p}'; use fast, medium or slow"))?;
-    }
-    if let Some(v) = &b.voxel_res {
-        let text = match v {
-            toml::Value::String(s) => s.clone(),
-            toml::Value::Integer(i) => i.to_string(),
-            other => other.to_string(),
-        };
-        settings.voxel_res = VoxelRes::parse(&text).map_err(|e| format!("voxel_res: {e}"))?;
-    }
-    if let Some(n) = b.shaft_res {
-        if !(1..=8).contains(&n) {
-            return Err(format!("shaft_res is {n}; use 1..=8"));
-        }
-        settings.shaft_res = n;
-    }
-    let ranged = |name: &str, v: Option<u32>, lo: u32, hi: u32| -> Result<Option<u32>, String> {
-        match v {
-            Some(n) if !(lo..=hi).contains(&n) => Err(format!("{name} is {n}; use {lo}..={hi}")),
-            other => Ok(other),
-        }
-    };
-    if let Some(n) = ranged("brdf_lut_res", b.brdf_lut_res, 8, 1024)? {
-        settings.brdf_lut_res = n;
-    }
-    if let Some(n) = ranged("shadow_res", b.shadow_res, 16, 8192)? {
-        settings.shadow_res = n;
-    }
-    if let Some(n) = ranged("media_volume_res", b.media_volume_res, 2, 512)? {
-        settings.media_volume_res = n;
-    }
-    if let Some(v) = &b.shaft_variants {
-        settings.shaft_variants =
-            Some(crate::settings::parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
-    }
-    Ok(())
 }
 
 /// Validates and plans an imported scene (also the entry point of the demo).
@@ -118,8 +83,9 @@ pub fn finish(
     if strict && !scene.warnings.is_empty() {
         return Err(CliError::input(format!("{} warnings and --strict is set", scene.warnings.len())));
     }
-    let plan = Plan::new(&scene, &settings);
-    Ok(Loaded { scene, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
+    let geometry = SceneGeometry::new(&scene);
+    let plan = Plan::new(&scene, &geometry, &settings);
+    Ok(Loaded { scene, geometry, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
 }
 
 /// Validates, plans and bakes `scene` in memory, quietly and on the calling thread's pool, with no
@@ -127,7 +93,8 @@ pub fn finish(
 /// scenes in code).
 pub fn compile_to_bytes(scene: Scene, settings: Settings, source: &str) -> CliResult<Vec<u8>> {
     let loaded = finish(scene, settings, source, false, true, Instant::now())?;
-    let baked = bake::bake(&loaded.scene, &loaded.settings, &loaded.plan, Vec::new(), &Progress::hidden())?;
+    let progress = Progress::hidden();
+    let baked = bake::bake(&loaded.context(Vec::new(), &progress)?)?;
     bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))
 }
 
@@ -205,8 +172,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         .map_err(|e| CliError::io(format!("cannot start {threads} worker threads: {e}")))?;
     let progress = Progress::new(!out.quiet);
     let inputs = hash_inputs(&loaded.scene.inputs)?;
-    let baked =
-        pool.install(|| bake::bake(&loaded.scene, &loaded.settings, &loaded.plan, inputs, &progress))?;
+    let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress)?))?;
     progress.stage("write");
     let t_write = Instant::now();
     let bytes = bake::write(&baked, output).map_err(|e| CliError::io(e.to_string()))?;

@@ -3,6 +3,8 @@
 use clap::ValueEnum;
 use kiln_format::linespace::Variants;
 
+use crate::import::sidecar::BakeToml;
+
 /// BVH build effort (obvhs presets; none uses spatial splits, so every triangle lies in exactly
 /// one leaf and triangles can be stored in leaf order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
@@ -32,6 +34,63 @@ impl BvhPreset {
     }
 }
 
+/// A numeric setting: its name, default and valid range. The command line (through
+/// [`Ranged::parser`]) and the sidecar's `[bake]` table (through [`Ranged::check`]) both check
+/// values against it, and [`Settings::default`] takes its default from it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Ranged {
+    /// Key in the sidecar's `[bake]` table; the command-line option and the manifest key are the
+    /// same with `-` for `_`.
+    pub key: &'static str,
+    /// Default.
+    pub default: u32,
+    /// Smallest valid value.
+    pub min: u32,
+    /// Largest valid value.
+    pub max: u32,
+}
+
+impl Ranged {
+    /// `value`, or an error naming the key and the valid range (for the sidecar).
+    pub fn check(&self, value: u32) -> Result<u32, String> {
+        if (self.min..=self.max).contains(&value) {
+            Ok(value)
+        } else {
+            Err(format!("{} is {value}; use {}..={}", self.key, self.min, self.max))
+        }
+    }
+
+    /// The command-line parser: clap's range check, whose error names the option and the range.
+    pub fn parser(&self) -> clap::builder::RangedI64ValueParser<u32> {
+        clap::value_parser!(u32).range(self.min as i64..=self.max as i64)
+    }
+
+    /// Help text: `what`, the valid range and the default.
+    pub fn help(&self, what: &str) -> String {
+        format!("{what}, {}..={} [default: {}]", self.min, self.max, self.default)
+    }
+}
+
+/// Shaft resolution N (patches per voxel face edge): 4 by default, 3,840 shafts per voxel (the
+/// thesis used 5, 9,375 shafts; 4 keeps binary and PNMT data 2.4× smaller at the same voxel
+/// resolution).
+pub const SHAFT_RES: Ranged =
+    Ranged { key: "shaft_res", default: 4, min: 1, max: kiln_format::linespace::index::MAX_SHAFT_RES };
+
+/// BRDF table size: the integrals are smooth, so 128 × 128 keeps bilinear interpolation error
+/// far below the 16-bit quantisation step's effect on shading, in 64 KiB.
+pub const BRDF_LUT_RES: Ranged = Ranged { key: "brdf_lut_res", default: 128, min: 8, max: 1024 };
+
+/// Resolution of 2D shadow maps; cube faces get half of it (each covers 90°).
+pub const SHADOW_RES: Ranged = Ranged { key: "shadow_res", default: 1024, min: 16, max: 8192 };
+
+/// Light-visibility volume cells along the medium box's longest axis.
+pub const MEDIA_VOLUME_RES: Ranged = Ranged { key: "media_volume_res", default: 64, min: 2, max: 512 };
+
+/// Voxel grid cells along the scene's longest axis when given as a number (the default is
+/// [`VoxelRes::Auto`], so [`Ranged::default`] is unused here).
+pub const VOXEL_RES: Ranged = Ranged { key: "voxel_res", default: 0, min: 1, max: 1024 };
+
 /// Voxel grid resolution: cells along the scene's longest axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum VoxelRes {
@@ -43,14 +102,17 @@ pub enum VoxelRes {
 }
 
 impl VoxelRes {
-    /// Parses `auto` or a cell count in 1..=1024.
+    /// Parses `auto` or a cell count in [`VOXEL_RES`]'s range.
     pub fn parse(s: &str) -> Result<VoxelRes, String> {
         if s == "auto" {
             return Ok(VoxelRes::Auto);
         }
         match s.parse::<u32>() {
-            Ok(n) if (1..=1024).contains(&n) => Ok(VoxelRes::Cells(n)),
-            _ => Err(format!("'{s}' is neither 'auto' nor a cell count in 1..=1024")),
+            Ok(n) if (VOXEL_RES.min..=VOXEL_RES.max).contains(&n) => Ok(VoxelRes::Cells(n)),
+            _ => Err(format!(
+                "'{s}' is neither 'auto' nor a cell count in {}..={}",
+                VOXEL_RES.min, VOXEL_RES.max
+            )),
         }
     }
 
@@ -62,10 +124,6 @@ impl VoxelRes {
         }
     }
 }
-
-/// Default shaft resolution: 4 patches per face edge, 3,840 shafts per voxel (the thesis used 5,
-/// 9,375 shafts; 4 keeps binary and PNMT data 2.4× smaller at the same voxel resolution).
-pub const DEFAULT_SHAFT_RES: u32 = 4;
 
 /// Parses a `--shaft-variants` list: `binary`, `candidates`, `pnmt` separated by commas, or
 /// `none`.
@@ -123,16 +181,46 @@ impl Default for Settings {
         Settings {
             bvh_preset: BvhPreset::default(),
             voxel_res: VoxelRes::Auto,
-            shaft_res: DEFAULT_SHAFT_RES,
+            shaft_res: SHAFT_RES.default,
             shaft_variants: None,
-            brdf_lut_res: crate::bake::brdf_lut::DEFAULT_RESOLUTION,
-            shadow_res: crate::bake::shadow::DEFAULT_RESOLUTION,
-            media_volume_res: crate::bake::media::DEFAULT_RESOLUTION,
+            brdf_lut_res: BRDF_LUT_RES.default,
+            shadow_res: SHADOW_RES.default,
+            media_volume_res: MEDIA_VOLUME_RES.default,
         }
     }
 }
 
 impl Settings {
+    /// Applies the sidecar's `[bake]` table; the error names the key and what it accepts.
+    pub fn apply_bake_table(&mut self, b: &BakeToml) -> Result<(), String> {
+        if let Some(p) = &b.bvh_preset {
+            self.bvh_preset = BvhPreset::parse(p)
+                .ok_or_else(|| format!("bvh_preset is '{p}'; use fast, medium or slow"))?;
+        }
+        if let Some(v) = &b.voxel_res {
+            let text = match v {
+                toml::Value::String(s) => s.clone(),
+                toml::Value::Integer(i) => i.to_string(),
+                other => other.to_string(),
+            };
+            self.voxel_res = VoxelRes::parse(&text).map_err(|e| format!("voxel_res: {e}"))?;
+        }
+        for (table, value, setting) in [
+            (SHAFT_RES, b.shaft_res, &mut self.shaft_res),
+            (BRDF_LUT_RES, b.brdf_lut_res, &mut self.brdf_lut_res),
+            (SHADOW_RES, b.shadow_res, &mut self.shadow_res),
+            (MEDIA_VOLUME_RES, b.media_volume_res, &mut self.media_volume_res),
+        ] {
+            if let Some(n) = value {
+                *setting = table.check(n)?;
+            }
+        }
+        if let Some(v) = &b.shaft_variants {
+            self.shaft_variants = Some(parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
+        }
+        Ok(())
+    }
+
     /// The settings as key/value pairs for the manifest and content hashes.
     pub fn pairs(&self) -> Vec<(String, String)> {
         vec![

@@ -1,12 +1,16 @@
 //! A corpus of broken inputs, generated here: each gives its documented error or warning and
 //! none panics.
 
-mod util;
+#[path = "util/gltf.rs"]
+mod gltf_builder;
+#[path = "util/run.rs"]
+mod run;
 
+use gltf_builder::Gltf;
+use run::kiln;
 use serde_json::json;
-use util::{Gltf, kiln};
 
-fn compile(dir: &std::path::Path, input: &std::path::Path, extra: &[&str]) -> util::Run {
+fn compile(dir: &std::path::Path, input: &std::path::Path, extra: &[&str]) -> run::Run {
     let mut args = vec!["compile", input.to_str().unwrap(), "-o", "out.kiln"];
     args.extend_from_slice(extra);
     kiln(dir, &args)

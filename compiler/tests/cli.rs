@@ -1,8 +1,9 @@
 //! The command line: demo, inspect, verify, plan, help and exit codes.
 
-mod util;
+#[path = "util/run.rs"]
+mod run;
 
-use util::kiln;
+use run::kiln;
 
 #[test]
 fn demo_inspect_verify() {

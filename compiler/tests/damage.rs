@@ -1,9 +1,10 @@
 //! `kiln verify` on hundreds of randomly damaged copies of a real file: every one exits
 //! non-zero with one line of error, and none panics.
 
-mod util;
+#[path = "util/run.rs"]
+mod run;
 
-use util::kiln;
+use run::kiln;
 
 struct Rng(u64);
 impl Rng {
@@ -54,6 +55,8 @@ fn randomly_damaged_copies_are_all_refused() {
         assert!(run.code == 1 || run.code == 3, "case {case}: {run:?}");
         assert!(!run.stderr.contains("panicked"), "case {case}: {run:?}");
         assert_eq!(run.stderr.lines().count(), 1, "case {case}: {run:?}");
+        run.says("error: ");
+        assert!(run.stdout.is_empty(), "case {case}: a refused file printed a report: {run:?}");
         std::fs::remove_file(dir.path().join(&name)).unwrap();
     }
 }

@@ -1,16 +1,17 @@
 //! Import semantics: transforms, winding, primitive modes, sparse accessors, normals, GLB and
 //! data URIs, lights and cameras, OBJ/MTL rules, texture colour spaces and mip chains.
 
-mod util;
+#[path = "util/gltf.rs"]
+mod gltf_builder;
 
 use base64::Engine;
 use glam::Vec3;
+use gltf_builder::Gltf;
 use kiln_compiler::import::import;
 use kiln_compiler::ir::{Scene, TextureRole};
 use kiln_format::manifest::LightKind;
 use kiln_format::sections::MaterialFlags;
 use serde_json::json;
-use util::Gltf;
 
 /// cos 45° = sin 45°, for quaternions of 90° turns.
 const H: f32 = std::f32::consts::FRAC_1_SQRT_2;

@@ -2,7 +2,8 @@
 //! force, the light-visibility volume against brute-force visibility, and pre-illuminated
 //! radiance against an independent evaluation of the same shading.
 
-mod util;
+#[path = "util/run.rs"]
+mod run;
 
 use kiln_compiler::bake::brdf_lut;
 
@@ -99,7 +100,7 @@ fn reference(n_v: f64, roughness: f64) -> (f64, f64) {
 
 #[test]
 fn brdf_table_matches_an_independent_quadrature() {
-    let res = brdf_lut::DEFAULT_RESOLUTION;
+    let res = kiln_compiler::settings::BRDF_LUT_RES.default;
     let table = brdf_lut::bake(res, brdf_lut::SAMPLES);
     let mut worst = (0.0f64, 0, 0);
     // Every 16th texel in each direction plus the first and last rows and columns.
@@ -488,7 +489,7 @@ fn export_writes_readable_images() {
         ("shadow-map:0", "sm.pfm"),
         ("shadow-map", "sm.png"),
     ] {
-        util::kiln(dir.path(), &["export", "s.kiln", section, "-o", out]).expect(0);
+        run::kiln(dir.path(), &["export", "s.kiln", section, "-o", out]).expect(0);
     }
     // PFM: header, then little-endian floats, bottom row first.
     let pfm = std::fs::read(dir.path().join("sm.pfm")).unwrap();
@@ -498,11 +499,11 @@ fn export_writes_readable_images() {
     assert_eq!((lut.width(), lut.height()), (16, 16));
     let exr = image::open(dir.path().join("lut.exr")).unwrap().into_rgba32f();
     assert!(exr.pixels().all(|p| p[0] + p[1] <= 1.0 + 1e-4 && p[0] >= 0.0));
-    util::kiln(dir.path(), &["export", "s.kiln", "shadow-map:7", "-o", "x.pfm"])
+    run::kiln(dir.path(), &["export", "s.kiln", "shadow-map:7", "-o", "x.pfm"])
         .expect(1)
         .says("no shadow-map:7");
-    util::kiln(dir.path(), &["export", "s.kiln", "bvh", "-o", "x.pfm"]).expect(2).says("exportable");
-    util::kiln(dir.path(), &["export", "s.kiln", "brdf-lut", "-o", "x.bmp"])
+    run::kiln(dir.path(), &["export", "s.kiln", "bvh", "-o", "x.pfm"]).expect(2).says("exportable");
+    run::kiln(dir.path(), &["export", "s.kiln", "brdf-lut", "-o", "x.bmp"])
         .expect(2)
         .says("unknown image type");
 }

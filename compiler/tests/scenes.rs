@@ -1,9 +1,29 @@
 //! The real scenes in ../shared/scenes: compile with the shipped sidecars, verify with 10⁵
 //! rays, determinism across thread counts, depfile and report contents.
 
-mod util;
+#[path = "util/run.rs"]
+mod run;
 
-use util::{kiln, shared_scene, sidecar};
+use std::path::PathBuf;
+
+use run::kiln;
+
+/// The shared scenes folder, or `None` (the caller skips with a message).
+fn shared_scene(name: &str) -> Option<PathBuf> {
+    let p =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes").join(name).join("scene.gltf");
+    if p.is_file() {
+        Some(p)
+    } else {
+        eprintln!("skipped: {} is absent (the shared scenes live beside the checkout)", p.display());
+        None
+    }
+}
+
+/// The sidecar the tests ship for a shared scene.
+fn sidecar(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/scenes").join(format!("{name}.toml"))
+}
 
 fn compile_scene(
     name: &str,

@@ -1,4 +1,6 @@
-//! Analysis: final validation of the imported scene, and the plan of what to bake.
+//! Analysis: final validation of the imported scene, its geometry as the plan and the bake share
+//! it, and the plan of what to bake.
 
+pub mod geometry;
 pub mod plan;
 pub mod validate;

@@ -7,6 +7,7 @@ use crate::ir::Scene;
 use kiln_format::linespace::Variants;
 use kiln_format::manifest::LightKind;
 
+use crate::analyze::geometry::SceneGeometry;
 use crate::bake::linespace::voxelize::auto_resolution;
 use crate::settings::{Settings, VoxelRes, variants_name};
 
@@ -59,17 +60,11 @@ impl Stage {
 pub const DEFAULT_LINE_SPACE_BUDGET: u64 = 384 << 20;
 
 /// Default variants for a lit scene: all three, unless the estimated size exceeds
-/// [`DEFAULT_LINE_SPACE_BUDGET`]. The estimate voxelizes (cheap) to count non-empty cells and
-/// assumes 70% of their shafts filled with 5 candidate entries each, as measured on the benchmark
+/// [`DEFAULT_LINE_SPACE_BUDGET`]. The estimate counts the non-empty cells of the voxel grid
+/// (which the bake then reuses) and assumes 70% of their shafts filled with 5 candidate entries each, as measured on the benchmark
 /// and shared scenes.
-fn default_variants(scene: &Scene, res: u32, n: u32) -> (u32, String) {
-    let bounds = crate::analyze::validate::bounds(scene);
-    let grid = crate::bake::linespace::voxelize::grid(&bounds, res);
-    let corners: Vec<[[f32; 3]; 3]> =
-        scene.triangles.iter().map(|t| t.map(|i| scene.vertices[i as usize].position)).collect();
-    let local = crate::bake::linespace::voxelize::local_triangles(&grid, &corners);
-    let (offsets, _) = crate::bake::linespace::voxelize::voxelize(&grid, &local);
-    let slots = offsets.windows(2).filter(|w| w[1] > w[0]).count() as u64;
+fn default_variants(geometry: &SceneGeometry, res: u32, n: u32) -> (u32, String) {
+    let slots = geometry.voxels(res).occupied_cells() as u64;
     let filled = slots * kiln_format::linespace::index::shafts_per_voxel(n) as u64 * 7 / 10;
     let pnmt = filled * 32;
     let candidates = filled * (4 + 5 * 4);
@@ -121,8 +116,9 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// Decides every stage.
-    pub fn new(scene: &Scene, settings: &Settings) -> Plan {
+    /// Decides every stage; `geometry` is `scene`'s (its voxel grid is built here when the
+    /// default variants need a size estimate, and reused by the bake).
+    pub fn new(scene: &Scene, geometry: &SceneGeometry, settings: &Settings) -> Plan {
         let run = |stage, reason: String| Decision { stage, run: true, reason };
         let skip = |stage, reason: &str| Decision { stage, run: false, reason: reason.to_string() };
         let textured =
@@ -212,7 +208,7 @@ impl Plan {
         };
         let (shaft_variants, chosen) = match settings.shaft_variants {
             Some(v) => (v, "requested".to_string()),
-            None if lit => default_variants(scene, voxel_res, settings.shaft_res),
+            None if lit => default_variants(geometry, voxel_res, settings.shaft_res),
             None => (0, String::new()),
         };
         if shaft_variants == 0 {

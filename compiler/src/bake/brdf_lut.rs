@@ -13,10 +13,6 @@
 //! the estimator of ∫ f₁ (n·l) dl is G₂(v, l) / G₁(v), bounded by 1, which keeps grazing views
 //! (n·v → 0) as accurate as head-on ones.
 
-/// Default table size: the integrals are smooth, so 128 × 128 keeps bilinear interpolation
-/// error far below the 16-bit quantisation step's effect on shading, in 64 KiB.
-pub const DEFAULT_RESOLUTION: u32 = 128;
-
 /// Hammersley samples per texel: enough for a maximum absolute error below 10⁻³ against
 /// a high-order quadrature at every texel centre of the default table (measured by the tests).
 pub const SAMPLES: u32 = 2048;
@@ -99,4 +95,20 @@ pub fn bake(res: u32, samples: u32) -> Vec<[u16; 2]> {
             [q(r), q(g)]
         })
         .collect()
+}
+
+/// The BRDF-table stage. Its hash depends on the resolution and sample count alone, not on the
+/// scene, so that every file baked with the same settings shares it.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let res = ctx.settings.brdf_lut_res;
+    let hash = kiln_format::ContentHasher::new()
+        .part("stage", b"brdf-lut")
+        .part("algorithm", super::ALGORITHM_VERSION.as_bytes())
+        .part("res", &res.to_le_bytes())
+        .part("samples", &SAMPLES.to_le_bytes())
+        .finish();
+    let mut out = super::Sections::default();
+    out.push(kiln_format::sections::BRDF_LUT, 0, bytemuck::cast_slice(ctx.lut()).to_vec(), hash);
+    out.brdf_lut = Some(kiln_format::manifest::BrdfLutInfo { resolution: res, samples: SAMPLES });
+    out
 }

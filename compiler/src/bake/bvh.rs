@@ -64,3 +64,16 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
         .collect();
     Ok(BuiltBvh { nodes, order: bvh.primitive_indices })
 }
+
+/// The BVH stage: the nodes of the BVH the context built (every other stage stores triangles in
+/// its leaf order).
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let mut out = super::Sections::default();
+    out.push(
+        kiln_format::sections::BVH_NODES,
+        0,
+        bytemuck::cast_slice(&ctx.bvh.nodes).to_vec(),
+        ctx.hash("bvh", &[("preset", ctx.preset())]),
+    );
+    out
+}

@@ -10,9 +10,6 @@ use rayon::prelude::*;
 
 use crate::shading::ShadingScene;
 
-/// Default cells along the medium box's longest axis.
-pub const DEFAULT_RESOLUTION: u32 = 64;
-
 /// Shadow rays per cell and light (points on a 2 × 2 × 2 stratified pattern with per-cell
 /// jitter; rect lights are sampled at matching strata).
 pub const SAMPLES: u32 = 8;
@@ -98,4 +95,17 @@ pub fn bake(
         })
         .collect();
     (MediaVisibilityInfo { medium: index, dims, samples: SAMPLES, lights }, volumes)
+}
+
+/// The light-visibility stage: the volume of medium 0, one grid per shadow-casting light.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let res = ctx.settings.media_volume_res;
+    let (info, volumes) = bake(&ctx.shading(), &ctx.scene.media, 0, res);
+    let mut out = super::Sections::default();
+    for (i, v) in volumes.into_iter().enumerate() {
+        let hash = ctx.hash("media-visibility", &[("res", &res.to_string()), ("index", &i.to_string())]);
+        out.push(kiln_format::sections::MEDIA_VISIBILITY, i as u32, v, hash);
+    }
+    out.media_visibility = Some(info);
+    out
 }

@@ -22,9 +22,6 @@ use kiln_format::query::{BvhQuery, Ray, TriangleSource};
 use kiln_format::sections::CwbvhNode;
 use rayon::prelude::*;
 
-/// Default resolution of 2D maps; cube faces get half of it (each covers 90°).
-pub const DEFAULT_RESOLUTION: u32 = 1024;
-
 /// Depth of texels whose ray hits nothing.
 pub const NO_OCCLUDER: f32 = f32::MAX;
 
@@ -196,4 +193,28 @@ pub fn render(layout: &Layout, bvh: &[CwbvhNode], tris: &(impl TriangleSource + 
         .into_par_iter()
         .map(|k| q.closest_hit(&layout.texel_ray(k)).map_or(NO_OCCLUDER, |h| h.t))
         .collect()
+}
+
+/// The shadow-map stage: one map (or cube map) per shadow-casting light, rendered through the
+/// BVH; section indices count the maps, the records name their lights.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let res = ctx.settings.shadow_res;
+    let triangles = ctx.indexed();
+    let mut out = super::Sections::default();
+    for (i, light) in ctx.scene.lights.iter().enumerate() {
+        let Some(layout) = layout(light, i as u32, &ctx.geometry.bounds, res) else {
+            continue;
+        };
+        ctx.progress.stage(&format!("shadow map of light {i}"));
+        let depths = render(&layout, &ctx.bvh.nodes, &triangles);
+        let hash = ctx.hash("shadow-map", &[("preset", ctx.preset()), ("light", &format!("{i}:{res}"))]);
+        out.push(
+            kiln_format::sections::SHADOW_MAP,
+            out.shadow_maps.len() as u32,
+            bytemuck::cast_slice(&depths).to_vec(),
+            hash,
+        );
+        out.shadow_maps.push(layout.info);
+    }
+    out
 }

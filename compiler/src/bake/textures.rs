@@ -86,3 +86,18 @@ pub fn mip_chain(t: &Texture) -> Vec<u8> {
     }
     out
 }
+
+/// The texture stage: every texture's mip chain, in parallel.
+pub fn stage(ctx: &super::BakeContext) -> super::Sections {
+    let chains: Vec<Vec<u8>> = ctx.scene.textures.par_iter().map(mip_chain).collect();
+    let mut out = super::Sections::default();
+    for (i, chain) in chains.into_iter().enumerate() {
+        out.push(
+            kiln_format::sections::TEXTURE,
+            i as u32,
+            chain,
+            ctx.hash("texture", &[("index", &i.to_string())]),
+        );
+    }
+    out
+}

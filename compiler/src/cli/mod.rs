@@ -4,7 +4,10 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand};
 
-use crate::settings::{BvhPreset, DEFAULT_SHAFT_RES, VoxelRes, parse_variants};
+use crate::settings::{
+    BRDF_LUT_RES, BvhPreset, MEDIA_VOLUME_RES, SHADOW_RES, SHAFT_RES, Settings, VOXEL_RES, VoxelRes,
+    parse_variants,
+};
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
 /// lighting structures a player needs, checksummed, versioned and ready to memory-map.
@@ -74,17 +77,7 @@ pub struct SceneArgs {
     /// bake settings (see docs/sidecar.md).
     #[arg(long, short = 'c', value_name = "SIDECAR.toml")]
     pub config: Option<PathBuf>,
-    /// BVH build effort [default: medium, or the sidecar's bake.bvh_preset].
-    #[arg(long, value_enum, help_heading = "BVH")]
-    pub bvh_preset: Option<BvhPreset>,
-    /// Voxel grid cells along the scene's longest axis (cubic cells), or `auto`: the cube root
-    /// of the triangle count, clamped to 4..=64 [default: auto].
-    #[arg(long, value_name = "N|auto", value_parser = VoxelRes::parse, help_heading = "Voxel grid and line space")]
-    pub voxel_res: Option<VoxelRes>,
-    /// Shaft resolution N: patches per voxel face edge, 15·N⁴ shafts per voxel, 1..=8 [default: 4].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), help_heading = "Voxel grid and line space")]
-    pub shaft_res: Option<u32>,
-    /// Line-space variants and lighting-bake sizes.
+    /// Bake settings.
     #[command(flatten)]
     pub bake: BakeArgs,
     /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
@@ -93,41 +86,60 @@ pub struct SceneArgs {
     pub strict: bool,
 }
 
-/// Line-space variants and lighting-bake sizes, shared by `compile`, `plan` and `demo`; each
-/// overrides the sidecar's or the default setting when given.
+/// Bake settings, shared by `compile`, `plan` and `demo`; each overrides the sidecar's or the
+/// default setting when given. Ranges and defaults come from the tables in [`crate::settings`].
 #[derive(Debug, Args, Clone, Default)]
 pub struct BakeArgs {
+    /// BVH build effort.
+    #[arg(
+        long,
+        value_enum,
+        help_heading = "BVH",
+        help = "BVH build effort [default: medium, or the sidecar's bake.bvh_preset]"
+    )]
+    pub bvh_preset: Option<BvhPreset>,
+    /// Voxel grid cells along the longest axis, or `auto`.
+    #[arg(long, value_name = "N|auto", value_parser = VoxelRes::parse, help_heading = "Voxel grid and line space",
+          help = format!("Voxel grid cells along the scene's longest axis (cubic cells, {}..={}), or `auto`: the cube root of the triangle count, clamped to 4..=64 [default: auto]", VOXEL_RES.min, VOXEL_RES.max))]
+    pub voxel_res: Option<VoxelRes>,
+    /// Shaft resolution N.
+    #[arg(long, value_name = "N", value_parser = SHAFT_RES.parser(), help_heading = "Voxel grid and line space",
+          help = SHAFT_RES.help("Shaft resolution N: patches per voxel face edge, 15·N⁴ shafts per voxel"))]
+    pub shaft_res: Option<u32>,
     /// Line-space variants to bake, comma-separated: binary (one bit per shaft), candidates
     /// (exact triangle lists), pnmt (front/back hit records), preillum (front/back radiance under
     /// the static lights), or none [default: chosen by the plan].
     #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
     pub shaft_variants: Option<u32>,
-    /// BRDF lookup table size N (N × N texels, 8..=1024) [default: 128].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(8..=1024), help_heading = "Lighting bakes")]
+    /// BRDF lookup table size N.
+    #[arg(long, value_name = "N", value_parser = BRDF_LUT_RES.parser(), help_heading = "Lighting bakes",
+          help = BRDF_LUT_RES.help("BRDF lookup table size N (N × N texels)"))]
     pub brdf_lut_res: Option<u32>,
-    /// Shadow map size N (N × N for directional and spot lights; cube faces of N/2), 16..=8192 [default: 1024].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(16..=8192), help_heading = "Lighting bakes")]
+    /// Shadow map size N.
+    #[arg(long, value_name = "N", value_parser = SHADOW_RES.parser(), help_heading = "Lighting bakes",
+          help = SHADOW_RES.help("Shadow map size N (N × N for directional and spot lights; cube faces of N/2)"))]
     pub shadow_res: Option<u32>,
-    /// Light-visibility volume cells along the medium's longest axis, 2..=512 [default: 64].
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=512), help_heading = "Lighting bakes")]
+    /// Light-visibility volume cells along the medium's longest axis.
+    #[arg(long, value_name = "N", value_parser = MEDIA_VOLUME_RES.parser(), help_heading = "Lighting bakes",
+          help = MEDIA_VOLUME_RES.help("Light-visibility volume cells along the medium's longest axis"))]
     pub media_volume_res: Option<u32>,
 }
 
 impl BakeArgs {
     /// Applies the options given to `settings`.
-    pub fn apply(&self, settings: &mut crate::settings::Settings) {
-        if let Some(v) = self.shaft_variants {
-            settings.shaft_variants = Some(v);
+    pub fn apply(&self, settings: &mut Settings) {
+        fn set<T: Copy>(setting: &mut T, given: Option<T>) {
+            if let Some(v) = given {
+                *setting = v;
+            }
         }
-        if let Some(n) = self.brdf_lut_res {
-            settings.brdf_lut_res = n;
-        }
-        if let Some(n) = self.shadow_res {
-            settings.shadow_res = n;
-        }
-        if let Some(n) = self.media_volume_res {
-            settings.media_volume_res = n;
-        }
+        set(&mut settings.bvh_preset, self.bvh_preset);
+        set(&mut settings.voxel_res, self.voxel_res);
+        set(&mut settings.shaft_res, self.shaft_res);
+        set(&mut settings.shaft_variants, self.shaft_variants.map(Some));
+        set(&mut settings.brdf_lut_res, self.brdf_lut_res);
+        set(&mut settings.shadow_res, self.shadow_res);
+        set(&mut settings.media_volume_res, self.media_volume_res);
     }
 }
 
@@ -195,16 +207,7 @@ pub struct DemoArgs {
     /// Output file.
     #[arg(long, short = 'o', value_name = "OUT.kiln", default_value = "demo.kiln")]
     pub output: PathBuf,
-    /// BVH build effort.
-    #[arg(long, value_enum, default_value_t = BvhPreset::Medium, help_heading = "BVH")]
-    pub bvh_preset: BvhPreset,
-    /// Voxel grid cells along the longest axis, or `auto`.
-    #[arg(long, value_name = "N|auto", value_parser = VoxelRes::parse, default_value = "auto", help_heading = "Voxel grid and line space")]
-    pub voxel_res: VoxelRes,
-    /// Shaft resolution N (1..=8).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=8), default_value_t = DEFAULT_SHAFT_RES, help_heading = "Voxel grid and line space")]
-    pub shaft_res: u32,
-    /// Line-space variants and lighting-bake sizes.
+    /// Bake settings.
     #[command(flatten)]
     pub bake: BakeArgs,
     /// Report, depfile, threads.

@@ -29,12 +29,7 @@ pub fn run(args: &CompileArgs) -> CliResult {
 pub fn demo(args: &DemoArgs) -> CliResult {
     let start = Instant::now();
     let scene = crate::import::demo::cornell_box();
-    let mut settings = Settings {
-        bvh_preset: args.bvh_preset,
-        voxel_res: args.voxel_res,
-        shaft_res: args.shaft_res,
-        ..Settings::default()
-    };
+    let mut settings = Settings::default();
     args.bake.apply(&mut settings);
     let loaded = pipeline::finish(scene, settings, "demo", false, args.out.quiet, start)?;
     let report = pipeline::compile(&loaded, "demo", &args.output, &args.out)?;

@@ -3,12 +3,12 @@
 
 mod geometry;
 mod shafts;
+pub mod stages;
 pub mod voxelize;
 
 use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::MAX_SHAFT_RES;
 use kiln_format::linespace::{GridHeader, MAX_CANDIDATE_CELL_TRIANGLES, NO_SLOT, PnmtRecord, Variants};
-use kiln_format::manifest::Bounds;
 use kiln_format::sections::Vertex;
 use rayon::prelude::*;
 
@@ -86,27 +86,21 @@ impl HitAttributes for SceneAttributes<'_> {
     }
 }
 
-/// Bakes the grid over `bounds` at `res` cells along the longest axis, and the line space at
-/// shaft resolution `n` with `variants` (0: grid only).
+/// Bakes the line space over `voxels` (the voxel grid in `attrs`' triangle order, which took
+/// `voxel_ms` to build) at shaft resolution `n` with `variants` (0: grid only).
 pub fn bake(
     attrs: &SceneAttributes,
-    bounds: &Bounds,
-    res: u32,
+    voxels: voxelize::Voxels,
+    voxel_ms: f64,
     n: u32,
     variants: u32,
     shade: Option<&Shade<'_>>,
     progress: &Progress,
 ) -> CliResult<BakedLineSpace> {
     let start = std::time::Instant::now();
-    let mut header = voxelize::grid(bounds, res);
-    let corners: Vec<[[f32; 3]; 3]> =
-        attrs.triangles.iter().map(|t| t.map(|i| attrs.vertices[i as usize].position)).collect();
-    let local = voxelize::local_triangles(&header, &corners);
-    let (voxel_offsets, voxel_triangles) = voxelize::voxelize(&header, &local);
+    let voxelize::Voxels { mut header, local, offsets: voxel_offsets, triangles: voxel_triangles } = voxels;
     let cells = header.cell_count() as usize;
     let cell_len = |c: usize| (voxel_offsets[c + 1] - voxel_offsets[c]) as usize;
-    header.max_cell_triangles = (0..cells).map(cell_len).max().unwrap_or(0) as u32;
-    let voxel_ms = start.elapsed().as_secs_f64() * 1e3;
     let mut out = BakedLineSpace { voxel_ms, ..Default::default() };
     if variants == 0 {
         out.total_ms = voxel_ms;
@@ -213,7 +207,7 @@ pub fn bake(
     out.voxel_offsets = voxel_offsets;
     out.voxel_triangles = voxel_triangles;
     out.slots = slots;
-    out.total_ms = start.elapsed().as_secs_f64() * 1e3;
+    out.total_ms = voxel_ms + start.elapsed().as_secs_f64() * 1e3;
     Ok(out)
 }
 

@@ -105,3 +105,54 @@ pub fn voxelize(grid: &GridHeader, local: &[[DVec3; 3]]) -> (Vec<u32>, Vec<u32>)
     }
     (offsets, tris)
 }
+
+/// A voxelized scene: the grid, the triangles in grid-local coordinates and each cell's
+/// triangle list, in one triangle order.
+#[derive(Debug, Clone)]
+pub struct Voxels {
+    /// The grid (`max_cell_triangles` set; the line-space fields left at zero).
+    pub header: GridHeader,
+    /// Triangle corners in grid-local coordinates.
+    pub local: Vec<[DVec3; 3]>,
+    /// Cell triangle list offsets (CSR).
+    pub offsets: Vec<u32>,
+    /// Cell triangle lists, ascending within a cell.
+    pub triangles: Vec<u32>,
+}
+
+impl Voxels {
+    /// Voxelizes the triangles with world-space `corners` over `bounds` at `res` cells along the
+    /// longest axis.
+    pub fn new(bounds: &Bounds, res: u32, corners: &[[[f32; 3]; 3]]) -> Voxels {
+        let mut header = grid(bounds, res);
+        let local = local_triangles(&header, corners);
+        let (offsets, triangles) = voxelize(&header, &local);
+        header.max_cell_triangles = offsets.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0);
+        Voxels { header, local, offsets, triangles }
+    }
+
+    /// Cells holding at least one triangle.
+    pub fn occupied_cells(&self) -> usize {
+        self.offsets.windows(2).filter(|w| w[1] > w[0]).count()
+    }
+
+    /// The same voxelization with the triangles renumbered: `order[i]` is the triangle stored at
+    /// position `i`. Equal to voxelizing the reordered triangles, since a triangle's cells depend
+    /// on its corners alone.
+    pub fn reordered(&self, order: &[u32]) -> Voxels {
+        let mut position = vec![0u32; order.len()];
+        for (i, &t) in order.iter().enumerate() {
+            position[t as usize] = i as u32;
+        }
+        let mut triangles: Vec<u32> = self.triangles.iter().map(|&t| position[t as usize]).collect();
+        for w in self.offsets.windows(2) {
+            triangles[w[0] as usize..w[1] as usize].sort_unstable();
+        }
+        Voxels {
+            header: self.header,
+            local: order.iter().map(|&t| self.local[t as usize]).collect(),
+            offsets: self.offsets.clone(),
+            triangles,
+        }
+    }
+}

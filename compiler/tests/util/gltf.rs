@@ -1,59 +1,6 @@
-//! Helpers for CLI tests: run `kiln` in a fresh directory, build small glTF and OBJ files.
-
-#![allow(dead_code)]
+//! A glTF document builder for import tests (included as `mod gltf_builder`).
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-/// The outcome of one `kiln` run.
-#[derive(Debug)]
-pub struct Run {
-    pub code: i32,
-    pub stdout: String,
-    pub stderr: String,
-}
-
-impl Run {
-    /// Asserts the exit code and that nothing panicked.
-    pub fn expect(&self, code: i32) -> &Self {
-        assert!(!self.stderr.contains("panicked") && self.code != 70, "kiln panicked: {self:#?}");
-        assert_eq!(self.code, code, "unexpected exit code: {self:#?}");
-        self
-    }
-    /// Asserts that stderr mentions `text`.
-    pub fn says(&self, text: &str) -> &Self {
-        assert!(self.stderr.contains(text), "stderr lacks {text:?}: {self:#?}");
-        self
-    }
-}
-
-/// Runs `kiln` with `args` in `dir`.
-pub fn kiln(dir: &Path, args: &[&str]) -> Run {
-    let out =
-        Command::new(env!("CARGO_BIN_EXE_kiln")).args(args).current_dir(dir).output().expect("kiln runs");
-    Run {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
-
-/// The shared scenes folder, or `None` (the caller skips with a message).
-pub fn shared_scene(name: &str) -> Option<PathBuf> {
-    let p =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes").join(name).join("scene.gltf");
-    if p.is_file() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} is absent (the shared scenes live beside the checkout)", p.display());
-        None
-    }
-}
-
-/// The sidecar the tests ship for a shared scene.
-pub fn sidecar(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/scenes").join(format!("{name}.toml"))
-}
 
 /// A glTF document builder: one buffer (written as `scene.bin` or a data URI), accessors
 /// appended as needed.

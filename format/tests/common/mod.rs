@@ -1,7 +1,5 @@
 //! Fixtures shared by the format tests: a small but complete scene file.
 
-#![allow(dead_code)]
-
 use kiln_format::manifest::*;
 use kiln_format::sections::{self, CwbvhNode, GpuMaterial, Vertex};
 use kiln_format::{ContentHash, FileWriter};

@@ -1,0 +1,136 @@
+//! What every bake stage reads, computed once before the first stage: the BVH and the triangles
+//! in its leaf order, the GPU materials, the hash every stage's content hash starts from, and
+//! (on first use) the BRDF table the shading scene needs.
+
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use kiln_format::manifest::InputFile;
+use kiln_format::query::IndexedTriangles;
+use kiln_format::sections::GpuMaterial;
+use kiln_format::{ContentHash, ContentHasher};
+
+use super::{brdf_lut, bvh, input_hash, linespace};
+use crate::analyze::geometry::SceneGeometry;
+use crate::analyze::plan::{Plan, Stage};
+use crate::exit::CliResult;
+use crate::ir::Scene;
+use crate::progress::Progress;
+use crate::settings::Settings;
+use crate::shading::ShadingScene;
+
+/// The inputs of every bake stage.
+#[derive(Debug)]
+pub struct BakeContext<'a> {
+    /// The validated scene.
+    pub scene: &'a Scene,
+    /// Its world-space triangles, bounds and voxel grid.
+    pub geometry: &'a SceneGeometry,
+    /// Settings in effect.
+    pub settings: &'a Settings,
+    /// The plan.
+    pub plan: &'a Plan,
+    /// Where stages report progress.
+    pub progress: &'a Progress,
+    /// Every file read, for the manifest.
+    pub inputs: Vec<InputFile>,
+    /// The BVH; `bvh.order` is the stored triangle order.
+    pub bvh: bvh::BuiltBvh,
+    /// Wall time of the BVH build, ms.
+    pub bvh_ms: f64,
+    /// Triangles in stored (BVH leaf) order.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material of each stored triangle.
+    pub triangle_materials: Vec<u32>,
+    /// The material table.
+    pub materials: Vec<GpuMaterial>,
+    /// Hash of the inputs.
+    root: ContentHash,
+    /// The BRDF table, baked on first use.
+    lut: OnceLock<Vec<[u16; 2]>>,
+}
+
+impl<'a> BakeContext<'a> {
+    /// Builds the BVH (the geometry is stored in its leaf order) and everything derived from it.
+    pub fn new(
+        scene: &'a Scene,
+        geometry: &'a SceneGeometry,
+        settings: &'a Settings,
+        plan: &'a Plan,
+        inputs: Vec<InputFile>,
+        progress: &'a Progress,
+    ) -> CliResult<BakeContext<'a>> {
+        let start = Instant::now();
+        progress.stage(Stage::Bvh.name());
+        let built = bvh::build(&bvh::triangles(geometry.corners.iter().copied()), settings.bvh_preset)?;
+        let bvh_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(BakeContext {
+            root: input_hash(scene, &inputs),
+            triangles: built.order.iter().map(|&i| scene.triangles[i as usize]).collect(),
+            triangle_materials: built.order.iter().map(|&i| scene.triangle_materials[i as usize]).collect(),
+            materials: scene.materials.iter().map(|m| m.gpu).collect(),
+            bvh: built,
+            bvh_ms,
+            scene,
+            geometry,
+            settings,
+            plan,
+            progress,
+            inputs,
+            lut: OnceLock::new(),
+        })
+    }
+
+    /// The content hash of stage `label`'s output: the inputs' hash, the label and `extra`.
+    pub fn hash(&self, label: &str, extra: &[(&str, &str)]) -> ContentHash {
+        let mut h = ContentHasher::new();
+        h.hash("inputs", &self.root).part("stage", label.as_bytes());
+        for (k, v) in extra {
+            h.part(k, v.as_bytes());
+        }
+        h.finish()
+    }
+
+    /// The BRDF table at the configured resolution, baked on the first call; empty when the plan
+    /// skips it (no material has a specular lobe).
+    pub fn lut(&self) -> &[[u16; 2]] {
+        if !self.plan.runs(Stage::BrdfLut) {
+            return &[];
+        }
+        self.lut.get_or_init(|| brdf_lut::bake(self.settings.brdf_lut_res, brdf_lut::SAMPLES))
+    }
+
+    /// The shading view of the scene, over the stored triangles.
+    pub fn shading(&self) -> ShadingScene<'_> {
+        ShadingScene {
+            materials: &self.materials,
+            textures: &self.scene.textures,
+            lights: &self.scene.lights,
+            bvh: &self.bvh.nodes,
+            vertices: &self.scene.vertices,
+            triangles: &self.triangles,
+            lut: self.lut(),
+            lut_res: self.settings.brdf_lut_res,
+        }
+    }
+
+    /// The stored triangles as the BVH queries read them.
+    pub fn indexed(&self) -> IndexedTriangles<'_> {
+        IndexedTriangles { vertices: &self.scene.vertices, triangles: &self.triangles }
+    }
+
+    /// The stored triangles' attributes, as the line space reads them.
+    pub fn attributes(&self) -> linespace::SceneAttributes<'_> {
+        linespace::SceneAttributes {
+            vertices: &self.scene.vertices,
+            uvs: &self.scene.uvs,
+            triangles: &self.triangles,
+            materials: &self.triangle_materials,
+        }
+    }
+
+    /// The BVH preset's name, part of the hashes of everything stored in BVH order.
+    pub fn preset(&self) -> &'static str {
+        self.settings.bvh_preset.name()
+    }
+}
