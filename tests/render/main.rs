@@ -12,6 +12,7 @@ mod harness;
 mod analytic; // one light on a diffuse plane against its closed form, per pixel
 mod files; // damaged files fail with the right exit code; minimal files render
 mod raytraced; // ray-traced AO and reflections against closed forms, accumulation
+mod rect; // a rect light against the polygon irradiance: direct pass, RT shadows, reference
 mod reference; // the reference path tracer's GGX in a white furnace
 mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipelines agree
 mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows

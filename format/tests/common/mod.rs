@@ -4,8 +4,10 @@ use kiln_format::manifest::*;
 use kiln_format::sections::{self, CwbvhNode, GpuMaterial, Vertex};
 use kiln_format::{ContentHash, FileWriter};
 
-/// A one-quad scene with every section kind the format knows, a valid one-node BVH and a
-/// 2x2 texture, written by the reference writer.
+/// A one-quad scene with the geometry, material, texture and BVH kinds (a valid one-node BVH and
+/// a 2x2 texture), written by the reference writer. Every kind the format knows, line space,
+/// BRDF table, shadow maps and visibility volumes included, is in the compiler's damage fixture
+/// (`compiler/tests/damage.rs`, `every_kind_file`).
 pub fn small_file() -> Vec<u8> {
     let vertices = [
         Vertex { position: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
