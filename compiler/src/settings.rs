@@ -137,9 +137,10 @@ pub fn parse_variants(s: &str) -> Result<u32, String> {
             "binary" => Variants::BINARY,
             "candidates" => Variants::CANDIDATES,
             "pnmt" => Variants::PNMT,
+            "preillum" => Variants::PREILLUM,
             other => {
                 return Err(format!(
-                    "unknown shaft variant '{other}' (use binary, candidates, pnmt or none)"
+                    "unknown shaft variant '{other}' (use binary, candidates, pnmt, preillum or none)"
                 ));
             }
         };
@@ -149,11 +150,15 @@ pub fn parse_variants(s: &str) -> Result<u32, String> {
 
 /// A variant set as text.
 pub fn variants_name(v: u32) -> String {
-    let names: Vec<&str> =
-        [(Variants::BINARY, "binary"), (Variants::CANDIDATES, "candidates"), (Variants::PNMT, "pnmt")]
-            .into_iter()
-            .filter_map(|(bit, name)| (v & bit != 0).then_some(name))
-            .collect();
+    let names: Vec<&str> = [
+        (Variants::BINARY, "binary"),
+        (Variants::CANDIDATES, "candidates"),
+        (Variants::PNMT, "pnmt"),
+        (Variants::PREILLUM, "preillum"),
+    ]
+    .into_iter()
+    .filter_map(|(bit, name)| (v & bit != 0).then_some(name))
+    .collect();
     if names.is_empty() { "none".into() } else { names.join(",") }
 }
 

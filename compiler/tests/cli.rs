@@ -115,6 +115,26 @@ fn shaft_variants_and_resolutions_are_honoured() {
     let j: serde_json::Value =
         serde_json::from_str(&kiln(dir.path(), &["inspect", "n.kiln", "--json"]).stdout).unwrap();
     assert!(j["line_space"].is_null());
+    // Every variant the help lists is accepted (`preillum` was listed but refused).
+    kiln(
+        dir.path(),
+        &[
+            "demo",
+            "-o",
+            "p.kiln",
+            "-q",
+            "--shaft-variants",
+            "preillum",
+            "--voxel-res",
+            "3",
+            "--shaft-res",
+            "1",
+        ],
+    )
+    .expect(0);
+    let j: serde_json::Value =
+        serde_json::from_str(&kiln(dir.path(), &["inspect", "p.kiln", "--json"]).stdout).unwrap();
+    assert_eq!(j["line_space"]["variants"], "binary,preillum");
     kiln(dir.path(), &["demo", "-o", "x.kiln", "--shaft-variants", "fancy"])
         .expect(2)
         .says("unknown shaft variant");
