@@ -186,9 +186,10 @@ pub fn bake(res: u32) -> Vec<[u16; 2]> {
 /// callers may each compute it (no thread ever waits on another's bake, so a caller inside a
 /// rayon pool cannot deadlock); the first result stored is kept, and all are identical.
 pub fn table(res: u32) -> Arc<[[u16; 2]]> {
-    static CACHE: Mutex<Vec<(u32, Arc<[[u16; 2]]>)>> = Mutex::new(Vec::new());
-    let lookup =
-        |cache: &[(u32, Arc<[[u16; 2]]>)]| cache.iter().find(|(r, _)| *r == res).map(|(_, t)| t.clone());
+    /// A baked table and its resolution.
+    type Cached = (u32, Arc<[[u16; 2]]>);
+    static CACHE: Mutex<Vec<Cached>> = Mutex::new(Vec::new());
+    let lookup = |cache: &[Cached]| cache.iter().find(|(r, _)| *r == res).map(|(_, t)| t.clone());
     if let Some(t) = lookup(&CACHE.lock().unwrap_or_else(|e| e.into_inner())) {
         return t;
     }
