@@ -101,7 +101,7 @@ fn reference(n_v: f64, roughness: f64) -> (f64, f64) {
 #[test]
 fn brdf_table_matches_an_independent_quadrature() {
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
-    let table = brdf_lut::bake(res, brdf_lut::SAMPLES);
+    let table = brdf_lut::bake(res);
     let mut worst = (0.0f64, 0, 0);
     // Every 16th texel in each direction plus the first and last rows and columns.
     let picks: Vec<u32> = (0..res).filter(|i| i % 16 == 7 || *i == 0 || *i == res - 1).collect();

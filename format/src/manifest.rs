@@ -205,7 +205,7 @@ pub struct ShadowMapInfo {
 pub struct BrdfLutInfo {
     /// Texels per side.
     pub resolution: u32,
-    /// Hammersley samples per texel.
+    /// Evaluations of the integrand per texel.
     pub samples: u32,
 }
 

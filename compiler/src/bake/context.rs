@@ -47,7 +47,7 @@ pub struct BakeContext<'a> {
     /// Hash of the inputs.
     root: ContentHash,
     /// The BRDF table, baked on first use.
-    lut: OnceLock<Vec<[u16; 2]>>,
+    lut: OnceLock<std::sync::Arc<[[u16; 2]]>>,
 }
 
 impl<'a> BakeContext<'a> {
@@ -91,13 +91,13 @@ impl<'a> BakeContext<'a> {
         h.finish()
     }
 
-    /// The BRDF table at the configured resolution, baked on the first call; empty when the plan
+    /// The BRDF table at the configured resolution (shared by every compile in the process); empty when the plan
     /// skips it (no material has a specular lobe).
     pub fn lut(&self) -> &[[u16; 2]] {
         if !self.plan.runs(Stage::BrdfLut) {
             return &[];
         }
-        self.lut.get_or_init(|| brdf_lut::bake(self.settings.brdf_lut_res, brdf_lut::SAMPLES))
+        self.lut.get_or_init(|| brdf_lut::table(self.settings.brdf_lut_res))
     }
 
     /// The shading view of the scene, over the stored triangles.
