@@ -1,13 +1,23 @@
 //! Accelerated queries against brute force on random and adversarial triangle sets:
 //! property tests over soups, shared-edge grids, slivers, coplanar overlaps, and scenes far
-//! from the origin, tiny and huge; plus watertightness of closed meshes.
+//! from the origin, tiny and huge; plus watertightness of closed meshes. Both the BVH and the
+//! brute force are held to an exact reference (`kiln_tests::exact`, which shares no code with
+//! `intersect_triangle`) wherever it decides, and lattice meshes aim rays exactly at edges and
+//! vertices, where a `<` written as `<=` in the triangle test leaks.
 
 use glam::Vec3;
-use kiln_compiler::raycheck::{Agreement, RaySample, Rng, compare, generate};
+use kiln_compiler::raycheck::{Agreement, RELATIVE_TOLERANCE, RaySample, Rng, compare, generate};
 use kiln_compiler::settings::{BvhPreset, Settings};
-use kiln_format::query::{BruteForce, BvhQuery, IndexedTriangles, Ray, closest_hit_brute_force};
+use kiln_format::query::{
+    BruteForce, BvhQuery, Hit, IndexedTriangles, Ray, TriangleSource, any_hit_brute_force,
+    closest_hit_brute_force,
+};
 use kiln_format::{Checksums, KilnFile, SceneView};
-use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
+use kiln_tests::exact::{self, Closest};
+use kiln_tests::shapes::{
+    corners_and_edge_points, height_grid, lattice_cube, lattice_octahedron, shuffled_corners, soup, sphere,
+    transformed,
+};
 use kiln_tests::{compile, scene_of};
 use proptest::prelude::*;
 
@@ -17,16 +27,19 @@ fn geometry_only() -> Settings {
     Settings { shaft_variants: Some(0), ..Default::default() }
 }
 
-/// Compiles `tris`, then checks `rays` rays of every class: BVH against brute force.
-fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<(), String> {
+/// Compiles `tris`, then checks `rays` rays of every class: BVH against brute force, and both
+/// against the exact reference where it decides. Returns how many rays it decided.
+fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<u64, String> {
     let bytes = compile(scene_of(tris), Settings { bvh_preset: preset, ..geometry_only() });
     let file = KilnFile::from_bytes(&bytes, Checksums::Eager).map_err(|e| e.to_string())?;
     let view = SceneView::new(&file).map_err(|e| e.to_string())?;
     let t = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
+    let corners: Vec<[Vec3; 3]> = (0..t.len()).map(|i| t.corners(i)).collect();
     let bvh = BvhQuery::new(view.bvh, &t);
     let brute = BruteForce::new(&t);
     let (lo, hi) = (Vec3::from(view.manifest.bounds.min), Vec3::from(view.manifest.bounds.max));
     let tol = 1e-6 * (hi - lo).length();
+    let mut decided = 0;
     for RaySample { class, ray, .. } in generate(&t, lo, hi, rays, seed) {
         let want = brute.closest_hit(&ray);
         // The prefiltered brute force agrees with the plain one.
@@ -43,6 +56,64 @@ fn check(tris: &[[Vec3; 3]], preset: BvhPreset, rays: u64, seed: u64) -> Result<
         if bvh.any_hit(&ray) != want.is_some() || brute.any_hit(&ray) != want.is_some() {
             return Err(format!("{class:?} ray {ray:?}: any-hit disagrees with closest hit {want:?}"));
         }
+        let reference = exact::closest(
+            ray.origin,
+            ray.direction,
+            ray.tmin,
+            ray.tmax,
+            corners.iter().copied(),
+            f64::from(RELATIVE_TOLERANCE),
+            f64::from(tol),
+        );
+        if reference != Closest::Undecided {
+            decided += 1;
+        }
+        for (what, hit) in [("BVH", got), ("brute force", want)] {
+            agrees_with_exact(&corners, &ray, hit, reference, f64::from(tol))
+                .map_err(|e| format!("{class:?} ray {ray:?}: {what} {hit:?}: {e}"))?;
+        }
+    }
+    Ok(decided)
+}
+
+/// Whether a closest hit agrees with the exact reference's: both miss, or the same distance
+/// (within the tolerance of ties) on a triangle the ray truly meets.
+fn agrees_with_exact(
+    corners: &[[Vec3; 3]],
+    ray: &Ray,
+    hit: Option<Hit>,
+    reference: Closest,
+    tol: f64,
+) -> Result<(), String> {
+    let judged = hit
+        .map(|h| exact::judge(ray.origin, ray.direction, ray.tmin, ray.tmax, corners[h.triangle as usize]));
+    match (reference, hit, judged) {
+        (Closest::Undecided, ..) | (Closest::Miss, None, _) => Ok(()),
+        (Closest::Miss, Some(_), j) => {
+            Err(format!("the exact reference misses; of that triangle it says {j:?}"))
+        }
+        (Closest::Hit { t }, None, _) => Err(format!("the exact reference hits at t = {t}")),
+        (Closest::Hit { t }, Some(h), Some(j)) => {
+            if (f64::from(h.t) - t).abs() > f64::from(RELATIVE_TOLERANCE) * t.abs() + tol {
+                Err(format!("the exact reference hits first at t = {t}; of that triangle it says {j:?}"))
+            } else if !(j.closed_hit || j.near) {
+                Err(format!("the exact reference says the ray misses that triangle: {j:?}"))
+            } else {
+                Ok(())
+            }
+        }
+        (Closest::Hit { .. }, Some(_), None) => unreachable!("judged every hit"),
+    }
+}
+
+/// Asserts that the exact reference decided at least an eighth of `rays`, so that the
+/// comparison with it is not empty. Rays aimed at vertices and edges, grazing or starting on a
+/// surface are mostly within rounding reach and undecided; soups decide about half their rays,
+/// the flat one-triangle scene (whose ray origins hug its plane) and the slivers a quarter.
+fn enough(decided: Result<u64, String>, rays: u64) -> Result<(), String> {
+    let decided = decided?;
+    if decided * 8 < rays {
+        return Err(format!("the exact reference decided only {decided} of {rays} rays"));
     }
     Ok(())
 }
@@ -54,7 +125,7 @@ proptest! {
     fn soups_match_brute_force(seed in any::<u64>(), n in 1usize..400, size in 0.01f32..1.0) {
         let mut rng = Rng::new(seed);
         let tris = soup(&mut rng, n, size);
-        prop_assert_eq!(check(&tris, BvhPreset::Medium, 300, seed), Ok(()));
+        prop_assert_eq!(enough(check(&tris, BvhPreset::Medium, 300, seed), 300), Ok(()));
     }
 
     #[test]
@@ -62,7 +133,7 @@ proptest! {
         let mut rng = Rng::new(seed);
         let (scale, offset) = [(1.0, Vec3::ZERO), (1e-3, Vec3::ZERO), (1e3, Vec3::ZERO), (1.0, Vec3::splat(1e5))][which];
         let tris = transformed(&height_grid(n, 0.2, &mut rng), scale, offset);
-        prop_assert_eq!(check(&tris, BvhPreset::Fast, 300, seed), Ok(()));
+        prop_assert_eq!(enough(check(&tris, BvhPreset::Fast, 300, seed), 300), Ok(()));
     }
 }
 
@@ -71,7 +142,7 @@ fn every_preset_matches_brute_force() {
     let mut rng = Rng::new(7);
     let tris = soup(&mut rng, 3000, 0.1);
     for preset in [BvhPreset::Fast, BvhPreset::Medium, BvhPreset::Slow] {
-        check(&tris, preset, 3000, 7).unwrap();
+        enough(check(&tris, preset, 3000, 7), 3000).unwrap();
     }
 }
 
@@ -88,16 +159,16 @@ fn slivers_and_coplanar_overlaps() {
         let o = i as f32 * 0.01;
         tris.push([Vec3::new(o, o, 0.5), Vec3::new(1.0, o, 0.5), Vec3::new(o, 1.0, 0.5)]);
     }
-    check(&tris, BvhPreset::Medium, 5000, 3).unwrap();
+    enough(check(&tris, BvhPreset::Medium, 5000, 3), 5000).unwrap();
 }
 
 #[test]
 fn one_triangle_and_huge_triangle_scenes() {
-    check(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], BvhPreset::Medium, 2000, 1).unwrap();
+    enough(check(&[[Vec3::ZERO, Vec3::X, Vec3::Y]], BvhPreset::Medium, 2000, 1), 2000).unwrap();
     let mut rng = Rng::new(5);
     let mut tris = soup(&mut rng, 200, 0.05);
     tris.push([Vec3::new(-1e4, -1.0, -1e4), Vec3::new(1e4, -1.0, -1e4), Vec3::new(0.0, -1.0, 1e4)]);
-    check(&tris, BvhPreset::Medium, 3000, 5).unwrap();
+    enough(check(&tris, BvhPreset::Medium, 3000, 5), 3000).unwrap();
 }
 
 /// A closed, finely tessellated sphere: rays from the centre must hit it, whichever way they
@@ -124,5 +195,64 @@ fn closed_mesh_is_watertight() {
     for target in targets {
         let ray = Ray::new(centre, (target - centre).normalize(), 0.0, f32::INFINITY);
         assert!(bvh.closest_hit(&ray).is_some(), "ray towards {target:?} leaked out of the closed mesh");
+    }
+}
+
+/// Closed lattice meshes (a cube, an octahedron) with their triangles' corners rotated and
+/// reversed at random, so that each of the triangle test's three edge expressions sits on both
+/// sides of many shared edges: rays from inside aimed exactly at every vertex and at points
+/// along every edge must hit, through the BVH and both brute forces, at the distance the exact
+/// reference gives (1: the target), on a triangle it says the ray meets. From the cube's centre
+/// every direction's dominant coordinate is ±4, so the production test's shear is exact and its
+/// edge values are exactly zero on edges: there a `<` slipped to `<=` rejects both triangles.
+#[test]
+fn lattice_meshes_are_watertight_at_edges_and_vertices() {
+    let meshes = [
+        ("cube", lattice_cube(4), [Vec3::ZERO, Vec3::new(0.5, -1.25, 0.75)]),
+        ("octahedron", lattice_octahedron(8), [Vec3::ZERO, Vec3::new(-1.5, 0.25, 2.0)]),
+    ];
+    for (name, lattice, origins) in meshes {
+        for seed in 0..2 {
+            let tris = shuffled_corners(&lattice, &mut Rng::new(seed));
+            let bytes = compile(scene_of(&tris), geometry_only());
+            let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+            let view = SceneView::new(&file).unwrap();
+            let t = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
+            let corners: Vec<[Vec3; 3]> = (0..t.len()).map(|i| t.corners(i)).collect();
+            let (bvh, brute) = (BvhQuery::new(view.bvh, &t), BruteForce::new(&t));
+            for origin in origins {
+                for target in corners_and_edge_points(&corners) {
+                    let ray = Ray::new(origin, target - origin, 0.0, f32::INFINITY);
+                    let at = format!("{name} (seed {seed}) from {origin} towards {target}");
+                    let judged: Vec<_> = corners
+                        .iter()
+                        .map(|&c| exact::judge(ray.origin, ray.direction, 0.0, f32::INFINITY, c))
+                        .collect();
+                    // The reference itself: a closed mesh, seen from inside, is met exactly at the
+                    // target, on the boundary of at least the two triangles sharing an edge.
+                    let hits: Vec<_> = judged.iter().filter(|j| j.closed_hit).collect();
+                    assert!(
+                        hits.len() >= 2 && hits.iter().all(|j| j.on_boundary && (j.t - 1.0).abs() < 1e-12),
+                        "{at}: the exact reference's hits {hits:?}"
+                    );
+                    for (what, hit) in [
+                        ("BVH", bvh.closest_hit(&ray)),
+                        ("brute force", brute.closest_hit(&ray)),
+                        ("plain brute force", closest_hit_brute_force(&t, &ray)),
+                    ] {
+                        let h = hit.unwrap_or_else(|| panic!("{at}: {what} leaks (no hit)"));
+                        let j = judged[h.triangle as usize];
+                        assert!(
+                            (h.t - 1.0).abs() <= 1e-6 && (j.closed_hit || j.near),
+                            "{at}: {what} hits {h:?}; the exact reference says {j:?} of that triangle"
+                        );
+                    }
+                    assert!(
+                        bvh.any_hit(&ray) && brute.any_hit(&ray) && any_hit_brute_force(&t, &ray),
+                        "{at}: any-hit leaks"
+                    );
+                }
+            }
+        }
     }
 }

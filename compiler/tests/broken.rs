@@ -288,16 +288,58 @@ fn obj_without_faces() {
     compile(d.path(), &f, &[]).expect(1).says("has no faces");
 }
 
+/// Every table of the sidecar, with a minimal valid body: the unknown-key test below runs over
+/// this list, and `sidecar_tables_are_all_listed` fails when `Sidecar` gains a table that is not
+/// here.
+const SIDECAR_TABLES: [(&str, &str, &str); 6] = [
+    ("camera", "[camera]", "position = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n"),
+    ("light", "[[light]]", "kind = \"point\"\nposition = [0.0, 1.0, 0.0]\nintensity = 1.0\n"),
+    ("sky", "[sky]", "radiance = [0.1, 0.1, 0.1]\n"),
+    ("medium", "[[medium]]", "min = [0.0, 0.0, -1.0]\nmax = [1.0, 1.0, 1.0]\nsigma_s = [0.01, 0.01, 0.01]\n"),
+    ("material", "[material.\"default\"]", "roughness = 0.5\n"),
+    ("bake", "[bake]", "bvh_preset = \"fast\"\n"),
+];
+
 #[test]
-fn sidecar_unknown_key_is_named() {
-    let d = tempfile::tempdir().unwrap();
-    let f = Gltf::quad().write(d.path(), "s");
-    std::fs::write(
-        d.path().join("s.toml"),
-        "[camera]\nposition = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 40.0\n",
-    )
-    .unwrap();
-    compile(d.path(), &f, &["--config", "s.toml"]).expect(1).says("unknown field `fov`");
+fn sidecar_tables_compile_as_listed() {
+    // The bodies are valid, so that the misspelled key below is the only fault.
+    for (_, header, body) in SIDECAR_TABLES {
+        let d = tempfile::tempdir().unwrap();
+        let f = Gltf::quad().write(d.path(), "s");
+        std::fs::write(d.path().join("s.toml"), format!("{header}\n{body}")).unwrap();
+        // Small bakes: only the sidecar is under test here.
+        let small = ["--shaft-variants", "none", "--brdf-lut-res", "8", "--shadow-res", "16"];
+        compile(d.path(), &f, &[&["--config", "s.toml"][..], &small].concat()).expect(0);
+    }
+}
+
+#[test]
+fn sidecar_unknown_key_is_named_in_every_table() {
+    for (k, (_, header, body)) in SIDECAR_TABLES.iter().enumerate() {
+        // The next table follows, so that the message must name the right one.
+        let (_, next_header, next_body) = SIDECAR_TABLES[(k + 1) % SIDECAR_TABLES.len()];
+        for misspelled in ["colour = [1.0, 1.0, 1.0]", "fov = 40.0"] {
+            let d = tempfile::tempdir().unwrap();
+            let f = Gltf::quad().write(d.path(), "s");
+            let text = format!("{header}\n{body}{misspelled}\n\n{next_header}\n{next_body}");
+            std::fs::write(d.path().join("s.toml"), &text).unwrap();
+            let key = misspelled.split(' ').next().unwrap();
+            compile(d.path(), &f, &["--config", "s.toml"])
+                .expect(1)
+                .says(&format!("in {header}:"))
+                .says(&format!("unknown field `{key}`"));
+        }
+    }
+}
+
+#[test]
+fn sidecar_tables_are_all_listed() {
+    // Serde lists the tables `Sidecar` accepts when it refuses an unknown one.
+    let err = kiln_compiler::import::sidecar::Sidecar::parse("[no_such_table]\n").unwrap_err();
+    let expected = err.split("expected one of").nth(1).unwrap_or_else(|| panic!("no table list in {err:?}"));
+    let accepted: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    let listed: Vec<&str> = SIDECAR_TABLES.iter().map(|(name, ..)| *name).collect();
+    assert_eq!(accepted, listed, "Sidecar's tables and SIDECAR_TABLES differ: {err}");
 }
 
 #[test]

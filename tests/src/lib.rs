@@ -14,6 +14,8 @@ use kiln_player::render::{
 };
 use kiln_player::session::SessionOptions;
 
+pub mod exact;
+
 /// The shared scene folder (`../shared/scenes` beside the checkout), if present; if not, says
 /// that the test skips.
 pub fn shared_scenes() -> Option<PathBuf> {
@@ -224,5 +226,90 @@ pub mod shapes {
             }
         }
         tris
+    }
+
+    /// The surface of the cube [−h, h]³ on the integer lattice: each face `2h × 2h` unit squares,
+    /// split along alternating diagonals. Every corner, edge midpoint and edge quarter point is
+    /// exact in `f32`, and from the centre every such point has a dominant coordinate of ±h.
+    pub fn lattice_cube(h: i32) -> Vec<[Vec3; 3]> {
+        let mut tris = Vec::new();
+        for axis in 0..3 {
+            for side in [-h, h] {
+                let p = |i: i32, j: i32| {
+                    let mut v = [0.0; 3];
+                    v[axis] = side as f32;
+                    v[(axis + 1) % 3] = i as f32;
+                    v[(axis + 2) % 3] = j as f32;
+                    Vec3::from(v)
+                };
+                for i in -h..h {
+                    for j in -h..h {
+                        let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+                        if (i + j) % 2 == 0 {
+                            tris.extend([[a, b, c], [a, c, d]]);
+                        } else {
+                            tris.extend([[a, b, d], [b, c, d]]);
+                        }
+                    }
+                }
+            }
+        }
+        tris
+    }
+
+    /// The surface |x| + |y| + |z| = m on the integer lattice: each of the eight faces cut into
+    /// m² triangles. Its faces are not axis-aligned, and directions from inside to its lattice
+    /// points mostly have dominant coordinates that are not powers of two.
+    pub fn lattice_octahedron(m: i32) -> Vec<[Vec3; 3]> {
+        let mut tris = Vec::new();
+        for signs in 0..8 {
+            let s = Vec3::new(
+                if signs & 1 == 0 { 1.0 } else { -1.0 },
+                if signs & 2 == 0 { 1.0 } else { -1.0 },
+                if signs & 4 == 0 { 1.0 } else { -1.0 },
+            );
+            let p = |i: i32, j: i32| Vec3::new(i as f32, j as f32, (m - i - j) as f32) * s;
+            for i in 0..m {
+                for j in 0..m - i {
+                    tris.push([p(i, j), p(i + 1, j), p(i, j + 1)]);
+                    if i + j < m - 1 {
+                        tris.push([p(i + 1, j), p(i + 1, j + 1), p(i, j + 1)]);
+                    }
+                }
+            }
+        }
+        tris
+    }
+
+    /// The same triangles with their corners rotated (and, for half of them, reversed) at
+    /// random: a triangle test handles its three edges in different expressions, and a shared
+    /// edge should meet every pair of them.
+    pub fn shuffled_corners(tris: &[[Vec3; 3]], rng: &mut Rng) -> Vec<[Vec3; 3]> {
+        tris.iter()
+            .map(|&t| {
+                let r = rng.below(3);
+                let t = [t[r], t[(r + 1) % 3], t[(r + 2) % 3]];
+                if rng.below(2) == 0 { t } else { [t[0], t[2], t[1]] }
+            })
+            .collect()
+    }
+
+    /// The corners of `tris` and the points at a quarter, half and three quarters along each
+    /// edge, each once.
+    pub fn corners_and_edge_points(tris: &[[Vec3; 3]]) -> Vec<Vec3> {
+        let mut seen = std::collections::BTreeSet::new();
+        let mut out = Vec::new();
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                for f in [0.0, 0.25, 0.5, 0.75] {
+                    let p = a + (b - a) * f;
+                    if seen.insert(p.to_array().map(f32::to_bits)) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+        out
     }
 }

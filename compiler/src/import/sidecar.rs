@@ -54,6 +54,18 @@ pub struct CameraToml {
     pub zfar: Option<f32>,
 }
 
+/// The header (`[camera]`, `[[light]]`, `[material."x"]`) of the table whose body holds byte
+/// `at`; `None` on a header line itself or before the first header.
+fn enclosing_table(text: &str, at: usize) -> Option<&str> {
+    let line_start = text.get(..at)?.rfind('\n').map_or(0, |i| i + 1);
+    if text[line_start..].trim_start().starts_with('[') {
+        return None;
+    }
+    let header = text[..line_start].lines().rev().map(str::trim).find(|l| l.starts_with('['))?;
+    // A header may carry a comment; table names here hold no `#`.
+    Some(header.split('#').next().unwrap_or(header).trim_end())
+}
+
 fn up() -> [f32; 3] {
     [0.0, 1.0, 0.0]
 }
@@ -186,9 +198,16 @@ impl Sidecar {
         Self::parse(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
     }
 
-    /// Parses sidecar text.
+    /// Parses sidecar text. An error inside a table names the table (`in [[light]]: …`): a TOML
+    /// error shows only the offending line, and `colour` reads the same in every table.
     pub fn parse(text: &str) -> Result<Sidecar, String> {
-        toml::from_str(text).map_err(|e| e.to_string().trim_end().replace('\n', " "))
+        toml::from_str(text).map_err(|e: toml::de::Error| {
+            let msg = e.to_string().trim_end().replace('\n', " ");
+            match e.span().and_then(|span| enclosing_table(text, span.start)) {
+                Some(table) => format!("in {table}: {msg}"),
+                None => msg,
+            }
+        })
     }
 
     /// Applies the sidecar to an imported scene; `source` names the file in messages.
