@@ -92,9 +92,9 @@ fn agrees_with_exact(
         (Closest::Miss, Some(_), j) => {
             Err(format!("the exact reference misses; of that triangle it says {j:?}"))
         }
-        (Closest::Hit { t }, None, _) => Err(format!("the exact reference hits at t = {t}")),
-        (Closest::Hit { t }, Some(h), Some(j)) => {
-            if (f64::from(h.t) - t).abs() > f64::from(RELATIVE_TOLERANCE) * t.abs() + tol {
+        (Closest::Hit { t, .. }, None, _) => Err(format!("the exact reference hits at t = {t}")),
+        (Closest::Hit { t, reach }, Some(h), Some(j)) => {
+            if (f64::from(h.t) - t).abs() > f64::from(RELATIVE_TOLERANCE) * t.abs() + tol + reach {
                 Err(format!("the exact reference hits first at t = {t}; of that triangle it says {j:?}"))
             } else if !(j.closed_hit || j.near) {
                 Err(format!("the exact reference says the ray misses that triangle: {j:?}"))

@@ -78,8 +78,8 @@ impl Int {
         };
         let mut out = Vec::with_capacity(big.len());
         let mut borrow = 0i64;
-        for i in 0..big.len() {
-            let mut d = i64::from(big[i]) - i64::from(*small.get(i).unwrap_or(&0)) - borrow;
+        for (i, &limb) in big.iter().enumerate() {
+            let mut d = i64::from(limb) - i64::from(*small.get(i).unwrap_or(&0)) - borrow;
             borrow = i64::from(d < 0);
             if d < 0 {
                 d += 1 << 32;
@@ -228,7 +228,14 @@ pub struct Judgement {
     /// The smallest `t` at which a rounded test could report a hit on this triangle when
     /// [`near`](Self::near) holds: the ray's passage by the triangle's reach.
     pub t_first: f64,
+    /// How far an `f32` test's `t` may stray from [`t`](Self::t) on a clear hit: [`T_ROUNDING`]
+    /// times the corners' reach over cos θ, in units of `|d|`.
+    pub t_reach: f64,
 }
+
+/// The relative rounding of an `f32` test's corners that [`Judgement::t_reach`] allows for: a
+/// few times 2⁻²⁴, moving the crossing along the ray by that much of the reach over cos θ.
+pub const T_ROUNDING: f64 = 1e-6;
 
 /// The relative rounding that [`Judgement::near`] allows for: corners moved by `NEAR` times
 /// their distance from the origin, the direction tilted by `NEAR`, the crossing moved by `NEAR`
@@ -314,7 +321,9 @@ pub fn judge(origin: Vec3, direction: Vec3, tmin: f32, tmax: f32, p: [Vec3; 3]) 
     let outside = t_last < f64::from(tmin) || t_first >= f64::from(tmax);
     let near = t.is_nan() || at_end || (line_meets && grazing) || (near_edge && !outside);
     let on_boundary = line_meets && !in_plane && signs.contains(&Ordering::Equal);
-    Judgement { closed_hit, on_boundary, near, t, t_first }
+    let t_reach = T_ROUNDING * size / (cos * dd.length());
+    let t_reach = if t_reach.is_nan() { f64::INFINITY } else { t_reach };
+    Judgement { closed_hit, on_boundary, near, t, t_first, t_reach }
 }
 
 /// The reference's closest hit of a ray among `tris`, where it decides.
@@ -327,6 +336,8 @@ pub enum Closest {
     Hit {
         /// Ray parameter.
         t: f64,
+        /// How far an `f32` test's distance may stray from it ([`Judgement::t_reach`]).
+        reach: f64,
     },
     /// A near triangle could be the closest hit, or could hide nothing: undecided.
     Undecided,
@@ -334,7 +345,8 @@ pub enum Closest {
 
 /// The closest hit of the ray `origin + t direction` (`tmin <= t < tmax`) among `tris`, where
 /// the exact reference decides it; a near triangle within `relative · t + absolute` of the
-/// closest clear hit (the tolerance of ties) leaves it undecided.
+/// closest clear hit (the tolerance of ties, widened by the hit's `t_reach`) leaves it
+/// undecided.
 pub fn closest(
     origin: Vec3,
     direction: Vec3,
@@ -344,20 +356,22 @@ pub fn closest(
     relative: f64,
     absolute: f64,
 ) -> Closest {
-    let mut best = f64::INFINITY;
+    let (mut best, mut reach) = (f64::INFINITY, 0.0);
     let mut near_first: Option<f64> = None;
     for tri in tris {
         let j = judge(origin, direction, tmin, tmax, tri);
         if j.near {
             let t = if j.t_first.is_nan() { f64::NEG_INFINITY } else { j.t_first };
             near_first = Some(near_first.map_or(t, |n| n.min(t)));
-        } else if j.closed_hit {
-            best = best.min(j.t);
+        } else if j.closed_hit && j.t < best {
+            (best, reach) = (j.t, j.t_reach);
         }
     }
     match near_first {
-        Some(n) if !best.is_finite() || n <= best + relative * best.abs() + absolute => Closest::Undecided,
-        _ if best.is_finite() => Closest::Hit { t: best },
+        Some(n) if !best.is_finite() || n <= best + relative * best.abs() + absolute + reach => {
+            Closest::Undecided
+        }
+        _ if best.is_finite() => Closest::Hit { t: best, reach },
         _ => Closest::Miss,
     }
 }
