@@ -66,7 +66,7 @@ impl std::fmt::Debug for RayQuery {
 impl RayQuery {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<RayQuery> {
-        let storage = Binding { kind: BindingKind::Storage, count: 1 };
+        let storage = Binding::one(BindingKind::Storage);
         let mut layout = SetLayout::new(gpu, &[storage; 4], 1)?;
         let pipeline = ComputePipeline::new(gpu, spirv::TRACE_RAYS, &[&layout], 8)?;
         let set = layout.allocate(gpu)?;

@@ -47,6 +47,13 @@ pub struct Binding {
     pub count: u32,
 }
 
+impl Binding {
+    /// One descriptor of `kind`.
+    pub const fn one(kind: BindingKind) -> Binding {
+        Binding { kind, count: 1 }
+    }
+}
+
 /// A descriptor set layout and the pools its sets come from (grown `chunk` sets at a time).
 #[derive(Debug)]
 pub struct SetLayout {

@@ -7,8 +7,8 @@
 use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
-use super::kernel::{Kernel, many};
-use super::{FrameCtx, Pass, Shared, one, rt_ao, rt_reflections, rt_shadows};
+use super::kernel::Kernel;
+use super::{FrameCtx, Pass, Shared, rt_ao, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -39,11 +39,10 @@ impl DirectPass {
     pub fn new(gpu: &Gpu) -> PlayResult<DirectPass> {
         use BindingKind::*;
         let maps = Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 };
-        let bindings: Vec<Binding> = [one(Uniform), one(Storage), one(Storage), one(Sampled), maps, maps]
-            .into_iter()
-            .chain(many(Sampled, 5))
-            .chain(many(StorageImage, 4))
-            .collect();
+        let mut bindings = vec![Binding::one(Uniform), Binding::one(Storage), Binding::one(Storage)];
+        bindings.extend([Binding::one(Sampled), maps, maps]);
+        bindings.extend([Binding::one(Sampled); 5]);
+        bindings.extend([Binding::one(StorageImage); 4]);
         Ok(DirectPass(Kernel::new(gpu, &bindings, spirv::DIRECT, 0)?))
     }
 }

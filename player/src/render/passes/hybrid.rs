@@ -7,9 +7,9 @@ use crate::gpu::vk;
 use kiln_format::gpu::RtConstants;
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
-use super::{FrameCtx, Shared, one, rt_ao, rt_reflections, rt_shadows};
+use super::{FrameCtx, Shared, rt_ao, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{BindingKind, ComputePipeline, Gpu, SetLayout, Write};
+use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::scene::bindings as scene_bindings;
 
@@ -36,10 +36,10 @@ impl HybridSet {
     /// The layout.
     pub fn new(gpu: &Gpu) -> PlayResult<HybridSet> {
         use BindingKind::*;
-        let mut bindings = vec![one(Uniform)];
-        bindings.extend([one(Storage); 11]);
-        bindings.extend([one(Sampled); 4]);
-        bindings.extend([one(StorageImage); 6]);
+        let mut bindings = vec![Binding::one(Uniform)];
+        bindings.extend([Binding::one(Storage); 11]);
+        bindings.extend([Binding::one(Sampled); 4]);
+        bindings.extend([Binding::one(StorageImage); 6]);
         Ok(HybridSet { layout: SetLayout::new(gpu, &bindings, 1)?, set: vk::DescriptorSet::null() })
     }
 

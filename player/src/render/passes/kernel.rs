@@ -1,8 +1,7 @@
 //! A compute kernel with its own set layout and one descriptor set: what most passes are.
 
-use super::one;
 use crate::error::PlayResult;
-use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, Recorder, SetLayout, Write, vk};
+use crate::gpu::{Binding, ComputePipeline, Gpu, Recorder, SetLayout, Write, vk};
 
 /// Layout, pipeline and set of one compute kernel.
 #[derive(Debug)]
@@ -45,9 +44,4 @@ impl Kernel {
         self.pipeline.destroy(gpu);
         self.layout.destroy(gpu);
     }
-}
-
-/// `n` bindings of `kind`, one descriptor each.
-pub fn many(kind: BindingKind, n: usize) -> impl Iterator<Item = Binding> {
-    std::iter::repeat_n(one(kind), n)
 }

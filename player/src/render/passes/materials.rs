@@ -6,9 +6,9 @@ use crate::gpu::vk;
 use kiln_format::gpu::GpuMaterialLayout;
 use kiln_format::sections::NO_TEXTURE;
 
-use super::{Shared, one};
+use super::Shared;
 use crate::error::PlayResult;
-use crate::gpu::{BindingKind, Gpu, GraphicsDesc, GraphicsPipeline, Recorder, SetLayout, Write};
+use crate::gpu::{Binding, BindingKind, Gpu, GraphicsDesc, GraphicsPipeline, Recorder, SetLayout, Write};
 use crate::scene::GpuScene;
 
 /// Vertex buffer strides of the raster passes: positions + normals, texture coordinates.
@@ -35,8 +35,8 @@ pub struct SceneDraws {
 impl SceneDraws {
     /// The layouts (sets are allocated by [`SceneDraws::bind`]).
     pub fn new(gpu: &Gpu) -> PlayResult<SceneDraws> {
-        let frame_layout = SetLayout::new(gpu, &[one(BindingKind::Uniform)], 1)?;
-        let material_layout = match SetLayout::new(gpu, &[one(BindingKind::Sampled); 5], 64) {
+        let frame_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Uniform)], 1)?;
+        let material_layout = match SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); 5], 64) {
             Ok(l) => l,
             Err(e) => {
                 let mut f = frame_layout;

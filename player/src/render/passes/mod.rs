@@ -86,8 +86,3 @@ pub trait Pass: Send + std::fmt::Debug {
     /// Releases what it owns (the GPU must be idle).
     fn destroy(&mut self, gpu: &Gpu);
 }
-
-/// Binding helper: one binding of `kind`.
-pub(crate) fn one(kind: crate::gpu::BindingKind) -> crate::gpu::Binding {
-    crate::gpu::Binding { kind, count: 1 }
-}

@@ -4,8 +4,8 @@
 
 use crate::gpu::vk;
 
-use super::kernel::{Kernel, many};
-use super::one;
+use super::kernel::Kernel;
+
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, Buffer, Gpu, Use, Write};
 use crate::render::graph::{Access, FrameImages, TargetDecl};
@@ -31,8 +31,9 @@ impl PathTracePass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<PathTracePass> {
         use BindingKind::*;
-        let bindings: Vec<Binding> =
-            [one(Uniform)].into_iter().chain(many(Storage, 12)).chain([one(StorageImage)]).collect();
+        let mut bindings = vec![Binding::one(Uniform)];
+        bindings.extend([Binding::one(Storage); 12]);
+        bindings.push(Binding::one(StorageImage));
         Ok(PathTracePass(Kernel::new(gpu, &bindings, spirv::PATHTRACE, std::mem::size_of::<u32>() as u32)?))
     }
 

@@ -4,8 +4,8 @@
 //! targets the raster G-buffer writes.
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL, TRIANGLE};
-use super::kernel::{Kernel, many};
-use super::{FrameCtx, Pass, Shared, one};
+use super::kernel::Kernel;
+use super::{FrameCtx, Pass, Shared};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -22,12 +22,10 @@ impl ResolvePass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<ResolvePass> {
         use BindingKind::*;
-        let bindings: Vec<Binding> = [one(Uniform)]
-            .into_iter()
-            .chain(many(Storage, 7))
-            .chain(many(StorageImage, 5))
-            .chain([one(Sampled)])
-            .collect();
+        let mut bindings = vec![Binding::one(Uniform)];
+        bindings.extend([Binding::one(Storage); 7]);
+        bindings.extend([Binding::one(StorageImage); 5]);
+        bindings.push(Binding::one(Sampled));
         Ok(ResolvePass(Kernel::new(gpu, &bindings, spirv::RESOLVE, 0)?))
     }
 }

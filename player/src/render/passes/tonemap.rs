@@ -5,9 +5,9 @@ use crate::gpu::vk;
 
 use super::direct::RADIANCE;
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, one};
+use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
-use crate::gpu::{BindingKind, Gpu, ImageDesc, Use, Write};
+use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -29,7 +29,7 @@ impl TonemapPass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<TonemapPass> {
         use BindingKind::*;
-        let bindings = [one(Uniform), one(StorageImage), one(StorageImage)];
+        let bindings = [Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)];
         Ok(TonemapPass(Kernel::new(gpu, &bindings, spirv::TONEMAP, 0)?))
     }
 }
