@@ -12,7 +12,7 @@ use crate::analyze::geometry::SceneGeometry;
 use crate::analyze::plan::Plan;
 use crate::analyze::validate;
 use crate::bake::{self, BakeContext, StageReport};
-use crate::cli::{OutputArgs, SceneArgs};
+use crate::cli::{BakeArgs, OutputArgs, SceneArgs};
 use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
 use crate::ir::Scene;
@@ -50,17 +50,23 @@ impl Loaded {
 pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     let start = Instant::now();
     let mut scene = import::import(&args.input)?;
+    let settings = configure(&mut scene, args.config.as_deref(), &args.bake)?;
+    finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
+}
+
+/// Applies a sidecar (if any) to `scene` and returns the bake settings: the sidecar's `[bake]`
+/// table, overridden by the command line's.
+pub fn configure(scene: &mut Scene, config: Option<&Path>, bake: &BakeArgs) -> CliResult<Settings> {
     let mut settings = Settings::default();
-    if let Some(cfg) = &args.config {
+    if let Some(cfg) = config {
         let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
-        sidecar.apply(&mut scene, &cfg.display().to_string())?;
+        sidecar.apply(scene, &cfg.display().to_string())?;
         settings
             .apply_bake_table(&sidecar.bake)
             .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
     }
-    // The command line overrides the sidecar.
-    args.bake.apply(&mut settings);
-    finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
+    bake.apply(&mut settings);
+    Ok(settings)
 }
 
 /// Validates and plans an imported scene (also the entry point of the demo).

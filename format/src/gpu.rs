@@ -162,7 +162,8 @@ gpu_struct! {
         /// Image width, height, samples per pixel requested, emitter count (the index of the
         /// sample being taken is a push constant).
         pub size: [u32; 4] => "uvec4",
-        /// Light count, maximum path length, seed, unused.
+        /// Light count, maximum path length, seed, bounce limit (scattering events whose light
+        /// counts; 0: unlimited, 1: direct light only).
         pub params: [u32; 4] => "uvec4",
     }
 }

@@ -10,7 +10,7 @@ use crate::scene::SectionFate;
 use crate::session::{LoadTimes, Session, SessionOptions};
 
 /// Summary of one pass over the measured frames, in milliseconds.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct PassStats {
     /// Pass name.
     pub pass: String,
@@ -61,7 +61,8 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
     if i + 1 < sorted.len() { sorted[i] * (1.0 - f) + sorted[i + 1] * f } else { sorted[i] }
 }
 
-fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
+/// Summary of one pass's samples.
+pub fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
     v.sort_by(f64::total_cmp);
     PassStats {
         pass: pass.to_string(),

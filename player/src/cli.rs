@@ -129,9 +129,13 @@ pub struct Args {
     /// Ambient occlusion technique.
     #[arg(long, value_parser = techniques(Effect::Ao), default_value = "none")]
     pub ao: String,
-    /// With --ao rt: ray length in scene units (default: a tenth of the scene's diagonal).
+    /// With --ao rt: ray length in scene units (default: --ao-reach times the scene's diagonal).
     #[arg(long, value_name = "R")]
     pub ao_radius: Option<f32>,
+    /// With --ao rt: ray length as a fraction of the scene's bounding-box diagonal, when no
+    /// --ao-radius is given (≥ 10: every hit occludes fully, the sky's true visibility).
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.1)]
+    pub ao_reach: f32,
     /// Reflections technique.
     #[arg(long, value_parser = techniques(Effect::Reflections), default_value = "none")]
     pub reflections: String,
@@ -175,6 +179,7 @@ impl Args {
             "light-radius" => Some(KnobValue::Number(self.light_radius)),
             "sun-angle" => Some(KnobValue::Number(self.sun_angle)),
             "ao-radius" => self.ao_radius.map(KnobValue::Number),
+            "ao-reach" => Some(KnobValue::Number(self.ao_reach)),
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
             _ => None,
@@ -387,7 +392,7 @@ mod tests {
         ]);
         assert_eq!(t.gbuffer, GBuffer::Visibility);
         assert_eq!(t.shadows, Shadows::Rt { light_radius: 1.0, sun_degrees: 0.53 });
-        assert_eq!(t.ao, Ao::Rt { radius: Some(0.5) });
+        assert_eq!(t.ao, Ao::Rt { radius: Some(0.5), reach: 0.1 });
         assert_eq!(t.reflections, Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 });
         assert_eq!(t.aa, Aa::None);
         let d = techniques(&["f.kiln"]);
@@ -399,7 +404,7 @@ mod tests {
     fn the_last_flag_wins() {
         assert_eq!(techniques(&["f.kiln", "--shadows", "rt", "--shadows", "none"]).shadows, Shadows::None);
         let t = techniques(&["f.kiln", "--ao", "rt", "--ao-radius", "2", "--ao-radius", "3"]);
-        assert_eq!(t.ao, Ao::Rt { radius: Some(3.0) });
+        assert_eq!(t.ao, Ao::Rt { radius: Some(3.0), reach: 0.1 });
     }
 
     #[test]

@@ -8,6 +8,7 @@
 //! | 3 | unsupported: no Vulkan loader, no suitable device, a missing feature |
 //! | 4 | I/O failure: a file that cannot be read or written |
 //! | 5 | GPU failure while rendering (device lost, out of memory) |
+//! | 6 | `kiln-bench --compare`: a point regressed |
 //! | 70 | internal error (a bug) |
 
 use std::fmt;
@@ -25,6 +26,8 @@ pub enum Exit {
     Io = 4,
     /// 5.
     Gpu = 5,
+    /// 6.
+    Regression = 6,
 }
 
 /// An error ending the program: one message and an exit code.

@@ -3,7 +3,7 @@
 //!
 //! Layers, bottom up: [`gpu`] (the only module that speaks raw Vulkan), [`scene`] (streaming
 //! upload of a file's sections), [`render`] (passes and their targets), and the front ends
-//! [`headless`], [`window`] and [`bench`], driven by [`cli`].
+//! [`headless`], [`window`] and [`bench`], driven by [`cli`]; [`sweep`] is `kiln-bench`.
 
 pub mod bench;
 pub mod camera;
@@ -18,6 +18,7 @@ pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod session;
+pub mod sweep;
 pub mod trace;
 pub mod window;
 

@@ -40,8 +40,24 @@ pub const SPP_ATTRIBUTE: &str = "kilnSamplesPerPixel";
 /// Default cap on path length (vertices); Russian roulette ends nearly every path long before.
 pub const MAX_PATH: u32 = 1024;
 
+/// The random sequence `--reference` uses.
+pub const DEFAULT_SEED: u32 = 0x2545_f491;
+
 /// Renders `spp` samples per pixel; returns the report and the mean radiance (RGB per pixel).
 pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<(ReferenceReport, Vec<f32>)> {
+    render_seeded(options, spp, DEFAULT_SEED, 0, start)
+}
+
+/// [`render`] with another random sequence (images of different seeds are independent
+/// estimates, what a noise-floor estimate compares) and a bounce limit (`bounces` scattering
+/// events count; 0: no limit, 1: direct light alone).
+pub fn render_seeded(
+    options: &SessionOptions,
+    spp: u32,
+    seed: u32,
+    bounces: u32,
+    start: Instant,
+) -> PlayResult<(ReferenceReport, Vec<f32>)> {
     if spp == 0 {
         return Err(PlayError::new(Exit::Usage, "--spp must be at least 1"));
     }
@@ -49,7 +65,7 @@ pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<
     options.render.purpose = crate::render::Purpose::Reference;
     options.readback = None;
     let session = Session::open(&options, start)?;
-    let result = sample(&session, spp);
+    let result = sample(&session, spp, seed, bounces);
     let errors = session.close();
     let (report, pixels) = result?;
     if errors > 0 {
@@ -58,7 +74,7 @@ pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<
     Ok((report, pixels))
 }
 
-fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)> {
+fn sample(session: &Session, spp: u32, seed: u32, bounces: u32) -> PlayResult<(ReferenceReport, Vec<f32>)> {
     let gpu = &session.gpu;
     let scene = &session.scene;
     let Some(r) = &scene.reference else {
@@ -84,7 +100,7 @@ fn sample(session: &Session, spp: u32) -> PlayResult<(ReferenceReport, Vec<f32>)
         forward: [cam.forward.x as f32, cam.forward.y as f32, cam.forward.z as f32, 0.0],
         sky: [sky[0], sky[1], sky[2], 0.0],
         size: [w, h, spp, r.emitter_count],
-        params: [scene.manifest.lights.len() as u32, MAX_PATH, 0x2545_f491, 0],
+        params: [scene.manifest.lights.len() as u32, MAX_PATH, seed, bounces],
     };
     let plan: Vec<GpuLight> = lights::plan(&scene.manifest, &[], false).lights;
     let mut owned = Owned::default();

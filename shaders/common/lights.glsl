@@ -11,4 +11,24 @@ float spot_cone(GpuLight light, vec3 l) {
     return t * t * (3.0 - 2.0 * t);
 }
 
+// Where the ray origin + t·dir meets the emitting (front) side of rect light `light`: t, if
+// within (0, tmax) and the light's range; -1 otherwise. `dir` need not be unit length (t and
+// the range are then in its units).
+float rect_light_hit(GpuLight light, vec3 origin, vec3 dir, float tmax) {
+    float denom = dot(dir, light.direction);
+    if (denom >= 0.0) {
+        return -1.0;
+    }
+    float t = dot(light.position - origin, light.direction) / denom;
+    if (t <= 0.0 || t >= tmax || (light.range > 0.0 && t > light.range)) {
+        return -1.0;
+    }
+    vec3 q = origin + dir * t - light.position;
+    vec3 up = cross(light.direction, light.right);
+    if (abs(dot(q, light.right)) > 0.5 * light.width || abs(dot(q, up)) > 0.5 * light.height) {
+        return -1.0;
+    }
+    return t;
+}
+
 #endif

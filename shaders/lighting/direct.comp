@@ -185,9 +185,24 @@ void main() {
         return;
     }
     float depth = texelFetch(g_depth, pixel, 0).r;
-    // Reversed Z: the far plane (cleared, nothing drawn) is depth 0.
-    if (depth <= 0.0) {
-        imageStore(radiance_out, pixel, vec4(frame.sky.rgb, 1.0));
+    // Rect lights are surfaces the camera sees (as in the path tracer): the nearest in front of
+    // the G-buffer's surface shows its radiance. Reversed Z: the far plane (cleared, nothing
+    // drawn, the sky) is depth 0.
+    vec3 eye = frame.camera.xyz;
+    vec3 toward = world_at(pixel, depth > 0.0 ? depth : 1e-6) - eye;
+    float t_seen = depth > 0.0 ? 1.0 : 3.4e38;
+    vec3 seen = frame.sky.rgb;
+    for (uint i = 0u; i < frame.size.z; i++) {
+        if (lights[i].kind == LIGHT_RECT) {
+            float t = rect_light_hit(lights[i], eye, toward, t_seen);
+            if (t > 0.0) {
+                t_seen = t;
+                seen = lights[i].radiance;
+            }
+        }
+    }
+    if (depth <= 0.0 || t_seen < 1.0) {
+        imageStore(radiance_out, pixel, vec4(seen, 1.0));
         return;
     }
     vec3 p = world_at(pixel, depth);

@@ -7,6 +7,9 @@
 // and a BRDF-sampled continuation; emitters the continuation hits (emissive triangles, rect
 // lights) count with the power heuristic against the emitter sampling, delta lights by NEE
 // alone. Russian roulette from the fourth vertex; `params.y` caps the length as a safety net.
+// `params.w` > 0 limits the bounces: the light arriving after that many scattering events
+// counts and nothing further (1: direct light alone), what a benchmark compares a frame without
+// indirect light against.
 // BRDF: glTF metallic-roughness (Lambert diffuse weighted by 1 − F, GGX with height-correlated
 // Smith and Schlick F; α = roughness²) sampled with cosine-weighted diffuse and GGX visible
 // normals (Heitz 2018), or pure Lambert for diffuse-only materials. All surfaces are two-sided
@@ -19,6 +22,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform Constants { ReferenceConstants rc; };
 #include "../common/scene_bindings.glsl"   // bindings 1-8: the scene, the lights
+#include "../common/lights.glsl"
 layout(set = 0, binding = 9, std430) readonly buffer Emitters { GpuEmitter emitters[]; };
 layout(set = 0, binding = 10, std430) readonly buffer TriEmitters { int tri_emitter[]; };
 layout(set = 0, binding = 11, std430) readonly buffer Texels { uint texels[]; };
@@ -155,19 +159,11 @@ vec3 rect_lights_seen(vec3 origin, vec3 dir, float tmax, float pdf_brdf) {
             continue;
         }
         GpuLight l = lights[e.index];
+        float t = rect_light_hit(l, origin, dir, tmax);
+        if (t < 0.0) {
+            continue;
+        }
         float denom = dot(dir, l.direction);
-        if (denom >= 0.0) {
-            continue;
-        }
-        float t = dot(l.position - origin, l.direction) / denom;
-        if (t <= 0.0 || t >= tmax || (l.range > 0.0 && t > l.range)) {
-            continue;
-        }
-        vec3 q = origin + dir * t - l.position;
-        vec3 up = cross(l.direction, l.right);
-        if (abs(dot(q, l.right)) > 0.5 * l.width || abs(dot(q, up)) > 0.5 * l.height) {
-            continue;
-        }
         float area = l.width * l.height;
         float pdf_light = e.pdf * t * t / (-denom * area);
         sum += l.radiance * (pdf_brdf > 0.0 ? power_heuristic(pdf_brdf, pdf_light) : 1.0);
@@ -202,6 +198,9 @@ vec3 radiance(TraceRay r) {
                 weight = power_heuristic(pdf_brdf, pdf_light);
             }
             result += throughput * s.emission * weight;
+        }
+        if (rc.params.w != 0u && depth >= rc.params.w) {
+            break;
         }
         vec3 wo = -normalize(r.direction);
         result += throughput * sample_emitter(s, wo);

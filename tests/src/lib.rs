@@ -134,7 +134,7 @@ impl Options {
 
     /// Ray-traced ambient occlusion, rays of length `radius` (`None`: the player's default).
     pub fn rt_ao(mut self, radius: Option<f32>) -> Options {
-        self.0.render.techniques.ao = Ao::Rt { radius };
+        self.0.render.techniques.ao = Ao::Rt { radius, reach: 0.1 };
         self
     }
 

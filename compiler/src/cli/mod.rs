@@ -207,6 +207,10 @@ pub struct DemoArgs {
     /// Output file.
     #[arg(long, short = 'o', value_name = "OUT.kiln", default_value = "demo.kiln")]
     pub output: PathBuf,
+    /// TOML sidecar applied to the demo scene as to an imported one (e.g. a [sky] to light the
+    /// open front of the box; see docs/sidecar.md).
+    #[arg(long, short = 'c', value_name = "SIDECAR.toml")]
+    pub config: Option<PathBuf>,
     /// Bake settings.
     #[command(flatten)]
     pub bake: BakeArgs,

@@ -7,7 +7,6 @@ use crate::cli::{CompileArgs, DemoArgs};
 use crate::exit::CliResult;
 use crate::output::size;
 use crate::pipeline::{self, Report};
-use crate::settings::Settings;
 
 /// Runs `kiln compile`.
 pub fn run(args: &CompileArgs) -> CliResult {
@@ -28,9 +27,8 @@ pub fn run(args: &CompileArgs) -> CliResult {
 /// Runs `kiln demo`.
 pub fn demo(args: &DemoArgs) -> CliResult {
     let start = Instant::now();
-    let scene = crate::import::demo::cornell_box();
-    let mut settings = Settings::default();
-    args.bake.apply(&mut settings);
+    let mut scene = crate::import::demo::cornell_box();
+    let settings = pipeline::configure(&mut scene, args.config.as_deref(), &args.bake)?;
     let loaded = pipeline::finish(scene, settings, "demo", false, args.out.quiet, start)?;
     let report = pipeline::compile(&loaded, "demo", &args.output, &args.out)?;
     if !args.out.quiet {

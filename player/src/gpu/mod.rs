@@ -54,6 +54,21 @@ pub struct ValidationCounts {
     pub warnings: AtomicU32,
 }
 
+/// A device as a benchmark record names it.
+#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub struct DeviceIdentity {
+    /// Device name.
+    pub name: String,
+    /// Driver name (e.g. "NVIDIA", "llvmpipe").
+    pub driver_name: String,
+    /// Driver's own description of its version.
+    pub driver_info: String,
+    /// Driver version, decoded.
+    pub driver_version: String,
+    /// The device UUID (hex), stable across runs on one GPU.
+    pub uuid: String,
+}
+
 /// The Vulkan context: instance, device, queues, allocator.
 pub struct Gpu {
     /// Loader entry points.
@@ -335,6 +350,31 @@ impl Gpu {
     /// Validation errors reported so far.
     pub fn validation_errors(&self) -> u32 {
         self.validation.errors.load(Ordering::Relaxed)
+    }
+
+    /// What a benchmark record names the device by: name, driver and UUID.
+    pub fn identity(&self) -> DeviceIdentity {
+        let mut id = vk::PhysicalDeviceIDProperties::default();
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut props = vk::PhysicalDeviceProperties2::default().push_next(&mut id).push_next(&mut driver);
+        // SAFETY: `physical` belongs to `instance`; both chained structs are core in Vulkan 1.2,
+        // which device creation required.
+        unsafe { self.instance.get_physical_device_properties2(self.physical, &mut props) };
+        let text = |c: Result<&std::ffi::CStr, _>| c.map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+        let v = self.properties.driver_version;
+        // NVIDIA packs 10.8.8.6 bits; everyone else follows the Vulkan version macros.
+        let driver_version = if self.properties.vendor_id == 0x10de {
+            format!("{}.{}.{}", v >> 22, (v >> 14) & 0xff, (v >> 6) & 0xff)
+        } else {
+            format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
+        };
+        DeviceIdentity {
+            name: self.name.clone(),
+            driver_name: text(driver.driver_name_as_c_str()),
+            driver_info: text(driver.driver_info_as_c_str()),
+            driver_version,
+            uuid: id.device_uuid.iter().map(|b| format!("{b:02x}")).collect(),
+        }
     }
 
     /// Whether the device is Mesa's lavapipe (CPU).

@@ -154,7 +154,7 @@ impl Renderer {
         let shadow_layers = if rt_shadows { passes::rt_shadows::layers(lights_used) } else { 0 };
         let rt_constants = RtConstants {
             ao_radius: match t.ao {
-                Ao::Rt { radius } => radius.unwrap_or(0.1 * diagonal),
+                Ao::Rt { radius, reach } => radius.unwrap_or(reach * diagonal),
                 Ao::None => 0.1 * diagonal,
             }
             .max(1e-6),

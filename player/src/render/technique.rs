@@ -53,8 +53,11 @@ pub enum Ao {
     None,
     /// One cosine-weighted ray per pixel per frame; a hit at t weighs (t/R)².
     Rt {
-        /// Ray length R; `None`: a tenth of the scene's bounding-box diagonal.
+        /// Ray length R in scene units; `None`: `reach` times the scene's bounding-box diagonal.
         radius: Option<f32>,
+        /// R as a fraction of the scene's bounding-box diagonal (when `radius` is `None`); large
+        /// values (≥ 10) make every hit occlude fully: the sky's visibility.
+        reach: f32,
     },
 }
 
@@ -229,7 +232,7 @@ impl Techniques {
             (Effect::Ao, "none") => self.ao = Ao::None,
             (Effect::Ao, "rt") => {
                 let r = v(0).number();
-                self.ao = Ao::Rt { radius: (r > 0.0).then_some(r) };
+                self.ao = Ao::Rt { radius: (r > 0.0).then_some(r), reach: v(1).number() };
             }
             (Effect::Reflections, "none") => self.reflections = Reflections::None,
             (Effect::Reflections, "rt") => {
@@ -378,6 +381,19 @@ pub struct Knob {
     pub range: KnobRange,
     /// The default.
     pub default: KnobValue,
+    /// Whether it trades time for error, or changes what is rendered.
+    pub role: KnobRole,
+}
+
+/// What a knob does, for a sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KnobRole {
+    /// Trades time for error: a sweep measures its values.
+    Quality,
+    /// Changes the scene the technique renders (a light's size): a sweep holds it at its
+    /// default, which is what the reference path tracer renders (point, spot and directional
+    /// lights without extent).
+    Scene,
 }
 
 impl Knob {
@@ -423,7 +439,18 @@ const fn number(
     default: f32,
     sweep: &'static [f32],
 ) -> Knob {
-    Knob { name, help, range: KnobRange::Number { min, max, sweep }, default: KnobValue::Number(default) }
+    Knob {
+        name,
+        help,
+        range: KnobRange::Number { min, max, sweep },
+        default: KnobValue::Number(default),
+        role: KnobRole::Quality,
+    }
+}
+
+/// A knob that sizes the lights.
+const fn light_size(knob: Knob) -> Knob {
+    Knob { role: KnobRole::Scene, ..knob }
 }
 
 /// The upper end of an open range.
@@ -465,22 +492,22 @@ static CATALOGUE: [TechniqueInfo; 13] = [
         help: "ray-traced soft shadows: one ray per light per pixel per frame, averaged while the \
                camera is still (see --light-radius, --sun-angle)",
         knobs: &[
-            number(
+            light_size(number(
                 "light-radius",
                 "sphere radius of point and spot lights in scene units (0: hard shadows)",
                 0.0,
                 UNBOUNDED,
                 0.0,
                 &[0.0, 0.1, 1.0],
-            ),
-            number(
+            )),
+            light_size(number(
                 "sun-angle",
                 "angular diameter of directional lights in degrees (the sun: 0.53)",
                 0.0,
                 179.99,
                 0.0,
                 &[0.0, 0.53, 2.0],
-            ),
+            )),
         ],
         stochastic: true,
     },
@@ -494,15 +521,26 @@ static CATALOGUE: [TechniqueInfo; 13] = [
     TechniqueInfo {
         effect: Effect::Ao,
         name: "rt",
-        help: "ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius",
-        knobs: &[number(
-            "ao-radius",
-            "ray length in scene units (0: a tenth of the scene's diagonal)",
-            0.0,
-            UNBOUNDED,
-            0.0,
-            &[0.0],
-        )],
+        help: "ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius (or --ao-reach)",
+        knobs: &[
+            number(
+                "ao-radius",
+                "ray length in scene units (0: --ao-reach times the scene's diagonal)",
+                0.0,
+                UNBOUNDED,
+                0.0,
+                &[0.0],
+            ),
+            number(
+                "ao-reach",
+                "ray length as a fraction of the scene's bounding-box diagonal, when --ao-radius is 0 \
+                 (≥ 10: every hit occludes fully, the sky's true visibility)",
+                1e-4,
+                UNBOUNDED,
+                0.1,
+                &[0.03, 0.1, 0.3, 100.0],
+            ),
+        ],
         stochastic: true,
     },
     TechniqueInfo {
@@ -523,6 +561,7 @@ static CATALOGUE: [TechniqueInfo; 13] = [
                 help: "full: one ray per pixel; half: one per 2 × 2 pixels, upsampled with edge-aware weights",
                 range: KnobRange::Choice(&["full", "half"]),
                 default: KnobValue::Choice(0),
+                role: KnobRole::Quality,
             },
             number(
                 "reflection-max-roughness",
@@ -611,7 +650,7 @@ mod tests {
     fn needs_follow_the_techniques() {
         let d = Techniques::default();
         assert_eq!(d.needs(), Needs { shadow_maps: true, ..Needs::FRAME });
-        let rt = Techniques { ao: Ao::Rt { radius: None }, shadows: Shadows::None, ..d };
+        let rt = Techniques { ao: Ao::Rt { radius: None, reach: 0.1 }, shadows: Shadows::None, ..d };
         assert!(rt.needs().bvh && rt.needs().scene_buffers && !rt.needs().shadow_maps);
         let vis = Techniques { gbuffer: GBuffer::Visibility, ..d };
         assert!(vis.needs().scene_buffers && !vis.needs().bvh);

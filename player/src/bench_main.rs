@@ -1,0 +1,17 @@
+//! `kiln-bench`: every technique as a point of (GPU time, error against the reference) (see
+//! `kiln-bench --help`).
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use kiln_player::sweep::cli::{Args, run};
+
+fn main() -> ExitCode {
+    match run(Args::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(e.exit as u8)
+        }
+    }
+}

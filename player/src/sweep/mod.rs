@@ -1,0 +1,333 @@
+//! `kiln-bench`: every technique as a point of (GPU time, error against a path-traced
+//! reference), per effect, with the Pareto front.
+//!
+//! For each camera: the reference (two independent halves, cached; [`truth`]), then every
+//! configuration of the [`plan`] in a session of its own ([`measure`]): its image at each frame
+//! count it is measured at, compared with the reference ([`kiln_metrics`]), and its GPU time per
+//! frame over many frames. Effect charts hold the other effects fixed ([`plan::fixed`]), so that
+//! two points of a chart differ by their effect alone. [`report`] writes the JSON, CSV, charts
+//! and page.
+
+pub mod cli;
+pub mod measure;
+pub mod plan;
+pub mod report;
+pub mod results;
+pub mod truth;
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use kiln_format::sections::BVH_NODES;
+use xxhash_rust::xxh3::Xxh3;
+
+use crate::camera::{Camera, CameraOverride};
+use crate::error::{Exit, PlayError, PlayResult};
+use crate::gpu::{Gpu, GpuOptions};
+use crate::render::{Effect, Purpose, RenderSettings, Techniques};
+use crate::session::{SessionOptions, open_file};
+
+use measure::{Measured, Timing, measure};
+use truth::Reference;
+use plan::{Offers, Plan, Request, Skipped, Target};
+use results::{Figures, Point, ReferenceInfo, Results, SceneInfo, TimingInfo};
+
+/// The largest image side a sweep accepts (the reference accumulates in RGBA32F).
+pub const MAX_SIDE: u32 = 8192;
+
+/// Everything a sweep needs to know.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    /// The `.kiln` file.
+    pub file: PathBuf,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Cameras (`None`: the file's camera); at least one.
+    pub cameras: Vec<Option<CameraOverride>>,
+    /// What to sweep.
+    pub request: Request,
+    /// Reference samples per pixel (two halves of half each).
+    pub reference_spp: u32,
+    /// Frames timed per configuration.
+    pub timing: Timing,
+    /// Output folder (also the reference cache).
+    pub out: PathBuf,
+    /// Device options.
+    pub gpu: GpuOptions,
+    /// Write every measured image (EXR) and the reference into `OUT/images/`.
+    pub keep_images: bool,
+    /// Show progress bars.
+    pub progress: bool,
+}
+
+/// A sweep's outcome: the results, and points that could not be measured.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The results (every point that was measured).
+    pub results: Results,
+    /// Configurations that failed (a GPU error, an image with NaN or infinity), with why.
+    pub failures: Vec<Skipped>,
+}
+
+/// What the file offers, its scene name and content hash; refuses files the reference cannot
+/// render.
+fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Camera>)> {
+    let file = open_file(&options.file)?;
+    let manifest = file
+        .manifest()
+        .map_err(|e| PlayError::new(Exit::BadInput, format!("{}: {e}", options.file.display())))?;
+    let offers = Offers {
+        bvh: file.find(BVH_NODES, 0).is_some(),
+        shadow_maps: !manifest.shadow_maps.is_empty() && !manifest.lights.is_empty(),
+    };
+    if !offers.bvh {
+        return Err(PlayError::new(
+            Exit::BadInput,
+            format!(
+                "{}: the file has no BVH, so the reference path tracer cannot render it (compile it without skipping the BVH)",
+                options.file.display()
+            ),
+        ));
+    }
+    let mut h = Xxh3::new();
+    h.update(file.bytes());
+    let hash = format!("{:032x}", h.digest128());
+    let mut cameras = Vec::new();
+    for c in &options.cameras {
+        cameras.push(Camera::initial(&manifest.cameras, &manifest.bounds, *c).map_err(|e| {
+            PlayError::new(Exit::Usage, format!("--camera: {e}"))
+        })?);
+    }
+    Ok((offers, manifest.scene_name.clone(), hash, cameras))
+}
+
+/// Refuses sizes the reference cannot render, before any work.
+pub fn check_size(width: u32, height: u32) -> PlayResult {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(PlayError::new(
+            Exit::Usage,
+            format!("--size {width}x{height}: each side must be 1..={MAX_SIDE} pixels"),
+        ));
+    }
+    Ok(())
+}
+
+/// The camera's name in the results and the reference key.
+fn camera_name(c: &Option<CameraOverride>) -> String {
+    match c {
+        None => "file".into(),
+        Some(c) => {
+            let mut v: Vec<String> = c.position.iter().chain(&c.target).map(|x| x.to_string()).collect();
+            if let Some(f) = c.vfov_degrees {
+                v.push(f.to_string());
+            }
+            v.join(",")
+        }
+    }
+}
+
+fn techniques_map(t: &Techniques) -> BTreeMap<String, String> {
+    Effect::ALL.iter().map(|&e| (e.name().to_string(), t.name_of(e).to_string())).collect()
+}
+
+/// A bar on stderr when asked for, hidden otherwise.
+fn bar(show: bool, len: u64) -> ProgressBar {
+    let b = ProgressBar::with_draw_target(
+        Some(len),
+        if show { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
+    );
+    b.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    b
+}
+
+/// `pixels` (linear RGB) as the metrics take them.
+fn rgb_image(width: u32, height: u32, pixels: &[f32]) -> kiln_metrics::RgbImage<'_> {
+    kiln_metrics::RgbImage { width, height, pixels }
+}
+
+/// Runs the sweep.
+pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
+    let started = Instant::now();
+    check_size(options.width, options.height)?;
+    options.request.check().map_err(|e| PlayError::new(Exit::Usage, e))?;
+    if options.reference_spp < 2 {
+        return Err(PlayError::new(Exit::Usage, "--reference-spp must be at least 2 (two independent halves)"));
+    }
+    let (offers, scene_name, content_hash, _) = inspect(options)?;
+    let plan: Plan = plan::plan(&options.request, &offers);
+    let device = Gpu::new(&options.gpu)?.identity();
+    let cameras: Vec<Option<CameraOverride>> =
+        if options.cameras.is_empty() { vec![None] } else { options.cameras.clone() };
+    let images_per_camera: u64 = plan.configs.iter().map(|c| c.checkpoints.len() as u64).sum::<u64>() + 3;
+    let progress = bar(options.progress, images_per_camera * cameras.len() as u64);
+    let mut points = Vec::new();
+    let mut references = Vec::new();
+    let mut warnings: Vec<String> = Vec::new();
+    let mut failures = Vec::new();
+    for camera in &cameras {
+        let name = camera_name(camera);
+        let base = SessionOptions {
+            file: options.file.clone(),
+            gpu: options.gpu.clone(),
+            render: RenderSettings { techniques: plan.fixed, exposure: 0.0, purpose: Purpose::Frames },
+            width: options.width,
+            height: options.height,
+            camera: *camera,
+            readback: None,
+        };
+        let mut ref_options = base.clone();
+        ref_options.render.purpose = Purpose::Reference;
+        let mut bounces: Vec<u32> = plan.configs.iter().map(|c| plan::bounces(c.target)).collect();
+        bounces.sort_unstable();
+        bounces.dedup();
+        let mut refs: HashMap<u32, Reference> = HashMap::new();
+        for &b in &bounces {
+            let half = options.reference_spp.div_ceil(2);
+            let key = truth::key(&content_hash, &name, options.width, options.height, half, b);
+            progress.set_message(format!("reference, {} ({name})", plan::transport(b)));
+            let reference = truth::obtain(&ref_options, options.reference_spp, b, &key, &options.out.join("reference"), |m| {
+                progress.set_message(m.to_string())
+            })?;
+            progress.inc(1);
+            if options.keep_images {
+                report::keep_image(
+                    &options.out,
+                    &name,
+                    &format!("reference-{b}"),
+                    options.width,
+                    options.height,
+                    &reference.rgb,
+                    reference.spp,
+                )?;
+            }
+            references.push(ReferenceInfo {
+                camera: name.clone(),
+                spp: reference.spp,
+                bounces: b,
+                noise_floor: reference.noise_floor,
+                seconds: reference.seconds,
+                cached: reference.cached,
+                key: reference.key.clone(),
+            });
+            refs.insert(b, reference);
+        }
+        let mut done: HashMap<String, Measured> = HashMap::new();
+        let mut measure_once = |techniques: Techniques, checkpoints: &[u32], label: &str| -> PlayResult<Measured> {
+            let k = format!("{techniques:?} {checkpoints:?}");
+            if let Some(m) = done.get(&k) {
+                progress.inc(checkpoints.len() as u64);
+                return Ok(m.clone());
+            }
+            progress.set_message(label.to_string());
+            let m = measure(&base, techniques, checkpoints, options.timing, || progress.inc(1))?;
+            done.insert(k, m.clone());
+            Ok(m)
+        };
+        let fixed = measure_once(plan.fixed, &[1], "fixed frame")?;
+        let fixed_passes: Vec<String> = fixed.passes.iter().map(|p| p.pass.clone()).collect();
+        for config in &plan.configs {
+            let label = config.label(*config.checkpoints.last().unwrap_or(&1));
+            let m = match measure_once(config.techniques, &config.checkpoints, &label) {
+                Ok(m) => m,
+                Err(e) if e.exit == Exit::Gpu || e.exit == Exit::Unsupported => {
+                    failures.push(Skipped {
+                        effect: config.target.name().into(),
+                        technique: config.technique.clone(),
+                        reason: e.message,
+                    });
+                    continue;
+                }
+                Err(e) => return Err(e),
+            };
+            for w in &m.warnings {
+                if !warnings.contains(w) {
+                    warnings.push(w.clone());
+                }
+            }
+            let total = m.passes.last().expect("total is always there");
+            let effect_ms = match config.target {
+                Target::Frame => total.median_ms,
+                Target::Effect(_) => {
+                    m.passes.iter().filter(|p| p.pass != "total" && !fixed_passes.contains(&p.pass)).map(|p| p.median_ms).sum()
+                }
+            };
+            let reference = &refs[&plan::bounces(config.target)];
+            for (frames, rgb) in &m.images {
+                let label = config.label(*frames);
+                let (w, h) = (options.width, options.height);
+                let error: Figures = match kiln_metrics::compare(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
+                    Ok(e) => e.into(),
+                    Err(e) => {
+                        failures.push(Skipped {
+                            effect: config.target.name().into(),
+                            technique: label.clone(),
+                            reason: format!("cannot be measured: {e}"),
+                        });
+                        continue;
+                    }
+                };
+                if options.keep_images {
+                    report::keep_image(
+                        &options.out,
+                        &name,
+                        &format!("{}-{label}", config.target),
+                        options.width,
+                        options.height,
+                        rgb,
+                        *frames,
+                    )?;
+                }
+                points.push(Point {
+                    effect: config.target.name().into(),
+                    technique: config.technique.clone(),
+                    knobs: config.knobs.clone(),
+                    frames: *frames,
+                    label,
+                    camera: name.clone(),
+                    techniques: techniques_map(&config.techniques),
+                    frame_ms: total.median_ms,
+                    frame_p10_ms: total.p10_ms,
+                    frame_p90_ms: total.p90_ms,
+                    effect_ms,
+                    image_ms: total.median_ms * *frames as f64,
+                    passes: m.passes.clone(),
+                    error,
+                    reference_spp: reference.spp,
+                    reference_bounces: reference.bounces,
+                    noise_floor: reference.noise_floor,
+                    below_noise_floor: error.flip < reference.noise_floor.flip,
+                    on_front: false,
+                    regression: None,
+                });
+            }
+        }
+    }
+    progress.finish_and_clear();
+    results::mark_front(&mut points);
+    let fixed = techniques_map(&plan.fixed);
+    let results = Results {
+        schema: results::SCHEMA,
+        tool: format!("kiln-bench {}", env!("CARGO_PKG_VERSION")),
+        device,
+        scene: SceneInfo { name: scene_name, file: options.file.display().to_string(), content_hash },
+        width: options.width,
+        height: options.height,
+        timing: TimingInfo { warmup_frames: options.timing.warmup, frames: options.timing.frames },
+        metrics: results::METRICS.into(),
+        fixed,
+        references,
+        points,
+        skipped: plan.skipped,
+        warnings,
+        sweep_seconds: started.elapsed().as_secs_f64(),
+    };
+    Ok(Outcome { results, failures })
+}

@@ -1,0 +1,393 @@
+//! What a sweep renders: for each effect, every technique the catalogue lists with every value
+//! of its quality knobs, the other effects fixed; and the frame as a whole in a few presets.
+//! Built from [`catalogue`] alone, so a new technique or knob is swept without naming it here.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use crate::render::technique::{
+    KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of,
+};
+use crate::render::{Aa, Effect, Needs, Shadows, Techniques};
+
+/// What one chart of a sweep shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Target {
+    /// One effect's techniques, everything else fixed.
+    Effect(Effect),
+    /// Whole-frame presets.
+    Frame,
+}
+
+impl Target {
+    /// Every target `--effects` accepts, in the order they are swept.
+    pub const ALL: [Target; 6] = [
+        Target::Effect(Effect::Shadows),
+        Target::Effect(Effect::Ao),
+        Target::Effect(Effect::Reflections),
+        Target::Effect(Effect::Gi),
+        Target::Effect(Effect::Media),
+        Target::Frame,
+    ];
+
+    /// The name `--effects` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Effect(e) => e.name(),
+            Target::Frame => "frame",
+        }
+    }
+
+    /// The target called `name`.
+    pub fn parse(name: &str) -> Result<Target, String> {
+        Target::ALL.into_iter().find(|t| t.name() == name).ok_or_else(|| {
+            let names: Vec<&str> = Target::ALL.iter().map(|t| t.name()).collect();
+            format!("no effect '{name}' (one of: {})", names.join(", "))
+        })
+    }
+}
+
+impl fmt::Display for Target {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The light transport a chart's reference computes: the bounces (scattering events) whose
+/// light counts, 0 for all. Shadows and AO approximate direct light (from the lights and the
+/// sky), so their charts compare against direct light alone; reflections add one glossy bounce,
+/// so theirs against two bounces; indirect light, media and the whole frame against every
+/// bounce, the truth. Against all bounces a frame without indirect light is mostly wrong by what
+/// it leaves out, which would hide the difference between two shadow techniques.
+pub fn bounces(target: Target) -> u32 {
+    match target {
+        Target::Effect(Effect::Shadows | Effect::Ao) => 1,
+        Target::Effect(Effect::Reflections) => 2,
+        _ => 0,
+    }
+}
+
+/// How [`bounces`] reads in a sentence.
+pub fn transport(bounces: u32) -> String {
+    match bounces {
+        0 => "all bounces".into(),
+        1 => "direct light only (1 bounce)".into(),
+        n => format!("{n} bounces"),
+    }
+}
+
+/// What the file offers the techniques (decided from its sections before any rendering).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Offers {
+    /// A BVH (ray-traced techniques, the reference).
+    pub bvh: bool,
+    /// Shadow maps for at least one light.
+    pub shadow_maps: bool,
+}
+
+impl Offers {
+    /// Why `techniques` cannot run on this file, if they cannot.
+    pub fn lacks(&self, techniques: &Techniques) -> Option<&'static str> {
+        let n: Needs = techniques.needs();
+        if n.bvh && !self.bvh {
+            Some("needs the BVH, which the file does not have (compiled without one)")
+        } else if n.shadow_maps && !self.shadow_maps {
+            Some("needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)")
+        } else {
+            None
+        }
+    }
+}
+
+/// One configuration to render: a technique with its knob values, the rest fixed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    /// The chart it belongs to.
+    pub target: Target,
+    /// Technique name (for the frame: the preset's name).
+    pub technique: String,
+    /// Knob values as text, by knob name (only knobs the sweep varies or the user set).
+    pub knobs: BTreeMap<String, String>,
+    /// Everything the frame renders.
+    pub techniques: Techniques,
+    /// Frames accumulated at which the image is measured (ascending; `[1]` for deterministic
+    /// techniques).
+    pub checkpoints: Vec<u32>,
+}
+
+impl Config {
+    /// A short label for charts: technique, knob values, frames.
+    pub fn label(&self, frames: u32) -> String {
+        let mut s = self.technique.clone();
+        for v in self.knobs.values() {
+            s.push(' ');
+            s.push_str(v);
+        }
+        if self.checkpoints.len() > 1 || frames > 1 {
+            s.push_str(&format!(" {frames}f"));
+        }
+        s
+    }
+}
+
+/// A technique the sweep leaves out, and why.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Skipped {
+    /// Effect (or "frame").
+    pub effect: String,
+    /// Technique or preset.
+    pub technique: String,
+    /// Why.
+    pub reason: String,
+}
+
+/// Everything one sweep renders.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// Configurations by chart, in sweep order.
+    pub configs: Vec<Config>,
+    /// What was left out.
+    pub skipped: Vec<Skipped>,
+    /// The techniques every effect chart holds fixed (except its own effect).
+    pub fixed: Techniques,
+}
+
+/// What the user asked to sweep.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// Charts to make.
+    pub targets: Vec<Target>,
+    /// `EFFECT:TECHNIQUE` or `TECHNIQUE` filters; empty: everything.
+    pub techniques: Vec<String>,
+    /// Frames accumulated at which stochastic techniques are measured.
+    pub frames: Vec<u32>,
+}
+
+impl Request {
+    fn wants(&self, target: Target, technique: &str) -> bool {
+        self.techniques.is_empty()
+            || self.techniques.iter().any(|f| match f.split_once(':') {
+                Some((e, t)) => e == target.name() && t == technique,
+                None => f == technique,
+            })
+    }
+
+    /// Checks the technique filters against the catalogue (and the frame presets): a filter
+    /// that matches nothing is a typo the user should hear about.
+    pub fn check(&self) -> Result<(), String> {
+        for f in &self.techniques {
+            let known = Target::ALL.iter().any(|&target| {
+                names(target).iter().any(|t| match f.split_once(':') {
+                    Some((e, n)) => e == target.name() && n == *t,
+                    None => f == t,
+                })
+            });
+            if !known {
+                return Err(format!(
+                    "--techniques: '{f}' matches no technique (write EFFECT:TECHNIQUE or TECHNIQUE, e.g. ao:rt; `kiln-bench --list` shows them)"
+                ));
+            }
+        }
+        if self.frames.is_empty() || self.frames.contains(&0) {
+            return Err("--frames-accumulated needs at least one count, each at least 1".into());
+        }
+        Ok(())
+    }
+}
+
+/// Technique (or preset) names of a target.
+pub fn names(target: Target) -> Vec<&'static str> {
+    match target {
+        Target::Effect(e) => techniques_of(e).map(|t| t.name).collect(),
+        Target::Frame => PRESETS.iter().map(|p| p.0).collect(),
+    }
+}
+
+/// Whole-frame presets: (name, what it is, how it sets the techniques).
+type Preset = (&'static str, &'static str, fn(&mut Techniques));
+
+/// The frame presets, each with both G-buffers.
+const PRESETS: [Preset; 3] = [
+    ("baked", "shadow maps, no AO, split-sum reflections", |t| {
+        t.shadows = Shadows::ShadowMap;
+    }),
+    ("rt", "ray-traced shadows, AO and full-resolution reflections (seed 001)", |t| {
+        set(t, Effect::Shadows, "rt");
+        set(t, Effect::Ao, "rt");
+        set(t, Effect::Reflections, "rt");
+    }),
+    ("rt-half", "as rt with half-resolution reflections", |t| {
+        set(t, Effect::Shadows, "rt");
+        set(t, Effect::Ao, "rt");
+        t.set(Effect::Reflections, "rt", &[("reflection-res", KnobValue::Choice(1))])
+            .expect("a catalogue knob");
+    }),
+];
+
+fn set(t: &mut Techniques, effect: Effect, name: &str) {
+    t.set(effect, name, &[]).expect("a catalogue technique");
+}
+
+/// The techniques effect charts hold fixed: raster G-buffer, shadow maps where the file has
+/// them (else none), every other effect off, accumulation on.
+pub fn fixed(offers: &Offers) -> Techniques {
+    Techniques {
+        shadows: if offers.shadow_maps { Shadows::ShadowMap } else { Shadows::None },
+        aa: Aa::Accumulate,
+        ..Techniques::default()
+    }
+}
+
+/// Every combination of a technique's quality knobs (scene knobs stay at their defaults).
+fn knob_combinations(info: &TechniqueInfo) -> Vec<Vec<(&'static str, KnobValue, String)>> {
+    let mut combos: Vec<Vec<(&'static str, KnobValue, String)>> = vec![Vec::new()];
+    for k in info.knobs.iter().filter(|k| k.role == KnobRole::Quality) {
+        let values: Vec<(KnobValue, String)> = match k.range {
+            KnobRange::Number { sweep, .. } if sweep.len() > 1 => {
+                sweep.iter().map(|&v| (KnobValue::Number(v), v.to_string())).collect()
+            }
+            KnobRange::Number { .. } => continue,
+            KnobRange::Choice(options) => options
+                .iter()
+                .enumerate()
+                .map(|(i, o)| (KnobValue::Choice(i), o.to_string()))
+                .collect(),
+        };
+        combos = combos
+            .into_iter()
+            .flat_map(|c| {
+                values.iter().map(move |(v, text)| {
+                    let mut c = c.clone();
+                    c.push((k.name, *v, text.clone()));
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+}
+
+/// The plan for `request` on a file that `offers` what it offers.
+pub fn plan(request: &Request, offers: &Offers) -> Plan {
+    let fixed = fixed(offers);
+    let mut configs = Vec::new();
+    let mut skipped = Vec::new();
+    let checkpoints = |stochastic: bool, t: &Techniques| {
+        if stochastic && t.aa == Aa::Accumulate { request.frames.clone() } else { vec![1] }
+    };
+    for &target in &request.targets {
+        match target {
+            Target::Effect(effect) => {
+                for info in catalogue().iter().filter(|t| t.effect == effect) {
+                    if !request.wants(target, info.name) {
+                        continue;
+                    }
+                    for combo in knob_combinations(info) {
+                        let mut t = fixed;
+                        let knobs: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
+                        t.set(effect, info.name, &knobs).expect("catalogue values are valid");
+                        if let Some(reason) = offers.lacks(&t) {
+                            push_skip(&mut skipped, target, info.name, reason);
+                            continue;
+                        }
+                        configs.push(Config {
+                            target,
+                            technique: info.name.to_string(),
+                            knobs: combo.iter().map(|(n, _, text)| (n.to_string(), text.clone())).collect(),
+                            techniques: t,
+                            checkpoints: checkpoints(info.stochastic, &t),
+                        });
+                    }
+                }
+            }
+            Target::Frame => {
+                for (name, _, apply) in PRESETS {
+                    if !request.wants(target, name) {
+                        continue;
+                    }
+                    for gbuffer in techniques_of(Effect::GBuffer) {
+                        let mut t = Techniques { aa: Aa::Accumulate, ..Techniques::default() };
+                        set(&mut t, Effect::GBuffer, gbuffer.name);
+                        apply(&mut t);
+                        if let Some(reason) = offers.lacks(&t) {
+                            push_skip(&mut skipped, target, name, reason);
+                            continue;
+                        }
+                        configs.push(Config {
+                            target,
+                            technique: format!("{}/{name}", gbuffer.name),
+                            knobs: BTreeMap::new(),
+                            techniques: t,
+                            checkpoints: checkpoints(t.ray_traced(), &t),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    Plan { configs, skipped, fixed }
+}
+
+fn push_skip(skipped: &mut Vec<Skipped>, target: Target, technique: &str, reason: &str) {
+    let s = Skipped { effect: target.name().into(), technique: technique.into(), reason: reason.into() };
+    if !skipped.contains(&s) {
+        skipped.push(s);
+    }
+}
+
+/// "gbuffer raster, shadows shadowmap, ..." for the effects other than `except`, from a map
+/// of effect to technique.
+pub fn describe_fixed_map(fixed: &BTreeMap<String, String>, except: &str) -> String {
+    Effect::ALL
+        .iter()
+        .filter(|e| e.name() != except)
+        .filter_map(|e| fixed.get(e.name()).map(|t| format!("{e} {t}")))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// One line per preset for `--list`.
+pub fn preset_help() -> Vec<String> {
+    PRESETS.iter().map(|(n, help, _)| format!("{n}: {help} (with each G-buffer)")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request(targets: Vec<Target>, techniques: &[&str]) -> Request {
+        Request { targets, techniques: techniques.iter().map(|s| s.to_string()).collect(), frames: vec![1, 4] }
+    }
+
+    const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true };
+
+    #[test]
+    fn every_catalogue_technique_of_an_effect_is_swept() {
+        let p = plan(&request(vec![Target::Effect(Effect::Shadows)], &[]), &ALL_OFFERED);
+        let names: Vec<&str> = p.configs.iter().map(|c| c.technique.as_str()).collect();
+        // rt's knobs size the lights: held at their defaults, so one rt configuration.
+        assert_eq!(names, ["none", "shadowmap", "rt"]);
+        assert_eq!(p.configs[2].checkpoints, [1, 4]);
+        assert_eq!(p.configs[1].checkpoints, [1]);
+        let r = plan(&request(vec![Target::Effect(Effect::Reflections)], &["reflections:rt"]), &ALL_OFFERED);
+        // resolution (2 options) × max roughness (2 sweep values)
+        assert_eq!(r.configs.len(), 4);
+        assert!(r.configs.iter().all(|c| c.techniques.shadows == Shadows::ShadowMap));
+    }
+
+    #[test]
+    fn missing_sections_skip_with_a_reason() {
+        let p = plan(&request(Target::ALL.to_vec(), &[]), &Offers { bvh: false, shadow_maps: false });
+        assert!(p.configs.iter().all(|c| !c.techniques.ray_traced() && c.techniques.shadows != Shadows::ShadowMap));
+        assert!(p.skipped.iter().any(|s| s.effect == "ao" && s.technique == "rt" && s.reason.contains("BVH")));
+        assert!(p.skipped.iter().any(|s| s.technique == "shadowmap" && s.reason.contains("shadow maps")));
+    }
+
+    #[test]
+    fn filters_are_checked() {
+        assert!(request(vec![], &["ao:rt", "shadowmap", "frame:rt-half"]).check().is_ok());
+        let e = request(vec![], &["ao:shadowmap"]).check().unwrap_err();
+        assert!(e.contains("ao:shadowmap"), "{e}");
+        assert!(Target::parse("fog").unwrap_err().contains("shadows, ao"));
+    }
+}
