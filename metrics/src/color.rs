@@ -11,15 +11,19 @@ const RGB_TO_XYZ: [[f32; 3]; 3] = [
     [1425312.0 / 73733382.0, 8788810.0 / 73733382.0, 70074185.0 / 73733382.0],
 ];
 
-/// CIE XYZ (D65) to linear sRGB.
+/// CIE XYZ (D65) to linear sRGB. The digits are the reference's (more than `f32` holds), kept so
+/// that the two read the same.
+#[allow(clippy::excessive_precision)]
 const XYZ_TO_RGB: [[f32; 3]; 3] = [
     [3.241003275, -1.537398934, -0.498615861],
     [-0.969224334, 1.875930071, 0.041554224],
     [0.055639423, -0.204011202, 1.057148933],
 ];
 
-/// The D65 white point in XYZ, and its inverse (both as the reference writes them).
+/// The D65 white point in XYZ, and its inverse (both with the reference's digits).
+#[allow(clippy::excessive_precision)]
 const WHITE: [f32; 3] = [0.950428545, 1.0, 1.088900371];
+#[allow(clippy::excessive_precision)]
 const INV_WHITE: [f32; 3] = [1.052156925, 1.0, 0.918357670];
 
 fn mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {

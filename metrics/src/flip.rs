@@ -204,7 +204,15 @@ fn convolve_row(padded: &[f32], pad: usize, kernel: &[f32], out: &mut [f32]) {
 }
 
 /// `acc[x] = Σ_i kernel[i] · plane(y + i − r)[x]`, rows clamped to the image.
-fn convolve_column(rows: &[f32], w: usize, h: usize, y: usize, plane: usize, kernel: &[f32], acc: &mut [f32]) {
+fn convolve_column(
+    rows: &[f32],
+    w: usize,
+    h: usize,
+    y: usize,
+    plane: usize,
+    kernel: &[f32],
+    acc: &mut [f32],
+) {
     let r = kernel.len() / 2;
     acc.fill(0.0);
     for (i, &weight) in kernel.iter().enumerate() {
@@ -247,8 +255,7 @@ fn vertical_row(rows: &[f32], w: usize, h: usize, y: usize, k: &Kernels, acc: &m
         };
         let (edge_r, point_r) = strengths(0);
         let (edge_t, point_t) = strengths(8);
-        let feature_error =
-            (norm * (edge_r - edge_t).abs().max((point_r - point_t).abs())).powf(QF);
+        let feature_error = (norm * (edge_r - edge_t).abs().max((point_r - point_t).abs())).powf(QF);
         *o = color_error.powf(1.0 - feature_error);
     }
 }
