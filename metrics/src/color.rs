@@ -26,6 +26,7 @@ const WHITE: [f32; 3] = [0.950428545, 1.0, 1.088900371];
 #[allow(clippy::excessive_precision)]
 const INV_WHITE: [f32; 3] = [1.052156925, 1.0, 0.918357670];
 
+#[inline(always)]
 fn mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
     m.map(|row| row[0] * v[0] + row[1] * v[1] + row[2] * v[2])
 }
@@ -37,6 +38,7 @@ pub(crate) fn luminance(rgb: [f32; 3]) -> f32 {
 
 /// Clamps to `[0, 1]` the way the reference does (`min(max(v, 0), 1)` written with `>`), which
 /// sends NaN to 0: an overflowing tone-mapped value is black there, not NaN.
+#[inline(always)]
 pub(crate) fn clamp01(v: f32) -> f32 {
     let v = if v > 0.0 { v } else { 0.0 };
     if v > 1.0 { 1.0 } else { v }
@@ -51,6 +53,7 @@ pub(crate) fn linear_rgb_to_ycxcz(rgb: [f32; 3]) -> [f32; 3] {
 }
 
 /// YCxCz back to linear sRGB (unclamped).
+#[inline(always)]
 fn ycxcz_to_linear_rgb(ycxcz: [f32; 3]) -> [f32; 3] {
     let y = (ycxcz[0] + 16.0) / 116.0;
     let cx = ycxcz[1] / 500.0;
@@ -60,6 +63,7 @@ fn ycxcz_to_linear_rgb(ycxcz: [f32; 3]) -> [f32; 3] {
 }
 
 /// Linear sRGB to CIELAB (D65).
+#[inline(always)]
 fn linear_rgb_to_lab(rgb: [f32; 3]) -> [f32; 3] {
     const DELTA: f32 = 6.0 / 29.0;
     const DELTA_CUBE: f32 = DELTA * DELTA * DELTA;
@@ -68,19 +72,21 @@ fn linear_rgb_to_lab(rgb: [f32; 3]) -> [f32; 3] {
     let xyz = mul(&RGB_TO_XYZ, rgb);
     let f = |v: f32, white_inv: f32| {
         let v = v * white_inv;
-        if v > DELTA_CUBE { v.cbrt() } else { factor * v + term }
+        if v > DELTA_CUBE { crate::fastmath::cbrt(v) } else { factor * v + term }
     };
     let [fx, fy, fz] = [f(xyz[0], INV_WHITE[0]), f(xyz[1], INV_WHITE[1]), f(xyz[2], INV_WHITE[2])];
     [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
 }
 
 /// The Hunt effect (chroma looks stronger at higher luminance): scales a and b by L/100.
+#[inline(always)]
 fn hunt(lab: [f32; 3]) -> [f32; 3] {
     [lab[0], 0.01 * lab[0] * lab[1], 0.01 * lab[0] * lab[2]]
 }
 
 /// HyAB distance (Abasi et al. 2020): city-block in L plus Euclidean in (a, b), which suits large
 /// colour differences better than ΔE.
+#[inline(always)]
 fn hyab(p: [f32; 3], q: [f32; 3]) -> f32 {
     let (da, db) = (p[1] - q[1], p[2] - q[2]);
     (p[0] - q[0]).abs() + (da * da + db * db).sqrt()
@@ -95,6 +101,7 @@ const PC: f32 = 0.4;
 const PT: f32 = 0.95;
 
 /// A filtered YCxCz pixel, clamped to the RGB gamut, in Hunt-adjusted CIELAB.
+#[inline(always)]
 pub(crate) fn filtered_to_hunt_lab(ycxcz: [f32; 3]) -> [f32; 3] {
     hunt(linear_rgb_to_lab(ycxcz_to_linear_rgb(ycxcz).map(clamp01)))
 }
@@ -117,8 +124,9 @@ impl ColorScale {
     }
 
     /// The colour error in `[0, 1]` of two Hunt-adjusted CIELAB pixels.
+    #[inline(always)]
     pub(crate) fn error(&self, reference: [f32; 3], test: [f32; 3]) -> f32 {
-        let d = hyab(reference, test).powf(QC);
+        let d = crate::fastmath::pow(hyab(reference, test), QC);
         if d < self.pccmax {
             d * (PT / self.pccmax)
         } else {

@@ -29,6 +29,7 @@
 use rayon::prelude::*;
 
 use crate::color::{self, ColorScale};
+use crate::fastmath;
 
 /// A validated image: `width · height · 3` finite values, at least one pixel.
 #[derive(Debug, Clone, Copy)]
@@ -194,10 +195,13 @@ fn horizontal_row(
 /// `out[x] = Σ_i kernel[i] · padded[pad + x + i − r]`, summed in tap order like the reference.
 fn convolve_row(padded: &[f32], pad: usize, kernel: &[f32], out: &mut [f32]) {
     let start = pad - kernel.len() / 2;
-    out.fill(0.0);
-    for (i, &weight) in kernel.iter().enumerate() {
-        let src = &padded[start + i..start + i + out.len()];
-        for (o, &s) in out.iter_mut().zip(src) {
+    let n = out.len();
+    // The first tap assigns (0 + w·s is w·s), the others add.
+    for (o, &s) in out.iter_mut().zip(&padded[start..start + n]) {
+        *o = kernel[0] * s;
+    }
+    for (i, &weight) in kernel.iter().enumerate().skip(1) {
+        for (o, &s) in out.iter_mut().zip(&padded[start + i..start + i + n]) {
             *o += weight * s;
         }
     }
@@ -214,11 +218,17 @@ fn convolve_column(
     acc: &mut [f32],
 ) {
     let r = kernel.len() / 2;
-    acc.fill(0.0);
-    for (i, &weight) in kernel.iter().enumerate() {
+    let row = |i: usize| {
         let yy = (y + i).saturating_sub(r).min(h - 1);
         let start = (yy * PLANES + plane) * w;
-        for (a, &s) in acc.iter_mut().zip(&rows[start..start + w]) {
+        &rows[start..start + w]
+    };
+    // The first tap assigns (0 + w·s is w·s), the others add.
+    for (a, &s) in acc.iter_mut().zip(row(0)) {
+        *a = kernel[0] * s;
+    }
+    for (i, &weight) in kernel.iter().enumerate().skip(1) {
+        for (a, &s) in acc.iter_mut().zip(row(i)) {
             *a += weight * s;
         }
     }
@@ -242,22 +252,54 @@ fn vertical_row(rows: &[f32], w: usize, h: usize, y: usize, k: &Kernels, acc: &m
         convolve_column(rows, w, h, y, base + 6, &k.d1, accs.next().expect("16"));
         convolve_column(rows, w, h, y, base + 6, &k.d2, accs.next().expect("16"));
     }
+    // The per-pixel stage, as passes over whole rows of plain arrays so that each loop
+    // compiles to vector code (the colour conversions and powers are inline and branch-free).
+    let (acc, extra) = acc.split_at_mut(ACCUMULATORS * w);
+    let [l_r, a_r, b_r, l_t, a_t, b_t] = split6(extra, w);
+    let plane = |i: usize| &acc[i * w..(i + 1) * w];
+    hunt_lab_row([plane(0), plane(1), plane(2), plane(3)], [l_r, a_r, b_r]);
+    hunt_lab_row([plane(8), plane(9), plane(10), plane(11)], [l_t, a_t, b_t]);
     let scale = ColorScale::new();
-    let norm = 1.0 / 2.0f32.sqrt();
-    let a = |i: usize, x: usize| acc[i * w + x];
-    for (x, o) in out.iter_mut().enumerate() {
-        let lab = |b: usize| color::filtered_to_hunt_lab([a(b, x), a(b + 1, x), a(b + 2, x) + a(b + 3, x)]);
-        let color_error = scale.error(lab(0), lab(8));
-        // Edge strength: gradient magnitude; point strength: magnitude of the second derivatives.
-        let strengths = |b: usize| {
-            let (dx, ddx, dy, ddy) = (a(b + 4, x), a(b + 5, x), a(b + 6, x), a(b + 7, x));
-            ((dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt())
-        };
-        let (edge_r, point_r) = strengths(0);
-        let (edge_t, point_t) = strengths(8);
-        let feature_error = (norm * (edge_r - edge_t).abs().max((point_r - point_t).abs())).powf(QF);
-        *o = color_error.powf(1.0 - feature_error);
+    let features_r = [plane(4), plane(5), plane(6), plane(7)];
+    let features_t = [plane(12), plane(13), plane(14), plane(15)];
+    let (l_r, a_r, b_r, l_t, a_t, b_t) = (&l_r[..w], &a_r[..w], &b_r[..w], &l_t[..w], &a_t[..w], &b_t[..w]);
+    let out = &mut out[..w];
+    for x in 0..w {
+        let color_error = scale.error([l_r[x], a_r[x], b_r[x]], [l_t[x], a_t[x], b_t[x]]);
+        let feature_error = feature_error(features_r.map(|p| p[x]), features_t.map(|p| p[x]));
+        out[x] = fastmath::pow(color_error, 1.0 - feature_error);
     }
+}
+
+/// Six row-length slices of `buf`.
+fn split6(buf: &mut [f32], w: usize) -> [&mut [f32]; 6] {
+    let mut rows = buf.chunks_exact_mut(w);
+    std::array::from_fn(|_| rows.next().expect("6 rows of scratch"))
+}
+
+/// Hunt-adjusted CIELAB of a row of filtered pixels given as Y, Cx and the two parts of Cz.
+fn hunt_lab_row(ycxcz: [&[f32]; 4], lab: [&mut [f32]; 3]) {
+    let n = lab[0].len();
+    let [y, cx, cz1, cz2] = ycxcz.map(|p| &p[..n]);
+    let [l, a, b] = lab.map(|p| &mut p[..n]);
+    for x in 0..n {
+        [l[x], a[x], b[x]] = color::filtered_to_hunt_lab([y[x], cx[x], cz1[x] + cz2[x]]);
+    }
+}
+
+/// The feature error in [0, 1] from the filtered luminance derivatives (x, xx, y, yy) of the
+/// reference and the test pixel: the larger difference of edge strength (gradient magnitude) and
+/// of point strength (magnitude of the second derivatives), scaled to [0, 1] by 1/√2, to the
+/// power q_f = ½.
+#[inline(always)]
+fn feature_error(reference: [f32; 4], test: [f32; 4]) -> f32 {
+    let strengths =
+        |[dx, ddx, dy, ddy]: [f32; 4]| ((dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt());
+    let (edge_r, point_r) = strengths(reference);
+    let (edge_t, point_t) = strengths(test);
+    let difference = (edge_r - edge_t).abs().max((point_r - point_t).abs());
+    const { assert!(QF == 0.5) };
+    (std::f32::consts::FRAC_1_SQRT_2 * difference).sqrt()
 }
 
 /// Scratch buffers reused between exposures.
@@ -288,7 +330,7 @@ impl Work {
         );
         let rows = &self.rows;
         out.par_chunks_mut(w).enumerate().for_each_init(
-            || vec![0.0f32; ACCUMULATORS * w],
+            || vec![0.0f32; (ACCUMULATORS + 6) * w],
             |acc, (y, out)| vertical_row(rows, w, h, y, k, acc, out),
         );
     }

@@ -48,6 +48,7 @@
 #![deny(missing_docs)]
 
 mod color;
+mod fastmath;
 mod flip;
 
 /// Pixels per degree of visual angle that FLIP assumes: FLIP's default viewing conditions, a
