@@ -18,8 +18,11 @@ use std::process::Command;
 
 use kiln_metrics::{RgbImage, hdr_flip, ldr_flip};
 
-/// Largest allowed difference of the mean FLIP from flip_evaluator's.
-const TOLERANCE: f64 = 1e-3;
+/// Largest allowed difference of the mean FLIP from flip_evaluator's. kiln-bench needs 1e-3;
+/// the port agrees to about 1e-6 (both work in f32 with the same filters and order of
+/// summation), and 1e-3 let real bugs through: a blue-yellow CSF amplitude of 30 instead of 34.1
+/// moved the means by at most 5e-4, zero padding at the left border by at most 1.4e-3.
+const TOLERANCE: f64 = 1e-5;
 
 const INSTALL: &str = "run .ci/run or python3 -m venv .venv-mitsuba && \
                        .venv-mitsuba/bin/pip install mitsuba flip-evaluator numpy";
