@@ -67,7 +67,9 @@ pub(crate) fn png(chart: &Chart, width: u32, height: u32) -> Result<Vec<u8>, Plo
     font()?;
     let mut rgb = vec![255u8; width as usize * height as usize * 3];
     {
-        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+        let font = ab_glyph::FontRef::try_from_slice(FONT).map_err(|_| PlotError::Font)?;
+        let backend = crate::crisp::Crisp::new(BitMapBackend::with_buffer(&mut rgb, (width, height)), font);
+        let root = backend.into_drawing_area();
         let scale = (width as f64 / SVG_SIZE.0 as f64).min(height as f64 / SVG_SIZE.1 as f64).clamp(0.5, 4.0);
         draw(&root, chart, scale)?;
         root.present().map_err(draw_error)?;
@@ -255,20 +257,10 @@ where
 
     // The Pareto front as a step line: for a budget x, the least error within it, continued to
     // the right edge.
-    if !p.front.is_empty() {
-        let mut steps = Vec::new();
-        for (k, &i) in p.front.iter().enumerate() {
-            let pt = p.points[i];
-            if k > 0 {
-                steps.push((pt.x, p.points[p.front[k - 1]].y));
-            }
-            steps.push((pt.x, pt.y));
-        }
-        // Duplicated front points make zero-length steps: leave them out.
-        steps.dedup();
-        steps.push((p.x.hi, p.points[*p.front.last().unwrap_or(&0)].y));
+    let steps = front_steps(&p);
+    if !steps.is_empty() {
         let front_style = FRONT.mix(0.75).stroke_width((2.0 * s).round().max(1.0) as u32);
-        cc.draw_series(LineSeries::new(steps, front_style))
+        cc.draw_series(LineSeries::new(steps.iter().copied(), front_style))
             .map_err(draw_error)?
             .label("Pareto front")
             .legend(move |(x, y)| PathElement::new([(x - 10, y), (x + 10, y)], front_style));
@@ -330,6 +322,13 @@ where
         })
         .collect();
     taken.push(legend_box);
+    // The front's step line: horizontal and vertical segments, a few pixels thick.
+    for seg in steps.windows(2) {
+        let (a, b) = (cc.backend_coord(&seg[0]), cc.backend_coord(&seg[1]));
+        let (x0, x1) = (a.0.min(b.0) as f64 - 2.0, a.0.max(b.0) as f64 + 2.0);
+        let (y0, y1) = (a.1.min(b.1) as f64 - 2.0, a.1.max(b.1) as f64 + 2.0);
+        taken.push(Rect::new(x0, y0, x1 - x0, y1 - y0));
+    }
     let area =
         Rect::new(px.start as f64, py.start as f64, (px.end - px.start) as f64, (py.end - py.start) as f64);
     // Place labels left to right, the front's first (they matter most).
@@ -400,6 +399,25 @@ where
             .map_err(draw_error)?;
     }
     Ok(())
+}
+
+/// The Pareto front as a step line: for a budget x, the least error within it, continued to the
+/// right edge. Empty without points.
+fn front_steps(p: &Prepared) -> Vec<(f64, f64)> {
+    let mut steps = Vec::new();
+    for (k, &i) in p.front.iter().enumerate() {
+        let pt = p.points[i];
+        if k > 0 {
+            steps.push((pt.x, p.points[p.front[k - 1]].y));
+        }
+        steps.push((pt.x, pt.y));
+    }
+    // Duplicated front points make zero-length steps: leave them out.
+    steps.dedup();
+    if let Some(&last) = steps.last() {
+        steps.push((p.x.hi, last.1));
+    }
+    steps
 }
 
 /// An axis-aligned rectangle in pixels.

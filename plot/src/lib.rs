@@ -29,6 +29,7 @@
 #![deny(missing_docs)]
 
 mod axis;
+mod crisp;
 mod draw;
 mod html;
 
