@@ -42,7 +42,10 @@ fn text_is_escaped() {
     assert!(!h.contains("<b>"), "{h}");
     assert!(!h.contains("\"quoted\""), "{h}");
     assert!(!h.contains("'x'"), "{h}");
-    assert!(h.contains("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &quot;quoted&quot; &lt;b&gt;"), "{h}");
+    assert!(
+        h.contains("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &quot;quoted&quot; &lt;b&gt;"),
+        "{h}"
+    );
     // Every occurrence is escaped: title, heading, alt text, note, header and cell.
     assert_eq!(h.matches("&lt;script&gt;").count(), 7, "{h}");
     // The charts and the highlight are there.
