@@ -257,7 +257,11 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[f32], spp: u32) ->
 pub fn read_spp(path: &Path) -> Option<u32> {
     let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
     let header = meta.headers.first()?;
-    match header.shared_attributes.other.get(&exr::meta::attribute::Text::from(SPP_ATTRIBUTE))? {
+    let name = exr::meta::attribute::Text::from(SPP_ATTRIBUTE);
+    // The exr crate files an attribute written as the image's under the layer's on reading.
+    let value =
+        header.shared_attributes.other.get(&name).or_else(|| header.own_attributes.other.get(&name))?;
+    match value {
         exr::meta::attribute::AttributeValue::I32(n) => u32::try_from(*n).ok(),
         _ => None,
     }

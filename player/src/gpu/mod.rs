@@ -360,7 +360,8 @@ impl Gpu {
         // SAFETY: `physical` belongs to `instance`; both chained structs are core in Vulkan 1.2,
         // which device creation required.
         unsafe { self.instance.get_physical_device_properties2(self.physical, &mut props) };
-        let text = |c: Result<&std::ffi::CStr, _>| c.map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+        let text =
+            |c: Result<&std::ffi::CStr, _>| c.map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
         let v = self.properties.driver_version;
         // NVIDIA packs 10.8.8.6 bits; everyone else follows the Vulkan version macros.
         let driver_version = if self.properties.vendor_id == 0x10de {

@@ -7,9 +7,9 @@ use clap::Parser;
 
 use crate::camera::CameraOverride;
 use crate::cli::Size;
-use crate::gpu::default_cache_path;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::GpuOptions;
+use crate::gpu::default_cache_path;
 use crate::render::technique::{KnobRole, catalogue};
 
 use super::measure::Timing;
@@ -191,7 +191,10 @@ pub fn run(args: Args) -> PlayResult {
         return Err(PlayError::new(Exit::Gpu, format!("configurations failed:\n  {}", lines.join("\n  "))));
     }
     if regressions > 0 {
-        return Err(PlayError::new(Exit::Regression, format!("{regressions} point(s) regressed against the old run")));
+        return Err(PlayError::new(
+            Exit::Regression,
+            format!("{regressions} point(s) regressed against the old run"),
+        ));
     }
     Ok(())
 }

@@ -51,7 +51,12 @@ pub fn measure(
     Ok(measured)
 }
 
-fn run(session: &mut Session, checkpoints: &[u32], timing: Timing, tick: &mut dyn FnMut()) -> PlayResult<Measured> {
+fn run(
+    session: &mut Session,
+    checkpoints: &[u32],
+    timing: Timing,
+    tick: &mut dyn FnMut(),
+) -> PlayResult<Measured> {
     let (w, h) = (session.renderer.images().width as usize, session.renderer.images().height as usize);
     let last = checkpoints.iter().copied().max().unwrap_or(1).max(1);
     let mut images = Vec::new();

@@ -30,9 +30,9 @@ use crate::render::{Effect, Purpose, RenderSettings, Techniques};
 use crate::session::{SessionOptions, open_file};
 
 use measure::{Measured, Timing, measure};
-use truth::Reference;
 use plan::{Offers, Plan, Request, Skipped, Target};
 use results::{Figures, Point, ReferenceInfo, Results, SceneInfo, TimingInfo};
+use truth::Reference;
 
 /// The largest image side a sweep accepts (the reference accumulates in RGBA32F).
 pub const MAX_SIDE: u32 = 8192;
@@ -98,9 +98,10 @@ fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Ca
     let hash = format!("{:032x}", h.digest128());
     let mut cameras = Vec::new();
     for c in &options.cameras {
-        cameras.push(Camera::initial(&manifest.cameras, &manifest.bounds, *c).map_err(|e| {
-            PlayError::new(Exit::Usage, format!("--camera: {e}"))
-        })?);
+        cameras.push(
+            Camera::initial(&manifest.cameras, &manifest.bounds, *c)
+                .map_err(|e| PlayError::new(Exit::Usage, format!("--camera: {e}")))?,
+        );
     }
     Ok((offers, manifest.scene_name.clone(), hash, cameras))
 }
@@ -159,7 +160,10 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
     check_size(options.width, options.height)?;
     options.request.check().map_err(|e| PlayError::new(Exit::Usage, e))?;
     if options.reference_spp < 2 {
-        return Err(PlayError::new(Exit::Usage, "--reference-spp must be at least 2 (two independent halves)"));
+        return Err(PlayError::new(
+            Exit::Usage,
+            "--reference-spp must be at least 2 (two independent halves)",
+        ));
     }
     let (offers, scene_name, content_hash, _) = inspect(options)?;
     let plan: Plan = plan::plan(&options.request, &offers);
@@ -193,9 +197,14 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             let half = options.reference_spp.div_ceil(2);
             let key = truth::key(&content_hash, &name, options.width, options.height, half, b);
             progress.set_message(format!("reference, {} ({name})", plan::transport(b)));
-            let reference = truth::obtain(&ref_options, options.reference_spp, b, &key, &options.out.join("reference"), |m| {
-                progress.set_message(m.to_string())
-            })?;
+            let reference = truth::obtain(
+                &ref_options,
+                options.reference_spp,
+                b,
+                &key,
+                &options.out.join("reference"),
+                |m| progress.set_message(m.to_string()),
+            )?;
             progress.inc(1);
             if options.keep_images {
                 report::keep_image(
@@ -220,17 +229,18 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             refs.insert(b, reference);
         }
         let mut done: HashMap<String, Measured> = HashMap::new();
-        let mut measure_once = |techniques: Techniques, checkpoints: &[u32], label: &str| -> PlayResult<Measured> {
-            let k = format!("{techniques:?} {checkpoints:?}");
-            if let Some(m) = done.get(&k) {
-                progress.inc(checkpoints.len() as u64);
-                return Ok(m.clone());
-            }
-            progress.set_message(label.to_string());
-            let m = measure(&base, techniques, checkpoints, options.timing, || progress.inc(1))?;
-            done.insert(k, m.clone());
-            Ok(m)
-        };
+        let mut measure_once =
+            |techniques: Techniques, checkpoints: &[u32], label: &str| -> PlayResult<Measured> {
+                let k = format!("{techniques:?} {checkpoints:?}");
+                if let Some(m) = done.get(&k) {
+                    progress.inc(checkpoints.len() as u64);
+                    return Ok(m.clone());
+                }
+                progress.set_message(label.to_string());
+                let m = measure(&base, techniques, checkpoints, options.timing, || progress.inc(1))?;
+                done.insert(k, m.clone());
+                Ok(m)
+            };
         let fixed = measure_once(plan.fixed, &[1], "fixed frame")?;
         let fixed_passes: Vec<String> = fixed.passes.iter().map(|p| p.pass.clone()).collect();
         for config in &plan.configs {
@@ -255,25 +265,29 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             let total = m.passes.last().expect("total is always there");
             let effect_ms = match config.target {
                 Target::Frame => total.median_ms,
-                Target::Effect(_) => {
-                    m.passes.iter().filter(|p| p.pass != "total" && !fixed_passes.contains(&p.pass)).map(|p| p.median_ms).sum()
-                }
+                Target::Effect(_) => m
+                    .passes
+                    .iter()
+                    .filter(|p| p.pass != "total" && !fixed_passes.contains(&p.pass))
+                    .map(|p| p.median_ms)
+                    .sum(),
             };
             let reference = &refs[&plan::bounces(config.target)];
             for (frames, rgb) in &m.images {
                 let label = config.label(*frames);
                 let (w, h) = (options.width, options.height);
-                let error: Figures = match kiln_metrics::compare(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
-                    Ok(e) => e.into(),
-                    Err(e) => {
-                        failures.push(Skipped {
-                            effect: config.target.name().into(),
-                            technique: label.clone(),
-                            reason: format!("cannot be measured: {e}"),
-                        });
-                        continue;
-                    }
-                };
+                let error: Figures =
+                    match kiln_metrics::compare(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
+                        Ok(e) => e.into(),
+                        Err(e) => {
+                            failures.push(Skipped {
+                                effect: config.target.name().into(),
+                                technique: label.clone(),
+                                reason: format!("cannot be measured: {e}"),
+                            });
+                            continue;
+                        }
+                    };
                 if options.keep_images {
                     report::keep_image(
                         &options.out,

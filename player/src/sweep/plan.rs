@@ -5,9 +5,7 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use crate::render::technique::{
-    KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of,
-};
+use crate::render::technique::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
 use crate::render::{Aa, Effect, Needs, Shadows, Techniques};
 
 /// What one chart of a sweep shows.
@@ -92,7 +90,9 @@ impl Offers {
         if n.bvh && !self.bvh {
             Some("needs the BVH, which the file does not have (compiled without one)")
         } else if n.shadow_maps && !self.shadow_maps {
-            Some("needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)")
+            Some(
+                "needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)",
+            )
         } else {
             None
         }
@@ -247,11 +247,9 @@ fn knob_combinations(info: &TechniqueInfo) -> Vec<Vec<(&'static str, KnobValue, 
                 sweep.iter().map(|&v| (KnobValue::Number(v), v.to_string())).collect()
             }
             KnobRange::Number { .. } => continue,
-            KnobRange::Choice(options) => options
-                .iter()
-                .enumerate()
-                .map(|(i, o)| (KnobValue::Choice(i), o.to_string()))
-                .collect(),
+            KnobRange::Choice(options) => {
+                options.iter().enumerate().map(|(i, o)| (KnobValue::Choice(i), o.to_string())).collect()
+            }
         };
         combos = combos
             .into_iter()
@@ -356,7 +354,11 @@ mod tests {
     use super::*;
 
     fn request(targets: Vec<Target>, techniques: &[&str]) -> Request {
-        Request { targets, techniques: techniques.iter().map(|s| s.to_string()).collect(), frames: vec![1, 4] }
+        Request {
+            targets,
+            techniques: techniques.iter().map(|s| s.to_string()).collect(),
+            frames: vec![1, 4],
+        }
     }
 
     const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true };
@@ -373,13 +375,25 @@ mod tests {
         // resolution (2 options) × max roughness (2 sweep values)
         assert_eq!(r.configs.len(), 4);
         assert!(r.configs.iter().all(|c| c.techniques.shadows == Shadows::ShadowMap));
+        let ao = plan(&request(vec![Target::Effect(Effect::Ao)], &[]), &ALL_OFFERED);
+        // none, and rt at each reach (the absolute radius has one sweep value: not varied)
+        assert_eq!(
+            ao.configs.iter().map(|c| c.label(1)).collect::<Vec<_>>(),
+            ["none", "rt 0.03 1f", "rt 0.1 1f", "rt 0.3 1f", "rt 100 1f"]
+        );
     }
 
     #[test]
     fn missing_sections_skip_with_a_reason() {
         let p = plan(&request(Target::ALL.to_vec(), &[]), &Offers { bvh: false, shadow_maps: false });
-        assert!(p.configs.iter().all(|c| !c.techniques.ray_traced() && c.techniques.shadows != Shadows::ShadowMap));
-        assert!(p.skipped.iter().any(|s| s.effect == "ao" && s.technique == "rt" && s.reason.contains("BVH")));
+        assert!(
+            p.configs
+                .iter()
+                .all(|c| !c.techniques.ray_traced() && c.techniques.shadows != Shadows::ShadowMap)
+        );
+        assert!(
+            p.skipped.iter().any(|s| s.effect == "ao" && s.technique == "rt" && s.reason.contains("BVH"))
+        );
         assert!(p.skipped.iter().any(|s| s.technique == "shadowmap" && s.reason.contains("shadow maps")));
     }
 

@@ -19,14 +19,24 @@ pub const PNG_SIZE: (u32, u32) = (1000, 700);
 /// A file name made of `parts`: letters, digits, `.`, `-`, `_` kept, anything else `_`.
 pub fn file_name(parts: &[&str], extension: &str) -> String {
     let joined = parts.join("-");
-    let clean: String =
-        joined.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_') { c } else { '_' }).collect();
+    let clean: String = joined
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_') { c } else { '_' })
+        .collect();
     format!("{clean}.{extension}")
 }
 
 /// Writes a measured image (linear RGB, EXR with the frame or sample count in the header) to
 /// `OUT/images/` for independent checking.
-pub fn keep_image(out: &Path, camera: &str, what: &str, width: u32, height: u32, rgb: &[f32], count: u32) -> PlayResult {
+pub fn keep_image(
+    out: &Path,
+    camera: &str,
+    what: &str,
+    width: u32,
+    height: u32,
+    rgb: &[f32],
+    count: u32,
+) -> PlayResult {
     let dir = out.join("images");
     create_dir(&dir)?;
     let camera = if camera == "file" { "file".to_string() } else { format!("cam{:08x}", short_hash(camera)) };
@@ -63,7 +73,11 @@ pub fn charts(results: &Results) -> Vec<(String, String, Chart)> {
             let mut subtitle = vec![
                 format!(
                     "{} at {}x{} on {} (driver {}), camera {camera}",
-                    results.scene.name, results.width, results.height, results.device.name, results.device.driver_version
+                    results.scene.name,
+                    results.width,
+                    results.height,
+                    results.device.name,
+                    results.device.driver_version
                 ),
                 format!("reference: path traced, {}, {spp} spp", transport(bounces)),
             ];
@@ -77,7 +91,12 @@ pub fn charts(results: &Results) -> Vec<(String, String, Chart)> {
                 y_label: "mean HDR-FLIP against the reference".into(),
                 points: points
                     .iter()
-                    .map(|p| ChartPoint { label: p.label.clone(), series: p.technique.clone(), x: p.image_ms, y: p.error.flip })
+                    .map(|p| ChartPoint {
+                        label: p.label.clone(),
+                        series: p.technique.clone(),
+                        x: p.image_ms,
+                        y: p.error.flip,
+                    })
                     .collect(),
                 noise_floor: floor,
             };
@@ -100,17 +119,22 @@ pub fn write(results: &Results, out: &Path) -> PlayResult<Vec<PathBuf>> {
     put("results.json", results.to_json().as_bytes())?;
     put("results.csv", results.to_csv().as_bytes())?;
     let mut sections = Vec::new();
-    let single_camera = results.references.len() <= 1;
+    let mut cameras: Vec<&str> = results.references.iter().map(|r| r.camera.as_str()).collect();
+    cameras.dedup();
+    let single_camera = cameras.len() <= 1;
     for (effect, camera, chart) in charts(results) {
-        let stem = if single_camera { effect.clone() } else { format!("{effect}-cam{:08x}", short_hash(&camera)) };
+        let stem =
+            if single_camera { effect.clone() } else { format!("{effect}-cam{:08x}", short_hash(&camera)) };
         let svg_file = file_name(&[&stem], "svg");
         let png_file = file_name(&[&stem], "png");
-        let svg = kiln_plot::svg(&chart).map_err(|e| PlayError::new(Exit::Io, format!("drawing {stem}.svg: {e}")))?;
+        let svg = kiln_plot::svg(&chart)
+            .map_err(|e| PlayError::new(Exit::Io, format!("drawing {stem}.svg: {e}")))?;
         put(&svg_file, svg.as_bytes())?;
         let png = kiln_plot::png(&chart, PNG_SIZE.0, PNG_SIZE.1)
             .map_err(|e| PlayError::new(Exit::Io, format!("drawing {stem}.png: {e}")))?;
         put(&png_file, &png)?;
-        let points: Vec<&Point> = results.points.iter().filter(|p| p.effect == effect && p.camera == camera).collect();
+        let points: Vec<&Point> =
+            results.points.iter().filter(|p| p.effect == effect && p.camera == camera).collect();
         sections.push(Section { heading: chart.title.clone(), svg_file, png_file, table: table(&points) });
     }
     let mut notes = vec![
@@ -155,7 +179,16 @@ pub fn write(results: &Results, out: &Path) -> PlayResult<Vec<PathBuf>> {
 /// The table of a chart's points: front points highlighted.
 fn table(points: &[&Point]) -> Table {
     let headers = [
-        "technique", "knobs", "frames", "ms/frame (p10-p90)", "effect ms", "image ms", "FLIP", "relMSE", "RMSE", "note",
+        "technique",
+        "knobs",
+        "frames",
+        "ms/frame (p10-p90)",
+        "effect ms",
+        "image ms",
+        "FLIP",
+        "relMSE",
+        "RMSE",
+        "note",
     ];
     let rows = points
         .iter()

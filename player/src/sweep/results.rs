@@ -168,7 +168,10 @@ impl Results {
                 ));
             }
             None => {
-                return Err(PlayError::new(Exit::BadInput, format!("{name}: no \"schema\": not a kiln-bench results file")));
+                return Err(PlayError::new(
+                    Exit::BadInput,
+                    format!("{name}: no \"schema\": not a kiln-bench results file"),
+                ));
             }
         }
         serde_json::from_value(v).map_err(|e| PlayError::new(Exit::BadInput, format!("{name}: {e}")))
@@ -256,7 +259,8 @@ pub fn mark_front(points: &mut [Point]) {
         groups.entry((p.effect.clone(), p.camera.clone())).or_default().push(i);
     }
     for members in groups.values() {
-        let xy: Vec<(f64, f64)> = members.iter().map(|&i| (points[i].image_ms, points[i].error.flip)).collect();
+        let xy: Vec<(f64, f64)> =
+            members.iter().map(|&i| (points[i].image_ms, points[i].error.flip)).collect();
         let front = kiln_plot::pareto_front(&xy);
         for (k, &i) in members.iter().enumerate() {
             points[i].on_front = front.contains(&k);
@@ -288,9 +292,13 @@ pub fn compare(new: &mut Results, old: &Results) -> Vec<String> {
         notes.push("the old run is of another file (content hash differs)".into());
     }
     if (new.width, new.height) != (old.width, old.height) {
-        notes.push(format!("the old run is at {}x{}, this one at {}x{}", old.width, old.height, new.width, new.height));
+        notes.push(format!(
+            "the old run is at {}x{}, this one at {}x{}",
+            old.width, old.height, new.width, new.height
+        ));
     }
-    let key = |p: &Point| (p.effect.clone(), p.technique.clone(), p.knobs.clone(), p.frames, p.camera.clone());
+    let key =
+        |p: &Point| (p.effect.clone(), p.technique.clone(), p.knobs.clone(), p.frames, p.camera.clone());
     let olds: BTreeMap<_, &Point> = old.points.iter().map(|p| (key(p), p)).collect();
     let mut unmatched = 0;
     for p in &mut new.points {
@@ -336,5 +344,103 @@ pub fn regression(new: &Point, old: &Point) -> Option<String> {
         ))
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(effect: &str, frames: u32, image_ms: f64, flip: f64) -> Point {
+        Point {
+            effect: effect.into(),
+            technique: "rt".into(),
+            knobs: BTreeMap::from([("ao-reach".to_string(), "0.1".to_string())]),
+            frames,
+            label: format!("rt 0.1 {frames}f"),
+            camera: "file".into(),
+            techniques: BTreeMap::from([("ao".to_string(), "rt".to_string())]),
+            frame_ms: image_ms / frames as f64,
+            frame_p10_ms: image_ms / frames as f64 * 0.99,
+            frame_p90_ms: image_ms / frames as f64 * 1.01,
+            effect_ms: 0.25,
+            image_ms,
+            passes: vec![PassStats {
+                pass: "total".into(),
+                median_ms: image_ms / frames as f64,
+                p10_ms: 0.0,
+                p90_ms: 0.0,
+                min_ms: 0.0,
+                max_ms: 0.0,
+            }],
+            error: Figures { flip, rel_mse: 0.5, rmse: 1e-3 },
+            reference_spp: 64,
+            reference_bounces: 1,
+            noise_floor: Figures { flip: 0.01, rel_mse: 1e-4, rmse: 1e-5 },
+            below_noise_floor: false,
+            on_front: true,
+            regression: None,
+        }
+    }
+
+    fn results(points: Vec<Point>) -> Results {
+        Results {
+            schema: SCHEMA,
+            tool: "kiln-bench test".into(),
+            device: DeviceIdentity { name: "gpu \"x\", y".into(), uuid: "00ff".into(), ..Default::default() },
+            scene: SceneInfo { name: "s".into(), file: "s.kiln".into(), content_hash: "ab".into() },
+            width: 4,
+            height: 3,
+            timing: TimingInfo { warmup_frames: 1, frames: 2 },
+            metrics: METRICS.into(),
+            fixed: BTreeMap::new(),
+            references: vec![],
+            points,
+            skipped: vec![],
+            warnings: vec![],
+            sweep_seconds: 1.5,
+        }
+    }
+
+    #[test]
+    fn json_round_trips_and_other_schemas_are_refused() {
+        let r = results(vec![point("ao", 4, 2.0, 0.1), point("ao", 16, 8.0, 1.0 / 3.0)]);
+        assert_eq!(Results::from_json(&r.to_json(), "r.json").unwrap(), r);
+        let other = r.to_json().replacen(&format!("\"schema\": {SCHEMA}"), "\"schema\": 99", 1);
+        assert!(Results::from_json(&other, "r.json").unwrap_err().message.contains("schema 99"));
+        assert!(
+            Results::from_json("{}", "r.json").unwrap_err().message.contains("not a kiln-bench results file")
+        );
+    }
+
+    #[test]
+    fn csv_has_a_row_per_point_with_quoted_fields() {
+        let r = results(vec![point("ao", 4, 2.0, 0.1)]);
+        let csv = r.to_csv();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines[0].split(',').count(), CSV_COLUMNS.len());
+        // The device name has a comma and quotes: quoted, quotes doubled.
+        assert!(lines[1].contains("\"gpu \"\"x\"\", y\""), "{}", lines[1]);
+        assert!(lines[1].contains(",0.1,0.5,0.001,"), "{}", lines[1]);
+    }
+
+    #[test]
+    fn regressions_are_slower_at_equal_error_or_worse_at_equal_time() {
+        let old = point("ao", 4, 2.0, 0.1);
+        // Within tolerances: not a regression.
+        assert_eq!(regression(&point("ao", 4, 2.05, 0.1005), &old), None);
+        // 20% slower, same error.
+        assert!(regression(&point("ao", 4, 2.4, 0.1), &old).unwrap().starts_with("slower"));
+        // Slower but clearly more accurate: a trade, not a regression.
+        assert_eq!(regression(&point("ao", 4, 2.4, 0.05), &old), None);
+        // Same time, 10% worse.
+        assert!(regression(&point("ao", 4, 2.0, 0.11), &old).unwrap().starts_with("worse"));
+        // Worse but clearly faster: a trade.
+        assert_eq!(regression(&point("ao", 4, 1.5, 0.11), &old), None);
+        let mut new = results(vec![point("ao", 4, 2.4, 0.1), point("ao", 64, 1.0, 0.1)]);
+        let notes = compare(&mut new, &results(vec![old]));
+        assert!(new.points[0].regression.is_some() && new.points[1].regression.is_none());
+        assert_eq!(notes, ["1 point(s) have no partner in the old run"]);
     }
 }

@@ -96,10 +96,10 @@ pub fn obtain(
         halves.push(rgb);
     }
     let (a, b) = (&halves[0], &halves[1]);
-    let between = kiln_metrics::compare(super::rgb_image(w, h, a), super::rgb_image(w, h, b)).map_err(|e| {
-        PlayError::new(Exit::Gpu, format!("the reference halves cannot be compared: {e}"))
-    })?;
-    let noise_floor = Figures { flip: between.flip, rel_mse: between.rel_mse / 4.0, rmse: between.rmse / 2.0 };
+    let between = kiln_metrics::compare(super::rgb_image(w, h, a), super::rgb_image(w, h, b))
+        .map_err(|e| PlayError::new(Exit::Gpu, format!("the reference halves cannot be compared: {e}")))?;
+    let noise_floor =
+        Figures { flip: between.flip, rel_mse: between.rel_mse / 4.0, rmse: between.rmse / 2.0 };
     let rgb = a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect();
     Ok(Reference { rgb, spp: 2 * half, bounces, noise_floor, seconds, cached, key: key.to_string() })
 }
