@@ -269,8 +269,8 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
                     .passes
                     .iter()
                     .filter(|p| p.pass != "total" && !fixed_passes.contains(&p.pass))
-                    .map(|p| p.median_ms)
-                    .sum(),
+                    // From +0: an empty f64 sum is -0, which prints as "-0.000".
+                    .fold(0.0, |sum, p| sum + p.median_ms),
             };
             let reference = &refs[&plan::bounces(config.target)];
             for (frames, rgb) in &m.images {
