@@ -159,8 +159,12 @@ fn prepare(chart: &Chart) -> Prepared<'_> {
             Axis::log(lo / m, ymax * m * m)
         } else {
             let top = ymax.max(floor.unwrap_or(0.0));
-            // Room above the highest point for its label.
-            Axis::linear(0.0, if top > 0.0 { top * 1.15 } else { 1.0 })
+            // Room above the highest point for its label and for the legend (a row per series,
+            // the front and the band, about 4% of the plot's height each), so that the legend
+            // covers no point.
+            let rows = series.len() + 1 + usize::from(floor.is_some());
+            let free = (0.08 + 0.04 * rows as f64).min(0.6);
+            Axis::linear(0.0, if top > 0.0 { top / (1.0 - free) } else { 1.0 })
         };
         (x, y)
     };

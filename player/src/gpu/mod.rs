@@ -365,7 +365,7 @@ impl Gpu {
         let v = self.properties.driver_version;
         // NVIDIA packs 10.8.8.6 bits; everyone else follows the Vulkan version macros.
         let driver_version = if self.properties.vendor_id == 0x10de {
-            format!("{}.{}.{}", v >> 22, (v >> 14) & 0xff, (v >> 6) & 0xff)
+            format!("{}.{}.{:02}", v >> 22, (v >> 14) & 0xff, (v >> 6) & 0xff)
         } else {
             format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
         };

@@ -76,6 +76,10 @@ pub struct Args {
     /// List the effects, techniques, knobs and presets, and exit.
     #[arg(long)]
     pub list: bool,
+    /// Draw the charts, page and CSV of an earlier results.json into --out again (no GPU
+    /// needed), e.g. after a kiln-bench update; with --compare, marks its regressions.
+    #[arg(long, value_name = "RESULTS.json", conflicts_with_all = ["file", "json", "keep_images"])]
+    pub replot: Option<PathBuf>,
     /// Use the first device whose name contains this.
     #[arg(long)]
     pub device: Option<String>,
@@ -128,6 +132,13 @@ impl Args {
     }
 }
 
+/// An earlier results.json.
+fn read_results(path: &std::path::Path) -> PlayResult<Results> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| PlayError::new(Exit::Io, format!("{}: {e}", path.display())))?;
+    Results::from_json(&text, &path.display().to_string())
+}
+
 /// `--list`.
 fn list() -> String {
     let mut s = String::from("effects and techniques (EFFECT:TECHNIQUE for --techniques):\n");
@@ -154,20 +165,16 @@ pub fn run(args: Args) -> PlayResult {
         print!("{}", list());
         return Ok(());
     }
-    let Some(file) = args.file.clone() else {
-        return Err(PlayError::new(Exit::Usage, "give a .kiln file to benchmark (--help explains)"));
-    };
-    let options = args.options(file)?;
     // Read the old results first: a typo in the path should not cost a whole sweep.
-    let old = match &args.compare {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| PlayError::new(Exit::Io, format!("{}: {e}", path.display())))?;
-            Some(Results::from_json(&text, &path.display().to_string())?)
-        }
-        None => None,
+    let old = args.compare.as_deref().map(read_results).transpose()?;
+    let mut outcome = if let Some(path) = &args.replot {
+        super::Outcome { results: read_results(path)?, failures: Vec::new() }
+    } else {
+        let Some(file) = args.file.clone() else {
+            return Err(PlayError::new(Exit::Usage, "give a .kiln file to benchmark (--help explains)"));
+        };
+        super::run(&args.options(file)?)?
     };
-    let mut outcome = super::run(&options)?;
     let mut regressions = 0;
     if let Some(old) = &old {
         for note in results::compare(&mut outcome.results, old) {
@@ -175,7 +182,7 @@ pub fn run(args: Args) -> PlayResult {
         }
         regressions = outcome.results.points.iter().filter(|p| p.regression.is_some()).count();
     }
-    let written = report::write(&outcome.results, &options.out)?;
+    let written = report::write(&outcome.results, &args.out)?;
     for w in &outcome.results.warnings {
         eprintln!("warning: {w}");
     }
@@ -183,7 +190,7 @@ pub fn run(args: Args) -> PlayResult {
         println!("{}", outcome.results.to_json());
     } else {
         print!("{}", report::text(&outcome.results));
-        println!("wrote {} files to {} (open index.html)", written.len(), options.out.display());
+        println!("wrote {} files to {} (open index.html)", written.len(), args.out.display());
     }
     if !outcome.failures.is_empty() {
         let lines: Vec<String> =

@@ -52,6 +52,23 @@ fn create_dir(dir: &Path) -> PlayResult {
         .map_err(|e| PlayError::new(Exit::Io, format!("{}: cannot create the folder: {e}", dir.display())))
 }
 
+/// What charts and tables call the scene: the `.kiln` file's name without its extension
+/// (manifest names are often just "scene"), and the manifest's name when it says more.
+pub fn scene_label(results: &Results) -> String {
+    let stem = Path::new(&results.scene.file).file_stem().map(|s| s.to_string_lossy().into_owned());
+    match stem {
+        Some(stem)
+            if stem != results.scene.name
+                && results.scene.name != "scene"
+                && !results.scene.name.is_empty() =>
+        {
+            format!("{stem} ({})", results.scene.name)
+        }
+        Some(stem) => stem,
+        None => results.scene.name.clone(),
+    }
+}
+
 /// The charts of a sweep: one per (effect, camera), in sweep order.
 pub fn charts(results: &Results) -> Vec<(String, String, Chart)> {
     let mut groups: Vec<((String, String), Vec<&Point>)> = Vec::new();
@@ -73,7 +90,7 @@ pub fn charts(results: &Results) -> Vec<(String, String, Chart)> {
             let mut subtitle = vec![
                 format!(
                     "{} at {}x{} on {} (driver {}), camera {camera}",
-                    results.scene.name,
+                    scene_label(results),
                     results.width,
                     results.height,
                     results.device.name,
@@ -85,7 +102,11 @@ pub fn charts(results: &Results) -> Vec<(String, String, Chart)> {
                 subtitle.push(format!("fixed: {}", describe_fixed_map(&results.fixed, &effect)));
             }
             let chart = Chart {
-                title: if cameras > 1 { format!("{effect} (camera {camera})") } else { effect.clone() },
+                title: if cameras > 1 {
+                    format!("{effect}: {} (camera {camera})", scene_label(results))
+                } else {
+                    format!("{effect}: {}", scene_label(results))
+                },
                 subtitle,
                 x_label: "GPU ms to the image (frames accumulated x median ms per frame)".into(),
                 y_label: "mean HDR-FLIP against the reference".into(),
@@ -140,7 +161,7 @@ pub fn write(results: &Results, out: &Path) -> PlayResult<Vec<PathBuf>> {
     let mut notes = vec![
         format!(
             "{} ({}) at {}x{} on {}, driver {} {}, GPU UUID {}",
-            results.scene.name,
+            scene_label(results),
             results.scene.file,
             results.width,
             results.height,
@@ -171,7 +192,7 @@ pub fn write(results: &Results, out: &Path) -> PlayResult<Vec<PathBuf>> {
         notes.push(format!("skipped {} {}: {}", s.effect, s.technique, s.reason));
     }
     notes.extend(results.warnings.iter().map(|w| format!("warning: {w}")));
-    let page = Page { title: format!("kiln-bench: {}", results.scene.name), notes, sections };
+    let page = Page { title: format!("kiln-bench: {}", scene_label(results)), notes, sections };
     put("index.html", kiln_plot::index_html(&page).as_bytes())?;
     Ok(written)
 }
@@ -232,7 +253,11 @@ fn note(p: &Point) -> String {
 pub fn text(results: &Results) -> String {
     let mut s = format!(
         "{} at {}x{} on {} (driver {})\n",
-        results.scene.name, results.width, results.height, results.device.name, results.device.driver_version
+        scene_label(results),
+        results.width,
+        results.height,
+        results.device.name,
+        results.device.driver_version
     );
     for r in &results.references {
         s.push_str(&format!(
