@@ -269,3 +269,57 @@ fn rect_light_reference_path_tracer_matches_the_polygon_irradiance() {
         assert!((mean - 1.0).abs() < 0.02, "third {k}: mean ratio {mean} to the closed form");
     }
 }
+
+#[test]
+fn the_camera_sees_the_rect_light_itself_in_the_frame_and_the_reference() {
+    if !vulkan() {
+        return;
+    }
+    // From below the light's emitting side shows its radiance, exactly, in the frame (the direct
+    // pass intersects each pixel's ray with the rectangle) and in the path tracer (camera rays
+    // count it with weight 1); from above (`camera()`) only its dark back would be seen, which is
+    // what the other tests here rely on.
+    let dir = tempfile::tempdir().unwrap();
+    let rect = Rect::new();
+    let cam = Pinhole::new([0.5, 0.3, 1.5], [0.5, 2.0, -0.3], [0.0, 1.0, 0.0], 70.0, W, H);
+    let bytes = scene_bytes(&cam, &[]);
+    let (frame, _) = render(dir.path(), "rect-seen", &bytes, |f| Options::new(f, W, H).unshadowed());
+    let file = dir.path().join("rect-seen.kiln");
+    let o = Options::new(&file, W, H).reference().build();
+    let (_, traced) = kiln_player::reference::render(&o, 4, Instant::now()).expect("reference render");
+    // Whether the whole pixel footprint's rays cross the light (inside) or none does (outside),
+    // judged at the pixel's corners with the test's own ray-rectangle crossing.
+    let crossing = |x: u32, y: u32, margin: f64| {
+        let q = (cam.eye, cam.ray(x, y, W, H));
+        let denom = q.1.dot(rect.facing);
+        let t = (rect.centre - q.0).dot(rect.facing) / denom;
+        let p = q.0 + q.1 * t - rect.centre;
+        denom < 0.0
+            && t > 0.0
+            && p.dot(rect.right).abs() <= 0.5 * rect.width + margin
+            && p.dot(rect.up).abs() <= 0.5 * rect.height + margin
+    };
+    let (mut inside, mut outside) = (0, 0);
+    for y in 0..H {
+        for x in 0..W {
+            let i = (y * W + x) as usize * 3;
+            if crossing(x, y, -0.08) {
+                inside += 1;
+                for (name, img) in [("frame", &frame), ("reference", &traced)] {
+                    let v = &img[i..i + 3];
+                    assert!(
+                        v.iter().all(|&c| (c as f64 - rect.radiance).abs() < 1e-4),
+                        "{name} ({x}, {y}): {v:?}"
+                    );
+                }
+            } else if !crossing(x, y, 0.08) {
+                outside += 1;
+                assert!(
+                    frame[i..i + 3].iter().all(|&c| (c as f64) < 0.5 * rect.radiance),
+                    "frame ({x}, {y})"
+                );
+            }
+        }
+    }
+    assert!(inside > 50 && outside > 50, "{inside} pixels inside the light, {outside} outside");
+}

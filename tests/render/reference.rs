@@ -64,3 +64,48 @@ fn reference_path_tracer_reflects_a_uniform_sky_off_rough_metal_with_the_ggx_alb
         assert!((mean - 1.0).abs() < 0.01, "roughness {r}: mean ratio {mean} to the GGX albedo");
     }
 }
+
+#[test]
+fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
+    if !vulkan() {
+        return;
+    }
+    // Inside a closed box whose walls all emit Le and reflect diffusely with albedo ρ, every
+    // point receives the same radiance, so the light after at most N scattering events is
+    // Le (1 + ρ + … + ρ^N) everywhere, and Le / (1 − ρ) without a limit. The bounce limit that
+    // kiln-bench uses for its direct-light and two-bounce references must give exactly these.
+    let (emission, rho) = (1.0f32, 0.5f64);
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            // A face of the cube [-1, 1]³ wound so that its normal points inwards.
+            let mut n = Vec3::ZERO;
+            n[axis] = -sign;
+            let c = -n;
+            let u = if axis == 0 { Vec3::Y } else { Vec3::X };
+            let v = n.cross(u);
+            let p = [c - u - v, c + u - v, c + u + v, c - u + v];
+            tris.push([p[0], p[1], p[2]]);
+            tris.push([p[0], p[2], p[3]]);
+        }
+    }
+    let mut scene = scene_of(&tris);
+    let mut m = kiln_compiler::import::demo::lambert_material([rho as f32; 3]);
+    m.emission = [emission; 3];
+    scene.materials[0].gpu = m;
+    scene.sky = Sky { radiance: [0.0; 3] };
+    let cam = Pinhole::new([0.0, 0.2, 0.5], [0.3, 0.0, -1.0], [0.0, 1.0, 0.0], 70.0, W, H);
+    scene.cameras.push(cam.file_camera());
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("glowing-box.kiln");
+    std::fs::write(&file, compile(scene, fast_settings())).unwrap();
+    let o = Options::new(&file, W, H).reference().build();
+    for (bounces, expected) in [(1u32, 1.0 + rho), (2, 1.0 + rho + rho * rho), (0, 1.0 / (1.0 - rho))] {
+        let seed = kiln_player::reference::DEFAULT_SEED;
+        let (_, rgb) = kiln_player::reference::render_seeded(&o, 64, seed, bounces, Instant::now())
+            .expect("reference render");
+        let mean = rgb.iter().map(|&v| v as f64).sum::<f64>() / rgb.len() as f64;
+        eprintln!("{bounces} bounces (0: all): mean {mean:.4}, expected {expected:.4}");
+        assert!((mean / expected - 1.0).abs() < 0.01, "{bounces} bounces: mean {mean}, expected {expected}");
+    }
+}
