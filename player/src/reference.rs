@@ -43,21 +43,39 @@ pub const MAX_PATH: u32 = 1024;
 /// The random sequence `--reference` uses.
 pub const DEFAULT_SEED: u32 = 0x2545_f491;
 
-/// Renders `spp` samples per pixel; returns the report and the mean radiance (RGB per pixel).
-pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<(ReferenceReport, Vec<f32>)> {
-    render_seeded(options, spp, DEFAULT_SEED, 0, start)
+/// How a reference is sampled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sampling {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// The random sequence: images of different seeds are independent estimates (what a
+    /// noise-floor estimate compares).
+    pub seed: u32,
+    /// Scattering events whose light counts: 0 no limit, 1 direct light alone.
+    pub bounces: u32,
+    /// Show the samples taken on stderr when it is a terminal (off under another progress bar).
+    pub progress: bool,
 }
 
-/// [`render`] with another random sequence (images of different seeds are independent
-/// estimates, what a noise-floor estimate compares) and a bounce limit (`bounces` scattering
-/// events count; 0: no limit, 1: direct light alone).
-pub fn render_seeded(
+impl Sampling {
+    /// `spp` samples of the default sequence, every bounce, with progress.
+    pub fn new(spp: u32) -> Sampling {
+        Sampling { spp, seed: DEFAULT_SEED, bounces: 0, progress: true }
+    }
+}
+
+/// Renders `spp` samples per pixel; returns the report and the mean radiance (RGB per pixel).
+pub fn render(options: &SessionOptions, spp: u32, start: Instant) -> PlayResult<(ReferenceReport, Vec<f32>)> {
+    render_with(options, Sampling::new(spp), start)
+}
+
+/// [`render`] sampled as `sampling` says.
+pub fn render_with(
     options: &SessionOptions,
-    spp: u32,
-    seed: u32,
-    bounces: u32,
+    sampling: Sampling,
     start: Instant,
 ) -> PlayResult<(ReferenceReport, Vec<f32>)> {
+    let spp = sampling.spp;
     if spp == 0 {
         return Err(PlayError::new(Exit::Usage, "--spp must be at least 1"));
     }
@@ -65,7 +83,7 @@ pub fn render_seeded(
     options.render.purpose = crate::render::Purpose::Reference;
     options.readback = None;
     let session = Session::open(&options, start)?;
-    let result = sample(&session, spp, seed, bounces);
+    let result = sample(&session, sampling);
     let errors = session.close();
     let (report, pixels) = result?;
     if errors > 0 {
@@ -74,7 +92,8 @@ pub fn render_seeded(
     Ok((report, pixels))
 }
 
-fn sample(session: &Session, spp: u32, seed: u32, bounces: u32) -> PlayResult<(ReferenceReport, Vec<f32>)> {
+fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport, Vec<f32>)> {
+    let Sampling { spp, seed, bounces, progress } = sampling;
     let gpu = &session.gpu;
     let scene = &session.scene;
     let Some(r) = &scene.reference else {
@@ -138,7 +157,7 @@ fn sample(session: &Session, spp: u32, seed: u32, bounces: u32) -> PlayResult<(R
         owned.pool = Some(pool);
         let pool = owned.pool.as_ref().expect("set");
         let t0 = Instant::now();
-        let progress = std::io::stderr().is_terminal();
+        let progress = progress && std::io::stderr().is_terminal();
         let mut taken = 0u32;
         // Batches grow until one takes about 50 ms: few submissions, yet no long-running
         // command buffer that a watchdog could take for a hang.

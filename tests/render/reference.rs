@@ -101,9 +101,10 @@ fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
     std::fs::write(&file, compile(scene, fast_settings())).unwrap();
     let o = Options::new(&file, W, H).reference().build();
     for (bounces, expected) in [(1u32, 1.0 + rho), (2, 1.0 + rho + rho * rho), (0, 1.0 / (1.0 - rho))] {
-        let seed = kiln_player::reference::DEFAULT_SEED;
-        let (_, rgb) = kiln_player::reference::render_seeded(&o, 64, seed, bounces, Instant::now())
-            .expect("reference render");
+        let sampling =
+            kiln_player::reference::Sampling { bounces, ..kiln_player::reference::Sampling::new(64) };
+        let (_, rgb) =
+            kiln_player::reference::render_with(&o, sampling, Instant::now()).expect("reference render");
         let mean = rgb.iter().map(|&v| v as f64).sum::<f64>() / rgb.len() as f64;
         eprintln!("{bounces} bounces (0: all): mean {mean:.4}, expected {expected:.4}");
         assert!((mean / expected - 1.0).abs() < 0.01, "{bounces} bounces: mean {mean}, expected {expected}");

@@ -142,7 +142,7 @@ fn bar(show: bool, len: u64) -> ProgressBar {
         if show { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() },
     );
     b.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
+        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {wide_msg}")
             .expect("a valid template")
             .progress_chars("=> "),
     );

@@ -18,7 +18,7 @@ use xxhash_rust::xxh3::Xxh3;
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::image_out::read_exr;
-use crate::reference::{DEFAULT_SEED, MAX_PATH, read_spp, render_seeded, write_exr};
+use crate::reference::{DEFAULT_SEED, MAX_PATH, Sampling, read_spp, render_with, write_exr};
 use crate::render::spirv::PATHTRACE;
 use crate::session::SessionOptions;
 
@@ -90,7 +90,8 @@ pub fn obtain(
         cached = false;
         progress(&format!("reference: {half} samples per pixel, seed {seed:#x}"));
         let t = Instant::now();
-        let (_, rgb) = render_seeded(base, half, seed, bounces, Instant::now())?;
+        let sampling = Sampling { spp: half, seed, bounces, progress: false };
+        let (_, rgb) = render_with(base, sampling, Instant::now())?;
         seconds += t.elapsed().as_secs_f64();
         write_exr(&path, w, h, &rgb, half)?;
         halves.push(rgb);
