@@ -154,6 +154,142 @@ fn rgb_image(width: u32, height: u32, pixels: &[f32]) -> kiln_metrics::RgbImage<
     kiln_metrics::RgbImage { width, height, pixels }
 }
 
+/// A camera's reference and what the results say of it.
+struct CameraReference {
+    reference: Reference,
+    info: ReferenceInfo,
+}
+
+/// The references one camera's charts need (one per bounce limit), rendered or from the cache.
+fn camera_references(
+    options: &SweepOptions,
+    plan: &Plan,
+    content_hash: &str,
+    camera: &str,
+    base: &SessionOptions,
+    progress: &ProgressBar,
+) -> PlayResult<BTreeMap<u32, CameraReference>> {
+    let mut ref_options = base.clone();
+    ref_options.render.purpose = Purpose::Reference;
+    let mut refs = BTreeMap::new();
+    for b in plan.configs.iter().map(|c| plan::bounces(c.target)) {
+        if refs.contains_key(&b) {
+            continue;
+        }
+        let half = options.reference_spp.div_ceil(2);
+        let key = truth::key(content_hash, camera, options.width, options.height, half, b);
+        progress.set_message(format!("reference, {} ({camera})", plan::transport(b)));
+        let dir = options.out.join("reference");
+        let reference = truth::obtain(&ref_options, options.reference_spp, b, &key, &dir, |m| {
+            progress.set_message(m.to_string())
+        })?;
+        progress.inc(1);
+        if options.keep_images {
+            let (w, h) = (options.width, options.height);
+            report::keep_image(
+                &options.out,
+                camera,
+                &format!("reference-{b}"),
+                w,
+                h,
+                &reference.rgb,
+                reference.spp,
+            )?;
+        }
+        let info = ReferenceInfo {
+            camera: camera.to_string(),
+            spp: reference.spp,
+            bounces: b,
+            noise_floor: reference.noise_floor,
+            seconds: reference.seconds,
+            cached: reference.cached,
+            key: reference.key.clone(),
+        };
+        refs.insert(b, CameraReference { reference, info });
+    }
+    Ok(refs)
+}
+
+/// The points of one measured configuration: one per frame count whose image differs from the
+/// previous count's, each compared with `reference`. An image that cannot be measured (NaN or
+/// infinity) goes to `failures`.
+fn points_of(
+    options: &SweepOptions,
+    config: &plan::Config,
+    m: &Measured,
+    fixed_passes: &[String],
+    reference: &Reference,
+    camera: &str,
+    failures: &mut Vec<Skipped>,
+) -> PlayResult<Vec<Point>> {
+    let total = m.passes.last().expect("total is always there");
+    let effect_ms = match config.target {
+        Target::Frame => total.median_ms,
+        Target::Effect(_) => m
+            .passes
+            .iter()
+            .filter(|p| p.pass != "total" && !fixed_passes.contains(&p.pass))
+            // From +0: an empty f64 sum is -0, which prints as "-0.000".
+            .fold(0.0, |sum, p| sum + p.median_ms),
+    };
+    let (w, h) = (options.width, options.height);
+    let mut points = Vec::new();
+    for (i, (frames, rgb)) in m.images.iter().enumerate() {
+        // An image the same as at the previous frame count (a technique that is deterministic
+        // in this scene, e.g. ray-traced hard shadows) only costs more.
+        if i > 0 && m.images[i - 1].1 == *rgb {
+            continue;
+        }
+        let label = config.label(*frames);
+        let error: Figures =
+            match kiln_metrics::compare(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
+                Ok(e) => e.into(),
+                Err(e) => {
+                    failures.push(Skipped {
+                        effect: config.target.name().into(),
+                        technique: label,
+                        reason: format!("cannot be measured: {e}"),
+                    });
+                    continue;
+                }
+            };
+        if options.keep_images {
+            report::keep_image(
+                &options.out,
+                camera,
+                &format!("{}-{label}", config.target),
+                w,
+                h,
+                rgb,
+                *frames,
+            )?;
+        }
+        points.push(Point {
+            effect: config.target.name().into(),
+            technique: config.technique.clone(),
+            knobs: config.knobs.clone(),
+            frames: *frames,
+            label,
+            camera: camera.to_string(),
+            techniques: techniques_map(&config.techniques),
+            frame_ms: total.median_ms,
+            frame_p10_ms: total.p10_ms,
+            frame_p90_ms: total.p90_ms,
+            effect_ms,
+            image_ms: total.median_ms * *frames as f64,
+            passes: m.passes.clone(),
+            error,
+            reference_spp: reference.spp,
+            reference_bounces: reference.bounces,
+            noise_floor: reference.noise_floor,
+            below_noise_floor: error.flip < reference.noise_floor.flip,
+            on_front: false,
+            regression: None,
+        });
+    }
+    Ok(points)
+}
+
 /// Runs the sweep.
 pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
     let started = Instant::now();
@@ -187,47 +323,8 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             camera: *camera,
             readback: None,
         };
-        let mut ref_options = base.clone();
-        ref_options.render.purpose = Purpose::Reference;
-        let mut bounces: Vec<u32> = plan.configs.iter().map(|c| plan::bounces(c.target)).collect();
-        bounces.sort_unstable();
-        bounces.dedup();
-        let mut refs: HashMap<u32, Reference> = HashMap::new();
-        for &b in &bounces {
-            let half = options.reference_spp.div_ceil(2);
-            let key = truth::key(&content_hash, &name, options.width, options.height, half, b);
-            progress.set_message(format!("reference, {} ({name})", plan::transport(b)));
-            let reference = truth::obtain(
-                &ref_options,
-                options.reference_spp,
-                b,
-                &key,
-                &options.out.join("reference"),
-                |m| progress.set_message(m.to_string()),
-            )?;
-            progress.inc(1);
-            if options.keep_images {
-                report::keep_image(
-                    &options.out,
-                    &name,
-                    &format!("reference-{b}"),
-                    options.width,
-                    options.height,
-                    &reference.rgb,
-                    reference.spp,
-                )?;
-            }
-            references.push(ReferenceInfo {
-                camera: name.clone(),
-                spp: reference.spp,
-                bounces: b,
-                noise_floor: reference.noise_floor,
-                seconds: reference.seconds,
-                cached: reference.cached,
-                key: reference.key.clone(),
-            });
-            refs.insert(b, reference);
-        }
+        let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;
+        references.extend(refs.values().map(|r| r.info.clone()));
         let mut done: HashMap<String, Measured> = HashMap::new();
         let mut measure_once =
             |techniques: Techniques, checkpoints: &[u32], label: &str| -> PlayResult<Measured> {
@@ -262,71 +359,8 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
                     warnings.push(w.clone());
                 }
             }
-            let total = m.passes.last().expect("total is always there");
-            let effect_ms = match config.target {
-                Target::Frame => total.median_ms,
-                Target::Effect(_) => m
-                    .passes
-                    .iter()
-                    .filter(|p| p.pass != "total" && !fixed_passes.contains(&p.pass))
-                    // From +0: an empty f64 sum is -0, which prints as "-0.000".
-                    .fold(0.0, |sum, p| sum + p.median_ms),
-            };
-            let reference = &refs[&plan::bounces(config.target)];
-            for (i, (frames, rgb)) in m.images.iter().enumerate() {
-                // An image the same as at the previous frame count (a technique that is
-                // deterministic in this scene, e.g. ray-traced hard shadows) only costs more.
-                if i > 0 && m.images[i - 1].1 == *rgb {
-                    continue;
-                }
-                let label = config.label(*frames);
-                let (w, h) = (options.width, options.height);
-                let error: Figures =
-                    match kiln_metrics::compare(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
-                        Ok(e) => e.into(),
-                        Err(e) => {
-                            failures.push(Skipped {
-                                effect: config.target.name().into(),
-                                technique: label.clone(),
-                                reason: format!("cannot be measured: {e}"),
-                            });
-                            continue;
-                        }
-                    };
-                if options.keep_images {
-                    report::keep_image(
-                        &options.out,
-                        &name,
-                        &format!("{}-{label}", config.target),
-                        options.width,
-                        options.height,
-                        rgb,
-                        *frames,
-                    )?;
-                }
-                points.push(Point {
-                    effect: config.target.name().into(),
-                    technique: config.technique.clone(),
-                    knobs: config.knobs.clone(),
-                    frames: *frames,
-                    label,
-                    camera: name.clone(),
-                    techniques: techniques_map(&config.techniques),
-                    frame_ms: total.median_ms,
-                    frame_p10_ms: total.p10_ms,
-                    frame_p90_ms: total.p90_ms,
-                    effect_ms,
-                    image_ms: total.median_ms * *frames as f64,
-                    passes: m.passes.clone(),
-                    error,
-                    reference_spp: reference.spp,
-                    reference_bounces: reference.bounces,
-                    noise_floor: reference.noise_floor,
-                    below_noise_floor: error.flip < reference.noise_floor.flip,
-                    on_front: false,
-                    regression: None,
-                });
-            }
+            let reference = &refs[&plan::bounces(config.target)].reference;
+            points.extend(points_of(options, config, &m, &fixed_passes, reference, &name, &mut failures)?);
         }
     }
     progress.finish_and_clear();
