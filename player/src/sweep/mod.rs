@@ -325,6 +325,11 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
         };
         let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;
         references.extend(refs.values().map(|r| r.info.clone()));
+        if refs.values().any(|r| r.reference.rgb.iter().all(|&v| v == 0.0)) {
+            warnings.push(format!(
+                "camera {name}: the reference is black: nothing lights what the camera sees (give the scene a [sky] or [[light]] in a sidecar); every error is 0"
+            ));
+        }
         let mut done: HashMap<String, Measured> = HashMap::new();
         let mut measure_once =
             |techniques: Techniques, checkpoints: &[u32], label: &str| -> PlayResult<Measured> {
