@@ -495,3 +495,66 @@ fn the_reference_is_cached_by_file_camera_size_and_samples() {
     assert_ne!(first["key"], other["key"]);
     assert_eq!(other["spp"], 32);
 }
+
+/// Chromium's binary, if one is installed.
+fn chromium() -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .flat_map(|name| std::env::split_paths(&path).map(move |d| d.join(name)))
+        .find(|p| p.is_file())
+}
+
+/// A 1200 × 1600 screenshot of `html` by headless Chromium, decoded.
+fn screenshot(chromium: &Path, html: &Path) -> image::RgbImage {
+    let shot = html.with_file_name("shot.png");
+    let _ = std::fs::remove_file(&shot);
+    let profile = html.with_file_name("profile");
+    let o = Command::new(chromium)
+        .args(["--headless", "--disable-gpu", "--no-sandbox", "--disable-dev-shm-usage", "--hide-scrollbars"])
+        .args(["--no-first-run", "--window-size=1200,1600"])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", html.display()))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "chromium: {}", String::from_utf8_lossy(&o.stderr));
+    image::open(&shot).expect("chromium wrote the screenshot").to_rgb8()
+}
+
+#[test]
+fn the_page_of_a_sweep_shows_its_charts_in_a_browser() {
+    if !vulkan() {
+        return;
+    }
+    let Some(chromium) = chromium() else {
+        assert!(
+            std::env::var_os("KILN_REQUIRE_CHROMIUM").is_none(),
+            "no chromium, but KILN_REQUIRE_CHROMIUM is set"
+        );
+        eprintln!("skipping: chromium is not installed");
+        return;
+    };
+    // A copy of the sweep's page and charts, screenshotted with its SVG charts and without them:
+    // the charts' part of the page must differ (they really load and draw).
+    let (out, _) = sweep();
+    let page = tempfile::tempdir().unwrap();
+    for entry in std::fs::read_dir(out.path()).unwrap() {
+        let path = entry.unwrap().path();
+        if matches!(path.extension().and_then(|e| e.to_str()), Some("html" | "svg" | "png")) {
+            std::fs::copy(&path, page.path().join(path.file_name().unwrap())).unwrap();
+        }
+    }
+    let html = page.path().join("index.html");
+    let with = screenshot(&chromium, &html);
+    assert_eq!(with.dimensions(), (1200, 1600));
+    for chart in ["shadows.svg", "frame.svg"] {
+        std::fs::remove_file(page.path().join(chart)).unwrap();
+    }
+    let without = screenshot(&chromium, &html);
+    let differing = with.pixels().zip(without.pixels()).filter(|(a, b)| a != b).count();
+    assert!(differing > 50_000, "only {differing} pixels differ with the charts removed");
+    // The charts draw dark lines and text on white: plenty of non-white pixels where they are.
+    let inked = with.pixels().filter(|p| p.0.iter().any(|&c| c < 128)).count();
+    assert!(inked > 5_000, "{inked} dark pixels");
+}
