@@ -256,3 +256,92 @@ fn lattice_meshes_are_watertight_at_edges_and_vertices() {
         }
     }
 }
+
+/// The subtree box of node `n` computed from its leaves' triangles, and every decoded child box
+/// checked against its child's: returns the planes (node, slot, axis, by how much) that fall
+/// inside. Decoding is written here: `p + 2^(e-127)·q` in f32, per FORMAT.md.
+fn planes_inside(
+    nodes: &[kiln_format::sections::CwbvhNode],
+    corners: &[[Vec3; 3]],
+    n: usize,
+    bad: &mut Vec<String>,
+) -> (Vec3, Vec3) {
+    let node = &nodes[n];
+    let mut all = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for slot in 0..8 {
+        let meta = node.child_meta[slot];
+        if meta == 0 {
+            continue;
+        }
+        let (lo, hi) = if node.imask & (1 << slot) != 0 {
+            let below = (node.imask as u32 & ((1u32 << slot) - 1)).count_ones();
+            planes_inside(nodes, corners, (node.child_base_idx + below) as usize, bad)
+        } else {
+            let first = node.primitive_base_idx as usize + (meta & 0x1f) as usize;
+            let count = (meta >> 5).count_ones() as usize;
+            corners[first..first + count]
+                .iter()
+                .flatten()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)))
+        };
+        let q = |v: [[u8; 8]; 2], axis: usize| {
+            let step = f32::from_bits((node.e[axis] as u32) << 23);
+            (node.p[axis] + step * v[0][slot] as f32, node.p[axis] + step * v[1][slot] as f32)
+        };
+        let decoded = [
+            q([node.child_min_x, node.child_max_x], 0),
+            q([node.child_min_y, node.child_max_y], 1),
+            q([node.child_min_z, node.child_max_z], 2),
+        ];
+        for (axis, (dlo, dhi)) in decoded.into_iter().enumerate() {
+            if dlo > lo[axis] || dhi < hi[axis] {
+                bad.push(format!(
+                    "node {n} slot {slot} axis {axis}: decoded [{dlo}, {dhi}], exact [{}, {}]",
+                    lo[axis], hi[axis]
+                ));
+            }
+        }
+        all = (all.0.min(lo), all.1.max(hi));
+    }
+    all
+}
+
+/// FORMAT.md: "quantisation rounds outwards, so the decoded boxes contain the exact ones", in f32
+/// as every reader decodes them: on soups near and far from the origin, tiny and huge, and on the
+/// shared scenes when they are here.
+#[test]
+fn decoded_child_boxes_contain_their_subtrees_exactly() {
+    let mut files = Vec::new();
+    let mut rng = Rng::new(11);
+    for (i, (scale, offset)) in
+        [(1.0f32, 0.0f32), (3.0, 1.0e4), (1e-3, -5.0e3), (100.0, 3.0e5), (0.5, 77.7)].into_iter().enumerate()
+    {
+        let tris =
+            transformed(&soup(&mut rng, 3000, 0.05), scale, Vec3::new(offset, -0.5 * offset, 0.25 * offset));
+        let preset = [BvhPreset::Fast, BvhPreset::Medium][i % 2];
+        files.push((
+            format!("soup {scale} at {offset}"),
+            compile(scene_of(&tris), Settings { bvh_preset: preset, ..geometry_only() }),
+        ));
+    }
+    if let Some(dir) = kiln_tests::shared_scenes() {
+        for name in ["pica_pica", "cornell_box"] {
+            let scene = kiln_compiler::import::import(&dir.join(name).join("scene.gltf")).unwrap();
+            files.push((name.into(), compile(scene, geometry_only())));
+        }
+    }
+    for (name, bytes) in files {
+        let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+        let view = SceneView::new(&file).unwrap();
+        let t = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
+        let corners: Vec<[Vec3; 3]> = (0..t.len()).map(|i| t.corners(i)).collect();
+        let mut bad = Vec::new();
+        planes_inside(view.bvh, &corners, 0, &mut bad);
+        assert!(
+            bad.is_empty(),
+            "{name}: {} planes inside their subtree, e.g. {:?}",
+            bad.len(),
+            &bad[..bad.len().min(3)]
+        );
+    }
+}

@@ -61,8 +61,115 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
             child_min_z: n.child_min_z,
             child_max_z: n.child_max_z,
         })
-        .collect();
+        .collect::<Vec<_>>();
+    let mut nodes = nodes;
+    widen_to_contain(&mut nodes, tris, &bvh.primitive_indices);
     Ok(BuiltBvh { nodes, order: bvh.primitive_indices })
+}
+
+/// Makes every decoded child box contain its subtree's triangles exactly, as FORMAT.md promises.
+/// The builder quantises outwards in real arithmetic, but `p + s·q` evaluated in f32 can land an
+/// ulp or two inside the exact plane (seen in pica_pica's z planes); each such plane moves one
+/// grid step outwards until the f32 decode, the one every reader does, contains the exact box, and
+/// if a maximum plane would pass 255 the axis's grid step doubles (every slot of that axis
+/// re-quantised). Nodes already conservative are left as they are.
+fn widen_to_contain(nodes: &mut [CwbvhNode], tris: &[Triangle], order: &[u32]) {
+    if nodes.is_empty() {
+        return;
+    }
+    let leaf_box = |first: u64, count: u32| {
+        let mut b = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for k in first..first + count as u64 {
+            let t = &tris[order[k as usize] as usize];
+            for v in [t.v0, t.v1, t.v2] {
+                for a in 0..3 {
+                    b.0[a] = b.0[a].min(v[a]);
+                    b.1[a] = b.1[a].max(v[a]);
+                }
+            }
+        }
+        b
+    };
+    // Exact subtree boxes, children before parents (a child's index is always above its
+    // parent's in the builder's layout; checked, falling back to leaving the node alone).
+    let mut exact: Vec<Option<([f32; 3], [f32; 3])>> = vec![None; nodes.len()];
+    for n in (0..nodes.len()).rev() {
+        let node = nodes[n];
+        let mut children = [None; 8];
+        let mut all = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for (i, child) in children.iter_mut().enumerate() {
+            if node.is_empty(i) {
+                continue;
+            }
+            let b = if node.is_internal(i) {
+                let c = node.child_node(i) as usize;
+                match exact.get(c).copied().flatten() {
+                    Some(b) if c > n => b,
+                    _ => continue,
+                }
+            } else {
+                let (first, count) = node.leaf_range(i);
+                leaf_box(first, count)
+            };
+            for a in 0..3 {
+                all.0[a] = all.0[a].min(b.0[a]);
+                all.1[a] = all.1[a].max(b.1[a]);
+            }
+            *child = Some(b);
+        }
+        exact[n] = Some(all);
+        conservative(&mut nodes[n], &children);
+    }
+}
+
+/// Widens the quantised planes of `node` until each decoded child box contains `children[i]`.
+fn conservative(node: &mut CwbvhNode, children: &[Option<([f32; 3], [f32; 3])>; 8]) {
+    for a in 0..3 {
+        loop {
+            let s = f32::from_bits((node.e[a] as u32) << 23);
+            let decode = |q: u8| node.p[a] + s * q as f32;
+            let mut overflow = false;
+            let (mut lo, mut hi) = planes(node, a);
+            for (i, b) in children.iter().enumerate() {
+                let Some((min, max)) = b else { continue };
+                while decode(lo[i]) > min[a] && lo[i] > 0 {
+                    lo[i] -= 1;
+                }
+                while decode(hi[i]) < max[a] {
+                    if hi[i] == 255 {
+                        overflow = true;
+                        break;
+                    }
+                    hi[i] += 1;
+                }
+            }
+            if !overflow || node.e[a] >= 254 {
+                set_planes(node, a, lo, hi);
+                break;
+            }
+            // Double the step: every plane of this axis halves, rounded outwards, and is checked
+            // again.
+            node.e[a] += 1;
+            let (lo, hi) = planes(node, a);
+            set_planes(node, a, lo.map(|q| q / 2), hi.map(|q| q.div_ceil(2)));
+        }
+    }
+}
+
+fn planes(node: &CwbvhNode, axis: usize) -> ([u8; 8], [u8; 8]) {
+    match axis {
+        0 => (node.child_min_x, node.child_max_x),
+        1 => (node.child_min_y, node.child_max_y),
+        _ => (node.child_min_z, node.child_max_z),
+    }
+}
+
+fn set_planes(node: &mut CwbvhNode, axis: usize, lo: [u8; 8], hi: [u8; 8]) {
+    match axis {
+        0 => (node.child_min_x, node.child_max_x) = (lo, hi),
+        1 => (node.child_min_y, node.child_max_y) = (lo, hi),
+        _ => (node.child_min_z, node.child_max_z) = (lo, hi),
+    }
 }
 
 /// The BVH stage: the nodes of the BVH the context built (every other stage stores triangles in
@@ -76,4 +183,27 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
         ctx.hash("bvh", &[("preset", ctx.preset())]),
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn planes_move_outwards_and_the_step_doubles_past_255() {
+        // Step 1 on every axis (e = 127), origin 0: slot 0 claims [2, 255] on x.
+        let mut node = CwbvhNode { e: [127; 3], child_meta: [1, 0, 0, 0, 0, 0, 0, 0], ..Default::default() };
+        node.child_min_x[0] = 2;
+        node.child_max_x[0] = 255;
+        node.child_max_y[0] = 1;
+        node.child_max_z[0] = 1;
+        // The exact box reaches 1.5 below and 255.5 above: x needs a step of 2.
+        let exact = Some(([1.5, 0.0, 0.0], [255.5, 1.0, 1.0]));
+        let mut children = [None; 8];
+        children[0] = exact;
+        conservative(&mut node, &children);
+        assert_eq!(node.e, [128, 127, 127]);
+        assert_eq!((node.child_min_x[0], node.child_max_x[0]), (0, 128), "1.5 → 0·2, 255.5 → 128·2 = 256");
+        assert_eq!((node.child_max_y[0], node.child_max_z[0]), (1, 1), "already conservative: unchanged");
+    }
 }
