@@ -183,12 +183,14 @@ fn texel_ray(info: &kiln_format::manifest::ShadowMapInfo, k: usize) -> Ray {
             Ray::new(origin, d.normalize(), 0.0, f32::INFINITY)
         }
         _ => {
-            let inv = Mat4::from_cols_array(&info.view_proj).inverse();
-            let (ndc_x, ndc_y) = (2.0 * x / n as f32 - 1.0, 1.0 - 2.0 * y / n as f32);
-            let near = inv.project_point3(Vec3::new(ndc_x, ndc_y, 0.0));
-            let far = inv.project_point3(Vec3::new(ndc_x, ndc_y, 1.0));
-            let d = (far - near).normalize();
-            let o = if info.projection == ShadowProjection::Orthographic { near } else { origin };
+            // In f64: the stored matrix of a perspective map with a far/near ratio near 10⁴
+            // inverts badly in f32 (texel directions then stray by a tenth of a texel).
+            let inv = glam::DMat4::from_cols_array(&info.view_proj.map(f64::from)).inverse();
+            let (ndc_x, ndc_y) = (2.0 * x as f64 / n as f64 - 1.0, 1.0 - 2.0 * y as f64 / n as f64);
+            let near = inv.project_point3(glam::DVec3::new(ndc_x, ndc_y, 0.0));
+            let far = inv.project_point3(glam::DVec3::new(ndc_x, ndc_y, 1.0));
+            let d = (far - near).normalize().as_vec3();
+            let o = if info.projection == ShadowProjection::Orthographic { near.as_vec3() } else { origin };
             Ray::new(o, d, 0.0, f32::INFINITY)
         }
     }

@@ -15,7 +15,7 @@
 //! Depth is the distance along the texel's unit ray: from the near plane for orthographic maps,
 //! from the light position otherwise. Texels whose ray hits nothing hold `f32::MAX`.
 
-use glam::{Mat4, Vec3};
+use glam::{DMat4, DVec3, Mat4, Vec3};
 use kiln_format::manifest::{Bounds, Light, LightKind, ShadowMapInfo, ShadowProjection};
 use kiln_format::projection::{look_to_rh, orthographic_rh, perspective_rh};
 use kiln_format::query::{BvhQuery, Ray, TriangleSource};
@@ -170,14 +170,17 @@ impl Layout {
                 Ray::new(origin, cube_direction(face as u32, x, y, n as u32), 0.0, f32::INFINITY)
             }
             ShadowProjection::Orthographic | ShadowProjection::Perspective => {
-                let ndc_x = 2.0 * (x as f32 + 0.5) / n as f32 - 1.0;
-                let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / n as f32;
-                let inv = self.view_proj.inverse();
-                let near = inv.project_point3(Vec3::new(ndc_x, ndc_y, 0.0));
-                let far = inv.project_point3(Vec3::new(ndc_x, ndc_y, 1.0));
-                let d = (far - near).normalize_or(Vec3::from(self.info.direction));
+                // Through the texel centre of the stored (f32) matrix, unprojected in f64: a
+                // perspective map's far/near ratio (~10⁴) makes the f32 inverse stray by a
+                // tenth of a texel, and the map would not be what its matrix says.
+                let ndc_x = 2.0 * (x as f64 + 0.5) / n as f64 - 1.0;
+                let ndc_y = 1.0 - 2.0 * (y as f64 + 0.5) / n as f64;
+                let inv = DMat4::from_cols_array(&self.view_proj.to_cols_array().map(f64::from)).inverse();
+                let near = inv.project_point3(DVec3::new(ndc_x, ndc_y, 0.0));
+                let far = inv.project_point3(DVec3::new(ndc_x, ndc_y, 1.0));
+                let d = (far - near).normalize_or(DVec3::from(self.info.direction.map(f64::from))).as_vec3();
                 if self.info.projection == ShadowProjection::Orthographic {
-                    Ray::new(near, d, 0.0, f32::INFINITY)
+                    Ray::new(near.as_vec3(), d, 0.0, f32::INFINITY)
                 } else {
                     Ray::new(origin, d, 0.0, f32::INFINITY)
                 }
