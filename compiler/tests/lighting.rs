@@ -134,7 +134,7 @@ fn brdf_table_has_the_known_limits() {
     assert!(r + g < 0.9, "{r} {g}");
 }
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use kiln_compiler::bake::shadow;
 use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
