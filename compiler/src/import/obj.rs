@@ -4,6 +4,14 @@
 //! references out of range, polygons with fewer than three corners, non-finite positions) and
 //! reports it with its line number; then `tobj` loads the file.
 //!
+//! Smoothing groups (`s N`, `s off`), which `tobj` does not expose, are read in the same first
+//! pass: one group per triangle, in file order (a face of n corners gives n − 2 triangles). They
+//! are matched to `tobj`'s output by order: `tobj` appends each face's triangles (its own fan,
+//! n − 2 of them) to the current model in file order, and starts a new model (also in file
+//! order) at `o`, `g` or a `usemtl` that changes the material, so its models' triangles, read
+//! model after model, are the file's triangles in file order. Where the totals disagree, normals
+//! are flat and a warning says so.
+//!
 //! MTL → PBR rule (documented in the README):
 //! - `Kd` is the base colour (albedo), `map_Kd` its texture; `d` (or `1 - Tr`) its alpha.
 //! - `Ks 0 0 0` (or no `Ks`) with no metalness `Pm` → **pure Lambertian diffuse**: no specular
@@ -20,18 +28,22 @@ use std::path::Path;
 use kiln_format::manifest::Wrap;
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
-use super::geometry::{angle_weighted_normals, check_position};
+use super::geometry::{Sharing, check_position, corner_normals, given_corner_normals, split_by_normal};
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult};
 use crate::ir::{Material, Scene, TextureRole};
+use crate::settings::Normals;
 
 /// Imports an `.obj` file (and the MTL files it names) into `scene`.
-pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
+pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResult<()> {
     let file = path.display().to_string();
     let text = read_input(path, &mut scene.inputs)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mtllibs = precheck(&file, &text)?;
+    let Precheck { libs: mtllibs, groups, warnings } = precheck(&file, &text)?;
+    for w in warnings {
+        scene.warn(w);
+    }
     let options =
         tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(&text), &options, |p| {
@@ -87,6 +99,20 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
         scene.materials.push(Material { name: m.name.clone(), gpu });
     }
     let mut default_material: Option<u32> = None;
+    let tobj_triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let groups = if tobj_triangles == groups.len() {
+        groups
+    } else {
+        if normals_mode == Normals::Asset {
+            scene.warn(format!(
+                "{file}: {} triangles read, {tobj_triangles} loaded: smoothing groups cannot be matched to faces; normals not given are flat",
+                groups.len()
+            ));
+        }
+        vec![0; tobj_triangles]
+    };
+    // The next model's first triangle in `groups`.
+    let mut next_triangle = 0;
 
     for model in &models {
         let mesh = &model.mesh;
@@ -96,20 +122,35 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
             check_position(*p, || format!("{at}: vertex {i}"))?;
         }
         let tris: Vec<[u32; 3]> = mesh.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let tri_groups = &groups[next_triangle..next_triangle + tris.len()];
+        next_triangle += tris.len();
         if tris.is_empty() {
             continue;
         }
-        let normals: Vec<[f32; 3]> = if mesh.normals.len() == mesh.positions.len() {
-            let given: Vec<[f32; 3]> = mesh.normals.chunks_exact(3).map(|n| [n[0], n[1], n[2]]).collect();
-            let generated = angle_weighted_normals(&positions, &tris);
-            given
-                .iter()
-                .zip(generated)
-                .map(|(n, g)| glam::Vec3::from(*n).try_normalize().map_or(g, |v| v.to_array()))
-                .collect()
+        let corners = if mesh.normals.len() == mesh.positions.len() {
+            let given: Vec<[f32; 3]> = mesh
+                .normals
+                .chunks_exact(3)
+                .map(|n| {
+                    glam::Vec3::new(n[0], n[1], n[2]).try_normalize().map_or([f32::NAN; 3], |v| v.to_array())
+                })
+                .collect();
+            let (corners, replaced) = given_corner_normals(&positions, &tris, &given);
+            if replaced > 0 {
+                scene.warn(format!(
+                    "{at}: {replaced} triangle corners have a zero or non-finite normal (vn); they take their triangle's face normal (flat)"
+                ));
+            }
+            corners
         } else {
-            angle_weighted_normals(&positions, &tris)
+            let sharing = match normals_mode {
+                Normals::Asset => Sharing::Groups(tri_groups),
+                Normals::Flat => Sharing::Flat,
+                Normals::Smooth { crease_degrees } => Sharing::Smooth(crease_degrees.map(f64::from)),
+            };
+            corner_normals(&positions, &tris, sharing)
         };
+        let (source, normals, tris) = split_by_normal(positions.len(), &tris, &corners);
         // OBJ's v runs up the image; kiln (like glTF) stores v running down.
         let uvs: Vec<[f32; 2]> = if mesh.texcoords.len() / 2 == positions.len() {
             mesh.texcoords.chunks_exact(2).map(|t| [t[0], 1.0 - t[1]]).collect()
@@ -127,10 +168,10 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
             }),
         };
         let base_index = scene.vertices.len() as u32;
-        scene
-            .vertices
-            .extend(positions.iter().zip(&normals).map(|(p, n)| Vertex { position: *p, normal: *n }));
-        scene.uvs.extend(uvs);
+        scene.vertices.extend(
+            source.iter().zip(&normals).map(|(&i, n)| Vertex { position: positions[i as usize], normal: *n }),
+        );
+        scene.uvs.extend(source.iter().map(|&i| uvs[i as usize]));
         scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base_index)));
         scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
     }
@@ -204,12 +245,25 @@ fn convert_material(m: &tobj::Material, texture: &mut dyn FnMut(&str, TextureRol
     gpu
 }
 
-/// Checks face references and positions line by line; returns the `mtllib` names.
-fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
+/// What the first pass over the OBJ text finds besides errors.
+struct Precheck {
+    /// `mtllib` names.
+    libs: Vec<String>,
+    /// Smoothing group of each triangle in file order (a face of n corners gives n − 2): `0` for
+    /// `s off`, `s 0` or no `s` statement yet.
+    groups: Vec<u32>,
+    /// Warnings, with line numbers.
+    warnings: Vec<String>,
+}
+
+/// Checks face references and positions line by line; reads `mtllib` names and smoothing
+/// groups.
+fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     let text = String::from_utf8_lossy(text);
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let mut libs = Vec::new();
     let mut faces = 0u64;
+    let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
     let mut logical = String::new();
     let mut first_line = 0;
     for (i, raw) in text.lines().enumerate() {
@@ -241,12 +295,26 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
             Some("vt") => nt += 1,
             Some("vn") => nn += 1,
             Some("mtllib") => libs.extend(words.map(str::to_string)),
+            Some("s") => {
+                group = match words.next() {
+                    Some("off") => 0,
+                    Some(w) if w.parse::<u32>().is_ok() => w.parse().unwrap_or(0),
+                    other => {
+                        warnings.push(format!(
+                            "{file}:{first_line}: smoothing group '{}' is neither a number nor 'off'; read as off (flat)",
+                            other.unwrap_or("")
+                        ));
+                        0
+                    }
+                };
+            }
             Some("f") => {
                 faces += 1;
                 let corners: Vec<&str> = words.collect();
                 if corners.len() < 3 {
                     return Err(at(format!("face has {} vertices; a face needs at least 3", corners.len())));
                 }
+                groups.extend(std::iter::repeat_n(group, corners.len() - 2));
                 for (k, c) in corners.iter().enumerate() {
                     for (slot, (part, count, what)) in c
                         .split('/')
@@ -276,5 +344,5 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
     if faces == 0 {
         return Err(CliError::input(format!("{file}: has no faces")));
     }
-    Ok(libs)
+    Ok(Precheck { libs, groups, warnings })
 }
