@@ -476,3 +476,27 @@ fn normals_setting_parses_and_refuses() {
     let e = settings.apply_bake_table(&side.bake).unwrap_err();
     assert!(e.starts_with("normals: crease angle '200'"), "{e}");
 }
+
+#[test]
+fn zero_gltf_normal_takes_the_face_normal() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::new();
+    // A triangle in y = 0 facing +y; given normals +x, a zero one, +x.
+    let p = g.positions(&[[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]);
+    let bytes: Vec<u8> = [[1.0f32, 0.0, 0.0], [0.0; 3], [1.0, 0.0, 0.0]]
+        .iter()
+        .flatten()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    let v = g.view(&bytes, None);
+    let n = g.accessor(Some(v), 5126, 3, "VEC3", json!({}));
+    g.mesh(json!({"attributes": {"POSITION": p, "NORMAL": n}}));
+    let s = import(&g.write(d.path(), "z")).unwrap();
+    assert_eq!(geometric_normal(&s, 0), Vec3::Y);
+    assert_eq!([0, 1, 2].map(|k| corner_normal(&s, 0, k)), [Vec3::X, Vec3::Y, Vec3::X]);
+    assert!(
+        s.warnings.iter().any(|w| w.message.contains("1 NORMAL values are zero or not finite")),
+        "{:?}",
+        s.warnings
+    );
+}
