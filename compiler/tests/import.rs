@@ -500,3 +500,49 @@ fn zero_gltf_normal_takes_the_face_normal() {
         s.warnings
     );
 }
+
+#[test]
+fn obj_mtl_specular_colour_and_mirrors() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("m.mtl"),
+        "newmtl box\nKd 0 0 0\nKs 0.725 0.71 0.68\nNs 200\n\n\
+         newmtl mirror\nillum 3\nKd 0.1 0.1 0.1\nKs 0.9 0.8 0.7\n\n\
+         newmtl glossy\nillum 5\nKd 0.8 0.6 0.4\nKs 0.2 0.2 0.2\nNs 14\n\n\
+         newmtl matte\nKd 0.5 0.5 0.5\nKs 0 0 0\nillum 3\n",
+    )
+    .unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl box\nf 1 2 3\nusemtl mirror\nf 1 2 3\n\
+               usemtl glossy\nf 1 2 3\nusemtl matte\nf 1 2 3\n";
+    std::fs::write(d.path().join("s.obj"), obj).unwrap();
+    let s = import(&d.path().join("s.obj")).unwrap();
+    let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
+    let warned = |n: &str, what: &str| {
+        s.warnings.iter().any(|w| w.message.contains(&format!("material '{n}'")) && w.message.contains(what))
+    };
+    // The Cornell box's boxes: black Kd, bright Ks → a metal of colour Ks; roughness
+    // (2/202)^¼ = 0.315442 (computed by hand), no information lost (Kd was black).
+    let b = m("box");
+    assert_eq!(b.base_color, [0.725, 0.71, 0.68, 1.0]);
+    assert_eq!(b.metallic, 1.0);
+    assert!((b.roughness - 0.315_442).abs() < 1e-6, "{}", b.roughness);
+    assert_eq!(b.flags & MaterialFlags::DIFFUSE_ONLY, 0);
+    assert!(!s.warnings.iter().any(|w| w.message.contains("'box'")), "{:?}", s.warnings);
+    // illum 3 with Ks brighter than Kd and no Ns: a perfect mirror of colour Ks; Kd 0.1 dropped.
+    let r = m("mirror");
+    assert_eq!((r.base_color, r.metallic, r.roughness), ([0.9, 0.8, 0.7, 1.0], 1.0, 0.0));
+    assert!(warned("mirror", "Kd [0.1, 0.1, 0.1] is dropped"), "{:?}", s.warnings);
+    // illum 5 but Kd dominates: a dielectric of base colour Kd, roughness (2/16)^¼, Ks's
+    // colour lost with a warning.
+    let g = m("glossy");
+    assert_eq!((g.base_color, g.metallic), ([0.8, 0.6, 0.4, 1.0], 0.0));
+    assert!((g.roughness - 0.125f32.powf(0.25)).abs() < 1e-6);
+    assert!(warned("glossy", "colourless dielectric specular lobe"), "{:?}", s.warnings);
+    // Ks 0 stays pure Lambertian whatever illum says.
+    let t = m("matte");
+    assert_eq!(
+        (t.base_color, t.metallic, t.flags & MaterialFlags::DIFFUSE_ONLY),
+        ([0.5, 0.5, 0.5, 1.0], 0.0, MaterialFlags::DIFFUSE_ONLY)
+    );
+    assert!(!s.warnings.iter().any(|w| w.message.contains("'matte'")), "{:?}", s.warnings);
+}

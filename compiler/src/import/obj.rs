@@ -13,13 +13,17 @@
 //! are flat and a warning says so.
 //!
 //! MTL → PBR rule (documented in the README):
-//! - `Kd` is the base colour (albedo), `map_Kd` its texture; `d` (or `1 - Tr`) its alpha.
-//! - `Ks 0 0 0` (or no `Ks`) with no metalness `Pm` → **pure Lambertian diffuse**: no specular
-//!   lobe at all (flag `DIFFUSE_ONLY`), metallic 0, roughness 1.
-//! - Otherwise a GGX material: metallic `Pm` (default 0), roughness `Pr`, or from the Phong
-//!   exponent `Ns` as `(2 / (Ns + 2))^(1/4)` (Walter et al.'s Beckmann–Phong correspondence
-//!   α = √(2/(Ns+2)), with perceptual roughness √α); `Ks` itself only decides that a specular
-//!   lobe exists (dielectric F0 = 0.04).
+//! - `d` (or `1 - Tr`) is the alpha. Roughness is `Pr`, or from the Phong exponent `Ns` as
+//!   `(2 / (Ns + 2))^(1/4)` (Walter et al.'s Beckmann–Phong correspondence α = √(2/(Ns+2)), with
+//!   perceptual roughness √α); without either 1, or 0 for a mirror (`illum` 3 or 5).
+//! - `Ks 0 0 0` (or no `Ks`) with no metalness `Pm` → **pure Lambertian diffuse** of albedo
+//!   `Kd` (`map_Kd` its texture): no specular lobe at all (flag `DIFFUSE_ONLY`).
+//! - No `Pm` and a specular colour that is what one sees — `Kd` black (every channel ≤ 0.04), or
+//!   `illum` 3/5 with `Ks` at least as bright as `Kd` → a **metal of base colour `Ks`** (a
+//!   dielectric would render black). `Kd` dropped that way gets a warning.
+//! - Otherwise a GGX dielectric-or-`Pm` material of base colour `Kd`, metallic `Pm` (default 0);
+//!   `Ks` only decides that a specular lobe exists (F0 = 0.04), with a warning when both `Kd`
+//!   and `Ks` are significant, since Ks's colour and strength are lost.
 //! - `Ke` is emitted radiance in W/(sr·m²), `map_Ke` its texture; `norm`/`map_Bump` a normal map.
 
 use std::collections::HashMap;
@@ -74,29 +78,39 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     let mut tex_cache: HashMap<(String, TextureRole), u32> = HashMap::new();
     let first_material = scene.materials.len() as u32;
     let mtl_base = |name: &str| base.join(name);
+    let mut material_warnings = Vec::new();
     for m in &materials {
-        let gpu = convert_material(m, &mut |name: &str, role| {
-            if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
-                return i;
-            }
-            let full = mtl_base(name);
-            let bytes = std::fs::read(&full).map_err(|e| format!("cannot read {}: {e}", full.display()));
-            if bytes.is_ok() && !scene.inputs.contains(&full) {
-                scene.inputs.push(full.clone());
-            }
-            let i = (scene.textures.len() + requests.len()) as u32;
-            requests.push(TextureRequest {
-                name: name.to_string(),
-                bytes,
-                role,
-                wrap_u: Wrap::Repeat,
-                wrap_v: Wrap::Repeat,
-                mag_linear: true,
-            });
-            tex_cache.insert((name.to_string(), role), i);
-            i
-        });
+        let mut warnings = Vec::new();
+        let gpu = convert_material(
+            m,
+            &mut |name: &str, role| {
+                if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
+                    return i;
+                }
+                let full = mtl_base(name);
+                let bytes = std::fs::read(&full).map_err(|e| format!("cannot read {}: {e}", full.display()));
+                if bytes.is_ok() && !scene.inputs.contains(&full) {
+                    scene.inputs.push(full.clone());
+                }
+                let i = (scene.textures.len() + requests.len()) as u32;
+                requests.push(TextureRequest {
+                    name: name.to_string(),
+                    bytes,
+                    role,
+                    wrap_u: Wrap::Repeat,
+                    wrap_v: Wrap::Repeat,
+                    mag_linear: true,
+                });
+                tex_cache.insert((name.to_string(), role), i);
+                i
+            },
+            &mut warnings,
+        );
+        material_warnings.extend(warnings.into_iter().map(|w| format!("{file}: material '{}': {w}", m.name)));
         scene.materials.push(Material { name: m.name.clone(), gpu });
+    }
+    for w in material_warnings {
+        scene.warn(w);
     }
     let mut default_material: Option<u32> = None;
     let tobj_triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
@@ -198,22 +212,64 @@ fn param(m: &tobj::Material, key: &str) -> Option<f32> {
     m.unknown_param.get(key).and_then(|v| v.split_whitespace().next()?.parse().ok())
 }
 
-fn convert_material(m: &tobj::Material, texture: &mut dyn FnMut(&str, TextureRole) -> u32) -> GpuMaterial {
+/// Largest channel at or below which a diffuse colour (`Kd`) counts as black, and above which a
+/// specular colour (`Ks`) counts as significant: 4 %, about the darkest real diffuse albedos
+/// (charcoal, fresh asphalt) and the normal-incidence reflectance of common dielectrics.
+const NEAR_BLACK: f32 = 0.04;
+
+fn max3(c: [f32; 3]) -> f32 {
+    c[0].max(c[1]).max(c[2])
+}
+
+/// The MTL → PBR rule (module documentation and README). Warnings where the mapping drops
+/// information go to `warnings`.
+fn convert_material(
+    m: &tobj::Material,
+    texture: &mut dyn FnMut(&str, TextureRole) -> u32,
+    warnings: &mut Vec<String>,
+) -> GpuMaterial {
     let kd = m.diffuse.unwrap_or([0.8; 3]);
     let ks = m.specular.unwrap_or([0.0; 3]);
     let metallic = param(m, "Pm");
     let alpha = m.dissolve.or_else(|| param(m, "Tr").map(|t| 1.0 - t)).unwrap_or(1.0).clamp(0.0, 1.0);
+    // `illum` 3 and 5 turn on ray-traced reflection (5 with Fresnel): a mirror.
+    let mirror = matches!(m.illumination_model, Some(3 | 5));
+    // Roughness: `Pr`, or from the Phong exponent `Ns`; without either 1, or 0 for a mirror.
+    let roughness = param(m, "Pr")
+        .unwrap_or_else(|| match m.shininess {
+            Some(ns) => (2.0 / (ns.max(0.0) + 2.0)).powf(0.25),
+            None if mirror => 0.0,
+            None => 1.0,
+        })
+        .clamp(0.0, 1.0);
+    let (kd_max, ks_max) = (max3(kd), max3(ks));
     let mut gpu = if ks == [0.0; 3] && metallic.is_none_or(|v| v == 0.0) {
         lambert(kd)
+    } else if metallic.is_none() && ks != [0.0; 3] && (kd_max <= NEAR_BLACK || (mirror && ks_max >= kd_max)) {
+        // The specular colour is what is seen: a metal of colour Ks (a dielectric of base
+        // colour Kd would be black).
+        if kd_max > NEAR_BLACK {
+            warnings.push(format!(
+                "Kd {kd:?} is dropped: illum {} with Ks {ks:?} at least as bright makes it a metal of colour Ks, which has no diffuse lobe",
+                m.illumination_model.unwrap_or(0)
+            ));
+        }
+        GpuMaterial {
+            base_color: [ks[0], ks[1], ks[2], 1.0],
+            metallic: 1.0,
+            roughness,
+            ..GpuMaterial::default()
+        }
     } else {
-        let roughness = param(m, "Pr").unwrap_or_else(|| {
-            let ns = m.shininess.unwrap_or(0.0).max(0.0);
-            (2.0 / (ns + 2.0)).powf(0.25)
-        });
+        if metallic.is_none() && kd_max > NEAR_BLACK && ks_max > NEAR_BLACK {
+            warnings.push(format!(
+                "Ks {ks:?} becomes a colourless dielectric specular lobe (F0 0.04) over base colour Kd {kd:?}: a PBR base colour is diffuse albedo or metal reflectance, not both, and Kd, the larger part of most such materials' look, wins"
+            ));
+        }
         GpuMaterial {
             base_color: [kd[0], kd[1], kd[2], 1.0],
             metallic: metallic.unwrap_or(0.0).clamp(0.0, 1.0),
-            roughness: roughness.clamp(0.0, 1.0),
+            roughness,
             ..GpuMaterial::default()
         }
     };
