@@ -22,8 +22,9 @@
 //!   `illum` 3/5 with `Ks` at least as bright as `Kd` → a **metal of base colour `Ks`** (a
 //!   dielectric would render black). `Kd` dropped that way gets a warning.
 //! - Otherwise a GGX dielectric-or-`Pm` material of base colour `Kd`, metallic `Pm` (default 0);
-//!   `Ks` only decides that a specular lobe exists (F0 = 0.04), with a warning when both `Kd`
-//!   and `Ks` are significant, since Ks's colour and strength are lost.
+//!   `Ks` only decides that a specular lobe exists (F0 = 0.04); its colour and strength are not
+//!   kept (no warning: that is the reading of almost every OBJ material, and `--strict` must not
+//!   fail them all).
 //! - `Ke` is emitted radiance in W/(sr·m²), `map_Ke` its texture; `norm`/`map_Bump` a normal map.
 
 use std::collections::HashMap;
@@ -261,11 +262,9 @@ fn convert_material(
             ..GpuMaterial::default()
         }
     } else {
-        if metallic.is_none() && kd_max > NEAR_BLACK && ks_max > NEAR_BLACK {
-            warnings.push(format!(
-                "Ks {ks:?} becomes a colourless dielectric specular lobe (F0 0.04) over base colour Kd {kd:?}: a PBR base colour is diffuse albedo or metal reflectance, not both, and Kd, the larger part of most such materials' look, wins"
-            ));
-        }
+        // Ks then only decides that a specular lobe exists (F0 0.04): its colour and strength
+        // are not kept, without a warning — that is the usual reading of most OBJ materials
+        // (Kd 0.8, Ks 0.5), and warning on each would fail every such file under --strict.
         GpuMaterial {
             base_color: [kd[0], kd[1], kd[2], 1.0],
             metallic: metallic.unwrap_or(0.0).clamp(0.0, 1.0),
