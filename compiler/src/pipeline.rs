@@ -49,8 +49,29 @@ impl Loaded {
 /// `quiet`; with `strict` any warning is an error.
 pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     let start = Instant::now();
-    let mut scene = import::import(&args.input)?;
-    let settings = configure(&mut scene, args.config.as_deref(), &args.bake)?;
+    // The sidecar is read first since its `[bake] normals` decides the import; it is recorded
+    // as an input after the asset, in the order a reader of the depfile expects.
+    let mut sidecar_inputs = Vec::new();
+    let sidecar = match args.config.as_deref() {
+        Some(cfg) => Some((cfg, Sidecar::load(cfg, &mut sidecar_inputs)?)),
+        None => None,
+    };
+    let mut settings = Settings::default();
+    if let Some((cfg, sidecar)) = &sidecar {
+        settings
+            .apply_bake_table(&sidecar.bake)
+            .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
+    }
+    args.bake.apply(&mut settings);
+    let mut scene = import::import_with(&args.input, settings.normals)?;
+    for p in sidecar_inputs {
+        if !scene.inputs.contains(&p) {
+            scene.inputs.push(p);
+        }
+    }
+    if let Some((cfg, sidecar)) = &sidecar {
+        sidecar.apply(&mut scene, &cfg.display().to_string())?;
+    }
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
 }
 

@@ -162,6 +162,66 @@ pub fn variants_name(v: u32) -> String {
     if names.is_empty() { "none".into() } else { names.join(",") }
 }
 
+/// Largest crease angle of `--normals smooth:ANGLE`, degrees.
+pub const MAX_CREASE_DEGREES: f32 = 180.0;
+
+/// How vertex normals are made where the asset gives none (`--normals`, `[bake] normals`).
+/// Normals the asset gives are always kept.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Normals {
+    /// What the format says: glTF flat (glTF 2.0, "Vertex attributes": "client implementations
+    /// MUST calculate flat normals"), OBJ by its smoothing groups (`s N` smooth within group N,
+    /// `s off`, `s 0` or none flat).
+    #[default]
+    Asset,
+    /// Every triangle its own face normal.
+    Flat,
+    /// Angle-weighted vertex normals over all triangles at a vertex, except across edges whose
+    /// face normals differ by more than `crease_degrees` (`None`: no crease, smooth everywhere).
+    Smooth {
+        /// Crease angle in degrees, in `0..=180`.
+        crease_degrees: Option<f32>,
+    },
+}
+
+// The crease angle is checked finite when parsed, so equality is reflexive.
+impl Eq for Normals {}
+
+impl Normals {
+    /// Parses `asset`, `flat`, `smooth` or `smooth:ANGLE` (degrees, 0..=180).
+    pub fn parse(s: &str) -> Result<Normals, String> {
+        let usage = "use flat, smooth or smooth:ANGLE (crease angle in degrees, 0..=180)";
+        match s {
+            "asset" => Ok(Normals::Asset),
+            "flat" => Ok(Normals::Flat),
+            "smooth" => Ok(Normals::Smooth { crease_degrees: None }),
+            _ => {
+                let Some(angle) = s.strip_prefix("smooth:") else {
+                    return Err(format!("'{s}' is not a normals mode; {usage}"));
+                };
+                match angle.trim().parse::<f32>() {
+                    Ok(a) if a.is_finite() && (0.0..=MAX_CREASE_DEGREES).contains(&a) => {
+                        Ok(Normals::Smooth { crease_degrees: Some(a) })
+                    }
+                    _ => {
+                        Err(format!("crease angle '{angle}' is not a number of degrees in 0..=180; {usage}"))
+                    }
+                }
+            }
+        }
+    }
+
+    /// As text (parses back to the same value).
+    pub fn name(self) -> String {
+        match self {
+            Normals::Asset => "asset".into(),
+            Normals::Flat => "flat".into(),
+            Normals::Smooth { crease_degrees: None } => "smooth".into(),
+            Normals::Smooth { crease_degrees: Some(a) } => format!("smooth:{a}"),
+        }
+    }
+}
+
 /// Every setting that affects the output file.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Settings {
@@ -179,6 +239,8 @@ pub struct Settings {
     pub shadow_res: u32,
     /// Light-visibility volume cells along the medium's longest axis.
     pub media_volume_res: u32,
+    /// Normals where the asset gives none (applied at import).
+    pub normals: Normals,
 }
 
 impl Default for Settings {
@@ -191,6 +253,7 @@ impl Default for Settings {
             brdf_lut_res: BRDF_LUT_RES.default,
             shadow_res: SHADOW_RES.default,
             media_volume_res: MEDIA_VOLUME_RES.default,
+            normals: Normals::Asset,
         }
     }
 }
@@ -223,6 +286,9 @@ impl Settings {
         if let Some(v) = &b.shaft_variants {
             self.shaft_variants = Some(parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
         }
+        if let Some(n) = &b.normals {
+            self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;
+        }
         Ok(())
     }
 
@@ -236,6 +302,7 @@ impl Settings {
             ("brdf-lut-res".into(), self.brdf_lut_res.to_string()),
             ("shadow-res".into(), self.shadow_res.to_string()),
             ("media-volume-res".into(), self.media_volume_res.to_string()),
+            ("normals".into(), self.normals.name()),
         ]
     }
 }

@@ -80,6 +80,13 @@ fn exit_codes() {
     kiln(dir.path(), &["frobnicate"]).expect(2);
     kiln(dir.path(), &["compile"]).expect(2);
     kiln(dir.path(), &["compile", "x.obj", "--threads", "0"]).expect(2);
+    kiln(dir.path(), &["plan", "x.obj", "--normals", "smooth:500"]).expect(2).says("crease angle '500'");
+    kiln(dir.path(), &["plan", "x.obj", "--normals", "round"]).expect(2).says("flat, smooth or smooth:ANGLE");
+    std::fs::write(dir.path().join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "[bake]\nnormals = \"smooth:x\"\n").unwrap();
+    kiln(dir.path(), &["plan", "t.obj", "-c", "bad.toml"]).expect(1).says("[bake] normals: crease angle 'x'");
+    std::fs::write(dir.path().join("ok.toml"), "[bake]\nnormals = \"smooth:30\"\n").unwrap();
+    kiln(dir.path(), &["plan", "t.obj", "-c", "ok.toml", "--normals", "flat"]).expect(0);
     std::fs::write(dir.path().join("scene.fbx"), b"x").unwrap();
     kiln(dir.path(), &["compile", "scene.fbx"]).expect(3).says("unsupported input format");
     std::fs::write(dir.path().join("notes.kiln"), b"hello\n").unwrap();

@@ -7,8 +7,9 @@ mod gltf_builder;
 use base64::Engine;
 use glam::Vec3;
 use gltf_builder::Gltf;
-use kiln_compiler::import::import;
+use kiln_compiler::import::{import, import_with};
 use kiln_compiler::ir::{Scene, TextureRole};
+use kiln_compiler::settings::Normals;
 use kiln_format::manifest::LightKind;
 use kiln_format::sections::MaterialFlags;
 use serde_json::json;
@@ -66,7 +67,12 @@ fn strips_and_fans() {
     g.json["meshes"] = json!([{"primitives": [{"attributes": {"POSITION": p}, "mode": 5}, {"attributes": {"POSITION": p}, "mode": 6}]}]);
     let s = import(&g.write(d.path(), "sf")).unwrap();
     assert_eq!(&s.triangles[..3], &[[0, 1, 2], [2, 1, 3], [2, 3, 4]]);
-    assert_eq!(&s.triangles[3..], &[[6, 7, 5], [7, 8, 5], [8, 9, 5]]);
+    // The fan's second triangle faces -z, so flat normals give its corners their own vertices:
+    // compare corners by position (vertex i of the accessor is at `pos[i]`).
+    let pos = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 2.0, 0.0]];
+    let fan: Vec<[[f32; 3]; 3]> =
+        (3..6).map(|t| s.triangles[t].map(|i| s.vertices[i as usize].position)).collect();
+    assert_eq!(fan, [[1, 2, 0], [2, 3, 0], [3, 4, 0]].map(|t: [usize; 3]| t.map(|i| pos[i])));
     for t in 0..3 {
         assert!(close(geometric_normal(&s, t), Vec3::Z), "strip triangle {t} winding");
     }
@@ -86,7 +92,7 @@ fn sparse_accessor_overrides_values() {
 }
 
 #[test]
-fn generated_normals_are_angle_weighted() {
+fn smooth_normals_on_request_are_angle_weighted() {
     let d = tempfile::tempdir().unwrap();
     let mut g = Gltf::new();
     // Vertex 0 is shared by a triangle in z = 0 (corner angle 90°) and one in x = 0 (45°).
@@ -94,7 +100,8 @@ fn generated_normals_are_angle_weighted() {
         g.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, -1.0]]);
     let i = g.indices(&[0, 1, 2, 0, 2, 4, 0, 4, 3]);
     g.mesh(json!({"attributes": {"POSITION": p}, "indices": i}));
-    let s = import(&g.write(d.path(), "n")).unwrap();
+    // Angle-weighted smoothing is asked for: glTF's own rule is flat.
+    let s = import_with(&g.write(d.path(), "n"), Normals::Smooth { crease_degrees: None }).unwrap();
     // Face normals: +z (angle 90° at v0), -x (two triangles, 45° each).
     let expected = (Vec3::Z * 90f32.to_radians() + Vec3::NEG_X * 90f32.to_radians()).normalize();
     assert!(close(Vec3::from(s.vertices[0].normal), expected), "{:?}", s.vertices[0].normal);
@@ -261,4 +268,281 @@ intensity = 9.0
     assert!(matches!(s.lights[3].kind, LightKind::Rect { width, height } if width == 0.5 && height == 0.25));
     // `right` is made orthogonal to the direction and unit length.
     assert!(close(Vec3::from(s.lights[3].right), Vec3::new(1.0, 0.0, 0.5).normalize()));
+}
+
+/// Normal stored at corner `k` of triangle `t`.
+fn corner_normal(s: &Scene, t: usize, k: usize) -> Vec3 {
+    Vec3::from(s.vertices[s.triangles[t][k] as usize].normal)
+}
+
+/// A unit cube [0, 1]³ as 8 shared corners (vertex x + 2y + 4z) and 12 triangles, counter-clockwise
+/// seen from outside, without normals.
+fn cube_gltf() -> Gltf {
+    let mut g = Gltf::new();
+    let corners: Vec<[f32; 3]> =
+        (0..8).map(|v| [(v & 1) as f32, ((v >> 1) & 1) as f32, ((v >> 2) & 1) as f32]).collect();
+    let p = g.positions(&corners);
+    let quads = [[4, 5, 7, 6], [0, 2, 3, 1], [1, 3, 7, 5], [0, 4, 6, 2], [2, 6, 7, 3], [0, 1, 5, 4]];
+    let idx: Vec<u32> = quads.iter().flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]]).collect();
+    let i = g.indices(&idx);
+    g.mesh(json!({"attributes": {"POSITION": p}, "indices": i}));
+    g
+}
+
+/// The outward normal of a cube triangle, from its corners alone: the axis along which all
+/// three share a coordinate, positive where that coordinate is 1.
+fn cube_face_axis(c: [Vec3; 3]) -> Vec3 {
+    let axis = (0..3).find(|&a| c[0][a] == c[1][a] && c[1][a] == c[2][a]).unwrap();
+    let mut n = Vec3::ZERO;
+    n[axis] = if c[0][axis] == 1.0 { 1.0 } else { -1.0 };
+    n
+}
+
+#[test]
+fn gltf_without_normals_is_flat() {
+    let d = tempfile::tempdir().unwrap();
+    let s = import(&cube_gltf().write(d.path(), "cube")).unwrap();
+    assert_eq!(s.triangles.len(), 12);
+    // Each of the 8 corners is split into one vertex per face that meets there: 24.
+    assert_eq!(s.vertices.len(), 24);
+    assert_eq!(s.uvs.len(), 24);
+    for t in 0..12 {
+        let axis = cube_face_axis(corners(&s, t));
+        assert_eq!(geometric_normal(&s, t), axis, "winding of triangle {t}");
+        for k in 0..3 {
+            assert_eq!(corner_normal(&s, t, k), axis, "triangle {t} corner {k}");
+        }
+    }
+}
+
+#[test]
+fn crease_angle_on_a_cube_and_a_gentle_strip() {
+    let d = tempfile::tempdir().unwrap();
+    let cube = cube_gltf().write(d.path(), "cube");
+    let smooth = |crease: Option<f32>| Normals::Smooth { crease_degrees: crease };
+    // 90° between faces: a 30° crease keeps them flat.
+    let s = import_with(&cube, smooth(Some(30.0))).unwrap();
+    for t in 0..12 {
+        let axis = cube_face_axis(corners(&s, t));
+        (0..3).for_each(|k| assert_eq!(corner_normal(&s, t, k), axis, "crease 30: triangle {t} corner {k}"));
+    }
+    // No crease, or one of 100°: three faces meet at each corner with 90° of corner angle each, so
+    // the normal is the corner's diagonal (±1, ±1, ±1)/√3, pointing away from the centre.
+    for crease in [None, Some(100.0)] {
+        let s = import_with(&cube, smooth(crease)).unwrap();
+        assert_eq!(s.vertices.len(), 8, "{crease:?}");
+        for v in &s.vertices {
+            let diagonal = (Vec3::from(v.position) * 2.0 - Vec3::ONE) / 3f32.sqrt();
+            assert!(close(Vec3::from(v.normal), diagonal), "{crease:?}: {v:?}");
+        }
+    }
+
+    // A strip of 3 rectangles around the unit cylinder about y, columns at φ = 0°, 10°, 20°, 30°
+    // (x = sin φ, z = cos φ): 10° between neighbouring faces.
+    let mut g = Gltf::new();
+    let col = |i: usize| (i as f32 * 10.0).to_radians();
+    let pos: Vec<[f32; 3]> = (0..8).map(|v| [col(v / 2).sin(), (v % 2) as f32, col(v / 2).cos()]).collect();
+    let p = g.positions(&pos);
+    let idx: Vec<u32> =
+        (0..3u32).flat_map(|i| [2 * i, 2 * i + 2, 2 * i + 3, 2 * i, 2 * i + 3, 2 * i + 1]).collect();
+    let i = g.indices(&idx);
+    g.mesh(json!({"attributes": {"POSITION": p}, "indices": i}));
+    let strip = g.write(d.path(), "strip");
+    let radial = |phi: f32| Vec3::new(phi.sin(), 0.0, phi.cos());
+    // Face f (triangles 2f, 2f + 1) faces its middle angle (f + ½)·10°.
+    let face = |t: usize| radial(((t / 2) as f32 * 10.0 + 5.0).to_radians());
+    // A 30° crease smooths across 10°: inner columns get the mean of two unit normals at ±5°
+    // with equal weight (each rectangle has 90° at the vertex), i.e. their own radial direction;
+    // edge columns their one face's normal.
+    let s = import_with(&strip, smooth(Some(30.0))).unwrap();
+    assert_eq!(s.vertices.len(), 8);
+    for t in 0..6 {
+        assert!(close(geometric_normal(&s, t), face(t)), "strip winding {t}");
+        for k in 0..3 {
+            let p = Vec3::from(s.vertices[s.triangles[t][k] as usize].position);
+            let phi = p.x.atan2(p.z);
+            let inner = phi > 0.05 && phi < 30f32.to_radians() - 0.05;
+            let expected = if inner { radial(phi) } else { face(t) };
+            assert!(close(corner_normal(&s, t, k), expected), "crease 30: triangle {t} corner {k}");
+        }
+    }
+    // A 5° crease does not: every corner its face's normal.
+    let s = import_with(&strip, smooth(Some(5.0))).unwrap();
+    for t in 0..6 {
+        (0..3).for_each(|k| {
+            assert!(close(corner_normal(&s, t, k), face(t)), "crease 5: triangle {t} corner {k}")
+        });
+    }
+}
+
+#[test]
+fn obj_smoothing_groups() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(d.path().join("m.mtl"), "newmtl red\nKd 1 0 0\n\nnewmtl white\nKd 1 1 1\n").unwrap();
+    // C: a pentagon in y = 0 (tobj fans it into 3 triangles) before any `s`: flat.
+    // A (z = 0, +z) and B (x = 0, -x) in group 1 share the edge from P0 = (0,0,0) to P3 = (0,1,0)
+    // at 90°, after a `usemtl` that starts a new tobj model.
+    // D (y = 1) in group 2 shares P3 with A and B, and Q2 = (0,1,-1) with B.
+    // E (x = 1) after `s off` shares the edge P1 P2 with A and P2 with D.
+    let obj = "mtllib m.mtl\n\
+               v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 1 -1\nv 0 0 -1\nv 1 0 -1\nv 0.5 0 0.5\nv 1 1 -1\n\
+               o box\nusemtl red\nf 1 6 7 2 8\n\
+               usemtl white\ns 1\nf 1 2 3 4\nf 1 4 5 6\n\
+               s 2\nf 4 5 9 3\n\
+               s off\nf 2 3 7\n";
+    std::fs::write(d.path().join("g.obj"), obj).unwrap();
+    let s = import(&d.path().join("g.obj")).unwrap();
+    assert_eq!(s.triangles.len(), 3 + 2 + 2 + 2 + 1);
+    // At P0 and P3, A and B each have 90° of corner angle (45° + 45° at P0; 90° in one triangle
+    // at P3): the normal is (+z + -x)/√2.
+    let r = 0.5f32.sqrt();
+    let ab = Vec3::new(-r, 0.0, r);
+    let mut seen = [0; 5];
+    for t in 0..s.triangles.len() {
+        let c = corners(&s, t);
+        let n = geometric_normal(&s, t);
+        let on = |axis: usize, v: f32| c.iter().all(|p| p[axis] == v);
+        let (name, face) = if on(2, 0.0) {
+            ("A", Vec3::Z)
+        } else if on(0, 0.0) {
+            ("B", Vec3::NEG_X)
+        } else if on(1, 0.0) {
+            ("C", Vec3::NEG_Y)
+        } else if on(1, 1.0) {
+            ("D", Vec3::NEG_Y)
+        } else {
+            ("E", Vec3::NEG_X)
+        };
+        seen["ABCDE".find(name).unwrap()] += 1;
+        assert!(close(n, face), "{name}: winding");
+        for (k, p) in c.iter().enumerate() {
+            let shared_ab = (name == "A" || name == "B") && p.x == 0.0 && p.z == 0.0;
+            let expected = if shared_ab { ab } else { face };
+            assert!(
+                close(corner_normal(&s, t, k), expected),
+                "{name} corner at {p}: {}",
+                corner_normal(&s, t, k)
+            );
+        }
+    }
+    assert_eq!(seen, [2, 2, 3, 2, 1]);
+}
+
+#[test]
+fn obj_normals_override_and_given_normals() {
+    let d = tempfile::tempdir().unwrap();
+    // Two triangles folded at 90° along the edge (0,0,0)-(0,1,0), no `s`: flat by default,
+    // smooth on request; with `vn` normals given, those are kept whatever is asked.
+    let geometry = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 -1\n";
+    std::fs::write(d.path().join("f.obj"), format!("{geometry}f 1 2 3\nf 1 3 4\n")).unwrap();
+    std::fs::write(
+        d.path().join("n.obj"),
+        format!("{geometry}vn 0 0 2\nf 1//1 2//1 3//1\nf 1//1 3//1 4//1\n"),
+    )
+    .unwrap();
+    let flat = import(&d.path().join("f.obj")).unwrap();
+    assert_eq!(flat.vertices.len(), 6);
+    let smooth = import_with(&d.path().join("f.obj"), Normals::Smooth { crease_degrees: None }).unwrap();
+    assert_eq!(smooth.vertices.len(), 4);
+    // At (0,0,0): +z with 90° and -x with 90°.
+    let r = 0.5f32.sqrt();
+    assert!(close(Vec3::from(smooth.vertices[0].normal), Vec3::new(-r, 0.0, r)));
+    for t in 0..2 {
+        let face = geometric_normal(&flat, t);
+        (0..3).for_each(|k| assert_eq!(corner_normal(&flat, t, k), face));
+    }
+    for mode in [Normals::Asset, Normals::Flat, Normals::Smooth { crease_degrees: None }] {
+        let given = import_with(&d.path().join("n.obj"), mode).unwrap();
+        assert!(given.vertices.iter().all(|v| v.normal == [0.0, 0.0, 1.0]), "{mode:?}");
+    }
+}
+
+#[test]
+fn normals_setting_parses_and_refuses() {
+    use kiln_compiler::settings::Settings;
+    assert_eq!(Normals::parse("flat"), Ok(Normals::Flat));
+    assert_eq!(Normals::parse("smooth"), Ok(Normals::Smooth { crease_degrees: None }));
+    assert_eq!(Normals::parse("smooth:30"), Ok(Normals::Smooth { crease_degrees: Some(30.0) }));
+    assert_eq!(Normals::parse("smooth:12.5").map(Normals::name), Ok("smooth:12.5".to_string()));
+    for bad in ["round", "smooth:", "smooth:-1", "smooth:181", "smooth:NaN", "smooth:inf", "flat:30"] {
+        let e = Normals::parse(bad).unwrap_err();
+        assert!(e.contains("flat, smooth or smooth:ANGLE"), "{bad}: {e}");
+    }
+    let mut settings = Settings::default();
+    let side = kiln_compiler::import::sidecar::Sidecar::parse("[bake]\nnormals = \"smooth:30\"\n").unwrap();
+    settings.apply_bake_table(&side.bake).unwrap();
+    assert_eq!(settings.normals, Normals::Smooth { crease_degrees: Some(30.0) });
+    let side = kiln_compiler::import::sidecar::Sidecar::parse("[bake]\nnormals = \"smooth:200\"\n").unwrap();
+    let e = settings.apply_bake_table(&side.bake).unwrap_err();
+    assert!(e.starts_with("normals: crease angle '200'"), "{e}");
+}
+
+#[test]
+fn zero_gltf_normal_takes_the_face_normal() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::new();
+    // A triangle in y = 0 facing +y; given normals +x, a zero one, +x.
+    let p = g.positions(&[[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]);
+    let bytes: Vec<u8> = [[1.0f32, 0.0, 0.0], [0.0; 3], [1.0, 0.0, 0.0]]
+        .iter()
+        .flatten()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    let v = g.view(&bytes, None);
+    let n = g.accessor(Some(v), 5126, 3, "VEC3", json!({}));
+    g.mesh(json!({"attributes": {"POSITION": p, "NORMAL": n}}));
+    let s = import(&g.write(d.path(), "z")).unwrap();
+    assert_eq!(geometric_normal(&s, 0), Vec3::Y);
+    assert_eq!([0, 1, 2].map(|k| corner_normal(&s, 0, k)), [Vec3::X, Vec3::Y, Vec3::X]);
+    assert!(
+        s.warnings.iter().any(|w| w.message.contains("1 NORMAL values are zero or not finite")),
+        "{:?}",
+        s.warnings
+    );
+}
+
+#[test]
+fn obj_mtl_specular_colour_and_mirrors() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("m.mtl"),
+        "newmtl box\nKd 0 0 0\nKs 0.725 0.71 0.68\nNs 200\n\n\
+         newmtl mirror\nillum 3\nKd 0.1 0.1 0.1\nKs 0.9 0.8 0.7\n\n\
+         newmtl glossy\nillum 5\nKd 0.8 0.6 0.4\nKs 0.2 0.2 0.2\nNs 14\n\n\
+         newmtl matte\nKd 0.5 0.5 0.5\nKs 0 0 0\nillum 3\n",
+    )
+    .unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl box\nf 1 2 3\nusemtl mirror\nf 1 2 3\n\
+               usemtl glossy\nf 1 2 3\nusemtl matte\nf 1 2 3\n";
+    std::fs::write(d.path().join("s.obj"), obj).unwrap();
+    let s = import(&d.path().join("s.obj")).unwrap();
+    let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
+    let warned = |n: &str, what: &str| {
+        s.warnings.iter().any(|w| w.message.contains(&format!("material '{n}'")) && w.message.contains(what))
+    };
+    // The Cornell box's boxes: black Kd, bright Ks → a metal of colour Ks; roughness
+    // (2/202)^¼ = 0.315442 (computed by hand), no information lost (Kd was black).
+    let b = m("box");
+    assert_eq!(b.base_color, [0.725, 0.71, 0.68, 1.0]);
+    assert_eq!(b.metallic, 1.0);
+    assert!((b.roughness - 0.315_442).abs() < 1e-6, "{}", b.roughness);
+    assert_eq!(b.flags & MaterialFlags::DIFFUSE_ONLY, 0);
+    assert!(!s.warnings.iter().any(|w| w.message.contains("'box'")), "{:?}", s.warnings);
+    // illum 3 with Ks brighter than Kd and no Ns: a perfect mirror of colour Ks; Kd 0.1 dropped.
+    let r = m("mirror");
+    assert_eq!((r.base_color, r.metallic, r.roughness), ([0.9, 0.8, 0.7, 1.0], 1.0, 0.0));
+    assert!(warned("mirror", "Kd [0.1, 0.1, 0.1] is dropped"), "{:?}", s.warnings);
+    // illum 5 but Kd dominates: a dielectric of base colour Kd, roughness (2/16)^¼; Ks only
+    // makes the lobe exist, as for most OBJ materials, so no warning (--strict must pass them).
+    let g = m("glossy");
+    assert_eq!((g.base_color, g.metallic), ([0.8, 0.6, 0.4, 1.0], 0.0));
+    assert!((g.roughness - 0.125f32.powf(0.25)).abs() < 1e-6);
+    assert!(!s.warnings.iter().any(|w| w.message.contains("'glossy'")), "{:?}", s.warnings);
+    // Ks 0 stays pure Lambertian whatever illum says.
+    let t = m("matte");
+    assert_eq!(
+        (t.base_color, t.metallic, t.flags & MaterialFlags::DIFFUSE_ONLY),
+        ([0.5, 0.5, 0.5, 1.0], 0.0, MaterialFlags::DIFFUSE_ONLY)
+    );
+    assert!(!s.warnings.iter().any(|w| w.message.contains("'matte'")), "{:?}", s.warnings);
 }

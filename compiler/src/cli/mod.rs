@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
-    BRDF_LUT_RES, BvhPreset, MEDIA_VOLUME_RES, SHADOW_RES, SHAFT_RES, Settings, VOXEL_RES, VoxelRes,
+    BRDF_LUT_RES, BvhPreset, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings, VOXEL_RES, VoxelRes,
     parse_variants,
 };
 
@@ -123,6 +123,12 @@ pub struct BakeArgs {
     #[arg(long, value_name = "N", value_parser = MEDIA_VOLUME_RES.parser(), help_heading = "Lighting bakes",
           help = MEDIA_VOLUME_RES.help("Light-visibility volume cells along the medium's longest axis"))]
     pub media_volume_res: Option<u32>,
+    /// Normals where the asset gives none.
+    #[arg(long, value_name = "flat|smooth[:ANGLE]", value_parser = Normals::parse, help_heading = "Import",
+          help = "Normals where the asset gives none (given normals are kept): flat (face normals), smooth \
+(angle-weighted vertex normals), smooth:ANGLE (smooth except across edges whose faces differ by more \
+than ANGLE degrees) [default: asset: glTF flat as its spec says, OBJ by its smoothing groups]")]
+    pub normals: Option<Normals>,
 }
 
 impl BakeArgs {
@@ -140,6 +146,7 @@ impl BakeArgs {
         set(&mut settings.brdf_lut_res, self.brdf_lut_res);
         set(&mut settings.shadow_res, self.shadow_res);
         set(&mut settings.media_volume_res, self.media_volume_res);
+        set(&mut settings.normals, self.normals);
     }
 }
 

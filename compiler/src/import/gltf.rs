@@ -14,11 +14,12 @@ use glam::{DMat3, DMat4, DVec3};
 use kiln_format::manifest::{Camera, Light, LightKind, Wrap};
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
-use super::geometry::{angle_weighted_normals, check_position};
+use super::geometry::{Sharing, check_position, corner_normals, given_corner_normals, split_by_normal};
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult, Exit};
 use crate::ir::{Material, Scene, TextureRole};
+use crate::settings::Normals;
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
 const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
@@ -37,10 +38,12 @@ struct Importer<'a> {
     /// (glTF texture index, role) → IR texture index.
     textures: HashMap<(usize, TextureRole), u32>,
     requests: Vec<TextureRequest>,
+    /// Normals where a primitive has no NORMAL attribute.
+    normals: Normals,
 }
 
 /// Imports a `.gltf` or `.glb` file into `scene`.
-pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
+pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()> {
     let bytes = read_input(path, &mut scene.inputs)?;
     let file = path.display().to_string();
     let gltf = Gltf::from_slice_without_validation(&bytes)
@@ -70,6 +73,7 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
         materials: HashMap::new(),
         textures: HashMap::new(),
         requests: Vec::new(),
+        normals,
     };
     imp.walk_scene()?;
     let (textures, warnings) = decode_all(std::mem::take(&mut imp.requests));
@@ -344,34 +348,30 @@ impl Importer<'_> {
                 }
             }
 
-            let normals: Vec<[f32; 3]> = match normals_in {
+            // Without NORMAL, glTF 2.0 ("Vertex attributes") says: "client implementations MUST
+            // calculate flat normals"; `--normals smooth[:ANGLE]` asks otherwise.
+            let corners = match normals_in {
                 Some(n) => {
-                    let mut bad = 0usize;
-                    let mut out: Vec<[f32; 3]> = n
+                    let given: Vec<[f32; 3]> = n
                         .iter()
-                        .map(|n| match (normal_matrix * DVec3::from(n.map(f64::from))).try_normalize() {
-                            Some(v) => v.as_vec3().to_array(),
-                            None => {
-                                bad += 1;
-                                [f32::NAN; 3]
-                            }
+                        .map(|n| {
+                            (normal_matrix * DVec3::from(n.map(f64::from)))
+                                .try_normalize()
+                                .map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
                         })
                         .collect();
+                    let bad = given.iter().filter(|n| n[0].is_nan()).count();
+                    let (corners, replaced) = given_corner_normals(&positions, &tris, &given);
                     if bad > 0 {
                         self.scene.warn(format!(
-                            "{at}: {bad} NORMAL values are zero or not finite; replaced by generated normals"
+                            "{at}: {bad} NORMAL values are zero or not finite; the {replaced} triangle corners using them take their triangle's face normal (flat)"
                         ));
-                        let generated = angle_weighted_normals(&positions, &tris);
-                        for (o, g) in out.iter_mut().zip(generated) {
-                            if o[0].is_nan() {
-                                *o = g;
-                            }
-                        }
                     }
-                    out
+                    corners
                 }
-                None => angle_weighted_normals(&positions, &tris),
+                None => corner_normals(&positions, &tris, sharing(self.normals)),
             };
+            let (source, normals, tris) = split_by_normal(count, &tris, &corners);
 
             let material = self.material(prim.material())?;
             if self.scene.triangles.len() + tris.len() > MAX_TRIANGLES {
@@ -381,12 +381,15 @@ impl Importer<'_> {
                 )));
             }
             let base = self.scene.vertices.len() as u32;
-            self.scene
-                .vertices
-                .extend(positions.iter().zip(&normals).map(|(p, n)| Vertex { position: *p, normal: *n }));
+            self.scene.vertices.extend(
+                source
+                    .iter()
+                    .zip(&normals)
+                    .map(|(&i, n)| Vertex { position: positions[i as usize], normal: *n }),
+            );
             match uvs {
-                Some(uv) => self.scene.uvs.extend(uv),
-                None => self.scene.uvs.extend(std::iter::repeat_n([0.0; 2], count)),
+                Some(uv) => self.scene.uvs.extend(source.iter().map(|&i| uv[i as usize])),
+                None => self.scene.uvs.extend(std::iter::repeat_n([0.0; 2], source.len())),
             }
             self.scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base)));
             self.scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
@@ -707,6 +710,14 @@ impl Importer<'_> {
         }
         self.scene.lights.push(l);
         Ok(())
+    }
+}
+
+/// How triangles without given normals share them: flat unless asked otherwise.
+fn sharing(normals: Normals) -> Sharing<'static> {
+    match normals {
+        Normals::Asset | Normals::Flat => Sharing::Flat,
+        Normals::Smooth { crease_degrees } => Sharing::Smooth(crease_degrees.map(f64::from)),
     }
 }
 

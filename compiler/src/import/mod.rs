@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use crate::exit::{CliError, CliResult, Exit};
 use crate::ir::Scene;
+use crate::settings::Normals;
 
 pub use geometry::MAX_COORDINATE;
 
@@ -55,16 +56,22 @@ pub(crate) fn read_input(path: &Path, inputs: &mut Vec<PathBuf>) -> CliResult<Ve
     Ok(bytes)
 }
 
-/// Imports `path` into a new scene (geometry, materials, textures, asset lights and cameras).
+/// Imports `path` into a new scene (geometry, materials, textures, asset lights and cameras),
+/// with normals made as the format says where the asset gives none.
 pub fn import(path: &Path) -> CliResult<Scene> {
+    import_with(path, Normals::Asset)
+}
+
+/// Imports `path`, making normals by `normals` where the asset gives none.
+pub fn import_with(path: &Path, normals: Normals) -> CliResult<Scene> {
     let format = InputFormat::of(path)?;
     let mut scene = Scene {
         name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into()),
         ..Default::default()
     };
     match format {
-        InputFormat::Gltf | InputFormat::Glb => gltf::import(path, &mut scene)?,
-        InputFormat::Obj => obj::import(path, &mut scene)?,
+        InputFormat::Gltf | InputFormat::Glb => gltf::import(path, &mut scene, normals)?,
+        InputFormat::Obj => obj::import(path, &mut scene, normals)?,
     }
     Ok(scene)
 }

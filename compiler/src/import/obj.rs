@@ -4,14 +4,27 @@
 //! references out of range, polygons with fewer than three corners, non-finite positions) and
 //! reports it with its line number; then `tobj` loads the file.
 //!
+//! Smoothing groups (`s N`, `s off`), which `tobj` does not expose, are read in the same first
+//! pass: one group per triangle, in file order (a face of n corners gives n − 2 triangles). They
+//! are matched to `tobj`'s output by order: `tobj` appends each face's triangles (its own fan,
+//! n − 2 of them) to the current model in file order, and starts a new model (also in file
+//! order) at `o`, `g` or a `usemtl` that changes the material, so its models' triangles, read
+//! model after model, are the file's triangles in file order. Where the totals disagree, normals
+//! are flat and a warning says so.
+//!
 //! MTL → PBR rule (documented in the README):
-//! - `Kd` is the base colour (albedo), `map_Kd` its texture; `d` (or `1 - Tr`) its alpha.
-//! - `Ks 0 0 0` (or no `Ks`) with no metalness `Pm` → **pure Lambertian diffuse**: no specular
-//!   lobe at all (flag `DIFFUSE_ONLY`), metallic 0, roughness 1.
-//! - Otherwise a GGX material: metallic `Pm` (default 0), roughness `Pr`, or from the Phong
-//!   exponent `Ns` as `(2 / (Ns + 2))^(1/4)` (Walter et al.'s Beckmann–Phong correspondence
-//!   α = √(2/(Ns+2)), with perceptual roughness √α); `Ks` itself only decides that a specular
-//!   lobe exists (dielectric F0 = 0.04).
+//! - `d` (or `1 - Tr`) is the alpha. Roughness is `Pr`, or from the Phong exponent `Ns` as
+//!   `(2 / (Ns + 2))^(1/4)` (Walter et al.'s Beckmann–Phong correspondence α = √(2/(Ns+2)), with
+//!   perceptual roughness √α); without either 1, or 0 for a mirror (`illum` 3 or 5).
+//! - `Ks 0 0 0` (or no `Ks`) with no metalness `Pm` → **pure Lambertian diffuse** of albedo
+//!   `Kd` (`map_Kd` its texture): no specular lobe at all (flag `DIFFUSE_ONLY`).
+//! - No `Pm` and a specular colour that is what one sees — `Kd` black (every channel ≤ 0.04), or
+//!   `illum` 3/5 with `Ks` at least as bright as `Kd` → a **metal of base colour `Ks`** (a
+//!   dielectric would render black). `Kd` dropped that way gets a warning.
+//! - Otherwise a GGX dielectric-or-`Pm` material of base colour `Kd`, metallic `Pm` (default 0);
+//!   `Ks` only decides that a specular lobe exists (F0 = 0.04); its colour and strength are not
+//!   kept (no warning: that is the reading of almost every OBJ material, and `--strict` must not
+//!   fail them all).
 //! - `Ke` is emitted radiance in W/(sr·m²), `map_Ke` its texture; `norm`/`map_Bump` a normal map.
 
 use std::collections::HashMap;
@@ -20,18 +33,22 @@ use std::path::Path;
 use kiln_format::manifest::Wrap;
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
-use super::geometry::{angle_weighted_normals, check_position};
+use super::geometry::{Sharing, check_position, corner_normals, given_corner_normals, split_by_normal};
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult};
 use crate::ir::{Material, Scene, TextureRole};
+use crate::settings::Normals;
 
 /// Imports an `.obj` file (and the MTL files it names) into `scene`.
-pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
+pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResult<()> {
     let file = path.display().to_string();
     let text = read_input(path, &mut scene.inputs)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mtllibs = precheck(&file, &text)?;
+    let Precheck { libs: mtllibs, groups, warnings } = precheck(&file, &text)?;
+    for w in warnings {
+        scene.warn(w);
+    }
     let options =
         tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(&text), &options, |p| {
@@ -62,31 +79,55 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
     let mut tex_cache: HashMap<(String, TextureRole), u32> = HashMap::new();
     let first_material = scene.materials.len() as u32;
     let mtl_base = |name: &str| base.join(name);
+    let mut material_warnings = Vec::new();
     for m in &materials {
-        let gpu = convert_material(m, &mut |name: &str, role| {
-            if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
-                return i;
-            }
-            let full = mtl_base(name);
-            let bytes = std::fs::read(&full).map_err(|e| format!("cannot read {}: {e}", full.display()));
-            if bytes.is_ok() && !scene.inputs.contains(&full) {
-                scene.inputs.push(full.clone());
-            }
-            let i = (scene.textures.len() + requests.len()) as u32;
-            requests.push(TextureRequest {
-                name: name.to_string(),
-                bytes,
-                role,
-                wrap_u: Wrap::Repeat,
-                wrap_v: Wrap::Repeat,
-                mag_linear: true,
-            });
-            tex_cache.insert((name.to_string(), role), i);
-            i
-        });
+        let mut warnings = Vec::new();
+        let gpu = convert_material(
+            m,
+            &mut |name: &str, role| {
+                if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
+                    return i;
+                }
+                let full = mtl_base(name);
+                let bytes = std::fs::read(&full).map_err(|e| format!("cannot read {}: {e}", full.display()));
+                if bytes.is_ok() && !scene.inputs.contains(&full) {
+                    scene.inputs.push(full.clone());
+                }
+                let i = (scene.textures.len() + requests.len()) as u32;
+                requests.push(TextureRequest {
+                    name: name.to_string(),
+                    bytes,
+                    role,
+                    wrap_u: Wrap::Repeat,
+                    wrap_v: Wrap::Repeat,
+                    mag_linear: true,
+                });
+                tex_cache.insert((name.to_string(), role), i);
+                i
+            },
+            &mut warnings,
+        );
+        material_warnings.extend(warnings.into_iter().map(|w| format!("{file}: material '{}': {w}", m.name)));
         scene.materials.push(Material { name: m.name.clone(), gpu });
     }
+    for w in material_warnings {
+        scene.warn(w);
+    }
     let mut default_material: Option<u32> = None;
+    let tobj_triangles: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let groups = if tobj_triangles == groups.len() {
+        groups
+    } else {
+        if normals_mode == Normals::Asset {
+            scene.warn(format!(
+                "{file}: {} triangles read, {tobj_triangles} loaded: smoothing groups cannot be matched to faces; normals not given are flat",
+                groups.len()
+            ));
+        }
+        vec![0; tobj_triangles]
+    };
+    // The next model's first triangle in `groups`.
+    let mut next_triangle = 0;
 
     for model in &models {
         let mesh = &model.mesh;
@@ -96,20 +137,35 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
             check_position(*p, || format!("{at}: vertex {i}"))?;
         }
         let tris: Vec<[u32; 3]> = mesh.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let tri_groups = &groups[next_triangle..next_triangle + tris.len()];
+        next_triangle += tris.len();
         if tris.is_empty() {
             continue;
         }
-        let normals: Vec<[f32; 3]> = if mesh.normals.len() == mesh.positions.len() {
-            let given: Vec<[f32; 3]> = mesh.normals.chunks_exact(3).map(|n| [n[0], n[1], n[2]]).collect();
-            let generated = angle_weighted_normals(&positions, &tris);
-            given
-                .iter()
-                .zip(generated)
-                .map(|(n, g)| glam::Vec3::from(*n).try_normalize().map_or(g, |v| v.to_array()))
-                .collect()
+        let corners = if mesh.normals.len() == mesh.positions.len() {
+            let given: Vec<[f32; 3]> = mesh
+                .normals
+                .chunks_exact(3)
+                .map(|n| {
+                    glam::Vec3::new(n[0], n[1], n[2]).try_normalize().map_or([f32::NAN; 3], |v| v.to_array())
+                })
+                .collect();
+            let (corners, replaced) = given_corner_normals(&positions, &tris, &given);
+            if replaced > 0 {
+                scene.warn(format!(
+                    "{at}: {replaced} triangle corners have a zero or non-finite normal (vn); they take their triangle's face normal (flat)"
+                ));
+            }
+            corners
         } else {
-            angle_weighted_normals(&positions, &tris)
+            let sharing = match normals_mode {
+                Normals::Asset => Sharing::Groups(tri_groups),
+                Normals::Flat => Sharing::Flat,
+                Normals::Smooth { crease_degrees } => Sharing::Smooth(crease_degrees.map(f64::from)),
+            };
+            corner_normals(&positions, &tris, sharing)
         };
+        let (source, normals, tris) = split_by_normal(positions.len(), &tris, &corners);
         // OBJ's v runs up the image; kiln (like glTF) stores v running down.
         let uvs: Vec<[f32; 2]> = if mesh.texcoords.len() / 2 == positions.len() {
             mesh.texcoords.chunks_exact(2).map(|t| [t[0], 1.0 - t[1]]).collect()
@@ -127,10 +183,10 @@ pub fn import(path: &Path, scene: &mut Scene) -> CliResult<()> {
             }),
         };
         let base_index = scene.vertices.len() as u32;
-        scene
-            .vertices
-            .extend(positions.iter().zip(&normals).map(|(p, n)| Vertex { position: *p, normal: *n }));
-        scene.uvs.extend(uvs);
+        scene.vertices.extend(
+            source.iter().zip(&normals).map(|(&i, n)| Vertex { position: positions[i as usize], normal: *n }),
+        );
+        scene.uvs.extend(source.iter().map(|&i| uvs[i as usize]));
         scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base_index)));
         scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
     }
@@ -157,22 +213,62 @@ fn param(m: &tobj::Material, key: &str) -> Option<f32> {
     m.unknown_param.get(key).and_then(|v| v.split_whitespace().next()?.parse().ok())
 }
 
-fn convert_material(m: &tobj::Material, texture: &mut dyn FnMut(&str, TextureRole) -> u32) -> GpuMaterial {
+/// Largest channel at or below which a diffuse colour (`Kd`) counts as black, and above which a
+/// specular colour (`Ks`) counts as significant: 4 %, about the darkest real diffuse albedos
+/// (charcoal, fresh asphalt) and the normal-incidence reflectance of common dielectrics.
+const NEAR_BLACK: f32 = 0.04;
+
+fn max3(c: [f32; 3]) -> f32 {
+    c[0].max(c[1]).max(c[2])
+}
+
+/// The MTL → PBR rule (module documentation and README). Warnings where the mapping drops
+/// information go to `warnings`.
+fn convert_material(
+    m: &tobj::Material,
+    texture: &mut dyn FnMut(&str, TextureRole) -> u32,
+    warnings: &mut Vec<String>,
+) -> GpuMaterial {
     let kd = m.diffuse.unwrap_or([0.8; 3]);
     let ks = m.specular.unwrap_or([0.0; 3]);
     let metallic = param(m, "Pm");
     let alpha = m.dissolve.or_else(|| param(m, "Tr").map(|t| 1.0 - t)).unwrap_or(1.0).clamp(0.0, 1.0);
+    // `illum` 3 and 5 turn on ray-traced reflection (5 with Fresnel): a mirror.
+    let mirror = matches!(m.illumination_model, Some(3 | 5));
+    // Roughness: `Pr`, or from the Phong exponent `Ns`; without either 1, or 0 for a mirror.
+    let roughness = param(m, "Pr")
+        .unwrap_or_else(|| match m.shininess {
+            Some(ns) => (2.0 / (ns.max(0.0) + 2.0)).powf(0.25),
+            None if mirror => 0.0,
+            None => 1.0,
+        })
+        .clamp(0.0, 1.0);
+    let (kd_max, ks_max) = (max3(kd), max3(ks));
     let mut gpu = if ks == [0.0; 3] && metallic.is_none_or(|v| v == 0.0) {
         lambert(kd)
+    } else if metallic.is_none() && ks != [0.0; 3] && (kd_max <= NEAR_BLACK || (mirror && ks_max >= kd_max)) {
+        // The specular colour is what is seen: a metal of colour Ks (a dielectric of base
+        // colour Kd would be black).
+        if kd_max > NEAR_BLACK {
+            warnings.push(format!(
+                "Kd {kd:?} is dropped: illum {} with Ks {ks:?} at least as bright makes it a metal of colour Ks, which has no diffuse lobe",
+                m.illumination_model.unwrap_or(0)
+            ));
+        }
+        GpuMaterial {
+            base_color: [ks[0], ks[1], ks[2], 1.0],
+            metallic: 1.0,
+            roughness,
+            ..GpuMaterial::default()
+        }
     } else {
-        let roughness = param(m, "Pr").unwrap_or_else(|| {
-            let ns = m.shininess.unwrap_or(0.0).max(0.0);
-            (2.0 / (ns + 2.0)).powf(0.25)
-        });
+        // Ks then only decides that a specular lobe exists (F0 0.04): its colour and strength
+        // are not kept, without a warning — that is the usual reading of most OBJ materials
+        // (Kd 0.8, Ks 0.5), and warning on each would fail every such file under --strict.
         GpuMaterial {
             base_color: [kd[0], kd[1], kd[2], 1.0],
             metallic: metallic.unwrap_or(0.0).clamp(0.0, 1.0),
-            roughness: roughness.clamp(0.0, 1.0),
+            roughness,
             ..GpuMaterial::default()
         }
     };
@@ -204,12 +300,25 @@ fn convert_material(m: &tobj::Material, texture: &mut dyn FnMut(&str, TextureRol
     gpu
 }
 
-/// Checks face references and positions line by line; returns the `mtllib` names.
-fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
+/// What the first pass over the OBJ text finds besides errors.
+struct Precheck {
+    /// `mtllib` names.
+    libs: Vec<String>,
+    /// Smoothing group of each triangle in file order (a face of n corners gives n − 2): `0` for
+    /// `s off`, `s 0` or no `s` statement yet.
+    groups: Vec<u32>,
+    /// Warnings, with line numbers.
+    warnings: Vec<String>,
+}
+
+/// Checks face references and positions line by line; reads `mtllib` names and smoothing
+/// groups.
+fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     let text = String::from_utf8_lossy(text);
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let mut libs = Vec::new();
     let mut faces = 0u64;
+    let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
     let mut logical = String::new();
     let mut first_line = 0;
     for (i, raw) in text.lines().enumerate() {
@@ -241,12 +350,26 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
             Some("vt") => nt += 1,
             Some("vn") => nn += 1,
             Some("mtllib") => libs.extend(words.map(str::to_string)),
+            Some("s") => {
+                group = match words.next() {
+                    Some("off") => 0,
+                    Some(w) if w.parse::<u32>().is_ok() => w.parse().unwrap_or(0),
+                    other => {
+                        warnings.push(format!(
+                            "{file}:{first_line}: smoothing group '{}' is neither a number nor 'off'; read as off (flat)",
+                            other.unwrap_or("")
+                        ));
+                        0
+                    }
+                };
+            }
             Some("f") => {
                 faces += 1;
                 let corners: Vec<&str> = words.collect();
                 if corners.len() < 3 {
                     return Err(at(format!("face has {} vertices; a face needs at least 3", corners.len())));
                 }
+                groups.extend(std::iter::repeat_n(group, corners.len() - 2));
                 for (k, c) in corners.iter().enumerate() {
                     for (slot, (part, count, what)) in c
                         .split('/')
@@ -276,5 +399,5 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Vec<String>> {
     if faces == 0 {
         return Err(CliError::input(format!("{file}: has no faces")));
     }
-    Ok(libs)
+    Ok(Precheck { libs, groups, warnings })
 }

@@ -187,6 +187,8 @@ pub struct BakeToml {
     pub shadow_res: Option<u32>,
     /// Light-visibility volume resolution.
     pub media_volume_res: Option<u32>,
+    /// Normals where the asset gives none: `"flat"`, `"smooth"` or `"smooth:ANGLE"`.
+    pub normals: Option<String>,
 }
 
 impl Sidecar {
