@@ -56,13 +56,7 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
         Some(cfg) => Some((cfg, Sidecar::load(cfg, &mut sidecar_inputs)?)),
         None => None,
     };
-    let mut settings = Settings::default();
-    if let Some((cfg, sidecar)) = &sidecar {
-        settings
-            .apply_bake_table(&sidecar.bake)
-            .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
-    }
-    args.bake.apply(&mut settings);
+    let settings = bake_settings(sidecar.as_ref().map(|(c, s)| (*c, s)), &args.bake)?;
     let mut scene = import::import_with(&args.input, settings.normals)?;
     for p in sidecar_inputs {
         if !scene.inputs.contains(&p) {
@@ -75,19 +69,25 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
 }
 
-/// Applies a sidecar (if any) to `scene` and returns the bake settings: the sidecar's `[bake]`
-/// table, overridden by the command line's.
-pub fn configure(scene: &mut Scene, config: Option<&Path>, bake: &BakeArgs) -> CliResult<Settings> {
+/// The bake settings: the sidecar's `[bake]` table (if any), overridden by the command line's.
+fn bake_settings(sidecar: Option<(&Path, &Sidecar)>, bake: &BakeArgs) -> CliResult<Settings> {
     let mut settings = Settings::default();
-    if let Some(cfg) = config {
-        let sidecar = Sidecar::load(cfg, &mut scene.inputs)?;
-        sidecar.apply(scene, &cfg.display().to_string())?;
+    if let Some((cfg, sidecar)) = sidecar {
         settings
             .apply_bake_table(&sidecar.bake)
             .map_err(|e| CliError::input(format!("{}: [bake] {e}", cfg.display())))?;
     }
     bake.apply(&mut settings);
     Ok(settings)
+}
+
+/// Applies a sidecar (if any) to a scene built in code (the demo) and returns the bake settings.
+pub fn configure(scene: &mut Scene, config: Option<&Path>, bake: &BakeArgs) -> CliResult<Settings> {
+    let sidecar = config.map(|cfg| Sidecar::load(cfg, &mut scene.inputs).map(|s| (cfg, s))).transpose()?;
+    if let Some((cfg, sidecar)) = &sidecar {
+        sidecar.apply(scene, &cfg.display().to_string())?;
+    }
+    bake_settings(sidecar.as_ref().map(|(c, s)| (*c, s)), bake)
 }
 
 /// Validates and plans an imported scene (also the entry point of the demo).
