@@ -256,3 +256,182 @@ fn hostile_content_with_good_checksums_in_every_section_never_panics() {
         }
     }
 }
+
+// ---------------------------------------------------------------- a second decoder
+
+/// A minimal decoder of the header, the section table and the manifest's first fields, written
+/// from FORMAT.md's tables alone (not from `kiln-format`), so that the spec and the reference
+/// reader cannot drift apart silently: it checks every header and table rule the spec states and
+/// must agree, entry by entry, with `KilnFile::sections()`.
+mod spec_decoder {
+    use xxhash_rust::xxh3::xxh3_64;
+
+    /// One table entry as FORMAT.md lays it out.
+    #[derive(Debug, PartialEq, Eq)]
+    pub struct Entry {
+        pub kind: [u8; 4],
+        pub version: u16,
+        pub codec: u8,
+        pub align_log2: u8,
+        pub index: u32,
+        pub flags: u32,
+        pub offset: u64,
+        pub size: u64,
+        pub raw_size: u64,
+        pub checksum: u64,
+        pub content_hash: [u8; 16],
+    }
+
+    fn u16_at(b: &[u8], o: usize) -> u16 {
+        u16::from_le_bytes(b[o..o + 2].try_into().unwrap())
+    }
+    fn u32_at(b: &[u8], o: usize) -> u32 {
+        u32::from_le_bytes(b[o..o + 4].try_into().unwrap())
+    }
+    fn u64_at(b: &[u8], o: usize) -> u64 {
+        u64::from_le_bytes(b[o..o + 8].try_into().unwrap())
+    }
+
+    /// Header, table, placement and checksums; `Err` names the first rule broken.
+    pub fn decode(b: &[u8]) -> Result<Vec<Entry>, String> {
+        if b.len() < 64 || b[0..8] != [0x89, b'K', b'L', b'N', 0x0D, 0x0A, 0x1A, 0x0A] {
+            return Err("magic".into());
+        }
+        if u16_at(b, 8) != 1 {
+            return Err("major version".into());
+        }
+        if xxh3_64(&b[0..56]) != u64_at(b, 56) {
+            return Err("header checksum".into());
+        }
+        let flags = u32_at(b, 12);
+        if flags & 0xFFFF != 0 {
+            return Err("required flag".into());
+        }
+        let count = u32_at(b, 20) as u64;
+        if u32_at(b, 16) != 64 || u64_at(b, 24) != 64 || u64_at(b, 48) != 0 {
+            return Err("header fields".into());
+        }
+        if u64_at(b, 32) != b.len() as u64 {
+            return Err("file_size".into());
+        }
+        let table_end = 64 + 64 * count;
+        if table_end > b.len() as u64 {
+            return Err("table beyond the file".into());
+        }
+        let table = &b[64..table_end as usize];
+        if xxh3_64(table) != u64_at(b, 40) {
+            return Err("table checksum".into());
+        }
+        let mut cursor = table_end;
+        let mut entries: Vec<Entry> = Vec::new();
+        for e in table.chunks_exact(64) {
+            let entry = Entry {
+                kind: e[0..4].try_into().unwrap(),
+                version: u16_at(e, 4),
+                codec: e[6],
+                align_log2: e[7],
+                index: u32_at(e, 8),
+                flags: u32_at(e, 12),
+                offset: u64_at(e, 16),
+                size: u64_at(e, 24),
+                raw_size: u64_at(e, 32),
+                checksum: u64_at(e, 40),
+                content_hash: e[48..64].try_into().unwrap(),
+            };
+            if !(6..=16).contains(&entry.align_log2) || entry.flags != 0 || entry.version == 0 {
+                return Err("entry fields".into());
+            }
+            if entry.codec != 0 || entry.raw_size != entry.size {
+                return Err("codec".into());
+            }
+            let align = 1u64 << entry.align_log2;
+            if entry.offset != cursor.div_ceil(align) * align {
+                return Err("placement".into());
+            }
+            let end = entry.offset.checked_add(entry.size).filter(|&e| e <= b.len() as u64);
+            let Some(end) = end else { return Err("section beyond the file".into()) };
+            if b[cursor as usize..entry.offset as usize].iter().any(|&x| x != 0) {
+                return Err("padding".into());
+            }
+            if xxh3_64(&b[entry.offset as usize..end as usize]) != entry.checksum {
+                return Err("section checksum".into());
+            }
+            if entries.iter().any(|o| (o.kind, o.index) == (entry.kind, entry.index)) {
+                return Err("duplicate".into());
+            }
+            cursor = end;
+            entries.push(entry);
+        }
+        if cursor != b.len() as u64 {
+            return Err("trailing bytes".into());
+        }
+        if !entries.iter().any(|e| &e.kind == b"MANI") {
+            return Err("no manifest".into());
+        }
+        Ok(entries)
+    }
+
+    /// A bincode varint (FORMAT.md, `MANI`) at `*at`.
+    fn varint(b: &[u8], at: &mut usize) -> u64 {
+        let tag = b[*at];
+        *at += 1;
+        let width = match tag {
+            0..=250 => return tag as u64,
+            251 => 2,
+            252 => 4,
+            253 => 8,
+            _ => panic!("varint tag {tag}"),
+        };
+        let mut v = [0u8; 8];
+        v[..width].copy_from_slice(&b[*at..*at + width]);
+        *at += width;
+        u64::from_le_bytes(v)
+    }
+
+    /// The manifest's first two fields, `generator` and `scene_name`.
+    pub fn manifest_names(manifest: &[u8]) -> (String, String) {
+        let mut at = 0;
+        let mut string = || {
+            let n = varint(manifest, &mut at) as usize;
+            at += n;
+            String::from_utf8(manifest[at - n..at].to_vec()).unwrap()
+        };
+        (string(), string())
+    }
+}
+
+#[test]
+fn a_decoder_written_from_format_md_agrees_with_the_reference_reader() {
+    let bytes = every_kind_file();
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let entries = spec_decoder::decode(&bytes).unwrap();
+    assert_eq!(entries.len(), file.sections().len());
+    for (e, s) in entries.iter().zip(file.sections()) {
+        let r = &s.entry;
+        let theirs = spec_decoder::Entry {
+            kind: r.kind.0,
+            version: r.version,
+            codec: r.codec,
+            align_log2: r.align_log2,
+            index: r.index,
+            flags: r.flags,
+            offset: r.offset,
+            size: r.size,
+            raw_size: r.raw_size,
+            checksum: r.checksum,
+            content_hash: r.content_hash.0,
+        };
+        assert_eq!(e, &theirs, "entry {}", s.position);
+    }
+    let mani = entries.iter().find(|e| &e.kind == b"MANI").unwrap();
+    let m = file.manifest().unwrap();
+    let names =
+        spec_decoder::manifest_names(&bytes[mani.offset as usize..(mani.offset + mani.size) as usize]);
+    assert_eq!(names, (m.generator.clone(), m.scene_name.clone()));
+    // And it refuses what the spec refuses: a flipped byte of the table, of a section, of padding.
+    for at in [20usize, 64 + 7, 64 + 16, entries[1].offset as usize, bytes.len() - 1] {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0x40;
+        assert!(spec_decoder::decode(&bad).is_err(), "byte {at} flipped was accepted");
+    }
+}

@@ -66,3 +66,21 @@ impl ContentHasher {
         ContentHash(self.0.digest128().to_le_bytes())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// FORMAT.md's worked example: `ContentHash` stores the XXH3-128 value little-endian, so its
+    /// bytes (and `to_hex`) are the reverse of the big-endian digest `xxhsum -H2` prints
+    /// (xxhsum 0.8.1: `printf kiln | xxhsum -H2` → `29e4f6aff37a6f975bfb178850627e51`).
+    #[test]
+    fn content_hash_is_the_little_endian_xxh3_128() {
+        let xxhsum = "29e4f6aff37a6f975bfb178850627e51";
+        let h = ContentHash::of(b"kiln");
+        assert_eq!(format!("{:032x}", u128::from_le_bytes(h.0)), xxhsum);
+        assert_eq!(h.to_hex(), "517e62508817fb5b976f7af3aff6e429");
+        let empty = ContentHash::of(b"");
+        assert_eq!(format!("{:032x}", u128::from_le_bytes(empty.0)), "99aa06d3014798d86001c324468d497f");
+    }
+}

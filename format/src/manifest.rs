@@ -333,3 +333,38 @@ fn manifest_error(e: bincode::error::DecodeError) -> FormatError {
     };
     FormatError::new(ErrorKind::Manifest(msg))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn enc<T: Encode>(v: &T) -> Vec<u8> {
+        bincode::encode_to_vec(v, bincode::config::standard()).unwrap()
+    }
+
+    /// FORMAT.md's bincode table and its examples.
+    #[test]
+    fn bincode_rules_match_format_md() {
+        let lut = |resolution| Some(BrdfLutInfo { resolution, samples: 144 });
+        assert_eq!(enc(&lut(128)), [1, 0x80, 0x90]);
+        assert_eq!(enc(&lut(256)), [1, 0xFB, 0x00, 0x01, 0x90]);
+        assert_eq!(enc(&None::<BrdfLutInfo>), [0]);
+        assert_eq!(enc(&70_000u32), [0xFC, 0x70, 0x11, 0x01, 0x00]);
+        assert_eq!(enc(&(1u64 << 40)), [0xFD, 0, 0, 0, 0, 0, 1, 0, 0]);
+        assert_eq!(enc(&1.0f32), 1.0f32.to_le_bytes());
+        assert_eq!(enc(&true), [1]);
+        assert_eq!(enc(&"ab".to_string()), [2, b'a', b'b']);
+        assert_eq!(enc(&vec![7u32, 300]), [2, 7, 0xFB, 0x2C, 0x01]);
+        assert_eq!(enc(&[1u32, 2, 3]), [1, 2, 3]);
+        assert_eq!(enc(&LightKind::Spot { inner_cone: 0.0, outer_cone: 1.0 })[..1], [1]);
+        assert_eq!(enc(&LightKind::Spot { inner_cone: 0.0, outer_cone: 1.0 }).len(), 9);
+        assert_eq!(enc(&ShadowProjection::Cube), [2]);
+        // A longer varint than needed is accepted; a tag wider than the type is refused.
+        let cfg = bincode::config::standard();
+        assert_eq!(bincode::decode_from_slice::<u32, _>(&[0xFB, 5, 0], cfg).unwrap().0, 5);
+        assert!(bincode::decode_from_slice::<u32, _>(&[0xFD, 5, 0, 0, 0, 0, 0, 0, 0], cfg).is_err());
+        assert!(bincode::decode_from_slice::<bool, _>(&[2], cfg).is_err());
+        assert!(bincode::decode_from_slice::<Option<u32>, _>(&[2, 0], cfg).is_err());
+        assert!(bincode::decode_from_slice::<ShadowProjection, _>(&[3], cfg).is_err());
+    }
+}

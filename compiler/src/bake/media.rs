@@ -1,5 +1,6 @@
-//! The light-visibility volume of a participating medium: over the medium's box, cubic cells
-//! holding, per light, the fraction of shadow rays from points in the cell that reach the light.
+//! The light-visibility volume of a participating medium: over the medium's box, nearly cubic
+//! cells (box / dims per axis) holding, per light, the fraction of shadow rays from points in the
+//! cell that reach the light.
 //! A player ray-marching single scattering looks visibility up here instead of in a screen-space
 //! image, so shafts stay right when the light is off screen or behind geometry (seed 002's main
 //! failure cases).

@@ -29,8 +29,9 @@ use crate::exit::CliResult;
 use crate::ir::Scene;
 
 /// Bumped when a stage's algorithm changes its output, so that caches keyed by content hashes
-/// do not reuse stale sections.
-pub(crate) const ALGORITHM_VERSION: &str = "kiln-bake-1";
+/// do not reuse stale sections. 2: CWBVH planes widened past f32 rounding; the voxel grid padded
+/// by four of its own margins.
+pub(crate) const ALGORITHM_VERSION: &str = "kiln-bake-2";
 
 /// A baked section ready to be written.
 #[derive(Debug, Clone)]

@@ -107,6 +107,7 @@ impl<'a> LineSpace<'a> {
                 CANDIDATE_OFFSETS,
                 CANDIDATES,
                 PNMT,
+                PREILLUM,
             ] {
                 if file.find(k, 0).is_some() {
                     return Err(bad(format!("section {k} without a VGRD header")));

@@ -23,16 +23,41 @@ pub fn margin(origin: DVec3, extent: DVec3, cell: f64) -> f64 {
     (far + extent.length()) * 8.0 * f32::EPSILON as f64 + cell * 1e-6
 }
 
-/// The grid over `bounds` with `res` cubic cells along the longest axis. The bounds are first
-/// widened by four margins on every side, so that every point within a margin of a triangle (every
-/// point the single-precision ray–triangle test can report as a hit) lies strictly inside a cell.
+/// The grid over `bounds` with `res` cubic cells along the longest axis. It covers the bounds
+/// widened by four of its own margins on every side, so that every point within a margin of a
+/// triangle (every point the single-precision ray–triangle test can report as a hit) lies strictly
+/// inside a cell: `origin ≤ min − 4·margin` and `origin + dims·cell ≥ max + 4·margin` per axis,
+/// evaluated in f64 (see [`covers`]). The margin depends on the grid it pads, so the padding is
+/// grown until the grid's own margin fits (once or twice).
 pub fn grid(bounds: &Bounds, res: u32) -> GridHeader {
     let lo0 = DVec3::from(bounds.min.map(f64::from));
     let hi0 = DVec3::from(bounds.max.map(f64::from));
-    let pad = 4.0 * margin(lo0, (hi0 - lo0).max(DVec3::ZERO), (hi0 - lo0).max_element() / res as f64);
+    let mut pad = 4.0 * margin(lo0, (hi0 - lo0).max(DVec3::ZERO), (hi0 - lo0).max_element() / res as f64);
+    loop {
+        let g = padded_grid(lo0, hi0, pad, res);
+        if covers(&g, bounds) {
+            return g;
+        }
+        pad = pad.max(4.0 * g.margin) * (1.0 + 1e-6);
+    }
+}
+
+/// Whether `g` covers `bounds` widened by four of its margins on every side (in f64).
+pub fn covers(g: &GridHeader, bounds: &Bounds) -> bool {
+    (0..3).all(|a| {
+        let far = g.origin[a] + g.dims[a] as f64 * g.cell;
+        g.origin[a] <= bounds.min[a] as f64 - 4.0 * g.margin && far >= bounds.max[a] as f64 + 4.0 * g.margin
+    })
+}
+
+fn padded_grid(lo0: DVec3, hi0: DVec3, pad: f64, res: u32) -> GridHeader {
     let (lo, hi) = (lo0 - pad, hi0 + pad);
     let extent = hi - lo;
-    let cell = (extent.max_element() / res as f64).max(f64::MIN_POSITIVE);
+    let mut cell = (extent.max_element() / res as f64).max(f64::MIN_POSITIVE);
+    // `res` cells must span the longest axis although the division rounds.
+    while res as f64 * cell < extent.max_element() {
+        cell = cell.next_up();
+    }
     let dims = [0, 1, 2].map(|a| ((extent[a] / cell).ceil() as u32).clamp(1, res));
     // Centre the grid on the bounds so that both sides have the same slack.
     let size = DVec3::new(dims[0] as f64, dims[1] as f64, dims[2] as f64) * cell;
@@ -154,5 +179,40 @@ impl Voxels {
             offsets: self.offsets.clone(),
             triangles,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The grid covers the bounds widened by four of its own margins (FORMAT.md, `VGRD`), over
+    /// boxes near and far from the origin, flat, tiny and at every resolution class.
+    #[test]
+    fn grid_covers_bounds_widened_by_four_margins() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut old_short = 0;
+        for i in 0..20_000 {
+            let scale = 10f64.powf(next() * 8.0 - 3.0);
+            let offset = 10f64.powf(next() * 7.0 - 1.0) * if next() < 0.5 { -1.0 } else { 1.0 };
+            let min = [0; 3].map(|_| (offset + (next() - 0.5) * scale) as f32);
+            let max = min.map(|m| m + if next() < 0.1 { 0.0 } else { (next() * scale) as f32 });
+            let bounds = Bounds { min, max };
+            let res = [1, 2, 3, 4, 7, 16, 64, 1024][i % 8];
+            let g = grid(&bounds, res);
+            assert!(covers(&g, &bounds), "{bounds:?} at {res}: {g:?}");
+            assert!(g.dims.iter().all(|&d| (1..=res).contains(&d)) && g.dims.contains(&res));
+            // The old padding (four margins of the unpadded bounds) fell short on some of these.
+            let (lo0, hi0) = (DVec3::from(min.map(f64::from)), DVec3::from(max.map(f64::from)));
+            let pad = 4.0 * margin(lo0, hi0 - lo0, (hi0 - lo0).max_element() / res as f64);
+            old_short += !covers(&padded_grid(lo0, hi0, pad, res), &bounds) as u32;
+        }
+        assert!(old_short > 0, "the test no longer exercises the shortfall");
     }
 }
