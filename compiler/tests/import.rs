@@ -509,11 +509,12 @@ fn obj_mtl_specular_colour_and_mirrors() {
         "newmtl box\nKd 0 0 0\nKs 0.725 0.71 0.68\nNs 200\n\n\
          newmtl mirror\nillum 3\nKd 0.1 0.1 0.1\nKs 0.9 0.8 0.7\n\n\
          newmtl glossy\nillum 5\nKd 0.8 0.6 0.4\nKs 0.2 0.2 0.2\nNs 14\n\n\
-         newmtl matte\nKd 0.5 0.5 0.5\nKs 0 0 0\nillum 3\n",
+         newmtl matte\nKd 0.5 0.5 0.5\nKs 0 0 0\nillum 3\n\n\
+         newmtl chrome\nillum 5\nKd 0.3 0.3 0.3\nKs 0.6 0.6 0.65\nNs 1998\n",
     )
     .unwrap();
     let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl box\nf 1 2 3\nusemtl mirror\nf 1 2 3\n\
-               usemtl glossy\nf 1 2 3\nusemtl matte\nf 1 2 3\n";
+               usemtl glossy\nf 1 2 3\nusemtl matte\nf 1 2 3\nusemtl chrome\nf 1 2 3\n";
     std::fs::write(d.path().join("s.obj"), obj).unwrap();
     let s = import(&d.path().join("s.obj")).unwrap();
     let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
@@ -538,6 +539,12 @@ fn obj_mtl_specular_colour_and_mirrors() {
     assert_eq!((g.base_color, g.metallic), ([0.8, 0.6, 0.4, 1.0], 0.0));
     assert!((g.roughness - 0.125f32.powf(0.25)).abs() < 1e-6);
     assert!(!s.warnings.iter().any(|w| w.message.contains("'glossy'")), "{:?}", s.warnings);
+    // illum 5 (Fresnel reflection) with Ks brighter than Kd: a metal of colour Ks, roughness
+    // (2/2000)^¼ = 0.177828 by hand; Kd 0.3 dropped with a warning.
+    let c = m("chrome");
+    assert_eq!((c.base_color, c.metallic), ([0.6, 0.6, 0.65, 1.0], 1.0));
+    assert!((c.roughness - 0.177_828).abs() < 1e-6, "{}", c.roughness);
+    assert!(warned("chrome", "Kd [0.3, 0.3, 0.3] is dropped"), "{:?}", s.warnings);
     // Ks 0 stays pure Lambertian whatever illum says.
     let t = m("matte");
     assert_eq!(
