@@ -65,9 +65,38 @@ pub struct Texture {
     pub mag_linear: bool,
 }
 
+/// What a warning is about, so that a build can choose which ones fail it (`--strict` fails on
+/// data loss only; `-W CLASS=error|warn|ignore` sets any class).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WarningClass {
+    /// The file is not what the asset says: something was dropped or changed (an unsupported
+    /// extension, a skipped primitive, an unreadable image, degenerate triangles, a material
+    /// mapping that loses a term).
+    DataLoss,
+    /// The asset lacks what rendering needs and kiln made it up or found nothing (no camera,
+    /// nothing that lights the scene): a sidecar supplies it.
+    MissingSetup,
+}
+
+impl WarningClass {
+    /// Every class.
+    pub const ALL: [WarningClass; 2] = [WarningClass::DataLoss, WarningClass::MissingSetup];
+
+    /// The class's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            WarningClass::DataLoss => "data-loss",
+            WarningClass::MissingSetup => "missing-setup",
+        }
+    }
+}
+
 /// A non-fatal problem found while importing, with the object it concerns.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Warning {
+    /// What kind of problem.
+    pub class: WarningClass,
     /// The message, naming file and object.
     pub message: String,
 }
@@ -106,9 +135,14 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Records a warning.
+    /// Records a warning of data loss (what most import warnings are).
     pub fn warn(&mut self, message: impl Into<String>) {
-        self.warnings.push(Warning { message: message.into() });
+        self.warn_as(WarningClass::DataLoss, message);
+    }
+
+    /// Records a warning of class `class`.
+    pub fn warn_as(&mut self, class: WarningClass, message: impl Into<String>) {
+        self.warnings.push(Warning { class, message: message.into() });
     }
 
     /// Whether some material samples a texture.

@@ -16,3 +16,4 @@ pub mod progress;
 pub mod raycheck;
 pub mod settings;
 pub mod shading;
+pub mod warnings;

@@ -18,6 +18,7 @@ use crate::import::{self, sidecar::Sidecar};
 use crate::ir::Scene;
 use crate::progress::Progress;
 use crate::settings::Settings;
+use crate::warnings::{WarningLevel, WarningPolicy};
 
 /// A scene ready to bake.
 #[derive(Debug)]
@@ -45,8 +46,17 @@ impl Loaded {
     }
 }
 
+/// A warning in the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReportWarning {
+    /// Its class (`data-loss`, `missing-setup`).
+    pub class: crate::ir::WarningClass,
+    /// The message.
+    pub message: String,
+}
+
 /// Imports, applies the sidecar, validates and plans. Warnings are printed to stderr unless
-/// `quiet`; with `strict` any warning is an error.
+/// `quiet`; `--strict` and `-W` decide which classes of warning fail it.
 pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     let start = Instant::now();
     // The sidecar is read first since its `[bake] normals` decides the import; it is recorded
@@ -66,7 +76,8 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some((cfg, sidecar)) = &sidecar {
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
     }
-    finish(scene, settings, &args.input.display().to_string(), args.strict, quiet, start)
+    let policy = WarningPolicy::new(args.strict, &args.warning_levels);
+    finish(scene, settings, &args.input.display().to_string(), &policy, quiet, start)
 }
 
 /// The bake settings: the sidecar's `[bake]` table (if any), overridden by the command line's.
@@ -95,20 +106,28 @@ pub fn finish(
     mut scene: Scene,
     settings: Settings,
     source: &str,
-    strict: bool,
+    policy: &WarningPolicy,
     quiet: bool,
     start: Instant,
 ) -> CliResult<Loaded> {
     let valid = validate::finish(&mut scene, source);
+    let failing = policy.failing(&scene.warnings).len();
     // Warnings first, also when validation failed: they often explain the failure.
-    if !quiet || strict || valid.is_err() {
+    if !quiet || failing > 0 || valid.is_err() {
         for w in &scene.warnings {
-            eprintln!("warning: {}", w.message);
+            if policy.level(w.class) != WarningLevel::Ignore {
+                eprintln!("warning: {} [{}]", w.message, w.class.name());
+            }
         }
     }
     valid?;
-    if strict && !scene.warnings.is_empty() {
-        return Err(CliError::input(format!("{} warnings and --strict is set", scene.warnings.len())));
+    if failing > 0 {
+        let mut classes: Vec<&str> = policy.failing(&scene.warnings).iter().map(|w| w.class.name()).collect();
+        classes.dedup();
+        return Err(CliError::input(format!(
+            "{failing} warning(s) of class {} and --strict or -W CLASS=error is set",
+            classes.join(", ")
+        )));
     }
     let geometry = SceneGeometry::new(&scene);
     let plan = Plan::new(&scene, &geometry, &settings);
@@ -119,7 +138,7 @@ pub fn finish(
 /// input files recorded: the bytes `kiln compile` would write (tests and benchmarks build their
 /// scenes in code).
 pub fn compile_to_bytes(scene: Scene, settings: Settings, source: &str) -> CliResult<Vec<u8>> {
-    let loaded = finish(scene, settings, source, false, true, Instant::now())?;
+    let loaded = finish(scene, settings, source, &WarningPolicy::default(), true, Instant::now())?;
     let progress = Progress::hidden();
     let baked = bake::bake(&loaded.context(Vec::new(), &progress)?)?;
     bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))
@@ -180,8 +199,8 @@ pub struct Report {
     pub stages: Vec<StageReport>,
     /// Counts.
     pub counts: Counts,
-    /// Every warning.
-    pub warnings: Vec<String>,
+    /// Every warning, with its class (ignored ones too).
+    pub warnings: Vec<ReportWarning>,
     /// Every file read.
     pub inputs: Vec<String>,
     /// Voxel grid and line space figures (memory per variant), when baked.
@@ -242,7 +261,11 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
                 .map_or(0, |x| x.bytes.len() / 80),
             degenerate_triangles: s.degenerate_triangles,
         },
-        warnings: s.warnings.iter().map(|w| w.message.clone()).collect(),
+        warnings: s
+            .warnings
+            .iter()
+            .map(|w| ReportWarning { class: w.class, message: w.message.clone() })
+            .collect(),
         inputs: s.inputs.iter().map(|p| p.display().to_string()).collect(),
         line_space: baked.line_space.clone(),
     };

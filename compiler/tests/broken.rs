@@ -91,7 +91,34 @@ fn missing_image_warns_and_strict_refuses() {
     let run = compile(d.path(), &f, &[]);
     run.expect(0).says("warning:").says("image 'nowhere.png': cannot read").says("placeholder");
     kiln(d.path(), &["verify", "out.kiln"]).expect(0);
-    compile(d.path(), &f, &["--strict"]).expect(1).says("--strict");
+    compile(d.path(), &f, &["--strict"]).expect(1).says("--strict").says("class data-loss");
+}
+
+#[test]
+fn warnings_have_classes_and_strict_fails_on_data_loss_only() {
+    // A quad without camera or light: two missing-setup warnings and nothing lost.
+    let d = tempfile::tempdir().unwrap();
+    let f = quad_with(d.path(), "bare", |_| {});
+    compile(d.path(), &f, &["--report", "r.json"])
+        .expect(0)
+        .says("no camera in the asset or sidecar")
+        .says("[missing-setup]");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("r.json")).unwrap()).unwrap();
+    let classes: Vec<&str> =
+        report["warnings"].as_array().unwrap().iter().map(|w| w["class"].as_str().unwrap()).collect();
+    assert_eq!(classes, ["missing-setup", "missing-setup"], "{report}");
+    compile(d.path(), &f, &["--strict"]).expect(0);
+    compile(d.path(), &f, &["--strict", "-W", "missing-setup=error"]).expect(1).says("class missing-setup");
+    let quiet = compile(d.path(), &f, &["-W", "missing-setup=ignore"]);
+    assert!(!quiet.expect(0).stderr.contains("warning:"), "{}", quiet.stderr);
+    // A missing image is data loss: --strict fails unless -W relaxes it again.
+    let g = quad_with(d.path(), "img", |g| {
+        g.textured(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}), "nowhere.png")
+    });
+    compile(d.path(), &g, &["--strict", "-W", "data-loss=warn"]).expect(0).says("[data-loss]");
+    compile(d.path(), &g, &["-W", "data-loss"]).expect(2).says("CLASS=LEVEL");
+    compile(d.path(), &g, &["-W", "perf=error"]).expect(2).says("no warning class 'perf'");
 }
 
 #[test]

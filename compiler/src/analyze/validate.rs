@@ -5,7 +5,7 @@ use glam::{DVec3, Vec3};
 use kiln_format::manifest::{Bounds, Camera};
 
 use crate::exit::{CliError, CliResult};
-use crate::ir::Scene;
+use crate::ir::{Scene, WarningClass};
 
 /// Whether a triangle has zero area: repeated indices, or corners that are collinear in
 /// double precision.
@@ -82,9 +82,12 @@ pub fn finish(scene: &mut Scene, source: &str) -> CliResult<()> {
             znear: 0.0,
             zfar: 0.0,
         });
-        scene.warn(format!(
-            "{source}: no camera in the asset or sidecar; a default camera framing the scene was added"
-        ));
+        scene.warn_as(
+            WarningClass::MissingSetup,
+            format!(
+                "{source}: no camera in the asset or sidecar; a default camera framing the scene was added"
+            ),
+        );
     }
     for c in &mut scene.cameras {
         if c.znear <= 0.0 {
@@ -95,7 +98,7 @@ pub fn finish(scene: &mut Scene, source: &str) -> CliResult<()> {
         && scene.materials.iter().all(|m| m.gpu.emission == [0.0; 3])
         && scene.sky.radiance == [0.0; 3]
     {
-        scene.warn(format!("{source}: the scene has no lights, no emissive materials and a black sky; it will render black (add lights in a sidecar)"));
+        scene.warn_as(WarningClass::MissingSetup, format!("{source}: the scene has no lights, no emissive materials and a black sky; it will render black (add lights in a sidecar)"));
     }
     Ok(())
 }

@@ -80,10 +80,16 @@ pub struct SceneArgs {
     /// Bake settings.
     #[command(flatten)]
     pub bake: BakeArgs,
-    /// Treat every warning (missing image, unsupported extension, skipped primitive, ...) as
-    /// an error.
+    /// Fail on warnings of data loss (an unreadable image, an unsupported extension, a skipped
+    /// primitive, ...); warnings of missing setup (no camera, nothing lights the scene) stay
+    /// warnings, since a sidecar supplies those.
     #[arg(long)]
     pub strict: bool,
+    /// How a class of warnings is treated: CLASS=error|warn|ignore with CLASS data-loss or
+    /// missing-setup (repeatable; applied after --strict, the last setting of a class winning).
+    /// Ignored warnings are not printed but stay in the --report.
+    #[arg(short = 'W', long = "warnings", value_name = "CLASS=LEVEL", value_parser = crate::warnings::parse_setting)]
+    pub warning_levels: Vec<(crate::ir::WarningClass, crate::warnings::WarningLevel)>,
 }
 
 /// Bake settings, shared by `compile`, `plan` and `demo`; each overrides the sidecar's or the

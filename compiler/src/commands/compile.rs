@@ -29,7 +29,7 @@ pub fn demo(args: &DemoArgs) -> CliResult {
     let start = Instant::now();
     let mut scene = crate::import::demo::cornell_box();
     let settings = pipeline::configure(&mut scene, args.config.as_deref(), &args.bake)?;
-    let loaded = pipeline::finish(scene, settings, "demo", false, args.out.quiet, start)?;
+    let loaded = pipeline::finish(scene, settings, "demo", &Default::default(), args.out.quiet, start)?;
     let report = pipeline::compile(&loaded, "demo", &args.output, &args.out)?;
     if !args.out.quiet {
         summary(&report);
