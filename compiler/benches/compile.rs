@@ -101,8 +101,13 @@ fn tiny(runs: usize) {
     let dir = tempfile::tempdir().expect("temp dir");
     let input = write_box(dir.path());
     let out = dir.path().join("box.kiln");
-    let scene_args =
-        SceneArgs { input: input.clone(), config: None, bake: BakeArgs::default(), strict: false };
+    let scene_args = SceneArgs {
+        input: input.clone(),
+        config: None,
+        bake: BakeArgs::default(),
+        strict: false,
+        warning_levels: Vec::new(),
+    };
     let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
     let (mut process, mut in_process, mut lut) = (Vec::new(), Vec::new(), Vec::new());
@@ -160,6 +165,7 @@ fn pica(runs: usize) {
             ..BakeArgs::default()
         },
         strict: false,
+        warning_levels: Vec::new(),
     };
     let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };
     println!("pica_pica, {runs} runs, {} threads; medians (min..max) in ms", rayon::current_num_threads());
