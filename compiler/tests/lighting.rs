@@ -429,7 +429,7 @@ fn plan_skips_each_lighting_bake_with_its_reason() {
             scene,
             Settings::default(),
             "t",
-            false,
+            &Default::default(),
             true,
             std::time::Instant::now(),
         )
