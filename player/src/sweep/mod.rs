@@ -31,7 +31,7 @@ use crate::session::{SessionOptions, open_file};
 
 use measure::{Measured, Timing, measure};
 use plan::{Offers, Plan, Request, Skipped, Target};
-use results::{Figures, Point, ReferenceInfo, Results, SceneInfo, TimingInfo};
+use results::{Figures, Point, Results, SceneInfo, TimingInfo};
 use truth::Reference;
 
 /// The largest image side a sweep accepts (the reference accumulates in RGBA32F).
@@ -154,12 +154,6 @@ fn rgb_image(width: u32, height: u32, pixels: &[f32]) -> kiln_metrics::RgbImage<
     kiln_metrics::RgbImage { width, height, pixels }
 }
 
-/// A camera's reference and what the results say of it.
-struct CameraReference {
-    reference: Reference,
-    info: ReferenceInfo,
-}
-
 /// The references one camera's charts need (one per bounce limit), rendered or from the cache.
 fn camera_references(
     options: &SweepOptions,
@@ -168,7 +162,7 @@ fn camera_references(
     camera: &str,
     base: &SessionOptions,
     progress: &ProgressBar,
-) -> PlayResult<BTreeMap<u32, CameraReference>> {
+) -> PlayResult<BTreeMap<u32, Reference>> {
     let mut ref_options = base.clone();
     ref_options.render.purpose = Purpose::Reference;
     let mut refs = BTreeMap::new();
@@ -180,7 +174,7 @@ fn camera_references(
         let key = truth::key(content_hash, camera, options.width, options.height, half, b);
         progress.set_message(format!("reference, {} ({camera})", plan::transport(b)));
         let dir = options.out.join("reference");
-        let reference = truth::obtain(&ref_options, options.reference_spp, b, &key, &dir, |m| {
+        let reference = truth::obtain(&ref_options, camera, options.reference_spp, b, &key, &dir, |m| {
             progress.set_message(m.to_string())
         })?;
         progress.inc(1);
@@ -193,19 +187,10 @@ fn camera_references(
                 w,
                 h,
                 &reference.rgb,
-                reference.spp,
+                reference.info.spp,
             )?;
         }
-        let info = ReferenceInfo {
-            camera: camera.to_string(),
-            spp: reference.spp,
-            bounces: b,
-            noise_floor: reference.noise_floor,
-            seconds: reference.seconds,
-            cached: reference.cached,
-            key: reference.key.clone(),
-        };
-        refs.insert(b, CameraReference { reference, info });
+        refs.insert(b, reference);
     }
     Ok(refs)
 }
@@ -279,10 +264,10 @@ fn points_of(
             image_ms: total.median_ms * *frames as f64,
             passes: m.passes.clone(),
             error,
-            reference_spp: reference.spp,
-            reference_bounces: reference.bounces,
-            noise_floor: reference.noise_floor,
-            below_noise_floor: error.flip < reference.noise_floor.flip,
+            reference_spp: reference.info.spp,
+            reference_bounces: reference.info.bounces,
+            noise_floor: reference.info.noise_floor,
+            below_noise_floor: error.flip < reference.info.noise_floor.flip,
             on_front: false,
             regression: None,
         });
@@ -325,7 +310,7 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
         };
         let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;
         references.extend(refs.values().map(|r| r.info.clone()));
-        if refs.values().any(|r| r.reference.rgb.iter().all(|&v| v == 0.0)) {
+        if refs.values().any(|r| r.rgb.iter().all(|&v| v == 0.0)) {
             warnings.push(format!(
                 "camera {name}: the reference is black: nothing lights what the camera sees (give the scene a [sky] or [[light]] in a sidecar); every error is 0"
             ));
@@ -364,7 +349,7 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
                     warnings.push(w.clone());
                 }
             }
-            let reference = &refs[&plan::bounces(config.target)].reference;
+            let reference = &refs[&plan::bounces(config.target)];
             points.extend(points_of(options, config, &m, &fixed_passes, reference, &name, &mut failures)?);
         }
     }

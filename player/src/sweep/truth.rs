@@ -22,29 +22,19 @@ use crate::reference::{DEFAULT_SEED, MAX_PATH, Sampling, read_spp, render_with, 
 use crate::render::spirv::PATHTRACE;
 use crate::session::SessionOptions;
 
-use super::results::Figures;
+use super::results::{Figures, ReferenceInfo};
 
 /// The second half's seed: 2^31 away from the first, so that its sample sequence (index × the
 /// golden ratio + seed, hashed) never meets the first half's.
 const SECOND_SEED: u32 = DEFAULT_SEED.wrapping_add(1 << 31);
 
-/// A reference image and its noise floor.
+/// A reference image and what the results say of it (samples, bounces, noise floor, cache).
 #[derive(Debug, Clone)]
 pub struct Reference {
     /// Linear RGB radiance, the mean of both halves.
     pub rgb: Vec<f32>,
-    /// Samples per pixel in all.
-    pub spp: u32,
-    /// Bounce limit (0: all).
-    pub bounces: u32,
-    /// The errors an image indistinguishable from the reference would have.
-    pub noise_floor: Figures,
-    /// Seconds spent path tracing (0 when both halves came from the cache).
-    pub seconds: f64,
-    /// Whether both halves came from the cache.
-    pub cached: bool,
-    /// The cache key.
-    pub key: String,
+    /// Its record in the results.
+    pub info: ReferenceInfo,
 }
 
 /// The cache key of a reference: hex of a 128-bit hash.
@@ -66,9 +56,11 @@ pub fn files(dir: &Path, key: &str) -> [PathBuf; 2] {
 }
 
 /// Renders (or loads from `dir`) the reference of `spp` samples (rounded up to even) and
-/// `bounces` (0: all) for the camera and size of `base`, cached under `key`.
+/// `bounces` (0: all) for the camera and size of `base` (named `camera` in the results), cached
+/// under `key`.
 pub fn obtain(
     base: &SessionOptions,
+    camera: &str,
     spp: u32,
     bounces: u32,
     key: &str,
@@ -102,7 +94,16 @@ pub fn obtain(
     let noise_floor =
         Figures { flip: between.flip, rel_mse: between.rel_mse / 4.0, rmse: between.rmse / 2.0 };
     let rgb = a.iter().zip(b).map(|(x, y)| 0.5 * (x + y)).collect();
-    Ok(Reference { rgb, spp: 2 * half, bounces, noise_floor, seconds, cached, key: key.to_string() })
+    let info = ReferenceInfo {
+        camera: camera.to_string(),
+        spp: 2 * half,
+        bounces,
+        noise_floor,
+        seconds,
+        cached,
+        key: key.to_string(),
+    };
+    Ok(Reference { rgb, info })
 }
 
 /// A cached half, if `path` holds one of the right size and sample count.
