@@ -21,21 +21,13 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 
-use clap::Parser;
 use serde_json::Value;
+
+mod common;
+use common::{kiln, vulkan};
 
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn vulkan() -> bool {
-    let required = std::env::var_os("KILN_REQUIRE_VULKAN").is_some();
-    if kiln_player::gpu::list_devices().map_or(true, |d| d.is_empty()) {
-        assert!(!required, "no Vulkan device but KILN_REQUIRE_VULKAN is set");
-        eprintln!("skipping: no Vulkan device");
-        return false;
-    }
-    true
 }
 
 /// The Python with flip-evaluator and numpy (`.venv-mitsuba`, which `.ci/run` makes).
@@ -65,16 +57,7 @@ fn demo() -> &'static (tempfile::TempDir, PathBuf) {
     DEMO.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
         let file = dir.path().join("demo.kiln");
-        let cli = kiln_compiler::cli::Cli::parse_from([
-            "kiln",
-            "demo",
-            "-q",
-            "--shaft-variants",
-            "none",
-            "-o",
-            file.to_str().unwrap(),
-        ]);
-        kiln_compiler::commands::run(cli).unwrap();
+        kiln(&["demo", "-q", "--shaft-variants", "none", "-o", file.to_str().unwrap()]);
         (dir, file)
     })
 }
@@ -114,8 +97,7 @@ fn sky_scene() -> &'static (tempfile::TempDir, PathBuf) {
         std::fs::write(dir.path().join("scene.toml"), sidecar).unwrap();
         let file = dir.path().join("sky.kiln");
         let (obj, toml) = (dir.path().join("scene.obj"), dir.path().join("scene.toml"));
-        let cli = kiln_compiler::cli::Cli::parse_from([
-            "kiln",
+        kiln(&[
             "compile",
             obj.to_str().unwrap(),
             "--config",
@@ -126,7 +108,6 @@ fn sky_scene() -> &'static (tempfile::TempDir, PathBuf) {
             "-o",
             file.to_str().unwrap(),
         ]);
-        kiln_compiler::commands::run(cli).unwrap();
         (dir, file)
     })
 }

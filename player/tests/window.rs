@@ -5,7 +5,7 @@
 
 use std::process::Command;
 
-use clap::Parser;
+mod common;
 
 #[test]
 fn window_presents_frames_and_exits_cleanly_under_xvfb() {
@@ -15,23 +15,12 @@ fn window_presents_frames_and_exits_cleanly_under_xvfb() {
         eprintln!("skipping: xvfb-run is not installed (Debian: xvfb xauth)");
         return;
     }
-    if kiln_player::gpu::list_devices().map_or(true, |d| d.is_empty()) {
-        assert!(!required, "no Vulkan device but KILN_REQUIRE_VULKAN is set");
-        eprintln!("skipping: no Vulkan device");
+    if !common::vulkan() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("demo.kiln");
-    let cli = kiln_compiler::cli::Cli::parse_from([
-        "kiln",
-        "demo",
-        "-q",
-        "--shaft-variants",
-        "none",
-        "-o",
-        file.to_str().unwrap(),
-    ]);
-    kiln_compiler::commands::run(cli).unwrap();
+    common::kiln(&["demo", "-q", "--shaft-variants", "none", "-o", file.to_str().unwrap()]);
     // The default frame, and the hybrid one (every ray-traced pass, the visibility buffer).
     let hybrid = ["--shadows", "rt", "--ao", "rt", "--reflections", "rt", "--gbuffer", "visibility"];
     for extra in [&[][..], &hybrid[..]] {

@@ -85,15 +85,23 @@ impl Rect {
         self.radiance / 2.0 * sum.abs()
     }
 
-    /// Whether the ray o + t d (t > 0) crosses the rectangle (the path tracer sees the light).
-    fn crossed_by(&self, o: DVec3, d: DVec3) -> bool {
+    /// Whether the ray o + t d (t > 0) crosses the rectangle grown by `margin` on every side
+    /// (shrunk where negative), and if so whether from its emitting side (`Some(true)`).
+    fn crossing(&self, o: DVec3, d: DVec3, margin: f64) -> Option<bool> {
         let denom = d.dot(self.facing);
         let t = (self.centre - o).dot(self.facing) / denom;
         let q = o + d * t - self.centre;
-        denom != 0.0
+        (denom != 0.0
             && t > 0.0
-            && q.dot(self.right).abs() <= 0.5 * self.width + 0.05
-            && q.dot(self.up).abs() <= 0.5 * self.height + 0.05
+            && q.dot(self.right).abs() <= 0.5 * self.width + margin
+            && q.dot(self.up).abs() <= 0.5 * self.height + margin)
+            .then_some(denom < 0.0)
+    }
+
+    /// Whether the ray o + t d (t > 0) crosses the rectangle, from either side, with a margin
+    /// (the path tracer sees the light).
+    fn crossed_by(&self, o: DVec3, d: DVec3) -> bool {
+        self.crossing(o, d, 0.05).is_some()
     }
 }
 
@@ -287,23 +295,16 @@ fn the_camera_sees_the_rect_light_itself_in_the_frame_and_the_reference() {
     let file = dir.path().join("rect-seen.kiln");
     let o = Options::new(&file, W, H).reference().build();
     let (_, traced) = kiln_player::reference::render(&o, 4, Instant::now()).expect("reference render");
-    // Whether the whole pixel footprint's rays cross the light (inside) or none does (outside),
-    // judged at the pixel's corners with the test's own ray-rectangle crossing.
-    let crossing = |x: u32, y: u32, margin: f64| {
-        let q = (cam.eye, cam.ray(x, y, W, H));
-        let denom = q.1.dot(rect.facing);
-        let t = (rect.centre - q.0).dot(rect.facing) / denom;
-        let p = q.0 + q.1 * t - rect.centre;
-        denom < 0.0
-            && t > 0.0
-            && p.dot(rect.right).abs() <= 0.5 * rect.width + margin
-            && p.dot(rect.up).abs() <= 0.5 * rect.height + margin
-    };
+    // Whether every ray of the pixel's footprint crosses the light's emitting side (inside) or
+    // none does (outside): the centre ray against the rectangle shrunk or grown by more than
+    // half a footprint.
+    let front =
+        |x: u32, y: u32, margin: f64| rect.crossing(cam.eye, cam.ray(x, y, W, H), margin) == Some(true);
     let (mut inside, mut outside) = (0, 0);
     for y in 0..H {
         for x in 0..W {
             let i = (y * W + x) as usize * 3;
-            if crossing(x, y, -0.08) {
+            if front(x, y, -0.08) {
                 inside += 1;
                 for (name, img) in [("frame", &frame), ("reference", &traced)] {
                     let v = &img[i..i + 3];
@@ -312,7 +313,7 @@ fn the_camera_sees_the_rect_light_itself_in_the_frame_and_the_reference() {
                         "{name} ({x}, {y}): {v:?}"
                     );
                 }
-            } else if !crossing(x, y, 0.08) {
+            } else if !front(x, y, 0.08) {
                 outside += 1;
                 assert!(
                     frame[i..i + 3].iter().all(|&c| (c as f64) < 0.5 * rect.radiance),
