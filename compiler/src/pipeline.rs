@@ -15,7 +15,7 @@ use crate::bake::{self, BakeContext, StageReport};
 use crate::cli::{BakeArgs, OutputArgs, SceneArgs};
 use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
-use crate::ir::Scene;
+use crate::ir::{Scene, WarningClass};
 use crate::progress::Progress;
 use crate::settings::Settings;
 use crate::warnings::{WarningLevel, WarningPolicy};
@@ -111,7 +111,12 @@ pub fn finish(
     start: Instant,
 ) -> CliResult<Loaded> {
     let valid = validate::finish(&mut scene, source);
-    let failing = policy.failing(&scene.warnings).len();
+    // The classes of the warnings that fail the compile, each once.
+    let mut failing_classes: Vec<WarningClass> =
+        policy.failing(&scene.warnings).iter().map(|w| w.class).collect();
+    let failing = failing_classes.len();
+    failing_classes.sort_unstable();
+    failing_classes.dedup();
     // Warnings first, also when validation failed: they often explain the failure.
     if !quiet || failing > 0 || valid.is_err() {
         for w in &scene.warnings {
@@ -122,8 +127,7 @@ pub fn finish(
     }
     valid?;
     if failing > 0 {
-        let mut classes: Vec<&str> = policy.failing(&scene.warnings).iter().map(|w| w.class.name()).collect();
-        classes.dedup();
+        let classes: Vec<&str> = failing_classes.iter().map(|c| c.name()).collect();
         return Err(CliError::input(format!(
             "{failing} warning(s) of class {} and --strict or -W CLASS=error is set",
             classes.join(", ")
