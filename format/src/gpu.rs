@@ -305,7 +305,7 @@ pub fn glsl_offsets<T: GlslStruct>() -> (Vec<usize>, usize) {
     (out, offset.div_ceil(align_max) * align_max)
 }
 
-fn declare<T: GlslStruct>(out: &mut String) {
+pub(crate) fn declare<T: GlslStruct>(out: &mut String) {
     out.push_str(&format!("struct {} {{\n", T::NAME));
     for (name, ty, offset, _) in T::fields() {
         out.push_str(&format!("    {ty} {name}; // offset {offset}\n"));
@@ -357,6 +357,53 @@ pub fn glsl_layout() -> String {
     }
     s.push_str("\n#endif\n");
     s
+}
+
+gpu_struct! {
+    /// The voxel grid and line space as the player's queries read them (`shaders/common/
+    /// linespace.glsl`; uniform, std140, 128 bytes). The arrays the chosen techniques need are
+    /// concatenated into one space of 32-bit words, split into storage buffers ("chunks") of
+    /// `1 << chunk_shift` words each, so that no buffer exceeds the device's
+    /// `maxStorageBufferRange`; each array's first word in that space is a `*_base` field
+    /// (`u32::MAX` for an array not uploaded).
+    pub struct GpuGrid {
+        /// Minimum corner of the grid: the file's f64 origin rounded to f32 …
+        pub origin: [f32; 3] => "vec3",
+        /// Cell edge length.
+        pub cell: f32 => "float",
+        /// … and what the rounding lost (origin − `origin` in f64, rounded): grid coordinates
+        /// are `((p − origin) − origin_lo) / cell`, exact to a few ulps of the cell even 1e5 from
+        /// the world's origin, where `origin` alone is off by up to 4e-3.
+        pub origin_lo: [f32; 3] => "vec3",
+        /// 1 / cell.
+        pub inv_cell: f32 => "float",
+        /// Cells along x, y, z.
+        pub dims: [u32; 3] => "uvec3",
+        /// Shaft resolution N (0 without line space).
+        pub shaft_res: u32 => "uint",
+        /// The grid margin (scene units): how far cells and shafts were widened.
+        pub margin: f32 => "float",
+        /// Shaft-bit words per slot.
+        pub words_per_slot: u32 => "uint",
+        /// `Variants` present in the file.
+        pub variants: u32 => "uint",
+        /// Slack of the candidate lists' early exit, in cell units (see `query.rs`), widened for
+        /// single-precision key evaluation.
+        pub key_eps: f32 => "float",
+        /// PNMT self-hit distance: a record must lie further than this in front of the origin's
+        /// surface (the position quantisation step plus the margin).
+        pub pnmt_step: f32 => "float",
+        /// log2 of the words per chunk.
+        pub chunk_shift: u32 => "uint",
+        /// Zero.
+        pub reserved: [u32; 2] => "uvec2",
+        /// First word of: cell triangle offsets, cell triangle lists, slots, shaft bits.
+        pub bases_a: [u32; 4] => "uvec4",
+        /// First word of: shaft ranks, candidate offsets, candidate entries, PNMT records.
+        pub bases_b: [u32; 4] => "uvec4",
+        /// First word of: pre-illuminated records; then three zeros.
+        pub bases_c: [u32; 4] => "uvec4",
+    }
 }
 
 gpu_struct! {
@@ -431,6 +478,8 @@ mod tests {
         check::<ReferenceConstants>();
         check::<GpuEmitter>();
         check::<GpuTexture>();
+        check::<RtConstants>();
+        check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {
             base_color_texture: 3,

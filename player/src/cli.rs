@@ -234,6 +234,7 @@ impl Args {
                 pipeline_cache: if self.no_pipeline_cache { None } else { default_cache_path() },
                 // Only the ray benchmark traces through the driver's pipeline.
                 ray_tracing_pipeline: self.bench_rays,
+                max_storage_buffer: None,
             },
             render: RenderSettings {
                 techniques,

@@ -20,6 +20,7 @@ pub mod scene;
 pub mod session;
 pub mod sweep;
 pub mod trace;
+pub mod trace_linespace;
 pub mod window;
 
 pub use error::{Exit, PlayError, PlayResult};

@@ -8,6 +8,32 @@ const uint LS_MAX_SHAFT_RES = 8u;
 const uint LS_NO_SLOT = 4294967295u;
 const uint LS_NO_RECORD = 65535u;
 const uint LS_MAX_CELL_TRIANGLES = 65536u;
+const uint LS_MAX_CHUNKS = 8u;
+const uint LS_NO_BASE = 4294967295u;
+const uint LS_BINARY = 1u;
+const uint LS_CANDIDATES = 2u;
+const uint LS_PNMT = 4u;
+const uint LS_PREILLUM = 8u;
+
+struct GpuGrid {
+    vec3 origin; // offset 0
+    float cell; // offset 12
+    vec3 origin_lo; // offset 16
+    float inv_cell; // offset 28
+    uvec3 dims; // offset 32
+    uint shaft_res; // offset 44
+    float margin; // offset 48
+    uint words_per_slot; // offset 52
+    uint variants; // offset 56
+    float key_eps; // offset 60
+    float pnmt_step; // offset 64
+    uint chunk_shift; // offset 68
+    uvec2 reserved; // offset 72
+    uvec4 bases_a; // offset 80
+    uvec4 bases_b; // offset 96
+    uvec4 bases_c; // offset 112
+}; // 128 bytes
+
 
 // Pair number of faces (a, b), a < b, at [a * 6 + b]; -1 elsewhere.
 const int LS_PAIR[36] = int[36](-1, 0, 1, 2, 3, 4, -1, -1, 5, 6, 7, 8, -1, -1, -1, 9, 10, 11, -1, -1, -1, -1, 12, 13, -1, -1, -1, -1, -1, 14, -1, -1, -1, -1, -1, -1);

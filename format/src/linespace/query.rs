@@ -44,6 +44,21 @@ pub struct PnmtQueryHit {
     pub hit: PnmtHit,
 }
 
+impl super::GridHeader {
+    /// Slack of the candidate lists' early exit in cell units: keys are compared against the
+    /// key of the best hit so far, which the single-precision triangle test may place up to a
+    /// margin off the true surface.
+    pub fn key_eps(&self) -> f64 {
+        4.0 * self.margin / self.cell + 1e-9
+    }
+
+    /// How far in front of the origin's surface a PNMT record must lie to be accepted (the
+    /// position quantisation step plus the margin; see the module documentation).
+    pub fn pnmt_step(&self) -> f64 {
+        self.cell * 3f64.sqrt() / 65535.0 + self.margin
+    }
+}
+
 /// Outward normal of a face as a vector.
 fn outward(face: u32) -> DVec3 {
     let mut n = DVec3::ZERO;
@@ -102,7 +117,7 @@ impl LineSpace<'_> {
         let h = &self.header;
         let d_len = ray.direction.as_dvec3().length();
         let margin_t = h.margin / d_len * 2.0;
-        let key_eps = 4.0 * h.margin / h.cell + 1e-9;
+        let key_eps = h.key_eps();
         let mut best: Option<Hit> = None;
         for visit in Dda::new(h, ray.origin, ray.direction, ray.tmin, ray.tmax) {
             if best.is_some_and(|b| visit.t_enter > b.t as f64 + margin_t) {
@@ -181,7 +196,7 @@ impl LineSpace<'_> {
         let h = &self.header;
         let o = ray.origin.as_dvec3();
         let d = ray.direction.as_dvec3();
-        let q = h.cell * 3f64.sqrt() / 65535.0 + h.margin;
+        let q = h.pnmt_step();
         for visit in Dda::new(h, ray.origin, ray.direction, ray.tmin, ray.tmax) {
             let slot = self.slots[h.cell_index(visit.cell)];
             if slot == NO_SLOT {

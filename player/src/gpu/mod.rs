@@ -43,6 +43,9 @@ pub struct GpuOptions {
     /// Enable the driver's ray-tracing pipeline and acceleration structures when the device has
     /// them (the peer of the compute traversal in `--bench-rays`).
     pub ray_tracing_pipeline: bool,
+    /// Caps one storage buffer below the device's `maxStorageBufferRange` (tests split a small
+    /// scene's line space into several buffers as a large one is split on any device).
+    pub max_storage_buffer: Option<u64>,
 }
 
 /// Counts of validation messages (errors are what tests require to be zero).
@@ -100,6 +103,7 @@ pub struct Gpu {
     cache_path: Option<PathBuf>,
     /// Whether VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure are enabled.
     pub ray_tracing_pipeline: bool,
+    storage_cap: Option<u64>,
 }
 
 /// Device extensions the ray-tracing-pipeline peer needs.
@@ -344,6 +348,7 @@ impl Gpu {
             pipeline_cache,
             cache_path: options.pipeline_cache.clone(),
             ray_tracing_pipeline,
+            storage_cap: options.max_storage_buffer,
         })
     }
 
@@ -388,9 +393,11 @@ impl Gpu {
         self.properties.limits.timestamp_period as f64
     }
 
-    /// Largest storage buffer range the device allows (lavapipe: 128 MiB).
+    /// Largest storage buffer range the device allows (lavapipe: 128 MiB), or the cap of
+    /// [`GpuOptions::max_storage_buffer`] when smaller.
     pub fn max_storage_buffer(&self) -> u64 {
-        self.properties.limits.max_storage_buffer_range as u64
+        let device = self.properties.limits.max_storage_buffer_range as u64;
+        self.storage_cap.map_or(device, |cap| cap.min(device))
     }
 
     pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {

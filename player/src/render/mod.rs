@@ -41,7 +41,8 @@ pub enum Purpose {
     /// Frames of the chosen techniques.
     #[default]
     Frames,
-    /// Frames, and ray queries through the BVH ([`crate::trace::RayQuery`]).
+    /// Frames, and ray queries through the BVH ([`crate::trace::RayQuery`]) and whatever line
+    /// space the file has ([`crate::trace_linespace::LineSpaceQuery`]).
     RayQueries,
     /// The reference path tracer.
     Reference,
@@ -65,7 +66,12 @@ impl RenderSettings {
         let n = self.techniques.needs();
         match self.purpose {
             Purpose::Frames => n,
-            Purpose::RayQueries => n.union(Needs::RAYS),
+            // Whatever line space the file has: the ray benchmark measures every variant.
+            Purpose::RayQueries => n.union(Needs {
+                line_space: crate::scene::linespace::LsArrays::ALL
+                    | crate::scene::linespace::LsArrays::IF_PRESENT,
+                ..Needs::RAYS
+            }),
             Purpose::Reference => n.union(Needs::TRACED_SURFACES),
         }
     }

@@ -27,6 +27,8 @@ shaders! {
     TONEMAP = "post" / "tonemap.comp";
     /// Ray queries from a buffer.
     TRACE_RAYS = "trace" / "rays.comp";
+    /// Line-space queries from a buffer.
+    TRACE_LINESPACE = "trace" / "linespace.comp";
     /// Visibility-buffer raster pass.
     VISIBILITY_FRAG = "gbuffer" / "visibility.frag";
     /// Visibility-buffer raster pass for opaque one-sided materials.

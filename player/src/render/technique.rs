@@ -136,6 +136,8 @@ pub struct Needs {
     /// Materials, per-triangle materials, texels and the emitter table as storage buffers
     /// (what passes that shade surfaces in compute read).
     pub scene_buffers: bool,
+    /// Arrays of the voxel grid and line space ([`crate::scene::linespace::LsArrays`] bits).
+    pub line_space: u32,
 }
 
 impl Needs {
@@ -147,18 +149,37 @@ impl Needs {
             shadow_maps: self.shadow_maps || o.shadow_maps,
             bvh: self.bvh || o.bvh,
             scene_buffers: self.scene_buffers || o.scene_buffers,
+            line_space: self.line_space | o.line_space,
         }
     }
 
     /// What ray queries through the BVH read.
-    pub const RAYS: Needs =
-        Needs { textures: false, brdf_lut: false, shadow_maps: false, bvh: true, scene_buffers: false };
+    pub const RAYS: Needs = Needs {
+        textures: false,
+        brdf_lut: false,
+        shadow_maps: false,
+        bvh: true,
+        scene_buffers: false,
+        line_space: 0,
+    };
     /// What the ray-traced passes and the path tracer read: the BVH and the surfaces it hits.
-    pub const TRACED_SURFACES: Needs =
-        Needs { textures: false, brdf_lut: false, shadow_maps: false, bvh: true, scene_buffers: true };
+    pub const TRACED_SURFACES: Needs = Needs {
+        textures: false,
+        brdf_lut: false,
+        shadow_maps: false,
+        bvh: true,
+        scene_buffers: true,
+        line_space: 0,
+    };
     /// What the G-buffer and the direct-light pass always read.
-    pub const FRAME: Needs =
-        Needs { textures: true, brdf_lut: true, shadow_maps: false, bvh: false, scene_buffers: false };
+    pub const FRAME: Needs = Needs {
+        textures: true,
+        brdf_lut: true,
+        shadow_maps: false,
+        bvh: false,
+        scene_buffers: false,
+        line_space: 0,
+    };
 }
 
 impl Techniques {

@@ -2,6 +2,7 @@
 //! staging ring, only those the enabled passes read. The rest are skipped and listed.
 
 pub mod bindings;
+pub mod linespace;
 pub mod reference;
 pub mod upload;
 
@@ -63,6 +64,8 @@ pub struct Prepared<'f> {
     bvh_triangles: Vec<[f32; 4]>,
     /// Emitter and texture tables of the reference path tracer.
     reference: Option<reference::ReferenceTables>,
+    /// Where the line-space arrays go, when a technique reads them.
+    line_space: Option<linespace::LineSpaceLayout>,
 }
 
 impl std::fmt::Debug for Prepared<'_> {
@@ -87,8 +90,19 @@ impl<'f> Prepared<'f> {
     /// Validates `file` and prepares what the upload copies.
     pub fn new(file: &'f KilnFile, needs: Needs) -> PlayResult<Prepared<'f>> {
         let view = SceneView::new(file).map_err(bad)?;
+        let line_space = if needs.line_space & linespace::LsArrays::ALL != 0 {
+            linespace::LineSpaceLayout::new(
+                file,
+                view.triangles.len(),
+                view.materials.len(),
+                needs.line_space,
+            )?
+        } else {
+            None
+        };
         for s in file.sections() {
-            if s.known.is_some() && uploads(s.entry.kind, needs) {
+            let ls = line_space.as_ref().is_some_and(|l| l.uploads(s.entry.kind));
+            if s.known.is_some() && (uploads(s.entry.kind, needs) || ls) {
                 file.verify_section(s.position).map_err(bad)?;
             }
         }
@@ -105,7 +119,7 @@ impl<'f> Prepared<'f> {
                 view.materials,
             )
         });
-        Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference })
+        Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space })
     }
 }
 
@@ -235,6 +249,8 @@ pub struct GpuScene {
     pub bvh: Option<BvhBuffers>,
     /// The reference path tracer's buffers, when asked for.
     pub reference: Option<ReferenceBuffers>,
+    /// The voxel grid and line space arrays the techniques read.
+    pub line_space: Option<linespace::LineSpaceBuffers>,
     /// Every section of the file and its fate.
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
@@ -331,6 +347,7 @@ impl GpuScene {
             shadow_maps: Vec::new(),
             bvh: None,
             reference: None,
+            line_space: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
             samplers,
@@ -362,6 +379,9 @@ impl GpuScene {
         if let Some(tables) = &prepared.reference {
             self.reference = Some(reference_buffers(gpu, view, tables)?);
         }
+        if let Some(layout) = &prepared.line_space {
+            self.line_space = Some(linespace::LineSpaceBuffers::new(gpu, layout, up)?);
+        }
         for s in file.sections() {
             let kind = s.entry.kind;
             let index = s.entry.index;
@@ -372,9 +392,15 @@ impl GpuScene {
             };
             let mut fate =
                 SectionFate { section: name, bytes: s.entry.raw_size, uploaded: true, reason: String::new() };
+            let line_space_array = match (&self.line_space, s.known.is_some()) {
+                (Some(ls), true) => ls.upload(kind, &file.section_bytes(s).map_err(bad)?, up)?,
+                _ => false,
+            };
             if s.known.is_none() {
                 fate.uploaded = false;
                 fate.reason = "unknown kind or newer version".into();
+            } else if line_space_array {
+                // Uploaded into the line space's chunks above.
             } else if let (Some(r), true) = (&self.reference, kind == sections::MATERIALS) {
                 up.buffer(&r.materials, 0, bytemuck::cast_slice(view.materials))?;
             } else if let (Some(r), true) = (&self.reference, kind == sections::TRIANGLE_MATERIALS) {
@@ -543,6 +569,9 @@ impl GpuScene {
         }
         if let Some(r) = &mut self.reference {
             r.destroy(gpu);
+        }
+        if let Some(l) = &mut self.line_space {
+            l.destroy(gpu);
         }
         for s in self.samplers.values_mut() {
             s.destroy(gpu);

@@ -125,6 +125,7 @@ impl Args {
                 surface_extensions: Vec::new(),
                 pipeline_cache: default_cache_path(),
                 ray_tracing_pipeline: false,
+                max_storage_buffer: None,
             },
             keep_images: self.keep_images,
             progress: !self.quiet && std::io::stderr().is_terminal(),
