@@ -71,6 +71,15 @@ pub enum ReflectionResArg {
     Half,
 }
 
+/// `--ls-shadow-test` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LsShadowTestArg {
+    /// Exact tests in the cells holding the ray's ends.
+    Ends,
+    /// Exact tests wherever the shaft is filled.
+    Filled,
+}
+
 /// kiln-play renders .kiln files with Vulkan 1.3: in a window, headless to PNG or EXR, or as a
 /// benchmark.
 #[derive(Debug, Parser)]
@@ -152,6 +161,11 @@ pub struct Args {
     /// With --shadows rt: angular diameter of directional lights in degrees (the sun: 0.53).
     #[arg(long, value_name = "DEGREES", default_value_t = 0.0)]
     pub sun_angle: f32,
+    /// With --shadows linespace: how a filled shaft is decided. ends: exact triangle tests in the
+    /// cells holding the ray's ends, a filled shaft elsewhere occludes (conservative, cheapest);
+    /// filled: exact tests wherever the shaft is filled (exact).
+    #[arg(long, value_enum, default_value = "ends")]
+    pub ls_shadow_test: LsShadowTestArg,
     /// Do not average the ray-traced passes over frames (every frame shows one sample).
     #[arg(long)]
     pub no_accumulate: bool,
@@ -178,6 +192,7 @@ impl Args {
         match name {
             "light-radius" => Some(KnobValue::Number(self.light_radius)),
             "sun-angle" => Some(KnobValue::Number(self.sun_angle)),
+            "ls-shadow-test" => Some(KnobValue::Choice(self.ls_shadow_test as usize)),
             "ao-radius" => self.ao_radius.map(KnobValue::Number),
             "ao-reach" => Some(KnobValue::Number(self.ao_reach)),
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),

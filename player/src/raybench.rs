@@ -5,7 +5,9 @@
 //! diagonal) and unbounded diffuse bounces. Rays stay in pixel order, as a frame traces them.
 //! Times are GPU timestamps around the dispatch. Where the device has a ray-tracing pipeline, the
 //! same rays go through it too ([`crate::peer`]), traces of the two interleaved, and the hits are
-//! compared.
+//! compared. Where the file has a line space, its queries run on the shadow rays (binary, binary
+//! with exact end cells or filled cells, candidates any hit) and the diffuse rays (PNMT,
+//! candidates closest hit), timed in the same loop, and are compared with the BVH's exact answers.
 
 use std::time::Instant;
 
@@ -17,8 +19,11 @@ use serde::Serialize;
 
 use crate::bench::quantile;
 use crate::error::{Exit, PlayError, PlayResult};
+use crate::scene::linespace::LineSpaceBuffers;
 use crate::session::{Session, SessionOptions, open_file};
 use crate::trace::{GpuHit, GpuRay, NO_HIT, RayQuery, WARMUP_TRACES};
+use crate::trace_linespace::{LineSpaceQuery, LsQuery};
+use kiln_format::linespace::Variants;
 
 /// One ray set's figures.
 #[derive(Debug, Clone, Serialize)]
@@ -39,6 +44,26 @@ pub struct RaySetStats {
     pub mrays_per_s: f64,
     /// The driver's ray-tracing pipeline on the same rays, when present.
     pub peer: Option<PeerStats>,
+    /// The line-space queries on the same rays, when the file has a line space.
+    pub line_space: Vec<LineSpaceStats>,
+}
+
+/// One line-space query's figures on a set, against kiln's BVH traversal on the same rays.
+#[derive(Debug, Clone, Serialize)]
+pub struct LineSpaceStats {
+    /// The query ([`LsQuery::name`]).
+    pub query: String,
+    /// Median GPU milliseconds per trace.
+    pub median_ms: f64,
+    /// Million rays per second at the median.
+    pub mrays_per_s: f64,
+    /// Its Mrays/s over the BVH traversal's on the same set.
+    pub ratio_to_bvh: f64,
+    /// Rays where it reports a hit and the exact answer a miss, or the reverse.
+    pub hit_miss_disagreeing: usize,
+    /// Approximate queries (PNMT), where both hit: how far along the ray its point lies from the
+    /// exact hit (|t − t_exact|·|d|), scene units (median, 99th percentile).
+    pub position_error: Option<[f64; 2]>,
 }
 
 /// The ray-tracing pipeline's figures for one set.
@@ -107,6 +132,19 @@ impl RayBenchReport {
                 )),
                 None => s.push_str("            -          -        -\n"),
             }
+            for l in &r.line_space {
+                s.push_str(&format!(
+                    "  line space {:<22} {:>10.3} {:>10.1}  {:>6.2}x BVH, {:>6.3} % hit/miss differ{}\n",
+                    l.query,
+                    l.median_ms,
+                    l.mrays_per_s,
+                    l.ratio_to_bvh,
+                    100.0 * l.hit_miss_disagreeing as f64 / r.rays as f64,
+                    l.position_error.map_or(String::new(), |[m, p]| format!(
+                        ", point off by {m:.2e} (median) {p:.2e} (p99)"
+                    ))
+                ));
+            }
         }
         match self.peer_build_ms {
             Some(ms) => s.push_str(&format!("driver acceleration structures built in {ms:.3} ms (GPU)\n")),
@@ -135,8 +173,22 @@ pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult
     let session = Session::open(&o, start)?;
     let mut query = RayQuery::new(&session.gpu)?;
     query.warmup = WARMUP_TRACES;
-    let result = measure(&session, &mut query, &o, repeats.max(1));
+    let mut ls_query =
+        match session.scene.line_space.as_ref().map(|_| LineSpaceQuery::new(&session.gpu)).transpose() {
+            Ok(q) => q,
+            Err(e) => {
+                query.destroy(&session.gpu);
+                return Err(e);
+            }
+        };
+    if let Some(q) = &mut ls_query {
+        q.warmup = WARMUP_TRACES;
+    }
+    let result = measure(&session, &mut query, ls_query.as_mut(), &o, repeats.max(1));
     query.destroy(&session.gpu);
+    if let Some(q) = &mut ls_query {
+        q.destroy(&session.gpu);
+    }
     let errors = session.close();
     let report = result?;
     if errors > 0 {
@@ -148,6 +200,7 @@ pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult
 fn measure(
     session: &Session,
     query: &mut RayQuery,
+    ls_query: Option<&mut LineSpaceQuery>,
     o: &SessionOptions,
     repeats: u32,
 ) -> PlayResult<RayBenchReport> {
@@ -186,6 +239,8 @@ fn measure(
     let mut shadow = Vec::new();
     let mut ao = Vec::new();
     let mut diffuse = Vec::new();
+    // The geometric normal each secondary ray leaves (PNMT's self-hit rule reads it).
+    let mut normals = Vec::new();
     let bounds = view.manifest.bounds;
     let ao_radius = 0.1 * Vec3::from(bounds.max).distance(Vec3::from(bounds.min));
     for (i, (r, hit)) in primary.iter().zip(&hits).enumerate() {
@@ -203,6 +258,7 @@ fn measure(
             n = -n;
         }
         let origin = offset_origin(p, n).to_array();
+        normals.push([n.x, n.y, n.z, 0.0]);
         if let Some(l) = light {
             let (dir, tmax) = match l.kind {
                 LightKind::Directional => (-Vec3::from(l.direction), f32::MAX),
@@ -230,13 +286,35 @@ fn measure(
     if let Some(p) = &mut peer {
         p.warmup = WARMUP_TRACES;
     }
+    // Line-space queries on the sets seed 004 routes through it: shadow feelers (any hit) and
+    // diffuse bounces (closest hit), each with the variants the file has.
+    let variants = session.scene.line_space.as_ref().map_or(0, |l| l.header.variants);
+    let has = |v: u32| variants & v != 0;
+    let shadow_ls: Vec<LsQuery> = [
+        (has(Variants::BINARY), LsQuery::Binary),
+        (has(Variants::BINARY), LsQuery::BinaryEnds),
+        (has(Variants::BINARY), LsQuery::BinaryFilled),
+        (has(Variants::CANDIDATES), LsQuery::CandidatesAny),
+    ]
+    .into_iter()
+    .filter_map(|(ok, q)| ok.then_some(q))
+    .collect();
+    let diffuse_ls: Vec<LsQuery> =
+        [(has(Variants::PNMT), LsQuery::Pnmt), (has(Variants::CANDIDATES), LsQuery::CandidatesClosest)]
+            .into_iter()
+            .filter_map(|(ok, q)| ok.then_some(q))
+            .collect();
+    let ls = match (ls_query, session.scene.line_space.as_ref()) {
+        (Some(q), Some(b)) => Some((q, b, normals.as_slice())),
+        _ => None,
+    };
     let sets = [
-        ("primary", &primary, false),
-        ("shadow", &shadow, true),
-        ("ao", &ao, false),
-        ("diffuse", &diffuse, false),
+        RaySet { name: "primary", rays: &primary, any: false, line_space: &[] },
+        RaySet { name: "shadow", rays: &shadow, any: true, line_space: &shadow_ls },
+        RaySet { name: "ao", rays: &ao, any: false, line_space: &[] },
+        RaySet { name: "diffuse", rays: &diffuse, any: false, line_space: &diffuse_ls },
     ];
-    let result = trace_sets(gpu, bvh, query, peer.as_mut(), repeats, sets);
+    let result = trace_sets(gpu, bvh, query, peer.as_mut(), ls, repeats, sets);
     let peer_build_ms = peer.as_ref().map(|p| p.build_ms);
     if let Some(p) = &mut peer {
         let _ = gpu.wait_idle();
@@ -262,18 +340,30 @@ fn agree(a: &GpuHit, b: &GpuHit, any_hit: bool) -> bool {
     !ha || any_hit || a.triangle == b.triangle || (a.t - b.t).abs() <= 1e-4 * a.t.abs().max(b.t.abs())
 }
 
+/// One ray set: its rays, whether any hit suffices, and the line-space queries to time on it.
+struct RaySet<'a> {
+    name: &'static str,
+    rays: &'a [GpuRay],
+    any: bool,
+    line_space: &'a [LsQuery],
+}
+
+/// The line-space queries with their buffers and the rays' origin normals.
+type LineSpaceRun<'a> = (&'a mut LineSpaceQuery, &'a LineSpaceBuffers, &'a [[f32; 4]]);
+
 /// Traces each set `repeats` times through kiln's traversal and, interleaved (so that clocks and
-/// temperature treat both alike), through the peer.
+/// temperature treat all alike), through the peer and the set's line-space queries.
 fn trace_sets(
     gpu: &crate::gpu::Gpu,
     bvh: &crate::scene::BvhBuffers,
     query: &mut RayQuery,
     mut peer: Option<&mut crate::peer::RtPipelinePeer>,
+    mut ls: Option<LineSpaceRun>,
     repeats: u32,
-    sets: [(&str, &Vec<GpuRay>, bool); 4],
+    sets: [RaySet; 4],
 ) -> PlayResult<Vec<RaySetStats>> {
     let mut out = Vec::new();
-    for (name, rays, any) in sets {
+    for RaySet { name, rays, any, line_space } in sets {
         if rays.is_empty() {
             continue;
         }
@@ -281,6 +371,9 @@ fn trace_sets(
         let mut peer_ms = Vec::with_capacity(repeats as usize);
         let mut hits = Vec::new();
         let mut peer_hits = Vec::new();
+        let queries = if ls.is_some() { line_space } else { &[] };
+        let mut ls_ms = vec![Vec::with_capacity(repeats as usize); queries.len()];
+        let mut ls_hits = vec![Vec::new(); queries.len()];
         for _ in 0..repeats {
             let (h, t) = query.trace(gpu, bvh, rays, any)?;
             hits = h;
@@ -289,6 +382,13 @@ fn trace_sets(
                 let (h, t) = p.trace(gpu, rays, any)?;
                 peer_hits = h;
                 peer_ms.push(t);
+            }
+            if let Some((q, buffers, normals)) = ls.as_mut() {
+                for (k, &which) in queries.iter().enumerate() {
+                    let (h, t) = q.trace(gpu, bvh, buffers, rays, normals, which)?;
+                    ls_hits[k] = h;
+                    ls_ms[k].push(t);
+                }
             }
         }
         ms.sort_by(f64::total_cmp);
@@ -305,6 +405,36 @@ fn trace_sets(
                 agreeing: hits.iter().zip(&peer_hits).filter(|(a, b)| agree(a, b, any)).count(),
             }
         });
+        let line_space = queries
+            .iter()
+            .zip(ls_ms.iter_mut().zip(&ls_hits))
+            .map(|(&which, (times, got))| {
+                times.sort_by(f64::total_cmp);
+                let m = quantile(times, 0.5);
+                let l_mrays = rays.len() as f64 / (m * 1e3);
+                let differ =
+                    got.iter().zip(&hits).filter(|(a, b)| (a.t != NO_HIT) != (b.t != NO_HIT)).count();
+                let position_error = (which == LsQuery::Pnmt).then(|| {
+                    let mut e: Vec<f64> = got
+                        .iter()
+                        .zip(&hits)
+                        .zip(rays)
+                        .filter(|((a, b), _)| a.t != NO_HIT && b.t != NO_HIT)
+                        .map(|((a, b), r)| ((a.t - b.t).abs() * Vec3::from(r.direction).length()) as f64)
+                        .collect();
+                    e.sort_by(f64::total_cmp);
+                    if e.is_empty() { [0.0; 2] } else { [quantile(&e, 0.5), quantile(&e, 0.99)] }
+                });
+                LineSpaceStats {
+                    query: which.name().into(),
+                    median_ms: m,
+                    mrays_per_s: l_mrays,
+                    ratio_to_bvh: l_mrays / mrays,
+                    hit_miss_disagreeing: differ,
+                    position_error,
+                }
+            })
+            .collect();
         out.push(RaySetStats {
             set: name.into(),
             rays: rays.len(),
@@ -314,6 +444,7 @@ fn trace_sets(
             p90_ms: quantile(&ms, 0.9),
             mrays_per_s: mrays,
             peer,
+            line_space,
         });
     }
     Ok(out)

@@ -49,7 +49,7 @@ impl LsQuery {
             LsQuery::CandidatesAny => "candidates any",
             LsQuery::Binary => "binary",
             LsQuery::Pnmt => "pnmt",
-            LsQuery::BinaryEnds => "binary, exact ends",
+            LsQuery::BinaryEnds => "binary, exact near ends",
             LsQuery::BinaryFilled => "binary, exact filled",
         }
     }

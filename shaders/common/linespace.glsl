@@ -2,10 +2,9 @@
 // format/src/linespace/query.rs step for step (a test holds them to it): a 3D-DDA over the cells,
 // in each non-empty cell the shaft the ray's line passes through, then
 //   - ls_any_binary:      conservative any hit from the shaft bits alone;
-//   - ls_occluded_ends:   the bits in the cells between the ray's ends, exact triangle tests in
-//                         the cells holding its ends (no self-shadowing, no "voxel offset");
-//   - ls_occluded_filled: exact triangle tests in every cell whose shaft is filled: the exact
-//                         answer, with the bits as a skip test;
+//   - ls_occluded_binary: the bits, with exact triangle tests in filled cells near the ray's
+//                         ends (no self-shadowing, no "voxel offset") or in every filled cell
+//                         (the exact answer, the bits as a skip test);
 //   - ls_trace_candidates: closest or any hit through the candidate lists (exact);
 //   - ls_pnmt_hit:        the approximate hit stored for the shaft (PNMT), with the self-hit rule;
 //   - ls_preillum:        the pre-illuminated radiance of a shaft's front or back hit.
@@ -273,19 +272,23 @@ bool ls_any_binary(vec3 origin, vec3 dir, float tmin, float tmax) {
     return false;
 }
 
-// Any hit with exact triangle tests where the binary answer says "filled": in the cells that
-// hold the ray's ends only (`exact_everywhere` false: conservative in between, the thesis's
-// shadow feelers without its self-shadowing), or in every filled cell (exact).
+// Cells within this many cell edges of a ray's ends are tested exactly by ls_occluded_binary:
+// a surface's own triangles fill the shafts of its neighbouring cells too, so a feeler leaving it
+// at a shallow angle would otherwise be blocked by the surface it starts on (the thesis's "voxel
+// offset" problem, which it solved by skipping the start voxel and lost shadows in corners).
+const float LS_EXACT_REACH = 2.0;
+
+// Any hit with exact triangle tests where the binary answer says "filled": in the cells within
+// LS_EXACT_REACH cells of the ray's ends only (`exact_everywhere` false: conservative in between,
+// seed 004's shadow feelers without their self-shadowing), or in every filled cell (exact).
 bool ls_occluded_binary(TraceRay r, bool exact_everywhere) {
     LsDda s = ls_dda(r.origin, r.direction, r.tmin, r.tmax);
-    bool first = s.t == r.tmin;  // the ray starts inside the grid: its first cell holds the start
+    float reach = LS_EXACT_REACH / length(s.d);  // in ray parameter units
     ivec3 cell;
     float t_in, t_out;
     while (ls_dda_next(s, cell, t_in, t_out)) {
         uint c = ls_cell_index(cell);
         uint slot = ls_slot(c);
-        bool end = first || t_out >= r.tmax;
-        first = false;
         if (slot == LS_NO_SLOT) {
             continue;
         }
@@ -294,7 +297,8 @@ bool ls_occluded_binary(TraceRay r, bool exact_everywhere) {
         if (!filled) {
             continue;
         }
-        if (!exact_everywhere && !end) {
+        bool near_end = t_in <= r.tmin + reach || t_out >= r.tmax - reach;
+        if (!exact_everywhere && !near_end) {
             return true;
         }
         TraceHit h = TraceHit(NO_HIT, 0u, 0.0, 0.0);

@@ -5,6 +5,8 @@ use std::path::Path;
 
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
+use kiln_compiler::settings::{Settings, VoxelRes};
+use kiln_format::linespace::Variants;
 use kiln_format::manifest::LightKind;
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
@@ -19,7 +21,7 @@ fn an_occluder_casts_the_shadow_its_geometry_implies() {
         return;
     }
     // Shadow maps: PCF blurs the edge over a few texels.
-    occluder_case("occluder", 0.15, |f| Options::new(f, W, H));
+    occluder_case("occluder", [0.15; 2], fast_settings(), |f| Options::new(f, W, H));
 }
 
 #[test]
@@ -29,10 +31,64 @@ fn ray_traced_hard_shadows_are_exact_up_to_the_pixel_at_the_umbra_edge() {
     }
     // A point light of radius 0: one ray per pixel decides exactly, so only pixels whose
     // footprint straddles the edge (about 0.06 units here) are left out.
-    occluder_case("occluder-rt", 0.04, |f| Options::new(f, W, H).rt_shadows(0.0, 0.0));
+    occluder_case("occluder-rt", [0.04; 2], fast_settings(), |f| Options::new(f, W, H).rt_shadows(0.0, 0.0));
 }
 
-fn occluder_case(name: &str, margin: f64, shadowed: impl Fn(&Path) -> Options) {
+/// The compile settings of the line-space cases: a coarse grid (6 cells on the floor's side) so
+/// that most feelers cross cells beyond the exact reach of their ends.
+fn line_space_settings() -> Settings {
+    Settings {
+        shaft_variants: Some(Variants::BINARY),
+        voxel_res: VoxelRes::Cells(6),
+        shaft_res: 4,
+        ..fast_settings()
+    }
+}
+
+#[test]
+fn line_space_shadow_feelers_exact_in_filled_shafts_equal_ray_traced_shadows() {
+    if !vulkan() {
+        return;
+    }
+    occluder_case("occluder-ls-filled", [0.04; 2], line_space_settings(), |f| {
+        Options::new(f, W, H).line_space_shadows(true)
+    });
+}
+
+#[test]
+fn line_space_shadow_feelers_darken_the_umbra_and_only_what_the_shafts_cover() {
+    if !vulkan() {
+        return;
+    }
+    // Conservative between the ends: the umbra is exact and black; the lit floor may be darkened
+    // only within the shafts around the occluder, which at 6 cells and N = 4 reach at most one
+    // floor cell (10 / 6 units) beyond the umbra's edge.
+    occluder_case("occluder-ls-ends", [0.04, 10.0 / 6.0], line_space_settings(), |f| {
+        Options::new(f, W, H).line_space_shadows(false)
+    });
+}
+
+#[test]
+fn line_space_shadows_refuse_a_file_without_line_space() {
+    if !vulkan() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = compile(scene_of(&square(0.0, 1.0)), fast_settings());
+    let file = dir.path().join("plain.kiln");
+    std::fs::write(&file, bytes).unwrap();
+    let e = kiln_player::session::Session::open(
+        &Options::new(&file, 8, 8).line_space_shadows(false).build(),
+        std::time::Instant::now(),
+    )
+    .unwrap_err();
+    assert!(e.message.contains("--shaft-variants binary"), "{}", e.message);
+}
+
+/// `margins`: how far inside the umbra's edge pixels must be black, and how far outside it they
+/// must be fully lit (the filters' or the shafts' reach).
+fn occluder_case(name: &str, margins: [f64; 2], settings: Settings, shadowed: impl Fn(&Path) -> Options) {
+    let [inner, outer] = margins;
     let dir = tempfile::tempdir().unwrap();
     // A 2 × 2 square at height 1 under a point light at height 4: its umbra on the floor is the
     // square scaled by 4 / (4 − 1), |x|, |z| < 4/3.
@@ -45,7 +101,7 @@ fn occluder_case(name: &str, margin: f64, shadowed: impl Fn(&Path) -> Options) {
     let intensity = 20.0;
     scene.lights.push(light(LightKind::Point, lp, [0.0, -1.0, 0.0], intensity));
     scene.cameras.push(cam.file_camera());
-    let bytes = compile(scene, fast_settings());
+    let bytes = compile(scene, settings);
     let (rgb, _) = render(dir.path(), name, &bytes, shadowed);
     let a = albedo();
     let l = DVec3::from_array(lp.map(f64::from));
@@ -64,10 +120,10 @@ fn occluder_case(name: &str, margin: f64, shadowed: impl Fn(&Path) -> Options) {
     };
     // Outside the umbra (beyond the PCF footprint) the floor is fully lit...
     let outside =
-        |p: DVec3, d: DVec3| visible(p, d) && (p.x.abs() > edge + margin || p.z.abs() > edge + margin);
+        |p: DVec3, d: DVec3| visible(p, d) && (p.x.abs() > edge + outer || p.z.abs() > edge + outer);
     let n_lit = compare_plane(&rgb, &cam, 6.0, outside, lit, TOLERANCE);
     // ...and inside it, black.
-    let inside = |p: DVec3, d: DVec3| visible(p, d) && p.x.abs() < edge - margin && p.z.abs() < edge - margin;
+    let inside = |p: DVec3, d: DVec3| visible(p, d) && p.x.abs() < edge - inner && p.z.abs() < edge - inner;
     let mut n_dark = 0;
     for (i, p, d) in floor_pixels(&cam, edge) {
         if inside(p, d) {

@@ -10,7 +10,8 @@ use kiln_format::sections::Vertex;
 use kiln_player::camera::CameraOverride;
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{
-    Ao, GBuffer as GBufferTechnique, Purpose, ReflectionRes, Reflections as ReflectionsTechnique, Shadows,
+    Ao, GBuffer as GBufferTechnique, LsShadowTest, Purpose, ReflectionRes,
+    Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::session::SessionOptions;
 
@@ -129,6 +130,14 @@ impl Options {
     /// `light_radius`, directional lights `sun_degrees` wide (0 and 0: hard shadows).
     pub fn rt_shadows(mut self, light_radius: f32, sun_degrees: f32) -> Options {
         self.0.render.techniques.shadows = Shadows::Rt { light_radius, sun_degrees };
+        self
+    }
+
+    /// Line-space shadow feelers (`--shadows linespace`) with hard lights, exact in filled
+    /// shafts (`exact`) or near the rays' ends only.
+    pub fn line_space_shadows(mut self, exact: bool) -> Options {
+        let test = if exact { LsShadowTest::Filled } else { LsShadowTest::Ends };
+        self.0.render.techniques.shadows = Shadows::LineSpace { light_radius: 0.0, sun_degrees: 0.0, test };
         self
     }
 

@@ -14,7 +14,7 @@ use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::visibility::VisibilityPass;
-use super::technique::{Ao, GBuffer, Reflections, Shadows, Techniques};
+use super::technique::{Ao, GBuffer, Reflections, Techniques};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc};
 
@@ -38,8 +38,8 @@ fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<B
                 made.push(Box::new(ResolvePass::new(gpu)?));
             }
         }
-        if let Shadows::Rt { .. } = techniques.shadows {
-            made.push(Box::new(RtShadowsPass::new(gpu, lights)?));
+        if techniques.shadows.traced().is_some() {
+            made.push(Box::new(RtShadowsPass::new(gpu, techniques.shadows, lights)?));
         }
         if let Ao::Rt { .. } = techniques.ao {
             made.push(Box::new(RtAoPass::new(gpu)?));

@@ -28,7 +28,7 @@ use frame::Frame;
 use graph::{Access, FrameImages};
 use passes::{FrameCtx, Shared};
 pub use technique::{
-    Aa, Ao, Effect, GBuffer, Gi, Media, Needs, ReflectionRes, Reflections, Shadows, Techniques,
+    Aa, Ao, Effect, GBuffer, Gi, LsShadowTest, Media, Needs, ReflectionRes, Reflections, Shadows, Techniques,
 };
 
 /// Shadow maps of each kind the direct-light pass can bind, and lights with a ray-traced shadow
@@ -128,17 +128,14 @@ impl Renderer {
     ) -> PlayResult<Renderer> {
         let t = settings.techniques;
         let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, t.shadows == Shadows::ShadowMap);
-        let rt_shadows = matches!(t.shadows, Shadows::Rt { .. });
+        let rt_shadows = t.shadows.traced().is_some();
         if rt_shadows && plan.lights_used as usize > MAX_RT_SHADOW_LIGHTS {
             plan.warnings.push(format!(
                 "{} light(s) are drawn without ray-traced shadows: at most {MAX_RT_SHADOW_LIGHTS} have them",
                 plan.lights_used as usize - MAX_RT_SHADOW_LIGHTS
             ));
         }
-        let (light_radius, sun_degrees) = match t.shadows {
-            Shadows::Rt { light_radius, sun_degrees } => (light_radius, sun_degrees),
-            _ => (0.0, 0.0),
-        };
+        let (light_radius, sun_degrees) = t.shadows.traced().unwrap_or((0.0, 0.0));
         for l in &mut plan.lights {
             l.radius = match l.kind {
                 LightKinds::POINT | LightKinds::SPOT => light_radius.max(0.0),

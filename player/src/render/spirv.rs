@@ -39,6 +39,10 @@ shaders! {
     PATHTRACE = "reference" / "pathtrace.comp";
     /// Ray-traced soft shadows.
     RT_SHADOWS = "rt" / "shadows.comp";
+    /// Soft shadows by line-space feelers, exact in the end cells.
+    RT_SHADOWS_LINESPACE = "rt" / "shadows_linespace.comp";
+    /// Soft shadows by line-space feelers, exact in filled shafts.
+    RT_SHADOWS_LINESPACE_EXACT = "rt" / "shadows_linespace_exact.comp";
     /// Ray-traced ambient occlusion.
     RT_AO = "rt" / "ao.comp";
     /// Ray-traced glossy reflections.

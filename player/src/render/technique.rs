@@ -8,6 +8,8 @@
 
 use std::fmt;
 
+use crate::scene::linespace::LsArrays;
+
 /// Resolution of the ray-traced reflections.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ReflectionRes {
@@ -43,6 +45,39 @@ pub enum Shadows {
         /// Angular diameter of directional lights in degrees (0: hard).
         sun_degrees: f32,
     },
+    /// The same estimator with its rays through the binary line space (seed 004's shadow
+    /// feelers).
+    LineSpace {
+        /// As for [`Shadows::Rt`].
+        light_radius: f32,
+        /// As for [`Shadows::Rt`].
+        sun_degrees: f32,
+        /// How a filled shaft is decided.
+        test: LsShadowTest,
+    },
+}
+
+impl Shadows {
+    /// The light sizes of a traced technique (point/spot radius, sun degrees); `None` for the
+    /// others.
+    pub fn traced(&self) -> Option<(f32, f32)> {
+        match *self {
+            Shadows::Rt { light_radius, sun_degrees }
+            | Shadows::LineSpace { light_radius, sun_degrees, .. } => Some((light_radius, sun_degrees)),
+            _ => None,
+        }
+    }
+}
+
+/// How line-space shadow feelers decide a filled shaft.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LsShadowTest {
+    /// Exact triangle tests in the cells holding the ray's ends, a filled shaft elsewhere counts
+    /// as occluded: conservative (never a missed occluder), the cheapest.
+    Ends,
+    /// Exact triangle tests wherever the shaft is filled: the exact answer, the bits skipping
+    /// empty shafts.
+    Filled,
 }
 
 /// Ambient occlusion.
@@ -192,6 +227,10 @@ impl Techniques {
         match self.shadows {
             Shadows::ShadowMap => n.shadow_maps = true,
             Shadows::Rt { .. } => n = n.union(Needs::TRACED_SURFACES),
+            Shadows::LineSpace { .. } => {
+                n = n.union(Needs::TRACED_SURFACES);
+                n.line_space |= LsArrays::BINARY_QUERY;
+            }
             Shadows::None => {}
         }
         if self.ray_traced() {
@@ -202,7 +241,7 @@ impl Techniques {
 
     /// Whether any ray-traced pass runs.
     pub fn ray_traced(&self) -> bool {
-        matches!(self.shadows, Shadows::Rt { .. })
+        self.shadows.traced().is_some()
             || matches!(self.ao, Ao::Rt { .. })
             || matches!(self.reflections, Reflections::Rt { .. })
     }
@@ -211,7 +250,7 @@ impl Techniques {
     /// falls back to when the file has no BVH).
     pub fn without_rays(self) -> Techniques {
         Techniques {
-            shadows: if matches!(self.shadows, Shadows::Rt { .. }) { Shadows::None } else { self.shadows },
+            shadows: if self.shadows.traced().is_some() { Shadows::None } else { self.shadows },
             ao: Ao::None,
             reflections: Reflections::None,
             ..self
@@ -250,6 +289,17 @@ impl Techniques {
             (Effect::Shadows, "rt") => {
                 self.shadows = Shadows::Rt { light_radius: v(0).number(), sun_degrees: v(1).number() }
             }
+            (Effect::Shadows, "linespace") => {
+                self.shadows = Shadows::LineSpace {
+                    light_radius: v(0).number(),
+                    sun_degrees: v(1).number(),
+                    test: if v(2) == KnobValue::Choice(1) {
+                        LsShadowTest::Filled
+                    } else {
+                        LsShadowTest::Ends
+                    },
+                }
+            }
             (Effect::Ao, "none") => self.ao = Ao::None,
             (Effect::Ao, "rt") => {
                 let r = v(0).number();
@@ -286,6 +336,7 @@ impl Techniques {
                 Shadows::None => "none",
                 Shadows::ShadowMap => "shadowmap",
                 Shadows::Rt { .. } => "rt",
+                Shadows::LineSpace { .. } => "linespace",
             },
             Effect::Ao => match self.ao {
                 Ao::None => "none",
@@ -477,7 +528,27 @@ const fn light_size(knob: Knob) -> Knob {
 /// The upper end of an open range.
 const UNBOUNDED: f32 = f32::INFINITY;
 
-static CATALOGUE: [TechniqueInfo; 13] = [
+/// The sphere radius of point and spot lights, for the traced shadow techniques.
+const LIGHT_RADIUS: Knob = light_size(number(
+    "light-radius",
+    "sphere radius of point and spot lights in scene units (0: hard shadows)",
+    0.0,
+    UNBOUNDED,
+    0.0,
+    &[0.0, 0.1, 1.0],
+));
+
+/// The angular diameter of directional lights, for the traced shadow techniques.
+const SUN_ANGLE: Knob = light_size(number(
+    "sun-angle",
+    "angular diameter of directional lights in degrees (the sun: 0.53)",
+    0.0,
+    179.99,
+    0.0,
+    &[0.0, 0.53, 2.0],
+));
+
+static CATALOGUE: [TechniqueInfo; 14] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -512,23 +583,26 @@ static CATALOGUE: [TechniqueInfo; 13] = [
         name: "rt",
         help: "ray-traced soft shadows: one ray per light per pixel per frame, averaged while the \
                camera is still (see --light-radius, --sun-angle)",
+        knobs: &[LIGHT_RADIUS, SUN_ANGLE],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Shadows,
+        name: "linespace",
+        help: "the ray-traced estimator with its shadow feelers through the binary line space \
+               (seed 004; needs a file compiled with line space, see --ls-shadow-test)",
         knobs: &[
-            light_size(number(
-                "light-radius",
-                "sphere radius of point and spot lights in scene units (0: hard shadows)",
-                0.0,
-                UNBOUNDED,
-                0.0,
-                &[0.0, 0.1, 1.0],
-            )),
-            light_size(number(
-                "sun-angle",
-                "angular diameter of directional lights in degrees (the sun: 0.53)",
-                0.0,
-                179.99,
-                0.0,
-                &[0.0, 0.53, 2.0],
-            )),
+            LIGHT_RADIUS,
+            SUN_ANGLE,
+            Knob {
+                name: "ls-shadow-test",
+                help: "ends: exact triangle tests in the cells holding the ray's ends, a filled shaft \
+                       elsewhere occludes (conservative, cheapest); filled: exact tests wherever the \
+                       shaft is filled (exact)",
+                range: KnobRange::Choice(&["ends", "filled"]),
+                default: KnobValue::Choice(0),
+                role: KnobRole::Quality,
+            },
         ],
         stochastic: true,
     },

@@ -73,6 +73,32 @@ fn variant_of(bit: u32) -> (u32, &'static str) {
     }
 }
 
+/// The `--shaft-variants` a file must hold for the arrays `wanted` asks for (0 for none).
+pub fn variants_needed(wanted: u32) -> u32 {
+    if wanted & LsArrays::ALL == 0 {
+        return 0;
+    }
+    [LsArrays::CANDIDATES, LsArrays::PNMT, LsArrays::PREILLUM]
+        .iter()
+        .filter(|&&b| wanted & b != 0)
+        .fold(Variants::BINARY, |v, &b| v | variant_of(b).0)
+}
+
+/// `variants` as a `--shaft-variants` list.
+pub fn variants_list(variants: u32) -> String {
+    let names: Vec<&str> = [
+        (Variants::BINARY, "binary"),
+        (Variants::CANDIDATES, "candidates"),
+        (Variants::PNMT, "pnmt"),
+        (Variants::PREILLUM, "preillum"),
+    ]
+    .iter()
+    .filter(|(v, _)| variants & v != 0)
+    .map(|(_, n)| *n)
+    .collect();
+    names.join(",")
+}
+
 /// Where each needed array goes in the word space, decided on the CPU before the device exists.
 #[derive(Debug, Clone)]
 pub struct LineSpaceLayout {
@@ -174,28 +200,12 @@ fn dedup(mut v: Vec<&str>) -> Vec<&str> {
 }
 
 fn missing(what: &str, wanted: u32) -> PlayError {
-    let mut variants = Variants::BINARY;
-    for bit in [LsArrays::CANDIDATES, LsArrays::PNMT, LsArrays::PREILLUM] {
-        if wanted & bit != 0 {
-            variants |= variant_of(bit).0;
-        }
-    }
-    let list: Vec<&str> = [
-        (Variants::BINARY, "binary"),
-        (Variants::CANDIDATES, "candidates"),
-        (Variants::PNMT, "pnmt"),
-        (Variants::PREILLUM, "preillum"),
-    ]
-    .iter()
-    .filter(|(v, _)| variants & v != 0)
-    .map(|(_, n)| *n)
-    .collect();
     PlayError::new(
         Exit::Usage,
         format!(
             "{what}, which the chosen technique reads: recompile the scene with \
              `kiln compile --shaft-variants {}` (or choose another technique)",
-            list.join(",")
+            variants_list(variants_needed(wanted))
         ),
     )
 }

@@ -20,7 +20,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use kiln_format::sections::BVH_NODES;
+use kiln_format::linespace::GridHeader;
+use kiln_format::sections::{BVH_NODES, GRID};
 use xxhash_rust::xxh3::Xxh3;
 
 use crate::camera::{Camera, CameraOverride};
@@ -83,6 +84,12 @@ fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Ca
     let offers = Offers {
         bvh: file.find(BVH_NODES, 0).is_some(),
         shadow_maps: !manifest.shadow_maps.is_empty() && !manifest.lights.is_empty(),
+        line_space: file
+            .pod::<GridHeader>(GRID, 0)
+            .ok()
+            .flatten()
+            .and_then(|h| h.first())
+            .map_or(0, |h| h.variants),
     };
     if !offers.bvh {
         return Err(PlayError::new(

@@ -7,6 +7,7 @@ use std::fmt;
 
 use crate::render::technique::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
 use crate::render::{Aa, Effect, Needs, Shadows, Techniques};
+use crate::scene::linespace::{variants_list, variants_needed};
 
 /// What one chart of a sweep shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -81,18 +82,28 @@ pub struct Offers {
     pub bvh: bool,
     /// Shadow maps for at least one light.
     pub shadow_maps: bool,
+    /// The line-space variants in the file (`kiln_format::linespace::Variants`; 0: none).
+    pub line_space: u32,
 }
 
 impl Offers {
     /// Why `techniques` cannot run on this file, if they cannot.
-    pub fn lacks(&self, techniques: &Techniques) -> Option<&'static str> {
+    pub fn lacks(&self, techniques: &Techniques) -> Option<String> {
         let n: Needs = techniques.needs();
+        let variants = variants_needed(n.line_space);
         if n.bvh && !self.bvh {
-            Some("needs the BVH, which the file does not have (compiled without one)")
+            Some("needs the BVH, which the file does not have (compiled without one)".into())
         } else if n.shadow_maps && !self.shadow_maps {
             Some(
-                "needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)",
+                "needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)"
+                    .into(),
             )
+        } else if variants & !self.line_space != 0 {
+            Some(format!(
+                "needs the line space's {}, which the file does not have (compile with --shaft-variants {})",
+                variants_list(variants & !self.line_space),
+                variants_list(variants | self.line_space)
+            ))
         } else {
             None
         }
@@ -285,7 +296,7 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                         let knobs: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
                         t.set(effect, info.name, &knobs).expect("catalogue values are valid");
                         if let Some(reason) = offers.lacks(&t) {
-                            push_skip(&mut skipped, target, info.name, reason);
+                            push_skip(&mut skipped, target, info.name, &reason);
                             continue;
                         }
                         configs.push(Config {
@@ -308,7 +319,7 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                         set(&mut t, Effect::GBuffer, gbuffer.name);
                         apply(&mut t);
                         if let Some(reason) = offers.lacks(&t) {
-                            push_skip(&mut skipped, target, name, reason);
+                            push_skip(&mut skipped, target, name, &reason);
                             continue;
                         }
                         configs.push(Config {
@@ -361,14 +372,16 @@ mod tests {
         }
     }
 
-    const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true };
+    const ALL_OFFERED: Offers =
+        Offers { bvh: true, shadow_maps: true, line_space: kiln_format::linespace::Variants::ALL };
 
     #[test]
     fn every_catalogue_technique_of_an_effect_is_swept() {
         let p = plan(&request(vec![Target::Effect(Effect::Shadows)], &[]), &ALL_OFFERED);
         let names: Vec<&str> = p.configs.iter().map(|c| c.technique.as_str()).collect();
-        // rt's knobs size the lights: held at their defaults, so one rt configuration.
-        assert_eq!(names, ["none", "shadowmap", "rt"]);
+        // rt's knobs size the lights: held at their defaults, so one rt configuration; linespace
+        // has one quality knob of two choices.
+        assert_eq!(names, ["none", "shadowmap", "rt", "linespace", "linespace"]);
         assert_eq!(p.configs[2].checkpoints, [1, 4]);
         assert_eq!(p.configs[1].checkpoints, [1]);
         let r = plan(&request(vec![Target::Effect(Effect::Reflections)], &["reflections:rt"]), &ALL_OFFERED);
@@ -385,7 +398,10 @@ mod tests {
 
     #[test]
     fn missing_sections_skip_with_a_reason() {
-        let p = plan(&request(Target::ALL.to_vec(), &[]), &Offers { bvh: false, shadow_maps: false });
+        let p = plan(
+            &request(Target::ALL.to_vec(), &[]),
+            &Offers { bvh: false, shadow_maps: false, line_space: 0 },
+        );
         assert!(
             p.configs
                 .iter()
@@ -395,6 +411,15 @@ mod tests {
             p.skipped.iter().any(|s| s.effect == "ao" && s.technique == "rt" && s.reason.contains("BVH"))
         );
         assert!(p.skipped.iter().any(|s| s.technique == "shadowmap" && s.reason.contains("shadow maps")));
+        // With the BVH but no line space, the feelers are skipped, naming the variant they need.
+        let offers = Offers { bvh: true, shadow_maps: true, line_space: 0 };
+        let p = plan(&request(vec![Target::Effect(Effect::Shadows)], &[]), &offers);
+        assert!(
+            p.skipped
+                .iter()
+                .any(|s| s.technique == "linespace" && s.reason.contains("--shaft-variants binary"))
+        );
+        assert!(p.configs.iter().all(|c| c.technique != "linespace"));
     }
 
     #[test]

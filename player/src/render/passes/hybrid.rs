@@ -12,6 +12,10 @@ use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::scene::bindings as scene_bindings;
+use crate::scene::linespace::LineSpaceBuffers;
+
+/// The first of the line space's bindings (`LS_BINDING` in the line-space kernels).
+pub const LINE_SPACE_BINDING: u32 = 22;
 
 /// The G-buffer targets the ray-traced passes sample.
 pub const GBUFFER_READS: [TargetDecl; 4] = [TRIANGLE, NORMAL, ALBEDO, MATERIAL];
@@ -28,19 +32,29 @@ pub fn bound() -> Vec<TargetDecl> {
 #[derive(Debug)]
 pub struct HybridSet {
     layout: SetLayout,
+    /// Whether the layout ends with the line space's bindings (at [`LINE_SPACE_BINDING`]).
+    line_space: bool,
     /// The set (allocated by the first [`HybridSet::bind`]).
     pub set: vk::DescriptorSet,
 }
 
 impl HybridSet {
-    /// The layout.
-    pub fn new(gpu: &Gpu) -> PlayResult<HybridSet> {
+    /// The layout; with `line_space`, followed by the line space's bindings.
+    pub fn new(gpu: &Gpu, line_space: bool) -> PlayResult<HybridSet> {
         use BindingKind::*;
         let mut bindings = vec![Binding::one(Uniform)];
         bindings.extend([Binding::one(Storage); 11]);
         bindings.extend([Binding::one(Sampled); 4]);
         bindings.extend([Binding::one(StorageImage); 6]);
-        Ok(HybridSet { layout: SetLayout::new(gpu, &bindings, 1)?, set: vk::DescriptorSet::null() })
+        debug_assert_eq!(bindings.len() as u32, LINE_SPACE_BINDING);
+        if line_space {
+            bindings.extend(LineSpaceBuffers::bindings());
+        }
+        Ok(HybridSet {
+            layout: SetLayout::new(gpu, &bindings, 1)?,
+            line_space,
+            set: vk::DescriptorSet::null(),
+        })
     }
 
     /// A compute pipeline over this layout with the ray-traced passes' push constants.
@@ -79,6 +93,12 @@ impl HybridSet {
         for (i, t) in rt_reflections::TARGETS.iter().enumerate() {
             writes.push(Write::StorageImage(18 + i as u32, img(t)));
         }
+        if self.line_space {
+            let ls = scene.line_space.as_ref().ok_or_else(|| {
+                PlayError::new(Exit::Gpu, "a line-space pass is bound to a scene without its line space")
+            })?;
+            writes.extend(ls.writes(LINE_SPACE_BINDING));
+        }
         self.layout.write(gpu, self.set, &writes);
         Ok(())
     }
@@ -107,7 +127,16 @@ pub struct HybridKernel {
 impl HybridKernel {
     /// The kernel from SPIR-V; on failure nothing is left behind.
     pub fn new(gpu: &Gpu, spirv: &[u8]) -> PlayResult<HybridKernel> {
-        let mut set = HybridSet::new(gpu)?;
+        Self::make(gpu, spirv, false)
+    }
+
+    /// A kernel that also reads the line space.
+    pub fn with_line_space(gpu: &Gpu, spirv: &[u8]) -> PlayResult<HybridKernel> {
+        Self::make(gpu, spirv, true)
+    }
+
+    fn make(gpu: &Gpu, spirv: &[u8], line_space: bool) -> PlayResult<HybridKernel> {
+        let mut set = HybridSet::new(gpu, line_space)?;
         match set.pipeline(gpu, spirv) {
             Ok(pipeline) => Ok(HybridKernel { set, pipeline }),
             Err(e) => {

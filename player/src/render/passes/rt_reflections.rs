@@ -54,7 +54,7 @@ pub struct RtReflectionsPass {
 impl RtReflectionsPass {
     /// Builds the pipelines for `resolution` and a scene of `lights` lights.
     pub fn new(gpu: &Gpu, resolution: ReflectionRes, lights: usize) -> PlayResult<RtReflectionsPass> {
-        let mut set = HybridSet::new(gpu)?;
+        let mut set = HybridSet::new(gpu, false)?;
         let trace = match set.pipeline(gpu, spirv::RT_REFLECTIONS) {
             Ok(p) => p,
             Err(e) => {

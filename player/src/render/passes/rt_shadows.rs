@@ -1,6 +1,7 @@
-//! Ray-traced soft shadows (`shaders/rt/shadows.comp`, seed 001 with its errata fixed): one ray
+//! Ray-traced soft shadows (`shaders/rt/shadows.glsl`, seed 001 with its errata fixed): one ray
 //! per light per pixel per frame towards a point sampled on the light, averaged into one layer
-//! per light.
+//! per light; the rays through the BVH (`shadows.comp`) or the binary line space
+//! (`shadows_linespace*.comp`, seed 004's shadow feelers).
 
 use crate::gpu::vk;
 
@@ -9,6 +10,7 @@ use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc, Use};
 use crate::render::graph::{Access, TargetDecl};
+use crate::render::technique::{LsShadowTest, Shadows};
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
 
 /// Shadow visibility, one layer per light.
@@ -32,9 +34,19 @@ pub struct RtShadowsPass {
 }
 
 impl RtShadowsPass {
-    /// Builds the pipeline for a scene of `lights` lights.
-    pub fn new(gpu: &Gpu, lights: usize) -> PlayResult<RtShadowsPass> {
-        Ok(RtShadowsPass { kernel: HybridKernel::new(gpu, spirv::RT_SHADOWS)?, layers: layers(lights) })
+    /// Builds the pipeline of `technique` (its rays through the BVH or the line space) for a
+    /// scene of `lights` lights.
+    pub fn new(gpu: &Gpu, technique: Shadows, lights: usize) -> PlayResult<RtShadowsPass> {
+        let kernel = match technique {
+            Shadows::LineSpace { test: LsShadowTest::Ends, .. } => {
+                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE)?
+            }
+            Shadows::LineSpace { test: LsShadowTest::Filled, .. } => {
+                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE_EXACT)?
+            }
+            _ => HybridKernel::new(gpu, spirv::RT_SHADOWS)?,
+        };
+        Ok(RtShadowsPass { kernel, layers: layers(lights) })
     }
 }
 
