@@ -1,13 +1,14 @@
 //! The binding table every ray-traced pass of the hybrid pipeline shares
 //! (`shaders/rt/hybrid.glsl`): the frame constants, the scene as the traversal and shading read
-//! it, the G-buffer, and every ray-traced target (those of passes that are off are 1 × 1
-//! placeholders). Each pass has its own set of this layout.
+//! it, the G-buffer, every ray-traced target (those of passes that are off are 1 × 1
+//! placeholders), and the emitter table of next-event estimation. Each pass has its own set of
+//! this layout.
 
 use crate::gpu::vk;
 use kiln_format::gpu::RtConstants;
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
-use super::{FrameCtx, Shared, rt_ao, rt_reflections, rt_shadows};
+use super::{FrameCtx, Shared, rt_ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -21,6 +22,7 @@ pub fn bound() -> Vec<TargetDecl> {
     let mut t = GBUFFER_READS.to_vec();
     t.extend([rt_shadows::SHADOWS, rt_ao::AO]);
     t.extend(rt_reflections::TARGETS);
+    t.push(rt_gi::GI);
     t
 }
 
@@ -40,6 +42,8 @@ impl HybridSet {
         bindings.extend([Binding::one(Storage); 11]);
         bindings.extend([Binding::one(Sampled); 4]);
         bindings.extend([Binding::one(StorageImage); 6]);
+        bindings.extend([Binding::one(Storage); 2]);
+        bindings.push(Binding::one(StorageImage));
         Ok(HybridSet { layout: SetLayout::new(gpu, &bindings, 1)?, set: vk::DescriptorSet::null() })
     }
 
@@ -79,6 +83,11 @@ impl HybridSet {
         for (i, t) in rt_reflections::TARGETS.iter().enumerate() {
             writes.push(Write::StorageImage(18 + i as u32, img(t)));
         }
+        writes.extend([
+            Write::Buffer(22, &r.emitters),
+            Write::Buffer(23, &r.triangle_emitter),
+            Write::StorageImage(24, img(&rt_gi::GI)),
+        ]);
         self.layout.write(gpu, self.set, &writes);
         Ok(())
     }
