@@ -10,7 +10,7 @@ use kiln_format::sections::Vertex;
 use kiln_player::camera::CameraOverride;
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{
-    Ao, GBuffer as GBufferTechnique, Purpose, ReflectionRes, Reflections as ReflectionsTechnique, Shadows,
+    Ao, GBuffer as GBufferTechnique, Gi, Purpose, ReflectionRes, Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::session::SessionOptions;
 
@@ -146,6 +146,12 @@ impl Options {
         };
         self.0.render.techniques.reflections =
             ReflectionsTechnique::Rt { resolution: res, max_roughness: 1.0 };
+        self
+    }
+
+    /// Path-traced diffuse GI counting `bounces` scattering events after the visible surface.
+    pub fn rt_gi(mut self, bounces: u32) -> Options {
+        self.0.render.techniques.gi = Gi::Rt { bounces };
         self
     }
 
