@@ -5,7 +5,7 @@
 //!
 //! The estimator is independent of the ray structure: a kernel defines its hooks (closest hit,
 //! shadow rays) and includes it. [`RtGiPass::new`] takes that kernel's SPIR-V; `--gi rt` gives
-//! it [`spirv::RT_GI`], whose hooks trace the CWBVH.
+//! it [`crate::render::spirv::RT_GI`], whose hooks trace the CWBVH.
 
 use crate::gpu::vk;
 
@@ -14,8 +14,6 @@ use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc, Use};
 use crate::render::graph::{Access, TargetDecl};
-#[cfg(doc)]
-use crate::render::spirv;
 
 /// Mean incoming radiance over the cosine-weighted hemisphere of each pixel's surface (rgb).
 pub const GI: TargetDecl = TargetDecl {
@@ -31,7 +29,7 @@ pub struct RtGiPass(HybridKernel);
 
 impl RtGiPass {
     /// Builds the pipeline of a GI kernel: `spirv` includes `shaders/rt/gi.glsl` with the hooks
-    /// of its ray structure (e.g. [`spirv::RT_GI`]).
+    /// of its ray structure (e.g. [`crate::render::spirv::RT_GI`]).
     pub fn new(gpu: &Gpu, spirv: &[u8]) -> PlayResult<RtGiPass> {
         Ok(RtGiPass(HybridKernel::new(gpu, spirv)?))
     }
