@@ -169,7 +169,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 32 bytes).
+    /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
         /// replaces them).
@@ -187,8 +187,11 @@ gpu_struct! {
         /// Lights whose shadow rays at reflection hits are traced in the separate, lean
         /// reflection-shadow pass (the first ones; any further ones are traced inline).
         pub reflection_lights: u32 => "uint",
-        /// Zero.
-        pub reserved: u32 => "uint",
+        /// GI: scattering events after the primary surface whose light the estimate counts (1:
+        /// what the first surface a ray from the primary surface hits emits and receives directly).
+        pub gi_bounces: u32 => "uint",
+        /// GI: entries of the emitter table (`GpuEmitter`s) its next-event estimation chooses from.
+        pub emitters: u32 => "uint",
     }
 }
 
@@ -265,6 +268,9 @@ impl FrameFlags {
     pub const RT_REFLECTIONS: u32 = 1 << 3;
     /// The reflection image has half the width and height.
     pub const REFLECTIONS_HALF: u32 = 1 << 4;
+    /// Diffuse global illumination from the ray-traced GI image: it replaces the sky's diffuse
+    /// ambient (and the AO that would darken it).
+    pub const RT_GI: u32 = 1 << 5;
 }
 
 /// Shadow maps of each kind (2D and cube) the direct-light pass can bind: the length of its
@@ -339,6 +345,7 @@ pub fn glsl_layout() -> String {
         ("FRAME_RT_AO", FrameFlags::RT_AO),
         ("FRAME_RT_REFLECTIONS", FrameFlags::RT_REFLECTIONS),
         ("FRAME_REFLECTIONS_HALF", FrameFlags::REFLECTIONS_HALF),
+        ("FRAME_RT_GI", FrameFlags::RT_GI),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),

@@ -169,9 +169,13 @@ pub struct Args {
     /// Do not average the ray-traced passes over frames (every frame shows one sample).
     #[arg(long)]
     pub no_accumulate: bool,
-    /// Global illumination technique (later passes add techniques).
+    /// Global illumination technique.
     #[arg(long, value_parser = techniques(Effect::Gi), default_value = "none")]
     pub gi: String,
+    /// With --gi rt: bounces of indirect light after the visible surface, 1 to 8 (1: the sky,
+    /// emissive surfaces and the light the first surface hit receives directly).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub gi_bounces: u32,
     /// Participating media technique (later passes add techniques).
     #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
     pub media: String,
@@ -197,6 +201,7 @@ impl Args {
             "ao-reach" => Some(KnobValue::Number(self.ao_reach)),
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
+            "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
             _ => None,
         }
     }
@@ -372,7 +377,7 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{Ao, GBuffer, ReflectionRes, Reflections, Shadows};
+    use crate::render::{Ao, GBuffer, Gi, ReflectionRes, Reflections, Shadows};
 
     fn parse(args: &[&str]) -> Result<Args, clap::Error> {
         Args::try_parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))
@@ -404,13 +409,20 @@ mod tests {
             "half",
             "--reflection-max-roughness",
             "0.4",
+            "--gi",
+            "rt",
+            "--gi-bounces",
+            "2",
             "--no-accumulate",
         ]);
         assert_eq!(t.gbuffer, GBuffer::Visibility);
         assert_eq!(t.shadows, Shadows::Rt { light_radius: 1.0, sun_degrees: 0.53 });
         assert_eq!(t.ao, Ao::Rt { radius: Some(0.5), reach: 0.1 });
         assert_eq!(t.reflections, Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 });
+        assert_eq!(t.gi, Gi::Rt { bounces: 2 });
         assert_eq!(t.aa, Aa::None);
+        let e = parse(&["f.kiln", "--gi", "rt", "--gi-bounces", "9"]).unwrap().techniques().unwrap_err();
+        assert!(e.to_string().contains("gi-bounces"), "{e}");
         let d = techniques(&["f.kiln"]);
         assert_eq!(d, Techniques::default());
         assert_eq!(d.shadows, Shadows::ShadowMap);

@@ -91,8 +91,9 @@ struct RtConstants {
     uint shadow_lights; // offset 16
     uint reflection_step; // offset 20
     uint reflection_lights; // offset 24
-    uint reserved; // offset 28
-}; // 32 bytes
+    uint gi_bounces; // offset 28
+    uint emitters; // offset 32
+}; // 36 bytes
 
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
@@ -106,6 +107,7 @@ const uint FRAME_RT_SHADOWS = 2u;
 const uint FRAME_RT_AO = 4u;
 const uint FRAME_RT_REFLECTIONS = 8u;
 const uint FRAME_REFLECTIONS_HALF = 16u;
+const uint FRAME_RT_GI = 32u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;

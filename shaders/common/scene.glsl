@@ -43,11 +43,13 @@ struct Surface {
     bool front;     // the ray hit the triangle's front (counter-clockwise) face
     Material mat;
     vec3 emission;  // emitted radiance towards the ray (zero from a back face of a one-sided material)
+    uint triangle;  // the triangle hit (leaf order)
 };
 
 Surface surface_at(TraceRay r, TraceHit h) {
     Surface s;
     uint tri = h.triangle;
+    s.triangle = tri;
     vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
     float w0 = 1.0 - h.u - h.v;
     s.p = w0 * p0 + h.u * p1 + h.v * p2;
@@ -195,11 +197,14 @@ vec3 sample_vndf(vec3 v, float a, vec2 xi) {
     return normalize(vec3(a * nh.x, a * nh.y, max(nh.z, 0.0)));
 }
 
-vec3 sample_brdf(Surface s, vec3 wo) {
+// A direction sampled with density `brdf_pdf`; `specular`: it came from the GGX lobe (rather
+// than the cosine-weighted diffuse one).
+vec3 sample_brdf_lobe(Surface s, vec3 wo, out bool specular) {
     mat3 f = basis(s.ns);
     float ps = specular_probability(s, wo);
     vec2 xi = vec2(rnd(), rnd());
-    if (rnd() < ps) {
+    specular = rnd() < ps;
+    if (specular) {
         vec3 v = transpose(f) * wo;
         vec3 h = f * sample_vndf(v, ggx_alpha(s.mat.roughness), xi);
         return reflect(-wo, h);
@@ -207,6 +212,11 @@ vec3 sample_brdf(Surface s, vec3 wo) {
     float r = sqrt(xi.x);
     float phi = 2.0 * PI * xi.y;
     return f * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - xi.x)));
+}
+
+vec3 sample_brdf(Surface s, vec3 wo) {
+    bool specular;
+    return sample_brdf_lobe(s, wo, specular);
 }
 
 // Whether something blocks the segment from `o`, a ray origin already offset off its surface,

@@ -2,8 +2,9 @@
 #extension GL_EXT_control_flow_attributes : require
 // Direct light and composition: every analytic light over the G-buffer, shadowed by the baked
 // shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, plus the constant sky
-// through the split-sum table (its diffuse part times the ray-traced AO; its specular part
-// replaced by the ray-traced reflections where they were traced) and emission.
+// through the split-sum table (its diffuse part times the ray-traced AO, or replaced by the
+// ray-traced GI; its specular part replaced by the ray-traced reflections where they were
+// traced) and emission.
 // Output: linear scene radiance (before exposure and tone mapping).
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
@@ -31,6 +32,7 @@ layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D radiance_out;
 layout(set = 0, binding = 12, r32f) uniform readonly image2DArray rt_shadows;
 layout(set = 0, binding = 13, r32f) uniform readonly image2D rt_ao;
 layout(set = 0, binding = 14, rgba32f) uniform readonly image2D rt_reflections;
+layout(set = 0, binding = 15, rgba32f) uniform readonly image2D rt_gi;
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -230,14 +232,19 @@ void main() {
         traced = reflection_at(pixel, p, n);
     }
     // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.
+    // With GI the diffuse part is the diffuse weight times the traced mean incoming radiance,
+    // which holds the sky (its misses), the emissive surfaces and the indirect light, occluded
+    // by the scene itself: no AO or occlusion texture multiplies it.
+    bool gi = (frame.size.w & FRAME_RT_GI) != 0u;
+    vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : frame.sky.rgb * occlusion;
     if (m.diffuse_only) {
-        radiance += m.base * frame.sky.rgb * occlusion;
+        radiance += m.base * diffuse_in;
     } else {
         vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.roughness)).rg : vec2(1.0, 0.0);
         vec3 f0 = fresnel_f0(m.base, m.metallic);
         vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
         vec3 diffuse = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - m.metallic) * m.base;
-        radiance += diffuse * frame.sky.rgb * occlusion;
+        radiance += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
         vec3 split_sum = (f0 * rg.r + rg.g) * frame.sky.rgb * occlusion;

@@ -1,4 +1,4 @@
-// What the hybrid ray-traced passes share (seed 001's shadows, AO and reflections over the
+// What the hybrid ray-traced passes share (seed 001's shadows, AO and reflections, and GI, over the
 // G-buffer, with kiln's compute traversal instead of a ray-tracing pipeline): one descriptor set,
 // the exact surface point under a pixel, and progressive accumulation.
 //
@@ -34,6 +34,12 @@ layout(set = 0, binding = 18, rgba32f) uniform image2D rt_reflections;  // rgb, 
 layout(set = 0, binding = 19, rgba32f) uniform image2D refl_partial;
 layout(set = 0, binding = 20, rgba32f) uniform image2D refl_origin;
 layout(set = 0, binding = 21, rgba32f) uniform image2DArray refl_lights;
+// The emitter table of next-event estimation (`common/emitters.glsl`; `rt.emitters` entries) and
+// each triangle's entry in it, and the GI target: mean incoming radiance over the cosine-weighted
+// hemisphere (irradiance / π), rgb.
+layout(set = 0, binding = 22, std430) readonly buffer Emitters { GpuEmitter emitters[]; };
+layout(set = 0, binding = 23, std430) readonly buffer TriEmitters { int tri_emitter[]; };
+layout(set = 0, binding = 24, rgba32f) uniform image2D rt_gi;
 layout(push_constant) uniform Params { RtConstants rt; };
 
 #include "../common/random.glsl"

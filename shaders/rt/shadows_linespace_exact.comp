@@ -3,7 +3,7 @@
 // rays through the binary line space with exact triangle tests in every cell whose shaft is
 // filled: the exact answer, the bits only skipping empty shafts.
 #include "hybrid.glsl"
-#define LS_BINDING 22
+#define LS_BINDING 25
 #include "../common/linespace.glsl"
 
 bool shadow_feeler(vec3 o, vec3 dir, float tmax) {

@@ -11,6 +11,7 @@ mod harness;
 // The tests, by topic.
 mod analytic; // one light on a diffuse plane against its closed form, per pixel
 mod files; // damaged files fail with the right exit code; minimal files render
+mod gi; // path-traced GI plus direct light against the two-bounce reference
 mod raytraced; // ray-traced AO and reflections against closed forms, accumulation
 mod rect; // a rect light against the polygon irradiance: direct pass, RT shadows, reference
 mod reference; // the reference path tracer's GGX in a white furnace

@@ -10,7 +10,7 @@ use kiln_format::sections::Vertex;
 use kiln_player::camera::CameraOverride;
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{
-    Ao, GBuffer as GBufferTechnique, LsShadowTest, Purpose, ReflectionRes,
+    Ao, GBuffer as GBufferTechnique, Gi, LsShadowTest, Purpose, ReflectionRes,
     Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::session::SessionOptions;
@@ -155,6 +155,12 @@ impl Options {
         };
         self.0.render.techniques.reflections =
             ReflectionsTechnique::Rt { resolution: res, max_roughness: 1.0 };
+        self
+    }
+
+    /// Path-traced diffuse GI counting `bounces` scattering events after the visible surface.
+    pub fn rt_gi(mut self, bounces: u32) -> Options {
+        self.0.render.techniques.gi = Gi::Rt { bounces };
         self
     }
 

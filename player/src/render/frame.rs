@@ -2,7 +2,7 @@
 //! images they make and bind.
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
-//! reflections (each when chosen) → direct light and composition → tone mapping.
+//! reflections, GI (each when chosen) → direct light and composition → tone mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
@@ -10,11 +10,13 @@ use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
 use super::passes::resolve::ResolvePass;
 use super::passes::rt_ao::RtAoPass;
+use super::passes::rt_gi::RtGiPass;
 use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::visibility::VisibilityPass;
-use super::technique::{Ao, GBuffer, Reflections, Techniques};
+use super::spirv;
+use super::technique::{Ao, GBuffer, Gi, Reflections, Techniques};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc};
 
@@ -46,6 +48,9 @@ fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<B
         }
         if let Reflections::Rt { resolution, .. } = techniques.reflections {
             made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights)?));
+        }
+        if let Gi::Rt { .. } = techniques.gi {
+            made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI)?));
         }
         made.push(Box::new(DirectPass::new(gpu)?));
         made.push(Box::new(TonemapPass::new(gpu)?));

@@ -165,6 +165,11 @@ impl Renderer {
             shadow_lights: shadow_layers.min(plan.lights_used),
             reflection_step,
             reflection_lights,
+            gi_bounces: match t.gi {
+                Gi::Rt { bounces } => bounces,
+                Gi::None => 0,
+            },
+            emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count),
             ..Default::default()
         };
         let mut flags = if plan.shadows_bound && !rt_shadows { FrameFlags::SHADOW_MAPS } else { 0 };
@@ -173,6 +178,9 @@ impl Renderer {
         }
         if matches!(t.ao, Ao::Rt { .. }) {
             flags |= FrameFlags::RT_AO;
+        }
+        if matches!(t.gi, Gi::Rt { .. }) {
+            flags |= FrameFlags::RT_GI;
         }
         match t.reflections {
             Reflections::Rt { resolution: ReflectionRes::Full, .. } => flags |= FrameFlags::RT_REFLECTIONS,

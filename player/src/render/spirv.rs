@@ -47,6 +47,8 @@ shaders! {
     RT_AO = "rt" / "ao.comp";
     /// Ray-traced glossy reflections.
     RT_REFLECTIONS = "rt" / "reflections.comp";
+    /// Diffuse global illumination, its rays through the CWBVH.
+    RT_GI = "rt" / "gi.comp";
     /// Shadow rays at the reflection hits.
     RT_REFLECTION_SHADOWS = "rt" / "reflection_shadows.comp";
     /// Ray generation of the driver-pipeline peer: one ray of the buffer per launch index.

@@ -111,12 +111,19 @@ pub enum Reflections {
     },
 }
 
-/// Indirect diffuse light (techniques come with later passes).
+/// Indirect diffuse light: what replaces the sky's diffuse ambient.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Gi {
-    /// None.
+    /// None: the constant sky, darkened by AO where it runs.
     #[default]
     None,
+    /// Path traced from the G-buffer through the CWBVH: one cosine-weighted path per pixel per
+    /// frame, next-event estimation at its hits (`shaders/rt/gi.glsl`).
+    Rt {
+        /// Scattering events after the primary surface whose light counts (1: the sky, and
+        /// what the first surface hit emits and receives directly), 1..=8.
+        bounces: u32,
+    },
 }
 
 /// Participating media (techniques come with later passes).
@@ -234,6 +241,7 @@ impl Techniques {
             Shadows::None => {}
         }
         if self.ray_traced() {
+            // Surfaces at hits, and for GI the emitter table (made with the scene buffers).
             n = n.union(Needs::TRACED_SURFACES);
         }
         n
@@ -244,6 +252,7 @@ impl Techniques {
         self.shadows.traced().is_some()
             || matches!(self.ao, Ao::Rt { .. })
             || matches!(self.reflections, Reflections::Rt { .. })
+            || matches!(self.gi, Gi::Rt { .. })
     }
 
     /// Every ray-traced technique replaced by its effect's default or off (what the frame
@@ -253,6 +262,7 @@ impl Techniques {
             shadows: if self.shadows.traced().is_some() { Shadows::None } else { self.shadows },
             ao: Ao::None,
             reflections: Reflections::None,
+            gi: Gi::None,
             ..self
         }
     }
@@ -317,6 +327,13 @@ impl Techniques {
                 }
             }
             (Effect::Gi, "none") => self.gi = Gi::None,
+            (Effect::Gi, "rt") => {
+                let bounces = v(0).number();
+                if bounces.fract() != 0.0 {
+                    return Err(format!("{effect} {name}: gi-bounces must be a whole number, not {bounces}"));
+                }
+                self.gi = Gi::Rt { bounces: bounces as u32 };
+            }
             (Effect::Media, "none") => self.media = Media::None,
             (Effect::Aa, "none") => self.aa = Aa::None,
             (Effect::Aa, "accumulate") => self.aa = Aa::Accumulate,
@@ -346,7 +363,10 @@ impl Techniques {
                 Reflections::None => "none",
                 Reflections::Rt { .. } => "rt",
             },
-            Effect::Gi => "none",
+            Effect::Gi => match self.gi {
+                Gi::None => "none",
+                Gi::Rt { .. } => "rt",
+            },
             Effect::Media => "none",
             Effect::Aa => match self.aa {
                 Aa::None => "none",
@@ -548,7 +568,7 @@ const SUN_ANGLE: Knob = light_size(number(
     &[0.0, 0.53, 2.0],
 ));
 
-static CATALOGUE: [TechniqueInfo; 14] = [
+static CATALOGUE: [TechniqueInfo; 15] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -672,9 +692,27 @@ static CATALOGUE: [TechniqueInfo; 14] = [
     TechniqueInfo {
         effect: Effect::Gi,
         name: "none",
-        help: "no indirect diffuse light",
+        help: "no indirect diffuse light: the sky lights every surface unoccluded (times AO where it runs)",
         knobs: &[],
         stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Gi,
+        name: "rt",
+        help: "path-traced diffuse GI from the G-buffer through the BVH: one cosine-weighted path per \
+               pixel per frame, next-event estimation to lights and emissive surfaces at its hits, \
+               averaged while the camera is still; replaces the sky's diffuse ambient and its AO \
+               (see --gi-bounces)",
+        knobs: &[number(
+            "gi-bounces",
+            "bounces of indirect light after the visible surface (1: the sky, emissive surfaces and \
+             the light the first surface hit receives directly; each more adds one bounce)",
+            1.0,
+            8.0,
+            1.0,
+            &[1.0, 2.0],
+        )],
+        stochastic: true,
     },
     TechniqueInfo {
         effect: Effect::Media,
@@ -749,5 +787,28 @@ mod tests {
         assert!(rt.needs().bvh && rt.needs().scene_buffers && !rt.needs().shadow_maps);
         let vis = Techniques { gbuffer: GBuffer::Visibility, ..d };
         assert!(vis.needs().scene_buffers && !vis.needs().bvh);
+        let gi = Techniques { gi: Gi::Rt { bounces: 1 }, ..d };
+        assert!(gi.ray_traced() && gi.needs().bvh && gi.needs().scene_buffers);
+        assert_eq!(gi.without_rays().gi, Gi::None);
+    }
+
+    #[test]
+    fn the_catalogue_builds_gi_rt_with_its_bounces() {
+        let mut t = Techniques::default();
+        t.set(Effect::Gi, "rt", &[]).unwrap();
+        assert_eq!(t.gi, Gi::Rt { bounces: 1 });
+        assert_eq!(t.name_of(Effect::Gi), "rt");
+        t.set(Effect::Gi, "rt", &[("gi-bounces", KnobValue::Number(3.0))]).unwrap();
+        assert_eq!(t.gi, Gi::Rt { bounces: 3 });
+        for bad in [0.0, 9.0, 1.5] {
+            let e = t.set(Effect::Gi, "rt", &[("gi-bounces", KnobValue::Number(bad))]).unwrap_err();
+            assert!(e.contains("gi-bounces"), "{e}");
+        }
+        let info = techniques_of(Effect::Gi).find(|i| i.name == "rt").unwrap();
+        assert!(info.stochastic);
+        assert_eq!(info.knobs[0].role, KnobRole::Quality);
+        assert_eq!(info.knobs[0].range, KnobRange::Number { min: 1.0, max: 8.0, sweep: &[1.0, 2.0] });
+        t.set(Effect::Gi, "none", &[]).unwrap();
+        assert_eq!(t.gi, Gi::None);
     }
 }

@@ -1,14 +1,14 @@
 //! Direct light and composition (`shaders/lighting/direct.comp`): every analytic light over the
 //! G-buffer (Lambert or Cook–Torrance GGX, multiple-scattering compensation from the baked
 //! table), shadowed by the baked shadow maps (PCF; PCSS for rect lights) or by the ray-traced
-//! layers, the constant sky through the split-sum table, ray-traced AO and reflections
+//! layers, the constant sky through the split-sum table, ray-traced AO, reflections and GI
 //! composited where they ran; writes linear radiance.
 
 use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, rt_ao, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared, rt_ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -27,8 +27,8 @@ pub const RADIANCE: TargetDecl = TargetDecl {
 /// The G-buffer targets it samples, in binding order (6–10).
 const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
 
-/// The ray-traced results it composites, in binding order (12–14).
-const RAY_TRACED: [TargetDecl; 3] = [rt_shadows::SHADOWS, rt_ao::AO, rt_reflections::REFLECTIONS];
+/// The ray-traced results it composites, in binding order (12–15).
+const RAY_TRACED: [TargetDecl; 4] = [rt_shadows::SHADOWS, rt_ao::AO, rt_reflections::REFLECTIONS, rt_gi::GI];
 
 /// The direct-light pass.
 #[derive(Debug)]
@@ -42,7 +42,7 @@ impl DirectPass {
         let mut bindings = vec![Binding::one(Uniform), Binding::one(Storage), Binding::one(Storage)];
         bindings.extend([Binding::one(Sampled), maps, maps]);
         bindings.extend([Binding::one(Sampled); 5]);
-        bindings.extend([Binding::one(StorageImage); 4]);
+        bindings.extend([Binding::one(StorageImage); 5]);
         Ok(DirectPass(Kernel::new(gpu, &bindings, spirv::DIRECT, 0)?))
     }
 }

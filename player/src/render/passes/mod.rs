@@ -15,6 +15,7 @@ pub mod materials;
 pub mod pathtrace;
 pub mod resolve;
 pub mod rt_ao;
+pub mod rt_gi;
 pub mod rt_reflections;
 pub mod rt_shadows;
 pub mod tonemap;

@@ -1,0 +1,146 @@
+// Diffuse global illumination by path tracing from the G-buffer: the estimator, independent of
+// the ray structure that answers its rays.
+//
+// Per pixel and frame, one cosine-weighted direction around the primary surface's shading normal
+// (below its geometric surface: zero) and the radiance L arriving along it: a one-sample
+// estimate of the mean incoming radiance over the cosine-weighted hemisphere, irradiance / π,
+// which the composition multiplies by the diffuse weight (Lambert: the base colour) in place of
+// the sky's diffuse ambient. Averaged over frames while the camera is still.
+//
+// What counts, so that the frame counts every light path exactly once: the direct pass covers
+// the analytic lights (point, spot, directional, rect) at the primary surface, and this pass
+// replaces its diffuse sky ambient. So along the first ray:
+//  - the sky on a miss counts (it is no longer in the direct pass; the sky is no emitter of the
+//    table, no next-event estimation reaches it);
+//  - an emissive triangle it hits counts with weight 1: the direct pass does not sample emissive
+//    triangles, so BRDF (cosine) sampling is the only strategy for them at the primary surface
+//    and there is nothing to weigh it against;
+//  - a rect light it crosses does not count: the direct pass integrates rect lights.
+// At each hit, next-event estimation towards one emitter of the table (analytic lights and
+// emissive triangles, the path tracer's `sample_emitter`). At the last hit (`rt.gi_bounces`
+// scattering events after the primary surface) it is unweighted: no continuation follows that
+// could reach the emitters; the sky, which is no emitter of the table, comes from one
+// BRDF-sampled shadow ray that escapes (`sky_seen`). Before the last hit next-event estimation
+// is weighted with the power heuristic and the path continues with a BRDF sample, whose ray
+// counts the emissive triangles it hits and the rect lights it crosses with the complementary
+// weights (as the path tracer does) and the sky on a miss. Delta lights count by next-event
+// estimation alone. No Russian roulette (at most 8 bounces).
+//
+// The includer includes hybrid.glsl (the descriptor set: emitter table, `rt_gi`) and defines
+// before including this file the ray structure's answers:
+//   bool gi_hit(TraceRay r, vec3 origin_ng, bool exact, out Surface s)
+//       the closest surface along r (r.origin already offset off the surface of geometric normal
+//       `origin_ng` it leaves, r.direction unit length): true and the surface, or false on a
+//       miss. `exact` is true for continuations sampled from a specular lobe, where an
+//       approximate answer would show; false for diffuse ones.
+//   bool gi_occluded(vec3 from, vec3 ng, vec3 to)
+//       whether the segment from `from` (on a surface of geometric normal `ng`, not offset) to
+//       `to` is blocked: next-event shadow rays towards points on emitters.
+//   bool gi_occluded_dir(vec3 from, vec3 ng, vec3 dir)
+//       the same for the unbounded ray along `dir` (directional lights).
+// `gi_main()` is the kernel's body.
+#ifndef KILN_GI_GLSL
+#define KILN_GI_GLSL
+
+uint emitter_count() {
+    return rt.emitters;
+}
+
+bool emitter_occluded(vec3 from, vec3 ng, vec3 to) {
+    return gi_occluded(from, ng, to);
+}
+
+bool emitter_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
+    return gi_occluded_dir(from, ng, dir);
+}
+
+#include "../common/emitters.glsl"
+
+// The sky reflected at the last hit s towards wo: no emitter of the table, so one BRDF-sampled
+// shadow ray that escapes brings it (rect lights it crosses do not count: the unweighted
+// next-event estimation has them).
+vec3 sky_seen(Surface s, vec3 wo) {
+    if (all(equal(frame.sky.rgb, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    vec3 wi = sample_brdf(s, wo);
+    float pdf = brdf_pdf(s, wo, wi);
+    if (pdf <= 0.0 || gi_occluded_dir(s.p, s.ng, wi)) {
+        return vec3(0.0);
+    }
+    return brdf_cos(s, wo, wi) / pdf * frame.sky.rgb;
+}
+
+// One sample of the radiance arriving at the primary surface s along a cosine-weighted
+// direction (the mean over samples is irradiance / π).
+vec3 gi_sample(Primary s) {
+    float r2 = rnd();
+    float phi = 2.0 * PI * rnd();
+    float r1 = sqrt(r2);
+    vec3 dir = basis(s.n) * vec3(r1 * cos(phi), r1 * sin(phi), sqrt(max(0.0, 1.0 - r2)));
+    if (dot(dir, s.ng) <= 0.0) {
+        return vec3(0.0);
+    }
+    TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), dir, 0.0, 3.4e38);
+    vec3 origin_ng = s.ng;
+    bool exact = false;
+    vec3 result = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    float pdf_brdf = 0.0;  // density of the BRDF sample that made r; 0 for the first ray
+    for (uint bounce = 1u;; bounce++) {
+        Surface h;
+        bool hit = gi_hit(r, origin_ng, exact, h);
+        if (bounce > 1u) {
+            float tmax = hit ? length(h.p - r.origin) : 3.4e38;
+            result += throughput * rect_lights_seen(r.origin, r.direction, tmax, pdf_brdf);
+        }
+        if (!hit) {
+            result += throughput * frame.sky.rgb;
+            break;
+        }
+        if (any(greaterThan(h.emission, vec3(0.0)))) {
+            float d = length(h.p - r.origin);
+            float cos_l = abs(dot(h.ng, r.direction));
+            result += throughput * h.emission * triangle_emission_weight(h.triangle, d, cos_l, pdf_brdf);
+        }
+        vec3 wo = -r.direction;
+        bool last = bounce >= rt.gi_bounces;
+        result += throughput * sample_emitter(h, wo, !last);
+        if (last) {
+            result += throughput * sky_seen(h, wo);
+            break;
+        }
+        vec3 wi = sample_brdf_lobe(h, wo, exact);
+        pdf_brdf = brdf_pdf(h, wo, wi);
+        if (pdf_brdf <= 0.0) {
+            break;
+        }
+        throughput *= brdf_cos(h, wo, wi) / pdf_brdf;
+        if (all(equal(throughput, vec3(0.0)))) {
+            break;
+        }
+        r = make_ray(offset_ray_origin(h.p, h.ng), wi, 0.0, 3.4e38);
+        origin_ng = h.ng;
+    }
+    return result;
+}
+
+void gi_main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(uvec2(pixel), frame.size.xy))) {
+        return;
+    }
+    Primary s;
+    vec3 l = vec3(0.0);
+    if (primary_at(pixel, s)) {
+        seed_rng(pixel, 5u);
+        l = gi_sample(s);
+        // A non-finite sample would poison the average; it is dropped (counted as zero).
+        if (any(isnan(l)) || any(isinf(l))) {
+            l = vec3(0.0);
+        }
+    }
+    imageStore(rt_gi, pixel, accumulate(imageLoad(rt_gi, pixel), vec4(l, 1.0)));
+}
+
+#endif
