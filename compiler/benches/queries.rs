@@ -19,7 +19,7 @@ use kiln_format::{Checksums, KilnFile, SceneView};
 fn compile(scene: Scene, res: u32, n: u32) -> Vec<u8> {
     let settings = Settings {
         voxel_res: VoxelRes::Cells(res),
-        shaft_res: n,
+        shaft_res: Some(n),
         shaft_variants: Some(Variants::ALL),
         ..Default::default()
     };
