@@ -17,8 +17,10 @@
 //! never skips a fitting resolution of such a scene), at least one cell.
 //!
 //! **Variants**, when the plan chooses them: at the requested resolutions, all three, else binary
-//! + PNMT (candidates go first: their entries grow with the triangles per cell, so coarser cells
-//!   barely shrink them); if neither fits, binary + PNMT at lower resolutions, then binary alone.
+//! + PNMT; if neither fits, binary + PNMT at lower resolutions, then binary alone. Candidates go
+//!   first because coarser cells shrink them least (their entries per filled shaft grow with the
+//!   triangles per cell: on the teapot-count box at N = 5, 32³ → 8³ shrinks PNMT 17×, candidates
+//!   7×, `benches/linespace.rs` rows 3 and 4), and the plan dropped them first before budgets.
 //!
 //! Explicit `--voxel-res` and `--shaft-res` are not searched: with both given, a budget they
 //! exceed is a usage error naming them.
@@ -208,7 +210,7 @@ pub fn choose(geometry: &SceneGeometry, req: Request) -> Result<Choice, String> 
             "; candidates skipped: a cell holds {} triangles, over the {MAX_CANDIDATE_CELL_TRIANGLES} they address",
             start.max_cell_triangles
         ),
-        (None, true) => "; candidates skipped (their size barely shrinks with coarser cells)".into(),
+        (None, true) => "; candidates skipped first (coarser cells shrink them least)".into(),
         (None, false) => "; PNMT and candidates skipped: binary + PNMT fits at no resolution".into(),
     };
     let mut smallest = start;

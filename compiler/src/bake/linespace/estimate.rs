@@ -8,8 +8,14 @@ use rayon::prelude::*;
 use super::shafts::{self, HitAttributes};
 use super::voxelize::Voxels;
 
-/// Cells baked per estimate (all of them when fewer), at about 256 / slots of the bake's time.
+/// Most cells baked per estimate.
 pub const SAMPLE_CELLS: usize = 256;
+
+/// Cell–triangle pairs the sample may bake whatever the scene's size: below this many in all, every
+/// cell is baked (the estimate is then exact); above, the sample takes an eighth of them, so that
+/// an estimate costs at most about an eighth of the bake even on coarse grids of heavy cells (the
+/// bunny count at 8³: 383 cells, a 39 s PNMT bake on two threads; baking 192 of them took 12 s).
+pub const SAMPLE_PAIRS: usize = 16_384;
 
 /// Standard errors added to the sample's mean: the estimate is an upper bound at about 97.5%
 /// confidence, so that a configuration chosen to fit a budget fits once baked (the per-cell
@@ -67,7 +73,8 @@ impl HitAttributes for NoAttributes {
     }
 }
 
-/// Bakes up to `max_cells` non-empty cells of `voxels`, evenly spaced in cell order, at shaft
+/// Bakes up to `max_cells` non-empty cells of `voxels` (holding about [`SAMPLE_PAIRS`] or an
+/// eighth of the cell–triangle pairs, whichever is more), evenly spaced in cell order, at shaft
 /// resolution `n`, and counts their filled shafts and candidate entries. Deterministic.
 pub fn sample(voxels: &Voxels, n: u32, max_cells: usize) -> FillSample {
     let h = &voxels.header;
@@ -77,7 +84,9 @@ pub fn sample(voxels: &Voxels, n: u32, max_cells: usize) -> FillSample {
     if occupied.is_empty() || max_cells == 0 {
         return FillSample { occupied: occupied.len() as u64, cells: Vec::new() };
     }
-    let step = occupied.len().div_ceil(max_cells);
+    let pairs = voxels.triangles.len();
+    let target = (pairs / 8).max(SAMPLE_PAIRS);
+    let step = occupied.len().div_ceil(max_cells).max(pairs.div_ceil(target));
     let picked: Vec<usize> = occupied.iter().copied().step_by(step).collect();
     let margin_local = h.margin / h.cell;
     let cells: Vec<(u64, u64)> = picked
