@@ -164,7 +164,7 @@ impl Plan {
             VoxelRes::Cells(n) => n,
         };
         // When line space pays: whenever rays are traced through the scene, that is, whenever
-        // something emits light. Even on the 36-triangle Cornell box (N = 4, 8^3 cells) the
+        // something emits light. Even on the 32-triangle Cornell box (N = 4, 8^3 cells) the
         // binary variant's any-hit query ran 1.34x the BVH's any hit (5.0 vs 3.7 Mrays/s, one
         // thread, `cargo bench --bench queries`), and its line space is small (under 8 MiB at
         // auto resolution), so no triangle minimum would save anything worth a missing variant.

@@ -223,10 +223,11 @@ pub struct PlanArgs {
 /// A built-in scene of `kiln demo`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum DemoScene {
-    /// The demo Cornell box: five walls, two blocks, a warm ceiling light, 34 triangles.
+    /// The demo Cornell box: five walls, two blocks, a warm ceiling light, 30 triangles.
     #[default]
     Demo,
-    /// Seed 004's scene 4: the 36-triangle Cornell box (walls, two blocks, light quad).
+    /// Seed 004's scene 4: the Cornell box with two blocks and a light quad (32 triangles here:
+    /// the blocks have no bottoms; the thesis's box has 36).
     Cornell,
     /// The 12-triangle box around a 15,704-triangle object (the Utah teapot's count).
     BoxTeapot,
