@@ -1,12 +1,14 @@
 //! Voxel grid and line-space bake time and memory for the configurations of seed 004's Table 1,
-//! with PNMT and with candidates, against the thesis's GTX 1080 times; and query throughput of
-//! every variant against BVH closest hit on the same rays.
+//! with PNMT and with candidates, against the thesis's GTX 1080 times; and the plan's size
+//! estimate (`analyze::budget`: central, and the two-standard-error bound the budget uses)
+//! against the baked bytes of the grid and each variant.
 //!
 //! `cargo bench -p kiln-compiler --bench linespace [-- ROWS]` (ROWS: comma-separated row numbers,
 //! default all; KILN_BENCH_RUNS: runs per row, default 3).
 
 use std::time::Instant;
 
+use kiln_compiler::analyze::budget::Estimate;
 use kiln_compiler::bake::linespace::{self, SceneAttributes};
 use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
 use kiln_compiler::ir::Scene;
@@ -39,6 +41,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn mib(b: u64) -> f64 {
     b as f64 / (1024.0 * 1024.0)
+}
+
+/// Signed error of `estimate` against `actual`, percent.
+fn pct(estimate: u64, actual: u64) -> f64 {
+    100.0 * (estimate as f64 / actual as f64 - 1.0)
 }
 
 fn attrs_of(scene: &Scene) -> SceneAttributes<'_> {
@@ -130,6 +137,26 @@ fn main() {
                     + lc.slots.len()) as u64),
         );
         let _ = row.thesis_voxel_ms;
+        let t = Instant::now();
+        let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);
+        let central = Estimate::with_errors(&geometry, row.res, row.n, 0.0);
+        let bound = Estimate::new(&geometry, row.res, row.n);
+        let estimate_ms = t.elapsed().as_secs_f64() * 1e3 / 2.0;
+        let grid = 96 + 4 * (ls.voxel_offsets.len() + ls.voxel_triangles.len()) as u64;
+        let binary = 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len()) as u64;
+        let with_pnmt = grid + binary + 16 * ls.pnmt.len() as u64;
+        let with_cand = grid + binary + 4 * (lc.candidates.len() + lc.candidate_offsets.len()) as u64;
+        let pn = Variants::BINARY | Variants::PNMT;
+        let bc = Variants::BINARY | Variants::CANDIDATES;
+        println!(
+            "      estimate ({estimate_ms:.0} ms): grid+binary+PNMT {:.1} MiB central {:+.1}%, bound {:+.1}%; grid+binary+candidates {:.1} MiB central {:+.1}%, bound {:+.1}%",
+            mib(with_pnmt),
+            pct(central.bytes.total(pn), with_pnmt),
+            pct(bound.bytes.total(pn), with_pnmt),
+            mib(with_cand),
+            pct(central.bytes.total(bc), with_cand),
+            pct(bound.bytes.total(bc), with_cand),
+        );
         println!(
             "      tests {} ({:.2} per candidate entry), filled {} ({:.1}%), false fills {:.3}% (of 20,000 sampled), entries {}, PNMT records missing {}",
             lc.tests,

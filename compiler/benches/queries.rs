@@ -19,7 +19,7 @@ use kiln_format::{Checksums, KilnFile, SceneView};
 fn compile(scene: Scene, res: u32, n: u32) -> Vec<u8> {
     let settings = Settings {
         voxel_res: VoxelRes::Cells(res),
-        shaft_res: n,
+        shaft_res: Some(n),
         shaft_variants: Some(Variants::ALL),
         ..Default::default()
     };
@@ -62,7 +62,7 @@ fn rate(label: &str, rays: &[(Ray, Option<Vec3>)], mut f: impl FnMut(&Ray, Optio
 
 fn main() {
     let mut scenes: Vec<(String, Scene, u32)> = vec![
-        ("box (36 tris), 8^3".into(), cornell_with_object(0, 42), 8),
+        ("box (32 tris), 8^3".into(), cornell_with_object(0, 42), 8),
         ("box + 15,704, 32^3".into(), cornell_with_object(TEAPOT, 42), 32),
         ("box + 69,451, 32^3".into(), cornell_with_object(BUNNY, 42), 32),
     ];

@@ -134,7 +134,7 @@ pub fn finish(
         )));
     }
     let geometry = SceneGeometry::new(&scene);
-    let plan = Plan::new(&scene, &geometry, &settings);
+    let plan = Plan::new(&scene, &geometry, &settings).map_err(CliError::usage)?;
     Ok(Loaded { scene, geometry, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
 }
 
@@ -209,6 +209,10 @@ pub struct Report {
     pub inputs: Vec<String>,
     /// Voxel grid and line space figures (memory per variant), when baked.
     pub line_space: Option<crate::bake::LineSpaceStats>,
+    /// The plan's line-space configuration and its size estimate, when baked.
+    pub line_space_plan: Option<crate::analyze::budget::Choice>,
+    /// Bytes of the grid and line-space sections written (to compare with the estimate).
+    pub line_space_bytes: u64,
 }
 
 /// Bakes and writes `loaded` to `output`; writes the report and depfile if asked.
@@ -272,6 +276,13 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
             .collect(),
         inputs: s.inputs.iter().map(|p| p.display().to_string()).collect(),
         line_space: baked.line_space.clone(),
+        line_space_plan: loaded.plan.line_space.clone(),
+        line_space_bytes: baked
+            .sections
+            .iter()
+            .filter(|x| crate::bake::linespace::stages::SECTION_KINDS.contains(&x.kind))
+            .map(|x| x.bytes.len() as u64)
+            .sum(),
     };
     if let Some(path) = &out.report {
         let json = serde_json::to_string_pretty(&report).map_err(|e| CliError::io(e.to_string()))?;

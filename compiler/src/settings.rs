@@ -77,6 +77,16 @@ impl Ranged {
 pub const SHAFT_RES: Ranged =
     Ranged { key: "shaft_res", default: 4, min: 1, max: kiln_format::linespace::index::MAX_SHAFT_RES };
 
+/// Size budget of the voxel grid and line space sections, MiB (`--line-space-budget`): the plan
+/// lowers the voxel resolution, then N (and drops variants it chose itself) until the estimate
+/// fits; see [`crate::analyze::budget`]. The default guards only the plan's own choices.
+pub const LINE_SPACE_BUDGET: Ranged = Ranged {
+    key: "line_space_budget",
+    default: crate::analyze::budget::DEFAULT_LINE_SPACE_BUDGET_MIB,
+    min: 1,
+    max: 1 << 20,
+};
+
 /// BRDF table size: the integrals are smooth, so 128 × 128 keeps bilinear interpolation error
 /// far below the 16-bit quantisation step's effect on shading, in 64 KiB.
 pub const BRDF_LUT_RES: Ranged = Ranged { key: "brdf_lut_res", default: 128, min: 8, max: 1024 };
@@ -229,10 +239,13 @@ pub struct Settings {
     pub bvh_preset: BvhPreset,
     /// Voxel grid resolution.
     pub voxel_res: VoxelRes,
-    /// Shaft resolution N.
-    pub shaft_res: u32,
+    /// Shaft resolution N; `None`: [`SHAFT_RES`]'s default, which a budget may lower.
+    pub shaft_res: Option<u32>,
     /// Line-space variants; `None` lets the plan choose.
     pub shaft_variants: Option<u32>,
+    /// Budget of the grid and line space, MiB; `None`: [`LINE_SPACE_BUDGET`]'s default, applied
+    /// only when the plan chooses the variants.
+    pub line_space_budget: Option<u32>,
     /// BRDF table size.
     pub brdf_lut_res: u32,
     /// Shadow map size (2D maps; cube faces get half).
@@ -248,8 +261,9 @@ impl Default for Settings {
         Settings {
             bvh_preset: BvhPreset::default(),
             voxel_res: VoxelRes::Auto,
-            shaft_res: SHAFT_RES.default,
+            shaft_res: None,
             shaft_variants: None,
+            line_space_budget: None,
             brdf_lut_res: BRDF_LUT_RES.default,
             shadow_res: SHADOW_RES.default,
             media_volume_res: MEDIA_VOLUME_RES.default,
@@ -275,6 +289,13 @@ impl Settings {
         }
         for (table, value, setting) in [
             (SHAFT_RES, b.shaft_res, &mut self.shaft_res),
+            (LINE_SPACE_BUDGET, b.line_space_budget, &mut self.line_space_budget),
+        ] {
+            if let Some(n) = value {
+                *setting = Some(table.check(n)?);
+            }
+        }
+        for (table, value, setting) in [
             (BRDF_LUT_RES, b.brdf_lut_res, &mut self.brdf_lut_res),
             (SHADOW_RES, b.shadow_res, &mut self.shadow_res),
             (MEDIA_VOLUME_RES, b.media_volume_res, &mut self.media_volume_res),
@@ -297,8 +318,13 @@ impl Settings {
         vec![
             ("bvh-preset".into(), self.bvh_preset.name().into()),
             ("voxel-res".into(), self.voxel_res.name()),
-            ("shaft-res".into(), self.shaft_res.to_string()),
+            ("shaft-res".into(), self.shaft_res.map_or_else(|| "plan".into(), |n| n.to_string())),
             ("shaft-variants".into(), self.shaft_variants.map_or_else(|| "plan".into(), variants_name)),
+            (
+                "line-space-budget".into(),
+                self.line_space_budget
+                    .map_or_else(|| format!("default {}", LINE_SPACE_BUDGET.default), |n| n.to_string()),
+            ),
             ("brdf-lut-res".into(), self.brdf_lut_res.to_string()),
             ("shadow-res".into(), self.shadow_res.to_string()),
             ("media-volume-res".into(), self.media_volume_res.to_string()),

@@ -112,7 +112,7 @@ fn every_kind_file() -> Vec<u8> {
     });
     let settings = Settings {
         voxel_res: VoxelRes::Cells(4),
-        shaft_res: 1,
+        shaft_res: Some(1),
         shaft_variants: Some(Variants::ALL),
         brdf_lut_res: BRDF_LUT_RES.min,
         shadow_res: SHADOW_RES.min,

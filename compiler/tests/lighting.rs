@@ -304,7 +304,7 @@ fn preilluminated_radiance_matches_direct_evaluation() {
         floor_and_blocker(),
         Settings {
             voxel_res: kiln_compiler::settings::VoxelRes::Cells(4),
-            shaft_res: 3,
+            shaft_res: Some(3),
             shaft_variants: Some(Variants::PNMT | Variants::PREILLUM),
             ..Default::default()
         },

@@ -4,12 +4,12 @@
 use serde::Serialize;
 
 use crate::ir::Scene;
-use kiln_format::linespace::Variants;
 use kiln_format::manifest::LightKind;
 
+use crate::analyze::budget::{self, Choice, Request};
 use crate::analyze::geometry::SceneGeometry;
 use crate::bake::linespace::voxelize::auto_resolution;
-use crate::settings::{Settings, VoxelRes, variants_name};
+use crate::settings::{LINE_SPACE_BUDGET, SHAFT_RES, Settings, VoxelRes, variants_name};
 
 /// The bake stages, in the order they run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -55,44 +55,6 @@ impl Stage {
     }
 }
 
-/// Size budget of the line space chosen by default (variants are dropped, most expensive
-/// first, until the estimate fits); `--shaft-variants` overrides it.
-pub const DEFAULT_LINE_SPACE_BUDGET: u64 = 384 << 20;
-
-/// Default variants for a lit scene: all three, unless the estimated size exceeds
-/// [`DEFAULT_LINE_SPACE_BUDGET`]. The estimate counts the non-empty cells of the voxel grid
-/// (which the bake then reuses) and assumes 70% of their shafts filled with 5 candidate entries each, as measured on the benchmark
-/// and shared scenes.
-fn default_variants(geometry: &SceneGeometry, res: u32, n: u32) -> (u32, String) {
-    let slots = geometry.voxels(res).occupied_cells() as u64;
-    let filled = slots * kiln_format::linespace::index::shafts_per_voxel(n) as u64 * 7 / 10;
-    let pnmt = filled * 32;
-    let candidates = filled * (4 + 5 * 4);
-    let mib = |b: u64| b >> 20;
-    let budget = DEFAULT_LINE_SPACE_BUDGET;
-    if pnmt + candidates <= budget {
-        (Variants::DEFAULT, format!("all variants: the scene is lit; about {} MiB", mib(pnmt + candidates)))
-    } else if pnmt <= budget {
-        (
-            Variants::BINARY | Variants::PNMT,
-            format!(
-                "candidate lists skipped: with PNMT about {} MiB, over the {} MiB default budget",
-                mib(pnmt + candidates),
-                mib(budget)
-            ),
-        )
-    } else {
-        (
-            Variants::BINARY,
-            format!(
-                "PNMT and candidates skipped: about {} MiB, over the {} MiB default budget",
-                mib(pnmt + candidates),
-                mib(budget)
-            ),
-        )
-    }
-}
-
 /// One stage's decision.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Decision {
@@ -105,20 +67,25 @@ pub struct Decision {
 }
 
 /// The plan for a scene.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Plan {
     /// Every stage, in order.
     pub stages: Vec<Decision>,
     /// Voxel grid cells along the longest axis (resolved from `auto`).
     pub voxel_res: u32,
+    /// Shaft resolution N (resolved from the default by the budget).
+    pub shaft_res: u32,
     /// Line-space variants to bake (0: none).
     pub shaft_variants: u32,
+    /// The line space's configuration, its estimated size and why (when baked).
+    pub line_space: Option<Choice>,
 }
 
 impl Plan {
-    /// Decides every stage; `geometry` is `scene`'s (its voxel grid is built here when the
-    /// default variants need a size estimate, and reused by the bake).
-    pub fn new(scene: &Scene, geometry: &SceneGeometry, settings: &Settings) -> Plan {
+    /// Decides every stage; `geometry` is `scene`'s (its voxel grids are built here for the size
+    /// estimate, and the chosen one reused by the bake). The error (a usage error) says why no
+    /// line-space configuration fits the budget.
+    pub fn new(scene: &Scene, geometry: &SceneGeometry, settings: &Settings) -> Result<Plan, String> {
         let run = |stage, reason: String| Decision { stage, run: true, reason };
         let skip = |stage, reason: &str| Decision { stage, run: false, reason: reason.to_string() };
         let textured =
@@ -192,49 +159,102 @@ impl Plan {
                 ),
             )
         });
-        let voxel_res = match settings.voxel_res {
+        let requested_res = match settings.voxel_res {
             VoxelRes::Auto => auto_resolution(scene.triangles.len()),
             VoxelRes::Cells(n) => n,
         };
+        // When line space pays: whenever rays are traced through the scene, that is, whenever
+        // something emits light. Even on the 32-triangle Cornell box (N = 4, 8^3 cells) the
+        // binary variant's any-hit query ran 1.34x the BVH's any hit (5.0 vs 3.7 Mrays/s, one
+        // thread, `cargo bench --bench queries`), and its line space is small (under 8 MiB at
+        // auto resolution), so no triangle minimum would save anything worth a missing variant.
         let lit = !scene.lights.is_empty()
             || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
             || scene.sky.radiance.iter().any(|&r| r > 0.0);
-        let res_text = match settings.voxel_res {
-            VoxelRes::Auto => format!(
-                "{voxel_res} cells on the longest axis (auto: cube root of {} triangles)",
-                scene.triangles.len()
-            ),
-            VoxelRes::Cells(n) => format!("{n} cells on the longest axis"),
+        let wanted = match settings.shaft_variants {
+            Some(v) => v != 0,
+            None => lit,
         };
-        let (shaft_variants, chosen) = match settings.shaft_variants {
-            Some(v) => (v, "requested".to_string()),
-            None if lit => default_variants(geometry, voxel_res, settings.shaft_res),
-            None => (0, String::new()),
-        };
-        if shaft_variants == 0 {
-            let why = if settings.shaft_variants.is_some() {
-                "disabled by --shaft-variants none"
-            } else {
-                "nothing emits light, so no shadow or GI query needs it (ask with --shaft-variants)"
-            };
-            stages.push(skip(Stage::VoxelGrid, why));
-            stages.push(skip(Stage::LineSpace, why));
+        let choice = if wanted {
+            Some(budget::choose(
+                geometry,
+                Request {
+                    voxel_res: (requested_res, matches!(settings.voxel_res, VoxelRes::Cells(_))),
+                    shaft_res: (
+                        settings.shaft_res.unwrap_or(SHAFT_RES.default),
+                        settings.shaft_res.is_some(),
+                    ),
+                    variants: settings.shaft_variants,
+                    budget_mib: (
+                        settings.line_space_budget.unwrap_or(LINE_SPACE_BUDGET.default),
+                        settings.line_space_budget.is_some(),
+                    ),
+                },
+            )?)
         } else {
-            stages.push(run(Stage::VoxelGrid, res_text));
-            stages.push(run(
-                Stage::LineSpace,
-                format!(
-                    "N = {}, {} ({chosen})",
-                    settings.shaft_res,
-                    variants_name(shaft_variants | Variants::BINARY)
-                ),
-            ));
+            None
+        };
+        let (voxel_res, shaft_res, shaft_variants) = match &choice {
+            Some(c) => (c.estimate.voxel_res, c.estimate.shaft_res, c.variants),
+            None => (requested_res, settings.shaft_res.unwrap_or(SHAFT_RES.default), 0),
+        };
+        match &choice {
+            None => {
+                let why = if settings.shaft_variants.is_some() {
+                    "disabled by --shaft-variants none"
+                } else {
+                    "nothing emits light, so no shadow or GI query needs it (ask with --shaft-variants)"
+                };
+                stages.push(skip(Stage::VoxelGrid, why));
+                stages.push(skip(Stage::LineSpace, why));
+            }
+            Some(c) => {
+                let e = &c.estimate;
+                let auto = match settings.voxel_res {
+                    VoxelRes::Auto if voxel_res == requested_res => {
+                        format!(" (auto: cube root of {} triangles)", scene.triangles.len())
+                    }
+                    _ => String::new(),
+                };
+                stages.push(run(
+                    Stage::VoxelGrid,
+                    format!(
+                        "{voxel_res} cells on the longest axis{auto}, {}x{}x{}, cell {} scene units, {} non-empty",
+                        e.dims[0],
+                        e.dims[1],
+                        e.dims[2],
+                        short(e.cell),
+                        e.slots
+                    ),
+                ));
+                let budget = c.budget.map_or(String::new(), |b| format!(" of {} MiB", b >> 20));
+                stages.push(run(
+                    Stage::LineSpace,
+                    format!(
+                        "N = {shaft_res} (shafts span 1/{shaft_res} of a cell: patches of {} scene units), {}, about {}{budget} ({})",
+                        short(e.patch()),
+                        variants_name(shaft_variants),
+                        mib(c.bytes),
+                        c.why
+                    ),
+                ));
+            }
         }
-        Plan { stages, voxel_res, shaft_variants }
+        Ok(Plan { stages, voxel_res, shaft_res, shaft_variants, line_space: choice })
     }
 
     /// Whether `stage` runs.
     pub fn runs(&self, stage: Stage) -> bool {
         self.stages.iter().any(|d| d.stage == stage && d.run)
     }
+}
+
+/// `x` with four significant digits.
+fn short(x: f64) -> String {
+    format!("{x:.4}").trim_end_matches('0').trim_end_matches('.').to_string().replace("-0", "0")
+}
+
+/// Bytes as MiB with one decimal.
+fn mib(b: u64) -> String {
+    format!("{:.1} MiB", b as f64 / (1 << 20) as f64)
 }

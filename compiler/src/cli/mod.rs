@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
-    BRDF_LUT_RES, BvhPreset, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings, VOXEL_RES, VoxelRes,
-    parse_variants,
+    BRDF_LUT_RES, BvhPreset, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings,
+    VOXEL_RES, VoxelRes, parse_variants,
 };
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
@@ -28,7 +28,8 @@ pub enum Command {
     Compile(CompileArgs),
     /// Show every bake stage with run or skip and the reason, without writing anything.
     Plan(PlanArgs),
-    /// Compile the built-in demo scene (a Cornell box with a ceiling light and a camera).
+    /// Compile a built-in scene: the demo Cornell box, or a benchmark scene of seed 004
+    /// (`--scene`).
     Demo(DemoArgs),
     /// Write an image-like section (brdf-lut, shadow-map, texture, media-visibility) as PFM or
     /// EXR (float) or PNG, chosen by the output's extension.
@@ -117,6 +118,10 @@ pub struct BakeArgs {
     /// the static lights), or none [default: chosen by the plan].
     #[arg(long, value_name = "LIST", value_parser = parse_variants, help_heading = "Voxel grid and line space")]
     pub shaft_variants: Option<u32>,
+    /// Size budget of the grid and line space, MiB.
+    #[arg(long, value_name = "MiB", value_parser = LINE_SPACE_BUDGET.parser(), help_heading = "Voxel grid and line space",
+          help = LINE_SPACE_BUDGET.help("Size budget of the voxel grid and line space in MiB: lowers the voxel resolution, then N (those not given), and drops candidates, then PNMT (when --shaft-variants is not given), until the estimate fits; a usage error if nothing fits. The default applies only when the plan chooses the variants"))]
+    pub line_space_budget: Option<u32>,
     /// BRDF lookup table size N.
     #[arg(long, value_name = "N", value_parser = BRDF_LUT_RES.parser(), help_heading = "Lighting bakes",
           help = BRDF_LUT_RES.help("BRDF lookup table size N (N × N texels)"))]
@@ -147,7 +152,8 @@ impl BakeArgs {
         }
         set(&mut settings.bvh_preset, self.bvh_preset);
         set(&mut settings.voxel_res, self.voxel_res);
-        set(&mut settings.shaft_res, self.shaft_res);
+        set(&mut settings.shaft_res, self.shaft_res.map(Some));
+        set(&mut settings.line_space_budget, self.line_space_budget.map(Some));
         set(&mut settings.shaft_variants, self.shaft_variants.map(Some));
         set(&mut settings.brdf_lut_res, self.brdf_lut_res);
         set(&mut settings.shadow_res, self.shadow_res);
@@ -214,9 +220,31 @@ pub struct PlanArgs {
     pub json: bool,
 }
 
+/// A built-in scene of `kiln demo`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum DemoScene {
+    /// The demo Cornell box: five walls, two blocks, a warm ceiling light, 30 triangles.
+    #[default]
+    Demo,
+    /// Seed 004's scene 4: the Cornell box with two blocks and a light quad (32 triangles here:
+    /// the blocks have no bottoms; the thesis's box has 36).
+    Cornell,
+    /// The 12-triangle box around a 15,704-triangle object (the Utah teapot's count).
+    BoxTeapot,
+    /// The 12-triangle box around a 69,451-triangle object (the Stanford bunny's count).
+    BoxBunny,
+    /// The 12-triangle box around an 871,306-triangle object (the Stanford dragon's count).
+    BoxDragon,
+}
+
 /// `kiln demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
+    /// Which scene: the demo, or one of seed 004's benchmark settings (Table 1) for
+    /// `kiln-play FILE --bench-rays`; each has the demo's camera looking into the box. The objects
+    /// are seeded bumpy spheres with the thesis meshes' triangle counts, not the meshes.
+    #[arg(long, value_enum, default_value_t = DemoScene::Demo)]
+    pub scene: DemoScene,
     /// Output file.
     #[arg(long, short = 'o', value_name = "OUT.kiln", default_value = "demo.kiln")]
     pub output: PathBuf,

@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use crate::cli::{CompileArgs, DemoArgs};
+use crate::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
+use crate::cli::{CompileArgs, DemoArgs, DemoScene};
 use crate::exit::CliResult;
 use crate::output::size;
 use crate::pipeline::{self, Report};
@@ -24,13 +25,23 @@ pub fn run(args: &CompileArgs) -> CliResult {
     Ok(())
 }
 
+/// Seed of the benchmark scenes' objects (as `benches/linespace.rs` and `benches/queries.rs`
+/// use, so that the files match the benchmarks' scenes).
+const SEED: u64 = 42;
+
 /// Runs `kiln demo`.
 pub fn demo(args: &DemoArgs) -> CliResult {
     let start = Instant::now();
-    let mut scene = crate::import::demo::cornell_box();
+    let (mut scene, name) = match args.scene {
+        DemoScene::Demo => (crate::import::demo::cornell_box(), "demo"),
+        DemoScene::Cornell => (cornell_with_object(0, SEED), "cornell"),
+        DemoScene::BoxTeapot => (cornell_with_object(TEAPOT, SEED), "box-teapot"),
+        DemoScene::BoxBunny => (cornell_with_object(BUNNY, SEED), "box-bunny"),
+        DemoScene::BoxDragon => (cornell_with_object(DRAGON, SEED), "box-dragon"),
+    };
     let settings = pipeline::configure(&mut scene, args.config.as_deref(), &args.bake)?;
-    let loaded = pipeline::finish(scene, settings, "demo", &Default::default(), args.out.quiet, start)?;
-    let report = pipeline::compile(&loaded, "demo", &args.output, &args.out)?;
+    let loaded = pipeline::finish(scene, settings, name, &Default::default(), args.out.quiet, start)?;
+    let report = pipeline::compile(&loaded, name, &args.output, &args.out)?;
     if !args.out.quiet {
         summary(&report);
     }
@@ -51,6 +62,20 @@ fn summary(r: &Report) {
         c.bvh_nodes,
         r.total_ms
     );
+    if let Some(p) = &r.line_space_plan {
+        let e = &p.estimate;
+        println!(
+            "  line space: {} cells on the longest axis (cell {:.4} scene units), N = {} (patch {:.4}), {}: estimated {}, written {}{}",
+            e.voxel_res,
+            e.cell,
+            e.shaft_res,
+            e.patch(),
+            crate::settings::variants_name(p.variants),
+            size(p.bytes),
+            size(r.line_space_bytes),
+            p.budget.map_or(String::new(), |b| format!(" (budget {})", size(b)))
+        );
+    }
     for s in r.stages.iter().filter(|s| !s.run) {
         println!("  skipped {}: {}", s.stage, s.reason);
     }

@@ -19,6 +19,8 @@ struct PlanJson<'a> {
     cameras: usize,
     media: usize,
     stages: &'a [Decision],
+    /// The line space's configuration, estimated size and why.
+    line_space: Option<&'a crate::analyze::budget::Choice>,
     warnings: Vec<String>,
 }
 
@@ -36,6 +38,7 @@ pub fn run(args: &PlanArgs) -> CliResult {
         cameras: s.cameras.len(),
         media: s.media.len(),
         stages: &loaded.plan.stages,
+        line_space: loaded.plan.line_space.as_ref(),
         warnings: s.warnings.iter().map(|w| w.message.clone()).collect(),
     };
     if args.json {

@@ -181,6 +181,8 @@ pub struct BakeToml {
     pub shaft_res: Option<u32>,
     /// Comma-separated variants or `"none"`.
     pub shaft_variants: Option<String>,
+    /// Budget of the grid and line space, MiB.
+    pub line_space_budget: Option<u32>,
     /// BRDF table size.
     pub brdf_lut_res: Option<u32>,
     /// Shadow map size.

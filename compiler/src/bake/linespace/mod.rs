@@ -1,6 +1,7 @@
 //! The voxel grid and line-space stages (seed 004, made exact and sparse): voxelize, then fill
 //! the shafts of every non-empty cell in parallel, then lay the results out as sections.
 
+pub mod estimate;
 mod geometry;
 mod shafts;
 pub mod stages;

@@ -9,13 +9,27 @@ use kiln_format::sections::{
 };
 
 use super::BakedLineSpace;
+
+/// Every section the voxel-grid and line-space stages write: what `--line-space-budget` bounds.
+pub const SECTION_KINDS: [kiln_format::SectionKind; 10] = [
+    GRID,
+    VOXEL_OFFSETS,
+    VOXEL_TRIANGLES,
+    SHAFT_SLOTS,
+    SHAFT_BITS,
+    SHAFT_RANKS,
+    CANDIDATE_OFFSETS,
+    CANDIDATES,
+    PNMT,
+    PREILLUM,
+];
 use crate::bake::{BakeContext, Sections};
 use crate::exit::CliResult;
 
 /// The hash of the grid's and line space's sections: the BVH preset (they store triangles in
 /// its order) and the grid settings.
 fn hash(ctx: &BakeContext, label: &str) -> kiln_format::ContentHash {
-    let grid = format!("{};{};{}", ctx.plan.voxel_res, ctx.settings.shaft_res, ctx.plan.shaft_variants);
+    let grid = format!("{};{};{}", ctx.plan.voxel_res, ctx.plan.shaft_res, ctx.plan.shaft_variants);
     ctx.hash(label, &[("preset", ctx.preset()), ("grid", &grid)])
 }
 
@@ -34,7 +48,7 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
         &ctx.attributes(),
         voxels,
         voxel_ms,
-        ctx.settings.shaft_res,
+        ctx.plan.shaft_res,
         ctx.plan.shaft_variants,
         Some(&shade),
         ctx.progress,
