@@ -71,6 +71,17 @@ pub enum ReflectionResArg {
     Half,
 }
 
+/// `--gi-structure` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GiStructureArg {
+    /// The shaft's PNMT record.
+    Pnmt,
+    /// The shaft's candidate list.
+    Candidates,
+    /// The record's pre-illuminated radiance.
+    Preillum,
+}
+
 /// `--ls-shadow-test` (order as the catalogue's choices).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum LsShadowTestArg {
@@ -172,10 +183,15 @@ pub struct Args {
     /// Global illumination technique.
     #[arg(long, value_parser = techniques(Effect::Gi), default_value = "none")]
     pub gi: String,
-    /// With --gi rt: bounces of indirect light after the visible surface, 1 to 8 (1: the sky,
+    /// With --gi rt or linespace: bounces of indirect light after the visible surface, 1 to 8 (1: the sky,
     /// emissive surfaces and the light the first surface hit receives directly).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub gi_bounces: u32,
+    /// With --gi linespace: what answers the bounce rays. pnmt: the shaft's stored hit, no
+    /// triangle test (approximate); candidates: the shaft's triangle list (exact); preillum: the
+    /// stored hit's baked radiance (one bounce, no shading).
+    #[arg(long, value_enum, default_value = "pnmt")]
+    pub gi_structure: GiStructureArg,
     /// Participating media technique (later passes add techniques).
     #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
     pub media: String,
@@ -202,6 +218,7 @@ impl Args {
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
+            "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
             _ => None,
         }
     }

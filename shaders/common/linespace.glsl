@@ -272,6 +272,25 @@ bool ls_any_binary(vec3 origin, vec3 dir, float tmin, float tmax) {
     return false;
 }
 
+// Any hit among the triangles that can meet the ray in cell c: the shaft's candidate list when
+// the candidates are uploaded (a fraction of the cell's triangles), else the cell's list. `l` is
+// the shaft, if the line meets the cell (`has_shaft`; if not, the cell's list).
+bool ls_shaft_hit(TraceRay r, uint c, uint slot, bool has_shaft, LsShaft l, inout TraceHit best) {
+    int rank = grid.bases_b.z != LS_NO_BASE && has_shaft ? ls_rank(slot, l.shaft) : -1;
+    if (rank < 0) {
+        return ls_cell_hit(r, c, true, best);
+    }
+    uint first = ls_cell_offset(c);
+    uint a = ls_candidate_offset(uint(rank)), b = ls_candidate_offset(uint(rank) + 1u);
+    for (uint k = a; k < b; k++) {
+        ls_test_triangle(r, ls_cell_triangle(first + ls_entry_local(ls_candidate(k))), best);
+        if (best.t != NO_HIT) {
+            return true;
+        }
+    }
+    return false;
+}
+
 // Cells within this many cell edges of a ray's ends are tested exactly by ls_occluded_binary:
 // a surface's own triangles fill the shafts of its neighbouring cells too, so a feeler leaving it
 // at a shallow angle would otherwise be blocked by the surface it starts on (the thesis's "voxel
@@ -293,8 +312,8 @@ bool ls_occluded_binary(TraceRay r, bool exact_everywhere) {
             continue;
         }
         LsShaft l;
-        bool filled = !ls_lookup(cell, s.o, s.d, l) || ls_filled(slot, l.shaft);
-        if (!filled) {
+        bool has_shaft = ls_lookup(cell, s.o, s.d, l);
+        if (has_shaft && !ls_filled(slot, l.shaft)) {
             continue;
         }
         bool near_end = t_in <= r.tmin + reach || t_out >= r.tmax - reach;
@@ -302,7 +321,7 @@ bool ls_occluded_binary(TraceRay r, bool exact_everywhere) {
             return true;
         }
         TraceHit h = TraceHit(NO_HIT, 0u, 0.0, 0.0);
-        if (ls_cell_hit(r, c, true, h)) {
+        if (ls_shaft_hit(r, c, slot, has_shaft, l, h)) {
             return true;
         }
     }

@@ -46,6 +46,32 @@ struct Surface {
     uint triangle;  // the triangle hit (leaf order)
 };
 
+// The material of a surface at texture coordinates uv: s.mat and s.emission (towards the side
+// s.front says the ray came from). Shared by triangle hits and the line space's stored hits.
+void surface_material(inout Surface s, GpuMaterialLayout m, vec2 uv) {
+    vec4 base = m.base_color;
+    if (m.base_color_texture != NO_TEXTURE) {
+        base *= sample_texture(m.base_color_texture, uv);
+    }
+    s.mat.base = base.rgb;
+    s.mat.metallic = m.metallic;
+    s.mat.roughness = m.roughness;
+    if (m.metallic_roughness_texture != NO_TEXTURE) {
+        vec4 mr = sample_texture(m.metallic_roughness_texture, uv);
+        s.mat.metallic *= mr.b;
+        s.mat.roughness *= mr.g;
+    }
+    s.mat.metallic = clamp(s.mat.metallic, 0.0, 1.0);
+    s.mat.roughness = clamp(s.mat.roughness, 0.0, 1.0);
+    s.mat.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    vec3 e = m.emission;
+    if (m.emissive_texture != NO_TEXTURE && any(greaterThan(e, vec3(0.0)))) {
+        e *= sample_texture(m.emissive_texture, uv).rgb;
+    }
+    bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
+    s.emission = (s.front || double_sided) ? e : vec3(0.0);
+}
+
 Surface surface_at(TraceRay r, TraceHit h) {
     Surface s;
     uint tri = h.triangle;
@@ -94,27 +120,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
     }
     s.ng = ng;
     s.ns = ns;
-    vec4 base = m.base_color;
-    if (m.base_color_texture != NO_TEXTURE) {
-        base *= sample_texture(m.base_color_texture, uv);
-    }
-    s.mat.base = base.rgb;
-    s.mat.metallic = m.metallic;
-    s.mat.roughness = m.roughness;
-    if (m.metallic_roughness_texture != NO_TEXTURE) {
-        vec4 mr = sample_texture(m.metallic_roughness_texture, uv);
-        s.mat.metallic *= mr.b;
-        s.mat.roughness *= mr.g;
-    }
-    s.mat.metallic = clamp(s.mat.metallic, 0.0, 1.0);
-    s.mat.roughness = clamp(s.mat.roughness, 0.0, 1.0);
-    s.mat.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
-    vec3 e = m.emission;
-    if (m.emissive_texture != NO_TEXTURE && any(greaterThan(e, vec3(0.0)))) {
-        e *= sample_texture(m.emissive_texture, uv).rgb;
-    }
-    bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
-    s.emission = (s.front || double_sided) ? e : vec3(0.0);
+    surface_material(s, m, uv);
     return s;
 }
 

@@ -38,6 +38,9 @@
 //       `to` is blocked: next-event shadow rays towards points on emitters.
 //   bool gi_occluded_dir(vec3 from, vec3 ng, vec3 dir)
 //       the same for the unbounded ray along `dir` (directional lights).
+// Defining GI_HIT_RADIANCE and
+//   bool gi_hit_radiance(TraceRay r, vec3 origin_ng, out vec3 radiance)
+// instead ends every path at its first hit with the radiance the structure stores for it.
 // `gi_main()` is the kernel's body.
 #ifndef KILN_GI_GLSL
 #define KILN_GI_GLSL
@@ -83,6 +86,12 @@ vec3 gi_sample(Primary s) {
     }
     TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), dir, 0.0, 3.4e38);
     vec3 origin_ng = s.ng;
+#ifdef GI_HIT_RADIANCE
+    // The structure stores the light leaving every hit (the pre-illuminated line space): one
+    // lookup ends the path, the sky on a miss.
+    vec3 stored;
+    return gi_hit_radiance(r, origin_ng, stored) ? stored : frame.sky.rgb;
+#endif
     bool exact = false;
     vec3 result = vec3(0.0);
     vec3 throughput = vec3(1.0);

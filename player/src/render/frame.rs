@@ -16,7 +16,7 @@ use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::visibility::VisibilityPass;
 use super::spirv;
-use super::technique::{Ao, GBuffer, Gi, Reflections, Techniques};
+use super::technique::{Ao, GBuffer, Gi, GiStructure, Reflections, Techniques};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc};
 
@@ -49,8 +49,17 @@ fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<B
         if let Reflections::Rt { resolution, .. } = techniques.reflections {
             made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights)?));
         }
-        if let Gi::Rt { .. } = techniques.gi {
-            made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI)?));
+        match techniques.gi {
+            Gi::Rt { .. } => made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI)?)),
+            Gi::LineSpace { structure, .. } => {
+                let code = match structure {
+                    GiStructure::Pnmt => spirv::RT_GI_LINESPACE_PNMT,
+                    GiStructure::Candidates => spirv::RT_GI_LINESPACE_CANDIDATES,
+                    GiStructure::Preillum => spirv::RT_GI_LINESPACE_PREILLUM,
+                };
+                made.push(Box::new(RtGiPass::with_line_space(gpu, code)?));
+            }
+            Gi::None => {}
         }
         made.push(Box::new(DirectPass::new(gpu)?));
         made.push(Box::new(TonemapPass::new(gpu)?));

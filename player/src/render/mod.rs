@@ -166,7 +166,7 @@ impl Renderer {
             reflection_step,
             reflection_lights,
             gi_bounces: match t.gi {
-                Gi::Rt { bounces } => bounces,
+                Gi::Rt { bounces } | Gi::LineSpace { bounces, .. } => bounces,
                 Gi::None => 0,
             },
             emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count),
@@ -179,7 +179,7 @@ impl Renderer {
         if matches!(t.ao, Ao::Rt { .. }) {
             flags |= FrameFlags::RT_AO;
         }
-        if matches!(t.gi, Gi::Rt { .. }) {
+        if t.gi.bounces().is_some() {
             flags |= FrameFlags::RT_GI;
         }
         match t.reflections {

@@ -49,6 +49,12 @@ shaders! {
     RT_REFLECTIONS = "rt" / "reflections.comp";
     /// Diffuse global illumination, its rays through the CWBVH.
     RT_GI = "rt" / "gi.comp";
+    /// Diffuse GI through the line space: PNMT bounce hits.
+    RT_GI_LINESPACE_PNMT = "rt" / "gi_linespace_pnmt.comp";
+    /// Diffuse GI through the line space: candidate-list bounce hits.
+    RT_GI_LINESPACE_CANDIDATES = "rt" / "gi_linespace_candidates.comp";
+    /// Diffuse GI through the line space: pre-illuminated records.
+    RT_GI_LINESPACE_PREILLUM = "rt" / "gi_linespace_preillum.comp";
     /// Shadow rays at the reflection hits.
     RT_REFLECTION_SHADOWS = "rt" / "reflection_shadows.comp";
     /// Ray generation of the driver-pipeline peer: one ray of the buffer per launch index.

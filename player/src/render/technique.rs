@@ -124,6 +124,34 @@ pub enum Gi {
         /// what the first surface hit emits and receives directly), 1..=8.
         bounces: u32,
     },
+    /// The same estimator with its rays through the line space (seed 004).
+    LineSpace {
+        /// As for [`Gi::Rt`].
+        bounces: u32,
+        /// What answers the bounce rays.
+        structure: GiStructure,
+    },
+}
+
+/// What answers the bounce rays of `--gi linespace` (shadow rays: the binary line space).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GiStructure {
+    /// The shaft's PNMT record: an approximate hit without triangle tests.
+    Pnmt,
+    /// The candidate lists: the exact hit.
+    Candidates,
+    /// The record's pre-illuminated radiance: one lookup, no shading, one bounce.
+    Preillum,
+}
+
+impl Gi {
+    /// The bounce count of a path-traced technique.
+    pub fn bounces(&self) -> Option<u32> {
+        match *self {
+            Gi::Rt { bounces } | Gi::LineSpace { bounces, .. } => Some(bounces),
+            Gi::None => None,
+        }
+    }
 }
 
 /// Participating media (techniques come with later passes).
@@ -244,6 +272,18 @@ impl Techniques {
             // Surfaces at hits, and for GI the emitter table (made with the scene buffers).
             n = n.union(Needs::TRACED_SURFACES);
         }
+        if let Gi::LineSpace { structure, .. } = self.gi {
+            n.line_space |= match structure {
+                GiStructure::Pnmt => LsArrays::PNMT_QUERY | LsArrays::BINARY_QUERY,
+                GiStructure::Candidates => LsArrays::CANDIDATE_QUERY | LsArrays::BINARY_QUERY,
+                GiStructure::Preillum => LsArrays::PNMT_QUERY | LsArrays::PREILLUM,
+            };
+        }
+        if n.line_space & LsArrays::CELL_LISTS != 0 {
+            // Exact tests near the shadow feelers' ends read the shaft's candidates, when the
+            // file has them, instead of the whole cell's triangles.
+            n.line_space |= LsArrays::CANDIDATES_IF_PRESENT;
+        }
         n
     }
 
@@ -252,7 +292,7 @@ impl Techniques {
         self.shadows.traced().is_some()
             || matches!(self.ao, Ao::Rt { .. })
             || matches!(self.reflections, Reflections::Rt { .. })
-            || matches!(self.gi, Gi::Rt { .. })
+            || self.gi.bounces().is_some()
     }
 
     /// Every ray-traced technique replaced by its effect's default or off (what the frame
@@ -327,12 +367,22 @@ impl Techniques {
                 }
             }
             (Effect::Gi, "none") => self.gi = Gi::None,
-            (Effect::Gi, "rt") => {
+            (Effect::Gi, "rt" | "linespace") => {
                 let bounces = v(0).number();
                 if bounces.fract() != 0.0 {
                     return Err(format!("{effect} {name}: gi-bounces must be a whole number, not {bounces}"));
                 }
-                self.gi = Gi::Rt { bounces: bounces as u32 };
+                let bounces = bounces as u32;
+                self.gi = if name == "rt" {
+                    Gi::Rt { bounces }
+                } else {
+                    let structure = match v(1) {
+                        KnobValue::Choice(1) => GiStructure::Candidates,
+                        KnobValue::Choice(2) => GiStructure::Preillum,
+                        _ => GiStructure::Pnmt,
+                    };
+                    Gi::LineSpace { bounces, structure }
+                };
             }
             (Effect::Media, "none") => self.media = Media::None,
             (Effect::Aa, "none") => self.aa = Aa::None,
@@ -366,6 +416,7 @@ impl Techniques {
             Effect::Gi => match self.gi {
                 Gi::None => "none",
                 Gi::Rt { .. } => "rt",
+                Gi::LineSpace { .. } => "linespace",
             },
             Effect::Media => "none",
             Effect::Aa => match self.aa {
@@ -548,6 +599,17 @@ const fn light_size(knob: Knob) -> Knob {
 /// The upper end of an open range.
 const UNBOUNDED: f32 = f32::INFINITY;
 
+/// Bounces of the path-traced GI techniques.
+const GI_BOUNCES: Knob = number(
+    "gi-bounces",
+    "bounces of indirect light after the visible surface (1: the sky, emissive surfaces and \
+     the light the first surface hit receives directly; each more adds one bounce)",
+    1.0,
+    8.0,
+    1.0,
+    &[1.0, 2.0],
+);
+
 /// The sphere radius of point and spot lights, for the traced shadow techniques.
 const LIGHT_RADIUS: Knob = light_size(number(
     "light-radius",
@@ -568,7 +630,7 @@ const SUN_ANGLE: Knob = light_size(number(
     &[0.0, 0.53, 2.0],
 ));
 
-static CATALOGUE: [TechniqueInfo; 15] = [
+static CATALOGUE: [TechniqueInfo; 16] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -703,15 +765,27 @@ static CATALOGUE: [TechniqueInfo; 15] = [
                pixel per frame, next-event estimation to lights and emissive surfaces at its hits, \
                averaged while the camera is still; replaces the sky's diffuse ambient and its AO \
                (see --gi-bounces)",
-        knobs: &[number(
-            "gi-bounces",
-            "bounces of indirect light after the visible surface (1: the sky, emissive surfaces and \
-             the light the first surface hit receives directly; each more adds one bounce)",
-            1.0,
-            8.0,
-            1.0,
-            &[1.0, 2.0],
-        )],
+        knobs: &[GI_BOUNCES],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Gi,
+        name: "linespace",
+        help: "the path-traced GI estimator with its rays through the line space (seed 004): bounce \
+               rays through --gi-structure, shadow rays through the binary line space; specular \
+               bounces and emissive hits through the BVH (needs a file compiled with line space)",
+        knobs: &[
+            GI_BOUNCES,
+            Knob {
+                name: "gi-structure",
+                help: "pnmt: the shaft's stored hit, no triangle test (approximate); candidates: the \
+                       shaft's triangle list (exact); preillum: the stored hit's baked radiance, one \
+                       bounce, no shading",
+                range: KnobRange::Choice(&["pnmt", "candidates", "preillum"]),
+                default: KnobValue::Choice(0),
+                role: KnobRole::Quality,
+            },
+        ],
         stochastic: true,
     },
     TechniqueInfo {

@@ -41,6 +41,9 @@ impl LsArrays {
     /// With this bit, arrays the file lacks are left out instead of refused (ray benchmarks
     /// measure whatever variants the file has).
     pub const IF_PRESENT: u32 = 1 << 31;
+    /// With this bit, the ranks and candidate lists too if the file has them (exact tests of a
+    /// shaft's triangles instead of its cell's).
+    pub const CANDIDATES_IF_PRESENT: u32 = 1 << 30;
 
     /// What a closest-hit query through the candidate lists reads.
     pub const CANDIDATE_QUERY: u32 = Self::CELL_LISTS | Self::SHAFTS | Self::RANKS | Self::CANDIDATES;
@@ -139,6 +142,10 @@ impl LineSpaceLayout {
                 _ => h.variants & variant != 0,
             }
         };
+        let mut wanted = wanted;
+        if wanted & LsArrays::CANDIDATES_IF_PRESENT != 0 && h.variants & Variants::CANDIDATES != 0 {
+            wanted |= LsArrays::RANKS | LsArrays::CANDIDATES;
+        }
         let lacking: u32 = (0..6).map(|i| 1u32 << i).filter(|&b| wanted & b != 0 && !present(b)).sum();
         if lacking != 0 && !optional {
             let names: Vec<&str> =

@@ -33,6 +33,11 @@ impl RtGiPass {
     pub fn new(gpu: &Gpu, spirv: &[u8]) -> PlayResult<RtGiPass> {
         Ok(RtGiPass(HybridKernel::new(gpu, spirv)?))
     }
+
+    /// A GI kernel whose hooks read the line space (`shaders/rt/gi_linespace*.comp`).
+    pub fn with_line_space(gpu: &Gpu, spirv: &[u8]) -> PlayResult<RtGiPass> {
+        Ok(RtGiPass(HybridKernel::with_line_space(gpu, spirv)?))
+    }
 }
 
 impl Pass for RtGiPass {

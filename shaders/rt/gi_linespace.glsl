@@ -1,0 +1,100 @@
+// The hooks of the GI estimator (gi.glsl) answered by the line space (seed 004): the includer
+// defines GI_LS_STRUCTURE, then includes this file.
+//   GI_LS_PNMT (0):       bounce rays take the PNMT record of the shaft they pass through (no
+//                         triangle test); records of emissive materials and specular-lobe rays
+//                         are re-traced through the CWBVH, exactly (the estimator weighs emission
+//                         by its triangle, and a mirror would show an approximate hit);
+//   GI_LS_CANDIDATES (1): bounce rays through the candidate lists (exact);
+//   GI_LS_PREILLUM (2):   one PNMT lookup per pixel, and the radiance baked for that record
+//                         (emission and the analytic lights' direct light, shadowed): no shading,
+//                         no shadow ray, no further bounce; it lacks the sky's and emissive
+//                         triangles' light at the hit and every longer path.
+// Shadow rays (next-event estimation, the sky at the last hit) go through the binary line space,
+// exact near their ends (ls_occluded_binary).
+#ifndef KILN_GI_LINESPACE_GLSL
+#define KILN_GI_LINESPACE_GLSL
+
+#define GI_LS_PNMT 0
+#define GI_LS_CANDIDATES 1
+#define GI_LS_PREILLUM 2
+
+#include "hybrid.glsl"
+#define LS_BINDING 25
+#include "../common/linespace.glsl"
+
+// The surface of a PNMT record seen along `dir`: its stored normal as both geometric and
+// shading normal (normal maps are not applied), its material at its stored uv.
+Surface surface_of_record(LsRecord rec, vec3 dir) {
+    Surface s;
+    s.triangle = 0xffffffffu;
+    s.p = rec.position;
+    vec3 n = rec.normal;
+    s.front = dot(n, dir) < 0.0;
+    if (!s.front) {
+        n = -n;
+    }
+    s.ng = n;
+    s.ns = n;
+    surface_material(s, materials[rec.material], rec.uv);
+    return s;
+}
+
+bool gi_exact_hit(TraceRay r, out Surface s) {
+    TraceHit h = trace(r, false);
+    if (h.t == NO_HIT) {
+        return false;
+    }
+    s = surface_at(r, h);
+    return true;
+}
+
+bool gi_hit(TraceRay r, vec3 origin_ng, bool exact, out Surface s) {
+#if GI_LS_STRUCTURE == GI_LS_CANDIDATES
+    TraceHit h = ls_trace_candidates(r, false);
+    if (h.t == NO_HIT) {
+        return false;
+    }
+    s = surface_at(r, h);
+    return true;
+#else
+    if (exact) {
+        return gi_exact_hit(r, s);
+    }
+    LsRecord rec;
+    if (!ls_pnmt_hit(r.origin, r.direction, r.tmin, r.tmax, origin_ng, rec)) {
+        return false;
+    }
+    if (any(greaterThan(materials[rec.material].emission, vec3(0.0)))) {
+        return gi_exact_hit(r, s);
+    }
+    s = surface_of_record(rec, r.direction);
+    return true;
+#endif
+}
+
+bool gi_occluded(vec3 from, vec3 ng, vec3 to) {
+    vec3 o = offset_ray_origin(from, ng);
+    vec3 d = to - o;
+    float dist = length(d);
+    return dist > 0.0 && ls_occluded_binary(make_ray(o, d / dist, 0.0, dist * (1.0 - 1e-5)), false);
+}
+
+bool gi_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
+    return ls_occluded_binary(make_ray(offset_ray_origin(from, ng), dir, 0.0, 3.4e38), false);
+}
+
+#if GI_LS_STRUCTURE == GI_LS_PREILLUM
+#define GI_HIT_RADIANCE
+bool gi_hit_radiance(TraceRay r, vec3 origin_ng, out vec3 radiance) {
+    LsRecord rec;
+    if (!ls_pnmt_hit(r.origin, r.direction, r.tmin, r.tmax, origin_ng, rec)) {
+        return false;
+    }
+    radiance = ls_preillum(rec);
+    return true;
+}
+#endif
+
+#include "gi.glsl"
+
+#endif

@@ -1,0 +1,8 @@
+#version 460
+// Diffuse GI (gi.glsl) through the line space, structure preillum (see gi_linespace.glsl).
+#define GI_LS_STRUCTURE GI_LS_PREILLUM
+#include "gi_linespace.glsl"
+
+void main() {
+    gi_main();
+}
