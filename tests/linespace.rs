@@ -15,7 +15,7 @@ use proptest::prelude::*;
 fn settings(res: u32, n: u32) -> Settings {
     Settings {
         voxel_res: VoxelRes::Cells(res),
-        shaft_res: n,
+        shaft_res: Some(n),
         shaft_variants: Some(Variants::ALL),
         ..Default::default()
     }

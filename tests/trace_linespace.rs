@@ -32,7 +32,7 @@ use kiln_tests::{Options, compile, scene_of, shared_scenes, vulkan};
 fn settings(res: u32, n: u32) -> Settings {
     Settings {
         voxel_res: VoxelRes::Cells(res),
-        shaft_res: n,
+        shaft_res: Some(n),
         shaft_variants: Some(Variants::ALL),
         shadow_res: 16,
         ..Default::default()

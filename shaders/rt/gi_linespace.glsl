@@ -27,7 +27,6 @@
 Surface surface_of_record(LsRecord rec, vec3 dir) {
     Surface s;
     s.triangle = 0xffffffffu;
-    s.p = rec.position;
     vec3 n = rec.normal;
     s.front = dot(n, dir) < 0.0;
     if (!s.front) {
@@ -35,6 +34,10 @@ Surface surface_of_record(LsRecord rec, vec3 dir) {
     }
     s.ng = n;
     s.ns = n;
+    // The stored point is quantised (up to a 65535th of the cell per axis), so it may lie a hair
+    // behind the surface it stands for; lifted by the quantisation step plus the margin towards
+    // the ray, the rays leaving it do not hit that surface again.
+    s.p = rec.position + n * grid.pnmt_step;
     surface_material(s, materials[rec.material], rec.uv);
     return s;
 }

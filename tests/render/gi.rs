@@ -2,13 +2,16 @@
 //! direct pass plus GI must converge to the reference limited to N + 1 scattering events: under
 //! a lit ceiling (point light, emissive panel, sky), and beside a wall that reflects the sky.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
+use kiln_compiler::settings::{Settings, VoxelRes};
+use kiln_format::linespace::Variants;
 use kiln_format::manifest::{LightKind, Sky};
 use kiln_player::reference::{Sampling, render_with};
+use kiln_player::render::GiStructure;
 use kiln_player::render::Readable;
 use kiln_player::session::Session;
 use kiln_tests::{Options, compile, scene_of, vulkan};
@@ -95,25 +98,7 @@ fn gi_plus_direct_light_converges_to_the_reference_of_one_more_bounce_under_a_li
     // hide it, and the light of the point light and the panel that the ceiling reflects. That is
     // exactly what the reference counts with two scattering events.
     let dir = tempfile::tempdir().unwrap();
-    let albedo = srgb8(188); // stored exactly by the sRGB G-buffer
-    let cam = Pinhole::new([0.0, 0.9, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 90.0, W, H);
-    let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
-    let ceiling = square(1.0, 1.0).map(|t| [t[0], t[2], t[1]]); // facing down
-    let panel = square(0.0, 0.25).map(|t| [t[0], t[2], t[1]].map(|p| p + Vec3::new(-0.3, 0.95, 0.1)));
-    tris.extend(ceiling);
-    tris.extend(panel);
-    let mut scene = scene_of(&tris);
-    scene.materials[0].gpu = lambert_material([albedo; 3]);
-    let mut glow = lambert_material([0.0; 3]);
-    glow.emission = [4.0; 3];
-    scene.materials.push(kiln_compiler::ir::Material { name: "panel".into(), gpu: glow });
-    let n = scene.triangle_materials.len();
-    scene.triangle_materials[n - 2..].fill(1);
-    scene.lights.push(light(LightKind::Point, [0.3, 0.5, 0.2], [0.0, -1.0, 0.0], 1.0));
-    scene.sky = Sky { radiance: [0.1; 3] };
-    scene.cameras.push(cam.file_camera());
-    let file = dir.path().join("lit-ceiling.kiln");
-    std::fs::write(&file, compile(scene, fast_settings())).unwrap();
+    let file = lit_ceiling(dir.path(), fast_settings());
     let none = two_estimates(&Options::new(&file, W, H).unshadowed(), 1);
     // One bounce against two scattering events, and (through the MIS-weighted continuation) two
     // against three.
@@ -131,6 +116,61 @@ fn gi_plus_direct_light_converges_to_the_reference_of_one_more_bounce_under_a_li
             );
         }
     }
+}
+
+/// A diffuse floor under a diffuse ceiling (2 × 2 units at height 1) lit by a point light
+/// between them, an emissive panel just below the ceiling and a dim sky around it, compiled with
+/// `settings` into `dir`.
+fn lit_ceiling(dir: &Path, settings: Settings) -> PathBuf {
+    let albedo = srgb8(188); // stored exactly by the sRGB G-buffer
+    let cam = Pinhole::new([0.0, 0.9, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 90.0, W, H);
+    let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
+    let ceiling = square(1.0, 1.0).map(|t| [t[0], t[2], t[1]]); // facing down
+    let panel = square(0.0, 0.25).map(|t| [t[0], t[2], t[1]].map(|p| p + Vec3::new(-0.3, 0.95, 0.1)));
+    tris.extend(ceiling);
+    tris.extend(panel);
+    let mut scene = scene_of(&tris);
+    scene.materials[0].gpu = lambert_material([albedo; 3]);
+    let mut glow = lambert_material([0.0; 3]);
+    glow.emission = [4.0; 3];
+    scene.materials.push(kiln_compiler::ir::Material { name: "panel".into(), gpu: glow });
+    let n = scene.triangle_materials.len();
+    scene.triangle_materials[n - 2..].fill(1);
+    scene.lights.push(light(LightKind::Point, [0.3, 0.5, 0.2], [0.0, -1.0, 0.0], 1.0));
+    scene.sky = Sky { radiance: [0.1; 3] };
+    scene.cameras.push(cam.file_camera());
+    let file = dir.join("lit-ceiling.kiln");
+    std::fs::write(&file, compile(scene, settings)).unwrap();
+    file
+}
+
+#[test]
+fn gi_through_the_line_space_converges_to_the_reference_with_candidates_and_near_it_with_pnmt() {
+    if !vulkan() {
+        return;
+    }
+    // The same estimator as --gi rt: with the candidate lists every bounce hit is exact, and the
+    // shadow rays through the binary line space are exact within two cells of their ends, which
+    // covers every feeler under the 1-unit ceiling at both resolutions below. So the result
+    // converges to the reference as --gi rt does. PNMT's hits are the shafts' stored midpoint
+    // hits, one per shaft and direction: biased. At 32 cells over the 20-unit floor (cells 0.625
+    // units, below the ceiling's height) the bias stays within 10 % of the floor's radiance
+    // (measured: see the printed quadrants); at 8 cells a floor cell also holds the ceiling, the
+    // floor is its first surface from below, and the panel and ceiling are lost (-30 %).
+    let dir = tempfile::tempdir().unwrap();
+    let settings = |res| Settings {
+        shaft_variants: Some(Variants::ALL),
+        voxel_res: VoxelRes::Cells(res),
+        shaft_res: Some(4),
+        ..fast_settings()
+    };
+    let file = lit_ceiling(dir.path(), settings(8));
+    let candidates = Options::new(&file, W, H).unshadowed().line_space_gi(1, GiStructure::Candidates);
+    converges_with(&file, 1, &candidates, 0.0);
+    let fine = tempfile::tempdir().unwrap();
+    let file = lit_ceiling(fine.path(), settings(32));
+    let pnmt = Options::new(&file, W, H).unshadowed().line_space_gi(1, GiStructure::Pnmt);
+    converges_with(&file, 1, &pnmt, 0.30);
 }
 
 #[test]
@@ -174,8 +214,14 @@ struct Quadrant {
 /// `gi_bounces` + 1 scattering events in each quadrant of the image of `file` (unshadowed: the
 /// direct pass's lights must see every pixel); returns the comparisons.
 fn converges(file: &Path, gi_bounces: u32) -> Vec<Quadrant> {
+    converges_with(file, gi_bounces, &Options::new(file, W, H).unshadowed().rt_gi(gi_bounces), 0.0)
+}
+
+/// [`converges`] for the GI technique of `options`, allowing a bias of `bias` (relative) on top
+/// of the noise.
+fn converges_with(file: &Path, gi_bounces: u32, options: &Options, bias: f64) -> Vec<Quadrant> {
     let t = Instant::now();
-    let gi = two_estimates(&Options::new(file, W, H).unshadowed().rt_gi(gi_bounces), FRAMES);
+    let gi = two_estimates(options, FRAMES);
     let reference: [Vec<f32>; 2] = [1u32, 2].map(|seed| {
         let sampling = Sampling { spp: SPP, seed, bounces: gi_bounces + 1, progress: false };
         let o = Options::new(file, W, H).reference().build();
@@ -190,7 +236,7 @@ fn converges(file: &Path, gi_bounces: u32) -> Vec<Quadrant> {
         // Four standard deviations of the difference, plus 0.5 % for the sRGB G-buffer's
         // approximate decoding on lavapipe and the direct pass's pixel centres against the
         // reference's pixel-wide box filter.
-        let tolerance = 4.0 * (s_gi * s_gi + s_ref * s_ref).sqrt() + 0.005 * m_ref;
+        let tolerance = 4.0 * (s_gi * s_gi + s_ref * s_ref).sqrt() + (0.005 + bias) * m_ref;
         eprintln!(
             "quadrant {rect:?}: GI {m_gi:.4} (±{s_gi:.4}), reference {m_ref:.4} (±{s_ref:.4}); \
              tolerance {tolerance:.4}"

@@ -40,7 +40,7 @@ fn line_space_settings() -> Settings {
     Settings {
         shaft_variants: Some(Variants::BINARY),
         voxel_res: VoxelRes::Cells(6),
-        shaft_res: 4,
+        shaft_res: Some(4),
         ..fast_settings()
     }
 }

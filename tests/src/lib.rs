@@ -10,7 +10,7 @@ use kiln_format::sections::Vertex;
 use kiln_player::camera::CameraOverride;
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{
-    Ao, GBuffer as GBufferTechnique, Gi, LsShadowTest, Purpose, ReflectionRes,
+    Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Purpose, ReflectionRes,
     Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::session::SessionOptions;
@@ -161,6 +161,13 @@ impl Options {
     /// Path-traced diffuse GI counting `bounces` scattering events after the visible surface.
     pub fn rt_gi(mut self, bounces: u32) -> Options {
         self.0.render.techniques.gi = Gi::Rt { bounces };
+        self
+    }
+
+    /// Path-traced GI through the line space with `bounces` bounces, bounce rays through
+    /// `structure`.
+    pub fn line_space_gi(mut self, bounces: u32, structure: GiStructure) -> Options {
+        self.0.render.techniques.gi = Gi::LineSpace { bounces, structure };
         self
     }
 

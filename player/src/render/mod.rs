@@ -28,7 +28,8 @@ use frame::Frame;
 use graph::{Access, FrameImages};
 use passes::{FrameCtx, Shared};
 pub use technique::{
-    Aa, Ao, Effect, GBuffer, Gi, LsShadowTest, Media, Needs, ReflectionRes, Reflections, Shadows, Techniques,
+    Aa, Ao, Effect, GBuffer, Gi, GiStructure, LsShadowTest, Media, Needs, ReflectionRes, Reflections,
+    Shadows, Techniques,
 };
 
 /// Shadow maps of each kind the direct-light pass can bind, and lights with a ray-traced shadow
