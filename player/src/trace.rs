@@ -45,14 +45,52 @@ pub struct GpuHit {
 /// `t` of a miss (`NO_HIT` in the shader).
 pub const NO_HIT: f32 = 3.402823e38;
 
+/// A compute kernel that traces a buffer of rays: its pipeline over one set (rewritten by every
+/// trace: the previous trace has finished by then), its command pool and timestamps. What the
+/// BVH's and the line space's queries share.
+pub(crate) struct TraceKernel {
+    pub(crate) layout: SetLayout,
+    pub(crate) set: vk::DescriptorSet,
+    pub(crate) pipeline: ComputePipeline,
+    pub(crate) pool: CommandPool,
+    pub(crate) timestamps: TimestampPool,
+}
+
+impl TraceKernel {
+    /// The kernel of `spirv` over `bindings`, with 8 bytes of push constants (count, mode); on
+    /// failure nothing is left behind.
+    pub(crate) fn new(gpu: &Gpu, bindings: &[Binding], spirv: &[u8]) -> PlayResult<TraceKernel> {
+        let mut layout = SetLayout::new(gpu, bindings, 1)?;
+        let pipeline = match ComputePipeline::new(gpu, spirv, &[&layout], 8) {
+            Ok(p) => p,
+            Err(e) => {
+                layout.destroy(gpu);
+                return Err(e);
+            }
+        };
+        let mut kernel = TraceKernel {
+            set: vk::DescriptorSet::null(),
+            pool: CommandPool::new(gpu, gpu.family)?,
+            timestamps: TimestampPool::new(gpu, 2)?,
+            layout,
+            pipeline,
+        };
+        kernel.set = kernel.layout.allocate(gpu)?;
+        Ok(kernel)
+    }
+
+    /// Releases everything.
+    pub(crate) fn destroy(&mut self, gpu: &Gpu) {
+        self.pool.destroy(gpu);
+        self.timestamps.destroy(gpu);
+        self.pipeline.destroy(gpu);
+        self.layout.destroy(gpu);
+    }
+}
+
 /// The compute traversal, bound to one scene's BVH.
 pub struct RayQuery {
-    layout: SetLayout,
-    /// One set, rewritten by every trace (the previous trace has finished by then).
-    set: vk::DescriptorSet,
-    pipeline: ComputePipeline,
-    pool: CommandPool,
-    timestamps: TimestampPool,
+    kernel: TraceKernel,
     /// Untimed traces recorded before each timed one (0; benchmarks set [`WARMUP_TRACES`]).
     pub warmup: u32,
 }
@@ -67,17 +105,7 @@ impl RayQuery {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<RayQuery> {
         let storage = Binding::one(BindingKind::Storage);
-        let mut layout = SetLayout::new(gpu, &[storage; 4], 1)?;
-        let pipeline = ComputePipeline::new(gpu, spirv::TRACE_RAYS, &[&layout], 8)?;
-        let set = layout.allocate(gpu)?;
-        Ok(RayQuery {
-            layout,
-            set,
-            pipeline,
-            pool: CommandPool::new(gpu, gpu.family)?,
-            timestamps: TimestampPool::new(gpu, 2)?,
-            warmup: 0,
-        })
+        Ok(RayQuery { kernel: TraceKernel::new(gpu, &[storage; 4], spirv::TRACE_RAYS)?, warmup: 0 })
     }
 
     /// Traces `rays` through `bvh`; returns one hit per ray and the GPU milliseconds of the
@@ -89,44 +117,34 @@ impl RayQuery {
         rays: &[GpuRay],
         any_hit: bool,
     ) -> PlayResult<(Vec<GpuHit>, f64)> {
-        let (layout, pipeline, set) = (&self.layout, &self.pipeline, self.set);
+        let k = &self.kernel;
+        let (layout, pipeline, set) = (&k.layout, &k.pipeline, k.set);
         let usage = vk::BufferUsageFlags::empty();
         // The set points at this trace's buffers; it is written once, before its first use (the
         // trace is recorded several times, and writing a bound set invalidates the recording).
         let written = std::cell::Cell::new(false);
-        timed_trace(
-            gpu,
-            &self.pool,
-            &self.timestamps,
-            rays,
-            usage,
-            self.warmup,
-            |rec, input, output, count| {
-                if !written.replace(true) {
-                    layout.write(
-                        gpu,
-                        set,
-                        &[
-                            Write::Buffer(0, &bvh.nodes),
-                            Write::Buffer(1, &bvh.triangles),
-                            Write::Buffer(2, input),
-                            Write::Buffer(3, output),
-                        ],
-                    );
-                }
-                let push: [u32; 2] = [count, any_hit as u32];
-                rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
-                vk::PipelineStageFlags2::COMPUTE_SHADER
-            },
-        )
+        timed_trace(gpu, &k.pool, &k.timestamps, rays, usage, self.warmup, |rec, input, output, count| {
+            if !written.replace(true) {
+                layout.write(
+                    gpu,
+                    set,
+                    &[
+                        Write::Buffer(0, &bvh.nodes),
+                        Write::Buffer(1, &bvh.triangles),
+                        Write::Buffer(2, input),
+                        Write::Buffer(3, output),
+                    ],
+                );
+            }
+            let push: [u32; 2] = [count, any_hit as u32];
+            rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
+            vk::PipelineStageFlags2::COMPUTE_SHADER
+        })
     }
 
     /// Releases the pipeline and its pools.
     pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pool.destroy(gpu);
-        self.timestamps.destroy(gpu);
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
+        self.kernel.destroy(gpu);
     }
 }
 

@@ -6,13 +6,11 @@
 use gpu_allocator::MemoryLocation;
 
 use crate::error::PlayResult;
-use crate::gpu::{
-    Binding, BindingKind, Buffer, CommandPool, ComputePipeline, Gpu, SetLayout, TimestampPool, Write, vk,
-};
+use crate::gpu::{Binding, BindingKind, Buffer, Gpu, Write, vk};
 use crate::render::spirv;
 use crate::scene::BvhBuffers;
 use crate::scene::linespace::LineSpaceBuffers;
-use crate::trace::{GpuHit, GpuRay, timed_trace};
+use crate::trace::{GpuHit, GpuRay, TraceKernel, timed_trace};
 
 /// Which query a trace runs (the shader's `mode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -57,11 +55,7 @@ impl LsQuery {
 
 /// The line-space queries, bound to one scene.
 pub struct LineSpaceQuery {
-    layout: SetLayout,
-    set: vk::DescriptorSet,
-    pipeline: ComputePipeline,
-    pool: CommandPool,
-    timestamps: TimestampPool,
+    kernel: TraceKernel,
     /// Untimed traces recorded before each timed one (see [`crate::trace::WARMUP_TRACES`]).
     pub warmup: u32,
 }
@@ -77,23 +71,7 @@ impl LineSpaceQuery {
     pub fn new(gpu: &Gpu) -> PlayResult<LineSpaceQuery> {
         let mut bindings = vec![Binding::one(BindingKind::Storage); 5];
         bindings.extend(LineSpaceBuffers::bindings());
-        let mut layout = SetLayout::new(gpu, &bindings, 1)?;
-        let pipeline = match ComputePipeline::new(gpu, spirv::TRACE_LINESPACE, &[&layout], 8) {
-            Ok(p) => p,
-            Err(e) => {
-                layout.destroy(gpu);
-                return Err(e);
-            }
-        };
-        let set = layout.allocate(gpu)?;
-        Ok(LineSpaceQuery {
-            layout,
-            set,
-            pipeline,
-            pool: CommandPool::new(gpu, gpu.family)?,
-            timestamps: TimestampPool::new(gpu, 2)?,
-            warmup: 0,
-        })
+        Ok(LineSpaceQuery { kernel: TraceKernel::new(gpu, &bindings, spirv::TRACE_LINESPACE)?, warmup: 0 })
     }
 
     /// Traces `rays` with `query`; `normals` (one per ray, or empty for none) are the geometric
@@ -121,13 +99,14 @@ impl LineSpaceQuery {
             bytes[..rays.len() * 16].copy_from_slice(bytemuck::cast_slice(normals));
         }
         let result = normal_buffer.write(&bytes).and_then(|()| {
-            let (layout, pipeline, set) = (&self.layout, &self.pipeline, self.set);
+            let k = &self.kernel;
+            let (layout, pipeline, set) = (&k.layout, &k.pipeline, k.set);
             let written = std::cell::Cell::new(false);
             let normal_buffer = &normal_buffer;
             timed_trace(
                 gpu,
-                &self.pool,
-                &self.timestamps,
+                &k.pool,
+                &k.timestamps,
                 rays,
                 vk::BufferUsageFlags::empty(),
                 self.warmup,
@@ -155,9 +134,6 @@ impl LineSpaceQuery {
 
     /// Releases the pipeline and its pools.
     pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pool.destroy(gpu);
-        self.timestamps.destroy(gpu);
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
+        self.kernel.destroy(gpu);
     }
 }
