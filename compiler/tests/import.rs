@@ -553,3 +553,60 @@ fn obj_mtl_specular_colour_and_mirrors() {
     );
     assert!(!s.warnings.iter().any(|w| w.message.contains("'matte'")), "{:?}", s.warnings);
 }
+
+/// The quad with one morph target lifting corners 2 and 3 by 1 along z.
+fn morphed_quad() -> Gltf {
+    let mut g = Gltf::quad();
+    let deltas: Vec<u8> = [[0.0f32, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let v = g.view(&deltas, None);
+    let a = g.accessor(Some(v), 5126, 4, "VEC3", json!({"min": [0.0, 0.0, 0.0], "max": [0.0, 0.0, 1.0]}));
+    g.json["meshes"][0]["primitives"][0]["targets"] = json!([{"POSITION": a}]);
+    g
+}
+
+#[test]
+fn morph_targets_apply_at_the_default_weights_node_over_mesh() {
+    let d = tempfile::tempdir().unwrap();
+    // The mesh's weight 0.25; no node weights: corners 2 and 3 at z = 0.25, the others unmoved.
+    let mut g = morphed_quad();
+    g.json["meshes"][0]["weights"] = json!([0.25]);
+    let s = import(&g.write(d.path(), "morph-mesh")).unwrap();
+    assert_eq!(s.vertices[2].position, [1.0, 1.0, 0.25]);
+    assert_eq!(s.vertices[3].position, [0.0, 1.0, 0.25]);
+    assert_eq!(s.vertices[1].position, [1.0, 0.0, 0.0]);
+    // The node's weights win over the mesh's.
+    g.json["nodes"][0]["weights"] = json!([1.0]);
+    let s = import(&g.write(d.path(), "morph-node")).unwrap();
+    assert_eq!(s.vertices[2].position, [1.0, 1.0, 1.0]);
+    // No weights anywhere: 0, the base shape.
+    let mut g = morphed_quad();
+    let s = import(&g.write(d.path(), "morph-none")).unwrap();
+    assert_eq!(s.vertices[2].position, [1.0, 1.0, 0.0]);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn animations_and_skins_are_warned_about_never_fatal() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    let times: Vec<u8> = [0.0f32, 1.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+    let tv = g.view(&times, None);
+    let input = g.accessor(Some(tv), 5126, 2, "SCALAR", json!({"min": [0.0], "max": [1.0]}));
+    let output = g.positions(&[[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]]);
+    g.json["animations"] = json!([{
+        "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": input, "output": output}]
+    }]);
+    g.json["nodes"] = json!([{"mesh": 0, "skin": 0}, {}]);
+    g.json["skins"] = json!([{"joints": [1]}]);
+    let s = import(&g.write(d.path(), "anim")).unwrap();
+    // Compiled at the rest transform: the animation's 5-unit move is not applied.
+    assert_eq!(s.vertices[1].position, [1.0, 0.0, 0.0]);
+    let text: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert!(text.iter().any(|w| w.contains("1 animation(s) not baked")), "{text:?}");
+    assert!(text.iter().any(|w| w.contains("node 0 is skinned")), "{text:?}");
+}

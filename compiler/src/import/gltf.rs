@@ -204,6 +204,14 @@ impl Importer<'_> {
                 doc.nodes().filter(|n| !child[n.index()]).collect()
             }
         };
+        let animations = doc.animations().count();
+        if animations > 0 {
+            self.scene.warn(format!(
+                "{}: {animations} animation(s) not baked: the scene is compiled at the nodes' rest \
+                 transforms and default morph weights",
+                self.file
+            ));
+        }
         let mut path = Vec::new();
         for root in roots {
             self.visit(root, DMat4::IDENTITY, &mut path)?;
@@ -229,7 +237,17 @@ impl Importer<'_> {
             )));
         }
         if let Some(mesh) = node.mesh() {
-            self.add_mesh(&mesh, &world)?;
+            if node.skin().is_some() {
+                self.scene.warn(format!(
+                    "{}: node {} is skinned: its mesh is compiled at the node's rest transform, the skin \
+                     is not applied",
+                    self.file,
+                    node.index()
+                ));
+            }
+            // glTF: a node's morph weights override its mesh's; absent weights are 0.
+            let weights: Vec<f32> = node.weights().or(mesh.weights()).unwrap_or(&[]).to_vec();
+            self.add_mesh(&mesh, &world, &weights)?;
         }
         if let Some(camera) = node.camera() {
             self.add_camera(&camera, &world, node.index());
@@ -252,7 +270,7 @@ impl Importer<'_> {
         }
     }
 
-    fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: &DMat4) -> CliResult<()> {
+    fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: &DMat4, weights: &[f32]) -> CliResult<()> {
         let mirrored = world.determinant() < 0.0;
         let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
         for prim in mesh.primitives() {
@@ -268,12 +286,43 @@ impl Importer<'_> {
             self.check_accessor(&pos_acc, &at, "POSITION", &[Dimensions::Vec3], &[DataType::F32], false)?;
             let count = pos_acc.count();
             let reader = prim.reader(|b| self.buffers.get(b.index()).map(Vec::as_slice));
-            let local_pos: Vec<[f32; 3]> = reader
+            let mut local_pos: Vec<[f32; 3]> = reader
                 .read_positions()
                 .ok_or_else(|| {
                     CliError::input(format!("{at}: POSITION accessor {} has no data", pos_acc.index()))
                 })?
                 .collect();
+            // Morph targets at the default weights (the scene is static: no animation moves them).
+            let mut normal_deltas: Vec<(f32, Vec<[f32; 3]>)> = Vec::new();
+            for (k, target) in prim.morph_targets().enumerate() {
+                let w = weights.get(k).copied().unwrap_or(0.0);
+                if !w.is_finite() {
+                    return Err(CliError::input(format!("{at}: morph weight {k} is not finite: {w}")));
+                }
+                for (acc, what) in [(target.positions(), "POSITION"), (target.normals(), "NORMAL")] {
+                    if let Some(acc) = acc {
+                        let name = format!("morph target {k} {what}");
+                        self.check_accessor(&acc, &at, &name, &[Dimensions::Vec3], &[DataType::F32], false)?;
+                        self.check_count(&acc, count, &at, &name)?;
+                    }
+                }
+            }
+            for (k, (positions, normals, _)) in reader.read_morph_targets().enumerate() {
+                let w = weights.get(k).copied().unwrap_or(0.0);
+                if w == 0.0 {
+                    continue;
+                }
+                if let Some(deltas) = positions {
+                    for (p, d) in local_pos.iter_mut().zip(deltas) {
+                        for a in 0..3 {
+                            p[a] += w * d[a];
+                        }
+                    }
+                }
+                if let Some(deltas) = normals {
+                    normal_deltas.push((w, deltas.collect()));
+                }
+            }
             let mut positions = Vec::with_capacity(count);
             for (i, p) in local_pos.iter().enumerate() {
                 let w = world.transform_point3(DVec3::from(p.map(f64::from))).as_vec3().to_array();
@@ -285,7 +334,17 @@ impl Importer<'_> {
                 Some(acc) => {
                     self.check_accessor(&acc, &at, "NORMAL", &[Dimensions::Vec3], &[DataType::F32], false)?;
                     self.check_count(&acc, count, &at, "NORMAL")?;
-                    reader.read_normals().map(|it| it.collect())
+                    reader.read_normals().map(|it| {
+                        let mut n: Vec<[f32; 3]> = it.collect();
+                        for (w, deltas) in &normal_deltas {
+                            for (v, d) in n.iter_mut().zip(deltas) {
+                                for a in 0..3 {
+                                    v[a] += w * d[a];
+                                }
+                            }
+                        }
+                        n
+                    })
                 }
                 None => None,
             };
