@@ -610,3 +610,61 @@ fn animations_and_skins_are_warned_about_never_fatal() {
     assert!(text.iter().any(|w| w.contains("1 animation(s) not baked")), "{text:?}");
     assert!(text.iter().any(|w| w.contains("node 0 is skinned")), "{text:?}");
 }
+
+/// The quad with base-colour texture coordinates in sets 0 and 1 and a material whose base
+/// colour texture reads `tex_coord`, with `transform` (a `KHR_texture_transform` object) if given.
+fn two_uv_sets(tex_coord: u32, transform: Option<serde_json::Value>) -> Gltf {
+    let mut g = Gltf::quad();
+    g.textured(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}), "white.png");
+    let uv1: Vec<u8> = [[0.5f32, 0.25], [0.75, 0.25], [0.75, 0.5], [0.5, 0.5]]
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let v = g.view(&uv1, None);
+    let a = g.accessor(Some(v), 5126, 4, "VEC2", json!({}));
+    g.json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = a.into();
+    let info = &mut g.json["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"];
+    info["texCoord"] = tex_coord.into();
+    if let Some(t) = transform {
+        info["extensions"] = json!({ "KHR_texture_transform": t });
+        g.json["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    }
+    g
+}
+
+fn write_white_png(dir: &std::path::Path) {
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 255, 255, 255]))
+        .save(dir.join("white.png"))
+        .unwrap();
+}
+
+#[test]
+fn texcoord_set_1_is_read_when_the_material_samples_it() {
+    let d = tempfile::tempdir().unwrap();
+    write_white_png(d.path());
+    let s = import(&two_uv_sets(1, None).write(d.path(), "set1")).unwrap();
+    assert_eq!(s.uvs[..4], [[0.5, 0.25], [0.75, 0.25], [0.75, 0.5], [0.5, 0.5]]);
+    let s = import(&two_uv_sets(0, None).write(d.path(), "set0")).unwrap();
+    assert_eq!(s.uvs[..4], [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn texture_transforms_are_baked_into_the_coordinates() {
+    let d = tempfile::tempdir().unwrap();
+    write_white_png(d.path());
+    // The extension's matrix, translation · rotation · scale, applied by hand: with rotation
+    // π/2 (cos 0, sin 1), scale (2, 3), offset (0.5, 0): u' = -3 v + 0.5, v' = 2 u.
+    let t = json!({"offset": [0.5, 0.0], "rotation": std::f32::consts::FRAC_PI_2, "scale": [2.0, 3.0]});
+    let s = import(&two_uv_sets(0, Some(t)).write(d.path(), "tt")).unwrap();
+    let want = [[0.5f32, 0.0], [0.5, 2.0], [-2.5, 2.0], [-2.5, 0.0]];
+    for (got, want) in s.uvs.iter().zip(want) {
+        assert!((got[0] - want[0]).abs() < 1e-6 && (got[1] - want[1]).abs() < 1e-6, "{got:?} vs {want:?}");
+    }
+    // The extension's texCoord overrides the reference's.
+    let t = json!({"texCoord": 1, "offset": [1.0, 0.0]});
+    let s = import(&two_uv_sets(0, Some(t)).write(d.path(), "tt1")).unwrap();
+    assert_eq!(s.uvs[0], [1.5, 0.25]);
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}

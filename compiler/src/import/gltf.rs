@@ -22,7 +22,42 @@ use crate::ir::{Material, Scene, TextureRole};
 use crate::settings::Normals;
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
-const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_texture_transform"];
+
+/// How a material's textures map a primitive's texture coordinates: the set they read and the
+/// `KHR_texture_transform` they apply (baked into the stored coordinates, which the format holds
+/// one set of).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct UvMapping {
+    /// `TEXCOORD_n`.
+    set: u32,
+    /// u' = m[0]·u + m[1]·v + m[2], v' = m[3]·u + m[4]·v + m[5].
+    matrix: [f32; 6],
+}
+
+impl UvMapping {
+    const IDENTITY: [f32; 6] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+    /// The mapping of a texture reference: its set, or the transform's override of it, and the
+    /// transform's offset · rotation · scale (glTF's `KHR_texture_transform`).
+    fn of(tex_coord: u32, transform: Option<::gltf::texture::TextureTransform>) -> UvMapping {
+        let Some(t) = transform else { return UvMapping { set: tex_coord, matrix: Self::IDENTITY } };
+        let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
+        let (sn, c) = r.sin_cos();
+        UvMapping {
+            set: t.tex_coord().unwrap_or(tex_coord),
+            // translation · rotation · scale as the extension's GLSL writes them (column-major
+            // `mat3(cos, sin, 0, -sin, cos, 0, 0, 0, 1)`).
+            matrix: [c * sx, -sn * sy, ox, sn * sx, c * sy, oy],
+        }
+    }
+
+    fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
+        let m = &self.matrix;
+        [m[0] * uv[0] + m[1] * uv[1] + m[2], m[3] * uv[0] + m[4] * uv[1] + m[5]]
+    }
+}
 
 /// World triangles beyond this are refused (instancing can multiply a small file's geometry).
 const MAX_TRIANGLES: usize = 1 << 28;
@@ -37,6 +72,8 @@ struct Importer<'a> {
     materials: HashMap<Option<usize>, u32>,
     /// (glTF texture index, role) → IR texture index.
     textures: HashMap<(usize, TextureRole), u32>,
+    /// IR material index → how its textures read texture coordinates.
+    uv_mappings: HashMap<u32, UvMapping>,
     requests: Vec<TextureRequest>,
     /// Normals where a primitive has no NORMAL attribute.
     normals: Normals,
@@ -72,6 +109,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
         scene,
         materials: HashMap::new(),
         textures: HashMap::new(),
+        uv_mappings: HashMap::new(),
         requests: Vec::new(),
         normals,
     };
@@ -280,6 +318,7 @@ impl Importer<'_> {
                 self.scene.warn(format!("{at}: mode {mode:?} has no triangles; skipped"));
                 continue;
             }
+            let material = self.material(prim.material())?;
             let pos_acc = prim
                 .get(&::gltf::Semantic::Positions)
                 .ok_or_else(|| CliError::input(format!("{at}: has no POSITION attribute")))?;
@@ -348,25 +387,28 @@ impl Importer<'_> {
                 }
                 None => None,
             };
-            let uvs: Option<Vec<[f32; 2]>> = match prim.get(&::gltf::Semantic::TexCoords(0)) {
+            let mapping = self.uv_mappings.get(&material).copied().unwrap_or(UvMapping::of(0, None));
+            let set = mapping.set;
+            let uv_name = format!("TEXCOORD_{set}");
+            let uvs: Option<Vec<[f32; 2]>> = match prim.get(&::gltf::Semantic::TexCoords(set)) {
                 Some(acc) => {
                     self.check_accessor(
                         &acc,
                         &at,
-                        "TEXCOORD_0",
+                        &uv_name,
                         &[Dimensions::Vec2],
                         &[DataType::F32, DataType::U8, DataType::U16],
                         true,
                     )?;
-                    self.check_count(&acc, count, &at, "TEXCOORD_0")?;
-                    reader.read_tex_coords(0).map(|it| it.into_f32().collect())
+                    self.check_count(&acc, count, &at, &uv_name)?;
+                    reader.read_tex_coords(set).map(|it| it.into_f32().map(|uv| mapping.apply(uv)).collect())
                 }
                 None => None,
             };
             if let Some((i, uv)) =
                 uvs.iter().flatten().enumerate().find(|(_, uv)| !uv.iter().all(|c| c.is_finite()))
             {
-                return Err(CliError::input(format!("{at}: TEXCOORD_0 element {i} is not finite: {uv:?}")));
+                return Err(CliError::input(format!("{at}: {uv_name} element {i} is not finite: {uv:?}")));
             }
 
             let indices: Vec<u32> = match prim.indices() {
@@ -432,7 +474,6 @@ impl Importer<'_> {
             };
             let (source, normals, tris) = split_by_normal(count, &tris, &corners);
 
-            let material = self.material(prim.material())?;
             if self.scene.triangles.len() + tris.len() > MAX_TRIANGLES {
                 return Err(CliError::input(format!(
                     "{}: the scene expands to more than {MAX_TRIANGLES} triangles",
@@ -616,34 +657,53 @@ impl Importer<'_> {
         if m.double_sided() {
             gpu.flags |= MaterialFlags::DOUBLE_SIDED;
         }
-        let slot = |this: &mut Self, tex: Option<(::gltf::Texture, u32)>, role| -> u32 {
-            match tex {
-                Some((t, 0)) => this.texture(t, role),
-                Some((t, set)) => {
-                    this.scene.warn(format!(
-                        "{}: material '{name}' samples texture {} with TEXCOORD_{set}; only set 0 is supported, the texture is ignored",
-                        this.file,
-                        t.index()
-                    ));
-                    NO_TEXTURE
-                }
-                None => NO_TEXTURE,
+        // Every texture of the material reads one set of coordinates through one transform (the
+        // format stores one set per vertex, with the transform baked in); the first texture's
+        // mapping is that of all, and a texture mapped otherwise is named in a warning.
+        fn info(i: ::gltf::texture::Info<'_>) -> (::gltf::Texture<'_>, UvMapping) {
+            (i.texture(), UvMapping::of(i.tex_coord(), i.texture_transform()))
+        }
+        let refs = [
+            pbr.base_color_texture().map(info),
+            pbr.metallic_roughness_texture().map(info),
+            m.normal_texture().map(|i| (i.texture(), UvMapping::of(i.tex_coord(), None))),
+            m.occlusion_texture().map(|i| (i.texture(), UvMapping::of(i.tex_coord(), None))),
+            m.emissive_texture().map(info),
+        ];
+        let mapping = refs.iter().flatten().map(|(_, u)| *u).next().unwrap_or(UvMapping::of(0, None));
+        for (t, u) in refs.iter().flatten() {
+            if u.set != mapping.set || (u.matrix != mapping.matrix && u.matrix != UvMapping::IDENTITY) {
+                self.scene.warn(format!(
+                    "{}: material '{name}' maps texture {} with other texture coordinates or another \
+                     transform than its first texture; it is sampled with the first's (TEXCOORD_{})",
+                    self.file,
+                    t.index(),
+                    mapping.set
+                ));
             }
-        };
-        gpu.base_color_texture =
-            slot(self, pbr.base_color_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Color);
-        gpu.metallic_roughness_texture = slot(
-            self,
-            pbr.metallic_roughness_texture().map(|i| (i.texture(), i.tex_coord())),
+        }
+        let roles = [
+            TextureRole::Color,
             TextureRole::Data,
-        );
-        gpu.normal_texture =
-            slot(self, m.normal_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Normal);
-        gpu.occlusion_texture =
-            slot(self, m.occlusion_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Data);
-        gpu.emissive_texture =
-            slot(self, m.emissive_texture().map(|i| (i.texture(), i.tex_coord())), TextureRole::Color);
+            TextureRole::Normal,
+            TextureRole::Data,
+            TextureRole::Color,
+        ];
+        let mut slots = [NO_TEXTURE; 5];
+        for (k, r) in refs.into_iter().enumerate() {
+            if let Some((t, _)) = r {
+                slots[k] = self.texture(t, roles[k]);
+            }
+        }
+        [
+            gpu.base_color_texture,
+            gpu.metallic_roughness_texture,
+            gpu.normal_texture,
+            gpu.occlusion_texture,
+            gpu.emissive_texture,
+        ] = slots;
         let index = self.scene.materials.len() as u32;
+        self.uv_mappings.insert(index, mapping);
         self.scene.materials.push(Material { name, gpu });
         self.materials.insert(m.index(), index);
         Ok(index)
