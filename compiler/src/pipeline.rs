@@ -280,7 +280,9 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         line_space_bytes: baked
             .sections
             .iter()
-            .filter(|x| crate::bake::linespace::stages::SECTION_KINDS.contains(&x.kind))
+            .filter(|x| {
+                x.kind == kiln_format::sections::GRID || kiln_format::linespace::SECTIONS.contains(&x.kind)
+            })
             .map(|x| x.bytes.len() as u64)
             .sum(),
     };

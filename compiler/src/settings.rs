@@ -143,33 +143,17 @@ pub fn parse_variants(s: &str) -> Result<u32, String> {
     }
     let mut v = 0;
     for part in s.split(',').map(str::trim) {
-        v |= match part {
-            "binary" => Variants::BINARY,
-            "candidates" => Variants::CANDIDATES,
-            "pnmt" => Variants::PNMT,
-            "preillum" => Variants::PREILLUM,
-            other => {
-                return Err(format!(
-                    "unknown shaft variant '{other}' (use binary, candidates, pnmt, preillum or none)"
-                ));
-            }
-        };
+        v |=
+            Variants::NAMES.iter().find(|(_, name)| *name == part).map(|(bit, _)| *bit).ok_or_else(|| {
+                format!("unknown shaft variant '{part}' (use binary, candidates, pnmt, preillum or none)")
+            })?;
     }
     Ok(v)
 }
 
 /// A variant set as text.
 pub fn variants_name(v: u32) -> String {
-    let names: Vec<&str> = [
-        (Variants::BINARY, "binary"),
-        (Variants::CANDIDATES, "candidates"),
-        (Variants::PNMT, "pnmt"),
-        (Variants::PREILLUM, "preillum"),
-    ]
-    .into_iter()
-    .filter_map(|(bit, name)| (v & bit != 0).then_some(name))
-    .collect();
-    if names.is_empty() { "none".into() } else { names.join(",") }
+    Variants::list(v)
 }
 
 /// Largest crease angle of `--normals smooth:ANGLE`, degrees.

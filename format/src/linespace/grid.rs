@@ -22,6 +22,19 @@ impl Variants {
     pub const ALL: u32 = Self::BINARY | Self::CANDIDATES | Self::PNMT | Self::PREILLUM;
     /// What the compiler bakes by default for a lit scene (within its size budget).
     pub const DEFAULT: u32 = Self::BINARY | Self::CANDIDATES | Self::PNMT;
+    /// Each variant with its name in `--shaft-variants` lists.
+    pub const NAMES: [(u32, &'static str); 4] = [
+        (Self::BINARY, "binary"),
+        (Self::CANDIDATES, "candidates"),
+        (Self::PNMT, "pnmt"),
+        (Self::PREILLUM, "preillum"),
+    ];
+
+    /// A variant set as a `--shaft-variants` list (`none` for the empty set).
+    pub fn list(v: u32) -> String {
+        let names: Vec<&str> = Self::NAMES.iter().filter(|(bit, _)| v & bit != 0).map(|(_, n)| *n).collect();
+        if names.is_empty() { "none".into() } else { names.join(",") }
+    }
 }
 
 /// Header of the voxel grid and line space (section `VGRD`, one element). 96 bytes.

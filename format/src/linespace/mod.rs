@@ -28,6 +28,20 @@ use crate::sections::{
 };
 use index::{MAX_SHAFT_RES, shafts_per_voxel};
 
+/// The sections that follow the `VGRD` header: the voxel grid's cell lists, then the line
+/// space's variants, in the order the player lays them out for its queries.
+pub const SECTIONS: [crate::table::SectionKind; 9] = [
+    VOXEL_OFFSETS,
+    VOXEL_TRIANGLES,
+    SHAFT_SLOTS,
+    SHAFT_BITS,
+    SHAFT_RANKS,
+    CANDIDATE_OFFSETS,
+    CANDIDATES,
+    PNMT,
+    PREILLUM,
+];
+
 /// Slot value of an empty cell.
 pub const NO_SLOT: u32 = u32::MAX;
 
@@ -98,17 +112,7 @@ impl<'a> LineSpace<'a> {
     /// `materials` are the scene's counts.
     pub fn new(file: &'a KilnFile, triangles: usize, materials: usize) -> Result<Option<LineSpace<'a>>> {
         let Some(header) = file.pod::<GridHeader>(GRID, 0)? else {
-            for k in [
-                VOXEL_OFFSETS,
-                VOXEL_TRIANGLES,
-                SHAFT_SLOTS,
-                SHAFT_BITS,
-                SHAFT_RANKS,
-                CANDIDATE_OFFSETS,
-                CANDIDATES,
-                PNMT,
-                PREILLUM,
-            ] {
+            for k in SECTIONS {
                 if file.find(k, 0).is_some() {
                     return Err(bad(format!("section {k} without a VGRD header")));
                 }

@@ -10,9 +10,8 @@
 
 use kiln_format::gpu::GpuGrid;
 use kiln_format::linespace::glsl::{MAX_CHUNKS, NO_BASE};
-use kiln_format::linespace::{LineSpace, Variants};
+use kiln_format::linespace::{LineSpace, SECTIONS, Variants};
 use kiln_format::read::KilnFile;
-use kiln_format::sections::{self, PNMT, PREILLUM};
 use kiln_format::table::SectionKind;
 
 use crate::error::{Exit, PlayError, PlayResult};
@@ -53,53 +52,38 @@ impl LsArrays {
     pub const BINARY_QUERY: u32 = Self::CELL_LISTS | Self::SHAFTS;
 }
 
-/// The arrays in [`GpuGrid`] base order, with their section and the bit that asks for them.
-const ARRAYS: [(SectionKind, u32); 9] = [
-    (sections::VOXEL_OFFSETS, LsArrays::CELL_LISTS),
-    (sections::VOXEL_TRIANGLES, LsArrays::CELL_LISTS),
-    (sections::SHAFT_SLOTS, LsArrays::SHAFTS),
-    (sections::SHAFT_BITS, LsArrays::SHAFTS),
-    (sections::SHAFT_RANKS, LsArrays::RANKS),
-    (sections::CANDIDATE_OFFSETS, LsArrays::CANDIDATES),
-    (sections::CANDIDATES, LsArrays::CANDIDATES),
-    (PNMT, LsArrays::PNMT),
-    (PREILLUM, LsArrays::PREILLUM),
+/// The bit that asks for each of `kiln_format::linespace::SECTIONS` (the [`GpuGrid`] base order).
+const ARRAY_BITS: [u32; 9] = [
+    LsArrays::CELL_LISTS,
+    LsArrays::CELL_LISTS,
+    LsArrays::SHAFTS,
+    LsArrays::SHAFTS,
+    LsArrays::RANKS,
+    LsArrays::CANDIDATES,
+    LsArrays::CANDIDATES,
+    LsArrays::PNMT,
+    LsArrays::PREILLUM,
 ];
 
-/// The variant flag a `--shaft-variants` list needs for each array bit.
-fn variant_of(bit: u32) -> (u32, &'static str) {
+/// The variant that holds the arrays of `bit` (the voxel grid's cell lists come with any).
+fn variant_of(bit: u32) -> u32 {
     match bit {
-        LsArrays::CANDIDATES => (Variants::CANDIDATES, "candidates"),
-        LsArrays::PNMT => (Variants::PNMT, "pnmt"),
-        LsArrays::PREILLUM => (Variants::PREILLUM, "preillum"),
-        _ => (Variants::BINARY, "binary"),
+        LsArrays::CANDIDATES => Variants::CANDIDATES,
+        LsArrays::PNMT => Variants::PNMT,
+        LsArrays::PREILLUM => Variants::PREILLUM,
+        _ => Variants::BINARY,
     }
 }
 
-/// The `--shaft-variants` a file must hold for the arrays `wanted` asks for (0 for none).
+/// The variants that hold the arrays `bits` asks for.
+fn variants_of(bits: u32) -> u32 {
+    (0..6).map(|i| 1u32 << i).filter(|b| bits & b != 0).fold(0, |v, b| v | variant_of(b))
+}
+
+/// The `--shaft-variants` a file must hold for the arrays `wanted` asks for (0 for none): the
+/// binary variant indexes every other.
 pub fn variants_needed(wanted: u32) -> u32 {
-    if wanted & LsArrays::ALL == 0 {
-        return 0;
-    }
-    [LsArrays::CANDIDATES, LsArrays::PNMT, LsArrays::PREILLUM]
-        .iter()
-        .filter(|&&b| wanted & b != 0)
-        .fold(Variants::BINARY, |v, &b| v | variant_of(b).0)
-}
-
-/// `variants` as a `--shaft-variants` list.
-pub fn variants_list(variants: u32) -> String {
-    let names: Vec<&str> = [
-        (Variants::BINARY, "binary"),
-        (Variants::CANDIDATES, "candidates"),
-        (Variants::PNMT, "pnmt"),
-        (Variants::PREILLUM, "preillum"),
-    ]
-    .iter()
-    .filter(|(v, _)| variants & v != 0)
-    .map(|(_, n)| *n)
-    .collect();
-    names.join(",")
+    if wanted & LsArrays::ALL == 0 { 0 } else { Variants::BINARY | variants_of(wanted) }
 }
 
 /// Where each needed array goes in the word space, decided on the CPU before the device exists.
@@ -107,7 +91,7 @@ pub fn variants_list(variants: u32) -> String {
 pub struct LineSpaceLayout {
     /// The header as the shaders read it (`chunk_shift` set at upload).
     pub grid: GpuGrid,
-    /// Base word of each of [`ARRAYS`] (or [`NO_BASE`]).
+    /// Base word of each of `SECTIONS` (or [`NO_BASE`]).
     bases: [u32; 9],
     /// Words in the space.
     pub words: u64,
@@ -135,27 +119,20 @@ impl LineSpaceLayout {
             return Err(missing("the file has no voxel grid or line space", wanted));
         };
         let h = ls.header;
-        let present = |bit: u32| -> bool {
-            let (variant, _) = variant_of(bit);
-            match bit {
-                LsArrays::CELL_LISTS => true,
-                _ => h.variants & variant != 0,
-            }
-        };
+        let present = |bit: u32| bit == LsArrays::CELL_LISTS || h.variants & variant_of(bit) != 0;
         let mut wanted = wanted;
         if wanted & LsArrays::CANDIDATES_IF_PRESENT != 0 && h.variants & Variants::CANDIDATES != 0 {
             wanted |= LsArrays::RANKS | LsArrays::CANDIDATES;
         }
         let lacking: u32 = (0..6).map(|i| 1u32 << i).filter(|&b| wanted & b != 0 && !present(b)).sum();
         if lacking != 0 && !optional {
-            let names: Vec<&str> =
-                (0..6).map(|i| 1u32 << i).filter(|b| lacking & b != 0).map(|b| variant_of(b).1).collect();
-            return Err(missing(&format!("the file's line space lacks {}", dedup(names).join(", ")), wanted));
+            let what = format!("the file's line space lacks {}", Variants::list(variants_of(lacking)));
+            return Err(missing(&what, wanted));
         }
         let mut bases = [NO_BASE; 9];
         let mut words = 0u64;
-        for (i, (kind, bit)) in ARRAYS.iter().enumerate() {
-            if wanted & bit == 0 || !present(*bit) {
+        for (i, (kind, &bit)) in SECTIONS.iter().zip(&ARRAY_BITS).enumerate() {
+            if wanted & bit == 0 || !present(bit) {
                 continue;
             }
             let n = file.find(*kind, 0).map_or(0, |s| s.entry.raw_size / 4);
@@ -191,7 +168,7 @@ impl LineSpaceLayout {
 
     /// Base word of `kind`'s array, if it is uploaded.
     fn base_of(&self, kind: SectionKind) -> Option<u64> {
-        let i = ARRAYS.iter().position(|(k, _)| *k == kind)?;
+        let i = SECTIONS.iter().position(|k| *k == kind)?;
         (self.bases[i] != NO_BASE).then_some(self.bases[i] as u64)
     }
 
@@ -201,18 +178,13 @@ impl LineSpaceLayout {
     }
 }
 
-fn dedup(mut v: Vec<&str>) -> Vec<&str> {
-    v.dedup();
-    v
-}
-
 fn missing(what: &str, wanted: u32) -> PlayError {
     PlayError::new(
         Exit::Usage,
         format!(
             "{what}, which the chosen technique reads: recompile the scene with \
              `kiln compile --shaft-variants {}` (or choose another technique)",
-            variants_list(variants_needed(wanted))
+            Variants::list(variants_needed(wanted))
         ),
     )
 }
@@ -290,10 +262,15 @@ impl LineSpaceBuffers {
         Ok(made)
     }
 
-    /// Uploads the section `kind` (its bytes) if it is one of the arrays, split at chunk
-    /// boundaries. Returns whether it was.
-    pub fn upload(&self, kind: SectionKind, bytes: &[u8], up: &mut Uploader) -> PlayResult<bool> {
-        let Some(base) = self.layout.base_of(kind) else { return Ok(false) };
+    /// Whether the section `kind` is one of the uploaded arrays.
+    pub fn uploads(&self, kind: SectionKind) -> bool {
+        self.layout.uploads(kind)
+    }
+
+    /// Uploads the section `kind` (its bytes), one of the arrays ([`Self::uploads`]), split at
+    /// chunk boundaries.
+    pub fn upload(&self, kind: SectionKind, bytes: &[u8], up: &mut Uploader) -> PlayResult {
+        let Some(base) = self.layout.base_of(kind) else { return Ok(()) };
         let chunk_bytes = 4u64 << self.header.chunk_shift;
         let mut at = base * 4;
         let mut done = 0usize;
@@ -304,7 +281,7 @@ impl LineSpaceBuffers {
             done += n;
             at += n as u64;
         }
-        Ok(true)
+        Ok(())
     }
 
     /// The bindings [`Self::writes`] fills: the header, then [`MAX_CHUNKS`] storage buffers.

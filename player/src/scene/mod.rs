@@ -392,15 +392,11 @@ impl GpuScene {
             };
             let mut fate =
                 SectionFate { section: name, bytes: s.entry.raw_size, uploaded: true, reason: String::new() };
-            let line_space_array = match (&self.line_space, s.known.is_some()) {
-                (Some(ls), true) => ls.upload(kind, &file.section_bytes(s).map_err(bad)?, up)?,
-                _ => false,
-            };
             if s.known.is_none() {
                 fate.uploaded = false;
                 fate.reason = "unknown kind or newer version".into();
-            } else if line_space_array {
-                // Uploaded into the line space's chunks above.
+            } else if let Some(ls) = self.line_space.as_ref().filter(|l| l.uploads(kind)) {
+                ls.upload(kind, &file.section_bytes(s).map_err(bad)?, up)?;
             } else if let (Some(r), true) = (&self.reference, kind == sections::MATERIALS) {
                 up.buffer(&r.materials, 0, bytemuck::cast_slice(view.materials))?;
             } else if let (Some(r), true) = (&self.reference, kind == sections::TRIANGLE_MATERIALS) {

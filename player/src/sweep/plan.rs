@@ -7,7 +7,8 @@ use std::fmt;
 
 use crate::render::technique::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
 use crate::render::{Aa, Effect, Needs, Shadows, Techniques};
-use crate::scene::linespace::{variants_list, variants_needed};
+use crate::scene::linespace::variants_needed;
+use kiln_format::linespace::Variants;
 
 /// What one chart of a sweep shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -101,8 +102,8 @@ impl Offers {
         } else if variants & !self.line_space != 0 {
             Some(format!(
                 "needs the line space's {}, which the file does not have (compile with --shaft-variants {})",
-                variants_list(variants & !self.line_space),
-                variants_list(variants | self.line_space)
+                Variants::list(variants & !self.line_space),
+                Variants::list(variants | self.line_space)
             ))
         } else {
             None
@@ -372,8 +373,7 @@ mod tests {
         }
     }
 
-    const ALL_OFFERED: Offers =
-        Offers { bvh: true, shadow_maps: true, line_space: kiln_format::linespace::Variants::ALL };
+    const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true, line_space: Variants::ALL };
 
     #[test]
     fn every_catalogue_technique_of_an_effect_is_swept() {

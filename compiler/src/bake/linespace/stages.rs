@@ -10,19 +10,6 @@ use kiln_format::sections::{
 
 use super::BakedLineSpace;
 
-/// Every section the voxel-grid and line-space stages write: what `--line-space-budget` bounds.
-pub const SECTION_KINDS: [kiln_format::SectionKind; 10] = [
-    GRID,
-    VOXEL_OFFSETS,
-    VOXEL_TRIANGLES,
-    SHAFT_SLOTS,
-    SHAFT_BITS,
-    SHAFT_RANKS,
-    CANDIDATE_OFFSETS,
-    CANDIDATES,
-    PNMT,
-    PREILLUM,
-];
 use crate::bake::{BakeContext, Sections};
 use crate::exit::CliResult;
 
