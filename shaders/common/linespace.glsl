@@ -4,7 +4,8 @@
 //   - ls_any_binary:      conservative any hit from the shaft bits alone;
 //   - ls_occluded_binary: the bits, with exact triangle tests in filled cells near the ray's
 //                         ends (no self-shadowing, no "voxel offset") or in every filled cell
-//                         (the exact answer, the bits as a skip test);
+//                         (the exact answer, the bits as a skip test); ls_occluded and
+//                         ls_occluded_dir wrap it for shadow rays from a surface point;
 //   - ls_trace_candidates: closest or any hit through the candidate lists (exact);
 //   - ls_pnmt_hit:        the approximate hit stored for the shaft (PNMT), with the self-hit rule;
 //   - ls_preillum:        the pre-illuminated radiance of a shaft's front or back hit.
@@ -326,6 +327,21 @@ bool ls_occluded_binary(TraceRay r, bool exact_everywhere) {
         }
     }
     return false;
+}
+
+// Whether the segment from `from`, on a surface of geometric normal `ng` (the side it leaves
+// by), to `to` is blocked, through ls_occluded_binary: the origin offset and the end pulled back
+// as scene.glsl's `occluded` does them, so that neither end's own surface blocks.
+bool ls_occluded(vec3 from, vec3 ng, vec3 to, bool exact_everywhere) {
+    vec3 o = offset_ray_origin(from, ng);
+    vec3 d = to - o;
+    float dist = length(d);
+    return dist > 0.0 && ls_occluded_binary(make_ray(o, d / dist, 0.0, dist * (1.0 - 1e-5)), exact_everywhere);
+}
+
+// The same for the unbounded ray along `dir` (directional lights, the sky).
+bool ls_occluded_dir(vec3 from, vec3 ng, vec3 dir, bool exact_everywhere) {
+    return ls_occluded_binary(make_ray(offset_ray_origin(from, ng), dir, 0.0, 3.4e38), exact_everywhere);
 }
 
 // ---------------------------------------------------------------- candidates

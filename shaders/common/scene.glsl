@@ -124,6 +124,16 @@ Surface surface_at(TraceRay r, TraceHit h) {
     return s;
 }
 
+// The closest surface along r through the BVH: true and the surface, or false on a miss.
+bool trace_surface(TraceRay r, out Surface s) {
+    TraceHit h = trace(r, false);
+    if (h.t == NO_HIT) {
+        return false;
+    }
+    s = surface_at(r, h);
+    return true;
+}
+
 // ---------------------------------------------------------------- BRDF sampling
 float luminance(vec3 c) {
     return dot(c, vec3(0.2126, 0.7152, 0.0722));

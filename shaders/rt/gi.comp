@@ -5,12 +5,7 @@
 #include "hybrid.glsl"
 
 bool gi_hit(TraceRay r, vec3 origin_ng, bool exact, out Surface s) {
-    TraceHit h = trace(r, false);
-    if (h.t == NO_HIT) {
-        return false;
-    }
-    s = surface_at(r, h);
-    return true;
+    return trace_surface(r, s);
 }
 
 bool gi_occluded(vec3 from, vec3 ng, vec3 to) {

@@ -42,15 +42,6 @@ Surface surface_of_record(LsRecord rec, vec3 dir) {
     return s;
 }
 
-bool gi_exact_hit(TraceRay r, out Surface s) {
-    TraceHit h = trace(r, false);
-    if (h.t == NO_HIT) {
-        return false;
-    }
-    s = surface_at(r, h);
-    return true;
-}
-
 bool gi_hit(TraceRay r, vec3 origin_ng, bool exact, out Surface s) {
 #if GI_LS_STRUCTURE == GI_LS_CANDIDATES
     TraceHit h = ls_trace_candidates(r, false);
@@ -61,14 +52,14 @@ bool gi_hit(TraceRay r, vec3 origin_ng, bool exact, out Surface s) {
     return true;
 #else
     if (exact) {
-        return gi_exact_hit(r, s);
+        return trace_surface(r, s);
     }
     LsRecord rec;
     if (!ls_pnmt_hit(r.origin, r.direction, r.tmin, r.tmax, origin_ng, rec)) {
         return false;
     }
     if (any(greaterThan(materials[rec.material].emission, vec3(0.0)))) {
-        return gi_exact_hit(r, s);
+        return trace_surface(r, s);
     }
     s = surface_of_record(rec, r.direction);
     return true;
@@ -76,14 +67,11 @@ bool gi_hit(TraceRay r, vec3 origin_ng, bool exact, out Surface s) {
 }
 
 bool gi_occluded(vec3 from, vec3 ng, vec3 to) {
-    vec3 o = offset_ray_origin(from, ng);
-    vec3 d = to - o;
-    float dist = length(d);
-    return dist > 0.0 && ls_occluded_binary(make_ray(o, d / dist, 0.0, dist * (1.0 - 1e-5)), false);
+    return ls_occluded(from, ng, to, false);
 }
 
 bool gi_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
-    return ls_occluded_binary(make_ray(offset_ray_origin(from, ng), dir, 0.0, 3.4e38), false);
+    return ls_occluded_dir(from, ng, dir, false);
 }
 
 #if GI_LS_STRUCTURE == GI_LS_PREILLUM
