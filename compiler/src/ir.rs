@@ -6,6 +6,9 @@ use std::path::PathBuf;
 use kiln_format::manifest::{Camera, ColorSpace, Light, Medium, Sky, Wrap};
 use kiln_format::sections::{GpuMaterial, Vertex};
 
+/// A white vertex colour, unorm16.
+pub const WHITE: [u16; 4] = [u16::MAX; 4];
+
 /// A material: shading parameters as stored, plus its name.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
@@ -110,6 +113,8 @@ pub struct Scene {
     pub vertices: Vec<Vertex>,
     /// Texture coordinate per vertex.
     pub uvs: Vec<[f32; 2]>,
+    /// Vertex colour per vertex (unorm16 linear RGBA), or empty when every vertex is white.
+    pub colors: Vec<[u16; 4]>,
     /// Triangles (vertex index triples), front faces counter-clockwise.
     pub triangles: Vec<[u32; 3]>,
     /// Material of each triangle.
@@ -143,6 +148,21 @@ impl Scene {
     /// Records a warning of class `class`.
     pub fn warn_as(&mut self, class: WarningClass, message: impl Into<String>) {
         self.warnings.push(Warning { class, message: message.into() });
+    }
+
+    /// Records the colours of the vertices from `first` on (`None`: white), keeping
+    /// [`Scene::colors`] empty while every vertex is white and one per vertex once one is not.
+    pub fn set_colors(&mut self, first: usize, colors: Option<Vec<[u16; 4]>>) {
+        let count = self.vertices.len() - first;
+        match colors {
+            Some(c) if c.iter().any(|&c| c != WHITE) => {
+                debug_assert_eq!(c.len(), count);
+                self.colors.resize(first, WHITE);
+                self.colors.extend(c);
+            }
+            _ if !self.colors.is_empty() => self.colors.resize(first + count, WHITE),
+            _ => {}
+        }
     }
 
     /// Whether some material samples a texture.

@@ -236,6 +236,19 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// A vertex's attributes besides position and normal, as the player interleaves them from
+    /// `UVS0` and `COL0` (std430, 16 bytes): the raster passes' second vertex stream and what
+    /// the compute passes read at a hit.
+    pub struct GpuVertexAttributes {
+        /// Texture coordinates (zeros without `UVS0`).
+        pub uv: [f32; 2] => "vec2",
+        /// Colour: the `COL0` element's bytes, unorm16 R, G in word 0 and B, A in word 1, each
+        /// first channel in the low half (`unpackUnorm2x16`); white without `COL0`.
+        pub color: [u32; 2] => "uvec2",
+    }
+}
+
 /// Bits of [`GpuTexture::flags`].
 #[derive(Debug)]
 pub struct TextureFlags;
@@ -331,6 +344,7 @@ pub fn glsl_layout() -> String {
     declare::<ReferenceConstants>(&mut s);
     declare::<GpuEmitter>(&mut s);
     declare::<GpuTexture>(&mut s);
+    declare::<GpuVertexAttributes>(&mut s);
     declare::<RtConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
@@ -485,6 +499,7 @@ mod tests {
         check::<ReferenceConstants>();
         check::<GpuEmitter>();
         check::<GpuTexture>();
+        check::<GpuVertexAttributes>();
         check::<RtConstants>();
         check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.

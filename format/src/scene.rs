@@ -5,7 +5,7 @@ use crate::error::{FormatError, Result};
 use crate::manifest::{LightKind, Manifest, ShadowProjection};
 use crate::read::KilnFile;
 use crate::sections::{
-    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
+    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
     MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, UVS, VERTICES, Vertex,
 };
 
@@ -18,6 +18,8 @@ pub struct SceneView<'a> {
     pub vertices: &'a [Vertex],
     /// Texture coordinates per vertex (empty when no material samples a texture).
     pub uvs: &'a [[f32; 2]],
+    /// Vertex colours, unorm16 linear RGBA per vertex (empty: every vertex white).
+    pub colors: &'a [[u16; 4]],
     /// Triangles as vertex index triples, in BVH leaf order.
     pub triangles: &'a [[u32; 3]],
     /// Material of each triangle.
@@ -40,6 +42,7 @@ impl<'a> SceneView<'a> {
         let manifest = file.manifest()?;
         let vertices: &[Vertex] = file.pod(VERTICES, 0)?.unwrap_or(&[]);
         let uvs: &[[f32; 2]] = file.pod(UVS, 0)?.unwrap_or(&[]);
+        let colors: &[[u16; 4]] = file.pod(COLORS, 0)?.unwrap_or(&[]);
         let triangles: &[[u32; 3]] = file.pod(TRIANGLES, 0)?.unwrap_or(&[]);
         let triangle_materials: &[u32] = file.pod(TRIANGLE_MATERIALS, 0)?.unwrap_or(&[]);
         let materials: &[GpuMaterial] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
@@ -74,7 +77,17 @@ impl<'a> SceneView<'a> {
                 manifest.textures.len()
             )));
         }
-        let view = SceneView { manifest, vertices, uvs, triangles, triangle_materials, materials, bvh, file };
+        let view = SceneView {
+            manifest,
+            vertices,
+            uvs,
+            colors,
+            triangles,
+            triangle_materials,
+            materials,
+            bvh,
+            file,
+        };
         view.check_geometry()?;
         view.check_materials()?;
         view.check_manifest()?;
@@ -112,6 +125,13 @@ impl<'a> SceneView<'a> {
             return Err(FormatError::invalid(format!(
                 "{} texture coordinates for {} vertices",
                 self.uvs.len(),
+                self.vertices.len()
+            )));
+        }
+        if !self.colors.is_empty() && self.colors.len() != self.vertices.len() {
+            return Err(FormatError::invalid(format!(
+                "{} vertex colours for {} vertices",
+                self.colors.len(),
                 self.vertices.len()
             )));
         }

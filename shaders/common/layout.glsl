@@ -83,6 +83,11 @@ struct GpuTexture {
     uint flags; // offset 12
 }; // 16 bytes
 
+struct GpuVertexAttributes {
+    vec2 uv; // offset 0
+    uvec2 color; // offset 8
+}; // 16 bytes
+
 struct RtConstants {
     uint accumulated; // offset 0
     uint seed; // offset 4

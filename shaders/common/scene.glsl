@@ -4,8 +4,8 @@
 // hybrid passes so that both shade a hit identically.
 //
 // The includer declares these storage buffers (see shaders/reference/pathtrace.comp):
-//   bvh_nodes, bvh_tris (traverse.glsl), vertex_data (6 floats per vertex), uvs, indices (leaf
-//   order), tri_materials, materials, texels, textures
+//   bvh_nodes, bvh_tris (traverse.glsl), vertex_data (6 floats per vertex), vertex_attributes,
+//   indices (leaf order), tri_materials, materials, texels, textures
 // and includes random.glsl, layout.glsl and packing.glsl first.
 #ifndef KILN_SCENE_GLSL
 #define KILN_SCENE_GLSL
@@ -17,7 +17,12 @@
 
 vec2 triangle_uv(uint tri, float u, float v) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
-    return (1.0 - u - v) * uvs[idx.x] + u * uvs[idx.y] + v * uvs[idx.z];
+    return (1.0 - u - v) * vertex_uv(idx.x) + u * vertex_uv(idx.y) + v * vertex_uv(idx.z);
+}
+
+vec4 triangle_color(uint tri, float u, float v) {
+    uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
+    return (1.0 - u - v) * vertex_color(idx.x) + u * vertex_color(idx.y) + v * vertex_color(idx.z);
 }
 
 // Alpha-masked materials are cut out during traversal.
@@ -26,7 +31,7 @@ bool bvh_alpha_test(uint tri, float u, float v) {
     if (((m.flags >> MATERIAL_ALPHA_SHIFT) & 3u) != 1u) {
         return true;
     }
-    float a = m.base_color.a;
+    float a = m.base_color.a * triangle_color(tri, u, v).a;
     if (m.base_color_texture != NO_TEXTURE) {
         a *= sample_texture(m.base_color_texture, triangle_uv(tri, u, v)).a;
     }
@@ -46,10 +51,11 @@ struct Surface {
     uint triangle;  // the triangle hit (leaf order)
 };
 
-// The material of a surface at texture coordinates uv: s.mat and s.emission (towards the side
-// s.front says the ray came from). Shared by triangle hits and the line space's stored hits.
-void surface_material(inout Surface s, GpuMaterialLayout m, vec2 uv) {
-    vec4 base = m.base_color;
+// The material of a surface at texture coordinates uv with vertex colour `color`: s.mat and
+// s.emission (towards the side s.front says the ray came from). Shared by triangle hits and the
+// line space's stored hits.
+void surface_material(inout Surface s, GpuMaterialLayout m, vec2 uv, vec4 color) {
+    vec4 base = m.base_color * color;
     if (m.base_color_texture != NO_TEXTURE) {
         base *= sample_texture(m.base_color_texture, uv);
     }
@@ -93,7 +99,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
     if (m.normal_texture != NO_TEXTURE) {
         // Tangent frame of the triangle's texture mapping (glTF: v runs down the image, the
         // map's green axis up, hence the minus on the bitangent).
-        vec2 t0 = uvs[idx.x], t1 = uvs[idx.y], t2 = uvs[idx.z];
+        vec2 t0 = vertex_uv(idx.x), t1 = vertex_uv(idx.y), t2 = vertex_uv(idx.z);
         vec3 e1 = p1 - p0, e2 = p2 - p0;
         vec2 d1 = t1 - t0, d2 = t2 - t0;
         float det = d1.x * d2.y - d1.y * d2.x;
@@ -120,7 +126,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
     }
     s.ng = ng;
     s.ns = ns;
-    surface_material(s, m, uv);
+    surface_material(s, m, uv, w0 * vertex_color(idx.x) + h.u * vertex_color(idx.y) + h.v * vertex_color(idx.z));
     return s;
 }
 

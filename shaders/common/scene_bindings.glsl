@@ -12,8 +12,8 @@ layout(set = 0, binding = 1, std430) readonly buffer BvhNodes { uvec4 bvh_nodes[
 layout(set = 0, binding = 2, std430) readonly buffer BvhTriangles { vec4 bvh_tris[]; };
 // position and normal, 6 floats each
 layout(set = 0, binding = 3, std430) readonly buffer Vertices { float vertex_data[]; };
-// texture coordinates (zeros without)
-layout(set = 0, binding = 4, std430) readonly buffer Uvs { vec2 uvs[]; };
+// texture coordinates (zeros without) and colours (white without) per vertex
+layout(set = 0, binding = 4, std430) readonly buffer VertexAttributes { GpuVertexAttributes vertex_attributes[]; };
 // vertex indices in leaf order
 layout(set = 0, binding = 5, std430) readonly buffer Indices { uint indices[]; };
 // material of each triangle in leaf order

@@ -1,5 +1,6 @@
-// Vertex attributes from the vertex buffer as the passes bind it: the includer declares
-// `vertex_data` (6 floats per vertex: position, normal).
+// Vertex attributes from the vertex buffers as the passes bind them: the includer declares
+// `vertex_data` (6 floats per vertex: position, normal) and `vertex_attributes`
+// (GpuVertexAttributes: texture coordinates, colour).
 #ifndef KILN_VERTICES_GLSL
 #define KILN_VERTICES_GLSL
 
@@ -9,6 +10,16 @@ vec3 vertex_position(uint v) {
 
 vec3 vertex_normal(uint v) {
     return vec3(vertex_data[6u * v + 3u], vertex_data[6u * v + 4u], vertex_data[6u * v + 5u]);
+}
+
+vec2 vertex_uv(uint v) {
+    return vertex_attributes[v].uv;
+}
+
+// The vertex colour (COL0; white when the file has none), linear RGBA.
+vec4 vertex_color(uint v) {
+    uvec2 c = vertex_attributes[v].color;
+    return vec4(unpackUnorm2x16(c.x), unpackUnorm2x16(c.y));
 }
 
 #endif

@@ -23,6 +23,7 @@ layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) flat in uint in_first_triangle;
+layout(location = 4) in vec4 in_color;
 
 layout(location = 0) out vec2 out_normal;
 layout(location = 1) out vec4 out_albedo;
@@ -31,7 +32,7 @@ layout(location = 3) out vec4 out_emission;
 layout(location = 4) out uint out_triangle;
 
 void main() {
-    vec4 base = material.base_color;
+    vec4 base = material.base_color * in_color;
     if (material.base_color_texture != NO_TEXTURE) {
         base *= texture(base_color_tex, in_uv);
     }

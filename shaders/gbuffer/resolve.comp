@@ -13,7 +13,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Vertices { float vertex_data[]; };   // 6 floats each
-layout(set = 0, binding = 2, std430) readonly buffer Uvs { vec2 uvs[]; };
+layout(set = 0, binding = 2, std430) readonly buffer VertexAttributes { GpuVertexAttributes vertex_attributes[]; };
 layout(set = 0, binding = 3, std430) readonly buffer RasterIndices { uint raster_indices[]; };
 layout(set = 0, binding = 4, std430) readonly buffer RasterMaterials { uint raster_materials[]; };
 layout(set = 0, binding = 5, std430) readonly buffer Materials { GpuMaterialLayout materials[]; };
@@ -59,7 +59,7 @@ void main() {
     vec2 bx = barycentrics(pixel_ray(centre + vec2(1.0, 0.0)), p0, e1, e2);
     vec2 by = barycentrics(pixel_ray(centre + vec2(0.0, 1.0)), p0, e1, e2);
     GpuMaterialLayout m = materials[raster_materials[t]];
-    vec2 t0 = uvs[idx.x], t1 = uvs[idx.y], t2 = uvs[idx.z];
+    vec2 t0 = vertex_uv(idx.x), t1 = vertex_uv(idx.y), t2 = vertex_uv(idx.z);
     vec2 uv = t0 + b.x * (t1 - t0) + b.y * (t2 - t0);
     vec2 duv_dx = (bx.x - b.x) * (t1 - t0) + (bx.y - b.y) * (t2 - t0);
     vec2 duv_dy = (by.x - b.x) * (t1 - t0) + (by.y - b.y) * (t2 - t0);
@@ -78,7 +78,8 @@ void main() {
         vec3 ts = sample_texture_grad(m.normal_texture, uv, duv_dx, duv_dy).xyz * 2.0 - 1.0;
         n = normal_mapped(n, dp_dx, dp_dy, duv_dx, duv_dy, ts, m.normal_scale);
     }
-    vec4 base = m.base_color;
+    vec4 base = m.base_color
+        * ((1.0 - b.x - b.y) * vertex_color(idx.x) + b.x * vertex_color(idx.y) + b.y * vertex_color(idx.z));
     if (m.base_color_texture != NO_TEXTURE) {
         base *= sample_texture_grad(m.base_color_texture, uv, duv_dx, duv_dy);
     }

@@ -10,13 +10,14 @@ layout(push_constant) uniform Material { GpuMaterialLayout material; };
 
 layout(location = 2) in vec2 in_uv;
 layout(location = 3) flat in uint in_first_triangle;
+layout(location = 4) in vec4 in_color;
 
 layout(location = 0) out uint out_triangle;
 
 void main() {
     uint alpha_mode = (material.flags >> MATERIAL_ALPHA_SHIFT) & 3u;
     if (alpha_mode == 1u) {
-        float a = material.base_color.a;
+        float a = material.base_color.a * in_color.a;
         if (material.base_color_texture != NO_TEXTURE) {
             a *= texture(base_color_tex, in_uv).a;
         }

@@ -38,7 +38,8 @@ Surface surface_of_record(LsRecord rec, vec3 dir) {
     // behind the surface it stands for; lifted by the quantisation step plus the margin towards
     // the ray, the rays leaving it do not hit that surface again.
     s.p = rec.position + n * grid.pnmt_step;
-    surface_material(s, materials[rec.material], rec.uv);
+    // PNMT records hold no vertex colour (FORMAT.md, COL0): white.
+    surface_material(s, materials[rec.material], rec.uv, vec4(1.0));
     return s;
 }
 

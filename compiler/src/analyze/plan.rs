@@ -19,6 +19,8 @@ pub enum Stage {
     Geometry,
     /// Texture coordinates.
     Uvs,
+    /// Vertex colours.
+    VertexColors,
     /// Material table.
     Materials,
     /// Texture mip chains.
@@ -43,6 +45,7 @@ impl Stage {
         match self {
             Stage::Geometry => "geometry",
             Stage::Uvs => "uvs",
+            Stage::VertexColors => "vertex-colors",
             Stage::Materials => "materials",
             Stage::Textures => "textures",
             Stage::Bvh => "bvh",
@@ -99,6 +102,11 @@ impl Plan {
                 run(Stage::Uvs, format!("{textured} materials sample textures"))
             } else {
                 skip(Stage::Uvs, "no material samples a texture")
+            },
+            if scene.colors.is_empty() {
+                skip(Stage::VertexColors, "no vertex has a colour other than white")
+            } else {
+                run(Stage::VertexColors, format!("{} vertices coloured", scene.colors.len()))
             },
             run(Stage::Materials, format!("{} materials", scene.materials.len())),
             if scene.textures.is_empty() {

@@ -173,6 +173,7 @@ pub fn bake(ctx: &BakeContext) -> CliResult<Baked> {
             out = match decision.stage {
                 Stage::Geometry => geometry::stage(ctx),
                 Stage::Uvs => uvs::stage(ctx),
+                Stage::VertexColors => uvs::colors(ctx),
                 Stage::Materials => materials::stage(ctx),
                 Stage::Textures => textures::stage(ctx),
                 Stage::Bvh => bvh::stage(ctx),

@@ -1,6 +1,7 @@
-//! The texture-coordinate stage.
+//! The per-vertex attribute stages besides position and normal: texture coordinates and
+//! vertex colours.
 
-use kiln_format::sections::UVS;
+use kiln_format::sections::{COLORS, UVS};
 
 use super::{BakeContext, Sections};
 
@@ -8,5 +9,12 @@ use super::{BakeContext, Sections};
 pub fn stage(ctx: &BakeContext) -> Sections {
     let mut out = Sections::default();
     out.push(UVS, 0, bytemuck::cast_slice(&ctx.scene.uvs).to_vec(), ctx.hash("uvs", &[]));
+    out
+}
+
+/// Vertex colours per vertex (the plan runs this only when some vertex is not white).
+pub fn colors(ctx: &BakeContext) -> Sections {
+    let mut out = Sections::default();
+    out.push(COLORS, 0, bytemuck::cast_slice(&ctx.scene.colors).to_vec(), ctx.hash("vertex-colors", &[]));
     out
 }

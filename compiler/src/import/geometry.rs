@@ -190,3 +190,8 @@ pub fn given_corner_normals(
         .collect();
     (out, replaced)
 }
+
+/// A colour channel in [0, 1] (glTF: COLOR_0 floats are in range; clamped if not) as unorm16.
+pub fn unorm16(v: f32) -> u16 {
+    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
+}

@@ -14,7 +14,9 @@ use glam::{DMat3, DMat4, DVec3};
 use kiln_format::manifest::{Camera, Light, LightKind, Wrap};
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
-use super::geometry::{Sharing, check_position, corner_normals, given_corner_normals, split_by_normal};
+use super::geometry::{
+    Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
+};
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult, Exit};
@@ -411,6 +413,33 @@ impl Importer<'_> {
                 return Err(CliError::input(format!("{at}: {uv_name} element {i} is not finite: {uv:?}")));
             }
 
+            // COLOR_0 (linear RGB or RGBA) multiplies the base colour.
+            let colors: Option<Vec<[u16; 4]>> = match prim.get(&::gltf::Semantic::Colors(0)) {
+                Some(acc) => {
+                    self.check_accessor(
+                        &acc,
+                        &at,
+                        "COLOR_0",
+                        &[Dimensions::Vec3, Dimensions::Vec4],
+                        &[DataType::F32, DataType::U8, DataType::U16],
+                        true,
+                    )?;
+                    self.check_count(&acc, count, &at, "COLOR_0")?;
+                    let raw: Vec<[f32; 4]> =
+                        reader.read_colors(0).map(|c| c.into_rgba_f32().collect()).unwrap_or_default();
+                    if let Some((i, c)) =
+                        raw.iter().enumerate().find(|(_, c)| !c.iter().all(|v| v.is_finite()))
+                    {
+                        return Err(CliError::input(format!(
+                            "{at}: COLOR_0 accessor {} element {i} is not finite: {c:?}",
+                            acc.index()
+                        )));
+                    }
+                    Some(raw.iter().map(|c| c.map(unorm16)).collect())
+                }
+                None => None,
+            };
+
             let indices: Vec<u32> = match prim.indices() {
                 Some(acc) => {
                     self.check_accessor(
@@ -491,6 +520,8 @@ impl Importer<'_> {
                 Some(uv) => self.scene.uvs.extend(source.iter().map(|&i| uv[i as usize])),
                 None => self.scene.uvs.extend(std::iter::repeat_n([0.0; 2], source.len())),
             }
+            self.scene
+                .set_colors(base as usize, colors.map(|c| source.iter().map(|&i| c[i as usize]).collect()));
             self.scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base)));
             self.scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
         }

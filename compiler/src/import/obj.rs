@@ -33,7 +33,9 @@ use std::path::Path;
 use kiln_format::manifest::Wrap;
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
-use super::geometry::{Sharing, check_position, corner_normals, given_corner_normals, split_by_normal};
+use super::geometry::{
+    Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
+};
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult};
@@ -187,6 +189,18 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
             source.iter().zip(&normals).map(|(&i, n)| Vertex { position: positions[i as usize], normal: *n }),
         );
         scene.uvs.extend(source.iter().map(|&i| uvs[i as usize]));
+        // The `v x y z r g b` extension (MeshLab, ZBrush), read as linear like glTF's COLOR_0.
+        let colors = (mesh.vertex_color.len() == 3 * positions.len())
+            .then(|| {
+                let rgb: Vec<[u16; 4]> =
+                    mesh.vertex_color.chunks_exact(3).map(|c| [c[0], c[1], c[2], 1.0].map(unorm16)).collect();
+                if mesh.vertex_color.iter().any(|c| !c.is_finite()) {
+                    return Err(CliError::input(format!("{at}: a vertex colour is not finite")));
+                }
+                Ok(source.iter().map(|&i| rgb[i as usize]).collect())
+            })
+            .transpose()?;
+        scene.set_colors(base_index as usize, colors);
         scene.triangles.extend(tris.iter().map(|t| t.map(|i| i + base_index)));
         scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
     }

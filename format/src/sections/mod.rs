@@ -19,6 +19,9 @@ pub const MANIFEST: SectionKind = SectionKind(*b"MANI");
 pub const VERTICES: SectionKind = SectionKind(*b"VERT");
 /// Texture coordinates (`[f32; 2]`, set 0, glTF convention: v down the image), one per vertex.
 pub const UVS: SectionKind = SectionKind(*b"UVS0");
+/// Vertex colours (`[u16; 4]` unorm16 linear RGBA, glTF `COLOR_0`), one per vertex; they
+/// multiply the base colour. Absent: every vertex is white.
+pub const COLORS: SectionKind = SectionKind(*b"COL0");
 /// Triangles as three `u32` vertex indices each, in BVH leaf order.
 pub const TRIANGLES: SectionKind = SectionKind(*b"TRIS");
 /// Material index (`u32`) of each triangle.
@@ -115,6 +118,15 @@ pub const KNOWN: &[KindInfo] = &[
         required: false,
         indexed: false,
         description: "texture coordinates per vertex",
+    },
+    KindInfo {
+        kind: COLORS,
+        name: "vertex-colors",
+        version: 1,
+        element_size: 8,
+        required: false,
+        indexed: false,
+        description: "vertex colours (unorm16 RGBA), multiplying base colour",
     },
     KindInfo {
         kind: TRIANGLES,

@@ -37,12 +37,12 @@ pub const VERTICES: SceneBinding = SceneBinding {
     member: "float vertex_data[]",
     what: "position and normal, 6 floats each",
 };
-/// Texture coordinates.
-pub const UVS: SceneBinding = SceneBinding {
+/// Texture coordinates and colours.
+pub const VERTEX_ATTRIBUTES: SceneBinding = SceneBinding {
     binding: 4,
-    block: "Uvs",
-    member: "vec2 uvs[]",
-    what: "texture coordinates (zeros without)",
+    block: "VertexAttributes",
+    member: "GpuVertexAttributes vertex_attributes[]",
+    what: "texture coordinates (zeros without) and colours (white without) per vertex",
 };
 /// Vertex indices in leaf order.
 pub const LEAF_INDICES: SceneBinding = SceneBinding {
@@ -70,8 +70,16 @@ pub const LIGHTS: SceneBinding =
     SceneBinding { binding: 8, block: "Lights", member: "GpuLight lights[]", what: "the analytic lights" };
 
 /// The table, in binding order.
-pub const TABLE: [SceneBinding; 8] =
-    [BVH_NODES, BVH_TRIANGLES, VERTICES, UVS, LEAF_INDICES, TRIANGLE_MATERIALS, MATERIALS, LIGHTS];
+pub const TABLE: [SceneBinding; 8] = [
+    BVH_NODES,
+    BVH_TRIANGLES,
+    VERTICES,
+    VERTEX_ATTRIBUTES,
+    LEAF_INDICES,
+    TRIANGLE_MATERIALS,
+    MATERIALS,
+    LIGHTS,
+];
 
 /// The text of `shaders/common/scene_bindings.glsl`.
 pub fn glsl() -> String {

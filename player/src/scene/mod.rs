@@ -9,6 +9,7 @@ pub mod upload;
 use std::collections::HashMap;
 
 use crate::gpu::vk;
+use kiln_format::gpu::GpuVertexAttributes;
 use kiln_format::manifest::{ColorSpace, Manifest, ShadowProjection, Wrap};
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
@@ -78,6 +79,7 @@ impl std::fmt::Debug for Prepared<'_> {
 fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
     kind == sections::VERTICES
         || kind == sections::UVS
+        || kind == sections::COLORS
         || kind == sections::TRIANGLES
         || (kind == sections::TEXTURE && needs.textures)
         || (kind == sections::BRDF_LUT && needs.brdf_lut)
@@ -132,7 +134,7 @@ impl GpuScene {
             Write::Buffer(bindings::BVH_NODES.binding, &bvh.nodes),
             Write::Buffer(bindings::BVH_TRIANGLES.binding, &bvh.triangles),
             Write::Buffer(bindings::VERTICES.binding, &self.vertices),
-            Write::Buffer(bindings::UVS.binding, &self.uvs),
+            Write::Buffer(bindings::VERTEX_ATTRIBUTES.binding, &self.attributes),
             Write::Buffer(bindings::LEAF_INDICES.binding, &r.indices),
             Write::Buffer(bindings::TRIANGLE_MATERIALS.binding, &r.triangle_materials),
             Write::Buffer(bindings::MATERIALS.binding, &r.materials),
@@ -225,8 +227,9 @@ pub struct GpuScene {
     pub manifest: Manifest,
     /// Positions and normals (24-byte `Vertex`).
     pub vertices: Buffer,
-    /// Texture coordinates (zeros when the file has none).
-    pub uvs: Buffer,
+    /// Texture coordinates and colours per vertex (`GpuVertexAttributes`: zeros and white
+    /// when the file has none).
+    pub attributes: Buffer,
     /// Triangle indices sorted by material.
     pub indices: Buffer,
     /// One draw per material with triangles.
@@ -309,6 +312,19 @@ pub fn sort_by_material(
     (indices, draws)
 }
 
+/// `UVS0` and `COL0` interleaved per vertex, as the passes read them.
+fn vertex_attributes(view: &SceneView) -> Vec<GpuVertexAttributes> {
+    (0..view.vertices.len())
+        .map(|i| {
+            let c = view.colors.get(i).copied().unwrap_or([u16::MAX; 4]);
+            GpuVertexAttributes {
+                uv: view.uvs.get(i).copied().unwrap_or_default(),
+                color: [c[0] as u32 | (c[1] as u32) << 16, c[2] as u32 | (c[3] as u32) << 16],
+            }
+        })
+        .collect()
+}
+
 impl GpuScene {
     /// Uploads what `prepared` needs through `up`. Returns when everything is recorded; the
     /// caller flushes the uploader and waits on its timeline before drawing.
@@ -324,7 +340,12 @@ impl GpuScene {
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
         let vertices =
             Buffer::uploaded(gpu, "vertices", std::mem::size_of_val(view.vertices) as u64, vertex_usage)?;
-        let uvs = Buffer::uploaded(gpu, "uvs", (view.vertices.len() * 8) as u64, vertex_usage)?;
+        let attributes = Buffer::uploaded(
+            gpu,
+            "vertex attributes",
+            (view.vertices.len() * std::mem::size_of::<GpuVertexAttributes>()) as u64,
+            vertex_usage,
+        )?;
         let indices = Buffer::uploaded(
             gpu,
             "indices",
@@ -335,7 +356,7 @@ impl GpuScene {
         let mut scene = GpuScene {
             manifest: view.manifest.clone(),
             vertices,
-            uvs,
+            attributes,
             indices,
             draws: prepared.draws.clone(),
             materials: view.materials.to_vec(),
@@ -375,7 +396,6 @@ impl GpuScene {
         up: &mut Uploader,
     ) -> PlayResult {
         let (view, needs) = (&prepared.view, prepared.needs);
-        let mut uvs_uploaded = false;
         if let Some(tables) = &prepared.reference {
             self.reference = Some(reference_buffers(gpu, view, tables)?);
         }
@@ -409,9 +429,8 @@ impl GpuScene {
                 fate.reason = "read on the CPU".into();
             } else if kind == sections::VERTICES {
                 up.buffer(&self.vertices, 0, bytemuck::cast_slice(view.vertices))?;
-            } else if kind == sections::UVS {
-                up.buffer(&self.uvs, 0, bytemuck::cast_slice(view.uvs))?;
-                uvs_uploaded = true;
+            } else if kind == sections::UVS || kind == sections::COLORS {
+                // Interleaved with the other into one stream (below).
             } else if kind == sections::TRIANGLES {
                 // Uploaded re-sorted by material, so that each material is one draw.
                 up.buffer(&self.indices, 0, bytemuck::cast_slice(&prepared.indices))?;
@@ -490,9 +509,7 @@ impl GpuScene {
             }
             self.sections.push(fate);
         }
-        if !uvs_uploaded {
-            up.zero(&self.uvs)?;
-        }
+        up.buffer(&self.attributes, 0, bytemuck::cast_slice(&vertex_attributes(view)))?;
         if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
             up.buffer(&r.emitters, 0, bytemuck::cast_slice(&tables.emitters))?;
             up.buffer(&r.triangle_emitter, 0, bytemuck::cast_slice(&tables.triangle_emitter))?;
@@ -548,7 +565,7 @@ impl GpuScene {
     /// Releases every resource (the GPU must be idle).
     pub fn destroy(&mut self, gpu: &Gpu) {
         self.vertices.destroy(gpu);
-        self.uvs.destroy(gpu);
+        self.attributes.destroy(gpu);
         self.indices.destroy(gpu);
         for t in &mut self.textures {
             t.destroy(gpu);

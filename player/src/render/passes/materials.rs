@@ -11,14 +11,17 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, GraphicsDesc, GraphicsPipeline, Recorder, SetLayout, Write};
 use crate::scene::GpuScene;
 
-/// Vertex buffer strides of the raster passes: positions + normals, texture coordinates.
-pub const VERTEX_STRIDES: [u32; 2] = [24, 8];
+/// Vertex buffer strides of the raster passes: positions + normals (`Vertex`), texture
+/// coordinates + colours (`GpuVertexAttributes`).
+pub const VERTEX_STRIDES: [u32; 2] = [24, 16];
 
-/// (location, binding, format, offset) of the raster passes' vertex attributes.
-pub const ATTRIBUTES: [(u32, u32, vk::Format, u32); 3] = [
+/// (location, binding, format, offset) of the raster passes' vertex attributes: position,
+/// normal, texture coordinates, colour.
+pub const ATTRIBUTES: [(u32, u32, vk::Format, u32); 4] = [
     (0, 0, vk::Format::R32G32B32_SFLOAT, 0),
     (1, 0, vk::Format::R32G32B32_SFLOAT, 12),
     (2, 1, vk::Format::R32G32_SFLOAT, 0),
+    (3, 1, vk::Format::R16G16B16A16_UNORM, 8),
 ];
 
 /// Set layouts, sets and pushed materials of a raster pass.
@@ -133,7 +136,7 @@ impl SceneDraws {
         if scene.draws.is_empty() {
             return;
         }
-        rec.bind_geometry(&[&scene.vertices, &scene.uvs], &scene.indices);
+        rec.bind_geometry(&[&scene.vertices, &scene.attributes], &scene.indices);
         let mut bound: Option<&GraphicsPipeline> = None;
         for d in &scene.draws {
             let m = &self.materials[d.material as usize];

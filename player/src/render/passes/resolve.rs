@@ -57,7 +57,7 @@ impl Pass for ResolvePass {
             &[
                 Write::Buffer(0, shared.frame_ubo),
                 Write::Buffer(1, &scene.vertices),
-                Write::Buffer(2, &scene.uvs),
+                Write::Buffer(2, &scene.attributes),
                 Write::Buffer(3, &scene.indices),
                 Write::Buffer(4, &r.raster_materials),
                 Write::Buffer(5, &r.materials),
