@@ -26,12 +26,15 @@ fn quad_with(dir: &std::path::Path, name: &str, edit: impl FnOnce(&mut Gltf)) ->
 fn nan_position() {
     let d = tempfile::tempdir().unwrap();
     let mut g = Gltf::new();
-    let p = g.positions(&[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let p = g.positions(&[[0.0, 0.0, 0.0], [2.0, f32::NAN, 3.0], [0.0, 1.0, 0.0]]);
     g.mesh(json!({"attributes": {"POSITION": p}}));
+    // Behind a rotation that would smear the NaN over every coordinate: the message quotes the
+    // accessor's own values.
+    g.json["nodes"][0]["rotation"] = json!([0.0, 0.6, 0.0, 0.8]);
     let f = g.write(d.path(), "nan");
     compile(d.path(), &f, &[])
         .expect(1)
-        .says("mesh 0 primitive 0: POSITION accessor 0 element 1 is not finite");
+        .says("mesh 0 primitive 0: POSITION accessor 0 element 1 is not finite: [2.0, NaN, 3.0]");
 }
 
 #[test]

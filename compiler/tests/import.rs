@@ -608,7 +608,50 @@ fn animations_and_skins_are_warned_about_never_fatal() {
     assert_eq!(s.vertices[1].position, [1.0, 0.0, 0.0]);
     let text: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
     assert!(text.iter().any(|w| w.contains("1 animation(s) not baked")), "{text:?}");
-    assert!(text.iter().any(|w| w.contains("node 0 is skinned")), "{text:?}");
+    assert!(text.iter().any(|w| w.contains("skinned but it has no JOINTS_0")), "{text:?}");
+}
+
+/// Little-endian bytes of `values`.
+fn le<T: Copy, const N: usize>(values: &[[T; N]], bytes: impl Fn(T) -> Vec<u8>) -> Vec<u8> {
+    values.iter().flatten().flat_map(|&v| bytes(v)).collect()
+}
+
+#[test]
+fn skinned_meshes_are_posed_as_their_joint_nodes_stand() {
+    // Two joints as in Khronos's SimpleSkin: joint A at the origin, joint B one unit up, bound
+    // there (inverse bind: down one unit) but standing turned 90° about z in the nodes. A vertex
+    // bound to B at (0, 2, 0) swings to (−1, 1, 0); one bound to A stays; one half-and-half lands
+    // midway. The skinned node's own translation (10, 0, 0) is ignored, as glTF requires.
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::new();
+    let p = g.positions(&[[0.5, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 2.0, 0.0]]);
+    let i = g.indices(&[0, 1, 2]);
+    let jv = g.view(&le(&[[0u16, 1, 0, 0]; 3], |v: u16| v.to_le_bytes().to_vec()), None);
+    let joints = g.accessor(Some(jv), 5123, 3, "VEC4", json!({}));
+    // The third vertex's weights sum to 2 (glTF requires 1): normalised, it lands midway all the same.
+    let weights = [[1.0f32, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0]];
+    let wv = g.view(&le(&weights, |v: f32| v.to_le_bytes().to_vec()), None);
+    let weights = g.accessor(Some(wv), 5126, 3, "VEC4", json!({}));
+    let identity = [1.0f32, 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.];
+    let mut down = identity;
+    down[13] = -1.0; // column-major: translation (0, −1, 0)
+    let mv = g.view(&le(&[identity, down], |v: f32| v.to_le_bytes().to_vec()), None);
+    let ibm = g.accessor(Some(mv), 5126, 2, "MAT4", json!({}));
+    g.mesh(json!({"attributes": {"POSITION": p, "JOINTS_0": joints, "WEIGHTS_0": weights}, "indices": i}));
+    g.json["scenes"] = json!([{"nodes": [0, 1]}]);
+    g.json["nodes"] = json!([
+        {"mesh": 0, "skin": 0, "translation": [10.0, 0.0, 0.0]},
+        {"children": [2]},
+        {"translation": [0.0, 1.0, 0.0], "rotation": [0.0, 0.0, H, H]}
+    ]);
+    g.json["skins"] = json!([{"inverseBindMatrices": ibm, "joints": [1, 2]}]);
+    let s = import(&g.write(d.path(), "skin")).unwrap();
+    let got: Vec<Vec3> = s.vertices.iter().map(|v| Vec3::from(v.position)).collect();
+    for want in [Vec3::new(0.5, 0.0, 0.0), Vec3::new(-1.0, 1.0, 0.0), Vec3::new(-0.5, 1.5, 0.0)] {
+        assert!(got.iter().any(|&g| close(g, want)), "{want} not among {got:?}");
+    }
+    // No animation in the file: nothing is lost, so nothing is said.
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
 
 /// The quad with base-colour texture coordinates in sets 0 and 1 and a material whose base

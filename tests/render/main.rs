@@ -10,6 +10,7 @@ mod harness;
 
 // The tests, by topic.
 mod analytic; // one light on a diffuse plane against its closed form, per pixel
+mod colors; // vertex colours in both G-buffers and the reference, against closed forms
 mod files; // damaged files fail with the right exit code; minimal files render
 mod gi; // path-traced GI plus direct light against the two-bounce reference
 mod raytraced; // ray-traced AO and reflections against closed forms, accumulation

@@ -79,6 +79,17 @@ struct Importer<'a> {
     requests: Vec<TextureRequest>,
     /// Normals where a primitive has no NORMAL attribute.
     normals: Normals,
+    /// Parent of each node (skins need their joints' scene transforms).
+    parents: Vec<Option<usize>>,
+}
+
+/// Where a mesh's vertices go.
+enum Placement {
+    /// One transform for every vertex: the node's.
+    Rigid(DMat4),
+    /// Linear blend skinning with these joint matrices (JOINTS_n / WEIGHTS_n per vertex); the
+    /// node's transform serves a primitive without weights.
+    Skinned { joints: Vec<DMat4>, node: DMat4 },
 }
 
 /// Imports a `.gltf` or `.glb` file into `scene`.
@@ -114,6 +125,15 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
         uv_mappings: HashMap::new(),
         requests: Vec::new(),
         normals,
+        parents: {
+            let mut p = vec![None; doc.nodes().len()];
+            for n in doc.nodes() {
+                for c in n.children() {
+                    p[c.index()] = Some(n.index());
+                }
+            }
+            p
+        },
     };
     imp.walk_scene()?;
     let (textures, warnings) = decode_all(std::mem::take(&mut imp.requests));
@@ -277,17 +297,15 @@ impl Importer<'_> {
             )));
         }
         if let Some(mesh) = node.mesh() {
-            if node.skin().is_some() {
-                self.scene.warn(format!(
-                    "{}: node {} is skinned: its mesh is compiled at the node's rest transform, the skin \
-                     is not applied",
-                    self.file,
-                    node.index()
-                ));
-            }
             // glTF: a node's morph weights override its mesh's; absent weights are 0.
             let weights: Vec<f32> = node.weights().or(mesh.weights()).unwrap_or(&[]).to_vec();
-            self.add_mesh(&mesh, &world, &weights)?;
+            let placement = match node.skin() {
+                Some(skin) => {
+                    Placement::Skinned { joints: self.joint_matrices(&skin, node.index())?, node: world }
+                }
+                None => Placement::Rigid(world),
+            };
+            self.add_mesh(&mesh, &placement, &weights)?;
         }
         if let Some(camera) = node.camera() {
             self.add_camera(&camera, &world, node.index());
@@ -303,6 +321,85 @@ impl Importer<'_> {
         Ok(())
     }
 
+    /// The transform of `node` in the scene: its ancestors' local transforms composed with its
+    /// own (the rest pose the nodes describe; animations are not applied).
+    fn global_transform(&self, node: usize) -> CliResult<DMat4> {
+        let mut m = DMat4::IDENTITY;
+        let mut at = Some(node);
+        let mut steps = 0;
+        while let Some(n) = at {
+            steps += 1;
+            if steps > self.parents.len() {
+                return Err(CliError::input(format!(
+                    "{}: node hierarchy has a cycle through node {n}",
+                    self.file
+                )));
+            }
+            let local = self.doc.nodes().nth(n).map(|n| n.transform().matrix()).unwrap_or_default();
+            m = DMat4::from_cols_array_2d(&local.map(|c| c.map(f64::from))) * m;
+            at = self.parents[n];
+        }
+        Ok(m)
+    }
+
+    /// Joint matrices of `skin` in the rest pose: each joint's scene transform times its inverse
+    /// bind matrix (glTF 2.0, "Skins"; the skinned node's own transform is ignored). At the bind
+    /// pose they are the identity and the mesh stays where its positions put it.
+    fn joint_matrices(&mut self, skin: &::gltf::Skin, node: usize) -> CliResult<Vec<DMat4>> {
+        let at = format!("{}: skin {} (node {node})", self.file, skin.index());
+        let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
+        if joints.is_empty() {
+            return Err(CliError::input(format!("{at} has no joints")));
+        }
+        let inverse_bind: Vec<DMat4> = match skin.inverse_bind_matrices() {
+            Some(acc) => {
+                self.check_accessor(
+                    &acc,
+                    &at,
+                    "inverseBindMatrices",
+                    &[Dimensions::Mat4],
+                    &[DataType::F32],
+                    false,
+                )?;
+                if acc.count() < joints.len() {
+                    return Err(CliError::input(format!(
+                        "{at}: inverseBindMatrices accessor {} has {} matrices for {} joints",
+                        acc.index(),
+                        acc.count(),
+                        joints.len()
+                    )));
+                }
+                let reader = skin.reader(|b| self.buffers.get(b.index()).map(Vec::as_slice));
+                let raw: Vec<[[f32; 4]; 4]> =
+                    reader.read_inverse_bind_matrices().map(|it| it.collect()).unwrap_or_default();
+                if let Some((i, m)) =
+                    raw.iter().enumerate().find(|(_, m)| !m.as_flattened().iter().all(|v| v.is_finite()))
+                {
+                    return Err(CliError::input(format!(
+                        "{at}: inverseBindMatrices accessor {} element {i} is not finite: {m:?}",
+                        acc.index()
+                    )));
+                }
+                raw.iter().map(|m| DMat4::from_cols_array_2d(&m.map(|c| c.map(f64::from)))).collect()
+            }
+            None => vec![DMat4::IDENTITY; joints.len()],
+        };
+        let mut out = Vec::with_capacity(joints.len());
+        for (j, ibm) in joints.iter().zip(&inverse_bind) {
+            let m = self.global_transform(*j)? * *ibm;
+            if !m.is_finite() {
+                return Err(CliError::input(format!("{at}: joint node {j} has a non-finite transform")));
+            }
+            out.push(m);
+        }
+        if self.doc.animations().next().is_some() {
+            self.scene.warn(format!(
+                "{at}: skinned mesh posed as its joint nodes stand without animation; the animation is not baked"
+            ));
+        }
+        Ok(out)
+    }
+
     fn mesh_name(mesh: &::gltf::Mesh) -> String {
         match mesh.name() {
             Some(n) => format!("mesh {} '{n}'", mesh.index()),
@@ -310,9 +407,7 @@ impl Importer<'_> {
         }
     }
 
-    fn add_mesh(&mut self, mesh: &::gltf::Mesh, world: &DMat4, weights: &[f32]) -> CliResult<()> {
-        let mirrored = world.determinant() < 0.0;
-        let normal_matrix = DMat3::from_mat4(*world).inverse().transpose();
+    fn add_mesh(&mut self, mesh: &::gltf::Mesh, placement: &Placement, weights: &[f32]) -> CliResult<()> {
         for prim in mesh.primitives() {
             let at = format!("{}: {} primitive {}", self.file, Self::mesh_name(mesh), prim.index());
             let mode = prim.mode();
@@ -333,6 +428,14 @@ impl Importer<'_> {
                     CliError::input(format!("{at}: POSITION accessor {} has no data", pos_acc.index()))
                 })?
                 .collect();
+            // A non-finite value is reported as the accessor holds it, before morphing or transforms.
+            if let Some((i, p)) = local_pos.iter().enumerate().find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+            {
+                return Err(CliError::input(format!(
+                    "{at}: POSITION accessor {} element {i} is not finite: {p:?}",
+                    pos_acc.index()
+                )));
+            }
             // Morph targets at the default weights (the scene is static: no animation moves them).
             let mut normal_deltas: Vec<(f32, Vec<[f32; 3]>)> = Vec::new();
             for (k, target) in prim.morph_targets().enumerate() {
@@ -364,10 +467,29 @@ impl Importer<'_> {
                     normal_deltas.push((w, deltas.collect()));
                 }
             }
+            // One matrix for a rigid mesh, one per vertex for a skinned one.
+            let matrices: Vec<DMat4> = match placement {
+                Placement::Rigid(m) => vec![*m],
+                Placement::Skinned { joints, node } => match self.skin_matrices(&prim, joints, count, &at)? {
+                    Some(m) => m,
+                    None => {
+                        self.scene.warn(format!(
+                            "{at}: its node is skinned but it has no JOINTS_0/WEIGHTS_0: placed by the node's transform"
+                        ));
+                        vec![*node]
+                    }
+                },
+            };
+            let matrix = |i: usize| matrices[if matrices.len() == 1 { 0 } else { i }];
             let mut positions = Vec::with_capacity(count);
             for (i, p) in local_pos.iter().enumerate() {
-                let w = world.transform_point3(DVec3::from(p.map(f64::from))).as_vec3().to_array();
-                check_position(w, || format!("{at}: POSITION accessor {} element {i}", pos_acc.index()))?;
+                let w = matrix(i).transform_point3(DVec3::from(p.map(f64::from))).as_vec3().to_array();
+                check_position(w, || {
+                    format!(
+                        "{at}: POSITION accessor {} element {i} (accessor value {p:?}) after its node transform",
+                        pos_acc.index()
+                    )
+                })?;
                 positions.push(w);
             }
 
@@ -472,8 +594,9 @@ impl Importer<'_> {
                 self.scene.warn(format!("{at}: has no triangles"));
                 continue;
             }
-            if mirrored {
-                for t in &mut tris {
+            // A mirroring transform turns counter-clockwise into clockwise.
+            for t in &mut tris {
+                if matrix(t[0] as usize).determinant() < 0.0 {
                     t.swap(1, 2);
                 }
             }
@@ -482,12 +605,16 @@ impl Importer<'_> {
             // calculate flat normals"; `--normals smooth[:ANGLE]` asks otherwise.
             let corners = match normals_in {
                 Some(n) => {
+                    let normal_matrices: Vec<DMat3> =
+                        matrices.iter().map(|m| DMat3::from_mat4(*m).inverse().transpose()).collect();
                     let given: Vec<[f32; 3]> = n
                         .iter()
-                        .map(|n| {
-                            (normal_matrix * DVec3::from(n.map(f64::from)))
-                                .try_normalize()
-                                .map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
+                        .enumerate()
+                        .map(|(i, n)| {
+                            (normal_matrices[if normal_matrices.len() == 1 { 0 } else { i }]
+                                * DVec3::from(n.map(f64::from)))
+                            .try_normalize()
+                            .map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
                         })
                         .collect();
                     let bad = given.iter().filter(|n| n[0].is_nan()).count();
@@ -526,6 +653,78 @@ impl Importer<'_> {
             self.scene.triangle_materials.extend(std::iter::repeat_n(material, tris.len()));
         }
         Ok(())
+    }
+
+    /// Per-vertex skinning matrices: Σ weight · joint matrix over JOINTS_n/WEIGHTS_n (sets 0
+    /// and 1), weights normalised to sum 1 (glTF requires it up to rounding); a vertex with no
+    /// weight keeps its mesh-space position. `None` when the primitive has no weights at all.
+    fn skin_matrices(
+        &self,
+        prim: &::gltf::Primitive,
+        joints: &[DMat4],
+        count: usize,
+        at: &str,
+    ) -> CliResult<Option<Vec<DMat4>>> {
+        let reader = prim.reader(|b| self.buffers.get(b.index()).map(Vec::as_slice));
+        let mut sum = vec![DMat4::ZERO; count];
+        let mut total = vec![0.0f64; count];
+        let mut any = false;
+        for set in 0..2 {
+            let (Some(ja), Some(wa)) =
+                (prim.get(&::gltf::Semantic::Joints(set)), prim.get(&::gltf::Semantic::Weights(set)))
+            else {
+                continue;
+            };
+            let (jn, wn) = (format!("JOINTS_{set}"), format!("WEIGHTS_{set}"));
+            self.check_accessor(&ja, at, &jn, &[Dimensions::Vec4], &[DataType::U8, DataType::U16], false)?;
+            self.check_accessor(
+                &wa,
+                at,
+                &wn,
+                &[Dimensions::Vec4],
+                &[DataType::F32, DataType::U8, DataType::U16],
+                true,
+            )?;
+            self.check_count(&ja, count, at, &jn)?;
+            self.check_count(&wa, count, at, &wn)?;
+            let js: Vec<[u16; 4]> =
+                reader.read_joints(set).map(|j| j.into_u16().collect()).unwrap_or_default();
+            let ws: Vec<[f32; 4]> =
+                reader.read_weights(set).map(|w| w.into_f32().collect()).unwrap_or_default();
+            for (i, (j, w)) in js.iter().zip(&ws).enumerate() {
+                for k in 0..4 {
+                    if !(w[k].is_finite() && w[k] >= 0.0) {
+                        return Err(CliError::input(format!(
+                            "{at}: {wn} accessor {} element {i} is not a finite weight ≥ 0: {w:?}",
+                            wa.index()
+                        )));
+                    }
+                    if w[k] == 0.0 {
+                        continue;
+                    }
+                    let m = joints.get(j[k] as usize).ok_or_else(|| {
+                        CliError::input(format!(
+                            "{at}: {jn} accessor {} element {i} names joint {} of a skin with {}",
+                            ja.index(),
+                            j[k],
+                            joints.len()
+                        ))
+                    })?;
+                    sum[i] += *m * w[k] as f64;
+                    total[i] += w[k] as f64;
+                    any = true;
+                }
+            }
+        }
+        if !any {
+            return Ok(None);
+        }
+        Ok(Some(
+            sum.into_iter()
+                .zip(total)
+                .map(|(m, t)| if t > 0.0 { m * (1.0 / t) } else { DMat4::IDENTITY })
+                .collect(),
+        ))
     }
 
     fn check_count(&self, acc: &Accessor, count: usize, at: &str, what: &str) -> CliResult<()> {
