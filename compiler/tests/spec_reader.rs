@@ -480,6 +480,7 @@ struct Grid {
     cand_offsets: Vec<u32>,
     cands: Vec<u32>,
     pnmt: Vec<[u8; 16]>,
+    preillum: Vec<[u16; 8]>,
 }
 
 impl Grid {
@@ -509,6 +510,12 @@ impl Grid {
             cand_offsets: u32s_of(b"LSCO"),
             cands: u32s_of(b"LSCE"),
             pnmt: pnmt.chunks_exact(16).map(|r| r.try_into().unwrap()).collect(),
+            preillum: f
+                .section(b"LSPI", 0)
+                .unwrap_or(&[])
+                .chunks_exact(16)
+                .map(|r| std::array::from_fn(|k| u16_at(r, 2 * k)))
+                .collect(),
         })
     }
     fn cells(&self) -> usize {
@@ -701,6 +708,14 @@ fn check_grid(g: &Grid, geo: &Geometry, manifest: &Manifest, ls: &LineSpace) -> 
         assert!(e.windows(2).all(|p| lo(p[0]) <= lo(p[1]) && run(p[0]) <= run(p[1])), "rank {r}: {e:x?}");
     }
     assert_eq!(g.pnmt.len() as u64, 2 * g.filled);
+    // LSPI: eight binary16 per filled shaft (front R, G, B, 0, back R, G, B, 0), finite.
+    if g.variants & Variants::PREILLUM != 0 {
+        assert_eq!(g.preillum.len() as u64, g.filled);
+        assert_eq!(g.preillum, ls.preillum);
+        for r in &g.preillum {
+            assert!(r.iter().all(|&h| spec::half(h).is_finite()) && r[3] == 0 && r[7] == 0, "{r:x?}");
+        }
+    }
 
     // Lines through cells: the spec's shaft is filled, lists every triangle the line crosses in
     // the cell, and is the shaft `kiln_format::linespace::index::shaft` names.
@@ -1039,7 +1054,8 @@ fn a_reader_written_from_format_md_agrees_on_the_shared_scenes() {
     for (name, extra) in [
         (
             "cornell_box",
-            &["--voxel-res", "6", "--shaft-res", "2", "--shaft-variants", "binary,candidates,pnmt"][..],
+            &["--voxel-res", "6", "--shaft-res", "2", "--shaft-variants", "binary,candidates,pnmt,preillum"]
+                [..],
         ),
         ("pica_pica", &["--shaft-variants", "none"][..]),
     ] {
