@@ -437,6 +437,9 @@ fn light_visibility_volume_matches_brute_force() {
     let tris = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
     let brute = BruteForce::new(&tris);
     let medium = &view.manifest.media[0];
+    // FORMAT.md: cells are per axis (box / dims), and here not cubic (1.4 / 12 against 2 / 16).
+    let ext: [f32; 3] = std::array::from_fn(|a| medium.bounds.max[a] - medium.bounds.min[a]);
+    assert_eq!(info.dims, [16, 12, 16]);
     let mut rng = kiln_compiler::raycheck::Rng::new(5);
     let mut under_blocker = 0;
     for (i, &l) in info.lights.iter().enumerate() {
@@ -451,6 +454,14 @@ fn light_visibility_volume_matches_brute_force() {
             let seen = (0..info.samples)
                 .filter(|&k| {
                     let p = kiln_compiler::bake::media::sample_point(medium, info.dims, c, k);
+                    for a in 0..3 {
+                        let size = ext[a] as f64 / info.dims[a] as f64;
+                        let lo = medium.bounds.min[a] as f64 + size * c[a] as f64;
+                        assert!(
+                            (lo - 1e-6..=lo + size + 1e-6).contains(&(p[a] as f64)),
+                            "cell {c:?} sample {k}: {p} outside the cell's span on axis {a}"
+                        );
+                    }
                     let (d, tmax) = match light.kind {
                         LightKind::Directional => (-Vec3::from(light.direction).normalize(), f32::INFINITY),
                         _ => {
