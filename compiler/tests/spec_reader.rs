@@ -430,13 +430,12 @@ fn walk(
             };
             let first = node.prim_base as usize + (meta & 0x1f) as usize;
             let mut b = [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]];
-            for t in first..first + count {
-                leaves[t] += 1;
-                for &v in &g.tris[t] {
-                    for a in 0..3 {
-                        b[0][a] = b[0][a].min(g.positions[v as usize][a]);
-                        b[1][a] = b[1][a].max(g.positions[v as usize][a]);
-                    }
+            for (seen, tri) in leaves[first..first + count].iter_mut().zip(&g.tris[first..first + count]) {
+                *seen += 1;
+                for &v in tri {
+                    let p = g.positions[v as usize];
+                    b[0] = std::array::from_fn(|a| b[0][a].min(p[a]));
+                    b[1] = std::array::from_fn(|a| b[1][a].max(p[a]));
                 }
             }
             b
@@ -834,20 +833,17 @@ fn check_grid(g: &Grid, geo: &Geometry, manifest: &Manifest, ls: &LineSpace) -> 
                 }
                 let tri = geo.tris[t as usize];
                 let w = [1.0 - u - v, u, v];
-                let mut sn = [0.0; 3];
-                for (k, &vi) in tri.iter().enumerate() {
-                    for x in 0..3 {
-                        sn[x] += w[k] * geo.normals[vi as usize][x] as f64;
-                    }
-                }
+                let sn: [f64; 3] = std::array::from_fn(|x| {
+                    (0..3).map(|k| w[k] * geo.normals[tri[k] as usize][x] as f64).sum()
+                });
                 let l = (sn[0] * sn[0] + sn[1] * sn[1] + sn[2] * sn[2]).sqrt();
                 let got = oct_decode(normal);
                 let cos = (0..3).map(|x| got[x] * sn[x] / l).sum::<f64>();
                 assert!(cos > 1.0 - 1e-6, "{ctx}: normal {got:?} against {sn:?}");
                 if !geo.uvs.is_empty() {
-                    for x in 0..2 {
+                    for (x, &got) in uv.iter().enumerate() {
                         let want: f64 = (0..3).map(|k| w[k] * geo.uvs[tri[k] as usize][x] as f64).sum();
-                        assert!((uv[x] as f64 - want).abs() <= 2e-3 * want.abs().max(1.0), "{ctx}: uv {x}");
+                        assert!((got as f64 - want).abs() <= 2e-3 * want.abs().max(1.0), "{ctx}: uv {x}");
                     }
                 } else {
                     assert_eq!(uv, [0.0, 0.0]);
