@@ -966,6 +966,9 @@ fn agree(name: &str, bytes: &[u8]) -> String {
         geo.uvs.len(),
         manifest.inputs.len()
     );
+    // Lighting bakes and textures: sizes by the spec's rules, contents as the reader's.
+    let counts = check_bakes(name, &f, &manifest, &file);
+    summary += &format!("; {counts}");
     // The line space.
     let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap();
     match (Grid::decode(&f), ls) {
@@ -982,6 +985,67 @@ fn agree(name: &str, bytes: &[u8]) -> String {
         }
     }
     summary
+}
+
+/// `TEXL`, `BRDF`, `SHDW` and `MVIS` by FORMAT.md: one section per manifest record, sized by
+/// the record (mip chains; N² texels, six N × N faces for cube maps with N = `resolution`; one
+/// byte per `dims` cell), each equal to what the reader hands out.
+fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> String {
+    use kiln_format::sections::{BRDF_LUT, MEDIA_VISIBILITY, SHADOW_MAP, TEXTURE};
+    let count = |kind: &[u8; 4]| f.entries.iter().filter(|e| &e.kind == kind).count();
+    assert_eq!(count(b"TEXL"), m.textures.len(), "{name}: TEXL sections");
+    for (i, t) in m.textures.iter().enumerate() {
+        let levels = 32 - t.width.max(t.height).leading_zeros();
+        assert_eq!(t.mip_levels, levels, "{name}: texture {i} mip levels");
+        let texels: u64 =
+            (0..levels).map(|l| (t.width >> l).max(1) as u64 * (t.height >> l).max(1) as u64).sum();
+        let b = f.section(b"TEXL", i as u32).unwrap();
+        assert_eq!(b.len() as u64, 4 * texels, "{name}: texture {i} bytes");
+        assert_eq!(spec::u32s(b), file.pod::<u32>(TEXTURE, i as u32).unwrap().unwrap());
+    }
+    match (&m.brdf_lut, f.section(b"BRDF", 0)) {
+        (Some(lut), Some(b)) => {
+            assert_eq!(b.len(), 4 * (lut.resolution * lut.resolution) as usize, "{name}: BRDF bytes");
+            assert_eq!(spec::u32s(b), file.pod::<u32>(BRDF_LUT, 0).unwrap().unwrap());
+        }
+        (None, None) => {}
+        (lut, b) => panic!("{name}: brdf_lut {lut:?} with BRDF section {}", b.is_some()),
+    }
+    assert_eq!(count(b"SHDW"), m.shadow_maps.len(), "{name}: SHDW sections");
+    for (i, s) in m.shadow_maps.iter().enumerate() {
+        let faces = if s.projection == ShadowProjection::Cube { 6 } else { 1 };
+        let b = f.section(b"SHDW", i as u32).unwrap();
+        assert_eq!(
+            b.len(),
+            4 * faces * (s.resolution * s.resolution) as usize,
+            "{name}: shadow map {i} bytes"
+        );
+        let depths: Vec<f32> = (0..b.len() / 4).map(|k| spec::f32_at(b, 4 * k)).collect();
+        assert_eq!(depths, file.pod::<f32>(SHADOW_MAP, i as u32).unwrap().unwrap(), "{name}: shadow map {i}");
+        assert!(depths.iter().all(|d| d.is_finite() && *d >= 0.0), "{name}: shadow map {i} depths");
+        if s.projection == ShadowProjection::Cube {
+            assert_eq!(s.view_proj, glam::Mat4::IDENTITY.to_cols_array(), "{name}: cube map {i} view_proj");
+            assert_eq!(s.near, 0.0);
+        }
+    }
+    let mut volumes = 0;
+    if let Some(v) = &m.media_visibility {
+        assert_eq!(count(b"MVIS"), v.lights.len(), "{name}: MVIS sections");
+        for i in 0..v.lights.len() as u32 {
+            let b = f.section(b"MVIS", i).unwrap();
+            assert_eq!(b.len(), v.dims.iter().product::<u32>() as usize, "{name}: volume {i} bytes");
+            assert_eq!(b, file.pod::<u8>(MEDIA_VISIBILITY, i).unwrap().unwrap());
+            volumes += 1;
+        }
+    } else {
+        assert_eq!(count(b"MVIS"), 0);
+    }
+    format!(
+        "{} textures, BRDF {}, {} shadow maps, {volumes} visibility volumes",
+        m.textures.len(),
+        m.brdf_lut.is_some(),
+        m.shadow_maps.len()
+    )
 }
 
 /// The demo Cornell box with a textured material (so `UVS0` is written), a spot light, every
@@ -1007,11 +1071,22 @@ fn fixture() -> Vec<u8> {
     spot.kind = LightKind::Spot { inner_cone: 0.3, outer_cone: 0.5 };
     spot.position = [0.3, 1.9, 0.5];
     s.lights.push(spot);
+    s.media.push(kiln_format::manifest::Medium {
+        bounds: Bounds { min: [-0.9, 0.1, -0.9], max: [0.9, 1.3, 0.9] },
+        sigma_a: [0.05; 3],
+        sigma_s: [0.2; 3],
+        g: 0.3,
+    });
+    let metal = &mut s.materials[1].gpu;
+    metal.flags &= !kiln_format::sections::MaterialFlags::DIFFUSE_ONLY;
+    metal.metallic = 1.0;
+    metal.roughness = 0.4;
     let settings = Settings {
         voxel_res: VoxelRes::Cells(5),
         shaft_res: Some(3),
         shaft_variants: Some(Variants::ALL),
         shadow_res: 16,
+        media_volume_res: 8,
         ..Default::default()
     };
     compile_to_bytes(s, settings, "spec-reader").expect("the fixture compiles")
