@@ -1149,7 +1149,19 @@ fn a_reader_written_from_format_md_agrees_on_the_shared_scenes() {
         ];
         run::kiln(dir.path(), &args.iter().copied().chain(extra.iter().copied()).collect::<Vec<_>>())
             .expect(0);
-        let summary = agree(name, &std::fs::read(&out).unwrap());
+        let bytes = std::fs::read(&out).unwrap();
+        let summary = agree(name, &bytes);
+        // `kiln inspect --json` prints each content hash as hex of its stored bytes, in order.
+        let run = run::kiln(dir.path(), &["inspect", out.to_str().unwrap(), "--json"]);
+        run.expect(0);
+        let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+        let entries = spec::open(&bytes).unwrap().entries;
+        assert_eq!(j["sections"].as_array().unwrap().len(), entries.len());
+        for (e, js) in entries.iter().zip(j["sections"].as_array().unwrap()) {
+            let hex: String = e.content_hash.iter().map(|b| format!("{b:02x}")).collect();
+            assert_eq!(js["content_hash"], hex, "{name}: {}", js["kind"]);
+            assert_eq!(js["checksum"], format!("{:016x}", e.checksum), "{name}: {}", js["kind"]);
+        }
         eprintln!("{summary}");
         assert!(!summary.contains(" 0 inputs"), "{summary}");
         assert!(name != "pica_pica" || !summary.contains(" 0 uvs"), "{summary}");
