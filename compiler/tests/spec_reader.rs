@@ -1099,11 +1099,19 @@ fn a_reader_written_from_format_md_agrees_with_the_reference_reader() {
     assert_eq!(spec::hash_hex(b""), "7f498d4624c30160d8984701d306aa99");
     let bytes = fixture();
     let summary = agree("fixture", &bytes);
+    // Every kind the format knows is here (and so read above): a new kind fails this until the
+    // fixture writes it and this reader decodes it.
+    let f = spec::open(&bytes).unwrap();
+    let mut kinds: Vec<[u8; 4]> = f.entries.iter().map(|e| e.kind).collect();
+    let mut known: Vec<[u8; 4]> = kiln_format::sections::KNOWN.iter().map(|k| k.kind.0).collect();
+    kinds.sort();
+    kinds.dedup();
+    known.sort();
+    assert_eq!(kinds, known, "the fixture's kinds against sections::KNOWN");
     eprintln!("{summary}");
     assert!(summary.contains("grid") && !summary.contains(" 0 uvs"), "{summary}");
     // It refuses what the spec refuses: a flipped byte of the header, the table, a section,
     // padding, the last byte.
-    let f = spec::open(&bytes).unwrap();
     let pad = f
         .entries
         .windows(2)
