@@ -344,6 +344,7 @@ struct Geometry {
     positions: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,
     uvs: Vec<[f32; 2]>,
+    colors: Vec<[u16; 4]>,
     tris: Vec<[u32; 3]>,
     tmat: Vec<u32>,
 }
@@ -356,10 +357,16 @@ fn decode_geometry(f: &spec::File) -> Geometry {
     assert_eq!(tris.len() % 12, 0);
     let uvs = f.section(b"UVS0", 0).unwrap_or(&[]);
     assert_eq!(uvs.len() % 8, 0);
+    let colors = f.section(b"COL0", 0).unwrap_or(&[]);
+    assert_eq!(colors.len() % 8, 0);
     Geometry {
         positions: (0..vert.len() / 24).map(|i| f32s::<3>(vert, 24 * i)).collect(),
         normals: (0..vert.len() / 24).map(|i| f32s::<3>(vert, 24 * i + 12)).collect(),
         uvs: (0..uvs.len() / 8).map(|i| f32s::<2>(uvs, 8 * i)).collect(),
+        colors: colors
+            .chunks_exact(8)
+            .map(|c| std::array::from_fn(|k| u16::from_le_bytes([c[2 * k], c[2 * k + 1]])))
+            .collect(),
         tris: (0..tris.len() / 12).map(|i| std::array::from_fn(|k| u32_at(tris, 12 * i + 4 * k))).collect(),
         tmat: u32s(f.section(b"TMAT", 0).unwrap_or(&[])),
     }
@@ -900,6 +907,10 @@ fn agree(name: &str, bytes: &[u8]) -> String {
         assert_eq!((geo.positions[i], geo.normals[i]), (v.position, v.normal), "{name}: vertex {i}");
     }
     assert_eq!(geo.uvs, view.uvs, "{name}: UVS0");
+    // COL0: absent (all white) or one unorm16 RGBA per vertex, not all white.
+    assert!(geo.colors.is_empty() || geo.colors.len() == geo.positions.len(), "{name}: COL0 length");
+    assert!(geo.colors.is_empty() || geo.colors.iter().any(|c| *c != [u16::MAX; 4]), "{name}: white COL0");
+    assert_eq!(geo.colors, view.colors, "{name}: COL0");
     assert_eq!(geo.tris, view.triangles, "{name}: TRIS");
     assert_eq!(geo.tmat, view.triangle_materials, "{name}: TMAT");
     let matl = f.section(b"MATL", 0).unwrap();
@@ -1048,8 +1059,8 @@ fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> Str
     )
 }
 
-/// The demo Cornell box with a textured material (so `UVS0` is written), a spot light, every
-/// line-space variant at N = 3.
+/// The demo Cornell box with a textured material (so `UVS0` is written), vertex colours (`COL0`),
+/// a spot light, every line-space variant at N = 3.
 fn fixture() -> Vec<u8> {
     let mut s = cornell_box();
     s.textures.push(Texture {
@@ -1066,6 +1077,9 @@ fn fixture() -> Vec<u8> {
     for (i, uv) in s.uvs.iter_mut().enumerate() {
         *uv = [(i % 7) as f32 * 0.37 - 0.5, (i % 5) as f32 * 1.3];
     }
+    // Vertex colours, so that COL0 is written.
+    let colors = (0..s.vertices.len()).map(|i| [(i * 977 % 65536) as u16, 0, u16::MAX, 40000]).collect();
+    s.set_colors(0, Some(colors));
     let mut spot = s.lights[0].clone();
     spot.name = "spot".into();
     spot.kind = LightKind::Spot { inner_cone: 0.3, outer_cone: 0.5 };
