@@ -80,17 +80,22 @@ pub enum WarningClass {
     /// The asset lacks what rendering needs and kiln made it up or found nothing (no camera,
     /// nothing that lights the scene): a sidecar supplies it.
     MissingSetup,
+    /// The file is what the asset says but costs more than it needs to (instances flattened
+    /// into copies of their triangles).
+    Performance,
 }
 
 impl WarningClass {
     /// Every class.
-    pub const ALL: [WarningClass; 2] = [WarningClass::DataLoss, WarningClass::MissingSetup];
+    pub const ALL: [WarningClass; 3] =
+        [WarningClass::DataLoss, WarningClass::MissingSetup, WarningClass::Performance];
 
     /// The class's name on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             WarningClass::DataLoss => "data-loss",
             WarningClass::MissingSetup => "missing-setup",
+            WarningClass::Performance => "performance",
         }
     }
 }

@@ -89,12 +89,14 @@ mod tests {
 
     #[test]
     fn strict_fails_on_data_loss_only_and_w_settings_win_in_order() {
-        let all = [w(WarningClass::DataLoss), w(WarningClass::MissingSetup)];
+        let all = [w(WarningClass::DataLoss), w(WarningClass::MissingSetup), w(WarningClass::Performance)];
         assert!(WarningPolicy::default().failing(&all).is_empty());
         let strict = WarningPolicy::new(true, &[]);
         assert_eq!(strict.failing(&all), [&all[0]]);
         let both = WarningPolicy::new(true, &[parse_setting("missing-setup=error").unwrap()]);
         assert_eq!(both.failing(&all).len(), 2);
+        let perf = WarningPolicy::new(false, &[parse_setting("performance=error").unwrap()]);
+        assert_eq!(perf.failing(&all), [&all[2]]);
         let relaxed = WarningPolicy::new(
             true,
             &[parse_setting("data-loss=ignore").unwrap(), parse_setting("data-loss=warn").unwrap()],
@@ -102,7 +104,7 @@ mod tests {
         assert!(relaxed.failing(&all).is_empty());
         assert_eq!(relaxed.level(WarningClass::DataLoss), WarningLevel::Warn);
         assert!(parse_setting("data-loss").unwrap_err().contains("CLASS=LEVEL"));
-        assert!(parse_setting("perf=error").unwrap_err().contains("data-loss, missing-setup"));
+        assert!(parse_setting("perf=error").unwrap_err().contains("data-loss, missing-setup, performance"));
         assert!(parse_setting("data-loss=fatal").unwrap_err().contains("error, warn, ignore"));
     }
 }

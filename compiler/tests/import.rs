@@ -711,3 +711,32 @@ fn texture_transforms_are_baked_into_the_coordinates() {
     assert_eq!(s.uvs[0], [1.5, 0.25]);
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
+
+#[test]
+fn flattened_instances_are_a_performance_warning() {
+    // One quad (2 triangles) placed by three nodes: 6 stored triangles, 4 of them copies.
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    g.json["scenes"] = json!([{"nodes": [0, 1, 2]}]);
+    g.json["nodes"] = json!([
+        {"mesh": 0},
+        {"mesh": 0, "translation": [2.0, 0.0, 0.0]},
+        {"mesh": 0, "translation": [4.0, 0.0, 0.0]}
+    ]);
+    let s = import(&g.write(d.path(), "instances")).unwrap();
+    assert_eq!(s.triangles.len(), 6);
+    let perf: Vec<&str> = s
+        .warnings
+        .iter()
+        .filter(|w| w.class == kiln_compiler::ir::WarningClass::Performance)
+        .map(|w| w.message.as_str())
+        .collect();
+    assert_eq!(perf.len(), 1, "{:?}", s.warnings);
+    assert!(
+        perf[0].contains("1 mesh(es)") && perf[0].contains("4 of the scene's 6 triangles (67%)"),
+        "{perf:?}"
+    );
+    // Placed once: no warning.
+    let s = import(&Gltf::quad().write(d.path(), "single")).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}

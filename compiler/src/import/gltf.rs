@@ -20,7 +20,7 @@ use super::geometry::{
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult, Exit};
-use crate::ir::{Material, Scene, TextureRole};
+use crate::ir::{Material, Scene, TextureRole, WarningClass};
 use crate::settings::Normals;
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
@@ -81,6 +81,8 @@ struct Importer<'a> {
     normals: Normals,
     /// Parent of each node (skins need their joints' scene transforms).
     parents: Vec<Option<usize>>,
+    /// Per mesh: the nodes that place it, and the triangles one placement adds.
+    mesh_uses: HashMap<usize, (usize, usize)>,
 }
 
 /// Where a mesh's vertices go.
@@ -134,8 +136,10 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
             }
             p
         },
+        mesh_uses: HashMap::new(),
     };
     imp.walk_scene()?;
+    imp.warn_flattened_instances();
     let (textures, warnings) = decode_all(std::mem::take(&mut imp.requests));
     for w in warnings {
         imp.scene.warn(format!("{}: {w}", imp.file));
@@ -408,6 +412,43 @@ impl Importer<'_> {
     }
 
     fn add_mesh(&mut self, mesh: &::gltf::Mesh, placement: &Placement, weights: &[f32]) -> CliResult<()> {
+        let before = self.scene.triangles.len();
+        self.add_primitives(mesh, placement, weights)?;
+        let added = self.scene.triangles.len() - before;
+        let uses = self.mesh_uses.entry(mesh.index()).or_insert((0, added));
+        uses.0 += 1;
+        Ok(())
+    }
+
+    /// One warning (class `performance`) for every mesh placed by several nodes: the file
+    /// stores world-space triangles, so each placement is a copy.
+    fn warn_flattened_instances(&mut self) {
+        let (mut meshes, mut copies) = (0usize, 0usize);
+        for &(uses, tris) in self.mesh_uses.values() {
+            if uses > 1 {
+                meshes += 1;
+                copies += (uses - 1) * tris;
+            }
+        }
+        if copies > 0 {
+            let total = self.scene.triangles.len();
+            self.scene.warn_as(
+                WarningClass::Performance,
+                format!(
+                    "{}: {meshes} mesh(es) are placed by several nodes; kiln stores world-space triangles, so {copies} of the scene's {total} triangles ({:.0}%) are copies of instances",
+                    self.file,
+                    100.0 * copies as f64 / total.max(1) as f64
+                ),
+            );
+        }
+    }
+
+    fn add_primitives(
+        &mut self,
+        mesh: &::gltf::Mesh,
+        placement: &Placement,
+        weights: &[f32],
+    ) -> CliResult<()> {
         for prim in mesh.primitives() {
             let at = format!("{}: {} primitive {}", self.file, Self::mesh_name(mesh), prim.index());
             let mode = prim.mode();
