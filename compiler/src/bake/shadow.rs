@@ -210,12 +210,10 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
         };
         ctx.progress.stage(&format!("shadow map of light {i}"));
         let depths = render(&layout, &ctx.bvh.nodes, &triangles);
-        let hash = ctx.hash("shadow-map", &[("preset", ctx.preset()), ("light", &format!("{i}:{res}"))]);
         out.push(
             kiln_format::sections::SHADOW_MAP,
             out.shadow_maps.len() as u32,
             bytemuck::cast_slice(&depths).to_vec(),
-            hash,
         );
         out.shadow_maps.push(layout.info);
     }
