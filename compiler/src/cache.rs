@@ -144,18 +144,18 @@ impl Cache {
     /// exists but is unreadable, damaged or not this key's (the caller warns and re-bakes).
     pub fn load(&self, stage: &str, key: &ContentHash) -> Result<Option<Entry>, String> {
         let path = self.path(stage, key);
-        if !path.exists() {
-            return Ok(None);
-        }
-        let file = match KilnFile::open(&path, Checksums::Eager) {
-            Ok(f) => f,
-            // Evicted by a concurrent `kiln cache gc` between the check and the open.
-            Err(e) if !path.exists() => {
-                let _ = e;
-                return Ok(None);
-            }
+        // Read, not memory-mapped: an entry truncated in place by another program while mapped
+        // would be a SIGBUS; read bytes are only ever a short or damaged entry, which the layout
+        // and checksum checks turn into a miss.
+        let bytes = match std::fs::read(&path) {
+            Ok(b) => b,
+            // None, or evicted by a concurrent `kiln cache gc`.
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(e) => return Err(format!("{}: {e}", path.display())),
         };
+        let file =
+            KilnFile::from_bytes(&bytes, Checksums::Eager).map_err(|e| format!("{}: {e}", path.display()))?;
+        drop(bytes);
         let manifest = file.manifest().map_err(|e| format!("{}: {e}", path.display()))?;
         let mut entry = Entry { manifest, sections: Vec::new() };
         for s in file.sections() {

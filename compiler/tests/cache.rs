@@ -262,13 +262,16 @@ fn concurrent_compiles_into_one_cache_agree() {
             let mut c = Command::new(env!("CARGO_BIN_EXE_kiln"));
             c.args(["demo", "-o", &format!("{i}.kiln"), "--threads", "1", "-q", "--cache", "c"])
                 .current_dir(d)
-                .env_remove("KILN_CACHE");
+                .env_remove("KILN_CACHE")
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped());
             c.spawn().unwrap()
         })
         .collect();
     for (i, r) in runs.into_iter().enumerate() {
         let out = r.wait_with_output().unwrap();
-        assert!(out.status.success(), "compile {i} failed");
+        assert!(out.status.success(), "compile {i} failed: {}", text(&out.stderr));
+        assert!(out.stderr.is_empty(), "compile {i}: {}", text(&out.stderr));
         same(d, "plain.kiln", &format!("{i}.kiln"));
     }
     // Then one more that reads what they wrote.
@@ -353,4 +356,39 @@ fn a_cache_that_cannot_be_written_is_a_clear_error() {
     assert!(text(&out.stderr).contains("KILN_CACHE"));
     let out = kiln_env(d, &["cache", "gc", "--max-size", "12Q", "c"], None);
     assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn concurrent_stores_and_loads_of_one_key_never_see_a_partial_entry() {
+    use kiln_compiler::cache::Cache;
+    use kiln_format::{ContentHash, SectionKind};
+    let dir = tempfile::tempdir().unwrap();
+    let cache = Cache::open(&dir.path().join("c")).unwrap();
+    let key = ContentHash::of(b"one key");
+    // 4 MiB, so that a write takes long enough for the others to overlap it.
+    let payload: Vec<u8> = (0..4u32 << 20).map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8).collect();
+    let kind = SectionKind(*b"kTST");
+    std::thread::scope(|s| {
+        for t in 0..6 {
+            let (cache, payload) = (&cache, &payload);
+            s.spawn(move || {
+                for i in 0..12 {
+                    if (t + i) % 2 == 0 {
+                        cache.store("test", &key, &Default::default(), &[(kind, 0, payload)]).unwrap();
+                    } else {
+                        match cache.load("test", &key) {
+                            Ok(None) => {}
+                            Ok(Some(e)) => {
+                                assert!(e.sections[0].bytes == *payload, "a load returned other bytes")
+                            }
+                            Err(e) => panic!("a load saw a damaged entry: {e}"),
+                        }
+                    }
+                }
+            });
+        }
+    });
+    let e = cache.load("test", &key).unwrap().expect("stored");
+    assert!(e.sections[0].bytes == payload);
+    assert_eq!(std::fs::read_dir(dir.path().join("c/tmp")).unwrap().count(), 0, "no temporary file left");
 }
