@@ -153,7 +153,7 @@ fn shaft_variants_and_resolutions_are_honoured() {
 fn help_explains_every_command() {
     let dir = tempfile::tempdir().unwrap();
     let run = kiln(dir.path(), &["--help"]);
-    for cmd in ["compile", "plan", "demo", "inspect", "verify", "Exit codes"] {
+    for cmd in ["compile", "plan", "demo", "inspect", "verify", "cache", "Exit codes"] {
         assert!(run.stdout.contains(cmd), "--help lacks {cmd}");
     }
     let run = kiln(dir.path(), &["compile", "--help"]);
@@ -164,11 +164,20 @@ fn help_explains_every_command() {
         "--depfile",
         "--threads",
         "--strict",
+        "--cache",
+        "--no-cache",
+        "KILN_CACHE",
         "fast",
         "medium",
         "slow",
     ] {
         assert!(run.stdout.contains(flag), "compile --help lacks {flag}");
+    }
+    for (sub, flags) in [("stats", &["--json"][..]), ("gc", &["--max-size", "least recently used"][..])] {
+        let run = kiln(dir.path(), &["cache", sub, "--help"]);
+        for flag in flags.iter().chain(&["KILN_CACHE"]) {
+            assert!(run.stdout.contains(flag), "cache {sub} --help lacks {flag}");
+        }
     }
 }
 

@@ -114,7 +114,8 @@ impl<'a> BakeContext<'a> {
         cache: Option<&'a Cache>,
     ) -> CliResult<BakeContext<'a>> {
         let start = Instant::now();
-        progress.stage(Stage::Bvh.name());
+        // obvhs reports no progress while it builds: a spinner with the count to build over.
+        progress.stage(&format!("{}: {} triangles", Stage::Bvh.name(), scene.triangles.len()));
         let bvh_key = cache::key("bvh")
             .part("preset", settings.bvh_preset.name().as_bytes())
             .part("corners", bytemuck::cast_slice(&geometry.corners))
