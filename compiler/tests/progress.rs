@@ -25,7 +25,11 @@ fn a_build_log_gets_no_progress() {
 /// when `script` is missing.
 fn in_terminal(dir: &std::path::Path, args: &str) -> Option<String> {
     let cmd = format!("{} {args}", env!("CARGO_BIN_EXE_kiln"));
-    let out = Command::new("script").args(["-qec", &cmd, "/dev/null"]).current_dir(dir).env_remove("KILN_CACHE").output();
+    let out = Command::new("script")
+        .args(["-qec", &cmd, "/dev/null"])
+        .current_dir(dir)
+        .env_remove("KILN_CACHE")
+        .output();
     match out {
         Ok(o) if o.status.success() => Some(String::from_utf8_lossy(&o.stdout).into_owned()),
         Ok(o) => panic!("kiln failed in a terminal: {}", String::from_utf8_lossy(&o.stdout)),
