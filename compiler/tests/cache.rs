@@ -392,3 +392,44 @@ fn concurrent_stores_and_loads_of_one_key_never_see_a_partial_entry() {
     assert!(e.sections[0].bytes == payload);
     assert_eq!(std::fs::read_dir(dir.path().join("c/tmp")).unwrap().count(), 0, "no temporary file left");
 }
+
+#[test]
+fn a_material_change_misses_only_the_material_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = sidecar(d, "a.toml", [0.2, 1.2, 0.1]);
+    demo(d, "a.kiln", Some("c"), &["-c", a.to_str().unwrap()]);
+    // The same light, the red wall rougher: PNMT records hold material numbers, not parameters,
+    // and shadows ignore materials.
+    let b = d.join("b.toml");
+    std::fs::write(&b, std::fs::read_to_string(&a).unwrap().replace("roughness = 0.4", "roughness = 0.7"))
+        .unwrap();
+    let (stages, _) = demo(d, "b.kiln", Some("c"), &["-c", b.to_str().unwrap()]);
+    demo(d, "b-plain.kiln", None, &["-c", b.to_str().unwrap()]);
+    same(d, "b-plain.kiln", "b.kiln");
+    assert_eq!(with(&stages, false), ["materials"], "{stages:?}");
+}
+
+#[test]
+fn a_light_colour_change_rebakes_no_shadow_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = sidecar(d, "a.toml", [0.2, 1.2, 0.1]);
+    demo(d, "a.kiln", Some("c"), &["-c", a.to_str().unwrap()]);
+    let b = d.join("b.toml");
+    let text = std::fs::read_to_string(&a).unwrap();
+    std::fs::write(
+        &b,
+        text.replace("color = [1.0, 1.0, 1.0]\nintensity = 2.0", "color = [1.0, 0.5, 0.2]\nintensity = 7.0"),
+    )
+    .unwrap();
+    let (stages, _) = demo(d, "b.kiln", Some("c"), &["-c", b.to_str().unwrap()]);
+    demo(d, "b-plain.kiln", None, &["-c", b.to_str().unwrap()]);
+    same(d, "b-plain.kiln", "b.kiln");
+    assert_ne!(
+        std::fs::read(d.join("a.kiln")).unwrap(),
+        std::fs::read(d.join("b.kiln")).unwrap(),
+        "the light changed"
+    );
+    assert_eq!(with(&stages, false), Vec::<&str>::new(), "{stages:?}");
+}

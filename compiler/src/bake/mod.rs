@@ -213,6 +213,27 @@ fn records_bytes(
     Manifest { lights: lights.to_vec(), media: media.to_vec(), ..Default::default() }.encode()
 }
 
+/// What shadow maps read of the lights: whether each casts shadows, its kind with its cone or
+/// size, position and direction (bit for bit); not its colour, intensity or range, so that
+/// re-colouring a light re-bakes no shadow map.
+fn shadow_geometry(lights: &[kiln_format::manifest::Light]) -> Vec<u8> {
+    use kiln_format::manifest::LightKind;
+    let mut v = Vec::new();
+    for l in lights {
+        let (tag, a, b) = match l.kind {
+            LightKind::Point => (0u8, 0.0, 0.0),
+            LightKind::Spot { inner_cone, outer_cone } => (1, inner_cone, outer_cone),
+            LightKind::Directional => (2, 0.0, 0.0),
+            LightKind::Rect { width, height } => (3, width, height),
+        };
+        v.extend_from_slice(&[l.casts_shadows as u8, tag]);
+        for x in [a, b].iter().chain(&l.position).chain(&l.direction) {
+            v.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+    }
+    v
+}
+
 /// Adds every texture's texels and sampling state (its name aside) to `h`.
 fn hash_textures(h: &mut ContentHasher, scene: &Scene) {
     for t in &scene.textures {
@@ -255,7 +276,7 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
         Stage::ShadowMaps => {
             // Texel rays through the BVH from each caster's layout over the scene bounds.
             h.part("res", &s.shadow_res.to_le_bytes())
-                .part("lights", &records_bytes(&scene.lights, &[]))
+                .part("lights", &shadow_geometry(&scene.lights))
                 .part("bounds", &bounds(&ctx.geometry.bounds))
                 .hash("geometry", &ctx.geometry_key);
         }
