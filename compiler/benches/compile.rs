@@ -108,7 +108,8 @@ fn tiny(runs: usize) {
         strict: false,
         warning_levels: Vec::new(),
     };
-    let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };
+    let out_args =
+        OutputArgs { report: None, depfile: None, threads: None, quiet: true, cache: None, no_cache: true };
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
     let (mut process, mut in_process, mut lut) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..runs {
@@ -167,7 +168,8 @@ fn pica(runs: usize) {
         strict: false,
         warning_levels: Vec::new(),
     };
-    let out_args = OutputArgs { report: None, depfile: None, threads: None, quiet: true };
+    let out_args =
+        OutputArgs { report: None, depfile: None, threads: None, quiet: true, cache: None, no_cache: true };
     println!("pica_pica, {runs} runs, {} threads; medians (min..max) in ms", rayon::current_num_threads());
 
     // 1. Per-stage compile time.

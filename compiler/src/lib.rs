@@ -5,6 +5,7 @@
 pub mod analyze;
 pub mod bake;
 pub mod bench_scenes;
+pub mod cache;
 pub mod cli;
 pub mod commands;
 pub mod exit;

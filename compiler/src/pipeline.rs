@@ -12,6 +12,7 @@ use crate::analyze::geometry::SceneGeometry;
 use crate::analyze::plan::Plan;
 use crate::analyze::validate;
 use crate::bake::{self, BakeContext, StageReport};
+use crate::cache::Cache;
 use crate::cli::{BakeArgs, OutputArgs, SceneArgs};
 use crate::exit::{CliError, CliResult};
 use crate::import::{self, sidecar::Sidecar};
@@ -41,8 +42,9 @@ impl Loaded {
         &'a self,
         inputs: Vec<InputFile>,
         progress: &'a Progress,
+        cache: Option<&'a Cache>,
     ) -> CliResult<BakeContext<'a>> {
-        BakeContext::new(&self.scene, &self.geometry, &self.settings, &self.plan, inputs, progress)
+        BakeContext::new(&self.scene, &self.geometry, &self.settings, &self.plan, inputs, progress, cache)
     }
 }
 
@@ -144,7 +146,7 @@ pub fn finish(
 pub fn compile_to_bytes(scene: Scene, settings: Settings, source: &str) -> CliResult<Vec<u8>> {
     let loaded = finish(scene, settings, source, &WarningPolicy::default(), true, Instant::now())?;
     let progress = Progress::hidden();
-    let baked = bake::bake(&loaded.context(Vec::new(), &progress)?)?;
+    let baked = bake::bake(&loaded.context(Vec::new(), &progress, None)?)?;
     bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))
 }
 
@@ -197,6 +199,8 @@ pub struct Report {
     pub total_ms: f64,
     /// Worker threads.
     pub threads: usize,
+    /// The stage cache directory, when one was used.
+    pub cache: Option<String>,
     /// Settings in effect.
     pub settings: Vec<(String, String)>,
     /// Per-stage timing and size, including `import` and `write`.
@@ -224,9 +228,10 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         .num_threads(threads)
         .build()
         .map_err(|e| CliError::io(format!("cannot start {threads} worker threads: {e}")))?;
+    let cache = out.cache_dir().map(|d| Cache::open(&d)).transpose()?;
     let progress = Progress::new(!out.quiet);
     let inputs = hash_inputs(&loaded.scene.inputs)?;
-    let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress)?))?;
+    let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress, cache.as_ref())?))?;
     progress.stage("write");
     let t_write = Instant::now();
     let bytes = bake::write(&baked, output).map_err(|e| CliError::io(e.to_string()))?;
@@ -234,6 +239,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
     let mut stages = vec![StageReport {
         stage: "import",
         run: true,
+        cached: false,
         reason: "read, validate and plan".into(),
         ms: loaded.import_ms,
         bytes: baked.manifest.inputs.iter().map(|i| i.bytes).sum(),
@@ -242,6 +248,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
     stages.push(StageReport {
         stage: "write",
         run: true,
+        cached: false,
         reason: "atomic write".into(),
         ms: t_write.elapsed().as_secs_f64() * 1e3,
         bytes,
@@ -253,6 +260,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         bytes,
         total_ms: loaded.import_ms + start.elapsed().as_secs_f64() * 1e3,
         threads,
+        cache: cache.as_ref().map(|c| c.dir().display().to_string()),
         settings: loaded.settings.pairs(),
         stages,
         counts: Counts {

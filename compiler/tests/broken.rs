@@ -44,7 +44,9 @@ fn huge_position() {
     let p = g.positions(&[[0.0, 0.0, 0.0], [1e30, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     g.mesh(json!({"attributes": {"POSITION": p}}));
     let f = g.write(d.path(), "huge");
-    compile(d.path(), &f, &[]).expect(1).says("element 1 is [1e30, 0.0, 0.0], outside the supported range");
+    compile(d.path(), &f, &[]).expect(1).says(
+        "element 1 (accessor value [1e30, 0.0, 0.0]) after its node transform is [1e30, 0.0, 0.0], outside the supported range",
+    );
 }
 
 #[test]

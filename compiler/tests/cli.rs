@@ -14,7 +14,7 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.0");
+    assert_eq!(j["format_version"], "1.1");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(
@@ -31,7 +31,7 @@ fn demo_inspect_verify() {
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");
     let skipped: Vec<&str> =
         j["manifest"]["skipped"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
-    assert_eq!(skipped, ["uvs", "textures", "brdf-lut", "media-visibility"]);
+    assert_eq!(skipped, ["uvs", "vertex-colors", "textures", "brdf-lut", "media-visibility"]);
     let run = kiln(dir.path(), &["verify", "demo.kiln", "--rays", "20000", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
@@ -96,7 +96,7 @@ fn exit_codes() {
     let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
-    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.0").says("1.x");
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.1").says("1.x");
 }
 
 #[test]
@@ -153,7 +153,7 @@ fn shaft_variants_and_resolutions_are_honoured() {
 fn help_explains_every_command() {
     let dir = tempfile::tempdir().unwrap();
     let run = kiln(dir.path(), &["--help"]);
-    for cmd in ["compile", "plan", "demo", "inspect", "verify", "Exit codes"] {
+    for cmd in ["compile", "plan", "demo", "inspect", "verify", "cache", "Exit codes"] {
         assert!(run.stdout.contains(cmd), "--help lacks {cmd}");
     }
     let run = kiln(dir.path(), &["compile", "--help"]);
@@ -164,11 +164,20 @@ fn help_explains_every_command() {
         "--depfile",
         "--threads",
         "--strict",
+        "--cache",
+        "--no-cache",
+        "KILN_CACHE",
         "fast",
         "medium",
         "slow",
     ] {
         assert!(run.stdout.contains(flag), "compile --help lacks {flag}");
+    }
+    for (sub, flags) in [("stats", &["--json"][..]), ("gc", &["--max-size", "least recently used"][..])] {
+        let run = kiln(dir.path(), &["cache", sub, "--help"]);
+        for flag in flags.iter().chain(&["KILN_CACHE"]) {
+            assert!(run.stdout.contains(flag), "cache {sub} --help lacks {flag}");
+        }
     }
 }
 

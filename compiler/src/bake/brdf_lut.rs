@@ -206,15 +206,8 @@ pub fn table(res: u32) -> Arc<[[u16; 2]]> {
 /// scene, so that every file baked with the same settings shares it.
 pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let res = ctx.settings.brdf_lut_res;
-    let hash = kiln_format::ContentHasher::new()
-        .part("stage", b"brdf-lut")
-        .part("algorithm", super::ALGORITHM_VERSION.as_bytes())
-        .part("method", b"stretched-polar-gauss-legendre")
-        .part("res", &res.to_le_bytes())
-        .part("samples", &SAMPLES.to_le_bytes())
-        .finish();
     let mut out = super::Sections::default();
-    out.push(kiln_format::sections::BRDF_LUT, 0, bytemuck::cast_slice(ctx.lut()).to_vec(), hash);
+    out.push(kiln_format::sections::BRDF_LUT, 0, bytemuck::cast_slice(ctx.lut()).to_vec());
     out.brdf_lut = Some(kiln_format::manifest::BrdfLutInfo { resolution: res, samples: SAMPLES });
     out
 }

@@ -176,12 +176,7 @@ fn set_planes(node: &mut CwbvhNode, axis: usize, lo: [u8; 8], hi: [u8; 8]) {
 /// its leaf order).
 pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let mut out = super::Sections::default();
-    out.push(
-        kiln_format::sections::BVH_NODES,
-        0,
-        bytemuck::cast_slice(&ctx.bvh.nodes).to_vec(),
-        ctx.hash("bvh", &[("preset", ctx.preset())]),
-    );
+    out.push(kiln_format::sections::BVH_NODES, 0, bytemuck::cast_slice(&ctx.bvh.nodes).to_vec());
     out
 }
 

@@ -6,20 +6,9 @@ use super::{BakeContext, Sections};
 
 /// Vertices as imported; triangles and their materials in the BVH's leaf order.
 pub fn stage(ctx: &BakeContext) -> Sections {
-    let preset = ctx.preset();
     let mut out = Sections::default();
-    out.push(VERTICES, 0, bytemuck::cast_slice(&ctx.scene.vertices).to_vec(), ctx.hash("vertices", &[]));
-    out.push(
-        TRIANGLES,
-        0,
-        bytemuck::cast_slice(&ctx.triangles).to_vec(),
-        ctx.hash("triangles", &[("preset", preset)]),
-    );
-    out.push(
-        TRIANGLE_MATERIALS,
-        0,
-        bytemuck::cast_slice(&ctx.triangle_materials).to_vec(),
-        ctx.hash("triangle-materials", &[("preset", preset)]),
-    );
+    out.push(VERTICES, 0, bytemuck::cast_slice(&ctx.scene.vertices).to_vec());
+    out.push(TRIANGLES, 0, bytemuck::cast_slice(&ctx.triangles).to_vec());
+    out.push(TRIANGLE_MATERIALS, 0, bytemuck::cast_slice(&ctx.triangle_materials).to_vec());
     out
 }

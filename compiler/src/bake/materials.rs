@@ -7,6 +7,6 @@ use super::{BakeContext, Sections};
 /// The GPU material table.
 pub fn stage(ctx: &BakeContext) -> Sections {
     let mut out = Sections::default();
-    out.push(MATERIALS, 0, bytemuck::cast_slice(&ctx.materials).to_vec(), ctx.hash("materials", &[]));
+    out.push(MATERIALS, 0, bytemuck::cast_slice(&ctx.materials).to_vec());
     out
 }

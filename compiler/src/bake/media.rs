@@ -104,8 +104,7 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let (info, volumes) = bake(&ctx.shading(), &ctx.scene.media, 0, res);
     let mut out = super::Sections::default();
     for (i, v) in volumes.into_iter().enumerate() {
-        let hash = ctx.hash("media-visibility", &[("res", &res.to_string()), ("index", &i.to_string())]);
-        out.push(kiln_format::sections::MEDIA_VISIBILITY, i as u32, v, hash);
+        out.push(kiln_format::sections::MEDIA_VISIBILITY, i as u32, v);
     }
     out.media_visibility = Some(info);
     out

@@ -25,6 +25,7 @@ use kiln_format::{ContentHash, ContentHasher, SectionKind};
 use serde::Serialize;
 
 use crate::analyze::plan::Stage;
+use crate::cache::{self, Cache};
 use crate::exit::CliResult;
 use crate::ir::Scene;
 
@@ -53,6 +54,8 @@ pub struct StageReport {
     pub stage: &'static str,
     /// Whether it ran.
     pub run: bool,
+    /// Whether its output came from the stage cache (`--cache`) instead of being baked.
+    pub cached: bool,
     /// Why it ran or was skipped.
     pub reason: String,
     /// Wall time in milliseconds.
@@ -141,9 +144,40 @@ pub struct Sections {
 }
 
 impl Sections {
-    /// Adds a section.
-    pub fn push(&mut self, kind: SectionKind, index: u32, bytes: Vec<u8>, hash: ContentHash) {
-        self.list.push(BakedSection { kind, index, bytes, hash });
+    /// Adds a section (its content hash is set by [`bake`] from the stage's key).
+    pub fn push(&mut self, kind: SectionKind, index: u32, bytes: Vec<u8>) {
+        self.list.push(BakedSection { kind, index, bytes, hash: ContentHash::default() });
+    }
+
+    /// The sections and records of a cache entry (private sections left out).
+    fn from_entry(e: cache::Entry) -> Sections {
+        let mut out = Sections {
+            brdf_lut: e.manifest.brdf_lut,
+            shadow_maps: e.manifest.shadow_maps,
+            media_visibility: e.manifest.media_visibility,
+            ..Default::default()
+        };
+        for s in e.sections {
+            if kiln_format::sections::info(s.kind).is_some() {
+                out.push(s.kind, s.index, s.bytes);
+            }
+        }
+        out
+    }
+
+    /// The manifest of this stage's cache entry: its records, nothing else.
+    fn records(&self) -> Manifest {
+        Manifest {
+            brdf_lut: self.brdf_lut,
+            shadow_maps: self.shadow_maps.clone(),
+            media_visibility: self.media_visibility.clone(),
+            ..Default::default()
+        }
+    }
+
+    /// The sections as a cache entry lists them.
+    fn entry_sections(&self) -> Vec<(SectionKind, u32, &[u8])> {
+        self.list.iter().map(|s| (s.kind, s.index, s.bytes.as_slice())).collect()
     }
 
     /// Moves `other`'s sections and records after these.
@@ -160,64 +194,289 @@ impl Sections {
     }
 }
 
-/// Runs every stage the plan allows, in plan order, over `ctx`.
+/// Private section kind of the line-space cache entry: the overlap tests run and the PNMT
+/// records missing (two `u64`), which the report shows.
+const LINE_SPACE_COUNTS: SectionKind = SectionKind(*b"kLSC");
+
+/// Section kinds of the voxel-grid stage (the rest of the line-space entry is the line space's).
+const GRID_KINDS: [SectionKind; 3] = [
+    kiln_format::sections::GRID,
+    kiln_format::sections::VOXEL_OFFSETS,
+    kiln_format::sections::VOXEL_TRIANGLES,
+];
+
+/// Lights and media as the manifest encodes them (exact: every field, bit for bit).
+fn records_bytes(
+    lights: &[kiln_format::manifest::Light],
+    media: &[kiln_format::manifest::Medium],
+) -> Vec<u8> {
+    Manifest { lights: lights.to_vec(), media: media.to_vec(), ..Default::default() }.encode()
+}
+
+/// What shadow maps read of the lights: whether each casts shadows, its kind with its cone or
+/// size, position and direction (bit for bit); not its colour, intensity or range, so that
+/// re-colouring a light re-bakes no shadow map.
+fn shadow_geometry(lights: &[kiln_format::manifest::Light]) -> Vec<u8> {
+    use kiln_format::manifest::LightKind;
+    let mut v = Vec::new();
+    for l in lights {
+        let (tag, a, b) = match l.kind {
+            LightKind::Point => (0u8, 0.0, 0.0),
+            LightKind::Spot { inner_cone, outer_cone } => (1, inner_cone, outer_cone),
+            LightKind::Directional => (2, 0.0, 0.0),
+            LightKind::Rect { width, height } => (3, width, height),
+        };
+        v.extend_from_slice(&[l.casts_shadows as u8, tag]);
+        for x in [a, b].iter().chain(&l.position).chain(&l.direction) {
+            v.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+    }
+    v
+}
+
+/// Adds every texture's texels and sampling state (its name aside) to `h`.
+fn hash_textures(h: &mut ContentHasher, scene: &Scene) {
+    for t in &scene.textures {
+        let state =
+            format!("{}x{} {:?} {:?} {:?} {}", t.width, t.height, t.role, t.wrap_u, t.wrap_v, t.mag_linear);
+        h.part("texture", state.as_bytes()).part("rgba", &t.rgba);
+    }
+}
+
+/// The cache key of `stage`: the layout, compiler and algorithm versions, and exactly what the
+/// stage reads (settings and data), so that a hit is never stale. The voxel grid and the line
+/// space share one key (one bake makes both: the grid header holds the line space's figures).
+pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
+    let (s, scene) = (ctx.settings, ctx.scene);
+    let bounds =
+        |b: &kiln_format::manifest::Bounds| -> Vec<u8> { bytemuck::cast_slice(&[b.min, b.max]).to_vec() };
+    let mut h = match stage {
+        Stage::VoxelGrid | Stage::LineSpace => cache::key("line-space"),
+        _ => cache::key(stage.name()),
+    };
+    match stage {
+        Stage::Geometry => {
+            // The vertices, and the triangles and their materials in BVH leaf order.
+            h.hash("geometry", &ctx.geometry_key)
+                .part("triangle-materials", bytemuck::cast_slice(&ctx.triangle_materials));
+        }
+        Stage::Uvs => {
+            h.part("uvs", bytemuck::cast_slice(&scene.uvs));
+        }
+        Stage::VertexColors => {
+            h.part("colors", bytemuck::cast_slice(&scene.colors));
+        }
+        Stage::Materials => {
+            h.part("materials", bytemuck::cast_slice(&ctx.materials));
+        }
+        Stage::Textures => hash_textures(&mut h, scene),
+        Stage::Bvh => {
+            h.hash("bvh", &ctx.bvh_key);
+        }
+        Stage::BrdfLut => {
+            h.part("res", &s.brdf_lut_res.to_le_bytes()).part("samples", &brdf_lut::SAMPLES.to_le_bytes());
+        }
+        Stage::ShadowMaps => {
+            // Texel rays through the BVH from each caster's layout over the scene bounds.
+            h.part("res", &s.shadow_res.to_le_bytes())
+                .part("lights", &shadow_geometry(&scene.lights))
+                .part("bounds", &bounds(&ctx.geometry.bounds))
+                .hash("geometry", &ctx.geometry_key);
+        }
+        Stage::MediaVisibility => {
+            h.part("res", &s.media_volume_res.to_le_bytes())
+                .part("lights-media", &records_bytes(&scene.lights, &scene.media))
+                .hash("geometry", &ctx.geometry_key);
+        }
+        Stage::VoxelGrid | Stage::LineSpace => {
+            // The grid over the corners in stored order; PNMT records read normals (in the
+            // vertices), texture coordinates and materials; lights only through pre-illumination.
+            let p = ctx.plan;
+            h.part("voxel-res", &p.voxel_res.to_le_bytes())
+                .part("shaft-res", &p.shaft_res.to_le_bytes())
+                .part("variants", &p.shaft_variants.to_le_bytes())
+                .part("bounds", &bounds(&ctx.geometry.bounds))
+                .hash("geometry", &ctx.geometry_key)
+                .part("triangle-materials", bytemuck::cast_slice(&ctx.triangle_materials))
+                .part("uvs", bytemuck::cast_slice(&scene.uvs));
+            if p.shaft_variants & kiln_format::linespace::Variants::PREILLUM != 0 {
+                let lut = if p.runs(Stage::BrdfLut) { s.brdf_lut_res } else { 0 };
+                h.part("lights", &records_bytes(&scene.lights, &[]))
+                    .part("materials", bytemuck::cast_slice(&ctx.materials))
+                    .part("lut", &lut.to_le_bytes());
+                hash_textures(&mut h, scene);
+            }
+        }
+    }
+    h.finish()
+}
+
+/// The content hash of a section: its stage's key, kind and index (FORMAT.md: equal hashes mean
+/// the section can be reused).
+fn section_hash(key: &ContentHash, kind: SectionKind, index: u32) -> ContentHash {
+    ContentHasher::new().hash("stage", key).part("kind", &kind.0).part("index", &index.to_le_bytes()).finish()
+}
+
+/// Loads `stage`'s entry under `key`; a damaged one is warned about and treated as a miss.
+fn load(cache: &Cache, stage: &str, key: &ContentHash) -> Option<cache::Entry> {
+    match cache.load(stage, key) {
+        Ok(e) => e,
+        Err(why) => {
+            eprintln!("warning: stage cache: {why}; re-baking");
+            None
+        }
+    }
+}
+
+/// Stores an entry; a failure is a warning (the compile's output does not depend on it).
+fn store(
+    cache: &Cache,
+    stage: &str,
+    key: &ContentHash,
+    manifest: &Manifest,
+    sections: &[(SectionKind, u32, &[u8])],
+) {
+    if let Err(e) = cache.store(stage, key, manifest, sections) {
+        eprintln!("warning: stage cache: {e}");
+    }
+}
+
+/// The output of one of the simple stages, from the cache when it holds it; whether it did.
+fn cached_stage(ctx: &BakeContext, stage: Stage, key: &ContentHash) -> (Sections, bool) {
+    let run = || match stage {
+        Stage::Geometry => geometry::stage(ctx),
+        Stage::Uvs => uvs::stage(ctx),
+        Stage::VertexColors => uvs::colors(ctx),
+        Stage::Materials => materials::stage(ctx),
+        Stage::Textures => textures::stage(ctx),
+        Stage::BrdfLut => brdf_lut::stage(ctx),
+        Stage::ShadowMaps => shadow::stage(ctx),
+        Stage::MediaVisibility => media::stage(ctx),
+        // Made by the context (BVH) and by `grid_and_line_space`.
+        Stage::Bvh | Stage::VoxelGrid | Stage::LineSpace => Sections::default(),
+    };
+    let Some(cache) = ctx.cache else { return (run(), false) };
+    if let Some(e) = load(cache, stage.name(), key) {
+        return (Sections::from_entry(e), true);
+    }
+    let out = run();
+    store(cache, stage.name(), key, &out.records(), &out.entry_sections());
+    (out, false)
+}
+
+/// The voxel grid's and the line space's sections, their figures, their times (ms) and whether
+/// they came from the cache.
+struct GridAndLineSpace {
+    grid: Sections,
+    line_space: Sections,
+    stats: LineSpaceStats,
+    grid_ms: f64,
+    line_space_ms: f64,
+    cached: bool,
+}
+
+/// Bakes (or loads) the voxel grid and the line space: one bake, one cache entry.
+fn grid_and_line_space(ctx: &BakeContext, key: &ContentHash) -> CliResult<GridAndLineSpace> {
+    let start = Instant::now();
+    let split = |all: Vec<BakedSection>| -> (Sections, Sections) {
+        let (grid, ls): (Vec<_>, Vec<_>) = all.into_iter().partition(|s| GRID_KINDS.contains(&s.kind));
+        (Sections { list: grid, ..Default::default() }, Sections { list: ls, ..Default::default() })
+    };
+    if let Some(cache) = ctx.cache
+        && let Some(mut e) = load(cache, "line-space", key)
+    {
+        let counts = e.take(LINE_SPACE_COUNTS, 0).filter(|c| c.len() == 16);
+        let (grid, line_space) = split(Sections::from_entry(e).list);
+        let stats = counts.and_then(|c| {
+            let c: [u64; 2] = bytemuck::pod_read_unaligned(&c);
+            LineSpaceStats::of_sections(&grid, &line_space, c[0], c[1])
+        });
+        match stats {
+            Some(stats) => {
+                let grid_ms = start.elapsed().as_secs_f64() * 1e3;
+                return Ok(GridAndLineSpace {
+                    grid,
+                    line_space,
+                    stats,
+                    grid_ms,
+                    line_space_ms: 0.0,
+                    cached: true,
+                });
+            }
+            None => eprintln!(
+                "warning: stage cache: {}: no voxel grid header or counts; re-baking",
+                cache.path("line-space", key).display()
+            ),
+        }
+    }
+    let (grid, baked) = linespace::stages::voxel_grid(ctx)?;
+    let line_space = linespace::stages::line_space(&baked);
+    let counts = [baked.tests, baked.pnmt_missing];
+    let (grid_ms, line_space_ms) = (baked.voxel_ms, baked.total_ms - baked.voxel_ms);
+    drop(baked);
+    let stats = LineSpaceStats::of_sections(&grid, &line_space, counts[0], counts[1])
+        .ok_or_else(|| crate::exit::CliError::input("the voxel-grid stage made no grid header"))?;
+    if let Some(cache) = ctx.cache {
+        let mut sections = grid.entry_sections();
+        sections.extend(line_space.entry_sections());
+        sections.push((LINE_SPACE_COUNTS, 0, bytemuck::cast_slice(&counts)));
+        store(cache, "line-space", key, &Manifest::default(), &sections);
+    }
+    Ok(GridAndLineSpace { grid, line_space, stats, grid_ms, line_space_ms, cached: false })
+}
+
+/// Runs every stage the plan allows, in plan order, over `ctx`, taking each stage's output from
+/// the context's cache when it holds it (and storing it there when not).
 pub fn bake(ctx: &BakeContext) -> CliResult<Baked> {
     let mut all = Sections::default();
     let mut stages: Vec<StageReport> = Vec::new();
-    let mut line_space: Option<linespace::BakedLineSpace> = None;
+    let mut line_space: Option<LineSpaceStats> = None;
+    // The line-space stage's sections and time, made with the grid's.
+    let mut pending: Option<(Sections, f64, bool)> = None;
     for decision in &ctx.plan.stages {
         let start = Instant::now();
         let mut out = Sections::default();
+        let mut cached = false;
+        let mut ms = None;
         if decision.run {
             ctx.progress.stage(decision.stage.name());
-            out = match decision.stage {
-                Stage::Geometry => geometry::stage(ctx),
-                Stage::Uvs => uvs::stage(ctx),
-                Stage::VertexColors => uvs::colors(ctx),
-                Stage::Materials => materials::stage(ctx),
-                Stage::Textures => textures::stage(ctx),
-                Stage::Bvh => bvh::stage(ctx),
-                Stage::BrdfLut => brdf_lut::stage(ctx),
-                Stage::ShadowMaps => shadow::stage(ctx),
-                Stage::MediaVisibility => media::stage(ctx),
-                Stage::VoxelGrid => {
-                    let (out, baked) = linespace::stages::voxel_grid(ctx)?;
-                    line_space = Some(baked);
-                    out
+            let key = stage_key(ctx, decision.stage);
+            match decision.stage {
+                // The BVH is built (or loaded) before every stage: the geometry is stored in its
+                // leaf order.
+                Stage::Bvh => {
+                    out = bvh::stage(ctx);
+                    (cached, ms) = (ctx.bvh_cached, Some(ctx.bvh_ms));
                 }
-                Stage::LineSpace => line_space
-                    .as_ref()
-                    .map_or_else(Sections::default, |ls| linespace::stages::line_space(ctx, ls)),
-            };
-        }
-        // The BVH is built before every stage (the geometry is stored in its leaf order), and the
-        // voxel-grid stage bakes the line space too (the grid header holds its figures).
-        let ms = match decision.stage {
-            Stage::Bvh => ctx.bvh_ms,
-            Stage::VoxelGrid => line_space.as_ref().map_or(0.0, |l| l.voxel_ms),
-            Stage::LineSpace => {
-                let grid_ms = stages.iter().find(|s| s.stage == "voxel-grid").map_or(0.0, |s| s.ms);
-                line_space.as_ref().map_or(0.0, |l| l.total_ms - grid_ms)
+                Stage::VoxelGrid => {
+                    let g = grid_and_line_space(ctx, &key)?;
+                    (out, cached, ms) = (g.grid, g.cached, Some(g.grid_ms));
+                    line_space = Some(g.stats);
+                    pending = Some((g.line_space, g.line_space_ms, g.cached));
+                }
+                Stage::LineSpace => {
+                    if let Some((ls, ls_ms, ls_cached)) = pending.take() {
+                        (out, ms, cached) = (ls, Some(ls_ms), ls_cached);
+                    }
+                }
+                stage => (out, cached) = cached_stage(ctx, stage, &key),
             }
-            _ => start.elapsed().as_secs_f64() * 1e3,
-        };
+            for s in &mut out.list {
+                s.hash = section_hash(&key, s.kind, s.index);
+            }
+        }
         stages.push(StageReport {
             stage: decision.stage.name(),
             run: decision.run,
+            cached,
             reason: decision.reason.clone(),
-            ms,
+            ms: ms.unwrap_or_else(|| start.elapsed().as_secs_f64() * 1e3),
             bytes: out.bytes(),
         });
         all.append(out);
     }
     let (manifest, manifest_hash) = assemble_manifest(ctx, &all);
-    Ok(Baked {
-        manifest,
-        manifest_hash,
-        sections: all.list,
-        stages,
-        line_space: line_space.as_ref().map(LineSpaceStats::of),
-    })
+    Ok(Baked { manifest, manifest_hash, sections: all.list, stages, line_space })
 }
 
 /// The manifest and its content hash.
@@ -265,22 +524,36 @@ fn assemble_manifest(ctx: &BakeContext, all: &Sections) -> (Manifest, ContentHas
 }
 
 impl LineSpaceStats {
-    fn of(l: &linespace::BakedLineSpace) -> LineSpaceStats {
-        LineSpaceStats {
-            cells: l.header.dims,
-            slots: l.header.slots,
-            shaft_res: l.header.shaft_res,
-            variants: crate::settings::variants_name(l.header.variants),
-            filled_shafts: l.header.filled,
-            candidate_entries: l.header.entries,
-            max_cell_triangles: l.header.max_cell_triangles,
-            overlap_tests: l.tests,
-            pnmt_missing_records: l.pnmt_missing,
-            bytes_voxel_grid: 96 + 4 * (l.voxel_offsets.len() + l.voxel_triangles.len()) as u64,
-            bytes_binary: 4 * (l.slots.len() + l.bits.len() + l.ranks.len()) as u64,
-            bytes_candidates: 4 * (l.candidate_offsets.len() + l.candidates.len()) as u64,
-            bytes_pnmt: 16 * l.pnmt.len() as u64,
-        }
+    /// The figures of the voxel grid's and line space's sections (the grid header holds the
+    /// counts), with the overlap tests run and the PNMT records missing; `None` without a header.
+    fn of_sections(grid: &Sections, ls: &Sections, tests: u64, pnmt_missing: u64) -> Option<LineSpaceStats> {
+        use kiln_format::sections as k;
+        let bytes = |kinds: &[SectionKind]| -> u64 {
+            grid.list
+                .iter()
+                .chain(&ls.list)
+                .filter(|s| kinds.contains(&s.kind))
+                .map(|s| s.bytes.len() as u64)
+                .sum()
+        };
+        let header_bytes = grid.list.iter().find(|s| s.kind == k::GRID)?;
+        let header: kiln_format::linespace::GridHeader =
+            bytemuck::try_pod_read_unaligned(&header_bytes.bytes).ok()?;
+        Some(LineSpaceStats {
+            cells: header.dims,
+            slots: header.slots,
+            shaft_res: header.shaft_res,
+            variants: crate::settings::variants_name(header.variants),
+            filled_shafts: header.filled,
+            candidate_entries: header.entries,
+            max_cell_triangles: header.max_cell_triangles,
+            overlap_tests: tests,
+            pnmt_missing_records: pnmt_missing,
+            bytes_voxel_grid: bytes(&GRID_KINDS),
+            bytes_binary: bytes(&[k::SHAFT_SLOTS, k::SHAFT_BITS, k::SHAFT_RANKS]),
+            bytes_candidates: bytes(&[k::CANDIDATE_OFFSETS, k::CANDIDATES]),
+            bytes_pnmt: bytes(&[k::PNMT]),
+        })
     }
 }
 

@@ -191,10 +191,26 @@ impl Layout {
 
 /// Renders the map: one BVH ray per texel.
 pub fn render(layout: &Layout, bvh: &[CwbvhNode], tris: &(impl TriangleSource + ?Sized)) -> Vec<f32> {
+    render_counted(layout, bvh, tris, &crate::progress::Progress::hidden())
+}
+
+/// [`render`], counting texels on `progress` a row at a time.
+pub fn render_counted(
+    layout: &Layout,
+    bvh: &[CwbvhNode],
+    tris: &(impl TriangleSource + ?Sized),
+    progress: &crate::progress::Progress,
+) -> Vec<f32> {
     let q = BvhQuery::new(bvh, tris);
+    let row = layout.info.resolution as usize;
     (0..layout.len())
         .into_par_iter()
-        .map(|k| q.closest_hit(&layout.texel_ray(k)).map_or(NO_OCCLUDER, |h| h.t))
+        .map(|k| {
+            if k % row == row - 1 {
+                progress.inc(row as u64);
+            }
+            q.closest_hit(&layout.texel_ray(k)).map_or(NO_OCCLUDER, |h| h.t)
+        })
         .collect()
 }
 
@@ -204,18 +220,20 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let res = ctx.settings.shadow_res;
     let triangles = ctx.indexed();
     let mut out = super::Sections::default();
-    for (i, light) in ctx.scene.lights.iter().enumerate() {
-        let Some(layout) = layout(light, i as u32, &ctx.geometry.bounds, res) else {
-            continue;
-        };
-        ctx.progress.stage(&format!("shadow map of light {i}"));
-        let depths = render(&layout, &ctx.bvh.nodes, &triangles);
-        let hash = ctx.hash("shadow-map", &[("preset", ctx.preset()), ("light", &format!("{i}:{res}"))]);
+    let layouts: Vec<Layout> = ctx
+        .scene
+        .lights
+        .iter()
+        .enumerate()
+        .filter_map(|(i, light)| layout(light, i as u32, &ctx.geometry.bounds, res))
+        .collect();
+    ctx.progress.count("shadow maps: texels", layouts.iter().map(|l| l.len() as u64).sum());
+    for layout in layouts {
+        let depths = render_counted(&layout, &ctx.bvh.nodes, &triangles, ctx.progress);
         out.push(
             kiln_format::sections::SHADOW_MAP,
             out.shadow_maps.len() as u32,
             bytemuck::cast_slice(&depths).to_vec(),
-            hash,
         );
         out.shadow_maps.push(layout.info);
     }

@@ -92,12 +92,7 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let chains: Vec<Vec<u8>> = ctx.scene.textures.par_iter().map(mip_chain).collect();
     let mut out = super::Sections::default();
     for (i, chain) in chains.into_iter().enumerate() {
-        out.push(
-            kiln_format::sections::TEXTURE,
-            i as u32,
-            chain,
-            ctx.hash("texture", &[("index", &i.to_string())]),
-        );
+        out.push(kiln_format::sections::TEXTURE, i as u32, chain);
     }
     out
 }

@@ -39,6 +39,34 @@ pub enum Command {
     /// Validate a .kiln file completely: layout, every checksum, every cross-reference.
     /// Exits 0 when the file is sound; otherwise prints one line saying what is wrong and where.
     Verify(VerifyArgs),
+    /// Show or trim a stage cache (see `kiln compile --cache`).
+    #[command(subcommand)]
+    Cache(CacheCommand),
+}
+
+/// `kiln cache`.
+#[derive(Debug, Subcommand)]
+pub enum CacheCommand {
+    /// Entries and bytes of a stage cache, in all and per stage.
+    Stats {
+        /// The cache directory [default: $KILN_CACHE].
+        dir: Option<PathBuf>,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Remove least recently used entries (a compile's hit counts as a use) until the cache
+    /// takes at most SIZE; also removes temporary files over a day old.
+    Gc {
+        /// The cache directory [default: $KILN_CACHE].
+        dir: Option<PathBuf>,
+        /// The size to trim to: bytes, or with a binary unit K, M, G, T (e.g. 500M, 2G).
+        #[arg(long, value_name = "SIZE", value_parser = crate::cache::parse_size)]
+        max_size: u64,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// `kiln inspect`.
@@ -177,6 +205,21 @@ pub struct OutputArgs {
     /// Print nothing but errors and warnings.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Stage cache directory: each bake stage's output is kept there under the hash of what the
+    /// stage reads and reused by later compiles (the output is byte-identical either way).
+    /// Created if missing. Without this option or KILN_CACHE nothing is kept [env: KILN_CACHE]
+    #[arg(long, value_name = "DIR", help_heading = "Stage cache")]
+    pub cache: Option<PathBuf>,
+    /// Use no stage cache, even if KILN_CACHE is set.
+    #[arg(long, conflicts_with = "cache", help_heading = "Stage cache")]
+    pub no_cache: bool,
+}
+
+impl OutputArgs {
+    /// The stage cache directory: --cache, else KILN_CACHE (unless --no-cache), else none.
+    pub fn cache_dir(&self) -> Option<PathBuf> {
+        if self.no_cache { None } else { crate::cache::Cache::dir_from(self.cache.as_deref()) }
+    }
 }
 
 /// `kiln compile`.

@@ -76,6 +76,18 @@ fn summary(r: &Report) {
             p.budget.map_or(String::new(), |b| format!(" (budget {})", size(b)))
         );
     }
+    if let Some(dir) = &r.cache {
+        let names = |cached: bool| -> String {
+            let v: Vec<&str> = r
+                .stages
+                .iter()
+                .filter(|s| s.run && s.cached == cached && !matches!(s.stage, "import" | "write"))
+                .map(|s| s.stage)
+                .collect();
+            if v.is_empty() { "none".into() } else { v.join(", ") }
+        };
+        println!("  stage cache {dir}: cached {}; baked {}", names(true), names(false));
+    }
     for s in r.stages.iter().filter(|s| !s.run) {
         println!("  skipped {}: {}", s.stage, s.reason);
     }

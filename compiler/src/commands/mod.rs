@@ -1,5 +1,6 @@
 //! One module per subcommand; [`run`] dispatches.
 
+mod cache;
 mod compile;
 mod export;
 mod inspect;
@@ -18,5 +19,6 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Export(args) => export::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Verify(args) => verify::run(&args),
+        Command::Cache(c) => cache::run(&c),
     }
 }

@@ -138,7 +138,7 @@ pub fn bake(
     }
     header.slots = occupied.len() as u32;
     let margin_local = header.margin / header.cell;
-    let done = std::sync::atomic::AtomicUsize::new(0);
+    progress.count("line space: cells", occupied.len() as u64);
     let per_cell: Vec<shafts::CellShafts> = occupied
         .par_iter()
         .map_init(shafts::Scratch::default, |scratch, &c| {
@@ -159,10 +159,7 @@ pub fn bake(
                 shade,
                 scratch,
             );
-            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            if k.is_multiple_of(64) {
-                progress.stage(&format!("line space: {k}/{} cells", occupied.len()));
-            }
+            progress.inc(1);
             r
         })
         .collect();

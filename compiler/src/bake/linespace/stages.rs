@@ -13,13 +13,6 @@ use super::BakedLineSpace;
 use crate::bake::{BakeContext, Sections};
 use crate::exit::CliResult;
 
-/// The hash of the grid's and line space's sections: the BVH preset (they store triangles in
-/// its order) and the grid settings.
-fn hash(ctx: &BakeContext, label: &str) -> kiln_format::ContentHash {
-    let grid = format!("{};{};{}", ctx.plan.voxel_res, ctx.plan.shaft_res, ctx.plan.shaft_variants);
-    ctx.hash(label, &[("preset", ctx.preset()), ("grid", &grid)])
-}
-
 /// The voxel-grid stage: the scene's voxel grid (shared with the plan) renumbered to the stored
 /// triangle order, then the line space over it, since the grid header records the line space's
 /// figures. Returns the grid's sections and the whole line space for [`line_space`].
@@ -40,19 +33,17 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
         Some(&shade),
         ctx.progress,
     )?;
-    let h = hash(ctx, "voxel-grid");
     let mut out = Sections::default();
-    out.push(GRID, 0, bytemuck::bytes_of(&ls.header).to_vec(), h);
-    out.push(VOXEL_OFFSETS, 0, bytemuck::cast_slice(&ls.voxel_offsets).to_vec(), h);
-    out.push(VOXEL_TRIANGLES, 0, bytemuck::cast_slice(&ls.voxel_triangles).to_vec(), h);
+    out.push(GRID, 0, bytemuck::bytes_of(&ls.header).to_vec());
+    out.push(VOXEL_OFFSETS, 0, bytemuck::cast_slice(&ls.voxel_offsets).to_vec());
+    out.push(VOXEL_TRIANGLES, 0, bytemuck::cast_slice(&ls.voxel_triangles).to_vec());
     Ok((out, ls))
 }
 
 /// The line-space stage: the shaft sections of the variants baked.
-pub fn line_space(ctx: &BakeContext, ls: &BakedLineSpace) -> Sections {
-    let h = hash(ctx, "line-space");
+pub fn line_space(ls: &BakedLineSpace) -> Sections {
     let mut out = Sections::default();
-    let mut add = |kind, data: &[u8]| out.push(kind, 0, data.to_vec(), h);
+    let mut add = |kind, data: &[u8]| out.push(kind, 0, data.to_vec());
     add(SHAFT_SLOTS, bytemuck::cast_slice(&ls.slots));
     add(SHAFT_BITS, bytemuck::cast_slice(&ls.bits));
     add(SHAFT_RANKS, bytemuck::cast_slice(&ls.ranks));
