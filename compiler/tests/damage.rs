@@ -95,6 +95,8 @@ fn every_kind_file() -> Vec<u8> {
         mag_linear: true,
     });
     s.materials[0].gpu.base_color_texture = 0;
+    let colors = (0..s.vertices.len()).map(|i| [(i * 1031 % 65536) as u16, 7, u16::MAX, 1]).collect();
+    s.set_colors(0, Some(colors));
     let metal = &mut s.materials[1].gpu;
     metal.flags &= !MaterialFlags::DIFFUSE_ONLY;
     metal.metallic = 1.0;
