@@ -92,6 +92,7 @@ fn check_scene(name: &str, triangles: u64, textures: u64, extra: &[&str]) {
             "import",
             "geometry",
             "uvs",
+            "vertex-colors",
             "materials",
             "textures",
             "bvh",
