@@ -713,6 +713,30 @@ fn texture_transforms_are_baked_into_the_coordinates() {
 }
 
 #[test]
+fn a_malformed_animation_is_dropped_with_a_warning_other_errors_still_fail() {
+    let d = tempfile::tempdir().unwrap();
+    // A channel naming a sampler that does not exist, and an output accessor that does not.
+    let mut g = Gltf::quad();
+    g.json["animations"] = json!([{
+        "channels": [{"sampler": 3, "target": {"node": 0, "path": "translation"}}],
+        "samplers": [{"input": 0, "output": 99}]
+    }]);
+    let s = import(&g.write(d.path(), "bad-anim")).unwrap();
+    assert_eq!(s.triangles.len(), 2);
+    let text: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert!(
+        text.iter().any(|w| w.contains("1 animation(s) dropped unread, as they are malformed")),
+        "{text:?}"
+    );
+    assert!(text.iter().any(|w| w.contains("animations[0]")), "{text:?}");
+    // The same fault outside the animations is an error.
+    g.json["animations"] = json!([]);
+    g.json["meshes"][0]["primitives"][0]["indices"] = json!(99);
+    let err = import(&g.write(d.path(), "bad-mesh")).unwrap_err();
+    assert!(err.to_string().contains("invalid glTF"), "{err}");
+}
+
+#[test]
 fn flattened_instances_are_a_performance_warning() {
     // One quad (2 triangles) placed by three nodes: 6 stored triangles, 4 of them copies.
     let d = tempfile::tempdir().unwrap();

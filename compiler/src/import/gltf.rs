@@ -109,8 +109,24 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
         ));
     }
     let blob = gltf.blob;
-    let doc = Document::from_json(gltf.document.into_json())
-        .map_err(|e| CliError::input(format!("{file}: invalid glTF: {}", describe_validation(&e))))?;
+    let mut json = gltf.document.into_json();
+    let invalid =
+        |e: ::gltf::Error| CliError::input(format!("{file}: invalid glTF: {}", describe_validation(&e)));
+    let doc = match Document::from_json(json.clone()) {
+        Ok(doc) => doc,
+        // Animations are never baked: a malformed one costs nothing to drop, so it is a warning
+        // (the rest must validate without it).
+        Err(e @ ::gltf::Error::Validation(_)) if only_animations(&e) => {
+            scene.warn(format!(
+                "{file}: {} animation(s) dropped unread, as they are malformed: {}",
+                json.animations.len(),
+                describe_validation(&e)
+            ));
+            json.animations.clear();
+            Document::from_json(json).map_err(invalid)?
+        }
+        Err(e) => return Err(invalid(e)),
+    };
     for ext in doc.extensions_used().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)) {
         scene.warn(format!("{file}: extension {ext} is used but not supported; its effect is ignored"));
     }
@@ -146,6 +162,16 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
     }
     imp.scene.textures.extend(textures);
     Ok(())
+}
+
+/// Whether every validation error of `e` lies inside the `animations` array.
+fn only_animations(e: &::gltf::Error) -> bool {
+    match e {
+        ::gltf::Error::Validation(list) => {
+            !list.is_empty() && list.iter().all(|(path, _)| path.as_str().starts_with("animations["))
+        }
+        _ => false,
+    }
 }
 
 fn describe_validation(e: &::gltf::Error) -> String {
