@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use kiln_format::manifest::{Camera, ColorSpace, Light, Medium, Sky, Wrap};
+use kiln_format::manifest::{Camera, ColorSpace, Light, Medium, OrthographicCamera, Sky, Wrap};
 use kiln_format::sections::{GpuMaterial, Vertex};
 
 /// A white vertex colour, unorm16.
@@ -132,6 +132,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Cameras, default first.
     pub cameras: Vec<Camera>,
+    /// Which of `cameras` are orthographic, with their extents (indices into `cameras`).
+    pub orthographic: Vec<OrthographicCamera>,
     /// Sky.
     pub sky: Sky,
     /// Participating media.

@@ -122,8 +122,9 @@ fn simple_morph_sits_at_its_default_weights() {
 }
 
 #[test]
-fn cameras_keeps_its_perspective_camera() {
-    // yfov 0.7 rad from (0.5, 0.5, 3) looking down −z.
+fn cameras_keeps_its_perspective_and_orthographic_cameras() {
+    // yfov 0.7 rad from (0.5, 0.5, 3) looking down −z; then the orthographic one, xmag = ymag = 1
+    // (stored with the equivalent field of view 2·atan(1) = 90° for manifest-1 readers).
     let d = tempfile::tempdir().unwrap();
     let bytes = compiled(d.path(), "Cameras", &[]);
     let file = KilnFile::from_bytes(&bytes, Default::default()).unwrap();
@@ -132,18 +133,26 @@ fn cameras_keeps_its_perspective_camera() {
     assert!((c.vfov_degrees - 0.7f32.to_degrees()).abs() < 1e-4, "{c:?}");
     assert_eq!(c.position, [0.5, 0.5, 3.0]);
     assert!(c.target[2] < c.position[2] && c.target[0] == 0.5 && c.target[1] == 0.5, "{c:?}");
+    let manifest = file.manifest().unwrap();
+    assert_eq!(manifest.cameras.len(), 2);
+    assert_eq!(
+        manifest.orthographic,
+        [kiln_format::manifest::OrthographicCamera { camera: 1, xmag: 1.0, ymag: 1.0 }]
+    );
+    assert_eq!(manifest.cameras[1].position, [0.5, 0.5, 3.0]);
+    assert!((manifest.cameras[1].vfov_degrees - 90.0).abs() < 1e-4);
 }
 
 #[test]
 fn strict_passes_untouched_samples_that_lose_nothing() {
-    // Triangle and BoxVertexColors lose nothing (no camera, no light: missing setup, not data
-    // loss); SimpleMorph drops an animation and Cameras an orthographic camera: data loss.
+    // Triangle, BoxVertexColors and Cameras lose nothing (no camera, no light: missing setup, not
+    // data loss); SimpleMorph drops an animation: data loss.
     let d = tempfile::tempdir().unwrap();
     for (name, code, says) in [
         ("Triangle", 0, "[missing-setup]"),
         ("BoxVertexColors", 0, "[missing-setup]"),
         ("SimpleMorph", 1, "animation(s) not baked"),
-        ("Cameras", 1, "orthographic camera"),
+        ("Cameras", 0, "[missing-setup]"),
     ] {
         let out = d.path().join(format!("{name}.kiln"));
         kiln(d.path(), &["compile", model(name).to_str().unwrap(), "-o", out.to_str().unwrap(), "--strict"])

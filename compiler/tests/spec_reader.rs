@@ -21,8 +21,8 @@ use kiln_compiler::settings::{Settings, VoxelRes};
 use kiln_format::linespace::{LineSpace, Variants};
 use kiln_format::manifest::{
     Bounds, BrdfLutInfo, Camera, ColorSpace, InputFile, Light, LightKind, Manifest, MaterialInfo,
-    MediaVisibilityInfo, Medium, Setting, ShadowMapInfo, ShadowProjection, SkippedStage, Sky, TextureInfo,
-    Wrap,
+    MediaVisibilityInfo, Medium, OrthographicCamera, Setting, ShadowMapInfo, ShadowProjection, SkippedStage,
+    Sky, TextureInfo, Wrap,
 };
 use kiln_format::{Checksums, KilnFile, SceneView};
 use std::path::PathBuf;
@@ -334,8 +334,14 @@ fn decode_manifest(b: &[u8]) -> Manifest {
             samples: r.u32(),
             lights: r.vec(|r| r.u32()),
         }),
+        // Manifest version 2 appends the orthographic cameras; version 1 ends here.
+        orthographic: Vec::new(),
     };
-    assert_eq!(r.at, b.len(), "manifest version 1: no bytes after the last field");
+    let mut m = m;
+    if r.at < b.len() {
+        m.orthographic = r.vec(|r| OrthographicCamera { camera: r.u32(), xmag: r.f32(), ymag: r.f32() });
+    }
+    assert_eq!(r.at, b.len(), "no bytes after the last field");
     m
 }
 
@@ -1077,6 +1083,11 @@ fn fixture() -> Vec<u8> {
     for (i, uv) in s.uvs.iter_mut().enumerate() {
         *uv = [(i % 7) as f32 * 0.37 - 0.5, (i % 5) as f32 * 1.3];
     }
+    // A second camera, orthographic, so that manifest version 2's list is not empty.
+    let mut ortho = s.cameras[0].clone();
+    ortho.name = "ortho".into();
+    s.cameras.push(ortho);
+    s.orthographic.push(OrthographicCamera { camera: 1, xmag: 1.25, ymag: 0.75 });
     // Vertex colours, so that COL0 is written.
     let colors = (0..s.vertices.len()).map(|i| [(i * 977 % 65536) as u16, 0, u16::MAX, 40000]).collect();
     s.set_colors(0, Some(colors));

@@ -275,10 +275,34 @@ pub struct Manifest {
     pub shadow_maps: Vec<ShadowMapInfo>,
     /// The light-visibility volume, when baked.
     pub media_visibility: Option<MediaVisibilityInfo>,
+    /// Manifest version 2: the cameras that are orthographic (the others are perspective).
+    pub orthographic: Vec<OrthographicCamera>,
+}
+
+/// An orthographic camera (glTF `camera.orthographic`), manifest version 2: the camera
+/// `cameras[camera]` projects along its view direction onto a rectangle of half-width `xmag` and
+/// half-height `ymag` (scene units). Its `vfov_degrees` holds the field of view under which a
+/// perspective camera at its position sees the same height at its target, for readers of
+/// manifest version 1.
+#[derive(Debug, Clone, Copy, PartialEq, Encode, Decode, Serialize)]
+pub struct OrthographicCamera {
+    /// Index into `cameras`.
+    pub camera: u32,
+    /// Half-width of the view rectangle.
+    pub xmag: f32,
+    /// Half-height of the view rectangle.
+    pub ymag: f32,
+}
+
+impl Manifest {
+    /// The orthographic extents `(xmag, ymag)` of camera `i`, or `None` when it is perspective.
+    pub fn orthographic(&self, i: usize) -> Option<(f32, f32)> {
+        self.orthographic.iter().find(|o| o.camera as usize == i).map(|o| (o.xmag, o.ymag))
+    }
 }
 
 /// Manifest version this crate reads and writes (equals the `MANI` kind's version).
-pub const MANIFEST_VERSION: u16 = 1;
+pub const MANIFEST_VERSION: u16 = 2;
 
 impl Manifest {
     /// Encodes with bincode's standard configuration.
@@ -292,6 +316,15 @@ impl Manifest {
     /// limit, set to the smallest power of two at least four times the section length, so that
     /// no length read from the file can claim more memory than the file could describe.
     pub fn decode(bytes: &[u8], version: u16) -> Result<Manifest> {
+        // Version 1 ends before `orthographic`: read it as version 2 with that list empty (a
+        // zero length, one byte).
+        let v1;
+        let bytes = if version < 2 {
+            v1 = [bytes, &[0u8]].concat();
+            &v1[..]
+        } else {
+            bytes
+        };
         let (manifest, used) = decode_limited(bytes)?;
         if used != bytes.len() && version <= MANIFEST_VERSION {
             return Err(FormatError::new(ErrorKind::Manifest(format!(
@@ -340,6 +373,23 @@ mod tests {
 
     fn enc<T: Encode>(v: &T) -> Vec<u8> {
         bincode::encode_to_vec(v, bincode::config::standard()).unwrap()
+    }
+
+    /// A version-1 manifest is a version-2 one without its trailing `orthographic` list: it reads
+    /// with the list empty, and version 2 keeps the list.
+    #[test]
+    fn version_1_manifests_read_with_no_orthographic_cameras() {
+        let mut m = Manifest { scene_name: "s".into(), ..Default::default() };
+        let v1 = m.encode();
+        // The empty list is the last byte (a zero count); version 1 has no such byte.
+        assert_eq!(v1.last(), Some(&0));
+        let v1 = &v1[..v1.len() - 1];
+        assert_eq!(Manifest::decode(v1, 1).unwrap(), m);
+        assert!(Manifest::decode(v1, 2).is_err(), "version 2 requires the list");
+        m.orthographic.push(OrthographicCamera { camera: 0, xmag: 2.0, ymag: 1.5 });
+        let v2 = m.encode();
+        assert_eq!(&v2[v1.len()..], [1, 0, 0, 0, 0, 0x40, 0, 0, 0xc0, 0x3f]);
+        assert_eq!(Manifest::decode(&v2, 2).unwrap(), m);
     }
 
     /// FORMAT.md's bincode table and its examples.

@@ -218,6 +218,23 @@ impl<'a> SceneView<'a> {
                 )));
             }
         }
+        for (k, o) in m.orthographic.iter().enumerate() {
+            if o.camera as usize >= m.cameras.len()
+                || m.orthographic[..k].iter().any(|p| p.camera == o.camera)
+            {
+                return Err(FormatError::invalid(format!(
+                    "orthographic entry {k} names camera {} ({} cameras, each at most once)",
+                    o.camera,
+                    m.cameras.len()
+                )));
+            }
+            if !(o.xmag.is_finite() && o.ymag.is_finite() && o.xmag > 0.0 && o.ymag > 0.0) {
+                return Err(FormatError::invalid(format!(
+                    "orthographic camera {} has extents {} × {}, not positive and finite",
+                    o.camera, o.xmag, o.ymag
+                )));
+            }
+        }
         Ok(())
     }
 

@@ -3,11 +3,12 @@
 
 use glam::{DMat4, DVec3, Vec3};
 use kiln_format::manifest::{Bounds, Camera as FileCamera};
-use kiln_format::projection::{look_to_rh, perspective_infinite_reverse_rh, perspective_rh};
+use kiln_format::projection::{look_to_rh, orthographic_rh, perspective_infinite_reverse_rh, perspective_rh};
 
 use crate::error::{Exit, PlayError, PlayResult};
 
-/// A perspective camera looking from `position` along `forward`.
+/// A camera looking from `position` along `forward`: perspective, or orthographic when `ortho`
+/// is set.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// Eye position.
@@ -22,6 +23,11 @@ pub struct Camera {
     pub znear: f64,
     /// Far plane distance; 0 or infinite for an infinite far plane.
     pub zfar: f64,
+    /// Orthographic: the half-height of the view rectangle (its half-width follows from the
+    /// image's aspect ratio, as a perspective camera's horizontal field of view does).
+    pub ortho: Option<f64>,
+    /// Far plane of an orthographic camera without one: beyond the scene bounds.
+    pub ortho_far: f64,
 }
 
 /// A `--camera` override: position, target and optionally the vertical field of view.
@@ -73,10 +79,13 @@ fn d3(v: [f32; 3]) -> DVec3 {
 }
 
 impl Camera {
-    /// The camera to start with: the override applied to the file's first camera, or to a view of
-    /// the bounds from above and in front when the file has none.
+    /// The camera to start with: the override applied to the file's first camera (orthographic
+    /// with half-extents `ortho` when the manifest says so), or to a view of the bounds from
+    /// above and in front when the file has none. An override's field of view makes it
+    /// perspective.
     pub fn initial(
         cameras: &[FileCamera],
+        ortho: Option<(f32, f32)>,
         bounds: &Bounds,
         over: Option<CameraOverride>,
     ) -> PlayResult<Camera> {
@@ -93,6 +102,8 @@ impl Camera {
                 vfov_degrees: c.vfov_degrees as f64,
                 znear: c.znear as f64,
                 zfar: c.zfar as f64,
+                ortho: ortho.map(|(_, ymag)| ymag as f64),
+                ortho_far: 0.0,
             },
             None => {
                 let vfov = 45.0f64;
@@ -105,6 +116,8 @@ impl Camera {
                     vfov_degrees: vfov,
                     znear: 0.0,
                     zfar: 0.0,
+                    ortho: None,
+                    ortho_far: 0.0,
                 }
             }
         };
@@ -113,6 +126,7 @@ impl Camera {
             cam.forward = (DVec3::from_array(o.target) - cam.position).normalize();
             if let Some(f) = o.vfov_degrees {
                 cam.vfov_degrees = f;
+                cam.ortho = None;
             }
         }
         if !(cam.znear > 0.0) {
@@ -120,7 +134,10 @@ impl Camera {
             // costs nothing: 1/10000 of the scene diagonal (as the compiler's default).
             cam.znear = (2.0 * radius) * 1e-4;
         }
-        let usable = cam.position.is_finite()
+        // Everything in the bounds lies within this distance along any view direction.
+        cam.ortho_far = (cam.position - centre).length() + 2.0 * radius;
+        let usable = cam.ortho.is_none_or(|h| h.is_finite() && h > 0.0)
+            && cam.position.is_finite()
             && cam.forward.is_finite()
             && cam.vfov_degrees > 0.0
             && cam.vfov_degrees < 180.0;
@@ -142,6 +159,12 @@ impl Camera {
     /// View to clip with reversed Z (near → 1, far → 0) and Vulkan's [0, 1] depth; clip y up (the
     /// viewport flips it).
     pub fn projection(&self, aspect: f64) -> DMat4 {
+        if let Some(h) = self.ortho {
+            let far =
+                if self.zfar > self.znear && self.zfar.is_finite() { self.zfar } else { self.ortho_far };
+            // Reversed Z: near and far swapped.
+            return orthographic_rh(-h * aspect, h * aspect, -h, h, far, self.znear);
+        }
         let fov = self.vfov_degrees.to_radians();
         if self.zfar > self.znear && self.zfar.is_finite() {
             perspective_rh(fov, aspect, self.zfar, self.znear)
@@ -197,7 +220,7 @@ mod tests {
 
     #[test]
     fn reversed_depth_maps_near_to_one_and_far_towards_zero() {
-        let cam = Camera::initial(&[], &bounds(), Some("0,0,5,0,0,0,60".parse().unwrap())).unwrap();
+        let cam = Camera::initial(&[], None, &bounds(), Some("0,0,5,0,0,0,60".parse().unwrap())).unwrap();
         let exact = cam.projection(1.0) * cam.view();
         let near = exact * glam::DVec4::new(0.0, 0.0, 5.0 - cam.znear, 1.0);
         assert!((near.z / near.w - 1.0).abs() < 1e-9);
@@ -214,7 +237,7 @@ mod tests {
 
     #[test]
     fn default_view_sees_the_bounds() {
-        let cam = Camera::initial(&[], &bounds(), None).unwrap();
+        let cam = Camera::initial(&[], None, &bounds(), None).unwrap();
         let (vp, _) = cam.matrices(64, 64);
         let vp = glam::Mat4::from_cols_array(&vp);
         for corner in [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0], [1.0, -1.0, 1.0], [-1.0, 1.0, -1.0]] {
@@ -226,7 +249,7 @@ mod tests {
 
     #[test]
     fn turning_keeps_a_unit_forward_below_the_pole() {
-        let mut cam = Camera::initial(&[], &bounds(), None).unwrap();
+        let mut cam = Camera::initial(&[], None, &bounds(), None).unwrap();
         for _ in 0..100 {
             cam.turn(0.1, 0.1);
         }

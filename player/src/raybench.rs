@@ -225,9 +225,17 @@ fn measure(
         for x in 0..w {
             let nx = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
             let ny = 1.0 - (y as f64 + 0.5) / h as f64 * 2.0;
-            let d = (cam.forward + right * nx * tan * aspect + up * ny * tan).normalize().as_vec3();
+            // The camera's own rays: from the eye, or parallel from the image plane (orthographic).
+            let (origin, d) = match cam.ortho {
+                None => {
+                    (eye, (cam.forward + right * nx * tan * aspect + up * ny * tan).normalize().as_vec3())
+                }
+                Some(h) => {
+                    ((cam.position + right * nx * h * aspect + up * ny * h).as_vec3(), cam.forward.as_vec3())
+                }
+            };
             primary.push(GpuRay {
-                origin: eye.to_array(),
+                origin: origin.to_array(),
                 tmin: 0.0,
                 direction: d.to_array(),
                 tmax: f32::MAX,

@@ -235,7 +235,12 @@ impl Session {
             }
         };
         times.pipelines_ms = pipelines_ms;
-        let camera = match Camera::initial(&scene.manifest.cameras, &scene.manifest.bounds, options.camera) {
+        let camera = match Camera::initial(
+            &scene.manifest.cameras,
+            scene.manifest.orthographic(0),
+            &scene.manifest.bounds,
+            options.camera,
+        ) {
             Ok(c) => c,
             Err(e) => {
                 let (mut f, mut d) = (frame, dummies);

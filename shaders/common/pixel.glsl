@@ -4,23 +4,45 @@
 #ifndef KILN_PIXEL_GLSL
 #define KILN_PIXEL_GLSL
 
-// Direction of the camera ray through image point `at` (pixel units, (0.5, 0.5) the first
-// pixel's centre), by the projection's own mapping.
-vec3 pixel_ray(vec2 at) {
-    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
-    return frame.camera_forward.xyz + frame.camera_right.xyz * (ndc.x * frame.camera_right.w)
-        + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
+// The camera: perspective from the eye frame.camera.xyz (camera.w = 0; camera_right.w and
+// camera_up.w the tangents of the half fields of view) or orthographic (camera.w = 1; .w the
+// half-width and half-height of the view rectangle centred on camera.xyz).
+bool camera_orthographic() {
+    return frame.camera.w != 0.0;
 }
 
-// Barycentrics (of corners 1 and 2) where the camera ray along `dir` meets the plane of the
-// triangle p0, p0 + e1, p0 + e2 (Möller–Trumbore without the bounds test); 0 when parallel.
-vec2 barycentrics(vec3 dir, vec3 p0, vec3 e1, vec3 e2) {
+// The offset in the image plane of image point `at` (pixel units, (0.5, 0.5) the first pixel's
+// centre), by the projection's own mapping.
+vec3 pixel_offset(vec2 at) {
+    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
+    return frame.camera_right.xyz * (ndc.x * frame.camera_right.w) + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
+}
+
+// Origin of the camera ray through image point `at`.
+vec3 pixel_origin(vec2 at) {
+    return camera_orthographic() ? frame.camera.xyz + pixel_offset(at) : frame.camera.xyz;
+}
+
+// Direction of the camera ray through image point `at` (not normalised).
+vec3 pixel_ray(vec2 at) {
+    return camera_orthographic() ? frame.camera_forward.xyz : frame.camera_forward.xyz + pixel_offset(at);
+}
+
+// Unit direction from world point p towards the camera (the view vector).
+vec3 towards_camera(vec3 p) {
+    return camera_orthographic() ? -frame.camera_forward.xyz : normalize(frame.camera.xyz - p);
+}
+
+// Barycentrics (of corners 1 and 2) where the camera ray from `origin` along `dir` meets the
+// plane of the triangle p0, p0 + e1, p0 + e2 (Möller–Trumbore without the bounds test); 0 when
+// parallel.
+vec2 barycentrics(vec3 origin, vec3 dir, vec3 p0, vec3 e1, vec3 e2) {
     vec3 pv = cross(dir, e2);
     float det = dot(e1, pv);
     if (abs(det) <= 0.0) {
         return vec2(0.0);
     }
-    vec3 tv = frame.camera.xyz - p0;
+    vec3 tv = origin - p0;
     return vec2(dot(tv, pv), dot(dir, cross(tv, e1))) / det;
 }
 

@@ -55,9 +55,9 @@ void main() {
     vec3 e1 = p1 - p0, e2 = p2 - p0;
     vec2 centre = vec2(pixel) + 0.5;
     vec3 dir = pixel_ray(centre);
-    vec2 b = barycentrics(dir, p0, e1, e2);
-    vec2 bx = barycentrics(pixel_ray(centre + vec2(1.0, 0.0)), p0, e1, e2);
-    vec2 by = barycentrics(pixel_ray(centre + vec2(0.0, 1.0)), p0, e1, e2);
+    vec2 b = barycentrics(pixel_origin(centre), dir, p0, e1, e2);
+    vec2 bx = barycentrics(pixel_origin(centre + vec2(1.0, 0.0)), pixel_ray(centre + vec2(1.0, 0.0)), p0, e1, e2);
+    vec2 by = barycentrics(pixel_origin(centre + vec2(0.0, 1.0)), pixel_ray(centre + vec2(0.0, 1.0)), p0, e1, e2);
     GpuMaterialLayout m = materials[raster_materials[t]];
     vec2 t0 = vertex_uv(idx.x), t1 = vertex_uv(idx.y), t2 = vertex_uv(idx.z);
     vec2 uv = t0 + b.x * (t1 - t0) + b.y * (t2 - t0);

@@ -28,6 +28,7 @@ layout(set = 0, binding = 7) uniform sampler2D g_normal;
 layout(set = 0, binding = 8) uniform sampler2D g_albedo;
 layout(set = 0, binding = 9) uniform sampler2D g_material;
 layout(set = 0, binding = 10) uniform sampler2D g_emission;
+#include "../common/pixel.glsl"
 layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D radiance_out;
 layout(set = 0, binding = 12, r32f) uniform readonly image2DArray rt_shadows;
 layout(set = 0, binding = 13, r32f) uniform readonly image2D rt_ao;
@@ -190,7 +191,8 @@ void main() {
     // Rect lights are surfaces the camera sees (as in the path tracer): the nearest in front of
     // the G-buffer's surface shows its radiance. Reversed Z: the far plane (cleared, nothing
     // drawn, the sky) is depth 0.
-    vec3 eye = frame.camera.xyz;
+    // The ray's origin: the eye, or on an orthographic camera the pixel's point on the near plane.
+    vec3 eye = camera_orthographic() ? world_at(pixel, 1.0) : frame.camera.xyz;
     vec3 toward = world_at(pixel, depth > 0.0 ? depth : 1e-6) - eye;
     float t_seen = depth > 0.0 ? 1.0 : 3.4e38;
     vec3 seen = frame.sky.rgb;
@@ -211,7 +213,7 @@ void main() {
     vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
     vec4 mat = texelFetch(g_material, pixel, 0);
     Material m = Material(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
-    vec3 v = normalize(frame.camera.xyz - p);
+    vec3 v = towards_camera(p);
     if (dot(n, v) < 0.0) {
         n = -n;
     }

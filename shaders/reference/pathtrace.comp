@@ -103,8 +103,12 @@ void main() {
     rng = hash(pixel.x + rc.size.x * pixel.y) ^ hash(sample_index * 0x9e3779b9u + rc.params.z);
     vec2 jitter = vec2(rnd(), rnd());
     vec2 ndc = vec2((float(pixel.x) + jitter.x) / float(rc.size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + jitter.y) / float(rc.size.y) * 2.0);
-    vec3 dir = normalize(rc.forward.xyz + rc.right.xyz * ndc.x * rc.eye.w * rc.right.w + rc.up.xyz * ndc.y * rc.eye.w);
-    vec3 l = radiance(make_ray(rc.eye.xyz, dir, 0.0, 3.4e38));
+    // Perspective (up.w = 0): eye.w is tan(vfov / 2), right.w the aspect ratio. Orthographic
+    // (up.w = 1): eye.w is the half-height of the view rectangle around the eye.
+    vec3 offset = (rc.right.xyz * ndc.x * rc.right.w + rc.up.xyz * ndc.y) * rc.eye.w;
+    bool ortho = rc.up.w != 0.0;
+    vec3 dir = ortho ? rc.forward.xyz : normalize(rc.forward.xyz + offset);
+    vec3 l = radiance(make_ray(ortho ? rc.eye.xyz + offset : rc.eye.xyz, dir, 0.0, 3.4e38));
     // A non-finite sample would poison the average; it is dropped (counted as zero).
     if (any(isnan(l)) || any(isinf(l))) {
         l = vec3(0.0);

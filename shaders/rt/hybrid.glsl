@@ -66,7 +66,7 @@ bool primary_at(ivec2 pixel, out Primary s) {
     // Barycentrics of the pixel-centre ray, clamped onto the triangle (the rasteriser's sample
     // may lie a hair outside the triangle that won it).
     vec3 e1 = p1 - p0, e2 = p2 - p0;
-    vec2 b = barycentrics(dir, p0, e1, e2);
+    vec2 b = barycentrics(pixel_origin(vec2(pixel) + 0.5), dir, p0, e1, e2);
     float u = clamp(b.x, 0.0, 1.0);
     float w = clamp(b.y, 0.0, 1.0 - u);
     s.p = p0 + u * e1 + w * e2;

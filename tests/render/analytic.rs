@@ -75,3 +75,86 @@ fn directional_light_on_a_diffuse_plane_is_albedo_over_pi_times_e_cos() {
     );
     assert!(n > (W * H / 3) as usize, "only {n} pixels compared");
 }
+
+#[test]
+fn an_orthographic_camera_sees_the_lit_square_where_its_parallel_rays_meet_it() {
+    if !vulkan() {
+        return;
+    }
+    // Straight down onto a 6 × 6 square lit by a directional light, through an orthographic
+    // camera 4 units high (half extents): pixel (px, py) looks at x = ndc.x · 4 · aspect,
+    // z = −ndc.y · 4 (right = +x, up = −z). Inside the square: albedo/π · E cos; outside: the
+    // black sky. Both G-buffers and the reference path tracer. The square's vertex colours fall
+    // linearly along x, so that a surface point found off the pixel's parallel ray (the
+    // visibility resolve's barycentrics) shows the wrong shade.
+    let dir = tempfile::tempdir().unwrap();
+    let shade = |x: f64| 0.6 + 0.3 * x / 3.0;
+    let ymag = 4.0f64;
+    let aspect = W as f64 / H as f64;
+    let mut scene = scene_of(&square(0.0, 3.0));
+    scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
+    let colors = scene
+        .vertices
+        .iter()
+        .map(|v| [shade(v.position[0] as f64); 3].map(|c| (c * 65535.0).round() as u16))
+        .map(|[r, g, b]| [r, g, b, u16::MAX])
+        .collect();
+    scene.set_colors(0, Some(colors));
+    let travel = Vec3::new(-0.3, -1.0, 0.2).normalize();
+    let irradiance = 3.0;
+    scene.lights.push(light(LightKind::Directional, [0.0; 3], travel.to_array(), irradiance));
+    scene.sky = Sky { radiance: [0.0; 3] };
+    let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
+    scene.cameras.push(cam.file_camera());
+    scene.orthographic.push(kiln_format::manifest::OrthographicCamera {
+        camera: 0,
+        xmag: (ymag * aspect) as f32,
+        ymag: ymag as f32,
+    });
+    let bytes = compile(scene, fast_settings());
+    let lit = albedo().map(|k| k / std::f64::consts::PI * irradiance as f64 * -travel.y as f64);
+    let check = |rgb: &[f32], what: &str| {
+        let (mut inside, mut outside) = (0, 0);
+        for py in 0..H {
+            for px in 0..W {
+                let ndc =
+                    ((px as f64 + 0.5) / W as f64 * 2.0 - 1.0, 1.0 - (py as f64 + 0.5) / H as f64 * 2.0);
+                let (x, z) = (ndc.0 * ymag * aspect, -ndc.1 * ymag);
+                let i = ((py * W + px) * 3) as usize;
+                // A pixel is 8/72 units wide: stay a pixel away from the square's edges.
+                if x.abs() < 2.85 && z.abs() < 2.85 {
+                    for c in 0..3 {
+                        let want = lit[c] * shade(x);
+                        let rel = (rgb[i + c] as f64 - want).abs() / want;
+                        // The albedo target is 8-bit sRGB and the shaded albedo no sRGB code.
+                        assert!(
+                            rel < TOLERANCE + 0.006,
+                            "{what}: pixel ({px}, {py}) channel {c}: {} vs {want}",
+                            rgb[i + c]
+                        );
+                    }
+                    inside += 1;
+                } else if x.abs() > 3.15 || z.abs() > 3.15 {
+                    assert!(
+                        rgb[i..i + 3].iter().all(|&v| v == 0.0),
+                        "{what}: pixel ({px}, {py}) off the square is {:?}",
+                        &rgb[i..i + 3]
+                    );
+                    outside += 1;
+                }
+            }
+        }
+        assert!(inside > 1000 && outside > 1000, "{what}: {inside} inside, {outside} outside");
+    };
+    for mode in [GBuffer::Raster, GBuffer::Visibility] {
+        let (rgb, _) =
+            render(dir.path(), &format!("ortho-{mode:?}"), &bytes, |f| Options::new(f, W, H).gbuffer(mode));
+        check(&rgb, &format!("{mode:?}"));
+    }
+    let file = dir.path().join("ortho-ref.kiln");
+    std::fs::write(&file, &bytes).unwrap();
+    let o = Options::new(&file, W, H).build();
+    let (_, rgb) =
+        kiln_player::reference::render(&o, 4, std::time::Instant::now()).expect("reference render");
+    check(&rgb, "reference");
+}

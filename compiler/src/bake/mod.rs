@@ -122,7 +122,11 @@ pub fn input_hash(scene: &Scene, inputs: &[InputFile]) -> ContentHash {
             "materials",
             &scene.materials.iter().flat_map(|m| bytemuck::bytes_of(&m.gpu).to_vec()).collect::<Vec<u8>>(),
         );
-        h.part("lights", format!("{:?}{:?}{:?}", scene.lights, scene.cameras, scene.sky).as_bytes());
+        h.part(
+            "lights",
+            format!("{:?}{:?}{:?}{:?}", scene.lights, scene.cameras, scene.orthographic, scene.sky)
+                .as_bytes(),
+        );
     }
     for i in inputs {
         h.part("input", i.hash.as_bytes());
@@ -505,6 +509,7 @@ fn assemble_manifest(ctx: &BakeContext, all: &Sections) -> (Manifest, ContentHas
             .collect(),
         lights: scene.lights.clone(),
         cameras: scene.cameras.clone(),
+        orthographic: scene.orthographic.clone(),
         sky: scene.sky,
         media: scene.media.clone(),
         skipped: ctx

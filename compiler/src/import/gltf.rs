@@ -11,7 +11,7 @@ use ::gltf::mesh::Mode;
 use ::gltf::{Accessor, Document, Gltf};
 use base64::Engine;
 use glam::{DMat3, DMat4, DVec3};
-use kiln_format::manifest::{Camera, Light, LightKind, Wrap};
+use kiln_format::manifest::{Camera, Light, LightKind, OrthographicCamera, Wrap};
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
 use super::geometry::{
@@ -1045,41 +1045,56 @@ impl Importer<'_> {
 
     fn add_camera(&mut self, camera: &::gltf::Camera, world: &DMat4, node: usize) {
         let name = camera.name().map_or_else(|| format!("camera{}", camera.index()), str::to_string);
-        match camera.projection() {
+        // Orthographic: (xmag, ymag), and the field of view under which a perspective camera sees
+        // the same height one unit ahead (its target), for manifest-1 readers.
+        let (vfov, znear, zfar, ortho) = match camera.projection() {
             ::gltf::camera::Projection::Perspective(p) => {
-                let position = world.transform_point3(DVec3::ZERO);
-                let forward = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
-                let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
-                let cam = Camera {
-                    name,
-                    position: position.as_vec3().to_array(),
-                    target: (position + forward).as_vec3().to_array(),
-                    up: up.as_vec3().to_array(),
-                    vfov_degrees: p.yfov().to_degrees(),
-                    znear: p.znear(),
-                    zfar: p.zfar().unwrap_or(0.0),
-                };
-                let vals = [cam.position, cam.target, cam.up].concat();
-                if forward == DVec3::ZERO
-                    || up == DVec3::ZERO
-                    || !vals.iter().all(|v| v.is_finite())
-                    || !cam.vfov_degrees.is_finite()
-                {
+                (p.yfov().to_degrees(), p.znear(), p.zfar().unwrap_or(0.0), None)
+            }
+            ::gltf::camera::Projection::Orthographic(o) => {
+                let (x, y) = (o.xmag().abs(), o.ymag().abs());
+                let ok = x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0;
+                if !ok {
                     self.scene.warn(format!(
-                        "{}: camera '{}' on node {node} has a degenerate transform; skipped",
-                        self.file, cam.name
+                        "{}: orthographic camera '{name}' on node {node} has xmag {} and ymag {}; skipped",
+                        self.file,
+                        o.xmag(),
+                        o.ymag()
                     ));
-                } else {
-                    self.scene.cameras.push(cam);
+                    return;
                 }
+                ((2.0 * y.atan()).to_degrees(), o.znear(), o.zfar(), Some((x, y)))
             }
-            ::gltf::camera::Projection::Orthographic(_) => {
-                self.scene.warn(format!(
-                    "{}: orthographic camera '{name}' on node {node} is not supported; skipped",
-                    self.file
-                ));
-            }
+        };
+        let position = world.transform_point3(DVec3::ZERO);
+        let forward = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
+        let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
+        let cam = Camera {
+            name,
+            position: position.as_vec3().to_array(),
+            target: (position + forward).as_vec3().to_array(),
+            up: up.as_vec3().to_array(),
+            vfov_degrees: vfov,
+            znear,
+            zfar,
+        };
+        let vals = [cam.position, cam.target, cam.up].concat();
+        if forward == DVec3::ZERO
+            || up == DVec3::ZERO
+            || !vals.iter().all(|v| v.is_finite())
+            || !vfov.is_finite()
+        {
+            self.scene.warn(format!(
+                "{}: camera '{}' on node {node} has a degenerate transform; skipped",
+                self.file, cam.name
+            ));
+            return;
         }
+        if let Some((xmag, ymag)) = ortho {
+            let camera = self.scene.cameras.len() as u32;
+            self.scene.orthographic.push(OrthographicCamera { camera, xmag, ymag });
+        }
+        self.scene.cameras.push(cam);
     }
 
     fn add_light(

@@ -231,6 +231,10 @@ impl Sidecar {
             if !(c.vfov_degrees > 0.0 && c.vfov_degrees < 180.0) {
                 return bad(format!("[camera] vfov_degrees is {}, must be in (0, 180)", c.vfov_degrees));
             }
+            // The asset's cameras move up one place.
+            for o in &mut scene.orthographic {
+                o.camera += 1;
+            }
             scene.cameras.insert(
                 0,
                 Camera {

@@ -86,7 +86,7 @@ pub const KNOWN: &[KindInfo] = &[
     KindInfo {
         kind: MANIFEST,
         name: "manifest",
-        version: 1,
+        version: crate::manifest::MANIFEST_VERSION,
         element_size: 1,
         required: true,
         indexed: false,

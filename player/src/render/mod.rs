@@ -307,7 +307,7 @@ impl Renderer {
         let constants = FrameConstants {
             view_proj,
             inv_view_proj,
-            camera: [p.x, p.y, p.z, 0.0],
+            camera: [p.x, p.y, p.z, if camera.ortho.is_some() { 1.0 } else { 0.0 }],
             sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
             size: [w, h, self.plan.lights_used, self.flags],
             params: [
@@ -316,8 +316,9 @@ impl Renderer {
                 self.frame_count as f32,
                 self.rt_constants.max_roughness,
             ],
-            camera_right: v4(right, tan_half * aspect),
-            camera_up: v4(up, tan_half),
+            // Perspective: tangents of the half fields of view; orthographic: half extents.
+            camera_right: v4(right, camera.ortho.unwrap_or(tan_half) * aspect),
+            camera_up: v4(up, camera.ortho.unwrap_or(tan_half)),
             camera_forward: v4(camera.forward, 0.0),
         };
         self.frame_ubo.write(bytemuck::bytes_of(&constants))
