@@ -103,6 +103,7 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                 samples: 8,
                 lights: vec![0, 2],
             }),
+            orthographic: vec![OrthographicCamera { camera: 0, xmag: cam.3, ymag: cam.2[0] }],
         })
 }
 
