@@ -114,12 +114,16 @@ fn scene_json(s: &Scene) -> String {
             material.name
         );
         let mut remap = vec![u32::MAX; s.vertices.len()];
-        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+        let (mut positions, mut triangles, mut colors) = (Vec::new(), Vec::new(), Vec::new());
         for (t, _) in s.triangles.iter().zip(&s.triangle_materials).filter(|(_, tm)| **tm as usize == m) {
             for &i in t {
                 if remap[i as usize] == u32::MAX {
                     remap[i as usize] = (positions.len() / 3) as u32;
                     positions.extend(s.vertices[i as usize].position);
+                    // Vertex colours (unorm16) as Mitsuba reads them: linear floats.
+                    if let Some(c) = s.colors.get(i as usize) {
+                        colors.extend(c[..3].iter().map(|&v| v as f32 / 65535.0));
+                    }
                 }
                 triangles.push(remap[i as usize]);
             }
@@ -129,12 +133,13 @@ fn scene_json(s: &Scene) -> String {
         }
         let b = g.base_color;
         meshes.push(format!(
-            r#"{{"name":"{}","albedo":{},"emission":{},"positions":[{}],"triangles":[{}]}}"#,
+            r#"{{"name":"{}","albedo":{},"emission":{},"positions":[{}],"triangles":[{}],"colors":[{}]}}"#,
             material.name,
             vec3([b[0], b[1], b[2]]),
             vec3(g.emission),
             list(&mut positions.iter().map(|&x| num(x))),
             list(&mut triangles.iter().map(u32::to_string)),
+            list(&mut colors.iter().map(|&x| num(x))),
         ));
     }
     let mut rects = Vec::new();
@@ -300,6 +305,26 @@ fn cornell_box_with_a_rect_light_matches_mitsuba() {
     let scene = cornell_box();
     assert!(matches!(scene.lights[..], [ref l] if matches!(l.kind, LightKind::Rect { .. })));
     check("rect", scene);
+}
+
+#[test]
+fn cornell_box_with_vertex_colours_matches_mitsuba() {
+    // Every vertex coloured by an affine function of its position (so that both renderers'
+    // barycentric interpolation reproduce it exactly): green rises with height, blue with x. The
+    // red wall stays red; the light's emission is not coloured. Mitsuba reads the colours as its
+    // PLY `vertex_color` attribute times the albedo.
+    let mut scene = cornell_box();
+    let colors = scene
+        .vertices
+        .iter()
+        .map(|v| {
+            let p = v.position;
+            [1.0, 0.55 + 0.2 * p[1], 0.6 + 0.3 * p[0], 1.0]
+                .map(|c: f32| (c.clamp(0.0, 1.0) * 65535.0).round() as u16)
+        })
+        .collect();
+    scene.set_colors(0, Some(colors));
+    check("colors", scene);
 }
 
 #[test]

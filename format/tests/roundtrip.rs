@@ -219,14 +219,14 @@ fn unknown_sections_are_skipped_and_reported() {
 fn newer_manifest_version_reads_its_known_prefix() {
     let m = Manifest { scene_name: "future".into(), ..Default::default() };
     let mut body = m.encode();
-    body.extend_from_slice(b"fields of manifest v2");
+    body.extend_from_slice(b"fields of a later manifest version");
     let mut w = FileWriter::new();
-    w.raw(sections::MANIFEST, 0, 2, body.clone(), ContentHash::default()).unwrap();
+    w.raw(sections::MANIFEST, 0, MANIFEST_VERSION + 1, body.clone(), ContentHash::default()).unwrap();
     let f = KilnFile::from_bytes(&w.to_bytes().unwrap(), Checksums::Eager).unwrap();
     assert_eq!(f.manifest().unwrap(), m);
     // The same trailing bytes at the current version are damage.
     let mut w = FileWriter::new();
-    w.raw(sections::MANIFEST, 0, 1, body, ContentHash::default()).unwrap();
+    w.raw(sections::MANIFEST, 0, MANIFEST_VERSION, body, ContentHash::default()).unwrap();
     let f = KilnFile::from_bytes(&w.to_bytes().unwrap(), Checksums::Eager).unwrap();
     assert!(f.manifest().unwrap_err().to_string().contains("trailing"));
 }

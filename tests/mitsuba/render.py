@@ -15,6 +15,8 @@ emitted radiance) and one-sided rectangular lights. The conventions are kiln's r
 tracer's (shaders/reference/pathtrace.comp), mapped to Mitsuba's:
 
 - Lambertian surfaces reflect on both sides in kiln: `twosided(diffuse)`.
+- Vertex colours (a mesh's optional `colors`, linear RGB per vertex) multiply the albedo: the
+  product is written as the PLY's float `r, g, b`, read through `mesh_attribute` `vertex_color`.
 - Emissive triangles emit from the front face only (as Mitsuba's `area` emitter does); flat
   face normals (`face_normals`), as the kiln scenes' quads have.
 - A kiln rect light is no geometry (rays pass through it, it casts no shadow) and emits its
@@ -41,13 +43,23 @@ import time
 import numpy as np
 
 
-def write_ply(path, positions, triangles):
+def write_ply(path, positions, triangles, colors=None):
+    """Binary PLY; `colors` (linear RGB per vertex) become float r, g, b properties, which
+    Mitsuba's PLY loader turns into the `vertex_color` mesh attribute."""
     positions = np.asarray(positions, dtype="<f4").reshape(-1, 3)
     triangles = np.asarray(triangles, dtype="<u4").reshape(-1, 3)
+    fields = [("p", "<f4", 3)]
+    props = "property float x\nproperty float y\nproperty float z\n"
+    if colors is not None:
+        fields.append(("c", "<f4", 3))
+        props += "property float r\nproperty float g\nproperty float b\n"
+    vertices = np.zeros(len(positions), dtype=fields)
+    vertices["p"] = positions
+    if colors is not None:
+        vertices["c"] = np.asarray(colors, dtype="<f4").reshape(-1, 3)
     header = (
         "ply\nformat binary_little_endian 1.0\n"
-        f"element vertex {len(positions)}\n"
-        "property float x\nproperty float y\nproperty float z\n"
+        f"element vertex {len(positions)}\n" + props +
         f"element face {len(triangles)}\n"
         "property list uchar uint vertex_indices\nend_header\n"
     )
@@ -56,7 +68,7 @@ def write_ply(path, positions, triangles):
     faces["i"] = triangles
     with open(path, "wb") as f:
         f.write(header.encode("ascii"))
-        f.write(positions.tobytes())
+        f.write(vertices.tobytes())
         f.write(faces.tobytes())
 
 
@@ -91,12 +103,18 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
     }
     for i, m in enumerate(desc["meshes"]):
         path = os.path.join(tmp, f"mesh{i}.ply")
-        write_ply(path, m["positions"], m["triangles"])
+        colors = m.get("colors") or None
+        reflectance = rgb(m["albedo"])
+        if colors is not None:
+            # The base colour times the vertex colour: the albedo is baked into the colours.
+            colors = np.asarray(colors, dtype=float).reshape(-1, 3) * np.asarray(m["albedo"], dtype=float)
+            reflectance = {"type": "mesh_attribute", "name": "vertex_color"}
+        write_ply(path, m["positions"], m["triangles"], colors)
         shape = {
             "type": "ply",
             "filename": path,
             "face_normals": True,
-            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(m["albedo"])}},
+            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}},
         }
         if any(v > 0.0 for v in m["emission"]):
             shape["emitter"] = {"type": "area", "radiance": rgb(m["emission"])}
