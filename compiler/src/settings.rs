@@ -79,10 +79,12 @@ pub const SHAFT_RES: Ranged =
 
 /// Size budget of the voxel grid and line space sections, MiB (`--line-space-budget`): the plan
 /// lowers the voxel resolution, then N (and drops variants it chose itself) until the estimate
-/// fits; see [`crate::analyze::budget`]. The default guards only the plan's own choices.
+/// fits; see [`crate::analyze::budget`]. The default scales with the scene's geometry
+/// ([`crate::analyze::budget::default_budget_mib`]; `default` here is its ceiling) and guards
+/// only the plan's own choices.
 pub const LINE_SPACE_BUDGET: Ranged = Ranged {
     key: "line_space_budget",
-    default: crate::analyze::budget::DEFAULT_LINE_SPACE_BUDGET_MIB,
+    default: crate::analyze::budget::DEFAULT_BUDGET_MAX_MIB,
     min: 1,
     max: 1 << 20,
 };
@@ -307,7 +309,7 @@ impl Settings {
             (
                 "line-space-budget".into(),
                 self.line_space_budget
-                    .map_or_else(|| format!("default {}", LINE_SPACE_BUDGET.default), |n| n.to_string()),
+                    .map_or_else(|| "default, scaled to the geometry".into(), |n| n.to_string()),
             ),
             ("brdf-lut-res".into(), self.brdf_lut_res.to_string()),
             ("shadow-res".into(), self.shadow_res.to_string()),

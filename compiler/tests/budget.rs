@@ -38,7 +38,8 @@ fn report(dir: &Path, file: &str) -> serde_json::Value {
 #[test]
 fn a_budget_forces_a_smaller_configuration_that_fits() {
     let dir = tempfile::tempdir().unwrap();
-    // Unbudgeted (the default budget is far above): 4 cells, N = 4, all variants, 6.9 MiB.
+    // The default budget (its 8 MiB floor: the demo's geometry is tiny): 4 cells, N = 4, all
+    // variants, 6.9 MiB.
     kiln(dir.path(), &["demo", "-o", "full.kiln", "-q", "--report", "full.json"]).expect(0);
     let full = line_space_bytes(dir.path(), "full.kiln");
     let r = report(dir.path(), "full.json");

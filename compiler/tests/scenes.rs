@@ -58,9 +58,16 @@ fn compile_scene(
     Some(out)
 }
 
-fn check_scene(name: &str, triangles: u64, textures: u64, extra: &[&str]) {
+/// Compiles `name` with 1 and 2 threads and checks the outputs, the report and the depfile;
+/// returns the folder and the first output (`None`: the shared scenes are absent).
+fn check_scene(
+    name: &str,
+    triangles: u64,
+    textures: u64,
+    extra: &[&str],
+) -> Option<(tempfile::TempDir, PathBuf)> {
     let dir = tempfile::tempdir().unwrap();
-    let Some(one) = compile_scene(name, dir.path(), "1", extra) else { return };
+    let one = compile_scene(name, dir.path(), "1", extra)?;
     let two = compile_scene(name, dir.path(), "2", extra).unwrap();
     assert!(
         std::fs::read(&one).unwrap() == std::fs::read(&two).unwrap(),
@@ -124,6 +131,7 @@ fn check_scene(name: &str, triangles: u64, textures: u64, extra: &[&str]) {
     assert!(listed.contains(&folder.join("scene.bin").to_str().unwrap()), "{dep}");
     let pngs = listed.iter().filter(|p| p.ends_with(".png")).count() as u64;
     assert_eq!(pngs, textures, "{dep}");
+    Some((dir, one))
 }
 
 #[test]
@@ -132,11 +140,37 @@ fn cornell_box() {
     check_scene("cornell_box", 32, 0, &[]);
 }
 
+/// Bytes of `file`'s sections whose kind is in `kinds`, from `kiln inspect --json`.
+fn section_bytes(dir: &std::path::Path, file: &std::path::Path, kinds: &[&str]) -> u64 {
+    let run = kiln(dir, &["inspect", file.to_str().unwrap(), "--json"]);
+    run.expect(0);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    j["sections"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| kinds.contains(&s["kind"].as_str().unwrap()))
+        .map(|s| s["raw_size"].as_u64().unwrap())
+        .sum()
+}
+
 #[test]
 fn pica_pica() {
-    // Binary line space only here: the default (binary and PNMT, 300 MB) is covered below at a
-    // coarser resolution to keep the test quick.
-    check_scene("pica_pica", 76_274, 6, &["--shaft-variants", "binary"]);
+    // The defaults: binary and PNMT within the default budget, twice the geometry's bytes, at
+    // least 8 MiB (README, "Voxel grid and line space"); summed here from the written sections.
+    let Some((dir, file)) = check_scene("pica_pica", 76_274, 6, &[]) else { return };
+    let geometry = section_bytes(dir.path(), &file, &["VERT", "UVS0", "COL0", "TRIS", "TMAT"]);
+    let budget = (2 * geometry).div_ceil(1 << 20).clamp(8, 384) << 20;
+    let line_space = section_bytes(
+        dir.path(),
+        &file,
+        &["VGRD", "VOXO", "VOXT", "LSLT", "LSBN", "LSRK", "LSCO", "LSCE", "LSPN", "LSPI"],
+    );
+    assert!(geometry > 3 << 20, "{geometry} bytes of geometry sections");
+    assert!(line_space <= budget, "{line_space} bytes of line space over the {budget}-byte default budget");
+    assert!(line_space > budget / 2, "{line_space} bytes: the {budget}-byte budget was not used");
+    let pnmt = section_bytes(dir.path(), &file, &["LSPN"]);
+    assert!(pnmt > 0, "the default drops PNMT only when binary + PNMT fits nowhere");
 }
 
 #[test]

@@ -33,8 +33,25 @@ use crate::analyze::geometry::SceneGeometry;
 use crate::bake::linespace::estimate;
 use crate::settings::variants_name;
 
-/// The budget that guards the plan's own choice of variants when none is given, MiB.
-pub const DEFAULT_LINE_SPACE_BUDGET_MIB: u32 = 384;
+/// The default budget is this many times the geometry's bytes ([`default_budget_mib`]): the
+/// line space then at most doubles what a file needs to render, so a default file stays small
+/// enough to ship (issue: `pica_pica`'s 8 MB of glTF became 319 MiB of line space at 384 MiB).
+pub const DEFAULT_BUDGET_PER_GEOMETRY: u64 = 2;
+
+/// The default budget's floor, MiB: a small scene still gets a line space at the thesis's
+/// resolutions (the Cornell box's, all variants at 4³ cells, N = 4, is 6.9 MiB).
+pub const DEFAULT_BUDGET_MIN_MIB: u32 = 8;
+
+/// The default budget's ceiling, MiB (the fixed default before budgets scaled with the scene).
+pub const DEFAULT_BUDGET_MAX_MIB: u32 = 384;
+
+/// The default line-space budget for a scene whose geometry sections (`VERT`, `UVS0`, `COL0`,
+/// `TRIS`, `TMAT`) take `geometry_bytes`: [`DEFAULT_BUDGET_PER_GEOMETRY`] times them, rounded up
+/// to whole MiB, within [`DEFAULT_BUDGET_MIN_MIB`]..=[`DEFAULT_BUDGET_MAX_MIB`].
+pub fn default_budget_mib(geometry_bytes: u64) -> u32 {
+    let scaled = (geometry_bytes.saturating_mul(DEFAULT_BUDGET_PER_GEOMETRY)).div_ceil(1 << 20);
+    scaled.clamp(DEFAULT_BUDGET_MIN_MIB as u64, DEFAULT_BUDGET_MAX_MIB as u64) as u32
+}
 
 /// Lowest voxel resolution the search goes to before it lowers N (auto's lower clamp).
 pub const RES_FLOOR: u32 = 4;

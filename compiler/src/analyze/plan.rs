@@ -9,7 +9,7 @@ use kiln_format::manifest::LightKind;
 use crate::analyze::budget::{self, Choice, Request};
 use crate::analyze::geometry::SceneGeometry;
 use crate::bake::linespace::voxelize::auto_resolution;
-use crate::settings::{LINE_SPACE_BUDGET, SHAFT_RES, Settings, VoxelRes, variants_name};
+use crate::settings::{SHAFT_RES, Settings, VoxelRes, variants_name};
 
 /// The bake stages, in the order they run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -187,6 +187,12 @@ impl Plan {
             Some(v) => v != 0,
             None => lit,
         };
+        // The default budget scales with the geometry sections the file will hold.
+        let vertex_bytes =
+            24 + if textured > 0 { 8 } else { 0 } + if scene.colors.is_empty() { 0 } else { 8 };
+        let geometry_bytes =
+            scene.vertices.len() as u64 * vertex_bytes + scene.triangles.len() as u64 * (12 + 4);
+        let default_budget = budget::default_budget_mib(geometry_bytes);
         let choice = if wanted {
             Some(budget::choose(
                 geometry,
@@ -198,7 +204,7 @@ impl Plan {
                     ),
                     variants: settings.shaft_variants,
                     budget_mib: (
-                        settings.line_space_budget.unwrap_or(LINE_SPACE_BUDGET.default),
+                        settings.line_space_budget.unwrap_or(default_budget),
                         settings.line_space_budget.is_some(),
                     ),
                 },
@@ -240,11 +246,25 @@ impl Plan {
                     ),
                 ));
                 let budget = c.budget.map_or(String::new(), |b| format!(" of {} MiB", b >> 20));
+                let default_why = match (c.budget, settings.line_space_budget) {
+                    (Some(_), None) => format!(
+                        "; the default budget is {}x the geometry's {} within {}..={} MiB: raise --line-space-budget for finer cells",
+                        budget::DEFAULT_BUDGET_PER_GEOMETRY,
+                        if geometry_bytes < 1 << 20 {
+                            format!("{:.1} KiB", geometry_bytes as f64 / 1024.0)
+                        } else {
+                            mib(geometry_bytes)
+                        },
+                        budget::DEFAULT_BUDGET_MIN_MIB,
+                        budget::DEFAULT_BUDGET_MAX_MIB
+                    ),
+                    _ => String::new(),
+                };
                 stages.push(run(
                     Stage::LineSpace,
                     format!(
                         "N = {shaft_res} (shafts span 1/{shaft_res} of a cell: patches of {} scene units), {}, about {}{budget} ({}); \
-                         read by kiln-play --shadows linespace and --gi linespace",
+                         read by kiln-play --shadows linespace and --gi linespace{default_why}",
                         short(e.patch()),
                         variants_name(shaft_variants),
                         mib(c.bytes),

@@ -148,7 +148,7 @@ pub struct BakeArgs {
     pub shaft_variants: Option<u32>,
     /// Size budget of the grid and line space, MiB.
     #[arg(long, value_name = "MiB", value_parser = LINE_SPACE_BUDGET.parser(), help_heading = "Voxel grid and line space",
-          help = LINE_SPACE_BUDGET.help("Size budget of the voxel grid and line space in MiB: lowers the voxel resolution, then N (those not given), and drops candidates, then PNMT (when --shaft-variants is not given), until the estimate fits; a usage error if nothing fits. The default applies only when the plan chooses the variants"))]
+          help = format!("Size budget of the voxel grid and line space in MiB: lowers the voxel resolution, then N (those not given), and drops candidates, then PNMT (when --shaft-variants is not given), until the estimate fits; a usage error if nothing fits, {}..={}. [default: {}x the bytes of the geometry sections, within {}..={} MiB; it applies only when the plan chooses the variants]", LINE_SPACE_BUDGET.min, LINE_SPACE_BUDGET.max, crate::analyze::budget::DEFAULT_BUDGET_PER_GEOMETRY, crate::analyze::budget::DEFAULT_BUDGET_MIN_MIB, crate::analyze::budget::DEFAULT_BUDGET_MAX_MIB))]
     pub line_space_budget: Option<u32>,
     /// BRDF lookup table size N.
     #[arg(long, value_name = "N", value_parser = BRDF_LUT_RES.parser(), help_heading = "Lighting bakes",
