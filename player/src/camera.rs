@@ -150,6 +150,26 @@ impl Camera {
         Ok(cam)
     }
 
+    /// The image plane: unit right and up vectors, and the image's half height, at unit distance
+    /// for a perspective camera (the tangent of half the vertical field of view), in scene units
+    /// for an orthographic one (its half extent).
+    pub fn image_axes(&self) -> (DVec3, DVec3, f64) {
+        let right = self.forward.cross(self.up).normalize_or(DVec3::X);
+        let up = right.cross(self.forward);
+        (right, up, self.ortho.unwrap_or((self.vfov_degrees.to_radians() * 0.5).tan()))
+    }
+
+    /// The ray through image point (`nx`, `ny`) in [-1, 1]² (y up) of an image `aspect` wide per
+    /// unit of height: from the eye, or parallel from the image plane (orthographic).
+    pub fn pixel_ray(&self, nx: f64, ny: f64, aspect: f64) -> (DVec3, DVec3) {
+        let (right, up, half) = self.image_axes();
+        let offset = right * nx * half * aspect + up * ny * half;
+        match self.ortho {
+            None => (self.position, (self.forward + offset).normalize()),
+            Some(_) => (self.position + offset, self.forward),
+        }
+    }
+
     /// World to view.
     pub fn view(&self) -> DMat4 {
         let up = if self.forward.cross(self.up).length_squared() < 1e-12 { DVec3::Z } else { self.up };

@@ -215,29 +215,17 @@ fn measure(
         .map_err(|e| PlayError::new(Exit::BadInput, format!("invalid .kiln file: {e}")))?;
     let (w, h) = (o.width, o.height);
     let cam = &session.camera;
-    let right = cam.forward.cross(cam.up).normalize_or(glam::DVec3::X);
-    let up = right.cross(cam.forward);
-    let tan = (cam.vfov_degrees.to_radians() * 0.5).tan();
     let aspect = w as f64 / h as f64;
-    let eye = cam.position.as_vec3();
     let mut primary = Vec::with_capacity(w as usize * h as usize);
     for y in 0..h {
         for x in 0..w {
             let nx = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
             let ny = 1.0 - (y as f64 + 0.5) / h as f64 * 2.0;
-            // The camera's own rays: from the eye, or parallel from the image plane (orthographic).
-            let (origin, d) = match cam.ortho {
-                None => {
-                    (eye, (cam.forward + right * nx * tan * aspect + up * ny * tan).normalize().as_vec3())
-                }
-                Some(h) => {
-                    ((cam.position + right * nx * h * aspect + up * ny * h).as_vec3(), cam.forward.as_vec3())
-                }
-            };
+            let (origin, d) = cam.pixel_ray(nx, ny, aspect);
             primary.push(GpuRay {
-                origin: origin.to_array(),
+                origin: origin.as_vec3().to_array(),
                 tmin: 0.0,
-                direction: d.to_array(),
+                direction: d.as_vec3().to_array(),
                 tmax: f32::MAX,
             });
         }

@@ -104,16 +104,10 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
     };
     let (w, h) = (session.renderer.images().width, session.renderer.images().height);
     let cam = &session.camera;
-    let right = cam.forward.cross(cam.up).normalize_or(glam::DVec3::X);
-    let up = right.cross(cam.forward);
+    let (right, up, half) = cam.image_axes();
     let sky = scene.manifest.sky.radiance;
     let constants = ReferenceConstants {
-        eye: [
-            cam.position.x as f32,
-            cam.position.y as f32,
-            cam.position.z as f32,
-            cam.ortho.unwrap_or((cam.vfov_degrees.to_radians() * 0.5).tan()) as f32,
-        ],
+        eye: [cam.position.x as f32, cam.position.y as f32, cam.position.z as f32, half as f32],
         right: [right.x as f32, right.y as f32, right.z as f32, w as f32 / h as f32],
         up: [up.x as f32, up.y as f32, up.z as f32, if cam.ortho.is_some() { 1.0 } else { 0.0 }],
         forward: [cam.forward.x as f32, cam.forward.y as f32, cam.forward.z as f32, 0.0],

@@ -22,7 +22,7 @@ vec2 triangle_uv(uint tri, float u, float v) {
 
 vec4 triangle_color(uint tri, float u, float v) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
-    return (1.0 - u - v) * vertex_color(idx.x) + u * vertex_color(idx.y) + v * vertex_color(idx.z);
+    return interpolated_color(idx, u, v);
 }
 
 // Alpha-masked materials are cut out during traversal.
@@ -126,7 +126,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
     }
     s.ng = ng;
     s.ns = ns;
-    surface_material(s, m, uv, w0 * vertex_color(idx.x) + h.u * vertex_color(idx.y) + h.v * vertex_color(idx.z));
+    surface_material(s, m, uv, interpolated_color(idx, h.u, h.v));
     return s;
 }
 

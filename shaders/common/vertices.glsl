@@ -22,4 +22,10 @@ vec4 vertex_color(uint v) {
     return vec4(unpackUnorm2x16(c.x), unpackUnorm2x16(c.y));
 }
 
+// The vertex colour at barycentrics (u, v) of the triangle with vertices `idx` (u weighs idx.y,
+// v idx.z, as the intersection routines report them).
+vec4 interpolated_color(uvec3 idx, float u, float v) {
+    return (1.0 - u - v) * vertex_color(idx.x) + u * vertex_color(idx.y) + v * vertex_color(idx.z);
+}
+
 #endif

@@ -78,8 +78,7 @@ void main() {
         vec3 ts = sample_texture_grad(m.normal_texture, uv, duv_dx, duv_dy).xyz * 2.0 - 1.0;
         n = normal_mapped(n, dp_dx, dp_dy, duv_dx, duv_dy, ts, m.normal_scale);
     }
-    vec4 base = m.base_color
-        * ((1.0 - b.x - b.y) * vertex_color(idx.x) + b.x * vertex_color(idx.y) + b.y * vertex_color(idx.z));
+    vec4 base = m.base_color * interpolated_color(idx, b.x, b.y);
     if (m.base_color_texture != NO_TEXTURE) {
         base *= sample_texture_grad(m.base_color_texture, uv, duv_dx, duv_dy);
     }

@@ -547,7 +547,7 @@ impl Importer<'_> {
                     }
                 },
             };
-            let matrix = |i: usize| matrices[if matrices.len() == 1 { 0 } else { i }];
+            let matrix = |i: usize| per_vertex(&matrices, i);
             let mut positions = Vec::with_capacity(count);
             for (i, p) in local_pos.iter().enumerate() {
                 let w = matrix(i).transform_point3(DVec3::from(p.map(f64::from))).as_vec3().to_array();
@@ -678,10 +678,9 @@ impl Importer<'_> {
                         .iter()
                         .enumerate()
                         .map(|(i, n)| {
-                            (normal_matrices[if normal_matrices.len() == 1 { 0 } else { i }]
-                                * DVec3::from(n.map(f64::from)))
-                            .try_normalize()
-                            .map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
+                            (per_vertex(&normal_matrices, i) * DVec3::from(n.map(f64::from)))
+                                .try_normalize()
+                                .map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
                         })
                         .collect();
                     let bad = given.iter().filter(|n| n[0].is_nan()).count();
@@ -1170,4 +1169,9 @@ fn assemble(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
         Mode::TriangleFan => (1..idx.len().saturating_sub(1)).map(|i| [idx[i], idx[i + 1], idx[0]]).collect(),
         _ => Vec::new(),
     }
+}
+
+/// Vertex `i`'s entry of `m`: one per vertex (skinned), or one for all (rigid).
+fn per_vertex<T: Copy>(m: &[T], i: usize) -> T {
+    m[if m.len() == 1 { 0 } else { i }]
 }

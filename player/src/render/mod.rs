@@ -299,9 +299,7 @@ impl Renderer {
         }
         self.last_view_proj = Some(view_proj);
         let p = camera.position.as_vec3();
-        let right = camera.forward.cross(camera.up).normalize_or(glam::DVec3::X);
-        let up = right.cross(camera.forward);
-        let tan_half = (camera.vfov_degrees.to_radians() * 0.5).tan();
+        let (right, up, half) = camera.image_axes();
         let aspect = w as f64 / h as f64;
         let v4 = |v: glam::DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
         let constants = FrameConstants {
@@ -317,8 +315,8 @@ impl Renderer {
                 self.rt_constants.max_roughness,
             ],
             // Perspective: tangents of the half fields of view; orthographic: half extents.
-            camera_right: v4(right, camera.ortho.unwrap_or(tan_half) * aspect),
-            camera_up: v4(up, camera.ortho.unwrap_or(tan_half)),
+            camera_right: v4(right, half * aspect),
+            camera_up: v4(up, half),
             camera_forward: v4(camera.forward, 0.0),
         };
         self.frame_ubo.write(bytemuck::bytes_of(&constants))
