@@ -29,7 +29,7 @@ use glam::Vec3;
 use kiln_compiler::import::demo::{cornell_box, lambert_material};
 use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
-use kiln_format::manifest::LightKind;
+use kiln_format::manifest::{Bounds, LightKind, Medium};
 use kiln_format::sections::{MaterialFlags, NO_TEXTURE, Vertex};
 use kiln_tests::{Options, compile, skip, vulkan};
 
@@ -38,6 +38,9 @@ const W: u32 = 64;
 const H: u32 = 48;
 /// kiln's samples per pixel (about 28 s per case on lavapipe with two cores).
 const KILN_SPP: u32 = 512;
+/// kiln's samples per pixel in fog, where a path has more vertices and more noise (at 512 spp,
+/// mean FLIP 0.055 against a noise floor of 0.052).
+const KILN_SPP_FOG: u32 = 1024;
 /// Mitsuba's, for the reference (about 1.4 M paths/s on two cores): at 8192 its own noise is
 /// small beside kiln's (measured against 65536 spp: mean FLIP 0.011 at 16384 spp, 0.034 at 512).
 const MITSUBA_SPP: u32 = 8192;
@@ -158,8 +161,19 @@ fn scene_json(s: &Scene) -> String {
             vec3(l.color.map(|c| c * l.intensity)),
         ));
     }
+    // Mitsuba's medium fills all space (render.py): the same as kiln's box only if the box
+    // holds the closed room the camera is in, which the medium test sets up.
+    assert!(s.media.len() <= 1, "one medium at most maps onto Mitsuba here");
+    let medium = s.media.first().map_or(String::new(), |m| {
+        format!(
+            r#","medium":{{"sigma_a":{},"sigma_s":{},"g":{}}}"#,
+            vec3(m.sigma_a),
+            vec3(m.sigma_s),
+            num(m.g)
+        )
+    });
     format!(
-        r#"{{"camera":{{"position":{},"target":{},"up":{},"vfov_degrees":{}}},"meshes":[{}],"rect_lights":[{}]}}"#,
+        r#"{{"camera":{{"position":{},"target":{},"up":{},"vfov_degrees":{}}},"meshes":[{}],"rect_lights":[{}]{medium}}}"#,
         vec3(cam.position),
         vec3(cam.target),
         vec3(cam.up),
@@ -222,8 +236,8 @@ fn assert_red_left(name: &str, rgb: &[f32]) {
     );
 }
 
-/// Renders `scene` with both, compares, and asserts the bound on mean FLIP.
-fn check(case: &str, scene: Scene) {
+/// Renders `scene` with both (kiln at `kiln_spp`), compares, and asserts the bound on mean FLIP.
+fn check(case: &str, scene: Scene, kiln_spp: u32) {
     if !vulkan() {
         return;
     }
@@ -244,13 +258,16 @@ fn check(case: &str, scene: Scene) {
     let file = at("scene.kiln");
     std::fs::write(
         &file,
-        compile(scene, Settings { shaft_variants: Some(0), shadow_res: 64, ..Default::default() }),
+        compile(
+            scene,
+            Settings { shaft_variants: Some(0), shadow_res: 64, media_volume_res: 4, ..Default::default() },
+        ),
     )
     .unwrap();
 
     let options = Options::new(file, W, H).unshadowed().reference().build();
     let lock = MACHINE.lock().unwrap_or_else(|e| e.into_inner());
-    let (report, rgb) = kiln_player::reference::render(&options, KILN_SPP, Instant::now())
+    let (report, rgb) = kiln_player::reference::render(&options, kiln_spp, Instant::now())
         .unwrap_or_else(|e| panic!("{case}: kiln reference render: {e}"));
     assert_eq!(rgb.len(), (W * H * 3) as usize);
     assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0), "{case}: kiln's image holds NaN, Inf or < 0");
@@ -262,10 +279,10 @@ fn check(case: &str, scene: Scene) {
         python(&py, &["render", &scene_path.to_string_lossy(), &mitsuba_path.to_string_lossy(), &spp, &size]);
     // The noise floor: Mitsuba at kiln's sample count, another seed.
     let control = at("mitsuba-control.npy");
-    let kiln_spp = KILN_SPP.to_string();
+    let spp_text = kiln_spp.to_string();
     python(
         &py,
-        &["render", &scene_path.to_string_lossy(), &control.to_string_lossy(), &kiln_spp, &size, "1"],
+        &["render", &scene_path.to_string_lossy(), &control.to_string_lossy(), &spp_text, &size, "1"],
     );
     drop(lock);
     let c = python(&py, &["compare", &mitsuba_path.to_string_lossy(), &at("kiln.npy").to_string_lossy()]);
@@ -277,8 +294,8 @@ fn check(case: &str, scene: Scene) {
     }
     eprintln!(
         "mitsuba check {case}: mean FLIP {flip:.4}, relMSE {rel_mse:.5}, kiln/mitsuba mean radiance (RGB){ratio}; \
-         {W}x{H}, kiln {KILN_SPP} spp in {:.1} s, mitsuba {MITSUBA_SPP} spp in {:.1} s; \
-         noise floor (mitsuba {KILN_SPP} spp, another seed): mean FLIP {:.4}, relMSE {:.5}",
+         {W}x{H}, kiln {kiln_spp} spp in {:.1} s, mitsuba {MITSUBA_SPP} spp in {:.1} s; \
+         noise floor (mitsuba {kiln_spp} spp, another seed): mean FLIP {:.4}, relMSE {:.5}",
         report.seconds,
         m["seconds"].as_f64().unwrap(),
         n["mean_flip"].as_f64().unwrap(),
@@ -304,7 +321,7 @@ fn read_npy(path: &Path) -> Vec<f32> {
 fn cornell_box_with_a_rect_light_matches_mitsuba() {
     let scene = cornell_box();
     assert!(matches!(scene.lights[..], [ref l] if matches!(l.kind, LightKind::Rect { .. })));
-    check("rect", scene);
+    check("rect", scene, KILN_SPP);
 }
 
 #[test]
@@ -324,7 +341,40 @@ fn cornell_box_with_vertex_colours_matches_mitsuba() {
         })
         .collect();
     scene.set_colors(0, Some(colors));
-    check("colors", scene);
+    check("colors", scene, KILN_SPP);
+}
+
+#[test]
+fn a_closed_room_full_of_fog_matches_mitsuba() {
+    // The Cornell box closed by a white front wall, the camera inside it, the room filled with a
+    // chromatic, forward-scattering homogeneous medium (optical depth 0.7-1.2 across the room):
+    // single and multiple scattering, the rect light seen through the fog, shadow rays through
+    // it, surfaces inside it.
+    let mut scene = cornell_box();
+    let corners =
+        [Vec3::new(1., 0., 1.), Vec3::new(-1., 0., 1.), Vec3::new(-1., 2., 1.), Vec3::new(1., 2., 1.)];
+    let n = (corners[1] - corners[0]).cross(corners[2] - corners[0]).normalize();
+    assert!(n.z < -0.999, "the front wall must face into the room");
+    let base = scene.vertices.len() as u32;
+    for c in corners {
+        scene.vertices.push(Vertex { position: c.to_array(), normal: n.to_array() });
+        if !scene.uvs.is_empty() {
+            scene.uvs.push([0.0; 2]);
+        }
+    }
+    scene.triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    scene.triangle_materials.extend([0; 2]); // white
+    let cam = &mut scene.cameras[0];
+    cam.position = [0.0, 1.0, 0.9];
+    cam.target = [0.0, 0.9, 0.0];
+    cam.vfov_degrees = 75.0;
+    scene.media.push(Medium {
+        bounds: Bounds { min: [-1.0, 0.0, -1.0], max: [1.0, 2.0, 1.0] },
+        sigma_a: [0.05, 0.05, 0.1],
+        sigma_s: [0.3, 0.4, 0.5],
+        g: 0.4,
+    });
+    check("fog", scene, KILN_SPP_FOG);
 }
 
 #[test]
@@ -353,5 +403,5 @@ fn cornell_box_with_an_emissive_quad_matches_mitsuba() {
     }
     scene.triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
     scene.triangle_materials.extend([material; 2]);
-    check("emissive", scene);
+    check("emissive", scene, KILN_SPP);
 }

@@ -147,13 +147,14 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Constants of the reference path tracer (std140 uniform block, 112 bytes).
+    /// Constants of the reference path tracer (std140 uniform block, 128 bytes).
     pub struct ReferenceConstants {
-        /// Camera position, w = tan(vfov / 2).
+        /// Camera position, w = tan(vfov / 2) (perspective) or the view's half height
+        /// (orthographic).
         pub eye: [f32; 4] => "vec4",
         /// Unit right vector, w = aspect ratio (width / height).
         pub right: [f32; 4] => "vec4",
-        /// Unit up vector, w unused.
+        /// Unit up vector, w = 1 for an orthographic camera, else 0.
         pub up: [f32; 4] => "vec4",
         /// Unit forward vector, w unused.
         pub forward: [f32; 4] => "vec4",
@@ -165,6 +166,23 @@ gpu_struct! {
         /// Light count, maximum path length, seed, bounce limit (scattering events whose light
         /// counts; 0: unlimited, 1: direct light only).
         pub params: [u32; 4] => "uvec4",
+        /// Participating media (entries of the `GpuMedium` buffer), then three unused words.
+        pub media: [u32; 4] => "uvec4",
+    }
+}
+
+gpu_struct! {
+    /// A homogeneous participating medium filling an axis-aligned box, as the reference path
+    /// tracer reads it (std430, 64 bytes). Where boxes overlap, their coefficients add.
+    pub struct GpuMedium {
+        /// Box minimum corner, w = Henyey–Greenstein anisotropy g.
+        pub min: [f32; 4] => "vec4",
+        /// Box maximum corner, w unused.
+        pub max: [f32; 4] => "vec4",
+        /// Absorption coefficient per scene unit (RGB), w unused.
+        pub sigma_a: [f32; 4] => "vec4",
+        /// Scattering coefficient per scene unit (RGB), w unused.
+        pub sigma_s: [f32; 4] => "vec4",
     }
 }
 
@@ -343,6 +361,7 @@ pub fn glsl_layout() -> String {
     declare::<GpuMaterialLayout>(&mut s);
     declare::<ReferenceConstants>(&mut s);
     declare::<GpuEmitter>(&mut s);
+    declare::<GpuMedium>(&mut s);
     declare::<GpuTexture>(&mut s);
     declare::<GpuVertexAttributes>(&mut s);
     declare::<RtConstants>(&mut s);
@@ -498,6 +517,7 @@ mod tests {
         check::<GpuMaterialLayout>();
         check::<ReferenceConstants>();
         check::<GpuEmitter>();
+        check::<GpuMedium>();
         check::<GpuTexture>();
         check::<GpuVertexAttributes>();
         check::<RtConstants>();

@@ -114,6 +114,7 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
         sky: [sky[0], sky[1], sky[2], 0.0],
         size: [w, h, spp, r.emitter_count],
         params: [scene.manifest.lights.len() as u32, MAX_PATH, seed, bounces],
+        media: [r.media_count, 0, 0, 0],
     };
     let plan: Vec<GpuLight> = lights::plan(&scene.manifest, &[], false).lights;
     let mut owned = Owned::default();

@@ -11,7 +11,11 @@
 //   bool emitter_occluded(vec3 from, vec3 ng, vec3 to)           shadow ray of a segment
 //   bool emitter_occluded_dir(vec3 from, vec3 ng, vec3 dir)      shadow ray towards infinity
 // (`from` on a surface of geometric normal `ng`, not yet offset: scene.glsl's `occluded` and
-// `occluded_ray` are such functions).
+// `occluded_ray` are such functions). An includer with participating media also defines
+// EMITTER_TRANSMITTANCE and
+//   vec3 emitter_transmittance(vec3 from, EmitterSample es)      along a shadow ray
+//   vec3 emitter_seen_weight(float t)                            a rect light crossed at t
+// (declared here, after `EmitterSample`; the includer defines them anywhere in the shader).
 #ifndef KILN_EMITTERS_GLSL
 #define KILN_EMITTERS_GLSL
 
@@ -33,16 +37,38 @@ uint choose_emitter(float xi) {
     return lo;
 }
 
-// Next-event estimation: radiance arriving at s from one emitter (times the BRDF and cosine,
-// over the sampling density). `mis`: weighted with the power heuristic against a BRDF-sampled
-// continuation that counts the emitters it reaches (`rect_lights_seen`,
-// `triangle_emission_weight`); without one, unweighted, the whole of the emitters' light.
-vec3 sample_emitter(Surface s, vec3 wo, bool mis) {
+// One emitter of the table sampled from a point: the direction to it, the radiance it sends
+// there (point and spot lights: divided by the squared distance; no cosine at the receiver),
+// the density of the sample (solid angle; for delta lights, the selection probability), and
+// where a shadow ray ends.
+struct EmitterSample {
+    bool valid;
+    vec3 wi;
+    vec3 li;
+    float pdf;
+    bool delta;       // a point, spot or directional light: no MIS
+    bool directional; // the shadow ray is unbounded along wi
+    vec3 target;      // the shadow ray's end (moved off an emissive triangle)
+};
+
+#ifdef EMITTER_TRANSMITTANCE
+vec3 emitter_transmittance(vec3 from, EmitterSample es);
+vec3 emitter_seen_weight(float t);
+#endif
+
+EmitterSample sample_emitter_light(vec3 origin) {
+    EmitterSample es;
+    es.valid = false;
+    es.delta = true;
+    es.directional = false;
+    es.li = vec3(0.0);
+    es.wi = vec3(0.0, 0.0, 1.0);
+    es.target = origin;
+    es.pdf = 1.0;
     if (emitter_count() == 0u) {
-        return vec3(0.0);
+        return es;
     }
     GpuEmitter e = emitters[choose_emitter(rnd())];
-    vec3 origin = s.p;
     if (e.kind == EMITTER_TRIANGLE) {
         uint tri = e.index;
         vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
@@ -62,74 +88,89 @@ vec3 sample_emitter(Surface s, vec3 wo, bool mis) {
             cos_l = abs(cos_l);
         }
         if (cos_l <= 0.0 || area <= 0.0) {
-            return vec3(0.0);
-        }
-        vec3 f = brdf_cos(s, wo, wi);
-        // The sampled point, moved off the emitter towards the shading point: the shadow ray
-        // must not reach the emitter's own surface.
-        vec3 q_off = offset_ray_origin(q, dot(nl, wi) < 0.0 ? nl : -nl);
-        if (all(equal(f, vec3(0.0))) || emitter_occluded(origin, s.ng, q_off)) {
-            return vec3(0.0);
+            return es;
         }
         vec3 le = m.emission;
         if (m.emissive_texture != NO_TEXTURE) {
             le *= sample_texture(m.emissive_texture, triangle_uv(tri, b1, b2)).rgb;
         }
-        float pdf_light = e.pdf * d2 / (cos_l * area);
-        return f * le * (mis ? power_heuristic(pdf_light, brdf_pdf(s, wo, wi)) : 1.0) / pdf_light;
+        es.valid = true;
+        es.delta = false;
+        es.wi = wi;
+        es.li = le;
+        es.pdf = e.pdf * d2 / (cos_l * area);
+        // The sampled point, moved off the emitter towards the origin: the shadow ray must not
+        // reach the emitter's own surface.
+        es.target = offset_ray_origin(q, dot(nl, wi) < 0.0 ? nl : -nl);
+        return es;
     }
     GpuLight l = lights[e.index];
-    vec3 wi;
-    vec3 target;  // the point the shadow ray ends at (directional lights: none)
-    float dist;
-    vec3 li;
-    float pdf_light = e.pdf;
-    bool delta = true;
+    es.pdf = e.pdf;
     if (l.kind == LIGHT_DIRECTIONAL) {
-        wi = -l.direction;
-        target = vec3(0.0);
-        dist = 3.4e38;
-        li = l.radiance;
+        es.wi = -l.direction;
+        es.directional = true;
+        es.li = l.radiance;
     } else if (l.kind == LIGHT_RECT) {
         vec3 up = cross(l.direction, l.right);
         vec3 q = l.position + l.right * (rnd() - 0.5) * l.width + up * (rnd() - 0.5) * l.height;
-        target = q;
         vec3 to = q - origin;
         float d2 = dot(to, to);
-        dist = sqrt(d2);
-        wi = to / dist;
-        float cos_l = dot(-wi, l.direction);
+        float dist = sqrt(d2);
+        es.wi = to / dist;
+        es.target = q;
+        float cos_l = dot(-es.wi, l.direction);
         float area = l.width * l.height;
         if (cos_l <= 0.0 || area <= 0.0 || (l.range > 0.0 && dist > l.range)) {
-            return vec3(0.0);
+            return es;
         }
-        li = l.radiance;
-        pdf_light = e.pdf * d2 / (cos_l * area);
-        delta = false;
+        es.li = l.radiance;
+        es.pdf = e.pdf * d2 / (cos_l * area);
+        es.delta = false;
     } else {
-        target = l.position;
+        es.target = l.position;
         vec3 to = l.position - origin;
         float d2 = dot(to, to);
-        dist = sqrt(d2);
-        wi = to / max(dist, 1e-30);
+        float dist = sqrt(d2);
+        es.wi = to / max(dist, 1e-30);
         if (dist <= 0.0 || (l.range > 0.0 && dist > l.range)) {
-            return vec3(0.0);
+            return es;
         }
         float cone = 1.0;
         if (l.kind == LIGHT_SPOT) {
-            cone = spot_cone(l, wi);
+            cone = spot_cone(l, es.wi);
         }
-        li = l.radiance * cone / d2;
+        es.li = l.radiance * cone / d2;
     }
-    vec3 f = brdf_cos(s, wo, wi);
-    if (all(equal(f, vec3(0.0))) || all(equal(li, vec3(0.0)))) {
+    es.valid = !all(equal(es.li, vec3(0.0)));
+    return es;
+}
+
+// Whether the shadow ray of `es` from `origin` (on a surface of geometric normal `ng`; zero in
+// a medium) is blocked.
+bool emitter_blocked(EmitterSample es, vec3 origin, vec3 ng) {
+    return es.directional ? emitter_occluded_dir(origin, ng, es.wi) : emitter_occluded(origin, ng, es.target);
+}
+
+// Next-event estimation: radiance arriving at s from one emitter (times the BRDF and cosine,
+// over the sampling density), times `emitter_transmittance` when the includer defines
+// EMITTER_TRANSMITTANCE. `mis`: weighted with the power heuristic against a BRDF-sampled
+// continuation that counts the emitters it reaches (`rect_lights_seen`,
+// `triangle_emission_weight`); without one, unweighted, the whole of the emitters' light.
+vec3 sample_emitter(Surface s, vec3 wo, bool mis) {
+    EmitterSample es = sample_emitter_light(s.p);
+    if (!es.valid) {
         return vec3(0.0);
     }
-    if (l.kind == LIGHT_DIRECTIONAL ? emitter_occluded_dir(origin, s.ng, wi) : emitter_occluded(origin, s.ng, target)) {
+    vec3 f = brdf_cos(s, wo, es.wi);
+    if (all(equal(f, vec3(0.0))) || emitter_blocked(es, s.p, s.ng)) {
         return vec3(0.0);
     }
-    float weight = (delta || !mis) ? 1.0 : power_heuristic(pdf_light, brdf_pdf(s, wo, wi));
-    return f * li * weight / pdf_light;
+    float weight = (es.delta || !mis) ? 1.0 : power_heuristic(es.pdf, brdf_pdf(s, wo, es.wi));
+    vec3 contribution = f * es.li * weight / es.pdf;
+#ifdef EMITTER_TRANSMITTANCE
+    contribution *= emitter_transmittance(s.p, es);
+#endif
+    return contribution;
 }
 
 // Rect lights are not geometry: a BRDF-sampled ray sees one when it crosses its rectangle
@@ -150,7 +191,11 @@ vec3 rect_lights_seen(vec3 origin, vec3 dir, float tmax, float pdf_brdf) {
         float denom = dot(dir, l.direction);
         float area = l.width * l.height;
         float pdf_light = e.pdf * t * t / (-denom * area);
-        sum += l.radiance * (pdf_brdf > 0.0 ? power_heuristic(pdf_brdf, pdf_light) : 1.0);
+        vec3 seen = l.radiance * (pdf_brdf > 0.0 ? power_heuristic(pdf_brdf, pdf_light) : 1.0);
+#ifdef EMITTER_TRANSMITTANCE
+        seen *= emitter_seen_weight(t);
+#endif
+        sum += seen;
     }
     return sum;
 }

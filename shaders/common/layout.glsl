@@ -67,7 +67,8 @@ struct ReferenceConstants {
     vec4 sky; // offset 64
     uvec4 size; // offset 80
     uvec4 params; // offset 96
-}; // 112 bytes
+    uvec4 media; // offset 112
+}; // 128 bytes
 
 struct GpuEmitter {
     uint kind; // offset 0
@@ -75,6 +76,13 @@ struct GpuEmitter {
     float cdf; // offset 8
     float pdf; // offset 12
 }; // 16 bytes
+
+struct GpuMedium {
+    vec4 min; // offset 0
+    vec4 max; // offset 16
+    vec4 sigma_a; // offset 32
+    vec4 sigma_s; // offset 48
+}; // 64 bytes
 
 struct GpuTexture {
     uint offset; // offset 0

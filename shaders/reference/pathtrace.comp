@@ -15,6 +15,14 @@
 // normals (Heitz 2018), or pure Lambert for diffuse-only materials. All surfaces are two-sided
 // for reflection; emission leaves the front face only unless the material is double-sided.
 // Textures: mip 0, bilinear, from a texel buffer (portable: no descriptor indexing needed).
+// Participating media (`rc.media.x` homogeneous boxes; overlapping boxes add their
+// coefficients): free-flight distances sampled in one colour channel chosen uniformly and
+// weighted by the mean of the three channels' densities (spectral MIS, so chromatic media stay
+// unbiased), between the ray's boundary crossings of the boxes; at a scattering point, next-
+// event estimation with the Henyey–Greenstein phase function (the scattering-weighted mix
+// where boxes overlap) and a phase-sampled continuation, which the power heuristic weighs
+// against each other as at surfaces; shadow rays carry the analytic transmittance of every
+// box they cross. Scattering in a medium counts as a bounce.
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 
@@ -28,6 +36,7 @@ layout(set = 0, binding = 10, std430) readonly buffer TriEmitters { int tri_emit
 layout(set = 0, binding = 11, std430) readonly buffer Texels { uint texels[]; };
 layout(set = 0, binding = 12, std430) readonly buffer Textures { GpuTexture textures[]; };
 layout(set = 0, binding = 13, rgba32f) uniform image2D accumulation;
+layout(set = 0, binding = 14, std430) readonly buffer Media { GpuMedium media[]; };
 // Index of this sample (0 first): 0 overwrites the accumulation, later ones add to it.
 layout(push_constant) uniform Sample { uint sample_index; };
 
@@ -47,7 +56,220 @@ bool emitter_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
     return occluded_ray(from, ng, dir);
 }
 
+#define EMITTER_TRANSMITTANCE
 #include "../common/emitters.glsl"
+
+// ---------------------------------------------------------------- media
+const float FAR = 3.4e38;
+
+uint medium_count() {
+    return rc.media.x;
+}
+
+// The part [t0, t1] of the unit ray (o, d) inside the box [lo, hi] (empty when x >= y). An axis
+// the ray runs parallel to keeps all or nothing, without the NaN of 0 · ∞.
+vec2 box_span(vec3 lo, vec3 hi, vec3 o, vec3 d, float t0, float t1) {
+    [[unroll]] for (int a = 0; a < 3; a++) {
+        if (abs(d[a]) < 1e-30) {
+            if (o[a] < lo[a] || o[a] > hi[a]) {
+                return vec2(1.0, 0.0);
+            }
+        } else {
+            float inv = 1.0 / d[a];
+            float ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
+            t0 = max(t0, min(ta, tb));
+            t1 = min(t1, max(ta, tb));
+        }
+    }
+    return vec2(t0, t1);
+}
+
+vec3 medium_sigma_t(uint i) {
+    return media[i].sigma_a.rgb + media[i].sigma_s.rgb;
+}
+
+// Optical depth (RGB) of the unit ray (o, d) over [t0, t1].
+vec3 optical_depth(vec3 o, vec3 d, float t0, float t1) {
+    vec3 tau = vec3(0.0);
+    for (uint i = 0u; i < medium_count(); i++) {
+        vec2 span = box_span(media[i].min.xyz, media[i].max.xyz, o, d, t0, t1);
+        if (span.y > span.x) {
+            tau += medium_sigma_t(i) * (span.y - span.x);
+        }
+    }
+    return tau;
+}
+
+// The ray of the current path segment, for the weight of the rect lights it crosses.
+vec3 segment_origin;
+vec3 segment_dir;
+
+// Transmittance from the origin towards an emitter sample (to its point, or out of every box).
+vec3 emitter_transmittance(vec3 from, EmitterSample es) {
+    if (medium_count() == 0u) {
+        return vec3(1.0);
+    }
+    float dist = es.directional ? FAR : length(es.target - from);
+    return exp(-optical_depth(from, es.wi, 0.0, dist));
+}
+
+// A rect light crossed at distance t of the current segment counts when the sampled flight got
+// past it: weighted by the transmittance over the probability of getting that far.
+vec3 emitter_seen_weight(float t) {
+    if (medium_count() == 0u) {
+        return vec3(1.0);
+    }
+    vec3 tr = exp(-optical_depth(segment_origin, segment_dir, 0.0, t));
+    return tr / max(dot(tr, vec3(1.0 / 3.0)), 1e-30);
+}
+
+float hg(float g, float cos_theta) {
+    float denom = 1.0 + g * g - 2.0 * g * cos_theta;
+    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(max(denom, 1e-30)));
+}
+
+// The scattering at a point in the media: the boxes holding it, by their scattering.
+struct MediumPoint {
+    vec3 sigma_s;  // summed over the boxes holding the point
+};
+
+bool inside(uint i, vec3 p) {
+    return all(greaterThanEqual(p, media[i].min.xyz)) && all(lessThanEqual(p, media[i].max.xyz));
+}
+
+vec3 scattering_at(vec3 p) {
+    vec3 s = vec3(0.0);
+    for (uint i = 0u; i < medium_count(); i++) {
+        if (inside(i, p)) {
+            s += media[i].sigma_s.rgb;
+        }
+    }
+    return s;
+}
+
+// The phase function at p for light travelling along `d_in` leaving along `wi`, per channel
+// (the σs-weighted mix of the boxes' HG lobes), and the density its sampling has (the mix
+// weighted by each box's mean σs).
+vec3 phase(vec3 p, vec3 d_in, vec3 wi, out float pdf) {
+    float c = dot(d_in, wi);
+    vec3 f = vec3(0.0), total = vec3(0.0);
+    float wsum = 0.0;
+    pdf = 0.0;
+    for (uint i = 0u; i < medium_count(); i++) {
+        if (!inside(i, p)) {
+            continue;
+        }
+        vec3 ss = media[i].sigma_s.rgb;
+        float v = hg(media[i].min.w, c);
+        f += ss * v;
+        total += ss;
+        float w = dot(ss, vec3(1.0 / 3.0));
+        pdf += w * v;
+        wsum += w;
+    }
+    pdf = wsum > 0.0 ? pdf / wsum : 0.0;
+    return mix(vec3(0.0), f / max(total, vec3(1e-30)), greaterThan(total, vec3(0.0)));
+}
+
+// A direction from the phase mix at p (one box chosen by its mean σs, its HG lobe sampled).
+vec3 sample_phase(vec3 p, vec3 d_in) {
+    float wsum = 0.0;
+    for (uint i = 0u; i < medium_count(); i++) {
+        if (inside(i, p)) {
+            wsum += dot(media[i].sigma_s.rgb, vec3(1.0 / 3.0));
+        }
+    }
+    float pick = rnd() * wsum;
+    float g = 0.0;
+    for (uint i = 0u; i < medium_count(); i++) {
+        if (inside(i, p)) {
+            g = media[i].min.w;
+            pick -= dot(media[i].sigma_s.rgb, vec3(1.0 / 3.0));
+            if (pick < 0.0) {
+                break;
+            }
+        }
+    }
+    float u = rnd(), v = rnd();
+    float cos_theta;
+    if (abs(g) < 1e-3) {
+        cos_theta = 1.0 - 2.0 * u;
+    } else {
+        float q = (1.0 - g * g) / (1.0 - g + 2.0 * g * u);
+        cos_theta = (1.0 + g * g - q * q) / (2.0 * g);
+    }
+    cos_theta = clamp(cos_theta, -1.0, 1.0);
+    float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    float phi = 2.0 * PI * v;
+    vec3 t = abs(d_in.x) > 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 b1 = normalize(cross(d_in, t));
+    vec3 b2 = cross(d_in, b1);
+    return normalize(cos_theta * d_in + sin_theta * (cos(phi) * b1 + sin(phi) * b2));
+}
+
+// Samples where the unit ray (o, d) first interacts with the media before `tmax`: true with
+// the distance `t` and `weight` = transmittance · σs / density for a scattering event (absorption
+// is in the weight, not an event), false with `weight` = transmittance / probability of getting
+// through when the flight reaches `tmax`.
+bool sample_flight(vec3 o, vec3 d, float tmax, out float t, out vec3 weight) {
+    int c = min(int(rnd() * 3.0), 2);
+    float target = -log(max(1.0 - rnd(), 1e-30));
+    vec3 tau = vec3(0.0);
+    t = 0.0;
+    // Each step crosses one boundary: at most two per box.
+    for (uint step = 0u; step <= 2u * medium_count(); step++) {
+        float next = tmax;
+        vec3 st = vec3(0.0), ss = vec3(0.0);
+        for (uint i = 0u; i < medium_count(); i++) {
+            vec2 span = box_span(media[i].min.xyz, media[i].max.xyz, o, d, 0.0, tmax);
+            if (!(span.y > span.x)) {
+                continue;
+            }
+            if (span.x <= t && span.y > t) {
+                next = min(next, span.y);
+                st += medium_sigma_t(i);
+                ss += media[i].sigma_s.rgb;
+            } else if (span.x > t) {
+                next = min(next, span.x);
+            }
+        }
+        float need = target - tau[c];
+        if (st[c] > 0.0 && need <= st[c] * (next - t)) {
+            float ts = t + need / st[c];
+            tau += st * (ts - t);
+            t = ts;
+            vec3 tr = exp(-tau);
+            float density = dot(st * tr, vec3(1.0 / 3.0));
+            weight = density > 0.0 ? tr * ss / density : vec3(0.0);
+            return true;
+        }
+        tau += st * (next - t);
+        t = next;
+        if (t >= tmax) {
+            break;
+        }
+    }
+    t = tmax;
+    vec3 tr = exp(-tau);
+    float through = dot(tr, vec3(1.0 / 3.0));
+    weight = through > 0.0 ? tr / through : vec3(0.0);
+    return false;
+}
+
+// Next-event estimation from a point in the media.
+vec3 medium_emitter(vec3 p, vec3 d_in) {
+    EmitterSample es = sample_emitter_light(p);
+    if (!es.valid) {
+        return vec3(0.0);
+    }
+    float pdf_phase;
+    vec3 f = phase(p, d_in, es.wi, pdf_phase);
+    if (all(equal(f, vec3(0.0))) || emitter_blocked(es, p, vec3(0.0))) {
+        return vec3(0.0);
+    }
+    float weight = es.delta ? 1.0 : power_heuristic(es.pdf, pdf_phase);
+    return f * es.li * weight * emitter_transmittance(p, es) / es.pdf;
+}
 
 // ---------------------------------------------------------------- paths
 vec3 radiance(TraceRay r) {
@@ -57,8 +279,39 @@ vec3 radiance(TraceRay r) {
     vec3 last_p = r.origin;
     for (uint depth = 0u; depth < rc.params.y; depth++) {
         TraceHit h = trace(r, false);
-        float tmax = h.t == NO_HIT ? 3.4e38 : h.t;
-        result += throughput * rect_lights_seen(r.origin, r.direction, tmax, pdf_brdf);
+        float tmax = h.t == NO_HIT ? FAR : h.t;
+        segment_origin = r.origin;
+        segment_dir = r.direction;
+        float t_flight = tmax;
+        vec3 flight = vec3(1.0);
+        bool scattered = medium_count() != 0u && sample_flight(r.origin, r.direction, tmax, t_flight, flight);
+        result += throughput * rect_lights_seen(r.origin, r.direction, t_flight, pdf_brdf);
+        throughput *= flight;
+        if (scattered) {
+            if (rc.params.w != 0u && depth >= rc.params.w) {
+                break;
+            }
+            vec3 p = r.origin + t_flight * r.direction;
+            result += throughput * medium_emitter(p, r.direction);
+            vec3 wi = sample_phase(p, r.direction);
+            vec3 f = phase(p, r.direction, wi, pdf_brdf);
+            if (pdf_brdf <= 0.0) {
+                break;
+            }
+            throughput *= f / pdf_brdf;
+            if (depth >= 3u) {
+                float q = min(max(throughput.r, max(throughput.g, throughput.b)), 0.95);
+                if (rnd() >= q) {
+                    break;
+                }
+                throughput /= q;
+            }
+            if (all(equal(throughput, vec3(0.0)))) {
+                break;
+            }
+            r = make_ray(p, wi, 0.0, FAR);
+            continue;
+        }
         if (h.t == NO_HIT) {
             result += throughput * rc.sky.rgb;
             break;
@@ -90,7 +343,7 @@ vec3 radiance(TraceRay r) {
         if (all(equal(throughput, vec3(0.0)))) {
             break;
         }
-        r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, 3.4e38);
+        r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, FAR);
     }
     return result;
 }

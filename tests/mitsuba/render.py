@@ -27,6 +27,11 @@ tracer's (shaders/reference/pathtrace.comp), mapped to Mitsuba's:
   `fov_axis: y` and `rfilter: box` (kiln jitters uniformly over the pixel; a box of radius 0.5
   gives each sample to its own pixel).
 - Unbiased path tracing of unlimited length: `path` with `max_depth: -1`.
+- A participating medium (the scene's optional `medium`: sigma_a, sigma_s per channel, the
+  Henyey–Greenstein g) fills the whole space: a `homogeneous` medium (sigma_t = sigma_a +
+  sigma_s, albedo sigma_s / sigma_t, `hg` phase) given to the camera, rendered by `volpath`.
+  Surfaces without medium interfaces keep the medium a path is in, so this equals kiln's box
+  medium when the box holds a closed room with the camera inside (what tests/mitsuba.rs builds).
 
 FLIP: HDR-FLIP (Andersson et al. 2021, `flip_evaluator`), the variant for linear radiance: it
 tonemaps both images over the range of exposures the reference needs and reports the mean error
@@ -101,6 +106,19 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
             },
         },
     }
+    medium = desc.get("medium")
+    if medium is not None:
+        sigma_a = np.asarray(medium["sigma_a"], dtype=float)
+        sigma_s = np.asarray(medium["sigma_s"], dtype=float)
+        sigma_t = sigma_a + sigma_s
+        scene["integrator"] = {"type": "volpath", "max_depth": -1, "rr_depth": 5, "hide_emitters": False}
+        scene["sensor"]["medium"] = {
+            "type": "homogeneous",
+            "sigma_t": rgb(sigma_t),
+            "albedo": rgb(sigma_s / np.maximum(sigma_t, 1e-30)),
+            "scale": 1.0,
+            "phase": {"type": "hg", "g": float(medium["g"])},
+        }
     for i, m in enumerate(desc["meshes"]):
         path = os.path.join(tmp, f"mesh{i}.ply")
         colors = m.get("colors") or None

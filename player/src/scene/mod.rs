@@ -200,8 +200,12 @@ pub struct ReferenceBuffers {
     pub textures: Buffer,
     /// Material of each triangle in draw order (the G-buffer's triangle target).
     pub raster_materials: Buffer,
+    /// `GpuMedium` table.
+    pub media: Buffer,
     /// Entries in `emitters`.
     pub emitter_count: u32,
+    /// Entries in `media`.
+    pub media_count: u32,
 }
 
 impl ReferenceBuffers {
@@ -215,6 +219,7 @@ impl ReferenceBuffers {
             &mut self.texels,
             &mut self.textures,
             &mut self.raster_materials,
+            &mut self.media,
         ] {
             b.destroy(gpu);
         }
@@ -515,6 +520,7 @@ impl GpuScene {
             up.buffer(&r.triangle_emitter, 0, bytemuck::cast_slice(&tables.triangle_emitter))?;
             up.buffer(&r.textures, 0, bytemuck::cast_slice(&tables.textures))?;
             up.buffer(&r.raster_materials, 0, bytemuck::cast_slice(&raster_materials(&prepared.draws)))?;
+            up.buffer(&r.media, 0, bytemuck::cast_slice(&tables.media))?;
         }
         Ok(())
     }
@@ -613,6 +619,7 @@ fn reference_buffers(
         ("texels", tables.texel_words as usize * 4),
         ("texture table", std::mem::size_of_val(tables.textures.as_slice())),
         ("raster materials", view.triangles.len() * 4),
+        ("media", std::mem::size_of_val(tables.media.as_slice())),
     ];
     let mut made: Vec<Buffer> = Vec::new();
     for (name, size) in sizes {
@@ -637,7 +644,9 @@ fn reference_buffers(
         texels: next(),
         textures: next(),
         raster_materials: next(),
+        media: next(),
         emitter_count: tables.emitters.len() as u32,
+        media_count: tables.media.len() as u32,
     })
 }
 

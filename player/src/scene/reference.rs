@@ -2,7 +2,7 @@
 //! proportion to their power, the emitter of each triangle, and the layout of the texel buffer.
 
 use glam::Vec3;
-use kiln_format::gpu::{EmitterKinds, GpuEmitter, GpuTexture, TextureFlags};
+use kiln_format::gpu::{EmitterKinds, GpuEmitter, GpuMedium, GpuTexture, TextureFlags};
 use kiln_format::manifest::{ColorSpace, LightKind, Manifest, Wrap};
 use kiln_format::sections::{GpuMaterial, Vertex};
 
@@ -17,6 +17,8 @@ pub struct ReferenceTables {
     pub textures: Vec<GpuTexture>,
     /// Words (texels) in the texel buffer.
     pub texel_words: u64,
+    /// The participating media (the manifest's, validated when the file was opened).
+    pub media: Vec<GpuMedium>,
 }
 
 fn luminance(c: [f32; 3]) -> f32 {
@@ -89,6 +91,19 @@ pub fn tables(
             tables.triangle_emitter[index as usize] = i as i32;
         }
     }
+    tables.media = manifest
+        .media
+        .iter()
+        .map(|m| {
+            let v4 = |v: [f32; 3], w: f32| [v[0], v[1], v[2], w];
+            GpuMedium {
+                min: v4(m.bounds.min, m.g),
+                max: v4(m.bounds.max, 0.0),
+                sigma_a: v4(m.sigma_a, 0.0),
+                sigma_s: v4(m.sigma_s, 0.0),
+            }
+        })
+        .collect();
     for t in &manifest.textures {
         let mut flags = wrap_bits(t.wrap_u) << TextureFlags::WRAP_U_SHIFT
             | wrap_bits(t.wrap_v) << TextureFlags::WRAP_V_SHIFT;

@@ -34,6 +34,7 @@ impl PathTracePass {
         let mut bindings = vec![Binding::one(Uniform)];
         bindings.extend([Binding::one(Storage); 12]);
         bindings.push(Binding::one(StorageImage));
+        bindings.push(Binding::one(Storage));
         Ok(PathTracePass(Kernel::new(gpu, &bindings, spirv::PATHTRACE, std::mem::size_of::<u32>() as u32)?))
     }
 
@@ -62,6 +63,7 @@ impl PathTracePass {
             Write::Buffer(11, &r.texels),
             Write::Buffer(12, &r.textures),
             Write::StorageImage(13, images.get(&ACCUMULATION).view),
+            Write::Buffer(14, &r.media),
         ]);
         self.0.write(gpu, &writes)
     }
