@@ -187,6 +187,27 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of the ray-marched media pass (`shaders/media/march.comp`; 28 bytes).
+    pub struct MarchConstants {
+        /// Steps along the view ray's part inside each medium.
+        pub steps: u32 => "uint",
+        /// Entries of the `GpuMedium` buffer.
+        pub media: u32 => "uint",
+        /// The medium the light-visibility volumes cover (`u32::MAX`: none).
+        pub volume_medium: u32 => "uint",
+        /// Volume cells along x.
+        pub dims_x: u32 => "uint",
+        /// Volume cells along y.
+        pub dims_y: u32 => "uint",
+        /// Volume cells along z.
+        pub dims_z: u32 => "uint",
+        /// Lights with a volume: `volume_of[light]` is its first byte in the volume buffer, −1
+        /// without one (unshadowed in the medium).
+        pub lights: u32 => "uint",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
@@ -365,6 +386,7 @@ pub fn glsl_layout() -> String {
     declare::<GpuTexture>(&mut s);
     declare::<GpuVertexAttributes>(&mut s);
     declare::<RtConstants>(&mut s);
+    declare::<MarchConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -521,6 +543,7 @@ mod tests {
         check::<GpuTexture>();
         check::<GpuVertexAttributes>();
         check::<RtConstants>();
+        check::<MarchConstants>();
         check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {

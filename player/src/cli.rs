@@ -192,9 +192,12 @@ pub struct Args {
     /// stored hit's baked radiance (one bounce, no shading).
     #[arg(long, value_enum, default_value = "pnmt")]
     pub gi_structure: GiStructureArg,
-    /// Participating media technique (later passes add techniques).
+    /// Participating media technique.
     #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
     pub media: String,
+    /// With --media march: steps along the view ray through each medium, 1 to 1024.
+    #[arg(long, value_name = "N", default_value_t = 32)]
+    pub media_steps: u32,
     /// Render the unbiased reference path tracer instead (headless, needs -o OUT.exr).
     #[arg(long, conflicts_with_all = ["bench", "bench_rays"])]
     pub reference: bool,
@@ -219,6 +222,7 @@ impl Args {
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
             "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
+            "media-steps" => Some(KnobValue::Number(self.media_steps as f32)),
             _ => None,
         }
     }

@@ -273,6 +273,18 @@ impl Session {
         {
             warnings.push("--shadows shadowmap: the file has no shadow maps (compiled with shadows skipped); lights are unshadowed".into());
         }
+        if matches!(render.techniques.media, crate::render::Media::March { .. }) {
+            if scene.manifest.media.is_empty() {
+                warnings.push("--media march: the file has no participating medium (add a [[medium]] to the sidecar and recompile); nothing to march".into());
+            } else if scene.manifest.media_visibility.is_none()
+                && scene.manifest.lights.iter().any(|l| l.casts_shadows)
+            {
+                warnings.push(
+                    "--media march: the file has no light-visibility volume; shafts of light are unshadowed"
+                        .into(),
+                );
+            }
+        }
         Ok(Session {
             camera,
             times,

@@ -108,6 +108,16 @@ struct RtConstants {
     uint emitters; // offset 32
 }; // 36 bytes
 
+struct MarchConstants {
+    uint steps; // offset 0
+    uint media; // offset 4
+    uint volume_medium; // offset 8
+    uint dims_x; // offset 12
+    uint dims_y; // offset 16
+    uint dims_z; // offset 20
+    uint lights; // offset 24
+}; // 28 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;

@@ -10,7 +10,7 @@ use kiln_format::sections::Vertex;
 use kiln_player::camera::CameraOverride;
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{
-    Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Purpose, ReflectionRes,
+    Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose, ReflectionRes,
     Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::session::SessionOptions;
@@ -168,6 +168,12 @@ impl Options {
     /// `structure`.
     pub fn line_space_gi(mut self, bounces: u32, structure: GiStructure) -> Options {
         self.0.render.techniques.gi = Gi::LineSpace { bounces, structure };
+        self
+    }
+
+    /// Participating media by ray marching (`--media march`) with `steps` steps per medium.
+    pub fn media_march(mut self, steps: u32) -> Options {
+        self.0.render.techniques.media = Media::March { steps };
         self
     }
 

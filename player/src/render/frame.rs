@@ -2,12 +2,14 @@
 //! images they make and bind.
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
-//! reflections, GI (each when chosen) → direct light and composition → tone mapping.
+//! reflections, GI (each when chosen) → direct light and composition → participating media
+//! (when chosen) → tone mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
+use super::passes::media::MediaMarchPass;
 use super::passes::resolve::ResolvePass;
 use super::passes::rt_ao::RtAoPass;
 use super::passes::rt_gi::RtGiPass;
@@ -16,7 +18,7 @@ use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::visibility::VisibilityPass;
 use super::spirv;
-use super::technique::{Ao, GBuffer, Gi, GiStructure, Reflections, Techniques};
+use super::technique::{Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc};
 
@@ -62,6 +64,9 @@ fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<B
             Gi::None => {}
         }
         made.push(Box::new(DirectPass::new(gpu)?));
+        if let Media::March { steps } = techniques.media {
+            made.push(Box::new(MediaMarchPass::new(gpu, steps)?));
+        }
         made.push(Box::new(TonemapPass::new(gpu)?));
         Ok(())
     })();

@@ -25,6 +25,8 @@ shaders! {
     DIRECT = "lighting" / "direct.comp";
     /// Tone mapping.
     TONEMAP = "post" / "tonemap.comp";
+    /// Participating media by ray marching.
+    MEDIA_MARCH = "media" / "march.comp";
     /// Ray queries from a buffer.
     TRACE_RAYS = "trace" / "rays.comp";
     /// Line-space queries from a buffer.

@@ -154,12 +154,19 @@ impl Gi {
     }
 }
 
-/// Participating media (techniques come with later passes).
+/// Participating media.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Media {
     /// None.
     #[default]
     None,
+    /// Single scattering by marching each pixel's view ray through the media in world space:
+    /// light visibility from the baked volume (trilinear), transmittance analytic
+    /// (`shaders/media/march.comp`).
+    March {
+        /// Steps through each medium the ray crosses.
+        steps: u32,
+    },
 }
 
 /// What happens to the stochastic passes' samples across frames.
@@ -208,6 +215,8 @@ pub struct Needs {
     pub scene_buffers: bool,
     /// Arrays of the voxel grid and line space ([`crate::scene::linespace::LsArrays`] bits).
     pub line_space: u32,
+    /// The media table and the light-visibility volumes.
+    pub media: bool,
 }
 
 impl Needs {
@@ -220,6 +229,7 @@ impl Needs {
             bvh: self.bvh || o.bvh,
             scene_buffers: self.scene_buffers || o.scene_buffers,
             line_space: self.line_space | o.line_space,
+            media: self.media || o.media,
         }
     }
 
@@ -231,6 +241,7 @@ impl Needs {
         bvh: true,
         scene_buffers: false,
         line_space: 0,
+        media: false,
     };
     /// What the ray-traced passes and the path tracer read: the BVH and the surfaces it hits.
     pub const TRACED_SURFACES: Needs = Needs {
@@ -240,6 +251,7 @@ impl Needs {
         bvh: true,
         scene_buffers: true,
         line_space: 0,
+        media: false,
     };
     /// What the G-buffer and the direct-light pass always read.
     pub const FRAME: Needs = Needs {
@@ -249,6 +261,7 @@ impl Needs {
         bvh: false,
         scene_buffers: false,
         line_space: 0,
+        media: false,
     };
 }
 
@@ -278,6 +291,9 @@ impl Techniques {
                 GiStructure::Candidates => LsArrays::CANDIDATE_QUERY | LsArrays::BINARY_QUERY,
                 GiStructure::Preillum => LsArrays::PNMT_QUERY | LsArrays::PREILLUM,
             };
+        }
+        if let Media::March { .. } = self.media {
+            n.media = true;
         }
         if n.line_space & LsArrays::CELL_LISTS != 0 {
             // Exact tests near the shadow feelers' ends read the shaft's candidates, when the
@@ -385,6 +401,13 @@ impl Techniques {
                 };
             }
             (Effect::Media, "none") => self.media = Media::None,
+            (Effect::Media, "march") => {
+                let steps = v(0).number();
+                if steps.fract() != 0.0 {
+                    return Err(format!("{effect} {name}: media-steps must be a whole number, not {steps}"));
+                }
+                self.media = Media::March { steps: steps as u32 };
+            }
             (Effect::Aa, "none") => self.aa = Aa::None,
             (Effect::Aa, "accumulate") => self.aa = Aa::Accumulate,
             _ => unreachable!("every catalogue entry is matched above (checked by a test)"),
@@ -418,7 +441,10 @@ impl Techniques {
                 Gi::Rt { .. } => "rt",
                 Gi::LineSpace { .. } => "linespace",
             },
-            Effect::Media => "none",
+            Effect::Media => match self.media {
+                Media::None => "none",
+                Media::March { .. } => "march",
+            },
             Effect::Aa => match self.aa {
                 Aa::None => "none",
                 Aa::Accumulate => "accumulate",
@@ -630,7 +656,7 @@ const SUN_ANGLE: Knob = light_size(number(
     &[0.0, 0.53, 2.0],
 ));
 
-static CATALOGUE: [TechniqueInfo; 16] = [
+static CATALOGUE: [TechniqueInfo; 17] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -793,6 +819,22 @@ static CATALOGUE: [TechniqueInfo; 16] = [
         name: "none",
         help: "no participating media",
         knobs: &[],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Media,
+        name: "march",
+        help: "single scattering: each pixel's view ray marched through the media in world space \
+               (light visibility from the compiler's baked volume, transmittance analytic; works \
+               with the light off screen), see --media-steps",
+        knobs: &[number(
+            "media-steps",
+            "steps along the view ray through each medium",
+            1.0,
+            1024.0,
+            32.0,
+            &[8.0, 16.0, 32.0, 64.0],
+        )],
         stochastic: false,
     },
     TechniqueInfo {

@@ -3,6 +3,7 @@
 
 pub mod bindings;
 pub mod linespace;
+pub mod media;
 pub mod reference;
 pub mod upload;
 
@@ -85,6 +86,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::BRDF_LUT && needs.brdf_lut)
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
+        || (kind == sections::MEDIA_VISIBILITY && needs.media)
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
@@ -259,6 +261,8 @@ pub struct GpuScene {
     pub reference: Option<ReferenceBuffers>,
     /// The voxel grid and line space arrays the techniques read.
     pub line_space: Option<linespace::LineSpaceBuffers>,
+    /// The media table and light-visibility volumes, when a media technique reads them.
+    pub media: Option<media::MediaBuffers>,
     /// Every section of the file and its fate.
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
@@ -374,6 +378,7 @@ impl GpuScene {
             bvh: None,
             reference: None,
             line_space: None,
+            media: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
             samplers,
@@ -406,6 +411,9 @@ impl GpuScene {
         }
         if let Some(layout) = &prepared.line_space {
             self.line_space = Some(linespace::LineSpaceBuffers::new(gpu, layout, up)?);
+        }
+        if needs.media && !view.manifest.media.is_empty() {
+            self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, up)?);
         }
         for s in file.sections() {
             let kind = s.entry.kind;
@@ -472,6 +480,8 @@ impl GpuScene {
                     let t = tables.textures[index as usize];
                     up.buffer(&r.texels, t.offset as u64 * 4, view.texture(index as usize).map_err(bad)?)?;
                 }
+            } else if let (Some(m), true) = (&self.media, kind == sections::MEDIA_VISIBILITY) {
+                m.upload_volume(index, &file.section_bytes(s).map_err(bad)?, up)?;
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
                 let texels: &[[u16; 2]] = file.pod(sections::BRDF_LUT, 0).map_err(bad)?.unwrap_or(&[]);
@@ -506,6 +516,8 @@ impl GpuScene {
                     "textures off".into()
                 } else if kind == sections::BRDF_LUT {
                     "no pass reads the BRDF table".into()
+                } else if kind == sections::MEDIA_VISIBILITY {
+                    "no media technique reads it (--media march does)".into()
                 } else if kind == sections::SHADOW_MAP {
                     "no pass reads shadow maps (--shadows is not shadowmap)".into()
                 } else {
@@ -591,6 +603,9 @@ impl GpuScene {
         }
         if let Some(l) = &mut self.line_space {
             l.destroy(gpu);
+        }
+        if let Some(m) = &mut self.media {
+            m.destroy(gpu);
         }
         for s in self.samplers.values_mut() {
             s.destroy(gpu);

@@ -91,19 +91,7 @@ pub fn tables(
             tables.triangle_emitter[index as usize] = i as i32;
         }
     }
-    tables.media = manifest
-        .media
-        .iter()
-        .map(|m| {
-            let v4 = |v: [f32; 3], w: f32| [v[0], v[1], v[2], w];
-            GpuMedium {
-                min: v4(m.bounds.min, m.g),
-                max: v4(m.bounds.max, 0.0),
-                sigma_a: v4(m.sigma_a, 0.0),
-                sigma_s: v4(m.sigma_s, 0.0),
-            }
-        })
-        .collect();
+    tables.media = super::media::table(manifest);
     for t in &manifest.textures {
         let mut flags = wrap_bits(t.wrap_u) << TextureFlags::WRAP_U_SHIFT
             | wrap_bits(t.wrap_v) << TextureFlags::WRAP_V_SHIFT;

@@ -90,6 +90,7 @@ fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Ca
             .flatten()
             .and_then(|h| h.first())
             .map_or(0, |h| h.variants),
+        media: !manifest.media.is_empty(),
     };
     if !offers.bvh {
         return Err(PlayError::new(

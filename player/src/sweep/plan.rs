@@ -85,6 +85,8 @@ pub struct Offers {
     pub shadow_maps: bool,
     /// The line-space variants in the file (`kiln_format::linespace::Variants`; 0: none).
     pub line_space: u32,
+    /// A participating medium.
+    pub media: bool,
 }
 
 impl Offers {
@@ -99,6 +101,8 @@ impl Offers {
                 "needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)"
                     .into(),
             )
+        } else if n.media && !self.media {
+            Some("needs a participating medium, which the file does not have (add a [[medium]] to the sidecar)".into())
         } else if variants & !self.line_space != 0 {
             Some(format!(
                 "needs the line space's {}, which the file does not have (compile with --shaft-variants {})",
@@ -373,7 +377,7 @@ mod tests {
         }
     }
 
-    const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true, line_space: Variants::ALL };
+    const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true, line_space: Variants::ALL, media: true };
 
     #[test]
     fn every_catalogue_technique_of_an_effect_is_swept() {
@@ -400,7 +404,7 @@ mod tests {
     fn missing_sections_skip_with_a_reason() {
         let p = plan(
             &request(Target::ALL.to_vec(), &[]),
-            &Offers { bvh: false, shadow_maps: false, line_space: 0 },
+            &Offers { bvh: false, shadow_maps: false, line_space: 0, media: false },
         );
         assert!(
             p.configs
@@ -411,8 +415,9 @@ mod tests {
             p.skipped.iter().any(|s| s.effect == "ao" && s.technique == "rt" && s.reason.contains("BVH"))
         );
         assert!(p.skipped.iter().any(|s| s.technique == "shadowmap" && s.reason.contains("shadow maps")));
+        assert!(p.skipped.iter().any(|s| s.technique == "march" && s.reason.contains("[[medium]]")));
         // With the BVH but no line space, the feelers are skipped, naming the variant they need.
-        let offers = Offers { bvh: true, shadow_maps: true, line_space: 0 };
+        let offers = Offers { bvh: true, shadow_maps: true, line_space: 0, media: false };
         let p = plan(&request(vec![Target::Effect(Effect::Shadows)], &[]), &offers);
         assert!(
             p.skipped

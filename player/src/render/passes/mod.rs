@@ -12,6 +12,7 @@ pub mod gbuffer;
 pub mod hybrid;
 pub mod kernel;
 pub mod materials;
+pub mod media;
 pub mod pathtrace;
 pub mod resolve;
 pub mod rt_ao;
