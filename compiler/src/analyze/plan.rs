@@ -162,7 +162,7 @@ impl Plan {
             run(
                 Stage::MediaVisibility,
                 format!(
-                    "medium 0, {casters} lights, {} cells on the longest axis",
+                    "medium 0, {casters} lights, {} cells on the longest axis; read by kiln-play --media march",
                     settings.media_volume_res
                 ),
             )
