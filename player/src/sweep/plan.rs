@@ -55,13 +55,16 @@ impl fmt::Display for Target {
 
 /// The light transport a chart's reference computes: the bounces (scattering events) whose
 /// light counts, 0 for all. Shadows and AO approximate direct light (from the lights and the
-/// sky), so their charts compare against direct light alone; reflections add one glossy bounce,
-/// so theirs against two bounces; indirect light, media and the whole frame against every
-/// bounce, the truth. Against all bounces a frame without indirect light is mostly wrong by what
-/// it leaves out, which would hide the difference between two shadow techniques.
+/// sky), so their charts compare against direct light alone; media techniques approximate
+/// single scattering, the direct light of a scattering event in the medium, so theirs against
+/// one bounce too (surfaces lit directly, the medium scattering once); reflections add one
+/// glossy bounce, so theirs against two bounces; indirect light and the whole frame against
+/// every bounce, the truth. Against all bounces a frame without indirect light is mostly wrong
+/// by what it leaves out, which would hide the difference between two shadow (or media)
+/// techniques.
 pub fn bounces(target: Target) -> u32 {
     match target {
-        Target::Effect(Effect::Shadows | Effect::Ao) => 1,
+        Target::Effect(Effect::Shadows | Effect::Ao | Effect::Media) => 1,
         Target::Effect(Effect::Reflections) => 2,
         _ => 0,
     }
