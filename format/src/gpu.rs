@@ -129,7 +129,8 @@ gpu_struct! {
         pub inv_view_proj: [f32; 16] => "mat4",
         /// Camera position, w unused.
         pub camera: [f32; 4] => "vec4",
-        /// Sky radiance, w unused.
+        /// Sky radiance, w = the participating media that dim the light reaching surfaces
+        /// (entries of the direct pass's media buffer; 0 without a media technique).
         pub sky: [f32; 4] => "vec4",
         /// Image width, height, light count, flags.
         pub size: [u32; 4] => "uvec4",

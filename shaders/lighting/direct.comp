@@ -34,6 +34,9 @@ layout(set = 0, binding = 12, r32f) uniform readonly image2DArray rt_shadows;
 layout(set = 0, binding = 13, r32f) uniform readonly image2D rt_ao;
 layout(set = 0, binding = 14, rgba32f) uniform readonly image2D rt_reflections;
 layout(set = 0, binding = 15, rgba32f) uniform readonly image2D rt_gi;
+// Participating media between surfaces and lights (`frame.sky.w` boxes: with a media technique).
+layout(set = 0, binding = 16, std430) readonly buffer Media { GpuMedium media[]; };
+#include "../common/media.glsl"
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -302,6 +305,13 @@ void main() {
         }
         if (any(greaterThan(contribution, vec3(0.0)))) {
             contribution *= shadow_factor(i, light, p, n, shadow_dir, angle);
+            // Light through participating media arrives dimmed (towards the light's position,
+            // a rect light's centre; out of every box for directional lights).
+            uint media_count = uint(frame.sky.w);
+            if (media_count > 0u) {
+                float reach = light.kind == LIGHT_DIRECTIONAL ? 3.4e38 : length(light.position - p);
+                contribution *= exp(-optical_depth(media_count, p, shadow_dir, 0.0, reach));
+            }
         }
         radiance += contribution;
     }

@@ -31,32 +31,9 @@ layout(set = 0, binding = 6, rgba32f) uniform image2D radiance;
 layout(push_constant) uniform Push { MarchConstants mc; };
 
 #include "../common/pixel.glsl"
+#include "../common/media.glsl"
 
-const float PI = 3.14159265358979;
 const float FAR = 3.4e38;
-
-// The part [t0, t1] of the unit ray (o, d) inside the box [lo, hi] (empty when x >= y). An axis
-// the ray runs parallel to keeps all or nothing, without the NaN of 0 · ∞.
-vec2 box_span(vec3 lo, vec3 hi, vec3 o, vec3 d, float t0, float t1) {
-    for (int a = 0; a < 3; a++) {
-        if (abs(d[a]) < 1e-30) {
-            if (o[a] < lo[a] || o[a] > hi[a]) {
-                return vec2(1.0, 0.0);
-            }
-        } else {
-            float inv = 1.0 / d[a];
-            float ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
-            t0 = max(t0, min(ta, tb));
-            t1 = min(t1, max(ta, tb));
-        }
-    }
-    return vec2(t0, t1);
-}
-
-float hg(float g, float cos_theta) {
-    float denom = 1.0 + g * g - 2.0 * g * cos_theta;
-    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(max(denom, 1e-30)));
-}
 
 uint volume_byte(uint at) {
     return (volume_words[at >> 2u] >> (8u * (at & 3u))) & 0xFFu;

@@ -66,39 +66,7 @@ uint medium_count() {
     return rc.media.x;
 }
 
-// The part [t0, t1] of the unit ray (o, d) inside the box [lo, hi] (empty when x >= y). An axis
-// the ray runs parallel to keeps all or nothing, without the NaN of 0 · ∞.
-vec2 box_span(vec3 lo, vec3 hi, vec3 o, vec3 d, float t0, float t1) {
-    [[unroll]] for (int a = 0; a < 3; a++) {
-        if (abs(d[a]) < 1e-30) {
-            if (o[a] < lo[a] || o[a] > hi[a]) {
-                return vec2(1.0, 0.0);
-            }
-        } else {
-            float inv = 1.0 / d[a];
-            float ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
-            t0 = max(t0, min(ta, tb));
-            t1 = min(t1, max(ta, tb));
-        }
-    }
-    return vec2(t0, t1);
-}
-
-vec3 medium_sigma_t(uint i) {
-    return media[i].sigma_a.rgb + media[i].sigma_s.rgb;
-}
-
-// Optical depth (RGB) of the unit ray (o, d) over [t0, t1].
-vec3 optical_depth(vec3 o, vec3 d, float t0, float t1) {
-    vec3 tau = vec3(0.0);
-    for (uint i = 0u; i < medium_count(); i++) {
-        vec2 span = box_span(media[i].min.xyz, media[i].max.xyz, o, d, t0, t1);
-        if (span.y > span.x) {
-            tau += medium_sigma_t(i) * (span.y - span.x);
-        }
-    }
-    return tau;
-}
+#include "../common/media.glsl"
 
 // The ray of the current path segment, for the weight of the rect lights it crosses.
 vec3 segment_origin;
@@ -110,7 +78,7 @@ vec3 emitter_transmittance(vec3 from, EmitterSample es) {
         return vec3(1.0);
     }
     float dist = es.directional ? FAR : length(es.target - from);
-    return exp(-optical_depth(from, es.wi, 0.0, dist));
+    return exp(-optical_depth(medium_count(), from, es.wi, 0.0, dist));
 }
 
 // A rect light crossed at distance t of the current segment counts when the sampled flight got
@@ -119,13 +87,8 @@ vec3 emitter_seen_weight(float t) {
     if (medium_count() == 0u) {
         return vec3(1.0);
     }
-    vec3 tr = exp(-optical_depth(segment_origin, segment_dir, 0.0, t));
+    vec3 tr = exp(-optical_depth(medium_count(), segment_origin, segment_dir, 0.0, t));
     return tr / max(dot(tr, vec3(1.0 / 3.0)), 1e-30);
-}
-
-float hg(float g, float cos_theta) {
-    float denom = 1.0 + g * g - 2.0 * g * cos_theta;
-    return (1.0 - g * g) / (4.0 * PI * denom * sqrt(max(denom, 1e-30)));
 }
 
 // The scattering at a point in the media: the boxes holding it, by their scattering.

@@ -29,8 +29,21 @@ fn slab_file(
     travel: Vec3,
     irradiance: f32,
 ) -> Vec<u8> {
+    slab_over(sigma_a, sigma_s, g, depth, travel, irradiance, 0.0)
+}
+
+/// [`slab_file`] over a Lambertian floor of albedo `floor` (linear).
+fn slab_over(
+    sigma_a: [f32; 3],
+    sigma_s: [f32; 3],
+    g: f32,
+    depth: f32,
+    travel: Vec3,
+    irradiance: f32,
+    floor: f32,
+) -> Vec<u8> {
     let mut scene = scene_of(&square(-0.5, 60.0));
-    scene.materials[0].gpu = lambert_material([0.0; 3]);
+    scene.materials[0].gpu = lambert_material([floor; 3]);
     scene.lights.push(light(LightKind::Directional, [0.0; 3], travel.to_array(), irradiance));
     scene.sky = Sky { radiance: [0.0; 3] };
     scene.media.push(Medium {
@@ -237,4 +250,47 @@ fn the_ray_march_shows_the_volumetric_shadow_of_an_occluder() {
         }
     }
     assert!(lit > 100 && shaded > 100, "{lit} lit and {shaded} shaded pixel channels checked");
+}
+
+/// A grey floor under the lit slab through `--media march`: its light crosses the slab twice,
+/// dimmed on the way in (depth/μ) and on the way out (depth), and the slab's single scattering
+/// adds: albedo/π · E μ e^{−σt·D(1 + 1/μ)} + the closed form above, per channel.
+#[test]
+fn the_ray_march_dims_the_light_that_reaches_surfaces_through_the_medium() {
+    if !vulkan() {
+        return;
+    }
+    let travel = Vec3::new(0.8, -0.6, 0.0);
+    let (sigma_a, sigma_s, g, depth, irradiance) =
+        ([0.1f32, 0.2, 0.05], [0.1f32, 0.4, 0.85], 0.5f32, 1.5f32, 4.0f32);
+    // An albedo the G-buffer's 8-bit sRGB target holds exactly.
+    let albedo = crate::harness::srgb8(188);
+    let bytes = slab_over(sigma_a, sigma_s, g, depth, travel, irradiance, albedo);
+    let dir = tempfile::tempdir().unwrap();
+    let (rgb, _) =
+        render(dir.path(), "floor", &bytes, |f| Options::new(f, W, H).unshadowed().media_march(64));
+    let got = mean(&rgb);
+    let mu = -travel.y as f64;
+    for c in 0..3 {
+        let sigma_t = (sigma_a[c] + sigma_s[c]) as f64;
+        let surface = albedo as f64 / std::f64::consts::PI
+            * irradiance as f64
+            * mu
+            * (-sigma_t * depth as f64 * (1.0 + 1.0 / mu)).exp();
+        let want = surface
+            + single_scattering(
+                sigma_a[c] as f64,
+                sigma_s[c] as f64,
+                g as f64,
+                depth as f64,
+                travel,
+                irradiance as f64,
+            );
+        eprintln!("floor channel {c}: {:.6} vs {want:.6} (surface {surface:.6})", got[c]);
+        assert!(
+            (got[c] - want).abs() / want < 0.01,
+            "channel {c}: {:.6} vs the closed form {want:.6}",
+            got[c]
+        );
+    }
 }

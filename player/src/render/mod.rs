@@ -96,6 +96,9 @@ pub struct Renderer {
     flags: u32,
     lut_resolution: u32,
     sky: [f32; 3],
+    /// Media that dim the light reaching surfaces (those of the scene when a media technique
+    /// runs; 0 otherwise).
+    media_dimming: u32,
     settings: RenderSettings,
     timestamps: TimestampPool,
     /// Frames rendered.
@@ -244,6 +247,7 @@ impl Renderer {
             flags,
             lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
             sky: scene.manifest.sky.radiance,
+            media_dimming: scene.media.as_ref().map_or(0, |m| m.count),
             settings,
             timestamps,
             frame_count: 0,
@@ -306,7 +310,7 @@ impl Renderer {
             view_proj,
             inv_view_proj,
             camera: [p.x, p.y, p.z, if camera.ortho.is_some() { 1.0 } else { 0.0 }],
-            sky: [self.sky[0], self.sky[1], self.sky[2], 0.0],
+            sky: [self.sky[0], self.sky[1], self.sky[2], self.media_dimming as f32],
             size: [w, h, self.plan.lights_used, self.flags],
             params: [
                 2f32.powf(self.settings.exposure),

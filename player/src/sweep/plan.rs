@@ -380,7 +380,8 @@ mod tests {
         }
     }
 
-    const ALL_OFFERED: Offers = Offers { bvh: true, shadow_maps: true, line_space: Variants::ALL, media: true };
+    const ALL_OFFERED: Offers =
+        Offers { bvh: true, shadow_maps: true, line_space: Variants::ALL, media: true };
 
     #[test]
     fn every_catalogue_technique_of_an_effect_is_swept() {

@@ -2,7 +2,8 @@
 //! G-buffer (Lambert or Cook–Torrance GGX, multiple-scattering compensation from the baked
 //! table), shadowed by the baked shadow maps (PCF; PCSS for rect lights) or by the ray-traced
 //! layers, the constant sky through the split-sum table, ray-traced AO, reflections and GI
-//! composited where they ran; writes linear radiance.
+//! composited where they ran, the light dimmed by participating media when a media technique
+//! runs; writes linear radiance.
 
 use crate::gpu::vk;
 
@@ -43,6 +44,7 @@ impl DirectPass {
         bindings.extend([Binding::one(Sampled), maps, maps]);
         bindings.extend([Binding::one(Sampled); 5]);
         bindings.extend([Binding::one(StorageImage); 5]);
+        bindings.push(Binding::one(Storage));
         Ok(DirectPass(Kernel::new(gpu, &bindings, spirv::DIRECT, 0)?))
     }
 }
@@ -88,6 +90,9 @@ impl Pass for DirectPass {
         for (i, t) in RAY_TRACED.iter().enumerate() {
             writes.push(Write::StorageImage(12 + i as u32, img(t)));
         }
+        // The media table when a media technique uploaded it (the frame constants then count
+        // its entries), else any storage buffer: no entry is read.
+        writes.push(Write::Buffer(16, scene.media.as_ref().map_or(shared.lights, |m| &m.table)));
         self.0.write(gpu, &writes)
     }
 
