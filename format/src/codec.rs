@@ -56,7 +56,8 @@ impl Aligned {
     pub(crate) fn bytes(&self) -> &[u8] {
         // SAFETY: `Block` is 64 plain bytes with no padding, so a slice of blocks is a slice of
         // `64 * blocks.len()` initialised bytes; `len` never exceeds that.
-        let all = unsafe { std::slice::from_raw_parts(self.blocks.as_ptr().cast::<u8>(), self.blocks.len() * 64) };
+        let all =
+            unsafe { std::slice::from_raw_parts(self.blocks.as_ptr().cast::<u8>(), self.blocks.len() * 64) };
         &all[..self.len]
     }
 
@@ -106,7 +107,9 @@ pub(crate) fn decode_zstd(stored: &[u8], raw_size: u64, max: u64) -> Result<Alig
                 stored.len() - n
             )));
         }
-        Err(_) => return Err(bad(format!("the zstd frame is truncated or malformed ({} bytes)", stored.len()))),
+        Err(_) => {
+            return Err(bad(format!("the zstd frame is truncated or malformed ({} bytes)", stored.len())));
+        }
     }
     match zstd::zstd_safe::get_frame_content_size(stored) {
         Ok(Some(n)) if n == raw_size => {}
@@ -119,7 +122,8 @@ pub(crate) fn decode_zstd(stored: &[u8], raw_size: u64, max: u64) -> Result<Alig
     let len = usize::try_from(raw_size).map_err(|_| bad(format!("{raw_size} bytes do not fit in memory")))?;
     let mut out = Aligned::zeroed(len)
         .ok_or_else(|| bad(format!("cannot allocate {raw_size} bytes for the decoded section")))?;
-    let mut dctx = zstd::zstd_safe::DCtx::try_create().ok_or_else(|| bad("cannot create a zstd decoder".into()))?;
+    let mut dctx =
+        zstd::zstd_safe::DCtx::try_create().ok_or_else(|| bad("cannot create a zstd decoder".into()))?;
     // The output is a slice of exactly raw_size bytes: the decoder fails rather than write more.
     let written = dctx
         .decompress(out.bytes_mut(), stored)

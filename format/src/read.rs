@@ -232,7 +232,8 @@ impl KilnFile {
         if self.policy != Checksums::Deferred {
             self.verify_section(s.position)?;
         }
-        let here = |e: FormatError| e.in_section(s.position, s.entry.kind, s.entry.index).or_offset(s.entry.offset);
+        let here =
+            |e: FormatError| e.in_section(s.position, s.entry.kind, s.entry.index).or_offset(s.entry.offset);
         match Codec::from_u8(s.entry.codec) {
             Some(Codec::None) => Ok(self.stored_bytes(s)),
             Some(Codec::Zstd) => {

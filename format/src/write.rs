@@ -247,15 +247,17 @@ impl<'a> FileWriter<'a> {
         let results: Vec<Result<(), WriteError>> = std::thread::scope(|scope| {
             let workers: Vec<_> = (0..threads)
                 .map(|_| {
-                    scope.spawn(|| loop {
-                        let Some(p) = queue.lock().unwrap_or_else(|e| e.into_inner()).pop() else {
-                            return Ok(());
-                        };
-                        let frame = crate::codec::compress_zstd(&p.bytes).map_err(|source| {
-                            WriteError::Compress { kind: p.kind, index: p.index, source }
-                        })?;
-                        if frame.len() < p.bytes.len() {
-                            p.compressed = Some(frame);
+                    scope.spawn(|| {
+                        loop {
+                            let Some(p) = queue.lock().unwrap_or_else(|e| e.into_inner()).pop() else {
+                                return Ok(());
+                            };
+                            let frame = crate::codec::compress_zstd(&p.bytes).map_err(|source| {
+                                WriteError::Compress { kind: p.kind, index: p.index, source }
+                            })?;
+                            if frame.len() < p.bytes.len() {
+                                p.compressed = Some(frame);
+                            }
                         }
                     })
                 })

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
-    BRDF_LUT_RES, BvhPreset, Codec, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings,
-    VOXEL_RES, VoxelRes, parse_variants,
+    BRDF_LUT_RES, BvhPreset, Codec, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES,
+    Settings, VOXEL_RES, VoxelRes, parse_variants,
 };
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
