@@ -276,7 +276,14 @@ fn a_declared_size_beyond_the_limit_is_refused_before_allocating_it() {
     let huge = 1u64 << 50;
     for policy in [Checksums::Eager, Checksums::OnAccess, Checksums::Deferred] {
         let bytes = with_tmat(huge, f.clone());
-        let (r, largest) = largest_allocation(|| KilnFile::from_bytes(&bytes, policy).map(|_| ()));
+        // Opening and reading the section: wherever the reader checks the limit (while
+        // validating the layout, and again before decoding), it must be before allocating.
+        let (r, largest) = largest_allocation(|| {
+            KilnFile::from_bytes(&bytes, policy).and_then(|f| {
+                let s = *f.find(sections::TRIANGLE_MATERIALS, 0).expect("the section is there");
+                f.section_bytes(&s).map(|_| ())
+            })
+        });
         let e = r.unwrap_err();
         assert_eq!(e.kind, ErrorKind::DecodedTooLarge { declared: huge, limit: 1 << 32 }, "{e}");
         assert!(largest < 1 << 20, "{policy:?}: an allocation of {largest} bytes");
