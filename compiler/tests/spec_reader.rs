@@ -73,7 +73,6 @@ mod spec {
     /// A checked file: header, table, placement, padding and section checksums, every section
     /// decoded.
     pub struct File<'a> {
-        pub bytes: &'a [u8],
         pub version: (u16, u16),
         pub entries: Vec<Entry>,
         /// Decoded bytes per entry: the stored bytes for codec 0, the zstd frame's content for 1.
@@ -203,7 +202,7 @@ mod spec {
                 _ => std::borrow::Cow::Owned(decode_zstd(stored, e.raw_size)?),
             });
         }
-        Ok(File { bytes: b, version: (u16_at(b, 8), u16_at(b, 10)), entries, decoded })
+        Ok(File { version: (u16_at(b, 8), u16_at(b, 10)), entries, decoded })
     }
 
     /// A 128-bit hash as FORMAT.md writes it: hex of the stored (little-endian) bytes.
