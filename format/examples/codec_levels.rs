@@ -9,6 +9,9 @@ use std::time::Instant;
 
 use kiln_format::{Checksums, KilnFile};
 
+/// Per level: stored bytes, seconds compressing, seconds decompressing.
+type PerLevel = Vec<(u64, f64, f64)>;
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(path) = args.first() else {
@@ -22,7 +25,7 @@ fn main() {
     };
     let file = KilnFile::open(std::path::Path::new(path), Checksums::Eager).expect("a valid file");
     // kind -> (raw bytes, per level: (stored bytes, compress s, decompress s))
-    let mut by_kind: BTreeMap<String, (u64, Vec<(u64, f64, f64)>)> = BTreeMap::new();
+    let mut by_kind: BTreeMap<String, (u64, PerLevel)> = BTreeMap::new();
     for s in file.sections() {
         let raw = file.section_bytes(s).expect("readable section");
         let e = by_kind.entry(s.entry.kind.name()).or_insert_with(|| (0, vec![(0, 0.0, 0.0); levels.len()]));
