@@ -218,6 +218,50 @@ impl Normals {
     }
 }
 
+/// Which sections the output file stores compressed (FORMAT.md "Codecs").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Codec {
+    /// zstd for the kinds the player decodes on the CPU anyway
+    /// ([`kiln_format::sections::COMPRESSED_BY_DEFAULT`]), none for those it maps zero-copy.
+    #[default]
+    Auto,
+    /// Every section stored as is.
+    None,
+    /// Every section zstd-compressed (smallest file, for distribution; the player decodes
+    /// each section once while loading).
+    Zstd,
+}
+
+impl Codec {
+    /// Parses `auto`, `none` or `zstd`.
+    pub fn parse(s: &str) -> Result<Codec, String> {
+        match s {
+            "auto" => Ok(Codec::Auto),
+            "none" => Ok(Codec::None),
+            "zstd" => Ok(Codec::Zstd),
+            _ => Err(format!("'{s}' is not a codec; use auto, none or zstd")),
+        }
+    }
+
+    /// As text (parses back to the same value).
+    pub fn name(self) -> &'static str {
+        match self {
+            Codec::Auto => "auto",
+            Codec::None => "none",
+            Codec::Zstd => "zstd",
+        }
+    }
+
+    /// What the writer does.
+    pub fn compression(self) -> kiln_format::Compression {
+        match self {
+            Codec::Auto => kiln_format::Compression::Default,
+            Codec::None => kiln_format::Compression::None,
+            Codec::Zstd => kiln_format::Compression::All,
+        }
+    }
+}
+
 /// Every setting that affects the output file.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Settings {
@@ -240,6 +284,9 @@ pub struct Settings {
     pub media_volume_res: u32,
     /// Normals where the asset gives none (applied at import).
     pub normals: Normals,
+    /// Which sections are stored compressed. Changes the stored bytes only, never a section's
+    /// decoded bytes or content hash (so cached stages are reused across codecs).
+    pub codec: Codec,
 }
 
 impl Default for Settings {
@@ -254,6 +301,7 @@ impl Default for Settings {
             shadow_res: SHADOW_RES.default,
             media_volume_res: MEDIA_VOLUME_RES.default,
             normals: Normals::Asset,
+            codec: Codec::Auto,
         }
     }
 }
@@ -296,6 +344,9 @@ impl Settings {
         if let Some(n) = &b.normals {
             self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;
         }
+        if let Some(c) = &b.codec {
+            self.codec = Codec::parse(c).map_err(|e| format!("codec: {e}"))?;
+        }
         Ok(())
     }
 
@@ -315,6 +366,7 @@ impl Settings {
             ("shadow-res".into(), self.shadow_res.to_string()),
             ("media-volume-res".into(), self.media_volume_res.to_string()),
             ("normals".into(), self.normals.name()),
+            ("codec".into(), self.codec.name().into()),
         ]
     }
 }

@@ -14,7 +14,7 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.1");
+    assert_eq!(j["format_version"], "1.2");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(
@@ -96,7 +96,56 @@ fn exit_codes() {
     let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
-    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.1").says("1.x");
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.2").says("1.x");
+}
+
+#[test]
+fn codec_option_and_sidecar_key() {
+    // Which sections are compressed, as `kiln inspect --json` reports them: auto compresses the
+    // CPU-read kinds that shrink and nothing the player uploads zero-copy; zstd (command line or
+    // sidecar) every section that shrinks, the sidecar overridden by the command line; a bad
+    // value is a usage error naming the choices.
+    let dir = tempfile::tempdir().unwrap();
+    let codecs = |file: &str| -> Vec<(String, String)> {
+        let run = kiln(dir.path(), &["inspect", file, "--json"]);
+        run.expect(0);
+        let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+        j["sections"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| (s["kind"].as_str().unwrap().to_string(), s["codec"].as_str().unwrap().to_string()))
+            .collect()
+    };
+    kiln(dir.path(), &["demo", "-o", "auto.kiln", "-q"]).expect(0);
+    let zero_copy =
+        ["VERT", "CWBV", "SHDW", "VGRD", "VOXO", "VOXT", "LSLT", "LSBN", "LSRK", "LSCO", "LSCE", "LSPN"];
+    for (kind, codec) in codecs("auto.kiln") {
+        if zero_copy.contains(&kind.as_str()) {
+            assert_eq!(codec, "none", "{kind} compressed by default");
+        }
+        if kind == "TRIS" || kind == "MATL" {
+            assert_eq!(codec, "zstd", "{kind} not compressed by default");
+        }
+    }
+    kiln(dir.path(), &["demo", "-o", "none.kiln", "-q", "--codec", "none"]).expect(0);
+    assert!(codecs("none.kiln").iter().all(|(_, c)| c == "none"));
+    std::fs::write(dir.path().join("z.toml"), "[bake]\ncodec = \"zstd\"\n").unwrap();
+    std::fs::write(dir.path().join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    kiln(dir.path(), &["demo", "-o", "z.kiln", "-q", "--codec", "zstd"]).expect(0);
+    let z = codecs("z.kiln");
+    assert!(z.iter().filter(|(_, c)| c == "zstd").count() >= 12, "{z:?}");
+    kiln(dir.path(), &["compile", "t.obj", "-c", "z.toml", "-o", "t.kiln", "-q"]).expect(0);
+    kiln(dir.path(), &["compile", "t.obj", "-c", "z.toml", "-o", "t0.kiln", "-q", "--codec", "none"])
+        .expect(0);
+    assert!(codecs("t0.kiln").iter().all(|(_, c)| c == "none"));
+    let run = kiln(dir.path(), &["inspect", "t.kiln", "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
+    let settings = j["manifest"]["settings"].as_array().unwrap();
+    assert!(settings.iter().any(|s| s["key"] == "codec" && s["value"] == "zstd"), "{settings:?}");
+    kiln(dir.path(), &["demo", "-o", "x.kiln", "--codec", "lz4"]).expect(2).says("auto, none or zstd");
+    std::fs::write(dir.path().join("bad.toml"), "[bake]\ncodec = \"gzip\"\n").unwrap();
+    kiln(dir.path(), &["plan", "t.obj", "-c", "bad.toml"]).expect(1).says("codec: 'gzip' is not a codec");
 }
 
 #[test]

@@ -11,7 +11,7 @@ use std::collections::BTreeSet;
 use kiln_compiler::import::demo::cornell_box;
 use kiln_compiler::ir::{Texture, TextureRole};
 use kiln_compiler::pipeline::compile_to_bytes;
-use kiln_compiler::settings::{BRDF_LUT_RES, MEDIA_VOLUME_RES, SHADOW_RES, Settings, VoxelRes};
+use kiln_compiler::settings::{BRDF_LUT_RES, Codec, MEDIA_VOLUME_RES, SHADOW_RES, Settings, VoxelRes};
 use kiln_format::checksum::checksum64;
 use kiln_format::header::{HEADER_SIZE, Header};
 use kiln_format::linespace::Variants;
@@ -83,6 +83,11 @@ fn randomly_damaged_copies_are_all_refused() {
 /// spot light (2D shadow map), a medium (visibility volume per light), and all four line-space
 /// variants, everything at its smallest resolution so that the file stays small.
 fn every_kind_file() -> Vec<u8> {
+    every_kind_file_with(Codec::Auto)
+}
+
+/// The every-kind fixture with its sections compressed as `codec` says.
+fn every_kind_file_with(codec: Codec) -> Vec<u8> {
     let mut s = cornell_box();
     s.textures.push(Texture {
         name: "checker".into(),
@@ -119,6 +124,7 @@ fn every_kind_file() -> Vec<u8> {
         brdf_lut_res: BRDF_LUT_RES.min,
         shadow_res: SHADOW_RES.min,
         media_volume_res: MEDIA_VOLUME_RES.min,
+        codec,
         ..Default::default()
     };
     compile_to_bytes(s, settings, "every-kind").expect("the fixture compiles")
@@ -160,7 +166,13 @@ fn section_spans(bytes: &[u8]) -> Vec<(SectionKind, u32, usize, usize)> {
 
 #[test]
 fn damage_inside_every_section_is_refused_naming_the_section() {
-    let good = every_kind_file();
+    for codec in [Codec::None, Codec::Auto, Codec::Zstd] {
+        damage_inside_every_section_is_refused(&every_kind_file_with(codec));
+    }
+}
+
+fn damage_inside_every_section_is_refused(good: &[u8]) {
+    let good = good.to_vec();
     for (position, (kind, index, offset, size)) in section_spans(&good).into_iter().enumerate() {
         let name = format!("({kind}#{index})");
         for at in [offset, offset + size / 2, offset + size - 1] {
@@ -192,8 +204,14 @@ fn damage_inside_every_section_is_refused_naming_the_section() {
 
 #[test]
 fn kiln_verify_refuses_damage_in_every_section_naming_it() {
+    for codec in [Codec::Auto, Codec::Zstd] {
+        kiln_verify_refuses_damage_in_every_section(&every_kind_file_with(codec));
+    }
+}
+
+fn kiln_verify_refuses_damage_in_every_section(good: &[u8]) {
     let dir = tempfile::tempdir().unwrap();
-    let good = every_kind_file();
+    let good = good.to_vec();
     for (kind, index, offset, size) in section_spans(&good) {
         let mut bad = good.clone();
         bad[offset + size / 2] ^= 0x01;
@@ -257,4 +275,83 @@ fn hostile_content_with_good_checksums_in_every_section_never_panics() {
             }
         }
     }
+}
+
+#[test]
+fn every_kind_compressed_reads_back_the_uncompressed_sections() {
+    // Compiled with --codec zstd and with --codec none: the same sections, decoded bytes equal to
+    // the uncompressed file's stored bytes (sliced by its own table); a section is compressed
+    // exactly when the zstd library, asked directly, makes it smaller (level 9).
+    let plain = every_kind_file_with(Codec::None);
+    let packed = every_kind_file_with(Codec::Zstd);
+    let p = KilnFile::from_bytes(&plain, Checksums::Eager).unwrap();
+    let z = KilnFile::from_bytes(&packed, Checksums::Eager).unwrap();
+    assert_eq!(p.sections().len(), z.sections().len());
+    let mut compressed = BTreeSet::new();
+    for (ps, zs) in p.sections().iter().zip(z.sections()) {
+        let (pe, ze) = (ps.entry, zs.entry);
+        assert_eq!((pe.kind, pe.index), (ze.kind, ze.index));
+        assert_eq!(pe.codec, 0);
+        let raw = &plain[pe.offset as usize..(pe.offset + pe.size) as usize];
+        if pe.kind != sections::MANIFEST {
+            // (The manifest records the codec setting.)
+            assert_eq!(&*z.section_bytes(zs).unwrap(), raw, "{}#{}", ze.kind, ze.index);
+            let smaller = zstd::bulk::compress(raw, 9).unwrap().len() < raw.len();
+            assert_eq!(ze.codec == 1, smaller, "{}#{}: codec {}", ze.kind, ze.index, ze.codec);
+        }
+        if ze.codec == 1 {
+            compressed.insert(ze.kind.name());
+        }
+    }
+    assert!(compressed.len() >= 15, "only {compressed:?} compressed");
+    assert!(packed.len() < plain.len());
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("z.kiln"), &packed).unwrap();
+    let run = kiln(dir.path(), &["verify", "z.kiln", "--rays", "64"]);
+    run.expect(0);
+    assert!(run.stdout.contains(&format!("{} compressed)", compressed_count(&z))), "{run:?}");
+}
+
+#[test]
+fn kiln_verify_refuses_a_frame_that_does_not_decode_in_every_compressed_section() {
+    // Each compressed section's frame overwritten under good checksums (so only the frame rules
+    // can catch it): verify exits 1 naming the section and the decoding error.
+    let dir = tempfile::tempdir().unwrap();
+    let good = every_kind_file_with(Codec::Zstd);
+    let file = KilnFile::from_bytes(&good, Checksums::Eager).unwrap();
+    let compressed: Vec<_> = file.sections().iter().filter(|s| s.entry.codec == 1).copied().collect();
+    assert!(!compressed.is_empty());
+    for s in compressed {
+        // Flip a bit pattern in the frame's last byte (part of zstd's content checksum).
+        let mut bad = good.clone();
+        let last = (s.entry.offset + s.entry.size - 1) as usize;
+        bad[last] ^= 0x5a;
+        let bad = rechecksummed_as_is(&bad, s.position);
+        std::fs::write(dir.path().join("bad.kiln"), &bad).unwrap();
+        let run = kiln(dir.path(), &["verify", "bad.kiln"]);
+        run.expect(1)
+            .says(&format!("({}#{})", s.entry.kind, s.entry.index))
+            .says("compressed section cannot be decoded");
+    }
+}
+
+fn compressed_count(file: &KilnFile) -> usize {
+    file.sections().iter().filter(|s| s.entry.codec == 1).count()
+}
+
+/// `bytes` with the checksums of section `position`, the table and the header made right for
+/// the bytes as they are.
+fn rechecksummed_as_is(bytes: &[u8], position: usize) -> Vec<u8> {
+    let mut out = bytes.to_vec();
+    let mut header = Header::parse(&out).unwrap();
+    let table = header.table_offset as usize;
+    let at = table + position * ENTRY_SIZE;
+    let mut entry = SectionEntry::from_bytes(&out[at..at + ENTRY_SIZE]);
+    let (o, n) = (entry.offset as usize, entry.size as usize);
+    entry.checksum = checksum64(&out[o..o + n]);
+    out[at..at + ENTRY_SIZE].copy_from_slice(&entry.to_bytes());
+    let end = table + header.section_count as usize * ENTRY_SIZE;
+    header.table_checksum = checksum64(&out[table..end]);
+    out[..HEADER_SIZE].copy_from_slice(&header.to_bytes());
+    out
 }

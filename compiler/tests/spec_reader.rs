@@ -17,7 +17,7 @@ mod run;
 use kiln_compiler::import::demo::cornell_box;
 use kiln_compiler::ir::{Texture, TextureRole};
 use kiln_compiler::pipeline::compile_to_bytes;
-use kiln_compiler::settings::{Settings, VoxelRes};
+use kiln_compiler::settings::{Codec, Settings, VoxelRes};
 use kiln_format::linespace::{LineSpace, Variants};
 use kiln_format::manifest::{
     Bounds, BrdfLutInfo, Camera, ColorSpace, InputFile, Light, LightKind, Manifest, MaterialInfo,
@@ -70,21 +70,51 @@ mod spec {
         (0..b.len() / 4).map(|i| u32_at(b, 4 * i)).collect()
     }
 
-    /// A checked file: header, table, placement, padding and section checksums.
+    /// A checked file: header, table, placement, padding and section checksums, every section
+    /// decoded.
     pub struct File<'a> {
-        pub bytes: &'a [u8],
         pub version: (u16, u16),
         pub entries: Vec<Entry>,
+        /// Decoded bytes per entry: the stored bytes for codec 0, the zstd frame's content for 1.
+        pub decoded: Vec<std::borrow::Cow<'a, [u8]>>,
     }
 
-    impl<'a> File<'a> {
-        /// The stored bytes of `(kind, index)`, if present.
-        pub fn section(&self, kind: &[u8; 4], index: u32) -> Option<&'a [u8]> {
-            self.entries
-                .iter()
-                .find(|e| &e.kind == kind && e.index == index)
-                .map(|e| &self.bytes[e.offset as usize..(e.offset + e.size) as usize])
+    impl File<'_> {
+        /// The decoded bytes of `(kind, index)`, if present.
+        pub fn section(&self, kind: &[u8; 4], index: u32) -> Option<&[u8]> {
+            let i = self.entries.iter().position(|e| &e.kind == kind && e.index == index)?;
+            Some(&self.decoded[i])
         }
+    }
+
+    /// The decoding limit this reader chooses (FORMAT.md lets each reader choose one).
+    pub const MAX_DECODED: u64 = 1 << 32;
+
+    /// Codec 1 by FORMAT.md "Codecs": exactly one zstd frame (not skippable), declaring a content
+    /// size equal to `raw_size`, decoding to exactly that many bytes. Decoded with the zstd crate
+    /// (the reference library), never with kiln-format.
+    pub fn decode_zstd(stored: &[u8], raw_size: u64) -> Result<Vec<u8>, String> {
+        use zstd::zstd_safe;
+        if raw_size > MAX_DECODED {
+            return Err("raw_size beyond the limit".into());
+        }
+        if stored.len() < 4 || u32_at(stored, 0) != 0xFD2F_B528 {
+            return Err("zstd magic".into());
+        }
+        if zstd_safe::find_frame_compressed_size(stored) != Ok(stored.len()) {
+            return Err("not exactly one zstd frame".into());
+        }
+        if !matches!(zstd_safe::get_frame_content_size(stored), Ok(Some(n)) if n == raw_size) {
+            return Err("frame content size".into());
+        }
+        let mut out = vec![0u8; raw_size as usize];
+        let n = zstd::bulk::Decompressor::new()
+            .and_then(|mut d| d.decompress_to_buffer(stored, &mut out[..]))
+            .map_err(|e| format!("zstd: {e}"))?;
+        if n as u64 != raw_size {
+            return Err("decoded length".into());
+        }
+        Ok(out)
     }
 
     /// Header, table, placement and checksums; `Err` names the first rule broken.
@@ -135,8 +165,10 @@ mod spec {
             if !(6..=16).contains(&entry.align_log2) || entry.flags != 0 || entry.version == 0 {
                 return Err("entry fields".into());
             }
-            if entry.codec != 0 || entry.raw_size != entry.size {
-                return Err("codec".into());
+            match entry.codec {
+                0 if entry.raw_size == entry.size => {}
+                1 if entry.raw_size <= MAX_DECODED => {}
+                _ => return Err("codec".into()),
             }
             let align = 1u64 << entry.align_log2;
             if entry.offset != cursor.div_ceil(align) * align {
@@ -162,7 +194,15 @@ mod spec {
         if !entries.iter().any(|e| &e.kind == b"MANI") {
             return Err("no manifest".into());
         }
-        Ok(File { bytes: b, version: (u16_at(b, 8), u16_at(b, 10)), entries })
+        let mut decoded = Vec::with_capacity(entries.len());
+        for e in &entries {
+            let stored = &b[e.offset as usize..(e.offset + e.size) as usize];
+            decoded.push(match e.codec {
+                0 => std::borrow::Cow::Borrowed(stored),
+                _ => std::borrow::Cow::Owned(decode_zstd(stored, e.raw_size)?),
+            });
+        }
+        Ok(File { version: (u16_at(b, 8), u16_at(b, 10)), entries, decoded })
     }
 
     /// A 128-bit hash as FORMAT.md writes it: hex of the stored (little-endian) bytes.
@@ -1068,6 +1108,11 @@ fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> Str
 /// The demo Cornell box with a textured material (so `UVS0` is written), vertex colours (`COL0`),
 /// a spot light, every line-space variant at N = 3.
 fn fixture() -> Vec<u8> {
+    fixture_with(Codec::Auto)
+}
+
+/// The fixture, its sections compressed as `codec` says.
+fn fixture_with(codec: Codec) -> Vec<u8> {
     let mut s = cornell_box();
     s.textures.push(Texture {
         name: "checker".into(),
@@ -1112,6 +1157,7 @@ fn fixture() -> Vec<u8> {
         shaft_variants: Some(Variants::ALL),
         shadow_res: 16,
         media_volume_res: 8,
+        codec,
         ..Default::default()
     };
     compile_to_bytes(s, settings, "spec-reader").expect("the fixture compiles")
@@ -1147,6 +1193,44 @@ fn a_reader_written_from_format_md_agrees_with_the_reference_reader() {
         bad[at] ^= 0x40;
         assert!(spec::open(&bad).is_err(), "byte {at} flipped was accepted");
     }
+}
+
+#[test]
+fn a_reader_written_from_format_md_decodes_zstd_sections() {
+    // Every kind compressed (--codec zstd): both readers agree on everything, and the spec
+    // decoder's decoded sections equal the stored bytes of the same fixture written uncompressed
+    // (the manifest aside: it records the codec setting).
+    let zstd = fixture_with(Codec::Zstd);
+    let plain = fixture_with(Codec::None);
+    let z = spec::open(&zstd).unwrap_or_else(|e| panic!("the spec decoder refuses the zstd file: {e}"));
+    let p = spec::open(&plain).unwrap();
+    assert!(p.entries.iter().all(|e| e.codec == 0));
+    let mut compressed_kinds: Vec<[u8; 4]> =
+        z.entries.iter().filter(|e| e.codec == 1).map(|e| e.kind).collect();
+    compressed_kinds.dedup();
+    // Sections too small or too random for zstd to shrink stay codec 0; most kinds shrink.
+    assert!(compressed_kinds.len() * 3 >= kiln_format::sections::KNOWN.len() * 2, "{compressed_kinds:?}");
+    assert_eq!(z.entries.len(), p.entries.len());
+    for (ze, pe) in z.entries.iter().zip(&p.entries) {
+        assert_eq!((ze.kind, ze.index), (pe.kind, pe.index));
+        assert_eq!(ze.raw_size, pe.size);
+        if ze.codec == 1 {
+            assert!(ze.size < ze.raw_size, "a frame kept though not smaller");
+        }
+        if &ze.kind != b"MANI" {
+            assert_eq!(z.section(&ze.kind, ze.index), p.section(&pe.kind, pe.index), "{:?}", ze.kind);
+        }
+    }
+    let summary = agree("fixture, zstd", &zstd);
+    eprintln!("{summary}");
+    // The frame rules: a frame cut short, a byte after it, a different declared size are refused.
+    let e = z.entries.iter().find(|e| e.codec == 1 && e.size > 16).unwrap();
+    let frame = &zstd[e.offset as usize..(e.offset + e.size) as usize];
+    assert!(spec::decode_zstd(frame, e.raw_size).is_ok());
+    assert!(spec::decode_zstd(&frame[..frame.len() - 1], e.raw_size).is_err());
+    assert!(spec::decode_zstd(&[frame, &[0]].concat(), e.raw_size).is_err());
+    assert!(spec::decode_zstd(frame, e.raw_size + 1).is_err());
+    assert!(spec::decode_zstd(frame, e.raw_size - 1).is_err());
 }
 
 /// The shared scenes, compiled by `kiln compile` with their sidecars (so the manifest records

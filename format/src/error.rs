@@ -90,6 +90,21 @@ pub enum ErrorKind {
     /// A section uses a codec this reader cannot decode.
     #[error("codec {0} is unknown to this reader")]
     UnknownCodec(u8),
+    /// A compressed section's declared decoded size is above what this reader allows; refused
+    /// before anything of that size is allocated.
+    #[error(
+        "section decodes to {declared} bytes, more than this reader's limit of {limit} bytes per \
+         section (a damaged table, or a file made for a reader with a higher limit)"
+    )]
+    DecodedTooLarge {
+        /// `raw_size` from the table.
+        declared: u64,
+        /// The reader's limit.
+        limit: u64,
+    },
+    /// A compressed section does not decode to what its table entry declares.
+    #[error("compressed section cannot be decoded: {0}")]
+    Decode(String),
     /// A required section is missing.
     #[error("required section {0} is missing")]
     MissingSection(SectionKind),

@@ -19,6 +19,7 @@
 compile_error!("kiln-format reads sections zero-copy and supports little-endian hosts only");
 
 pub mod checksum;
+pub mod codec;
 pub mod error;
 pub mod gpu;
 pub mod header;
@@ -38,4 +39,4 @@ pub use manifest::Manifest;
 pub use read::{Checksums, KilnFile, Section};
 pub use scene::SceneView;
 pub use table::{SectionEntry, SectionKind};
-pub use write::{FileWriter, WriteError};
+pub use write::{Compression, FileWriter, WriteError};

@@ -4,11 +4,14 @@ use std::borrow::Cow;
 use std::fs::File;
 use std::path::Path;
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use bytemuck::Pod;
 use memmap2::Mmap;
 
 use crate::checksum::checksum64;
+use crate::codec::{Aligned, DEFAULT_MAX_DECODED, decode_zstd};
 use crate::error::{ErrorKind, FormatError, Result};
 use crate::header::{HEADER_SIZE, Header};
 use crate::manifest::Manifest;
@@ -28,37 +31,21 @@ pub enum Checksums {
     Deferred,
 }
 
-/// 64-byte aligned owned storage, so that sections copied into memory keep the alignment that a
-/// memory map gives for free.
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-struct Block([u8; 64]);
-
 enum Backing {
     Mapped(Mmap),
-    Owned { blocks: Vec<Block>, len: usize },
+    Owned(Aligned),
 }
 
 impl Backing {
     fn bytes(&self) -> &[u8] {
         match self {
             Backing::Mapped(m) => m,
-            Backing::Owned { blocks, len } => {
-                // SAFETY: `Block` is 64 plain bytes with no padding, so a slice of blocks is a
-                // slice of `64 * blocks.len()` initialised bytes; `len` never exceeds that.
-                let all =
-                    unsafe { std::slice::from_raw_parts(blocks.as_ptr().cast::<u8>(), blocks.len() * 64) };
-                &all[..*len]
-            }
+            Backing::Owned(a) => a.bytes(),
         }
     }
 
     fn copy_of(bytes: &[u8]) -> Backing {
-        let mut blocks = vec![Block([0; 64]); bytes.len().div_ceil(64)];
-        for (block, chunk) in blocks.iter_mut().zip(bytes.chunks(64)) {
-            block.0[..chunk.len()].copy_from_slice(chunk);
-        }
-        Backing::Owned { blocks, len: bytes.len() }
+        Backing::Owned(Aligned::copy_of(bytes))
     }
 }
 
@@ -80,7 +67,12 @@ pub struct KilnFile {
     header: Header,
     sections: Vec<Section>,
     verified: Vec<OnceLock<Result<()>>>,
+    /// Compressed sections, decoded once on first access and kept for the file's lifetime (so
+    /// that [`KilnFile::pod`] can lend them like mapped ones).
+    decoded: Vec<OnceLock<Result<Aligned>>>,
     policy: Checksums,
+    max_decoded: u64,
+    decode_nanos: AtomicU64,
 }
 
 impl std::fmt::Debug for KilnFile {
@@ -95,6 +87,13 @@ impl std::fmt::Debug for KilnFile {
 impl KilnFile {
     /// Opens and memory-maps `path`, then validates its layout.
     pub fn open(path: &Path, policy: Checksums) -> Result<KilnFile> {
+        Self::open_limited(path, policy, DEFAULT_MAX_DECODED)
+    }
+
+    /// [`KilnFile::open`] with a limit on the decoded size of each compressed section: a file
+    /// declaring a larger `raw_size` for a compressed section of a known kind is refused before
+    /// anything is allocated.
+    pub fn open_limited(path: &Path, policy: Checksums, max_decoded: u64) -> Result<KilnFile> {
         let io = |e: std::io::Error| FormatError::new(ErrorKind::Io(e.to_string()));
         let meta = std::fs::metadata(path).map_err(io)?;
         if !meta.is_file() {
@@ -112,18 +111,34 @@ impl KilnFile {
             // place instead).
             Backing::Mapped(unsafe { Mmap::map(&file) }.map_err(io)?)
         };
-        Self::from_backing(backing, policy)
+        Self::from_backing(backing, policy, max_decoded)
     }
 
     /// Validates a file held in memory (copied into aligned storage).
     pub fn from_bytes(bytes: &[u8], policy: Checksums) -> Result<KilnFile> {
-        Self::from_backing(Backing::copy_of(bytes), policy)
+        Self::from_bytes_limited(bytes, policy, DEFAULT_MAX_DECODED)
     }
 
-    fn from_backing(backing: Backing, policy: Checksums) -> Result<KilnFile> {
-        let (header, sections) = validate_layout(backing.bytes())?;
+    /// [`KilnFile::from_bytes`] with a limit on each compressed section's decoded size (see
+    /// [`KilnFile::open_limited`]).
+    pub fn from_bytes_limited(bytes: &[u8], policy: Checksums, max_decoded: u64) -> Result<KilnFile> {
+        Self::from_backing(Backing::copy_of(bytes), policy, max_decoded)
+    }
+
+    fn from_backing(backing: Backing, policy: Checksums, max_decoded: u64) -> Result<KilnFile> {
+        let (header, sections) = validate_layout(backing.bytes(), max_decoded)?;
         let verified = (0..sections.len()).map(|_| OnceLock::new()).collect();
-        let file = KilnFile { backing, header, sections, verified, policy };
+        let decoded = (0..sections.len()).map(|_| OnceLock::new()).collect();
+        let file = KilnFile {
+            backing,
+            header,
+            sections,
+            verified,
+            decoded,
+            policy,
+            max_decoded,
+            decode_nanos: AtomicU64::new(0),
+        };
         if policy == Checksums::Eager {
             file.verify_all()?;
         }
@@ -194,21 +209,51 @@ impl KilnFile {
     }
 
     /// The decoded bytes of a section, verifying its checksum unless the policy defers it.
+    /// Always borrowed: sections stored as is come from the file, compressed ones are decoded on
+    /// first access and kept.
     pub fn section_bytes(&self, s: &Section) -> Result<Cow<'_, [u8]>> {
+        self.decoded_bytes(s).map(Cow::Borrowed)
+    }
+
+    /// Decodes section `position` (verifying its stored checksum first unless the policy defers
+    /// it) and returns its decoded length: `kiln verify` calls it for every section, so that
+    /// damage behind the stored checksum (a frame that does not decode to `raw_size`) is found
+    /// even in sections no content check reads.
+    pub fn decode_section(&self, position: usize) -> Result<u64> {
+        self.decoded_bytes(&self.sections[position]).map(|b| b.len() as u64)
+    }
+
+    /// Wall time spent decoding compressed sections so far (each is decoded once).
+    pub fn decode_time(&self) -> std::time::Duration {
+        std::time::Duration::from_nanos(self.decode_nanos.load(Ordering::Relaxed))
+    }
+
+    fn decoded_bytes(&self, s: &Section) -> Result<&[u8]> {
         if self.policy != Checksums::Deferred {
             self.verify_section(s.position)?;
         }
+        let here =
+            |e: FormatError| e.in_section(s.position, s.entry.kind, s.entry.index).or_offset(s.entry.offset);
         match Codec::from_u8(s.entry.codec) {
-            Some(Codec::None) => Ok(Cow::Borrowed(self.stored_bytes(s))),
-            None => Err(FormatError::at(ErrorKind::UnknownCodec(s.entry.codec), s.entry.offset).in_section(
-                s.position,
-                s.entry.kind,
-                s.entry.index,
-            )),
+            Some(Codec::None) => Ok(self.stored_bytes(s)),
+            Some(Codec::Zstd) => {
+                let decoded = self.decoded[s.position].get_or_init(|| {
+                    let t = Instant::now();
+                    let d = decode_zstd(self.stored_bytes(s), s.entry.raw_size, self.max_decoded);
+                    self.decode_nanos.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+                    d
+                });
+                match decoded {
+                    Ok(a) => Ok(a.bytes()),
+                    Err(e) => Err(here(e.clone())),
+                }
+            }
+            None => Err(here(FormatError::new(ErrorKind::UnknownCodec(s.entry.codec)))),
         }
     }
 
-    /// A section of plain-old-data elements, zero-copy. `None` if absent.
+    /// A section of plain-old-data elements: zero-copy from the file when stored as is, from the
+    /// cached decoded bytes when compressed. `None` if absent.
     pub fn pod<T: Pod>(&self, kind: SectionKind, index: u32) -> Result<Option<&[T]>> {
         let Some(s) = self.find(kind, index) else {
             return Ok(None);
@@ -221,13 +266,10 @@ impl KilnFile {
                 s.known.map_or(0, |k| k.element_size)
             ))));
         }
-        match self.section_bytes(s).map_err(loc)? {
-            Cow::Borrowed(bytes) => bytemuck::try_cast_slice(bytes)
-                .map(Some)
-                .map_err(|e| loc(FormatError::invalid(format!("cannot view section as elements: {e}")))),
-            // No compressing codec exists yet; when one does, decoded sections are cached.
-            Cow::Owned(_) => Err(loc(FormatError::invalid("compressed POD sections are not supported"))),
-        }
+        let bytes = self.decoded_bytes(s).map_err(loc)?;
+        bytemuck::try_cast_slice(bytes)
+            .map(Some)
+            .map_err(|e| loc(FormatError::invalid(format!("cannot view section as elements: {e}"))))
     }
 
     /// Decodes the manifest.
@@ -242,7 +284,8 @@ impl KilnFile {
 
 /// Checks header, table, bounds, alignment, order, padding and lengths. Allocates only after
 /// the section count has been checked against the file length.
-fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
+/// `max_decoded` bounds the decoded size of compressed sections of known kinds.
+fn validate_layout(file: &[u8], max_decoded: u64) -> Result<(Header, Vec<Section>)> {
     let header = Header::parse(file)?;
     let len = file.len() as u64;
     let count = header.section_count as u64;
@@ -335,6 +378,13 @@ fn validate_layout(file: &[u8]) -> Result<(Header, Vec<Section>)> {
         if let Some(k) = known {
             if codec.is_none() {
                 return Err(here(ErrorKind::UnknownCodec(entry.codec), entry_at + 6));
+            }
+            // Before anything sized by it is allocated (decoding allocates exactly raw_size).
+            if codec == Some(Codec::Zstd) && entry.raw_size > max_decoded {
+                return Err(here(
+                    ErrorKind::DecodedTooLarge { declared: entry.raw_size, limit: max_decoded },
+                    entry_at + 32,
+                ));
             }
             if entry.version == 0 {
                 return Err(bad("section version 0 is not defined".into(), 4));

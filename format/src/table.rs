@@ -46,6 +46,8 @@ impl fmt::Debug for SectionKind {
 pub enum Codec {
     /// Stored as is: the bytes in the file are the section (zero-copy).
     None = 0,
+    /// One zstd frame (RFC 8878) that decodes to exactly `raw_size` bytes (format 1.2).
+    Zstd = 1,
 }
 
 impl Codec {
@@ -53,6 +55,7 @@ impl Codec {
     pub fn from_u8(v: u8) -> Option<Codec> {
         match v {
             0 => Some(Codec::None),
+            1 => Some(Codec::Zstd),
             _ => None,
         }
     }
@@ -61,6 +64,7 @@ impl Codec {
     pub fn name(self) -> &'static str {
         match self {
             Codec::None => "none",
+            Codec::Zstd => "zstd",
         }
     }
 }

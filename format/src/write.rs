@@ -29,6 +29,16 @@ pub enum WriteError {
         /// Element size of the kind.
         element: usize,
     },
+    /// The zstd library refused to compress (out of memory).
+    #[error("cannot compress section {kind}#{index}: {source}")]
+    Compress {
+        /// Kind.
+        kind: SectionKind,
+        /// Index.
+        index: u32,
+        /// Cause.
+        source: io::Error,
+    },
     /// No manifest was added.
     #[error("a kiln file needs a manifest section")]
     NoManifest,
@@ -49,6 +59,39 @@ struct Pending<'a> {
     align_log2: u8,
     bytes: Cow<'a, [u8]>,
     content_hash: ContentHash,
+    /// The zstd frame, when the section is compressed (set by `layout`).
+    compressed: Option<Vec<u8>>,
+}
+
+impl Pending<'_> {
+    fn stored(&self) -> &[u8] {
+        self.compressed.as_deref().unwrap_or(&self.bytes)
+    }
+}
+
+/// Which sections a writer compresses (with zstd, FORMAT.md "Codecs"). Whatever the choice, a
+/// section is stored as is when its zstd frame would not be smaller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Compression {
+    /// Every section stored as is.
+    #[default]
+    None,
+    /// The kinds in [`sections::COMPRESSED_BY_DEFAULT`]: those a reader decodes on the CPU
+    /// anyway; sections a player hands from the memory map to the GPU stay as is.
+    Default,
+    /// Every section.
+    All,
+}
+
+impl Compression {
+    /// Whether a section of `kind` is to be compressed.
+    pub fn compresses(self, kind: SectionKind) -> bool {
+        match self {
+            Compression::None => false,
+            Compression::Default => sections::COMPRESSED_BY_DEFAULT.contains(&kind),
+            Compression::All => true,
+        }
+    }
 }
 
 /// Collects sections and writes them as one `.kiln` file.
@@ -58,6 +101,7 @@ struct Pending<'a> {
 #[derive(Default)]
 pub struct FileWriter<'a> {
     pending: Vec<Pending<'a>>,
+    compression: Compression,
 }
 
 impl std::fmt::Debug for FileWriter<'_> {
@@ -70,6 +114,12 @@ impl<'a> FileWriter<'a> {
     /// An empty writer.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Chooses which sections are compressed (none unless called).
+    pub fn compression(&mut self, compression: Compression) -> &mut Self {
+        self.compression = compression;
+        self
     }
 
     /// Adds the manifest.
@@ -123,7 +173,15 @@ impl<'a> FileWriter<'a> {
         if self.pending.iter().any(|p| p.kind == kind && p.index == index) {
             return Err(WriteError::Duplicate(kind, index));
         }
-        self.pending.push(Pending { kind, index, version, align_log2: MIN_ALIGN_LOG2, bytes, content_hash });
+        self.pending.push(Pending {
+            kind,
+            index,
+            version,
+            align_log2: MIN_ALIGN_LOG2,
+            bytes,
+            content_hash,
+            compressed: None,
+        });
         Ok(self)
     }
 
@@ -133,6 +191,7 @@ impl<'a> FileWriter<'a> {
             return Err(WriteError::NoManifest);
         }
         self.pending.sort_by_key(|p| (sections::stream_rank(p.kind), p.kind, p.index));
+        self.compress()?;
         let mut cursor = (HEADER_SIZE + ENTRY_SIZE * self.pending.len()) as u64;
         let entries: Vec<SectionEntry> = self
             .pending
@@ -140,18 +199,19 @@ impl<'a> FileWriter<'a> {
             .map(|p| {
                 let align = 1u64 << p.align_log2;
                 let offset = align_up(cursor, align).expect("file offsets fit in u64");
-                cursor = offset + p.bytes.len() as u64;
+                let stored = p.stored();
+                cursor = offset + stored.len() as u64;
                 SectionEntry {
                     kind: p.kind,
                     version: p.version,
-                    codec: Codec::None as u8,
+                    codec: if p.compressed.is_some() { Codec::Zstd } else { Codec::None } as u8,
                     align_log2: p.align_log2,
                     index: p.index,
                     flags: 0,
                     offset,
-                    size: p.bytes.len() as u64,
+                    size: stored.len() as u64,
                     raw_size: p.bytes.len() as u64,
-                    checksum: checksum64(&p.bytes),
+                    checksum: checksum64(stored),
                     content_hash: p.content_hash,
                 }
             })
@@ -169,6 +229,47 @@ impl<'a> FileWriter<'a> {
         Ok((header, entries))
     }
 
+    /// Compresses the sections the policy selects, on as many threads as the machine has (each
+    /// section by one thread, so the bytes do not depend on the thread count); keeps a frame only
+    /// when it is smaller than the section.
+    fn compress(&mut self) -> Result<(), WriteError> {
+        let policy = self.compression;
+        let todo: Vec<&mut Pending<'a>> = self
+            .pending
+            .iter_mut()
+            .filter(|p| p.compressed.is_none() && !p.bytes.is_empty() && policy.compresses(p.kind))
+            .collect();
+        if todo.is_empty() {
+            return Ok(());
+        }
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(todo.len());
+        let queue = std::sync::Mutex::new(todo);
+        let results: Vec<Result<(), WriteError>> = std::thread::scope(|scope| {
+            let workers: Vec<_> = (0..threads)
+                .map(|_| {
+                    scope.spawn(|| {
+                        loop {
+                            let Some(p) = queue.lock().unwrap_or_else(|e| e.into_inner()).pop() else {
+                                return Ok(());
+                            };
+                            let frame = crate::codec::compress_zstd(&p.bytes).map_err(|source| {
+                                WriteError::Compress { kind: p.kind, index: p.index, source }
+                            })?;
+                            if frame.len() < p.bytes.len() {
+                                p.compressed = Some(frame);
+                            }
+                        }
+                    })
+                })
+                .collect();
+            workers
+                .into_iter()
+                .map(|w| w.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+                .collect()
+        });
+        results.into_iter().collect()
+    }
+
     /// Writes the file to `out`; returns its length.
     pub fn write_to(&mut self, out: &mut dyn Write) -> Result<u64, WriteError> {
         let (header, entries) = self.layout()?;
@@ -181,7 +282,7 @@ impl<'a> FileWriter<'a> {
         let zeros = [0u8; 1 << 16];
         for (e, p) in entries.iter().zip(&self.pending) {
             out.write_all(&zeros[..(e.offset - cursor) as usize]).map_err(io)?;
-            out.write_all(&p.bytes).map_err(io)?;
+            out.write_all(p.stored()).map_err(io)?;
             cursor = e.offset + e.size;
         }
         Ok(header.file_size)

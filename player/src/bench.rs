@@ -133,10 +133,11 @@ impl BenchReport {
         }
         let l = &self.load;
         s.push_str(&format!(
-            "\nload (wall clock ms)\n  open file            {:>8.1}\n  instance + device    {:>8.1}\n  validate (parallel)  {:>8.1}\n  pipelines (parallel) {:>8.1}\n  upload               {:>8.1}  ({:.1} MiB, {} sections uploaded, {} skipped)\n  first frame on GPU   {:>8.1}\n  resident after start {:>8.1}\n  first frame after start {:>5.1}\n",
+            "\nload (wall clock ms)\n  open file            {:>8.1}\n  instance + device    {:>8.1}\n  validate (parallel)  {:>8.1}\n  decode (in validate and upload) {:>6.1}\n  pipelines (parallel) {:>8.1}\n  upload               {:>8.1}  ({:.1} MiB, {} sections uploaded, {} skipped)\n  first frame on GPU   {:>8.1}\n  resident after start {:>8.1}\n  first frame after start {:>5.1}\n",
             l.open_file_ms,
             l.instance_and_device_ms,
             l.prepare_ms,
+            l.decode_ms,
             l.pipelines_ms,
             l.upload_ms,
             l.upload_bytes as f64 / (1 << 20) as f64,

@@ -60,6 +60,9 @@ pub struct LoadTimes {
     /// Validating the file, verifying the checksums of what is uploaded, sorting indices
     /// (parallel with instance and device creation).
     pub prepare_ms: f64,
+    /// Decoding compressed sections (each once, within `prepare_ms` and `upload_ms`; 0 when the
+    /// file stores every section as is).
+    pub decode_ms: f64,
     /// Building pipelines and allocating the frame's targets (parallel with the upload).
     pub pipelines_ms: f64,
     /// Recording and submitting every upload, until the GPU finished them.
@@ -219,6 +222,7 @@ impl Session {
             }
         };
         times.upload_ms = ms(upload_start);
+        times.decode_ms = file.decode_time().as_secs_f64() * 1e3;
         times.upload_bytes = bytes;
         times.sections_uploaded = scene.sections.iter().filter(|s| s.uploaded).count();
         times.sections_skipped = scene.sections.len() - times.sections_uploaded;

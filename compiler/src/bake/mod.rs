@@ -77,6 +77,8 @@ pub struct Baked {
     pub stages: Vec<StageReport>,
     /// Voxel grid and line-space figures, when baked.
     pub line_space: Option<LineSpaceStats>,
+    /// Which sections the written file compresses.
+    pub codec: crate::settings::Codec,
 }
 
 /// Figures of the voxel grid and line space, for the report.
@@ -480,7 +482,7 @@ pub fn bake(ctx: &BakeContext) -> CliResult<Baked> {
         all.append(out);
     }
     let (manifest, manifest_hash) = assemble_manifest(ctx, &all);
-    Ok(Baked { manifest, manifest_hash, sections: all.list, stages, line_space })
+    Ok(Baked { manifest, manifest_hash, sections: all.list, stages, line_space, codec: ctx.settings.codec })
 }
 
 /// The manifest and its content hash.
@@ -564,6 +566,7 @@ impl LineSpaceStats {
 
 fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::WriteError> {
     let mut w = kiln_format::FileWriter::new();
+    w.compression(baked.codec.compression());
     w.manifest(&baked.manifest, baked.manifest_hash)?;
     for s in &baked.sections {
         w.bytes(s.kind, s.index, s.bytes.as_slice(), s.hash)?;

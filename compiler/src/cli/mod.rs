@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
-    BRDF_LUT_RES, BvhPreset, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings,
-    VOXEL_RES, VoxelRes, parse_variants,
+    BRDF_LUT_RES, BvhPreset, Codec, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES,
+    Settings, VOXEL_RES, VoxelRes, parse_variants,
 };
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
@@ -168,6 +168,14 @@ pub struct BakeArgs {
 (angle-weighted vertex normals), smooth:ANGLE (smooth except across edges whose faces differ by more \
 than ANGLE degrees) [default: asset: glTF flat as its spec says, OBJ by its smoothing groups]")]
     pub normals: Option<Normals>,
+    /// Which sections are stored compressed.
+    #[arg(long, value_name = "auto|none|zstd", value_parser = Codec::parse, help_heading = "Output",
+          help = "Section compression: auto (zstd for the sections the player decodes on the CPU anyway: \
+manifest, materials, triangles, triangle materials, texture coordinates, vertex colours; everything it \
+maps and uploads zero-copy stays as is), none (every section as is: fastest to load), zstd (every section \
+that shrinks: smallest file, for distribution; the player decodes each section once while loading) \
+[default: auto, or the sidecar's bake.codec]")]
+    pub codec: Option<Codec>,
 }
 
 impl BakeArgs {
@@ -187,6 +195,7 @@ impl BakeArgs {
         set(&mut settings.shadow_res, self.shadow_res);
         set(&mut settings.media_volume_res, self.media_volume_res);
         set(&mut settings.normals, self.normals);
+        set(&mut settings.codec, self.codec);
     }
 }
 

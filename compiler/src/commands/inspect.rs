@@ -17,8 +17,12 @@ struct SectionJson {
     version: u16,
     codec: String,
     offset: u64,
+    /// Stored bytes.
     size: u64,
+    /// Decoded bytes.
     raw_size: u64,
+    /// raw_size / size: how much the codec shrank the section (1 for codec none).
+    ratio: f64,
     checksum: String,
     checksum_ok: bool,
     content_hash: String,
@@ -86,6 +90,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
                 offset: e.offset,
                 size: e.size,
                 raw_size: e.raw_size,
+                ratio: if e.size == 0 { 1.0 } else { e.raw_size as f64 / e.size as f64 },
                 checksum: format!("{:016x}", e.checksum),
                 checksum_ok: file.verify_section(s.position).is_ok(),
                 content_hash: e.content_hash.to_hex(),
@@ -118,7 +123,8 @@ pub fn run(args: &InspectArgs) -> CliResult {
         .and_then(|g| g.first().copied())
         .map(|g| {
             let size = |kinds: &[kiln_format::SectionKind]| {
-                kinds.iter().filter_map(|&k| file.find(k, 0)).map(|s| s.entry.size).sum::<u64>()
+                // Decoded bytes: what the structures take in memory, whatever the codec.
+                kinds.iter().filter_map(|&k| file.find(k, 0)).map(|s| s.entry.raw_size).sum::<u64>()
             };
             LineSpaceJson {
                 cells: g.dims,
@@ -180,20 +186,26 @@ fn print_text(r: &InspectJson) {
 }
 
 fn print_sections(r: &InspectJson) {
+    let raw: u64 = r.sections.iter().map(|s| s.raw_size).sum();
+    let stored: u64 = r.sections.iter().map(|s| s.size).sum();
+    let compressed = r.sections.iter().filter(|s| s.codec != "none").count();
     println!(
-        "{}: kiln format {}, {} sections, {}",
+        "{}: kiln format {}, {} sections ({compressed} compressed), {}; sections store {} of {} decoded ({:.2}x)",
         r.path,
         r.format_version,
         r.sections.len(),
-        size(r.file_size)
+        size(r.file_size),
+        size(stored),
+        size(raw),
+        if stored == 0 { 1.0 } else { raw as f64 / stored as f64 },
     );
     println!(
-        "  {:>3}  {:<4} {:<19} {:>5} {:>3}  {:<5} {:>10} {:>10}  {:<8} content hash",
-        "#", "kind", "name", "index", "ver", "codec", "offset", "size", "checksum"
+        "  {:>3}  {:<4} {:<19} {:>5} {:>3}  {:<5} {:>10} {:>10} {:>10} {:>7}  {:<8} content hash",
+        "#", "kind", "name", "index", "ver", "codec", "offset", "size", "decoded", "ratio", "checksum"
     );
     for s in &r.sections {
         println!(
-            "  {:>3}  {:<4} {:<19} {:>5} {:>3}  {:<5} {:>10} {:>10}  {:<8} {}",
+            "  {:>3}  {:<4} {:<19} {:>5} {:>3}  {:<5} {:>10} {:>10} {:>10} {:>7}  {:<8} {}",
             s.position,
             s.kind,
             s.name.unwrap_or("(unknown: skipped)"),
@@ -202,6 +214,8 @@ fn print_sections(r: &InspectJson) {
             s.codec,
             format!("{:#x}", s.offset),
             size(s.size),
+            size(s.raw_size),
+            format!("{:.2}x", s.ratio),
             if s.checksum_ok { "ok" } else { "BAD" },
             &s.content_hash[..16],
         );

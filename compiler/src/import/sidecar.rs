@@ -191,6 +191,8 @@ pub struct BakeToml {
     pub media_volume_res: Option<u32>,
     /// Normals where the asset gives none: `"flat"`, `"smooth"` or `"smooth:ANGLE"`.
     pub normals: Option<String>,
+    /// Which sections are compressed: `"auto"`, `"none"` or `"zstd"`.
+    pub codec: Option<String>,
 }
 
 impl Sidecar {

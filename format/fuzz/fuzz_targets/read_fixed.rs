@@ -1,6 +1,7 @@
 //! Fuzzes what lies behind the checksums: the input's header and table checksums, section
 //! checksums and length field are recomputed before reading, so that mutations reach the
-//! layout rules, manifest decoding and scene validation instead of stopping at a checksum.
+//! layout rules, zstd frame decoding, manifest decoding and scene validation instead of stopping
+//! at a checksum.
 #![no_main]
 
 use kiln_format::checksum::checksum64;
@@ -38,6 +39,13 @@ fuzz_target!(|data: &[u8]| {
     let bytes = fix(data);
     let Ok(file) = KilnFile::from_bytes(&bytes, Checksums::Eager) else { return };
     let _ = file.manifest();
+    // Compressed sections (codec 1) reach the zstd frame checks and the bounded decoder here,
+    // since their checksums were made right above.
+    for s in file.sections() {
+        if let Ok(bytes) = file.section_bytes(s) {
+            assert_eq!(bytes.len() as u64, s.entry.raw_size, "a section decoded to another size");
+        }
+    }
     if let Ok(view) = SceneView::new(&file) {
         let t = kiln_format::query::IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
         let q = kiln_format::query::BvhQuery::new(view.bvh, &t);

@@ -2,13 +2,21 @@
 
 use kiln_format::manifest::*;
 use kiln_format::sections::{self, CwbvhNode, GpuMaterial, Vertex};
-use kiln_format::{ContentHash, FileWriter};
+use kiln_format::{Compression, ContentHash, FileWriter};
 
 /// A one-quad scene with the geometry, material, texture and BVH kinds (a valid one-node BVH and
 /// a 2x2 texture), written by the reference writer. Every kind the format knows, line space,
 /// BRDF table, shadow maps and visibility volumes included, is in the compiler's damage fixture
 /// (`compiler/tests/damage.rs`, `every_kind_file`).
+#[allow(dead_code)] // Not every test binary that includes this module uses it.
 pub fn small_file() -> Vec<u8> {
+    small_file_with(2, Compression::None)
+}
+
+/// [`small_file`] with a `texture` × `texture` texture (a compressible pattern: zstd shrinks it
+/// when it is large enough) and its sections compressed as `compression` says.
+#[allow(dead_code)] // Not every test binary that includes this module uses it.
+pub fn small_file_with(texture: u32, compression: Compression) -> Vec<u8> {
     let vertices = [
         Vertex { position: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
         Vertex { position: [1.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
@@ -25,7 +33,11 @@ pub fn small_file() -> Vec<u8> {
     root.child_max_x[0] = 255;
     root.child_max_y[0] = 255;
     let nodes = [root];
-    let texels: Vec<u8> = (0..(4 + 1) * 4).map(|i| i as u8).collect();
+    let mip_levels = kiln_format::scene::mip_levels(texture, texture);
+    let texel_count: u32 = (0..mip_levels).map(|l| (texture >> l).max(1).pow(2)).sum();
+    // 2×2: the bytes 0..20 as before; larger: runs of a few values, which zstd shrinks.
+    let texels: Vec<u8> =
+        (0..texel_count * 4).map(|i| if texture <= 2 { i as u8 } else { (i / 12 % 5 * 40) as u8 }).collect();
     let manifest = Manifest {
         generator: "test".into(),
         scene_name: "quad".into(),
@@ -33,9 +45,9 @@ pub fn small_file() -> Vec<u8> {
         materials: vec![MaterialInfo { name: "m".into() }],
         textures: vec![TextureInfo {
             name: "t".into(),
-            width: 2,
-            height: 2,
-            mip_levels: 2,
+            width: texture,
+            height: texture,
+            mip_levels,
             color_space: ColorSpace::Srgb,
             wrap_u: Wrap::Repeat,
             wrap_v: Wrap::ClampToEdge,
@@ -56,6 +68,7 @@ pub fn small_file() -> Vec<u8> {
     };
     let h = ContentHash::of;
     let mut w = FileWriter::new();
+    w.compression(compression);
     w.manifest(&manifest, h(b"m")).unwrap();
     w.pod(sections::VERTICES, 0, &vertices, h(b"v")).unwrap();
     w.pod(sections::UVS, 0, &uvs, h(b"uv")).unwrap();
