@@ -34,6 +34,34 @@ impl BvhPreset {
     }
 }
 
+/// How textures are stored (`--texture-format`, `[bake] texture_format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum TextureFormat {
+    /// Block-compressed by role: BC7 for colour (sRGB) and for data textures whose three channels
+    /// are all read, BC5 for normal maps (x, y; z is reconstructed) and metallic-roughness (G, B),
+    /// BC4 for occlusion (R). A quarter (BC7, BC5) or an eighth (BC4) of RGBA8's bytes; the
+    /// player needs the device feature `textureCompressionBC`.
+    #[default]
+    Bc,
+    /// Uncompressed RGBA8 (exact; every device samples it).
+    Rgba8,
+}
+
+impl TextureFormat {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureFormat::Bc => "bc",
+            TextureFormat::Rgba8 => "rgba8",
+        }
+    }
+
+    /// Parses a sidecar value.
+    pub fn parse(s: &str) -> Option<TextureFormat> {
+        <TextureFormat as ValueEnum>::from_str(s, false).ok()
+    }
+}
+
 /// A numeric setting: its name, default and valid range. The command line (through
 /// [`Ranged::parser`]) and the sidecar's `[bake]` table (through [`Ranged::check`]) both check
 /// values against it, and [`Settings::default`] takes its default from it.
@@ -238,6 +266,8 @@ pub struct Settings {
     pub media_volume_res: u32,
     /// Normals where the asset gives none (applied at import).
     pub normals: Normals,
+    /// How textures are stored.
+    pub texture_format: TextureFormat,
 }
 
 impl Default for Settings {
@@ -252,6 +282,7 @@ impl Default for Settings {
             shadow_res: SHADOW_RES.default,
             media_volume_res: MEDIA_VOLUME_RES.default,
             normals: Normals::Asset,
+            texture_format: TextureFormat::default(),
         }
     }
 }
@@ -291,6 +322,10 @@ impl Settings {
         if let Some(v) = &b.shaft_variants {
             self.shaft_variants = Some(parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
         }
+        if let Some(f) = &b.texture_format {
+            self.texture_format = TextureFormat::parse(f)
+                .ok_or_else(|| format!("texture_format is '{f}'; use bc or rgba8"))?;
+        }
         if let Some(n) = &b.normals {
             self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;
         }
@@ -313,6 +348,7 @@ impl Settings {
             ("shadow-res".into(), self.shadow_res.to_string()),
             ("media-volume-res".into(), self.media_volume_res.to_string()),
             ("normals".into(), self.normals.name()),
+            ("texture-format".into(), self.texture_format.name().into()),
         ]
     }
 }
