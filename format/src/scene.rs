@@ -6,7 +6,8 @@ use crate::manifest::{ColorSpace, LightKind, Manifest, ShadowProjection};
 use crate::read::KilnFile;
 use crate::sections::{
     BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
-    MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TextureData, decode_texture, possible_v2_lengths, TRIANGLE_MATERIALS, TRIANGLES, UVS, VERTICES, Vertex,
+    MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, TextureData, UVS,
+    VERTICES, Vertex, decode_texture, possible_v2_lengths,
 };
 
 /// Borrowed, validated scene data of a [`KilnFile`].
@@ -67,7 +68,8 @@ impl<'a> SceneView<'a> {
             // some format gives.
             let fits = match s.entry.version {
                 1 => {
-                    let expected = mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(impossible)?;
+                    let expected =
+                        mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(impossible)?;
                     s.entry.raw_size == expected
                 }
                 _ => {

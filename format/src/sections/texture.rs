@@ -28,7 +28,8 @@ pub enum PixelFormat {
 
 impl PixelFormat {
     /// Every format, in number order.
-    pub const ALL: [PixelFormat; 4] = [PixelFormat::Rgba8, PixelFormat::Bc7, PixelFormat::Bc5, PixelFormat::Bc4];
+    pub const ALL: [PixelFormat; 4] =
+        [PixelFormat::Rgba8, PixelFormat::Bc7, PixelFormat::Bc5, PixelFormat::Bc4];
 
     /// The format with this stored number.
     pub fn from_u32(v: u32) -> Option<PixelFormat> {
@@ -119,7 +120,9 @@ impl Swizzle {
 
     /// The swizzle with this stored number.
     pub fn from_u8(v: u8) -> Option<Swizzle> {
-        [Swizzle::R, Swizzle::G, Swizzle::B, Swizzle::A, Swizzle::Zero, Swizzle::One].into_iter().find(|s| *s as u8 == v)
+        [Swizzle::R, Swizzle::G, Swizzle::B, Swizzle::A, Swizzle::Zero, Swizzle::One]
+            .into_iter()
+            .find(|s| *s as u8 == v)
     }
 }
 
@@ -221,7 +224,9 @@ pub fn decode_texture(
             let mut swizzle = [Swizzle::Zero; 4];
             for (c, &s) in h.swizzle.iter().enumerate() {
                 swizzle[c] = Swizzle::from_u8(s).ok_or_else(|| {
-                    FormatError::invalid(format!("texture swizzle {s} of channel {c} is unknown (0..=5 defined)"))
+                    FormatError::invalid(format!(
+                        "texture swizzle {s} of channel {c} is unknown (0..=5 defined)"
+                    ))
                 })?;
                 if s < 4 && s >= format.channels() {
                     return Err(FormatError::invalid(format!(
@@ -270,7 +275,8 @@ mod tests {
     #[test]
     fn decode_checks_header_and_length() {
         let chain = vec![0u8; 80];
-        let ok = encode_texture(PixelFormat::Bc5, [Swizzle::Zero, Swizzle::R, Swizzle::G, Swizzle::One], &chain);
+        let ok =
+            encode_texture(PixelFormat::Bc5, [Swizzle::Zero, Swizzle::R, Swizzle::G, Swizzle::One], &chain);
         let d = decode_texture(2, &ok, 8, 2, 4, false).unwrap();
         assert_eq!((d.format, d.levels.len()), (PixelFormat::Bc5, 80));
         assert_eq!(d.level_slices(8, 2, 4).iter().map(|l| l.len()).collect::<Vec<_>>(), [32, 16, 16, 16]);
@@ -297,7 +303,10 @@ mod tests {
         // BC5 has no sRGB form.
         assert!(decode_texture(2, &ok, 8, 2, 4, true).is_err());
         // Version 1 is bare RGBA8.
-        assert_eq!(decode_texture(1, &[0u8; 4 * (16 + 4 + 2 + 1)], 8, 2, 4, true).unwrap().format, PixelFormat::Rgba8);
+        assert_eq!(
+            decode_texture(1, &[0u8; 4 * (16 + 4 + 2 + 1)], 8, 2, 4, true).unwrap().format,
+            PixelFormat::Rgba8
+        );
         assert!(decode_texture(3, &ok, 8, 2, 4, false).is_err());
     }
 }

@@ -112,26 +112,16 @@ impl<'f> Prepared<'f> {
             sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
         let bvh_triangles =
             if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
-        if needs.scene_buffers && needs.textures {
-            // The ray-traced passes read textures from one storage buffer of RGBA8 words; they do
-            // not read block-compressed textures yet.
-            for i in 0..view.manifest.textures.len() {
-                let t = view.texture(i).map_err(bad)?;
-                if t.format.is_block_compressed() {
-                    return Err(PlayError::new(
-                        Exit::Unsupported,
-                        format!(
-                            "texture {i} ('{}') is {}-compressed, and the passes chosen (the reference \
-                             path tracer, the visibility-buffer resolve or a ray-traced effect) read \
-                             textures as RGBA8 only; recompile the scene with kiln compile \
-                             --texture-format rgba8, or use the raster G-buffer and no ray-traced pass",
-                            view.manifest.textures[i].name,
-                            t.format.name().to_uppercase()
-                        ),
-                    ));
-                }
-            }
-        }
+        // The ray-traced passes read each texture as stored (RGBA8 or BC blocks, the GLSL decodes
+        // them); their table needs each texture's format and swizzle from its section header.
+        let storage = if needs.scene_buffers && needs.textures {
+            (0..view.manifest.textures.len())
+                .map(|i| view.texture(i).map(|t| (t.format, t.swizzle)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(bad)?
+        } else {
+            Vec::new()
+        };
         let reference = needs.scene_buffers.then(|| {
             reference::tables(
                 &view.manifest,
@@ -139,6 +129,7 @@ impl<'f> Prepared<'f> {
                 view.triangles,
                 view.triangle_materials,
                 view.materials,
+                &storage,
             )
         });
         Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space })
@@ -485,7 +476,11 @@ impl GpuScene {
                 self.upload_texture(gpu, view, index as usize, up)?;
                 if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
                     let t = tables.textures[index as usize];
-                    up.buffer(&r.texels, t.offset as u64 * 4, view.texture(index as usize).map_err(bad)?.levels)?;
+                    up.buffer(
+                        &r.texels,
+                        t.offset as u64 * 4,
+                        view.texture(index as usize).map_err(bad)?.levels,
+                    )?;
                 }
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
@@ -573,8 +568,12 @@ impl GpuScene {
             Swizzle::One => vk::ComponentSwizzle::ONE,
         };
         let mut desc = sampled_desc(format, info.width, info.height, info.mip_levels, 1, false);
-        desc.components =
-            vk::ComponentMapping { r: swizzle(data.swizzle[0]), g: swizzle(data.swizzle[1]), b: swizzle(data.swizzle[2]), a: swizzle(data.swizzle[3]) };
+        desc.components = vk::ComponentMapping {
+            r: swizzle(data.swizzle[0]),
+            g: swizzle(data.swizzle[1]),
+            b: swizzle(data.swizzle[2]),
+            a: swizzle(data.swizzle[3]),
+        };
         let image = Image::new(gpu, &info.name, desc)?;
         let slices = data.level_slices(info.width, info.height, info.mip_levels);
         let levels: Vec<(u32, u32, u32, u32, &[u8])> = slices
