@@ -323,8 +323,8 @@ impl Settings {
             self.shaft_variants = Some(parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
         }
         if let Some(f) = &b.texture_format {
-            self.texture_format = TextureFormat::parse(f)
-                .ok_or_else(|| format!("texture_format is '{f}'; use bc or rgba8"))?;
+            self.texture_format =
+                TextureFormat::parse(f).ok_or_else(|| format!("texture_format is '{f}'; use bc or rgba8"))?;
         }
         if let Some(n) = &b.normals {
             self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;

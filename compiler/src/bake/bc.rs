@@ -39,7 +39,10 @@ impl Usage {
 
     /// As bytes, for the stage key.
     pub fn bits(self) -> u8 {
-        self.color as u8 | (self.metallic_roughness as u8) << 1 | (self.normal as u8) << 2 | (self.occlusion as u8) << 3
+        self.color as u8
+            | (self.metallic_roughness as u8) << 1
+            | (self.normal as u8) << 2
+            | (self.occlusion as u8) << 3
     }
 }
 
@@ -61,7 +64,12 @@ pub struct Choice {
 /// is two textures (the importer keys textures by image and role), so only a data texture can be
 /// read by two slots (an occlusion-roughness-metallic image): it keeps all three channels.
 pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
-    let rgba8 = |why| Choice { format: PixelFormat::Rgba8, swizzle: Swizzle::IDENTITY, channels: vec![0, 1, 2, 3], why };
+    let rgba8 = |why| Choice {
+        format: PixelFormat::Rgba8,
+        swizzle: Swizzle::IDENTITY,
+        channels: vec![0, 1, 2, 3],
+        why,
+    };
     if setting == TextureFormat::Rgba8 {
         return rgba8("--texture-format rgba8");
     }
@@ -153,12 +161,17 @@ fn encode_level(choice: &Choice, rgba: &[u8], width: u32, height: u32, alpha: bo
                     } else {
                         bytes.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect()
                     };
-                    bc7::compress_blocks(&settings, &RgbaSurface { data: &rgba, width: w, height: h, stride: w * 4 })
+                    bc7::compress_blocks(
+                        &settings,
+                        &RgbaSurface { data: &rgba, width: w, height: h, stride: w * 4 },
+                    )
                 }
                 PixelFormat::Bc5 => {
                     bc5::compress_blocks(&RgSurface { data: bytes, width: w, height: h, stride: w * 2 })
                 }
-                PixelFormat::Bc4 => bc4::compress_blocks(&RSurface { data: bytes, width: w, height: h, stride: w }),
+                PixelFormat::Bc4 => {
+                    bc4::compress_blocks(&RSurface { data: bytes, width: w, height: h, stride: w })
+                }
                 PixelFormat::Rgba8 => unreachable!("RGBA8 levels are stored as they are"),
             }
         })
@@ -308,7 +321,8 @@ pub fn error(t: &Texture, choice: &Choice, decoded: &[u8]) -> (Option<f64>, f64)
         }
         p
     }));
-    let test = image(&mut decoded.chunks_exact(4).map(|d| [d[0], d[1], d[2], if n < 4 { 255 } else { d[3] }]));
+    let test =
+        image(&mut decoded.chunks_exact(4).map(|d| [d[0], d[1], d[2], if n < 4 { 255 } else { d[3] }]));
     let flip = kiln_metrics::ldr_flip(
         kiln_metrics::RgbImage { width: t.width, height: t.height, pixels: &reference },
         kiln_metrics::RgbImage { width: t.width, height: t.height, pixels: &test },

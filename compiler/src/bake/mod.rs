@@ -280,9 +280,8 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
             // The format of each texture follows the setting and the material slots reading it.
             h.part("algorithm", textures::TEXTURE_ALGORITHM.as_bytes())
                 .part("texture-format", s.texture_format.name().as_bytes());
-            let usages: Vec<u8> = (0..scene.textures.len() as u32)
-                .map(|i| bc::Usage::of(&ctx.materials, i).bits())
-                .collect();
+            let usages: Vec<u8> =
+                (0..scene.textures.len() as u32).map(|i| bc::Usage::of(&ctx.materials, i).bits()).collect();
             h.part("usages", &usages);
             hash_textures(&mut h, scene);
         }

@@ -140,10 +140,12 @@ pub fn reports(ctx: &super::BakeContext, sections: &super::Sections) -> Vec<Text
         .filter_map(|&(i, s)| {
             let t = ctx.scene.textures.get(i)?;
             let levels = kiln_format::scene::mip_levels(t.width, t.height);
-            let data = kiln_format::sections::decode_texture(2, &s.bytes, t.width, t.height, levels, false).ok()?;
+            let data =
+                kiln_format::sections::decode_texture(2, &s.bytes, t.width, t.height, levels, false).ok()?;
             let choice = &choices[i];
             let decoded = bc::decode_level(data.format, data.levels, t.width, t.height);
-            let (psnr_db, mean_flip) = if data.format == PixelFormat::Rgba8 { (None, 0.0) } else { bc::error(t, choice, &decoded) };
+            let (psnr_db, mean_flip) =
+                if data.format == PixelFormat::Rgba8 { (None, 0.0) } else { bc::error(t, choice, &decoded) };
             let within_bound = psnr_db.is_none_or(|p| p >= PSNR_BOUND_DB) && mean_flip <= FLIP_BOUND;
             Some(TextureReport {
                 index: i as u32,

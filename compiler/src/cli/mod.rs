@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
-    BRDF_LUT_RES, BvhPreset, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings, TextureFormat,
-    VOXEL_RES, VoxelRes, parse_variants,
+    BRDF_LUT_RES, BvhPreset, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES, Settings,
+    TextureFormat, VOXEL_RES, VoxelRes, parse_variants,
 };
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
@@ -169,11 +169,15 @@ pub struct BakeArgs {
 than ANGLE degrees) [default: asset: glTF flat as its spec says, OBJ by its smoothing groups]")]
     pub normals: Option<Normals>,
     /// How textures are stored.
-    #[arg(long, value_enum, help_heading = "Textures",
-          help = "How textures are stored: bc (block-compressed by role: BC7 colour and sRGB, BC5 normal maps \
+    #[arg(
+        long,
+        value_enum,
+        help_heading = "Textures",
+        help = "How textures are stored: bc (block-compressed by role: BC7 colour and sRGB, BC5 normal maps \
 and metallic-roughness, BC4 occlusion; 4 to 8 times smaller than rgba8, error per texture in the report; the \
 player needs textureCompressionBC) or rgba8 (exact, every device) [default: bc, or the sidecar's \
-bake.texture_format]")]
+bake.texture_format]"
+    )]
     pub texture_format: Option<TextureFormat>,
 }
 

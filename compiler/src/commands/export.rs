@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use kiln_format::sections::Swizzle;
 use kiln_format::manifest::ShadowProjection;
+use kiln_format::sections::Swizzle;
 use kiln_format::{Checksums, KilnFile, SceneView, sections};
 
 use crate::cli::ExportArgs;

@@ -74,7 +74,8 @@ pub fn run(args: &PlanArgs) -> CliResult {
 
 /// What each texture of `loaded` becomes, as the texture stage decides it.
 fn texture_plans(loaded: &pipeline::Loaded) -> Vec<TexturePlan> {
-    let materials: Vec<kiln_format::sections::GpuMaterial> = loaded.scene.materials.iter().map(|m| m.gpu).collect();
+    let materials: Vec<kiln_format::sections::GpuMaterial> =
+        loaded.scene.materials.iter().map(|m| m.gpu).collect();
     loaded
         .scene
         .textures
@@ -86,7 +87,13 @@ fn texture_plans(loaded: &pipeline::Loaded) -> Vec<TexturePlan> {
                 crate::bake::bc::Usage::of(&materials, i as u32),
                 loaded.settings.texture_format,
             );
-            TexturePlan { name: t.name.clone(), width: t.width, height: t.height, format: c.format.name(), why: c.why }
+            TexturePlan {
+                name: t.name.clone(),
+                width: t.width,
+                height: t.height,
+                format: c.format.name(),
+                why: c.why,
+            }
         })
         .collect()
 }
