@@ -1008,7 +1008,7 @@ fn agree(name: &str, bytes: &[u8]) -> String {
 /// the record (mip chains; N² texels, six N × N faces for cube maps with N = `resolution`; one
 /// byte per `dims` cell), each equal to what the reader hands out.
 fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> String {
-    use kiln_format::sections::{BRDF_LUT, MEDIA_VISIBILITY, SHADOW_MAP, TEXTURE};
+    use kiln_format::sections::{BRDF_LUT, MEDIA_VISIBILITY, SHADOW_MAP};
     let count = |kind: &[u8; 4]| f.entries.iter().filter(|e| &e.kind == kind).count();
     assert_eq!(count(b"TEXL"), m.textures.len(), "{name}: TEXL sections");
     let mut formats = Vec::new();
