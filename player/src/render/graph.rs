@@ -44,7 +44,6 @@ impl TargetDecl {
             array: self.array,
             usage: self.usage,
             uploaded: false,
-            components: vk::ComponentMapping::default(),
         }
     }
 }
