@@ -13,6 +13,22 @@ use crate::harness::{Pinhole, fast_settings, light, render, square};
 const W: u32 = 32;
 const H: u32 = 24;
 
+/// The slab's medium and light: chromatic coefficients (optical depths 0.3 to 1.35 across the
+/// slab), forward scattering seen from behind the light's travel.
+struct Haze {
+    sigma_a: [f32; 3],
+    sigma_s: [f32; 3],
+    g: f32,
+    depth: f32,
+    irradiance: f32,
+}
+
+const HAZE: Haze =
+    Haze { sigma_a: [0.1, 0.2, 0.05], sigma_s: [0.1, 0.4, 0.85], g: 0.5, depth: 1.5, irradiance: 4.0 };
+
+/// The light's direction of travel (cos θ = −0.6 towards a camera looking straight down).
+const TRAVEL: [f32; 3] = [0.8, -0.6, 0.0];
+
 /// Henyey–Greenstein, written out here: (1 − g²) / (4π (1 + g² − 2g cos θ)^{3/2}).
 fn henyey_greenstein(g: f64, cos_theta: f64) -> f64 {
     (1.0 - g * g) / (4.0 * std::f64::consts::PI * (1.0 + g * g - 2.0 * g * cos_theta).powf(1.5))
@@ -99,13 +115,10 @@ fn single_scattering_in_a_lit_slab_matches_the_closed_form() {
     if !vulkan() {
         return;
     }
-    // Chromatic coefficients (optical depths 0.3 to 1.35 across the slab), forward scattering
-    // seen from behind the light's travel (cos θ = −0.6), and an isotropic case.
-    let travel = Vec3::new(0.8, -0.6, 0.0);
-    for (sigma_a, sigma_s, g) in
-        [([0.1f32, 0.2, 0.05], [0.1f32, 0.4, 0.85], 0.5f32), ([0.0; 3], [0.5; 3], 0.0)]
-    {
-        let (depth, irradiance) = (1.5f32, 4.0f32);
+    // The haze, and an isotropic medium.
+    let travel = Vec3::from_array(TRAVEL);
+    for (sigma_a, sigma_s, g) in [(HAZE.sigma_a, HAZE.sigma_s, HAZE.g), ([0.0; 3], [0.5; 3], 0.0)] {
+        let (depth, irradiance) = (HAZE.depth, HAZE.irradiance);
         let got = slab(sigma_a, sigma_s, g, depth, travel, irradiance);
         for c in 0..3 {
             let want = single_scattering(
@@ -135,9 +148,8 @@ fn the_ray_march_matches_single_scattering_in_a_lit_slab() {
     if !vulkan() {
         return;
     }
-    let travel = Vec3::new(0.8, -0.6, 0.0);
-    let (sigma_a, sigma_s, g, depth, irradiance) =
-        ([0.1f32, 0.2, 0.05], [0.1f32, 0.4, 0.85], 0.5f32, 1.5f32, 4.0f32);
+    let travel = Vec3::from_array(TRAVEL);
+    let Haze { sigma_a, sigma_s, g, depth, irradiance } = HAZE;
     let dir = tempfile::tempdir().unwrap();
     let bytes = slab_file(sigma_a, sigma_s, g, depth, travel, irradiance);
     let want: Vec<f64> = (0..3)
@@ -260,9 +272,8 @@ fn the_ray_march_dims_the_light_that_reaches_surfaces_through_the_medium() {
     if !vulkan() {
         return;
     }
-    let travel = Vec3::new(0.8, -0.6, 0.0);
-    let (sigma_a, sigma_s, g, depth, irradiance) =
-        ([0.1f32, 0.2, 0.05], [0.1f32, 0.4, 0.85], 0.5f32, 1.5f32, 4.0f32);
+    let travel = Vec3::from_array(TRAVEL);
+    let Haze { sigma_a, sigma_s, g, depth, irradiance } = HAZE;
     // An albedo the G-buffer's 8-bit sRGB target holds exactly.
     let albedo = crate::harness::srgb8(188);
     let bytes = slab_over(sigma_a, sigma_s, g, depth, travel, irradiance, albedo);
