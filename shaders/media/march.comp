@@ -62,7 +62,7 @@ float visibility(uint base, vec3 lo, vec3 hi, vec3 p) {
 // side transmittance): Σ lights p(θ) · L · V · e^{−σt·d_light}.
 vec3 in_scattered(uint m, vec3 p, vec3 d) {
     vec3 lo = media[m].min.xyz, hi = media[m].max.xyz;
-    vec3 sigma_t = media[m].sigma_a.rgb + media[m].sigma_s.rgb;
+    vec3 sigma_t = medium_sigma_t(m);
     float g = media[m].min.w;
     vec3 sum = vec3(0.0);
     for (uint i = 0u; i < frame.size.z; i++) {
@@ -140,7 +140,7 @@ void main() {
             break;
         }
         last = entry;
-        vec3 sigma_t = media[m].sigma_a.rgb + media[m].sigma_s.rgb;
+        vec3 sigma_t = medium_sigma_t(m);
         vec3 sigma_s = media[m].sigma_s.rgb;
         float len = span.y - span.x;
         float h = len / float(max(mc.steps, 1u));

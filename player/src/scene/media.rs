@@ -6,7 +6,7 @@ use kiln_format::gpu::GpuMedium;
 use kiln_format::manifest::Manifest;
 
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Buffer, Gpu, vk};
+use crate::gpu::{Buffer, Gpu};
 use crate::scene::upload::Uploader;
 
 /// The manifest's media as the shaders read them.
@@ -51,7 +51,6 @@ impl MediaBuffers {
     /// Allocates the buffers of `manifest`'s media and uploads the table and light map; the
     /// volumes arrive with their sections ([`MediaBuffers::upload_volume`]).
     pub fn new(gpu: &Gpu, manifest: &Manifest, up: &mut Uploader) -> PlayResult<MediaBuffers> {
-        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let media = table(manifest);
         let (dims, volume_medium, lights_with) = match &manifest.media_visibility {
             Some(v) => (v.dims, v.medium, v.lights.clone()),
@@ -70,23 +69,12 @@ impl MediaBuffers {
                 *slot = at;
             }
         }
-        let mut made: Vec<Buffer> = Vec::new();
-        for (name, size) in [
+        let sizes = [
             ("media", std::mem::size_of_val(media.as_slice()) as u64),
             ("visibility volumes", stride * lights_with.len() as u64),
             ("volume of each light", volume_of.len() as u64 * 4),
-        ] {
-            match Buffer::uploaded(gpu, name, size, storage) {
-                Ok(b) => made.push(b),
-                Err(e) => {
-                    for mut b in made {
-                        b.destroy(gpu);
-                    }
-                    return Err(e);
-                }
-            }
-        }
-        let mut it = made.into_iter();
+        ];
+        let mut it = super::storage_buffers(gpu, &sizes)?.into_iter();
         let mut next = || it.next().expect("one buffer per size");
         let buffers = MediaBuffers {
             table: next(),

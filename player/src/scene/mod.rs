@@ -619,6 +619,23 @@ fn raster_materials(draws: &[Draw]) -> Vec<u32> {
     draws.iter().flat_map(|d| std::iter::repeat_n(d.material, d.count as usize / 3)).collect()
 }
 
+/// Storage buffers of the given names and sizes, filled by uploads; on failure none is left.
+pub(crate) fn storage_buffers(gpu: &Gpu, sizes: &[(&str, u64)]) -> PlayResult<Vec<Buffer>> {
+    let mut made: Vec<Buffer> = Vec::new();
+    for &(name, size) in sizes {
+        match Buffer::uploaded(gpu, name, size, vk::BufferUsageFlags::STORAGE_BUFFER) {
+            Ok(b) => made.push(b),
+            Err(e) => {
+                for mut b in made {
+                    b.destroy(gpu);
+                }
+                return Err(e);
+            }
+        }
+    }
+    Ok(made)
+}
+
 /// Allocates the reference path tracer's buffers (filled as their sections stream past).
 fn reference_buffers(
     gpu: &Gpu,
@@ -636,19 +653,8 @@ fn reference_buffers(
         ("raster materials", view.triangles.len() * 4),
         ("media", std::mem::size_of_val(tables.media.as_slice())),
     ];
-    let mut made: Vec<Buffer> = Vec::new();
-    for (name, size) in sizes {
-        match Buffer::uploaded(gpu, name, size as u64, vk::BufferUsageFlags::STORAGE_BUFFER) {
-            Ok(b) => made.push(b),
-            Err(e) => {
-                for mut b in made {
-                    b.destroy(gpu);
-                }
-                return Err(e);
-            }
-        }
-    }
-    let mut it = made.into_iter();
+    let sizes = sizes.map(|(name, size)| (name, size as u64));
+    let mut it = storage_buffers(gpu, &sizes)?.into_iter();
     let mut next = || it.next().expect("one buffer per size");
     Ok(ReferenceBuffers {
         indices: next(),
