@@ -51,6 +51,17 @@ impl LightKinds {
     pub const RECT: u32 = 3;
 }
 
+/// Phase functions in [`TothConstants::phase`].
+#[derive(Debug)]
+pub struct Phases;
+
+impl Phases {
+    /// Henyey–Greenstein with the medium's g.
+    pub const HENYEY_GREENSTEIN: u32 = 0;
+    /// Rayleigh: 3/(16π) (1 + cos² θ).
+    pub const RAYLEIGH: u32 = 1;
+}
+
 /// Shadow projections in [`GpuShadow::projection`].
 #[derive(Debug)]
 pub struct ShadowKinds;
@@ -205,6 +216,45 @@ gpu_struct! {
         /// Lights with a volume: `volume_of[light]` is its first byte in the volume buffer, −1
         /// without one (unshadowed in the medium).
         pub lights: u32 => "uint",
+    }
+}
+
+gpu_struct! {
+    /// Push constants of the image-space god-ray passes (`shaders/mitchell/*`,
+    /// `shaders/sousa/*`; 32 bytes): one light's radial blur per dispatch.
+    pub struct GodRayConstants {
+        /// The light (index into the light buffer) whose shafts this dispatch makes.
+        pub light: u32 => "uint",
+        /// Samples along the pixel's path towards the light (Mitchell n, Sousa TAPS).
+        pub samples: u32 => "uint",
+        /// Mitchell: the density (the march covers 1/density of the way to the light); Sousa:
+        /// this pass's step in texture coordinates.
+        pub step: f32 => "float",
+        /// Mitchell: exposure per sample; Sousa: brightness.
+        pub gain: f32 => "float",
+        /// Mitchell: the decay per sample.
+        pub decay: f32 => "float",
+        /// Mitchell: the radius of the lights' emitting proxies; Sousa: the distance that maps
+        /// to depth 1 (the sky's).
+        pub extent: f32 => "float",
+        /// Sousa: 1 for the last pass (adds to the radiance), 0 for the others.
+        pub last: u32 => "uint",
+        /// Entries of the `GpuMedium` buffer (the shafts take medium 0's albedo and phase).
+        pub media: u32 => "uint",
+    }
+}
+
+gpu_struct! {
+    /// Push constants of the shadow-map ray march (`shaders/toth/*`; 16 bytes).
+    pub struct TothConstants {
+        /// Samples along each view ray's part inside the media (before interleaving).
+        pub samples: u32 => "uint",
+        /// Side of the interleaving block: each pixel of a block takes every block²-th sample.
+        pub block: u32 => "uint",
+        /// Phase function: 0 the medium's Henyey–Greenstein, 1 Rayleigh.
+        pub phase: u32 => "uint",
+        /// Entries of the `GpuMedium` buffer.
+        pub media: u32 => "uint",
     }
 }
 
@@ -388,11 +438,15 @@ pub fn glsl_layout() -> String {
     declare::<GpuVertexAttributes>(&mut s);
     declare::<RtConstants>(&mut s);
     declare::<MarchConstants>(&mut s);
+    declare::<GodRayConstants>(&mut s);
+    declare::<TothConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
         ("LIGHT_DIRECTIONAL", LightKinds::DIRECTIONAL),
         ("LIGHT_RECT", LightKinds::RECT),
+        ("PHASE_HENYEY_GREENSTEIN", Phases::HENYEY_GREENSTEIN),
+        ("PHASE_RAYLEIGH", Phases::RAYLEIGH),
         ("SHADOW_ORTHOGRAPHIC", ShadowKinds::ORTHOGRAPHIC),
         ("SHADOW_PERSPECTIVE", ShadowKinds::PERSPECTIVE),
         ("SHADOW_CUBE", ShadowKinds::CUBE),
@@ -545,6 +599,8 @@ mod tests {
         check::<GpuVertexAttributes>();
         check::<RtConstants>();
         check::<MarchConstants>();
+        check::<GodRayConstants>();
+        check::<TothConstants>();
         check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {

@@ -91,6 +91,26 @@ pub enum LsShadowTestArg {
     Filled,
 }
 
+/// `--media-res` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MediaResArg {
+    /// The screen's resolution.
+    Full,
+    /// Half on each axis.
+    Half,
+    /// A quarter on each axis.
+    Quarter,
+}
+
+/// `--media-phase` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MediaPhaseArg {
+    /// Henyey–Greenstein with the medium's g.
+    Medium,
+    /// Rayleigh.
+    Rayleigh,
+}
+
 /// kiln-play renders .kiln files with Vulkan 1.3: in a window, headless to PNG or EXR, or as a
 /// benchmark.
 #[derive(Debug, Parser)]
@@ -198,6 +218,33 @@ pub struct Args {
     /// With --media march: steps along the view ray through each medium, 1 to 1024.
     #[arg(long, value_name = "N", default_value_t = 32)]
     pub media_steps: u32,
+    /// With --media mitchell or toth: samples per pixel, 1 to 1024 (default 60): mitchell's
+    /// towards the light, toth's along the view ray (over an interleaving block).
+    #[arg(long, value_name = "N")]
+    pub media_samples: Option<u32>,
+    /// With --media mitchell or sousa: resolution of the occlusion image or depth map and the
+    /// first blurs, as a fraction of the screen's (default quarter).
+    #[arg(long, value_enum, value_name = "RES")]
+    pub media_res: Option<MediaResArg>,
+    /// With --media mitchell: the shafts' gain where every sample sees the emitter (default
+    /// 1.921, the seed's exposure 0.01921 × its 100 samples).
+    #[arg(long, value_name = "GAIN")]
+    pub media_exposure: Option<f32>,
+    /// With --media sousa: samples per pass, TAPS (3 passes, steps 1/TAPS, 1/TAPS², 1/TAPS³ of
+    /// the screen), 1 to 64 (default 6).
+    #[arg(long, value_name = "N")]
+    pub media_taps: Option<u32>,
+    /// With --media sousa: the factor on each pass's sum (default 0.19).
+    #[arg(long, value_name = "F")]
+    pub media_brightness: Option<f32>,
+    /// With --media toth: side of the interleaving block in pixels, 1 to 8 (default 4;
+    /// block² must not exceed --media-samples).
+    #[arg(long, value_name = "N")]
+    pub media_block: Option<u32>,
+    /// With --media toth: the phase function (default medium: Henyey–Greenstein with the
+    /// medium's g, as the reference renders).
+    #[arg(long, value_enum, value_name = "PHASE")]
+    pub media_phase: Option<MediaPhaseArg>,
     /// Render the unbiased reference path tracer instead (headless, needs -o OUT.exr).
     #[arg(long, conflicts_with_all = ["bench", "bench_rays"])]
     pub reference: bool,
@@ -223,6 +270,13 @@ impl Args {
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
             "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
             "media-steps" => Some(KnobValue::Number(self.media_steps as f32)),
+            "media-samples" => self.media_samples.map(|n| KnobValue::Number(n as f32)),
+            "media-res" => self.media_res.map(|r| KnobValue::Choice(r as usize)),
+            "media-exposure" => self.media_exposure.map(KnobValue::Number),
+            "media-taps" => self.media_taps.map(|n| KnobValue::Number(n as f32)),
+            "media-brightness" => self.media_brightness.map(KnobValue::Number),
+            "media-block" => self.media_block.map(|n| KnobValue::Number(n as f32)),
+            "media-phase" => self.media_phase.map(|p| KnobValue::Choice(p as usize)),
             _ => None,
         }
     }

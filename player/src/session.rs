@@ -277,16 +277,24 @@ impl Session {
         {
             warnings.push("--shadows shadowmap: the file has no shadow maps (compiled with shadows skipped); lights are unshadowed".into());
         }
-        if matches!(render.techniques.media, crate::render::Media::March { .. }) {
+        let media = render.techniques.media;
+        if media != crate::render::Media::None {
+            let flag = format!("--media {}", render.techniques.name_of(crate::render::Effect::Media));
+            let casters = scene.manifest.lights.iter().any(|l| l.casts_shadows);
             if scene.manifest.media.is_empty() {
-                warnings.push("--media march: the file has no participating medium (add a [[medium]] to the sidecar and recompile); nothing to march".into());
-            } else if scene.manifest.media_visibility.is_none()
-                && scene.manifest.lights.iter().any(|l| l.casts_shadows)
+                warnings.push(format!("{flag}: the file has no participating medium (add a [[medium]] to the sidecar and recompile); it adds nothing"));
+            } else if matches!(media, crate::render::Media::March { .. })
+                && scene.manifest.media_visibility.is_none()
+                && casters
             {
-                warnings.push(
-                    "--media march: the file has no light-visibility volume; shafts of light are unshadowed"
-                        .into(),
-                );
+                warnings.push(format!(
+                    "{flag}: the file has no light-visibility volume; shafts of light are unshadowed"
+                ));
+            } else if matches!(media, crate::render::Media::Toth { .. })
+                && scene.manifest.shadow_maps.is_empty()
+                && casters
+            {
+                warnings.push(format!("{flag}: the file has no shadow maps; shafts of light are unshadowed"));
             }
         }
         Ok(Session {

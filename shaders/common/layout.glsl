@@ -118,10 +118,30 @@ struct MarchConstants {
     uint lights; // offset 24
 }; // 28 bytes
 
+struct GodRayConstants {
+    uint light; // offset 0
+    uint samples; // offset 4
+    float step; // offset 8
+    float gain; // offset 12
+    float decay; // offset 16
+    float extent; // offset 20
+    uint last; // offset 24
+    uint media; // offset 28
+}; // 32 bytes
+
+struct TothConstants {
+    uint samples; // offset 0
+    uint block; // offset 4
+    uint phase; // offset 8
+    uint media; // offset 12
+}; // 16 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;
 const uint LIGHT_RECT = 3u;
+const uint PHASE_HENYEY_GREENSTEIN = 0u;
+const uint PHASE_RAYLEIGH = 1u;
 const uint SHADOW_ORTHOGRAPHIC = 0u;
 const uint SHADOW_PERSPECTIVE = 1u;
 const uint SHADOW_CUBE = 2u;

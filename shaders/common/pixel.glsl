@@ -33,6 +33,20 @@ vec3 towards_camera(vec3 p) {
     return camera_orthographic() ? -frame.camera_forward.xyz : normalize(frame.camera.xyz - p);
 }
 
+// What the distance along a camera ray is where a pixel shows the sky.
+const float SKY_DISTANCE = 3.4e38;
+
+// Distance along the unit camera ray (o, d) of image point `at` to the surface the G-buffer's
+// reversed-Z `depth` holds there; SKY_DISTANCE where it holds the sky (depth 0).
+float surface_distance(vec2 at, float depth, vec3 o, vec3 d) {
+    if (!(depth > 0.0)) {
+        return SKY_DISTANCE;
+    }
+    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
+    vec4 w = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+    return max(dot(w.xyz / w.w - o, d), 0.0);
+}
+
 // Barycentrics (of corners 1 and 2) where the camera ray from `origin` along `dir` meets the
 // plane of the triangle p0, p0 + e1, p0 + e2 (Möller–Trumbore without the bounds test); 0 when
 // parallel.

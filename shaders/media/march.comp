@@ -33,8 +33,6 @@ layout(push_constant) uniform Push { MarchConstants mc; };
 #include "../common/pixel.glsl"
 #include "../common/media.glsl"
 
-const float FAR = 3.4e38;
-
 uint volume_byte(uint at) {
     return (volume_words[at >> 2u] >> (8u * (at & 3u))) & 0xFFu;
 }
@@ -72,7 +70,7 @@ vec3 in_scattered(uint m, vec3 p, vec3 d) {
         vec3 li;
         if (l.kind == LIGHT_DIRECTIONAL) {
             wl = -l.direction;
-            dist = FAR;
+            dist = SKY_DISTANCE;
             li = l.radiance;
         } else {
             vec3 to = l.position - p;
@@ -111,19 +109,13 @@ void main() {
     vec2 at = vec2(pixel) + 0.5;
     vec3 o = pixel_origin(at);
     vec3 d = normalize(pixel_ray(at));
-    float depth = texelFetch(g_depth, pixel, 0).r;
-    float t_surface = FAR;
-    if (depth > 0.0) {
-        vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
-        vec4 w = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-        t_surface = max(dot(w.xyz / w.w - o, d), 0.0);
-    }
+    float t_surface = surface_distance(at, texelFetch(g_depth, pixel, 0).r, o, d);
     // 4 × 4 Bayer order: where in its step each pixel samples the source.
     const uint BAYER[16] = uint[16](0u, 8u, 2u, 10u, 12u, 4u, 14u, 6u, 3u, 11u, 1u, 9u, 15u, 7u, 13u, 5u);
     float jitter = (float(BAYER[(pixel.x & 3) + 4 * (pixel.y & 3)]) + 0.5) / 16.0;
     vec3 l = imageLoad(radiance, pixel).rgb;
     // Media from the furthest entry to the nearest.
-    float last = FAR * 2.0;
+    float last = SKY_DISTANCE * 2.0;
     for (uint pass = 0u; pass < mc.media; pass++) {
         uint m = 0xFFFFFFFFu;
         float entry = -1.0;

@@ -3,19 +3,22 @@
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
 //! reflections, GI (each when chosen) → direct light and composition → participating media
-//! (when chosen) → tone mapping.
+//! (march, mitchell, sousa or toth, when chosen) → tone mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
 use super::passes::media::MediaMarchPass;
+use super::passes::mitchell::MitchellPass;
 use super::passes::resolve::ResolvePass;
 use super::passes::rt_ao::RtAoPass;
 use super::passes::rt_gi::RtGiPass;
 use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
+use super::passes::sousa::SousaPass;
 use super::passes::tonemap::TonemapPass;
+use super::passes::toth::TothPass;
 use super::passes::visibility::VisibilityPass;
 use super::spirv;
 use super::technique::{Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
@@ -64,8 +67,18 @@ fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<B
             Gi::None => {}
         }
         made.push(Box::new(DirectPass::new(gpu)?));
-        if let Media::March { steps } = techniques.media {
-            made.push(Box::new(MediaMarchPass::new(gpu, steps)?));
+        match techniques.media {
+            Media::None => {}
+            Media::March { steps } => made.push(Box::new(MediaMarchPass::new(gpu, steps)?)),
+            Media::Mitchell { samples, resolution, exposure } => {
+                made.push(Box::new(MitchellPass::new(gpu, samples, resolution, exposure)?))
+            }
+            Media::Sousa { taps, resolution, brightness } => {
+                made.push(Box::new(SousaPass::new(gpu, taps, resolution, brightness)?))
+            }
+            Media::Toth { samples, block, phase } => {
+                made.push(Box::new(TothPass::new(gpu, samples, block, phase)?))
+            }
         }
         made.push(Box::new(TonemapPass::new(gpu)?));
         Ok(())

@@ -28,8 +28,8 @@ use frame::Frame;
 use graph::{Access, FrameImages};
 use passes::{FrameCtx, Shared};
 pub use technique::{
-    Aa, Ao, Effect, GBuffer, Gi, GiStructure, LsShadowTest, Media, Needs, ReflectionRes, Reflections,
-    Shadows, Techniques,
+    Aa, Ao, Effect, GBuffer, Gi, GiStructure, LsShadowTest, Media, Needs, Phase, ReflectionRes, Reflections,
+    ScreenFraction, Shadows, Techniques,
 };
 
 /// Shadow maps of each kind the direct-light pass can bind, and lights with a ray-traced shadow
@@ -131,7 +131,11 @@ impl Renderer {
         settings: RenderSettings,
     ) -> PlayResult<Renderer> {
         let t = settings.techniques;
-        let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, t.shadows == Shadows::ShadowMap);
+        // The shadow maps are bound for surfaces (`--shadows shadowmap`) or for the media march
+        // through them (`--media toth`); the flag below says whether surfaces use them.
+        let surface_maps = t.shadows == Shadows::ShadowMap;
+        let media_maps = matches!(t.media, Media::Toth { .. });
+        let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, surface_maps || media_maps);
         let rt_shadows = t.shadows.traced().is_some();
         if rt_shadows && plan.lights_used as usize > MAX_RT_SHADOW_LIGHTS {
             plan.warnings.push(format!(
@@ -176,7 +180,7 @@ impl Renderer {
             emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count),
             ..Default::default()
         };
-        let mut flags = if plan.shadows_bound && !rt_shadows { FrameFlags::SHADOW_MAPS } else { 0 };
+        let mut flags = if plan.shadows_bound && surface_maps { FrameFlags::SHADOW_MAPS } else { 0 };
         if rt_shadows {
             flags |= FrameFlags::RT_SHADOWS;
         }
@@ -247,7 +251,11 @@ impl Renderer {
             flags,
             lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
             sky: scene.manifest.sky.radiance,
-            media_dimming: scene.media.as_ref().map_or(0, |m| m.count),
+            media_dimming: if t.media.dims_surfaces() {
+                scene.media.as_ref().map_or(0, |m| m.count)
+            } else {
+                0
+            },
             settings,
             timestamps,
             frame_count: 0,

@@ -27,6 +27,20 @@ shaders! {
     TONEMAP = "post" / "tonemap.comp";
     /// Participating media by ray marching.
     MEDIA_MARCH = "media" / "march.comp";
+    /// Mitchell's occlusion image.
+    MITCHELL_OCCLUSION = "mitchell" / "occlusion.comp";
+    /// Mitchell's radial blur.
+    MITCHELL_BLUR = "mitchell" / "blur.comp";
+    /// Sousa's depth map.
+    SOUSA_DEPTH = "sousa" / "depth.comp";
+    /// Sousa's first two radial blurs.
+    SOUSA_BLUR = "sousa" / "blur.comp";
+    /// Sousa's last radial blur, added to the radiance.
+    SOUSA_COMPOSITE = "sousa" / "composite.comp";
+    /// Tóth & Umenhoffer's shadow-map ray march.
+    TOTH_MARCH = "toth" / "march.comp";
+    /// The blur that joins Tóth's interleaved samples.
+    TOTH_BLUR = "toth" / "blur.comp";
     /// Ray queries from a buffer.
     TRACE_RAYS = "trace" / "rays.comp";
     /// Line-space queries from a buffer.

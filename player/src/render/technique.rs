@@ -155,7 +155,7 @@ impl Gi {
 }
 
 /// Participating media.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Media {
     /// None.
     #[default]
@@ -167,6 +167,77 @@ pub enum Media {
         /// Steps through each medium the ray crosses.
         steps: u32,
     },
+    /// Mitchell's god rays (seed 002): a radial blur of an occlusion image towards each light's
+    /// screen position (`shaders/mitchell/`). Image space: no shafts from a light behind the
+    /// camera.
+    Mitchell {
+        /// Samples towards the light (the seed's n).
+        samples: u32,
+        /// Resolution of the occlusion image.
+        resolution: ScreenFraction,
+        /// The gain of a march that sees the emitter at every sample (the seed's exposure × n).
+        exposure: f32,
+    },
+    /// Sousa's sun shafts (seed 002): three chained radial blurs of the depth map with steps
+    /// TAPS⁻¹, TAPS⁻², TAPS⁻³ (`shaders/sousa/`). Image space, as Mitchell.
+    Sousa {
+        /// Samples per pass (TAPS).
+        taps: u32,
+        /// Resolution of the depth map and the first two passes.
+        resolution: ScreenFraction,
+        /// The factor on each pass's sum.
+        brightness: f32,
+    },
+    /// Tóth & Umenhoffer's ray march through the baked shadow maps (seed 002, errata fixed),
+    /// interleaved over block × block pixels and blurred back together (`shaders/toth/`).
+    Toth {
+        /// Samples along the view ray's part inside the media, over a block.
+        samples: u32,
+        /// Side of the interleaving block in pixels.
+        block: u32,
+        /// Phase function.
+        phase: Phase,
+    },
+}
+
+impl Media {
+    /// Whether this technique dims the light reaching surfaces through the media and the
+    /// surfaces seen through them (the world-space ones; the image-space blurs only add light,
+    /// as in the seed).
+    pub fn dims_surfaces(&self) -> bool {
+        matches!(self, Media::March { .. } | Media::Toth { .. })
+    }
+}
+
+/// A resolution as a fraction of the screen's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScreenFraction {
+    /// The screen's.
+    Full,
+    /// Half on each axis.
+    Half,
+    /// A quarter on each axis (the seed's 200 × 150 at 800 × 600).
+    Quarter,
+}
+
+impl ScreenFraction {
+    /// Screen pixels per image pixel along each axis.
+    pub fn divisor(self) -> u32 {
+        match self {
+            ScreenFraction::Full => 1,
+            ScreenFraction::Half => 2,
+            ScreenFraction::Quarter => 4,
+        }
+    }
+}
+
+/// The phase function of `--media toth`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Henyey–Greenstein with the medium's g.
+    Medium,
+    /// Rayleigh.
+    Rayleigh,
 }
 
 /// What happens to the stochastic passes' samples across frames.
@@ -215,8 +286,10 @@ pub struct Needs {
     pub scene_buffers: bool,
     /// Arrays of the voxel grid and line space ([`crate::scene::linespace::LsArrays`] bits).
     pub line_space: u32,
-    /// The media table and the light-visibility volumes.
+    /// The media table (from the manifest).
     pub media: bool,
+    /// The light-visibility volumes (`MVIS` sections).
+    pub media_volumes: bool,
 }
 
 impl Needs {
@@ -230,6 +303,7 @@ impl Needs {
             scene_buffers: self.scene_buffers || o.scene_buffers,
             line_space: self.line_space | o.line_space,
             media: self.media || o.media,
+            media_volumes: self.media_volumes || o.media_volumes,
         }
     }
 
@@ -242,6 +316,7 @@ impl Needs {
         scene_buffers: false,
         line_space: 0,
         media: false,
+        media_volumes: false,
     };
     /// What the ray-traced passes and the path tracer read: the BVH and the surfaces it hits.
     pub const TRACED_SURFACES: Needs = Needs {
@@ -252,6 +327,7 @@ impl Needs {
         scene_buffers: true,
         line_space: 0,
         media: false,
+        media_volumes: false,
     };
     /// What the G-buffer and the direct-light pass always read.
     pub const FRAME: Needs = Needs {
@@ -262,7 +338,26 @@ impl Needs {
         scene_buffers: false,
         line_space: 0,
         media: false,
+        media_volumes: false,
     };
+}
+
+/// A knob's value as a whole number, or an error naming it.
+fn whole(effect: Effect, technique: &str, knob: &str, value: KnobValue) -> Result<u32, String> {
+    let v = value.number();
+    if v.fract() != 0.0 {
+        return Err(format!("{effect} {technique}: {knob} must be a whole number, not {v}"));
+    }
+    Ok(v as u32)
+}
+
+/// The screen fraction of a `media-res` choice.
+fn fraction(value: KnobValue) -> ScreenFraction {
+    match value {
+        KnobValue::Choice(0) => ScreenFraction::Full,
+        KnobValue::Choice(1) => ScreenFraction::Half,
+        _ => ScreenFraction::Quarter,
+    }
 }
 
 impl Techniques {
@@ -292,8 +387,17 @@ impl Techniques {
                 GiStructure::Preillum => LsArrays::PNMT_QUERY | LsArrays::PREILLUM,
             };
         }
-        if let Media::March { .. } = self.media {
-            n.media = true;
+        match self.media {
+            Media::None => {}
+            Media::March { .. } => {
+                n.media = true;
+                n.media_volumes = true;
+            }
+            Media::Mitchell { .. } | Media::Sousa { .. } => n.media = true,
+            Media::Toth { .. } => {
+                n.media = true;
+                n.shadow_maps = true;
+            }
         }
         if n.line_space & LsArrays::CELL_LISTS != 0 {
             // Exact tests near the shadow feelers' ends read the shaft's candidates, when the
@@ -384,11 +488,7 @@ impl Techniques {
             }
             (Effect::Gi, "none") => self.gi = Gi::None,
             (Effect::Gi, "rt" | "linespace") => {
-                let bounces = v(0).number();
-                if bounces.fract() != 0.0 {
-                    return Err(format!("{effect} {name}: gi-bounces must be a whole number, not {bounces}"));
-                }
-                let bounces = bounces as u32;
+                let bounces = whole(effect, name, "gi-bounces", v(0))?;
                 self.gi = if name == "rt" {
                     Gi::Rt { bounces }
                 } else {
@@ -402,11 +502,34 @@ impl Techniques {
             }
             (Effect::Media, "none") => self.media = Media::None,
             (Effect::Media, "march") => {
-                let steps = v(0).number();
-                if steps.fract() != 0.0 {
-                    return Err(format!("{effect} {name}: media-steps must be a whole number, not {steps}"));
+                self.media = Media::March { steps: whole(effect, name, "media-steps", v(0))? };
+            }
+            (Effect::Media, "mitchell") => {
+                self.media = Media::Mitchell {
+                    samples: whole(effect, name, "media-samples", v(0))?,
+                    resolution: fraction(v(1)),
+                    exposure: v(2).number(),
+                };
+            }
+            (Effect::Media, "sousa") => {
+                self.media = Media::Sousa {
+                    taps: whole(effect, name, "media-taps", v(0))?,
+                    resolution: fraction(v(1)),
+                    brightness: v(2).number(),
+                };
+            }
+            (Effect::Media, "toth") => {
+                let samples = whole(effect, name, "media-samples", v(0))?;
+                let block = whole(effect, name, "media-block", v(1))?;
+                if block * block > samples {
+                    return Err(format!(
+                        "{effect} {name}: media-block {block} splits the samples over {} pixels: give at least \
+                         that many media-samples (not {samples}), or a smaller block",
+                        block * block
+                    ));
                 }
-                self.media = Media::March { steps: steps as u32 };
+                let phase = if v(2) == KnobValue::Choice(1) { Phase::Rayleigh } else { Phase::Medium };
+                self.media = Media::Toth { samples, block, phase };
             }
             (Effect::Aa, "none") => self.aa = Aa::None,
             (Effect::Aa, "accumulate") => self.aa = Aa::Accumulate,
@@ -444,6 +567,9 @@ impl Techniques {
             Effect::Media => match self.media {
                 Media::None => "none",
                 Media::March { .. } => "march",
+                Media::Mitchell { .. } => "mitchell",
+                Media::Sousa { .. } => "sousa",
+                Media::Toth { .. } => "toth",
             },
             Effect::Aa => match self.aa {
                 Aa::None => "none",
@@ -656,7 +782,33 @@ const SUN_ANGLE: Knob = light_size(number(
     &[0.0, 0.53, 2.0],
 ));
 
-static CATALOGUE: [TechniqueInfo; 17] = [
+/// Samples along the way of the media techniques that take a fixed count (Mitchell, Tóth).
+const MEDIA_SAMPLES: Knob = number(
+    "media-samples",
+    "samples per pixel: mitchell, towards the light; toth, along the view ray (over an \
+     interleaving block)",
+    1.0,
+    1024.0,
+    60.0,
+    &[18.0, 60.0, 100.0],
+);
+
+/// Resolution of the image-space god rays' first image.
+const MEDIA_RES: Knob = Knob {
+    name: "media-res",
+    help: "resolution of mitchell's occlusion image and sousa's depth map and first two blurs: \
+           full, half or quarter of the screen's on each axis (read bilinearly: smoother shafts)",
+    range: KnobRange::Choice(&["full", "half", "quarter"]),
+    default: KnobValue::Choice(2),
+    role: KnobRole::Quality,
+};
+
+/// The image-space techniques' artistic brightness: a sweep holds it at its default.
+const fn artistic(knob: Knob) -> Knob {
+    Knob { role: KnobRole::Scene, ..knob }
+}
+
+static CATALOGUE: [TechniqueInfo; 20] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -835,6 +987,77 @@ static CATALOGUE: [TechniqueInfo; 17] = [
             32.0,
             &[8.0, 16.0, 32.0, 64.0],
         )],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Media,
+        name: "mitchell",
+        help: "Mitchell's god rays (seed 002): each light's emitter (the sky for a directional \
+               light, a small sphere for the others) blurred radially towards its screen \
+               position; image space, so no shafts from a light behind the camera or from what \
+               the screen does not show; see --media-samples, --media-res, --media-exposure",
+        knobs: &[
+            MEDIA_SAMPLES,
+            MEDIA_RES,
+            artistic(number(
+                "media-exposure",
+                "the shafts' gain where every sample sees the emitter (the seed's exposure × n)",
+                0.0,
+                UNBOUNDED,
+                1.921,
+                &[],
+            )),
+        ],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Media,
+        name: "sousa",
+        help: "Sousa's sun shafts (seed 002, CryEngine): the depth map blurred radially towards \
+               each light in three chained passes of TAPS samples (steps 1/TAPS, 1/TAPS², 1/TAPS³ \
+               of the screen); image space, as mitchell; see --media-taps, --media-res, \
+               --media-brightness",
+        knobs: &[
+            number("media-taps", "samples per pass (TAPS; 3 passes)", 1.0, 64.0, 6.0, &[3.0, 6.0, 10.0]),
+            MEDIA_RES,
+            artistic(number(
+                "media-brightness",
+                "factor on each pass's sum (the seed's 0.19 for 6 taps)",
+                0.0,
+                UNBOUNDED,
+                0.19,
+                &[],
+            )),
+        ],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Media,
+        name: "toth",
+        help: "Tóth & Umenhoffer (seed 002, its errata fixed): each view ray marched through the \
+               media in world space, light visibility from the compiler's shadow maps, samples \
+               interleaved over a block of pixels and blurred back together; works with the \
+               light off screen; see --media-samples, --media-block, --media-phase",
+        knobs: &[
+            MEDIA_SAMPLES,
+            number(
+                "media-block",
+                "side of the interleaving block: each of its block² pixels takes every block²-th \
+                 sample, a block-wide blur joins them (1: every pixel takes all)",
+                1.0,
+                8.0,
+                4.0,
+                &[1.0, 2.0, 4.0],
+            ),
+            Knob {
+                name: "media-phase",
+                help: "medium: Henyey–Greenstein with the medium's g (what the reference renders); \
+                       rayleigh: 3/(16π)(1 + cos²θ)",
+                range: KnobRange::Choice(&["medium", "rayleigh"]),
+                default: KnobValue::Choice(0),
+                role: KnobRole::Scene,
+            },
+        ],
         stochastic: false,
     },
     TechniqueInfo {

@@ -49,12 +49,13 @@ pub struct MediaBuffers {
 
 impl MediaBuffers {
     /// Allocates the buffers of `manifest`'s media and uploads the table and light map; the
-    /// volumes arrive with their sections ([`MediaBuffers::upload_volume`]).
-    pub fn new(gpu: &Gpu, manifest: &Manifest, up: &mut Uploader) -> PlayResult<MediaBuffers> {
+    /// volumes (when `volumes`: a technique reads them) arrive with their sections
+    /// ([`MediaBuffers::upload_volume`]).
+    pub fn new(gpu: &Gpu, manifest: &Manifest, volumes: bool, up: &mut Uploader) -> PlayResult<MediaBuffers> {
         let media = table(manifest);
         let (dims, volume_medium, lights_with) = match &manifest.media_visibility {
-            Some(v) => (v.dims, v.medium, v.lights.clone()),
-            None => ([0; 3], u32::MAX, Vec::new()),
+            Some(v) if volumes => (v.dims, v.medium, v.lights.clone()),
+            _ => ([0; 3], u32::MAX, Vec::new()),
         };
         // Validated with the manifest: dims within the resolution limit, lights in range.
         let volume_bytes = dims.iter().map(|&d| d as u64).product::<u64>();

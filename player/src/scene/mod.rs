@@ -86,7 +86,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::BRDF_LUT && needs.brdf_lut)
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
-        || (kind == sections::MEDIA_VISIBILITY && needs.media)
+        || (kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
@@ -413,7 +413,7 @@ impl GpuScene {
             self.line_space = Some(linespace::LineSpaceBuffers::new(gpu, layout, up)?);
         }
         if needs.media && !view.manifest.media.is_empty() {
-            self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, up)?);
+            self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, needs.media_volumes, up)?);
         }
         for s in file.sections() {
             let kind = s.entry.kind;
@@ -480,7 +480,9 @@ impl GpuScene {
                     let t = tables.textures[index as usize];
                     up.buffer(&r.texels, t.offset as u64 * 4, view.texture(index as usize).map_err(bad)?)?;
                 }
-            } else if let (Some(m), true) = (&self.media, kind == sections::MEDIA_VISIBILITY) {
+            } else if let (Some(m), true) =
+                (&self.media, kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
+            {
                 m.upload_volume(index, &file.section_bytes(s).map_err(bad)?, up)?;
             } else if kind == sections::BRDF_LUT && needs.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
@@ -517,9 +519,9 @@ impl GpuScene {
                 } else if kind == sections::BRDF_LUT {
                     "no pass reads the BRDF table".into()
                 } else if kind == sections::MEDIA_VISIBILITY {
-                    "no media technique reads it (--media march does)".into()
+                    "no media technique reads it (--media march does; toth reads the shadow maps)".into()
                 } else if kind == sections::SHADOW_MAP {
-                    "no pass reads shadow maps (--shadows is not shadowmap)".into()
+                    "no pass reads shadow maps (neither --shadows shadowmap nor --media toth)".into()
                 } else {
                     "no enabled pass reads it".into()
                 };

@@ -1,4 +1,5 @@
-//! A compute kernel with its own set layout and one descriptor set: what most passes are.
+//! A compute kernel with its own set layout and descriptor sets (one for most passes; several
+//! where one pipeline runs over different images in turn, e.g. a chain of blurs).
 
 use crate::error::PlayResult;
 use crate::gpu::{Binding, ComputePipeline, Gpu, Recorder, SetLayout, Write, vk};
@@ -8,7 +9,7 @@ use crate::gpu::{Binding, ComputePipeline, Gpu, Recorder, SetLayout, Write, vk};
 pub struct Kernel {
     layout: SetLayout,
     pipeline: ComputePipeline,
-    set: vk::DescriptorSet,
+    sets: Vec<vk::DescriptorSet>,
 }
 
 impl Kernel {
@@ -17,7 +18,7 @@ impl Kernel {
     pub fn new(gpu: &Gpu, bindings: &[Binding], spirv: &[u8], push_bytes: u32) -> PlayResult<Kernel> {
         let mut layout = SetLayout::new(gpu, bindings, 1)?;
         match ComputePipeline::new(gpu, spirv, &[&layout], push_bytes) {
-            Ok(pipeline) => Ok(Kernel { layout, pipeline, set: vk::DescriptorSet::null() }),
+            Ok(pipeline) => Ok(Kernel { layout, pipeline, sets: Vec::new() }),
             Err(e) => {
                 layout.destroy(gpu);
                 Err(e)
@@ -25,18 +26,28 @@ impl Kernel {
         }
     }
 
-    /// Writes the set (allocated by the first call).
+    /// Writes set 0 (allocated by the first call).
     pub fn write(&mut self, gpu: &Gpu, writes: &[Write]) -> PlayResult {
-        if self.set == vk::DescriptorSet::null() {
-            self.set = self.layout.allocate(gpu)?;
+        self.write_set(gpu, 0, writes)
+    }
+
+    /// Writes set `index` (allocating the sets up to it by the first call).
+    pub fn write_set(&mut self, gpu: &Gpu, index: usize, writes: &[Write]) -> PlayResult {
+        while self.sets.len() <= index {
+            self.sets.push(self.layout.allocate(gpu)?);
         }
-        self.layout.write(gpu, self.set, writes);
+        self.layout.write(gpu, self.sets[index], writes);
         Ok(())
     }
 
-    /// Dispatches 8 × 8 groups over `width` × `height` with `push` constants.
+    /// Dispatches 8 × 8 groups over `width` × `height` with `push` constants and set 0.
     pub fn dispatch(&self, rec: &Recorder, push: &[u8], width: u32, height: u32) {
-        rec.dispatch(&self.pipeline, &[self.set], push, [width.div_ceil(8), height.div_ceil(8), 1]);
+        self.dispatch_set(rec, 0, push, width, height);
+    }
+
+    /// [`Kernel::dispatch`] with set `index` (written before).
+    pub fn dispatch_set(&self, rec: &Recorder, index: usize, push: &[u8], width: u32, height: u32) {
+        rec.dispatch(&self.pipeline, &[self.sets[index]], push, [width.div_ceil(8), height.div_ceil(8), 1]);
     }
 
     /// Releases pipeline and layout (and the set with it).

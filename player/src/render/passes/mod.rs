@@ -13,13 +13,16 @@ pub mod hybrid;
 pub mod kernel;
 pub mod materials;
 pub mod media;
+pub mod mitchell;
 pub mod pathtrace;
 pub mod resolve;
 pub mod rt_ao;
 pub mod rt_gi;
 pub mod rt_reflections;
 pub mod rt_shadows;
+pub mod sousa;
 pub mod tonemap;
+pub mod toth;
 pub mod visibility;
 
 use kiln_format::gpu::RtConstants;
