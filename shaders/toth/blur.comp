@@ -34,16 +34,19 @@ void main() {
     int block = int(max(tc.block, 1u));
     int reach = block / 2;
     bool even = (block & 1) == 0;
+    // The window, 2·reach + 1 wide, moved inside the image at its borders rather than cut: any
+    // window that wide still holds every sample set once.
+    ivec2 size = ivec2(frame.size.xy);
+    ivec2 first = clamp(pixel - reach, ivec2(0), max(size - 1 - 2 * reach, ivec2(0)));
+    ivec2 last = min(first + 2 * reach, size - 1);
     vec3 sum = vec3(0.0);
     float weights = 0.0;
-    for (int dy = -reach; dy <= reach; dy++) {
-        for (int dx = -reach; dx <= reach; dx++) {
-            ivec2 q = pixel + ivec2(dx, dy);
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(uvec2(q), frame.size.xy))) {
-                continue;
-            }
-            float w = (even && abs(dx) == reach ? 0.5 : 1.0) * (even && abs(dy) == reach ? 0.5 : 1.0);
-            if (dx != 0 || dy != 0) {
+    for (int y = first.y; y <= last.y; y++) {
+        for (int x = first.x; x <= last.x; x++) {
+            ivec2 q = ivec2(x, y);
+            float w = (even && (x == first.x || x == first.x + 2 * reach) ? 0.5 : 1.0)
+                    * (even && (y == first.y || y == first.y + 2 * reach) ? 0.5 : 1.0);
+            if (q != pixel) {
                 float tq = distance_at(q);
                 bool sky = t == SKY_DISTANCE, sky_q = tq == SKY_DISTANCE;
                 if (sky != sky_q || (!sky && abs(tq - t) > 0.1 * min(t, tq))) {

@@ -90,6 +90,18 @@ impl Pinhole {
             .normalize()
     }
 
+    /// Where the direction `w` (a point at infinity) lies in a `w` × `h` image's texture
+    /// coordinates (x right, y down, the image [0, 1]²); `None` behind the camera.
+    pub fn project_direction(&self, dir: DVec3) -> Option<(f64, f64)> {
+        let depth = dir.dot(self.forward);
+        if depth <= 0.0 {
+            return None;
+        }
+        let nx = dir.dot(self.right) / depth / (self.tan_half * self.aspect);
+        let ny = dir.dot(self.up) / depth / self.tan_half;
+        Some((0.5 + 0.5 * nx, 0.5 - 0.5 * ny))
+    }
+
     /// The same camera as a file's camera record.
     pub fn file_camera(&self) -> Camera {
         let t = self.eye + self.forward;

@@ -13,7 +13,8 @@ mod analytic; // one light on a diffuse plane against its closed form, per pixel
 mod colors; // vertex colours in both G-buffers and the reference, against closed forms
 mod files; // damaged files fail with the right exit code; minimal files render
 mod gi; // path-traced GI plus direct light against the two-bounce reference
-mod media; // single scattering in a lit slab against its closed form (reference path tracer)
+mod godrays; // Mitchell's and Sousa's image-space blurs, their failure with the light behind the camera
+mod media; // single scattering in a lit slab against its closed form (reference, march, toth)
 mod raytraced; // ray-traced AO and reflections against closed forms, accumulation
 mod rect; // a rect light against the polygon irradiance: direct pass, RT shadows, reference
 mod reference; // the reference path tracer's GGX in a white furnace

@@ -177,6 +177,12 @@ impl Options {
         self
     }
 
+    /// Participating media by `media` (any technique).
+    pub fn media(mut self, media: Media) -> Options {
+        self.0.render.techniques.media = media;
+        self
+    }
+
     /// Uploads the BVH for ray queries (`RayQuery`).
     pub fn rays(mut self) -> Options {
         self.0.render.purpose = Purpose::RayQueries;

@@ -147,7 +147,8 @@ impl Plan {
             run(
                 Stage::ShadowMaps,
                 format!(
-                    "{} maps of {1}x{1}, {cubes} cube maps of 6x{2}x{2}",
+                    "{} maps of {1}x{1}, {cubes} cube maps of 6x{2}x{2}; read by kiln-play --shadows shadowmap \
+                     (the default) and --media toth",
                     casters - cubes,
                     settings.shadow_res,
                     (settings.shadow_res / 2).max(1)
@@ -162,7 +163,8 @@ impl Plan {
             run(
                 Stage::MediaVisibility,
                 format!(
-                    "medium 0, {casters} lights, {} cells on the longest axis; read by kiln-play --media march",
+                    "medium 0, {casters} lights, {} cells on the longest axis; read by kiln-play --media march \
+                     (toth reads the shadow maps; mitchell and sousa neither)",
                     settings.media_volume_res
                 ),
             )

@@ -1132,6 +1132,34 @@ mod tests {
     }
 
     #[test]
+    fn media_techniques_read_only_the_sections_they_use() {
+        // What `kiln plan` says of the MVIS and SHDW stages: march reads the visibility
+        // volumes, toth the shadow maps, the image-space blurs neither; all read the media table.
+        let none = Techniques { shadows: Shadows::None, ..Techniques::default() };
+        let needs = |media| Techniques { media, ..none }.needs();
+        let march = needs(Media::March { steps: 8 });
+        assert!(march.media && march.media_volumes && !march.shadow_maps);
+        let toth = needs(Media::Toth { samples: 16, block: 2, phase: Phase::Medium });
+        assert!(toth.media && !toth.media_volumes && toth.shadow_maps);
+        for blur in [
+            Media::Mitchell { samples: 8, resolution: ScreenFraction::Half, exposure: 1.0 },
+            Media::Sousa { taps: 6, resolution: ScreenFraction::Half, brightness: 0.19 },
+        ] {
+            let n = needs(blur);
+            assert!(n.media && !n.media_volumes && !n.shadow_maps, "{blur:?}");
+            assert!(!blur.dims_surfaces(), "{blur:?}");
+        }
+        assert_eq!(needs(Media::None), Needs::FRAME);
+        assert!(Media::March { steps: 1 }.dims_surfaces());
+        // The block splits the samples: block² of them at least.
+        let mut t = Techniques::default();
+        let e = t.set(Effect::Media, "toth", &[("media-samples", KnobValue::Number(8.0))]).unwrap_err();
+        assert!(e.contains("media-block 4") && e.contains("16"), "{e}");
+        t.set(Effect::Media, "toth", &[("media-phase", KnobValue::Choice(1))]).unwrap();
+        assert_eq!(t.media, Media::Toth { samples: 60, block: 4, phase: Phase::Rayleigh });
+    }
+
+    #[test]
     fn the_catalogue_builds_gi_rt_with_its_bounces() {
         let mut t = Techniques::default();
         t.set(Effect::Gi, "rt", &[]).unwrap();
