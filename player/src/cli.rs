@@ -234,7 +234,8 @@ pub struct Args {
     /// the screen), 1 to 64 (default 6).
     #[arg(long, value_name = "N")]
     pub media_taps: Option<u32>,
-    /// With --media sousa: the factor on each pass's sum (default 0.19).
+    /// With --media sousa: the factor on each pass's sum at 6 taps (default 0.19, the seed's;
+    /// scaled by 6/TAPS for other tap counts, so that taps refine rather than brighten).
     #[arg(long, value_name = "F")]
     pub media_brightness: Option<f32>,
     /// With --media toth: side of the interleaving block in pixels, 1 to 8 (default 4;

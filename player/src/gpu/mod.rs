@@ -152,11 +152,34 @@ fn unsupported(msg: impl Into<String>) -> PlayError {
     PlayError::new(Exit::Unsupported, msg)
 }
 
+/// The Vulkan loader, loaded once per process, with one bare instance kept alive beside it.
+///
+/// The loader loads the drivers (ICDs) when an instance is created and unloads them when the
+/// last one is destroyed. NVIDIA's driver does not survive many such cycles in one process: on
+/// the H100, kiln-bench's 28th session (one per configuration) failed to create its instance
+/// with `ERROR_INCOMPATIBLE_DRIVER`. The kept instance holds the drivers loaded, so sessions
+/// come and go without reloading them. It has no layers and no objects, and ends with the process.
+fn loader() -> Result<ash::Entry, String> {
+    static LOADED: std::sync::OnceLock<Result<ash::Entry, String>> = std::sync::OnceLock::new();
+    LOADED
+        .get_or_init(|| {
+            // SAFETY: loading the system's Vulkan loader; its symbols are only called through ash.
+            let entry = unsafe { ash::Entry::load() }.map_err(|e| e.to_string())?;
+            let app = vk::ApplicationInfo::default().api_version(vk::API_VERSION_1_0);
+            // SAFETY: `app` outlives the call. A failure here is left for the session's own
+            // instance to report in full.
+            let _kept = unsafe {
+                entry.create_instance(&vk::InstanceCreateInfo::default().application_info(&app), None)
+            };
+            Ok(entry)
+        })
+        .clone()
+}
+
 impl Gpu {
     /// Creates instance and device, or says precisely why not.
     pub fn new(options: &GpuOptions) -> PlayResult<Gpu> {
-        // SAFETY: loading the system's Vulkan loader; its symbols are only called through ash.
-        let entry = unsafe { ash::Entry::load() }.map_err(|e| {
+        let entry = loader().map_err(|e| {
             unsupported(format!(
                 "no Vulkan loader ({e}): install a Vulkan driver, or Mesa's CPU driver lavapipe (Debian: libvulkan1 mesa-vulkan-drivers)"
             ))
@@ -458,7 +481,7 @@ impl Gpu {
 
 /// The Vulkan devices on this machine: (name, type, API version) each.
 pub fn list_devices() -> PlayResult<Vec<(String, String, String)>> {
-    let entry = unsafe { ash::Entry::load() }.map_err(|e| unsupported(format!("no Vulkan loader ({e})")))?;
+    let entry = loader().map_err(|e| unsupported(format!("no Vulkan loader ({e})")))?;
     let app = vk::ApplicationInfo::default().api_version(vk::API_VERSION_1_3);
     let instance =
         unsafe { entry.create_instance(&vk::InstanceCreateInfo::default().application_info(&app), None) }

@@ -185,7 +185,7 @@ pub enum Media {
         taps: u32,
         /// Resolution of the depth map and the first two passes.
         resolution: ScreenFraction,
-        /// The factor on each pass's sum.
+        /// The factor on each pass's sum at 6 taps (scaled by 6/TAPS for other counts).
         brightness: f32,
     },
     /// Tóth & Umenhoffer's ray march through the baked shadow maps (seed 002, errata fixed),
@@ -1022,7 +1022,7 @@ static CATALOGUE: [TechniqueInfo; 20] = [
             MEDIA_RES,
             artistic(number(
                 "media-brightness",
-                "factor on each pass's sum (the seed's 0.19 for 6 taps)",
+                "factor on each pass's sum at 6 taps (the seed's 0.19), scaled by 6/TAPS for others",
                 0.0,
                 UNBOUNDED,
                 0.19,

@@ -29,6 +29,9 @@ const fn small_target(name: &'static str) -> TargetDecl {
     }
 }
 
+/// The tap count the seed tuned its brightness of 0.19 for (Fig. 3.8).
+pub const SEED_TAPS: u32 = 6;
+
 /// The depth map (view distance over the scene's diagonal, the sky 1).
 pub const DEPTH_MAP: TargetDecl = small_target("sousa depth");
 /// The first blur's output.
@@ -84,7 +87,11 @@ impl SousaPass {
     /// `resolution`, each pass's sum times `brightness`.
     pub fn new(gpu: &Gpu, taps: u32, resolution: ScreenFraction, brightness: f32) -> PlayResult<SousaPass> {
         let [depth, blur, composite] = kernels(gpu, std::mem::size_of::<GodRayConstants>() as u32)?;
-        let constants = GodRayConstants { samples: taps.max(1), gain: brightness, ..Default::default() };
+        // The brightness is the seed's, tuned for its 6 taps: per sample it is scaled by 6/TAPS so
+        // that more taps refine the shafts instead of brightening them.
+        let taps = taps.max(1);
+        let gain = brightness * SEED_TAPS as f32 / taps as f32;
+        let constants = GodRayConstants { samples: taps, gain, ..Default::default() };
         Ok(SousaPass { depth, blur, composite, constants, divisor: resolution.divisor(), lights: 0 })
     }
 
