@@ -357,34 +357,38 @@ fn the_shadow_map_march_matches_single_scattering_in_a_lit_slab() {
     if !vulkan() {
         return;
     }
-    let travel = Vec3::from_array(TRAVEL);
     let Haze { sigma_a, sigma_s, g, depth, irradiance } = HAZE;
     let dir = tempfile::tempdir().unwrap();
-    let bytes = slab_file(sigma_a, sigma_s, g, depth, travel, irradiance);
-    let cos_theta = travel.y as f64;
-    for (phase, p) in
-        [(Phase::Medium, henyey_greenstein(g as f64, cos_theta)), (Phase::Rayleigh, rayleigh(cos_theta))]
-    {
-        let media = Media::Toth { samples: 64, block: 4, phase };
-        let (rgb, _) =
-            render(dir.path(), &format!("toth {phase:?}"), &bytes, |f| Options::new(f, W, H).media(media));
-        for c in 0..3 {
-            let want = scattered_with(
-                sigma_a[c] as f64,
-                sigma_s[c] as f64,
-                p,
-                depth as f64,
-                travel,
-                irradiance as f64,
-            );
-            eprintln!("toth {phase:?}: channel {c}: mean {:.6} vs {want:.6}", mean(&rgb)[c]);
-            for y in 2..H - 2 {
-                for x in 2..W - 2 {
-                    let got = rgb[((y * W + x) * 3) as usize + c] as f64;
-                    assert!(
-                        (got - want).abs() / want < 0.01,
-                        "{phase:?}: pixel ({x}, {y}) channel {c}: {got:.6} vs the closed form {want:.6}"
-                    );
+    // Two scattering angles (cos θ −0.6 and −0.96), so that a phase function with the right
+    // value at one angle but the wrong shape fails too.
+    for travel in [Vec3::from_array(TRAVEL), Vec3::new(0.28, -0.96, 0.0)] {
+        let bytes = slab_file(sigma_a, sigma_s, g, depth, travel, irradiance);
+        let cos_theta = travel.y as f64;
+        for (phase, p) in
+            [(Phase::Medium, henyey_greenstein(g as f64, cos_theta)), (Phase::Rayleigh, rayleigh(cos_theta))]
+        {
+            let media = Media::Toth { samples: 64, block: 4, phase };
+            let (rgb, _) = render(dir.path(), &format!("toth {phase:?}"), &bytes, |f| {
+                Options::new(f, W, H).media(media)
+            });
+            for c in 0..3 {
+                let want = scattered_with(
+                    sigma_a[c] as f64,
+                    sigma_s[c] as f64,
+                    p,
+                    depth as f64,
+                    travel,
+                    irradiance as f64,
+                );
+                eprintln!("toth {phase:?}: channel {c}: mean {:.6} vs {want:.6}", mean(&rgb)[c]);
+                for y in 2..H - 2 {
+                    for x in 2..W - 2 {
+                        let got = rgb[((y * W + x) * 3) as usize + c] as f64;
+                        assert!(
+                            (got - want).abs() / want < 0.01,
+                            "{phase:?}: pixel ({x}, {y}) channel {c}: {got:.6} vs the closed form {want:.6}"
+                        );
+                    }
                 }
             }
         }
