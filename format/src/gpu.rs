@@ -221,7 +221,7 @@ gpu_struct! {
 
 gpu_struct! {
     /// Push constants of the image-space god-ray passes (`shaders/mitchell/*`,
-    /// `shaders/sousa/*`; 32 bytes): one light's radial blur per dispatch.
+    /// `shaders/sousa/*`; 28 bytes): one light's radial blur per dispatch.
     pub struct GodRayConstants {
         /// The light (index into the light buffer) whose shafts this dispatch makes.
         pub light: u32 => "uint",
@@ -237,8 +237,6 @@ gpu_struct! {
         /// Mitchell: the radius of the lights' emitting proxies; Sousa: the distance that maps
         /// to depth 1 (the sky's).
         pub extent: f32 => "float",
-        /// Sousa: 1 for the last pass (adds to the radiance), 0 for the others.
-        pub last: u32 => "uint",
         /// Entries of the `GpuMedium` buffer (the shafts take medium 0's albedo and phase).
         pub media: u32 => "uint",
     }

@@ -16,6 +16,10 @@ bool light_on_screen(GpuLight l, out vec2 uv) {
     if (!(clip.w > 0.0)) {
         return false;
     }
+    // An orthographic projection keeps w = 1 behind the camera too.
+    if (camera_orthographic() && dot(l.position - frame.camera.xyz, frame.camera_forward.xyz) <= 0.0) {
+        return false;
+    }
     vec2 ndc = clip.xy / clip.w;
     uv = vec2(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     return all(lessThan(abs(uv), vec2(1e6)));
@@ -41,6 +45,9 @@ vec3 shaft_radiance(GpuLight l, vec3 d, uint media_count) {
         vec3 to = l.position - frame.camera.xyz;
         float d2 = dot(to, to);
         if (!(d2 > 0.0)) {
+            return vec3(0.0);
+        }
+        if (l.range > 0.0 && d2 > l.range * l.range) {
             return vec3(0.0);
         }
         towards = to * inversesqrt(d2);

@@ -125,9 +125,8 @@ struct GodRayConstants {
     float gain; // offset 12
     float decay; // offset 16
     float extent; // offset 20
-    uint last; // offset 24
-    uint media; // offset 28
-}; // 32 bytes
+    uint media; // offset 24
+}; // 28 bytes
 
 struct TothConstants {
     uint samples; // offset 0

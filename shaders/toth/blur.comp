@@ -40,7 +40,7 @@ void main() {
     ivec2 first = clamp(pixel - reach, ivec2(0), max(size - 1 - 2 * reach, ivec2(0)));
     ivec2 last = min(first + 2 * reach, size - 1);
     vec3 sum = vec3(0.0);
-    float weights = 0.0;
+    float taken = 0.0;
     for (int y = first.y; y <= last.y; y++) {
         for (int x = first.x; x <= last.x; x++) {
             ivec2 q = ivec2(x, y);
@@ -53,8 +53,9 @@ void main() {
                     continue;
                 }
             }
-            sum += w * texelFetch(scatter, q, 0).rgb;
-            weights += w;
+            vec4 s = texelFetch(scatter, q, 0);
+            sum += w * s.rgb;
+            taken += w * s.a;
         }
     }
     vec2 at = vec2(pixel) + 0.5;
@@ -62,5 +63,9 @@ void main() {
     vec3 d = normalize(pixel_ray(at));
     vec4 l0 = imageLoad(radiance, pixel);
     vec3 transmittance = exp(-optical_depth(tc.media, o, d, 0.0, t));
-    imageStore(radiance, pixel, vec4(l0.rgb * transmittance + sum / weights, l0.a));
+    // Σ w·sums / Σ w·counts is the mean over the samples taken, times the march's n: exact where
+    // the window holds every sample set once (a count that is no multiple of block² included),
+    // a ratio estimate where depth edges left neighbours out.
+    vec3 scattered = taken > 0.0 ? sum * (float(max(tc.samples, 1u)) / taken) : vec3(0.0);
+    imageStore(radiance, pixel, vec4(l0.rgb * transmittance + scattered, l0.a));
 }

@@ -14,9 +14,8 @@
 // is unshadowed), p the normalised Henyey–Greenstein (the medium's g) or Rayleigh phase function
 // and τ the optical depth through the media boxes, analytic. The transmittances are computed per
 // sample, not accumulated, so samples are independent: interleaved sampling splits the samples
-// over a block × block tile (each pixel takes every block²-th one, scaled up by the samples it
-// stands for), and `toth/blur.comp` averages the tile back together. Output: the in-scattered
-// radiance per pixel, before the blur.
+// over a block × block tile (each pixel takes every block²-th one), and `toth/blur.comp` joins
+// the tile back together. Output: the pixel's samples' sum (rgb) and how many it took (alpha).
 #include "../common/layout.glsl"
 #include "../common/lights.glsl"
 
@@ -153,8 +152,9 @@ void main() {
             sum += exp(-optical_depth(tc.media, o, d, 0.0, t)) * in_scattered(x, d);
             taken++;
         }
-        // Each sample this pixel took stands for n / taken of the march's.
-        sum *= taken > 0u ? ds * float(n) / float(taken) : 0.0;
+        sum *= ds;
+        imageStore(scatter, pixel, vec4(sum, float(taken)));
+        return;
     }
-    imageStore(scatter, pixel, vec4(sum, 1.0));
+    imageStore(scatter, pixel, vec4(0.0));
 }

@@ -524,7 +524,7 @@ impl Techniques {
                 if block * block > samples {
                     return Err(format!(
                         "{effect} {name}: media-block {block} splits the samples over {} pixels: give at least \
-                         that many media-samples (not {samples}), or a smaller block",
+                         that many media-samples (there are {samples}), or a smaller block",
                         block * block
                     ));
                 }
