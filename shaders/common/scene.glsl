@@ -14,6 +14,7 @@
 #include "lights.glsl"
 #include "textures.glsl"
 #include "vertices.glsl"
+#include "normalmap.glsl"
 
 vec2 triangle_uv(uint tri, float u, float v) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
@@ -108,7 +109,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
             vec3 bitangent = (e2 * d1.x - e1 * d2.x) / det;
             tangent = normalize(tangent - ns * dot(ns, tangent));
             bitangent = cross(ns, tangent) * (dot(cross(ns, tangent), bitangent) < 0.0 ? -1.0 : 1.0);
-            vec3 mtex = sample_texture(m.normal_texture, uv).xyz * 2.0 - 1.0;
+            vec3 mtex = normal_texel(sample_texture(m.normal_texture, uv));
             vec3 mapped = tangent * mtex.x * m.normal_scale - bitangent * mtex.y * m.normal_scale + ns * mtex.z;
             if (dot(mapped, mapped) > 0.0) {
                 ns = normalize(mapped);

@@ -75,7 +75,7 @@ void main() {
     if (m.normal_texture != NO_TEXTURE) {
         vec3 dp_dx = (bx.x - b.x) * e1 + (bx.y - b.y) * e2;
         vec3 dp_dy = (by.x - b.x) * e1 + (by.y - b.y) * e2;
-        vec3 ts = sample_texture_grad(m.normal_texture, uv, duv_dx, duv_dy).xyz * 2.0 - 1.0;
+        vec3 ts = normal_texel(sample_texture_grad(m.normal_texture, uv, duv_dx, duv_dy));
         n = normal_mapped(n, dp_dx, dp_dy, duv_dx, duv_dy, ts, m.normal_scale);
     }
     vec4 base = m.base_color * interpolated_color(idx, b.x, b.y);
