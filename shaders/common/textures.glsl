@@ -7,6 +7,13 @@
 
 #include "bc.glsl"
 
+// Whether the texel buffer holds BC blocks: a specialization constant the player sets per file
+// from its textures' formats when it builds the pipelines (player/src/render/texels.rs). Left
+// false, the driver drops every copy of the BC decoders before compiling, so a file without BC
+// textures compiles as fast as before they existed; a BC file read with it false would decode
+// its blocks as RGBA8 words.
+layout(constant_id = 0) const bool TEXELS_BC = false;
+
 int wrap(int i, int n, uint mode) {
     if (mode == 2u) {
         return clamp(i, 0, n - 1);
@@ -26,7 +33,7 @@ uint texture_format(GpuTexture t) {
 // Texel (x, y) of a level as stored (BC5: R, G, 0, 1; BC4: R, 0, 0, 1).
 vec4 stored_texel(GpuTexture t, uvec3 level, uint x, uint y) {
     uint f = texture_format(t);
-    if (f == 0u) {
+    if (!TEXELS_BC || f == 0u) {
         return unpackUnorm4x8(texels[level.z + y * level.x + x]);
     }
     uint block = (y >> 2u) * ((level.x + 3u) >> 2u) + (x >> 2u);
@@ -63,7 +70,7 @@ vec4 level_texel(GpuTexture t, uvec3 level, int x, int y) {
 uint level_words(GpuTexture t, uint w, uint h) {
     uint f = texture_format(t);
     uint blocks = ((w + 3u) >> 2u) * ((h + 3u) >> 2u);
-    return f == 0u ? w * h : (f == 3u ? 2u * blocks : 4u * blocks);
+    return !TEXELS_BC || f == 0u ? w * h : (f == 3u ? 2u * blocks : 4u * blocks);
 }
 
 // Mip level `level` of a texture: its size and first word.

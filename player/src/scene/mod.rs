@@ -18,7 +18,7 @@ use kiln_format::sections::{self, GpuMaterial, PixelFormat, Swizzle, Vertex};
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, Write};
-use crate::render::Needs;
+use crate::render::{Needs, TexelDecode};
 use upload::Uploader;
 
 /// One draw: the triangles of one material, contiguous in the index buffer.
@@ -136,6 +136,12 @@ impl<'f> Prepared<'f> {
         });
         Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space })
     }
+
+    /// How the passes that read the texel buffer must decode it: from the texture table they
+    /// read (the formats in the textures' section headers), known before any section uploads.
+    pub fn texel_decode(&self) -> TexelDecode {
+        self.reference.as_ref().map_or(TexelDecode::Rgba8, |r| TexelDecode::of(&r.textures))
+    }
 }
 
 impl GpuScene {
@@ -215,6 +221,8 @@ pub struct ReferenceBuffers {
     pub raster_materials: Buffer,
     /// `GpuMedium` table.
     pub media: Buffer,
+    /// How the passes that read `texels` decode it.
+    pub texel_decode: TexelDecode,
     /// Entries in `emitters`.
     pub emitter_count: u32,
     /// Entries in `media`.
@@ -712,6 +720,7 @@ fn reference_buffers(
         textures: next(),
         raster_materials: next(),
         media: next(),
+        texel_decode: TexelDecode::of(&tables.textures),
         emitter_count: tables.emitters.len() as u32,
         media_count: tables.media.len() as u32,
     })
