@@ -45,40 +45,39 @@ float bc4_channel(uint w0, uint w1, uint i) {
     return v / 255.0;
 }
 
-// Per mode: subsets, partition bits, rotation bits, index-selection bits, colour and alpha
-// endpoint bits, a P-bit per endpoint or per subset, primary and secondary index bits.
-const uint BC7_NS[8] = uint[](3u, 2u, 3u, 2u, 1u, 1u, 1u, 2u);
-const uint BC7_PB[8] = uint[](4u, 6u, 6u, 6u, 0u, 0u, 0u, 6u);
-const uint BC7_RB[8] = uint[](0u, 0u, 0u, 0u, 2u, 2u, 0u, 0u);
-const uint BC7_ISB[8] = uint[](0u, 0u, 0u, 0u, 1u, 0u, 0u, 0u);
-const uint BC7_CB[8] = uint[](4u, 6u, 5u, 7u, 5u, 7u, 7u, 5u);
-const uint BC7_AB[8] = uint[](0u, 0u, 0u, 0u, 6u, 8u, 7u, 5u);
-const uint BC7_EPB[8] = uint[](1u, 0u, 0u, 1u, 0u, 0u, 1u, 1u);
-const uint BC7_SPB[8] = uint[](0u, 1u, 0u, 0u, 0u, 0u, 0u, 0u);
-const uint BC7_IB[8] = uint[](3u, 3u, 2u, 2u, 2u, 2u, 4u, 2u);
-const uint BC7_IB2[8] = uint[](0u, 0u, 0u, 0u, 3u, 2u, 0u, 0u);
+// Per mode (4 bits each, mode 0 lowest): subsets, partition bits, rotation bits, index-selection
+// bits, colour and alpha endpoint bits, a P-bit per endpoint or per subset, primary and secondary
+// index bits. Packed words, not arrays: each dynamically indexed array is a table the driver
+// builds at every inlined copy of the decoder.
+const uint BC7_NS = 0x21112323u;
+const uint BC7_PB = 0x60006664u;
+const uint BC7_RB = 0x00220000u;
+const uint BC7_ISB = 0x00010000u;
+const uint BC7_CB = 0x57757564u;
+const uint BC7_AB = 0x57860000u;
+const uint BC7_EPB = 0x11001001u;
+const uint BC7_SPB = 0x00000010u;
+const uint BC7_IB = 0x24222233u;
+const uint BC7_IB2 = 0x00230000u;
 
-// Two-subset partitions: bit i is texel i's subset; the second subset's anchor texel.
-const uint BC7_P2[64] = uint[](
-    0xccccu, 0x8888u, 0xeeeeu, 0xecc8u, 0xc880u, 0xfeecu, 0xfec8u, 0xec80u,
-    0xc800u, 0xffecu, 0xfe80u, 0xe800u, 0xffe8u, 0xff00u, 0xfff0u, 0xf000u,
-    0xf710u, 0x008eu, 0x7100u, 0x08ceu, 0x008cu, 0x7310u, 0x3100u, 0x8cceu,
-    0x088cu, 0x3110u, 0x6666u, 0x366cu, 0x17e8u, 0x0ff0u, 0x718eu, 0x399cu,
-    0xaaaau, 0xf0f0u, 0x5a5au, 0x33ccu, 0x3c3cu, 0x55aau, 0x9696u, 0xa55au,
-    0x73ceu, 0x13c8u, 0x324cu, 0x3bdcu, 0x6996u, 0xc33cu, 0x9966u, 0x0660u,
-    0x0272u, 0x04e4u, 0x4e40u, 0x2720u, 0xc936u, 0x936cu, 0x39c6u, 0x639cu,
-    0x9336u, 0x9cc6u, 0x817eu, 0xe718u, 0xccf0u, 0x0fccu, 0x7744u, 0xee22u);
-const uint BC7_A2[64] = uint[](
-    15u, 15u, 15u, 15u, 15u, 15u, 15u, 15u,
-    15u, 15u, 15u, 15u, 15u, 15u, 15u, 15u,
-    15u, 2u, 8u, 2u, 2u, 8u, 8u, 15u,
-    2u, 8u, 2u, 2u, 8u, 8u, 2u, 2u,
-    15u, 15u, 6u, 8u, 2u, 8u, 15u, 15u,
-    2u, 8u, 2u, 2u, 2u, 15u, 15u, 6u,
-    6u, 2u, 6u, 8u, 15u, 15u, 2u, 2u,
-    15u, 15u, 15u, 15u, 15u, 2u, 2u, 15u);
+uint bc7_mode_field(uint table, uint mode) {
+    return (table >> (4u * mode)) & 15u;
+}
 
-// Three-subset partitions: bits 2i..2i+1 are texel i's subset; the anchors of subsets 1 and 2.
+// Per partition: bits 0-15 are texel i's subset in a two-subset partition (bit i); the anchor of
+// its second subset (bits 16-19); the anchors of subsets 1 and 2 of the three-subset partition of
+// the same number (bits 20-23, 24-27). One table where there were four.
+const uint BC7_PARTITION[64] = uint[](
+    0x0f3fccccu, 0x083f8888u, 0x08ffeeeeu, 0x03ffecc8u, 0x0f8fc880u, 0x0f3ffeecu, 0x03fffec8u, 0x08ffec80u,
+    0x0f8fc800u, 0x0f8fffecu, 0x0f6ffe80u, 0x0f6fe800u, 0x0f6fffe8u, 0x0f5fff00u, 0x0f3ffff0u, 0x083ff000u,
+    0x0f3ff710u, 0x0832008eu, 0x0f887100u, 0x03f208ceu, 0x0f32008cu, 0x08387310u, 0x0f683100u, 0x08af8cceu,
+    0x0352088cu, 0x0f883110u, 0x06826666u, 0x0a62366cu, 0x0f8817e8u, 0x0f580ff0u, 0x0af2718eu, 0x08f2399cu,
+    0x0f8faaaau, 0x03fff0f0u, 0x0f365a5au, 0x0a5833ccu, 0x0a623c3cu, 0x08a855aau, 0x098f9696u, 0x0affa55au,
+    0x06f273ceu, 0x0f3813c8u, 0x08f2324cu, 0x0f523bdcu, 0x03f26996u, 0x06ffc33cu, 0x06ff9966u, 0x08f60660u,
+    0x0f360272u, 0x03f204e4u, 0x0f564e40u, 0x0f582720u, 0x0f5fc936u, 0x0f8f936cu, 0x0f5239c6u, 0x0fa2639cu,
+    0x0f5f9336u, 0x0faf9cc6u, 0x0f8f817eu, 0x0fdfe718u, 0x03ffccf0u, 0x0fc20fccu, 0x0f327744u, 0x083fee22u);
+
+// Three-subset partitions: bits 2i..2i+1 are texel i's subset.
 const uint BC7_P3[64] = uint[](
     0xaa685050u, 0x6a5a5040u, 0x5a5a4200u, 0x5450a0a8u, 0xa5a50000u, 0xa0a05050u, 0x5555a0a0u, 0x5a5a5050u,
     0xaa550000u, 0xaa555500u, 0xaaaa5500u, 0x90909090u, 0x94949494u, 0xa4a4a4a4u, 0xa9a59450u, 0x2a0a4250u,
@@ -88,31 +87,12 @@ const uint BC7_P3[64] = uint[](
     0x500aa550u, 0xaaaa4444u, 0x66660000u, 0xa5a0a5a0u, 0x50a050a0u, 0x69286928u, 0x44aaaa44u, 0x66666600u,
     0xaa444444u, 0x54a854a8u, 0x95809580u, 0x96969600u, 0xa85454a8u, 0x80959580u, 0xaa141414u, 0x96960000u,
     0xaaaa1414u, 0xa05050a0u, 0xa0a5a5a0u, 0x96000000u, 0x40804080u, 0xa9a8a9a8u, 0xaaaaaa44u, 0x2a4a5254u);
-const uint BC7_A3A[64] = uint[](
-    3u, 3u, 15u, 15u, 8u, 3u, 15u, 15u,
-    8u, 8u, 6u, 6u, 6u, 5u, 3u, 3u,
-    3u, 3u, 8u, 15u, 3u, 3u, 6u, 10u,
-    5u, 8u, 8u, 6u, 8u, 5u, 15u, 15u,
-    8u, 15u, 3u, 5u, 6u, 10u, 8u, 15u,
-    15u, 3u, 15u, 5u, 15u, 15u, 15u, 15u,
-    3u, 15u, 5u, 5u, 5u, 8u, 5u, 10u,
-    5u, 10u, 8u, 13u, 15u, 12u, 3u, 3u);
-const uint BC7_A3B[64] = uint[](
-    15u, 8u, 8u, 3u, 15u, 15u, 3u, 8u,
-    15u, 15u, 15u, 15u, 15u, 15u, 15u, 8u,
-    15u, 8u, 15u, 3u, 15u, 8u, 15u, 8u,
-    3u, 15u, 6u, 10u, 15u, 15u, 10u, 8u,
-    15u, 3u, 15u, 10u, 10u, 8u, 9u, 10u,
-    6u, 15u, 8u, 15u, 3u, 6u, 6u, 8u,
-    15u, 3u, 15u, 15u, 15u, 15u, 15u, 15u,
-    15u, 15u, 15u, 15u, 3u, 15u, 15u, 8u);
 
-const uint BC7_W2[4] = uint[](0u, 21u, 43u, 64u);
-const uint BC7_W3[8] = uint[](0u, 9u, 18u, 27u, 37u, 46u, 55u, 64u);
-const uint BC7_W4[16] = uint[](0u, 4u, 9u, 13u, 17u, 21u, 26u, 30u, 34u, 38u, 43u, 47u, 51u, 55u, 60u, 64u);
-
+// Interpolation weight of `index` among 2^bits: round(64 index / (2^bits - 1)), the
+// specification's tables of 2-, 3- and 4-bit weights.
 uint bc7_weight(uint bits, uint index) {
-    return bits == 2u ? BC7_W2[index] : (bits == 3u ? BC7_W3[index] : BC7_W4[index]);
+    uint top = (1u << bits) - 1u;
+    return (128u * index + top) / (2u * top);
 }
 
 // An endpoint component of `bits` bits (P-bit appended when `pbit` is not ~0u), expanded to 8
@@ -133,31 +113,31 @@ vec4 bc7_texel(uvec4 b, uint i) {
     }
     uint mode = uint(findLSB(b.x & 0xffu));
     uint pos = mode + 1u;
-    uint ns = BC7_NS[mode];
-    uint part = bc_bits(b, pos, BC7_PB[mode]);
-    pos += BC7_PB[mode];
-    uint rotation = bc_bits(b, pos, BC7_RB[mode]);
-    pos += BC7_RB[mode];
-    uint isb = bc_bits(b, pos, BC7_ISB[mode]);
-    pos += BC7_ISB[mode];
+    uint ns = bc7_mode_field(BC7_NS, mode);
+    uint part = bc_bits(b, pos, bc7_mode_field(BC7_PB, mode));
+    pos += bc7_mode_field(BC7_PB, mode);
+    uint rotation = bc_bits(b, pos, bc7_mode_field(BC7_RB, mode));
+    pos += bc7_mode_field(BC7_RB, mode);
+    uint isb = bc_bits(b, pos, bc7_mode_field(BC7_ISB, mode));
+    pos += bc7_mode_field(BC7_ISB, mode);
     uint subset = 0u, anchor1 = 16u, anchor2 = 16u;
     if (ns == 2u) {
-        subset = (BC7_P2[part] >> i) & 1u;
-        anchor1 = BC7_A2[part];
+        subset = (BC7_PARTITION[part] >> i) & 1u;
+        anchor1 = (BC7_PARTITION[part] >> 16u) & 15u;
     } else if (ns == 3u) {
         subset = (BC7_P3[part] >> (2u * i)) & 3u;
-        anchor1 = BC7_A3A[part];
-        anchor2 = BC7_A3B[part];
+        anchor1 = (BC7_PARTITION[part] >> 20u) & 15u;
+        anchor2 = (BC7_PARTITION[part] >> 24u) & 15u;
     }
-    uint cb = BC7_CB[mode], ab = BC7_AB[mode];
+    uint cb = bc7_mode_field(BC7_CB, mode), ab = bc7_mode_field(BC7_AB, mode);
     uint pbits = pos + 6u * ns * cb + 2u * ns * ab;
     uint p0 = ~0u, p1 = ~0u;
     uint index_start = pbits;
-    if (BC7_EPB[mode] == 1u) {
+    if (bc7_mode_field(BC7_EPB, mode) == 1u) {
         p0 = bc_bits(b, pbits + 2u * subset, 1u);
         p1 = bc_bits(b, pbits + 2u * subset + 1u, 1u);
         index_start += 2u * ns;
-    } else if (BC7_SPB[mode] == 1u) {
+    } else if (bc7_mode_field(BC7_SPB, mode) == 1u) {
         p0 = bc_bits(b, pbits + subset, 1u);
         p1 = p0;
         index_start += ns;
@@ -178,12 +158,12 @@ vec4 bc7_texel(uvec4 b, uint i) {
     }
     // Primary indices: every texel IB bits but the anchors (texel 0 and each further subset's
     // anchor), which have one bit less.
-    uint ib = BC7_IB[mode];
+    uint ib = bc7_mode_field(BC7_IB, mode);
     uint before = (i > 0u ? 1u : 0u) + (anchor1 < i ? 1u : 0u) + (anchor2 < i ? 1u : 0u);
     bool anchor = i == 0u || i == anchor1 || i == anchor2;
     uint index = bc_bits(b, index_start + i * ib - before, anchor ? ib - 1u : ib);
     uint cw = bc7_weight(ib, index), aw = cw;
-    uint ib2 = BC7_IB2[mode];
+    uint ib2 = bc7_mode_field(BC7_IB2, mode);
     if (ib2 > 0u) {
         // Secondary indices (modes 4, 5; one subset): texel 0 alone is an anchor.
         uint start2 = index_start + 16u * ib - 1u;

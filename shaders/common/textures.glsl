@@ -135,4 +135,43 @@ vec4 sample_texture_grad(uint index, vec2 uv, vec2 dx, vec2 dy) {
     return filtered(t, uv, l0, l1, f, nearest);
 }
 
+// A material's texture slots: bit k of a slot mask is slot k of `material_texels`' array.
+const uint SLOT_BASE_COLOR = 0u;
+const uint SLOT_METALLIC_ROUGHNESS = 1u;
+const uint SLOT_NORMAL = 2u;
+const uint SLOT_OCCLUSION = 3u;
+const uint SLOT_EMISSIVE = 4u;
+const uint MATERIAL_SLOTS = 5u;
+const uint ALL_MATERIAL_SLOTS = (1u << MATERIAL_SLOTS) - 1u;
+
+uint material_texture(GpuMaterialLayout m, uint slot) {
+    return slot == SLOT_BASE_COLOR ? m.base_color_texture
+        : slot == SLOT_METALLIC_ROUGHNESS ? m.metallic_roughness_texture
+        : slot == SLOT_NORMAL ? m.normal_texture
+        : slot == SLOT_OCCLUSION ? m.occlusion_texture
+                                 : m.emissive_texture;
+}
+
+// The textures of material `m` in the slots of the mask `slots` at `uv` (trilinear by the
+// derivatives `dx`, `dy`; zero derivatives give mip 0 as `sample_texture` does), white in the
+// other slots and where the material has no texture. One loop around one sampling call, over
+// the slots present (a trip count the compiler cannot know, so it stays a loop): every call
+// site of a sampler is a copy of the texel fetch once inlined, BC decoders included, and a call
+// site per slot multiplied the shaders the driver compiles.
+void material_texels(GpuMaterialLayout m, uint slots, vec2 uv, vec2 dx, vec2 dy, out vec4 texel[MATERIAL_SLOTS]) {
+    uint pending = 0u;
+    for (uint k = 0u; k < MATERIAL_SLOTS; k++) {
+        texel[k] = vec4(1.0);
+        if (material_texture(m, k) != NO_TEXTURE) {
+            pending |= 1u << k;
+        }
+    }
+    pending &= slots;
+    while (pending != 0u) {
+        uint k = uint(findLSB(pending));
+        pending &= pending - 1u;
+        texel[k] = sample_texture_grad(material_texture(m, k), uv, dx, dy);
+    }
+}
+
 #endif
