@@ -217,6 +217,8 @@ pub struct Report {
     pub line_space_plan: Option<crate::analyze::budget::Choice>,
     /// Bytes of the grid and line-space sections written (to compare with the estimate).
     pub line_space_bytes: u64,
+    /// Per texture: stored format, bytes, and the error of mip 0 against the RGBA8 texels.
+    pub textures: Vec<crate::bake::bc::TextureReport>,
 }
 
 /// Bakes and writes `loaded` to `output`; writes the report and depfile if asked.
@@ -293,6 +295,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
             })
             .map(|x| x.bytes.len() as u64)
             .sum(),
+        textures: baked.textures.clone(),
     };
     if let Some(path) = &out.report {
         let json = serde_json::to_string_pretty(&report).map_err(|e| CliError::io(e.to_string()))?;

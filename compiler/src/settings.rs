@@ -34,6 +34,34 @@ impl BvhPreset {
     }
 }
 
+/// How textures are stored (`--texture-format`, `[bake] texture_format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum TextureFormat {
+    /// Block-compressed by role: BC7 for colour (sRGB) and for data textures whose three channels
+    /// are all read, BC5 for normal maps (x, y; z is reconstructed) and metallic-roughness (G, B),
+    /// BC4 for occlusion (R). A quarter (BC7, BC5) or an eighth (BC4) of RGBA8's bytes; the
+    /// player needs the device feature `textureCompressionBC`.
+    #[default]
+    Bc,
+    /// Uncompressed RGBA8 (exact; every device samples it).
+    Rgba8,
+}
+
+impl TextureFormat {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TextureFormat::Bc => "bc",
+            TextureFormat::Rgba8 => "rgba8",
+        }
+    }
+
+    /// Parses a sidecar value.
+    pub fn parse(s: &str) -> Option<TextureFormat> {
+        <TextureFormat as ValueEnum>::from_str(s, false).ok()
+    }
+}
+
 /// A numeric setting: its name, default and valid range. The command line (through
 /// [`Ranged::parser`]) and the sidecar's `[bake]` table (through [`Ranged::check`]) both check
 /// values against it, and [`Settings::default`] takes its default from it.
@@ -287,6 +315,8 @@ pub struct Settings {
     /// Which sections are stored compressed. Changes the stored bytes only, never a section's
     /// decoded bytes or content hash (so cached stages are reused across codecs).
     pub codec: Codec,
+    /// How textures are stored.
+    pub texture_format: TextureFormat,
 }
 
 impl Default for Settings {
@@ -302,6 +332,7 @@ impl Default for Settings {
             media_volume_res: MEDIA_VOLUME_RES.default,
             normals: Normals::Asset,
             codec: Codec::Auto,
+            texture_format: TextureFormat::default(),
         }
     }
 }
@@ -341,6 +372,10 @@ impl Settings {
         if let Some(v) = &b.shaft_variants {
             self.shaft_variants = Some(parse_variants(v).map_err(|e| format!("shaft_variants: {e}"))?);
         }
+        if let Some(f) = &b.texture_format {
+            self.texture_format =
+                TextureFormat::parse(f).ok_or_else(|| format!("texture_format is '{f}'; use bc or rgba8"))?;
+        }
         if let Some(n) = &b.normals {
             self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;
         }
@@ -367,6 +402,7 @@ impl Settings {
             ("media-volume-res".into(), self.media_volume_res.to_string()),
             ("normals".into(), self.normals.name()),
             ("codec".into(), self.codec.name().into()),
+            ("texture-format".into(), self.texture_format.name().into()),
         ]
     }
 }

@@ -1048,17 +1048,59 @@ fn agree(name: &str, bytes: &[u8]) -> String {
 /// the record (mip chains; N² texels, six N × N faces for cube maps with N = `resolution`; one
 /// byte per `dims` cell), each equal to what the reader hands out.
 fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> String {
-    use kiln_format::sections::{BRDF_LUT, MEDIA_VISIBILITY, SHADOW_MAP, TEXTURE};
+    use kiln_format::sections::{BRDF_LUT, MEDIA_VISIBILITY, SHADOW_MAP};
     let count = |kind: &[u8; 4]| f.entries.iter().filter(|e| &e.kind == kind).count();
     assert_eq!(count(b"TEXL"), m.textures.len(), "{name}: TEXL sections");
+    let mut formats = Vec::new();
     for (i, t) in m.textures.iter().enumerate() {
         let levels = 32 - t.width.max(t.height).leading_zeros();
         assert_eq!(t.mip_levels, levels, "{name}: texture {i} mip levels");
-        let texels: u64 =
-            (0..levels).map(|l| (t.width >> l).max(1) as u64 * (t.height >> l).max(1) as u64).sum();
+        let e = f.entries.iter().find(|e| &e.kind == b"TEXL" && e.index == i as u32).unwrap();
         let b = f.section(b"TEXL", i as u32).unwrap();
-        assert_eq!(b.len() as u64, 4 * texels, "{name}: texture {i} bytes");
-        assert_eq!(spec::u32s(b), file.pod::<u32>(TEXTURE, i as u32).unwrap().unwrap());
+        // Version 1: bare RGBA8. Version 2: a 16-byte header (u32 format: 0 RGBA8, 1 BC7, 2 BC5,
+        // 3 BC4; four swizzle bytes 0..=5; eight zero bytes), then the chain, each level
+        // ceil(w/4) × ceil(h/4) blocks of 16 bytes (BC7, BC5) or 8 (BC4).
+        let (format, swizzle, chain) = match e.version {
+            1 => (0u32, [0u8, 1, 2, 3], b),
+            2 => {
+                assert_eq!(&b[8..16], &[0u8; 8], "{name}: texture {i} reserved bytes");
+                (spec::u32_at(b, 0), [b[4], b[5], b[6], b[7]], &b[16..])
+            }
+            v => panic!("{name}: texture {i} section version {v}"),
+        };
+        let (block, block_bytes, channels) = match format {
+            0 => (1u64, 4u64, 4u8),
+            1 => (4, 16, 4),
+            2 => (4, 16, 2),
+            3 => (4, 8, 1),
+            other => panic!("{name}: texture {i} pixel format {other}"),
+        };
+        assert!(
+            swizzle.iter().all(|&c| c == 4 || c == 5 || c < channels),
+            "{name}: texture {i} swizzle {swizzle:?}"
+        );
+        if format >= 2 {
+            assert_eq!(
+                t.color_space,
+                kiln_format::manifest::ColorSpace::Linear,
+                "{name}: texture {i} BC4/BC5 sRGB"
+            );
+        }
+        let bytes: u64 = (0..levels)
+            .map(|l| {
+                let (w, h) = ((t.width >> l).max(1) as u64, (t.height >> l).max(1) as u64);
+                w.div_ceil(block) * h.div_ceil(block) * block_bytes
+            })
+            .sum();
+        assert_eq!(chain.len() as u64, bytes, "{name}: texture {i} bytes");
+        let view = SceneView::new(file).unwrap();
+        let theirs = view.texture(i).unwrap();
+        assert_eq!(
+            (format, swizzle, chain),
+            (theirs.format as u32, theirs.swizzle.map(|c| c as u8), theirs.levels),
+            "{name}: texture {i}"
+        );
+        formats.push(format);
     }
     match (&m.brdf_lut, f.section(b"BRDF", 0)) {
         (Some(lut), Some(b)) => {
@@ -1098,7 +1140,7 @@ fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> Str
         assert_eq!(count(b"MVIS"), 0);
     }
     format!(
-        "{} textures, BRDF {}, {} shadow maps, {volumes} visibility volumes",
+        "{} textures (formats {formats:?}), BRDF {}, {} shadow maps, {volumes} visibility volumes",
         m.textures.len(),
         m.brdf_lut.is_some(),
         m.shadow_maps.len()
@@ -1125,6 +1167,29 @@ fn fixture_with(codec: Codec) -> Vec<u8> {
         mag_linear: false,
     });
     s.materials[0].gpu.base_color_texture = 0;
+    // A normal map (BC5) and an occlusion map (BC4), sized to leave partial blocks.
+    s.textures.push(Texture {
+        name: "bumps".into(),
+        width: 6,
+        height: 5,
+        rgba: (0..30u32).flat_map(|i| [(100 + i * 3) as u8, (140 - i * 2) as u8, 240, 255]).collect(),
+        role: TextureRole::Normal,
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        mag_linear: true,
+    });
+    s.textures.push(Texture {
+        name: "occlusion".into(),
+        width: 9,
+        height: 3,
+        rgba: (0..27u32).flat_map(|i| [(i * 9) as u8, 0, 0, 255]).collect(),
+        role: TextureRole::Data,
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        mag_linear: true,
+    });
+    s.materials[0].gpu.normal_texture = 1;
+    s.materials[0].gpu.occlusion_texture = 2;
     for (i, uv) in s.uvs.iter_mut().enumerate() {
         *uv = [(i % 7) as f32 * 0.37 - 0.5, (i % 5) as f32 * 1.3];
     }

@@ -311,7 +311,7 @@ impl EmitterKinds {
 
 gpu_struct! {
     /// A texture in the texel buffer of the ray-traced passes (std430, 16 bytes): its mip chain
-    /// as packed RGBA8 words from `offset`.
+    /// as stored in its `TEXL` section (RGBA8 texels or BC blocks, as whole words) from `offset`.
     pub struct GpuTexture {
         /// First texel (in words).
         pub offset: u32 => "uint",
@@ -352,6 +352,11 @@ impl TextureFlags {
     pub const LINEAR: u32 = 1 << 5;
     /// Mip levels stored from `offset` (level after level, each `max(1, size >> l)`) in bits 8–12.
     pub const LEVELS_SHIFT: u32 = 8;
+    /// [`crate::sections::PixelFormat`] number in bits 13–14 (0 RGBA8, 1 BC7, 2 BC5, 3 BC4).
+    pub const FORMAT_SHIFT: u32 = 13;
+    /// [`crate::sections::Swizzle`] of the sampled R, G, B, A in bits 16–27, three bits each
+    /// (R lowest).
+    pub const SWIZZLE_SHIFT: u32 = 16;
 }
 
 /// Bits of `FrameConstants::size.w`.
@@ -465,6 +470,8 @@ pub fn glsl_layout() -> String {
         ("TEXTURE_SRGB", TextureFlags::SRGB),
         ("TEXTURE_LINEAR", TextureFlags::LINEAR),
         ("TEXTURE_LEVELS_SHIFT", TextureFlags::LEVELS_SHIFT),
+        ("TEXTURE_FORMAT_SHIFT", TextureFlags::FORMAT_SHIFT),
+        ("TEXTURE_SWIZZLE_SHIFT", TextureFlags::SWIZZLE_SHIFT),
         ("MAX_SHADOW_MAPS", MAX_SHADOW_MAPS as u32),
         ("MAX_RT_SHADOW_LIGHTS", MAX_RT_SHADOW_LIGHTS as u32),
     ] {

@@ -2,11 +2,12 @@
 //! the player and the queries can index without further checks.
 
 use crate::error::{FormatError, Result};
-use crate::manifest::{LightKind, Manifest, ShadowProjection};
+use crate::manifest::{ColorSpace, LightKind, Manifest, ShadowProjection};
 use crate::read::KilnFile;
 use crate::sections::{
     BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
-    MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, UVS, VERTICES, Vertex,
+    MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, TextureData, UVS,
+    VERTICES, Vertex, decode_texture, possible_v2_lengths,
 };
 
 /// Borrowed, validated scene data of a [`KilnFile`].
@@ -56,16 +57,33 @@ impl<'a> SceneView<'a> {
                     info.name
                 ))
             })?;
-            let expected = mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(|| {
+            let impossible = || {
                 FormatError::invalid(format!(
                     "texture {i} has impossible dimensions {}x{} with {} mip levels",
                     info.width, info.height, info.mip_levels
                 ))
-            })?;
-            if s.entry.raw_size != expected {
+            };
+            // Version 1 is bare RGBA8; version 2's exact length depends on the format in its
+            // header (read with the bytes, in `texture`), so here it must be one of the lengths
+            // some format gives.
+            let fits = match s.entry.version {
+                1 => {
+                    let expected =
+                        mip_chain_bytes(info.width, info.height, info.mip_levels).ok_or_else(impossible)?;
+                    s.entry.raw_size == expected
+                }
+                _ => {
+                    let lengths = possible_v2_lengths(info.width, info.height, info.mip_levels);
+                    if lengths.is_empty() {
+                        return Err(impossible());
+                    }
+                    lengths.contains(&s.entry.raw_size)
+                }
+            };
+            if !fits {
                 return Err(FormatError::invalid(format!(
-                    "texture {i} is {} bytes, its {}x{} RGBA8 mip chain needs {expected}",
-                    s.entry.raw_size, info.width, info.height
+                    "texture {i} is {} bytes, which no {}x{} mip chain of a version-{} texture section has",
+                    s.entry.raw_size, info.width, info.height, s.entry.version
                 ))
                 .in_section(s.position, TEXTURE, i as u32));
             }
@@ -96,15 +114,27 @@ impl<'a> SceneView<'a> {
         Ok(view)
     }
 
-    /// Texels of texture `i` (RGBA8 mip chain, level 0 first), checksummed on first access.
-    pub fn texture(&self, i: usize) -> Result<&'a [u8]> {
-        let bytes: &'a [u32] = self.file.pod(TEXTURE, i as u32)?.ok_or_else(|| {
+    /// Texels of texture `i` (its mip chain, level 0 first, with its pixel format and swizzle),
+    /// checksummed and checked against the manifest on first access.
+    pub fn texture(&self, i: usize) -> Result<TextureData<'a>> {
+        let missing = || {
             FormatError::invalid(format!(
                 "texture {i} does not exist ({} textures)",
                 self.manifest.textures.len()
             ))
-        })?;
-        Ok(bytemuck::cast_slice(bytes))
+        };
+        let info = self.manifest.textures.get(i).ok_or_else(missing)?;
+        let s = self.file.find(TEXTURE, i as u32).ok_or_else(missing)?;
+        let words: &'a [u32] = self.file.pod(TEXTURE, i as u32)?.ok_or_else(missing)?;
+        decode_texture(
+            s.entry.version,
+            bytemuck::cast_slice(words),
+            info.width,
+            info.height,
+            info.mip_levels,
+            info.color_space == ColorSpace::Srgb,
+        )
+        .map_err(|e| e.in_section(s.position, TEXTURE, i as u32).or_offset(s.entry.offset))
     }
 
     fn check_geometry(&self) -> Result<()> {

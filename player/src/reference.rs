@@ -143,7 +143,7 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?);
-        owned.pass = Some(PathTracePass::new(gpu)?);
+        owned.pass = Some(PathTracePass::new(gpu, r.texel_decode)?);
         let (ubo, lights) = (owned.ubo.as_ref().expect("set"), owned.lights.as_ref().expect("set"));
         let images = owned.images.as_mut().expect("set");
         let pass = owned.pass.as_mut().expect("set");

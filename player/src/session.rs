@@ -166,11 +166,12 @@ impl Session {
         }
         let techniques = render.techniques;
         let lights = prepared.manifest().lights.len();
+        let decode = prepared.texel_decode();
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
                 // The frame's targets too: allocating them costs milliseconds on some drivers.
-                let mut frame = Frame::new(&gpu, &techniques, lights, width, height)?;
+                let mut frame = Frame::new(&gpu, &techniques, lights, decode, width, height)?;
                 match readback.map(|r| Readback::new(&gpu, r, width, height)).transpose() {
                     Ok(rb) => Ok((frame, rb, ms(t))),
                     Err(e) => {

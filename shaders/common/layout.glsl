@@ -161,6 +161,8 @@ const uint TEXTURE_WRAP_V_SHIFT = 2u;
 const uint TEXTURE_SRGB = 16u;
 const uint TEXTURE_LINEAR = 32u;
 const uint TEXTURE_LEVELS_SHIFT = 8u;
+const uint TEXTURE_FORMAT_SHIFT = 13u;
+const uint TEXTURE_SWIZZLE_SHIFT = 16u;
 const uint MAX_SHADOW_MAPS = 8u;
 const uint MAX_RT_SHADOW_LIGHTS = 16u;
 

@@ -5,6 +5,14 @@
 #ifndef KILN_NORMALMAP_GLSL
 #define KILN_NORMALMAP_GLSL
 
+// A normal map's tangent-space normal from a sampled texel: x and y from red and green, z
+// reconstructed as sqrt(1 - x² - y²). Every normal map goes through this one path, so a map
+// stored as two channels (BC5, whose blue samples 0) and one stored as RGBA8 shade alike.
+vec3 normal_texel(vec4 texel) {
+    vec2 xy = texel.xy * 2.0 - 1.0;
+    return vec3(xy, sqrt(max(1.0 - dot(xy, xy), 0.0)));
+}
+
 vec3 normal_mapped(vec3 n, vec3 dp1, vec3 dp2, vec2 duv1, vec2 duv2, vec3 sample_ts, float scale) {
     vec3 dp2perp = cross(dp2, n);
     vec3 dp1perp = cross(n, dp1);

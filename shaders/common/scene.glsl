@@ -14,6 +14,7 @@
 #include "lights.glsl"
 #include "textures.glsl"
 #include "vertices.glsl"
+#include "normalmap.glsl"
 
 vec2 triangle_uv(uint tri, float u, float v) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
@@ -51,31 +52,33 @@ struct Surface {
     uint triangle;  // the triangle hit (leaf order)
 };
 
-// The material of a surface at texture coordinates uv with vertex colour `color`: s.mat and
-// s.emission (towards the side s.front says the ray came from). Shared by triangle hits and the
-// line space's stored hits.
-void surface_material(inout Surface s, GpuMaterialLayout m, vec2 uv, vec4 color) {
-    vec4 base = m.base_color * color;
-    if (m.base_color_texture != NO_TEXTURE) {
-        base *= sample_texture(m.base_color_texture, uv);
-    }
+// The slots `surface_textured` reads (occlusion is the raster G-buffer's alone); the emissive
+// texture only where the material emits.
+uint surface_slots(GpuMaterialLayout m) {
+    uint slots = (1u << SLOT_BASE_COLOR) | (1u << SLOT_METALLIC_ROUGHNESS) | (1u << SLOT_NORMAL);
+    return any(greaterThan(m.emission, vec3(0.0))) ? slots | (1u << SLOT_EMISSIVE) : slots;
+}
+
+// The material of a surface from its textures' texels (`material_texels`) and vertex colour
+// `color`: s.mat and s.emission (towards the side s.front says the ray came from).
+void surface_textured(inout Surface s, GpuMaterialLayout m, vec4 texel[MATERIAL_SLOTS], vec4 color) {
+    vec4 base = m.base_color * color * texel[SLOT_BASE_COLOR];
     s.mat.base = base.rgb;
-    s.mat.metallic = m.metallic;
-    s.mat.roughness = m.roughness;
-    if (m.metallic_roughness_texture != NO_TEXTURE) {
-        vec4 mr = sample_texture(m.metallic_roughness_texture, uv);
-        s.mat.metallic *= mr.b;
-        s.mat.roughness *= mr.g;
-    }
-    s.mat.metallic = clamp(s.mat.metallic, 0.0, 1.0);
-    s.mat.roughness = clamp(s.mat.roughness, 0.0, 1.0);
+    vec4 mr = texel[SLOT_METALLIC_ROUGHNESS];
+    s.mat.metallic = clamp(m.metallic * mr.b, 0.0, 1.0);
+    s.mat.roughness = clamp(m.roughness * mr.g, 0.0, 1.0);
     s.mat.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
-    vec3 e = m.emission;
-    if (m.emissive_texture != NO_TEXTURE && any(greaterThan(e, vec3(0.0)))) {
-        e *= sample_texture(m.emissive_texture, uv).rgb;
-    }
+    vec3 e = m.emission * texel[SLOT_EMISSIVE].rgb;
     bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
     s.emission = (s.front || double_sided) ? e : vec3(0.0);
+}
+
+// The material of a surface at texture coordinates uv with vertex colour `color`: s.mat and
+// s.emission. Shared by triangle hits and the line space's stored hits.
+void surface_material(inout Surface s, GpuMaterialLayout m, vec2 uv, vec4 color) {
+    vec4 texel[MATERIAL_SLOTS];
+    material_texels(m, surface_slots(m) & ~(1u << SLOT_NORMAL), uv, vec2(0.0), vec2(0.0), texel);
+    surface_textured(s, m, texel, color);
 }
 
 Surface surface_at(TraceRay r, TraceHit h) {
@@ -96,6 +99,9 @@ Surface surface_at(TraceRay r, TraceHit h) {
     if (textured) {
         uv = triangle_uv(tri, h.u, h.v);
     }
+    // Every texture of the hit through one sampling call (see material_texels).
+    vec4 texel[MATERIAL_SLOTS];
+    material_texels(m, surface_slots(m), uv, vec2(0.0), vec2(0.0), texel);
     if (m.normal_texture != NO_TEXTURE) {
         // Tangent frame of the triangle's texture mapping (glTF: v runs down the image, the
         // map's green axis up, hence the minus on the bitangent).
@@ -108,7 +114,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
             vec3 bitangent = (e2 * d1.x - e1 * d2.x) / det;
             tangent = normalize(tangent - ns * dot(ns, tangent));
             bitangent = cross(ns, tangent) * (dot(cross(ns, tangent), bitangent) < 0.0 ? -1.0 : 1.0);
-            vec3 mtex = sample_texture(m.normal_texture, uv).xyz * 2.0 - 1.0;
+            vec3 mtex = normal_texel(texel[SLOT_NORMAL]);
             vec3 mapped = tangent * mtex.x * m.normal_scale - bitangent * mtex.y * m.normal_scale + ns * mtex.z;
             if (dot(mapped, mapped) > 0.0) {
                 ns = normalize(mapped);
@@ -126,7 +132,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
     }
     s.ng = ng;
     s.ns = ns;
-    surface_material(s, m, uv, interpolated_color(idx, h.u, h.v));
+    surface_textured(s, m, texel, interpolated_color(idx, h.u, h.v));
     return s;
 }
 

@@ -1,8 +1,18 @@
 // Textures of the ray-traced passes, read from one texel buffer (portable: no descriptor
-// indexing, which lavapipe lacks): every texture's mip chain as packed RGBA8 words.
+// indexing, which lavapipe lacks): every texture's mip chain as stored in the file, packed
+// RGBA8 words or BC blocks (decoded here, bc.glsl), then swizzled as the file says.
 // The includer declares `texels` (uint[]) and `textures` (GpuTexture[]) storage buffers.
 #ifndef KILN_TEXTURES_GLSL
 #define KILN_TEXTURES_GLSL
+
+#include "bc.glsl"
+
+// Whether the texel buffer holds BC blocks: a specialization constant the player sets per file
+// from its textures' formats when it builds the pipelines (player/src/render/texels.rs). Left
+// false, the driver drops every copy of the BC decoders before compiling, so a file without BC
+// textures compiles as fast as before they existed; a BC file read with it false would decode
+// its blocks as RGBA8 words.
+layout(constant_id = 0) const bool TEXELS_BC = false;
 
 int wrap(int i, int n, uint mode) {
     if (mode == 2u) {
@@ -15,48 +25,91 @@ int wrap(int i, int n, uint mode) {
     return ((i % n) + n) % n;
 }
 
+// Pixel format: 0 RGBA8, 1 BC7, 2 BC5, 3 BC4.
+uint texture_format(GpuTexture t) {
+    return (t.flags >> TEXTURE_FORMAT_SHIFT) & 3u;
+}
+
+// Texel (x, y) of a level as stored (BC5: R, G, 0, 1; BC4: R, 0, 0, 1).
+vec4 stored_texel(GpuTexture t, uvec3 level, uint x, uint y) {
+    uint f = texture_format(t);
+    if (!TEXELS_BC || f == 0u) {
+        return unpackUnorm4x8(texels[level.z + y * level.x + x]);
+    }
+    uint block = (y >> 2u) * ((level.x + 3u) >> 2u) + (x >> 2u);
+    uint i = (y & 3u) * 4u + (x & 3u);
+    if (f == 3u) {
+        uint w = level.z + 2u * block;
+        return vec4(bc4_channel(texels[w], texels[w + 1u], i), 0.0, 0.0, 1.0);
+    }
+    uint w = level.z + 4u * block;
+    uvec4 b = uvec4(texels[w], texels[w + 1u], texels[w + 2u], texels[w + 3u]);
+    if (f == 2u) {
+        return vec4(bc4_channel(b.x, b.y, i), bc4_channel(b.z, b.w, i), 0.0, 1.0);
+    }
+    return bc7_texel(b, i);
+}
+
 vec4 level_texel(GpuTexture t, uvec3 level, int x, int y) {
     x = wrap(x, int(level.x), (t.flags >> TEXTURE_WRAP_U_SHIFT) & 3u);
     y = wrap(y, int(level.y), (t.flags >> TEXTURE_WRAP_V_SHIFT) & 3u);
-    vec4 c = unpackUnorm4x8(texels[level.z + uint(y) * level.x + uint(x)]);
+    vec4 c = stored_texel(t, level, uint(x), uint(y));
     if ((t.flags & TEXTURE_SRGB) != 0u) {
         c.rgb = srgb_to_linear(c.rgb);
     }
-    return c;
+    // The swizzle: three bits per sampled channel, a stored channel (0..3), zero (4) or one (5).
+    vec4 s;
+    for (uint k = 0u; k < 4u; k++) {
+        uint v = (t.flags >> (TEXTURE_SWIZZLE_SHIFT + 3u * k)) & 7u;
+        s[k] = v < 4u ? c[v] : (v == 5u ? 1.0 : 0.0);
+    }
+    return s;
 }
 
-vec4 texel(GpuTexture t, int x, int y) {
-    return level_texel(t, uvec3(t.width, t.height, t.offset), x, y);
+// Words of a `w × h` level: a word per texel, or four (BC7, BC5) or two (BC4) per 4×4 block.
+uint level_words(GpuTexture t, uint w, uint h) {
+    uint f = texture_format(t);
+    uint blocks = ((w + 3u) >> 2u) * ((h + 3u) >> 2u);
+    return !TEXELS_BC || f == 0u ? w * h : (f == 3u ? 2u * blocks : 4u * blocks);
 }
 
 // Mip level `level` of a texture: its size and first word.
 uvec3 texture_level(GpuTexture t, uint level) {
     uint w = t.width, h = t.height, offset = t.offset;
     for (uint l = 0u; l < level; l++) {
-        offset += w * h;
+        offset += level_words(t, w, h);
         w = max(w >> 1, 1u);
         h = max(h >> 1, 1u);
     }
     return uvec3(w, h, offset);
 }
 
-vec4 bilinear_level(GpuTexture t, uint level, vec2 uv) {
-    uvec3 l = texture_level(t, level);
-    vec2 x = uv * vec2(l.xy) - 0.5;
-    ivec2 i = ivec2(floor(x));
-    vec2 f = x - vec2(i);
-    return mix(mix(level_texel(t, l, i.x, i.y), level_texel(t, l, i.x + 1, i.y), f.x),
-        mix(level_texel(t, l, i.x, i.y + 1), level_texel(t, l, i.x + 1, i.y + 1), f.x), f.y);
+// Texture `t` at `uv`: level `l0` by its nearest texel or bilinearly, blended with level `l1` by
+// `f` (trilinear). Every tap goes through one loop around one `level_texel` call, whose trip
+// count the compiler cannot know: each call site is a copy of the BC decoders once inlined, and
+// a copy per tap made the shaders so large that lavapipe took minutes to compile them.
+vec4 filtered(GpuTexture t, vec2 uv, uint l0, uint l1, float f, bool nearest) {
+    uint taps = nearest ? 1u : (f > 0.0 ? 8u : 4u);
+    vec4 sum = vec4(0.0);
+    for (uint k = 0u; k < taps; k++) {
+        uvec3 l = texture_level(t, k < 4u ? l0 : l1);
+        vec2 x = uv * vec2(l.xy) - (nearest ? 0.0 : 0.5);
+        ivec2 i = ivec2(floor(x));
+        vec2 fr = x - vec2(i);
+        uint corner = k & 3u;
+        ivec2 o = ivec2(int(corner & 1u), int(corner >> 1u));
+        float w = nearest ? 1.0
+                          : (o.x == 1 ? fr.x : 1.0 - fr.x) * (o.y == 1 ? fr.y : 1.0 - fr.y)
+                * (k < 4u ? 1.0 - f : f);
+        sum += w * level_texel(t, l, i.x + o.x, i.y + o.y);
+    }
+    return sum;
 }
 
 // Mip 0, bilinear or nearest as the texture's filter says (what the path tracer samples).
 vec4 sample_texture(uint index, vec2 uv) {
     GpuTexture t = textures[index];
-    if ((t.flags & TEXTURE_LINEAR) == 0u) {
-        vec2 x = uv * vec2(t.width, t.height);
-        return texel(t, int(floor(x.x)), int(floor(x.y)));
-    }
-    return bilinear_level(t, 0u, uv);
+    return filtered(t, uv, 0u, 0u, 0.0, (t.flags & TEXTURE_LINEAR) == 0u);
 }
 
 // Trilinear filtering with the level chosen from the uv footprint of a pixel (the larger of its
@@ -70,13 +123,55 @@ vec4 sample_texture_grad(uint index, vec2 uv, vec2 dx, vec2 dy) {
     footprint = isnan(footprint) || isinf(footprint) ? 1e30 : footprint;
     float levels = float((t.flags >> TEXTURE_LEVELS_SHIFT) & 31u);
     float lod = clamp(log2(max(footprint, 1e-8)), 0.0, max(levels - 1.0, 0.0));
-    if (lod <= 0.0) {
-        return sample_texture(index, uv);
+    uint l0 = 0u, l1 = 0u;
+    float f = 0.0;
+    bool nearest = (t.flags & TEXTURE_LINEAR) == 0u;
+    if (lod > 0.0) {
+        l0 = min(uint(floor(lod)), uint(max(levels - 1.0, 0.0)));
+        l1 = min(l0 + 1u, uint(levels) - 1u);
+        f = lod - float(l0);
+        nearest = false;
     }
-    uint l0 = min(uint(floor(lod)), uint(max(levels - 1.0, 0.0)));
-    vec4 a = bilinear_level(t, l0, uv);
-    float f = lod - float(l0);
-    return f > 0.0 ? mix(a, bilinear_level(t, min(l0 + 1u, uint(levels) - 1u), uv), f) : a;
+    return filtered(t, uv, l0, l1, f, nearest);
+}
+
+// A material's texture slots: bit k of a slot mask is slot k of `material_texels`' array.
+const uint SLOT_BASE_COLOR = 0u;
+const uint SLOT_METALLIC_ROUGHNESS = 1u;
+const uint SLOT_NORMAL = 2u;
+const uint SLOT_OCCLUSION = 3u;
+const uint SLOT_EMISSIVE = 4u;
+const uint MATERIAL_SLOTS = 5u;
+const uint ALL_MATERIAL_SLOTS = (1u << MATERIAL_SLOTS) - 1u;
+
+uint material_texture(GpuMaterialLayout m, uint slot) {
+    return slot == SLOT_BASE_COLOR ? m.base_color_texture
+        : slot == SLOT_METALLIC_ROUGHNESS ? m.metallic_roughness_texture
+        : slot == SLOT_NORMAL ? m.normal_texture
+        : slot == SLOT_OCCLUSION ? m.occlusion_texture
+                                 : m.emissive_texture;
+}
+
+// The textures of material `m` in the slots of the mask `slots` at `uv` (trilinear by the
+// derivatives `dx`, `dy`; zero derivatives give mip 0 as `sample_texture` does), white in the
+// other slots and where the material has no texture. One loop around one sampling call, over
+// the slots present (a trip count the compiler cannot know, so it stays a loop): every call
+// site of a sampler is a copy of the texel fetch once inlined, BC decoders included, and a call
+// site per slot multiplied the shaders the driver compiles.
+void material_texels(GpuMaterialLayout m, uint slots, vec2 uv, vec2 dx, vec2 dy, out vec4 texel[MATERIAL_SLOTS]) {
+    uint pending = 0u;
+    for (uint k = 0u; k < MATERIAL_SLOTS; k++) {
+        texel[k] = vec4(1.0);
+        if (material_texture(m, k) != NO_TEXTURE) {
+            pending |= 1u << k;
+        }
+    }
+    pending &= slots;
+    while (pending != 0u) {
+        uint k = uint(findLSB(pending));
+        pending &= pending - 1u;
+        texel[k] = sample_texture_grad(material_texture(m, k), uv, dx, dy);
+    }
 }
 
 #endif

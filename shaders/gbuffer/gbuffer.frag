@@ -50,7 +50,7 @@ void main() {
     }
     if (material.normal_texture != NO_TEXTURE) {
         n = normal_mapped(n, dFdx(in_position), dFdy(in_position), dFdx(in_uv), dFdy(in_uv),
-            texture(normal_tex, in_uv).xyz * 2.0 - 1.0, material.normal_scale);
+            normal_texel(texture(normal_tex, in_uv)), material.normal_scale);
     }
     float metallic = material.metallic;
     float roughness = material.roughness;

@@ -72,31 +72,23 @@ void main() {
     if (!front) {
         n = -n;
     }
+    vec4 texel[MATERIAL_SLOTS];
+    material_texels(m, ALL_MATERIAL_SLOTS, uv, duv_dx, duv_dy, texel);
     if (m.normal_texture != NO_TEXTURE) {
         vec3 dp_dx = (bx.x - b.x) * e1 + (bx.y - b.y) * e2;
         vec3 dp_dy = (by.x - b.x) * e1 + (by.y - b.y) * e2;
-        vec3 ts = sample_texture_grad(m.normal_texture, uv, duv_dx, duv_dy).xyz * 2.0 - 1.0;
+        vec3 ts = normal_texel(texel[SLOT_NORMAL]);
         n = normal_mapped(n, dp_dx, dp_dy, duv_dx, duv_dy, ts, m.normal_scale);
     }
-    vec4 base = m.base_color * interpolated_color(idx, b.x, b.y);
-    if (m.base_color_texture != NO_TEXTURE) {
-        base *= sample_texture_grad(m.base_color_texture, uv, duv_dx, duv_dy);
-    }
-    float metallic = m.metallic;
-    float roughness = m.roughness;
-    if (m.metallic_roughness_texture != NO_TEXTURE) {
-        vec4 mr = sample_texture_grad(m.metallic_roughness_texture, uv, duv_dx, duv_dy);
-        metallic *= mr.b;
-        roughness *= mr.g;
-    }
+    vec4 base = m.base_color * interpolated_color(idx, b.x, b.y) * texel[SLOT_BASE_COLOR];
+    vec4 mr = texel[SLOT_METALLIC_ROUGHNESS];
+    float metallic = m.metallic * mr.b;
+    float roughness = m.roughness * mr.g;
     float occlusion = 1.0;
     if (m.occlusion_texture != NO_TEXTURE) {
-        occlusion = mix(1.0, sample_texture_grad(m.occlusion_texture, uv, duv_dx, duv_dy).r, m.occlusion_strength);
+        occlusion = mix(1.0, texel[SLOT_OCCLUSION].r, m.occlusion_strength);
     }
-    vec3 emission = m.emission;
-    if (m.emissive_texture != NO_TEXTURE) {
-        emission *= sample_texture_grad(m.emissive_texture, uv, duv_dx, duv_dy).rgb;
-    }
+    vec3 emission = m.emission * texel[SLOT_EMISSIVE].rgb;
     bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     imageStore(out_normal, pixel, vec4(oct_encode(n), 0.0, 0.0));
     imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), 1.0));

@@ -112,7 +112,14 @@ impl Plan {
             if scene.textures.is_empty() {
                 skip(Stage::Textures, "the scene has no textures")
             } else {
-                run(Stage::Textures, format!("{} textures with full mip chains", scene.textures.len()))
+                run(
+                    Stage::Textures,
+                    format!(
+                        "{} textures with full mip chains, --texture-format {}",
+                        scene.textures.len(),
+                        settings.texture_format.name()
+                    ),
+                )
             },
             run(Stage::Bvh, format!("CWBVH, preset {}", settings.bvh_preset.name())),
         ];

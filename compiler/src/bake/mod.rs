@@ -2,6 +2,7 @@
 //! timed, with content hashes computed from what they depend on. [`bake`] runs the plan's stages
 //! in order and assembles the manifest.
 
+pub mod bc;
 pub mod brdf_lut;
 pub mod bvh;
 pub mod context;
@@ -79,6 +80,8 @@ pub struct Baked {
     pub line_space: Option<LineSpaceStats>,
     /// Which sections the written file compresses.
     pub codec: crate::settings::Codec,
+    /// Format, bytes and error of each texture, when textures were baked.
+    pub textures: Vec<bc::TextureReport>,
 }
 
 /// Figures of the voxel grid and line space, for the report.
@@ -275,7 +278,15 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
         Stage::Materials => {
             h.part("materials", bytemuck::cast_slice(&ctx.materials));
         }
-        Stage::Textures => hash_textures(&mut h, scene),
+        Stage::Textures => {
+            // The format of each texture follows the setting and the material slots reading it.
+            h.part("algorithm", textures::TEXTURE_ALGORITHM.as_bytes())
+                .part("texture-format", s.texture_format.name().as_bytes());
+            let usages: Vec<u8> =
+                (0..scene.textures.len() as u32).map(|i| bc::Usage::of(&ctx.materials, i).bits()).collect();
+            h.part("usages", &usages);
+            hash_textures(&mut h, scene);
+        }
         Stage::Bvh => {
             h.hash("bvh", &ctx.bvh_key);
         }
@@ -437,6 +448,7 @@ pub fn bake(ctx: &BakeContext) -> CliResult<Baked> {
     let mut all = Sections::default();
     let mut stages: Vec<StageReport> = Vec::new();
     let mut line_space: Option<LineSpaceStats> = None;
+    let mut texture_reports = Vec::new();
     // The line-space stage's sections and time, made with the grid's.
     let mut pending: Option<(Sections, f64, bool)> = None;
     for decision in &ctx.plan.stages {
@@ -471,18 +483,32 @@ pub fn bake(ctx: &BakeContext) -> CliResult<Baked> {
                 s.hash = section_hash(&key, s.kind, s.index);
             }
         }
+        let ms = ms.unwrap_or_else(|| start.elapsed().as_secs_f64() * 1e3);
+        if decision.run && decision.stage == Stage::Textures {
+            // Measured after the stage's time is taken: the report's error figures are not part
+            // of what the texture stage costs a compile without them.
+            texture_reports = textures::reports(ctx, &out);
+        }
         stages.push(StageReport {
             stage: decision.stage.name(),
             run: decision.run,
             cached,
             reason: decision.reason.clone(),
-            ms: ms.unwrap_or_else(|| start.elapsed().as_secs_f64() * 1e3),
+            ms,
             bytes: out.bytes(),
         });
         all.append(out);
     }
     let (manifest, manifest_hash) = assemble_manifest(ctx, &all);
-    Ok(Baked { manifest, manifest_hash, sections: all.list, stages, line_space, codec: ctx.settings.codec })
+    Ok(Baked {
+        manifest,
+        manifest_hash,
+        sections: all.list,
+        stages,
+        line_space,
+        codec: ctx.settings.codec,
+        textures: texture_reports,
+    })
 }
 
 /// The manifest and its content hash.

@@ -1,4 +1,5 @@
-//! The texture stage: full mip chains, filtered in linear space.
+//! The texture stage: full mip chains, filtered in linear space, then stored as RGBA8 or
+//! block-compressed level by level ([`super::bc`]).
 //!
 //! Each level halves the previous one (rounding down, at least 1) with a 2×2 box filter, edge
 //! texels clamped for odd sizes. sRGB colour is filtered after conversion to linear light and
@@ -7,6 +8,9 @@
 
 use rayon::prelude::*;
 
+use kiln_format::sections::{PixelFormat, encode_texture};
+
+use super::bc::{self, Choice, FLIP_BOUND, PSNR_BOUND_DB, TextureReport, Usage, choose};
 use crate::ir::{Texture, TextureRole};
 
 fn srgb_to_linear(c: u8) -> f32 {
@@ -87,12 +91,87 @@ pub fn mip_chain(t: &Texture) -> Vec<u8> {
     out
 }
 
-/// The texture stage: every texture's mip chain, in parallel.
+/// Bumped when what the texture stage writes changes. 2: version-2 sections (pixel-format
+/// header), block compression.
+pub const TEXTURE_ALGORITHM: &str = "textures-2";
+
+/// What each texture becomes under `ctx`'s settings.
+pub fn choices(ctx: &super::BakeContext) -> Vec<Choice> {
+    ctx.scene
+        .textures
+        .iter()
+        .enumerate()
+        .map(|(i, t)| choose(t, Usage::of(&ctx.materials, i as u32), ctx.settings.texture_format))
+        .collect()
+}
+
+/// The texture stage: every texture's mip chain in its chosen format, in parallel (textures, and
+/// rows of blocks within a level, which are independent, so the bytes do not depend on the
+/// thread count).
 pub fn stage(ctx: &super::BakeContext) -> super::Sections {
-    let chains: Vec<Vec<u8>> = ctx.scene.textures.par_iter().map(mip_chain).collect();
+    let choices = choices(ctx);
+    let stored: Vec<Vec<u8>> = ctx
+        .scene
+        .textures
+        .par_iter()
+        .zip(&choices)
+        .map(|(t, c)| encode_texture(c.format, c.swizzle, &bc::encode(t, c, mip_chain(t))))
+        .collect();
     let mut out = super::Sections::default();
-    for (i, chain) in chains.into_iter().enumerate() {
-        out.push(kiln_format::sections::TEXTURE, i as u32, chain);
+    for (i, bytes) in stored.into_iter().enumerate() {
+        out.push(kiln_format::sections::TEXTURE, i as u32, bytes);
     }
     out
+}
+
+/// The report's line for every texture: format, bytes and the error of mip 0 against the RGBA8
+/// texels, decoded from the sections `sections` (baked or from the cache) with an independent
+/// decoder. A texture over the bound is named in a warning on standard error.
+pub fn reports(ctx: &super::BakeContext, sections: &super::Sections) -> Vec<TextureReport> {
+    let choices = choices(ctx);
+    let found: Vec<(usize, &super::BakedSection)> = sections
+        .list
+        .iter()
+        .filter(|s| s.kind == kiln_format::sections::TEXTURE)
+        .map(|s| (s.index as usize, s))
+        .collect();
+    let reports: Vec<TextureReport> = found
+        .par_iter()
+        .filter_map(|&(i, s)| {
+            let t = ctx.scene.textures.get(i)?;
+            let levels = kiln_format::scene::mip_levels(t.width, t.height);
+            let data =
+                kiln_format::sections::decode_texture(2, &s.bytes, t.width, t.height, levels, false).ok()?;
+            let choice = &choices[i];
+            let decoded = bc::decode_level(data.format, data.levels, t.width, t.height);
+            let (psnr_db, mean_flip) =
+                if data.format == PixelFormat::Rgba8 { (None, 0.0) } else { bc::error(t, choice, &decoded) };
+            let within_bound = psnr_db.is_none_or(|p| p >= PSNR_BOUND_DB) && mean_flip <= FLIP_BOUND;
+            Some(TextureReport {
+                index: i as u32,
+                name: t.name.clone(),
+                width: t.width,
+                height: t.height,
+                format: data.format.name(),
+                why: choice.why,
+                bytes: s.bytes.len() as u64,
+                rgba8_bytes: kiln_format::scene::mip_chain_bytes(t.width, t.height, levels).unwrap_or(0),
+                psnr_db,
+                mean_flip,
+                within_bound,
+            })
+        })
+        .collect();
+    for r in reports.iter().filter(|r| !r.within_bound) {
+        eprintln!(
+            "warning: texture {} '{}' as {}: PSNR {:.1} dB, mean FLIP {:.4} (bound: {PSNR_BOUND_DB} dB, FLIP \
+             {FLIP_BOUND}); --texture-format rgba8 keeps textures exact",
+            r.index,
+            r.name,
+            r.format,
+            r.psnr_db.unwrap_or(f64::INFINITY),
+            r.mean_flip
+        );
+    }
+    reports
 }

@@ -6,7 +6,7 @@ use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
     BRDF_LUT_RES, BvhPreset, Codec, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES,
-    Settings, VOXEL_RES, VoxelRes, parse_variants,
+    Settings, TextureFormat, VOXEL_RES, VoxelRes, parse_variants,
 };
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
@@ -176,6 +176,17 @@ maps and uploads zero-copy stays as is), none (every section as is: fastest to l
 that shrinks: smallest file, for distribution; the player decodes each section once while loading) \
 [default: auto, or the sidecar's bake.codec]")]
     pub codec: Option<Codec>,
+    /// How textures are stored.
+    #[arg(
+        long,
+        value_enum,
+        help_heading = "Textures",
+        help = "How textures are stored: bc (block-compressed by role: BC7 colour and sRGB, BC5 normal maps \
+and metallic-roughness, BC4 occlusion; 4 to 8 times smaller than rgba8, error per texture in the report; the \
+player needs textureCompressionBC) or rgba8 (exact, every device) [default: bc, or the sidecar's \
+bake.texture_format]"
+    )]
+    pub texture_format: Option<TextureFormat>,
 }
 
 impl BakeArgs {
@@ -196,6 +207,7 @@ impl BakeArgs {
         set(&mut settings.media_volume_res, self.media_volume_res);
         set(&mut settings.normals, self.normals);
         set(&mut settings.codec, self.codec);
+        set(&mut settings.texture_format, self.texture_format);
     }
 }
 

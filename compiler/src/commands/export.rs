@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use kiln_format::manifest::ShadowProjection;
+use kiln_format::sections::Swizzle;
 use kiln_format::{Checksums, KilnFile, SceneView, sections};
 
 use crate::cli::ExportArgs;
@@ -81,8 +82,19 @@ pub fn run(args: &ExportArgs) -> CliResult {
         "texture" => {
             let info = view.manifest.textures.get(index as usize).ok_or_else(missing)?;
             let texels = view.texture(index as usize).map_err(|e| format_error(&args.file, e))?;
-            let n = (info.width * info.height * 4) as usize;
-            let data = texels[..n].iter().map(|&b| b as f32 / 255.0).collect();
+            // Mip 0 as stored (block-compressed textures decoded), swizzled as a renderer samples it.
+            let level = texels.level_slices(info.width, info.height, info.mip_levels)[0];
+            let stored = crate::bake::bc::decode_level(texels.format, level, info.width, info.height);
+            let data = stored
+                .chunks_exact(4)
+                .flat_map(|p| {
+                    texels.swizzle.map(|s| match s {
+                        Swizzle::Zero => 0.0,
+                        Swizzle::One => 1.0,
+                        c => p[c as usize] as f32 / 255.0,
+                    })
+                })
+                .collect();
             Image { width: info.width, height: info.height, channels: 4, data, scale: 1.0, wide: false }
         }
         _ => {

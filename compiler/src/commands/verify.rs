@@ -124,6 +124,10 @@ fn check(args: &VerifyArgs, report: &mut VerifyJson) -> CliResult {
         }
     }
     let view = SceneView::new(&file).map_err(|e| format_error(&args.file, e))?;
+    // Texture headers (pixel format, swizzle) and exact lengths are read with the texels.
+    for i in 0..view.manifest.textures.len() {
+        view.texture(i).map_err(|e| format_error(&args.file, e))?;
+    }
     let line_space = LineSpace::new(&file, view.triangles.len(), view.materials.len())
         .map_err(|e| format_error(&args.file, e))?;
     report.sections = file.sections().len();

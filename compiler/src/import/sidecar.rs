@@ -175,6 +175,8 @@ pub struct MaterialToml {
 pub struct BakeToml {
     /// `fast`, `medium` or `slow`.
     pub bvh_preset: Option<String>,
+    /// `bc` or `rgba8`.
+    pub texture_format: Option<String>,
     /// `"auto"` or a cell count.
     pub voxel_res: Option<toml::Value>,
     /// Shaft resolution 1..=8.

@@ -6,10 +6,15 @@
 mod bvh;
 mod geometry;
 mod material;
+mod texture;
 
 pub use bvh::{BVH_TRAVERSAL_STACK, CwbvhNode};
 pub use geometry::Vertex;
 pub use material::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE};
+pub use texture::{
+    PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_texture, encode_texture,
+    possible_v2_lengths,
+};
 
 use crate::table::SectionKind;
 
@@ -28,7 +33,8 @@ pub const TRIANGLES: SectionKind = SectionKind(*b"TRIS");
 pub const TRIANGLE_MATERIALS: SectionKind = SectionKind(*b"TMAT");
 /// Materials ([`GpuMaterial`]).
 pub const MATERIALS: SectionKind = SectionKind(*b"MATL");
-/// One texture's full mip chain, RGBA8, mip 0 first, rows tightly packed; index = texture number.
+/// One texture's full mip chain, mip 0 first; version 1 bare RGBA8, version 2 a [`TextureHeader`]
+/// (pixel format: RGBA8, BC7, BC5 or BC4; swizzle) then the chain; index = texture number.
 pub const TEXTURE: SectionKind = SectionKind(*b"TEXL");
 /// Compressed wide BVH nodes ([`CwbvhNode`]); root is node 0.
 pub const BVH_NODES: SectionKind = SectionKind(*b"CWBV");
@@ -149,11 +155,11 @@ pub const KNOWN: &[KindInfo] = &[
     KindInfo {
         kind: TEXTURE,
         name: "texture",
-        version: 1,
+        version: 2,
         element_size: 4,
         required: false,
         indexed: true,
-        description: "RGBA8 mip chain",
+        description: "mip chain (RGBA8, BC7, BC5 or BC4)",
     },
     KindInfo {
         kind: BVH_NODES,

@@ -76,6 +76,9 @@ pub fn small_file_with(texture: u32, compression: Compression) -> Vec<u8> {
     w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h(b"tm")).unwrap();
     w.pod(sections::MATERIALS, 0, &materials, h(b"mat")).unwrap();
     w.pod(sections::BVH_NODES, 0, &nodes, h(b"b")).unwrap();
-    w.bytes(sections::TEXTURE, 0, texels, h(b"tex")).unwrap();
+    // A version-2 texture section: the 16-byte header (RGBA8, identity swizzle), then the chain.
+    let texture =
+        sections::encode_texture(sections::PixelFormat::Rgba8, sections::Swizzle::IDENTITY, &texels);
+    w.bytes(sections::TEXTURE, 0, texture, h(b"tex")).unwrap();
     w.to_bytes().unwrap()
 }

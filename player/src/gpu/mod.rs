@@ -104,6 +104,8 @@ pub struct Gpu {
     /// Whether VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure are enabled.
     pub ray_tracing_pipeline: bool,
     storage_cap: Option<u64>,
+    /// The device samples BC-compressed images (`textureCompressionBC`, enabled).
+    pub texture_compression_bc: bool,
 }
 
 /// Device extensions the ray-tracing-pipeline peer needs.
@@ -305,7 +307,12 @@ impl Gpu {
         // Geometry capability for it); no geometry shader is used.
         // shaderStorageImageExtendedFormats: the visibility-buffer resolve writes RG16_SNORM.
         // shaderInt64: the ray-tracing peer's shaders take 64-bit device addresses.
+        // textureCompressionBC: enabled where the device has it; a file with BC textures is
+        // refused on a device without it (scene upload), with the option that avoids them.
+        let supported = unsafe { instance.get_physical_device_features(physical) };
+        let texture_compression_bc = supported.texture_compression_bc == vk::TRUE;
         let features = vk::PhysicalDeviceFeatures::default()
+            .texture_compression_bc(texture_compression_bc)
             .shader_float64(true)
             .geometry_shader(true)
             .shader_storage_image_extended_formats(true)
@@ -372,6 +379,7 @@ impl Gpu {
             cache_path: options.pipeline_cache.clone(),
             ray_tracing_pipeline,
             storage_cap: options.max_storage_buffer,
+            texture_compression_bc,
         })
     }
 

@@ -205,18 +205,52 @@ pub struct ComputePipeline {
 }
 
 impl ComputePipeline {
-    /// A compute pipeline from SPIR-V with entry point `main`.
+    /// A compute pipeline from SPIR-V with entry point `main`, its specialization constants at
+    /// their defaults.
     pub fn new(gpu: &Gpu, spirv: &[u8], sets: &[&SetLayout], push_bytes: u32) -> PlayResult<ComputePipeline> {
+        Self::specialized(gpu, spirv, sets, push_bytes, &[])
+    }
+
+    /// A compute pipeline whose specialization constant `constant_id = i` is `constants[i]`
+    /// (32 bits each; a bool is 0 or 1). The driver folds them before it compiles, and the
+    /// pipeline cache keys on them. Ids the shader does not declare are ignored.
+    pub fn specialized(
+        gpu: &Gpu,
+        spirv: &[u8],
+        sets: &[&SetLayout],
+        push_bytes: u32,
+        constants: &[u32],
+    ) -> PlayResult<ComputePipeline> {
         let module = shader_module(gpu, spirv)?;
-        let layout = pipeline_layout(gpu, sets, push_bytes)?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
+        let layout = match pipeline_layout(gpu, sets, push_bytes) {
+            Ok(l) => l,
+            Err(e) => {
+                unsafe { gpu.device.destroy_shader_module(module, None) };
+                return Err(e);
+            }
+        };
+        let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let spec =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(constants));
+        let mut stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module)
             .name(c"main");
+        if !constants.is_empty() {
+            stage = stage.specialization_info(&spec);
+        }
         let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
         let result = unsafe { gpu.device.create_compute_pipelines(gpu.pipeline_cache, &[info], None) };
         unsafe { gpu.device.destroy_shader_module(module, None) };
-        let raw = result.map_err(|(_, e)| vk_err("creating a compute pipeline", e))?[0];
+        let raw = match result {
+            Ok(p) => p[0],
+            Err((_, e)) => {
+                unsafe { gpu.device.destroy_pipeline_layout(layout, None) };
+                return Err(vk_err("creating a compute pipeline", e));
+            }
+        };
         Ok(ComputePipeline { raw, layout })
     }
 

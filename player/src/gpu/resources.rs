@@ -131,6 +131,9 @@ pub struct ImageDesc {
     pub usage: vk::ImageUsageFlags,
     /// Filled by uploads: shared with the transfer queue when there is one.
     pub uploaded: bool,
+    /// Channel swizzle of the default view (identity for all but block-compressed textures
+    /// with fewer than four channels).
+    pub components: vk::ComponentMapping,
 }
 
 /// An image, its default view and memory.
@@ -196,6 +199,7 @@ impl Image {
                 vk::ImageViewType::TYPE_2D
             })
             .format(desc.format)
+            .components(desc.components)
             .subresource_range(vk::ImageSubresourceRange {
                 aspect_mask: aspect,
                 base_mip_level: 0,

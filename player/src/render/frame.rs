@@ -22,6 +22,7 @@ use super::passes::toth::TothPass;
 use super::passes::visibility::VisibilityPass;
 use super::spirv;
 use super::technique::{Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
+use super::texels::TexelDecode;
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc};
 
@@ -32,37 +33,45 @@ pub struct Frame {
     pub passes: Vec<Box<dyn Pass>>,
     /// Their images.
     pub images: FrameImages,
+    /// How the passes that read the texel buffer decode it.
+    pub decode: TexelDecode,
 }
 
-/// Builds the passes `techniques` need, in frame order, for a scene of `lights` lights.
-fn passes(gpu: &Gpu, techniques: &Techniques, lights: usize) -> PlayResult<Vec<Box<dyn Pass>>> {
+/// Builds the passes `techniques` need, in frame order, for a scene of `lights` lights whose
+/// texel buffer is decoded as `decode` says.
+fn passes(
+    gpu: &Gpu,
+    techniques: &Techniques,
+    lights: usize,
+    decode: TexelDecode,
+) -> PlayResult<Vec<Box<dyn Pass>>> {
     let mut made: Vec<Box<dyn Pass>> = Vec::new();
     let built = (|| -> PlayResult {
         match techniques.gbuffer {
             GBuffer::Raster => made.push(Box::new(GBufferPass::new(gpu)?)),
             GBuffer::Visibility => {
                 made.push(Box::new(VisibilityPass::new(gpu)?));
-                made.push(Box::new(ResolvePass::new(gpu)?));
+                made.push(Box::new(ResolvePass::new(gpu, decode)?));
             }
         }
         if techniques.shadows.traced().is_some() {
-            made.push(Box::new(RtShadowsPass::new(gpu, techniques.shadows, lights)?));
+            made.push(Box::new(RtShadowsPass::new(gpu, techniques.shadows, lights, decode)?));
         }
         if let Ao::Rt { .. } = techniques.ao {
-            made.push(Box::new(RtAoPass::new(gpu)?));
+            made.push(Box::new(RtAoPass::new(gpu, decode)?));
         }
         if let Reflections::Rt { resolution, .. } = techniques.reflections {
-            made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights)?));
+            made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?));
         }
         match techniques.gi {
-            Gi::Rt { .. } => made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI)?)),
+            Gi::Rt { .. } => made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI, decode)?)),
             Gi::LineSpace { structure, .. } => {
                 let code = match structure {
                     GiStructure::Pnmt => spirv::RT_GI_LINESPACE_PNMT,
                     GiStructure::Candidates => spirv::RT_GI_LINESPACE_CANDIDATES,
                     GiStructure::Preillum => spirv::RT_GI_LINESPACE_PREILLUM,
                 };
-                made.push(Box::new(RtGiPass::with_line_space(gpu, code)?));
+                made.push(Box::new(RtGiPass::with_line_space(gpu, code, decode)?));
             }
             Gi::None => {}
         }
@@ -99,18 +108,21 @@ fn make_images(gpu: &Gpu, passes: &[Box<dyn Pass>], width: u32, height: u32) -> 
 }
 
 impl Frame {
-    /// The passes of `techniques` and their images at `width` × `height` (scene-independent:
-    /// built while the scene uploads). On failure everything made is released.
+    /// The passes of `techniques` and their images at `width` × `height`, for a scene of
+    /// `lights` lights whose texel buffer `decode` reads (known from the file's tables before
+    /// its sections upload: the pipelines are built while the scene uploads). On failure
+    /// everything made is released.
     pub fn new(
         gpu: &Gpu,
         techniques: &Techniques,
         lights: usize,
+        decode: TexelDecode,
         width: u32,
         height: u32,
     ) -> PlayResult<Frame> {
-        let mut passes = passes(gpu, techniques, lights)?;
+        let mut passes = passes(gpu, techniques, lights, decode)?;
         match make_images(gpu, &passes, width, height) {
-            Ok(images) => Ok(Frame { passes, images }),
+            Ok(images) => Ok(Frame { passes, images, decode }),
             Err(e) => {
                 for p in &mut passes {
                     p.destroy(gpu);

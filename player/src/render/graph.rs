@@ -44,6 +44,7 @@ impl TargetDecl {
             array: self.array,
             usage: self.usage,
             uploaded: false,
+            components: vk::ComponentMapping::default(),
         }
     }
 }

@@ -14,6 +14,7 @@ pub mod lights;
 pub mod passes;
 pub mod spirv;
 pub mod technique;
+pub mod texels;
 
 use crate::gpu::vk;
 use gpu_allocator::MemoryLocation;
@@ -31,6 +32,7 @@ pub use technique::{
     Aa, Ao, Effect, GBuffer, Gi, GiStructure, LsShadowTest, Media, Needs, Phase, ReflectionRes, Reflections,
     ScreenFraction, Shadows, Techniques,
 };
+pub use texels::TexelDecode;
 
 /// Shadow maps of each kind the direct-light pass can bind, and lights with a ray-traced shadow
 /// layer: defined once in `kiln_format::gpu`, which also emits them into the shaders' `layout.glsl`.
@@ -290,6 +292,12 @@ impl Renderer {
         &self.frame.images
     }
 
+    /// How the passes that read the texel buffer decode it (what their pipelines were
+    /// specialized for).
+    pub fn texel_decode(&self) -> TexelDecode {
+        self.frame.decode
+    }
+
     /// Names of the passes that run, in order.
     pub fn pass_names(&self) -> Vec<&'static str> {
         self.frame.passes.iter().map(|p| p.name()).collect()
@@ -340,7 +348,7 @@ impl Renderer {
         rec.timestamp(&self.timestamps, 0);
         self.rt_constants.accumulated = self.accumulated;
         self.rt_constants.seed = self.frame_count as u32;
-        let Frame { passes, images } = &mut self.frame;
+        let Frame { passes, images, .. } = &mut self.frame;
         let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants };
         for (i, p) in passes.iter_mut().enumerate() {
             p.record(&mut ctx);

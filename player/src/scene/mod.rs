@@ -14,11 +14,11 @@ use kiln_format::gpu::GpuVertexAttributes;
 use kiln_format::manifest::{ColorSpace, Manifest, ShadowProjection, Wrap};
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
-use kiln_format::sections::{self, GpuMaterial, Vertex};
+use kiln_format::sections::{self, GpuMaterial, PixelFormat, Swizzle, Vertex};
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, Write};
-use crate::render::Needs;
+use crate::render::{Needs, TexelDecode};
 use upload::Uploader;
 
 /// One draw: the triangles of one material, contiguous in the index buffer.
@@ -114,6 +114,16 @@ impl<'f> Prepared<'f> {
             sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
         let bvh_triangles =
             if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
+        // The ray-traced passes read each texture as stored (RGBA8 or BC blocks, the GLSL decodes
+        // them); their table needs each texture's format and swizzle from its section header.
+        let storage = if needs.scene_buffers && needs.textures {
+            (0..view.manifest.textures.len())
+                .map(|i| view.texture(i).map(|t| (t.format, t.swizzle)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(bad)?
+        } else {
+            Vec::new()
+        };
         let reference = needs.scene_buffers.then(|| {
             reference::tables(
                 &view.manifest,
@@ -121,9 +131,16 @@ impl<'f> Prepared<'f> {
                 view.triangles,
                 view.triangle_materials,
                 view.materials,
+                &storage,
             )
         });
         Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space })
+    }
+
+    /// How the passes that read the texel buffer must decode it: from the texture table they
+    /// read (the formats in the textures' section headers), known before any section uploads.
+    pub fn texel_decode(&self) -> TexelDecode {
+        self.reference.as_ref().map_or(TexelDecode::Rgba8, |r| TexelDecode::of(&r.textures))
     }
 }
 
@@ -204,6 +221,8 @@ pub struct ReferenceBuffers {
     pub raster_materials: Buffer,
     /// `GpuMedium` table.
     pub media: Buffer,
+    /// How the passes that read `texels` decode it.
+    pub texel_decode: TexelDecode,
     /// Entries in `emitters`.
     pub emitter_count: u32,
     /// Entries in `media`.
@@ -478,7 +497,11 @@ impl GpuScene {
                 self.upload_texture(gpu, view, index as usize, up)?;
                 if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
                     let t = tables.textures[index as usize];
-                    up.buffer(&r.texels, t.offset as u64 * 4, view.texture(index as usize).map_err(bad)?)?;
+                    up.buffer(
+                        &r.texels,
+                        t.offset as u64 * 4,
+                        view.texture(index as usize).map_err(bad)?.levels,
+                    )?;
                 }
             } else if let (Some(m), true) =
                 (&self.media, kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
@@ -541,25 +564,56 @@ impl GpuScene {
 
     fn upload_texture(&mut self, gpu: &Gpu, view: &SceneView, i: usize, up: &mut Uploader) -> PlayResult {
         let info = &view.manifest.textures[i];
-        let bytes = view.texture(i).map_err(bad)?;
-        let format = match info.color_space {
-            ColorSpace::Srgb => vk::Format::R8G8B8A8_SRGB,
-            ColorSpace::Linear => vk::Format::R8G8B8A8_UNORM,
+        let data = view.texture(i).map_err(bad)?;
+        let srgb = info.color_space == ColorSpace::Srgb;
+        // The file's colour space and format were checked together (BC4 and BC5 are never sRGB).
+        let format = match (data.format, srgb) {
+            (PixelFormat::Rgba8, true) => vk::Format::R8G8B8A8_SRGB,
+            (PixelFormat::Rgba8, false) => vk::Format::R8G8B8A8_UNORM,
+            (PixelFormat::Bc7, true) => vk::Format::BC7_SRGB_BLOCK,
+            (PixelFormat::Bc7, false) => vk::Format::BC7_UNORM_BLOCK,
+            (PixelFormat::Bc5, _) => vk::Format::BC5_UNORM_BLOCK,
+            (PixelFormat::Bc4, _) => vk::Format::BC4_UNORM_BLOCK,
         };
-        let image = Image::new(
-            gpu,
-            &info.name,
-            sampled_desc(format, info.width, info.height, info.mip_levels, 1, false),
-        )?;
-        let mut levels = Vec::with_capacity(info.mip_levels as usize);
-        let mut offset = 0usize;
-        for mip in 0..info.mip_levels {
-            let (w, h) = ((info.width >> mip).max(1), (info.height >> mip).max(1));
-            let n = w as usize * h as usize * 4;
-            levels.push((mip, 0, w, h, &bytes[offset..offset + n]));
-            offset += n;
+        if data.format.is_block_compressed() && !gpu.texture_compression_bc {
+            return Err(PlayError::new(
+                Exit::Unsupported,
+                format!(
+                    "texture {i} ('{}') is {}-compressed and {} cannot sample BC textures (no \
+                     textureCompressionBC); recompile the scene with kiln compile --texture-format rgba8",
+                    info.name,
+                    data.format.name().to_uppercase(),
+                    gpu.name
+                ),
+            ));
         }
-        up.image(&image, 4, &levels)?;
+        let swizzle = |s: Swizzle| match s {
+            Swizzle::R => vk::ComponentSwizzle::R,
+            Swizzle::G => vk::ComponentSwizzle::G,
+            Swizzle::B => vk::ComponentSwizzle::B,
+            Swizzle::A => vk::ComponentSwizzle::A,
+            Swizzle::Zero => vk::ComponentSwizzle::ZERO,
+            Swizzle::One => vk::ComponentSwizzle::ONE,
+        };
+        let mut desc = sampled_desc(format, info.width, info.height, info.mip_levels, 1, false);
+        desc.components = vk::ComponentMapping {
+            r: swizzle(data.swizzle[0]),
+            g: swizzle(data.swizzle[1]),
+            b: swizzle(data.swizzle[2]),
+            a: swizzle(data.swizzle[3]),
+        };
+        let image = Image::new(gpu, &info.name, desc)?;
+        let slices = data.level_slices(info.width, info.height, info.mip_levels);
+        let levels: Vec<(u32, u32, u32, u32, &[u8])> = slices
+            .iter()
+            .enumerate()
+            .map(|(mip, bytes)| {
+                let mip = mip as u32;
+                (mip, 0, (info.width >> mip).max(1), (info.height >> mip).max(1), *bytes)
+            })
+            .collect();
+        // Uploaded as stored: blocks go to the GPU as they are in the file.
+        up.image_blocks(&image, data.format.block_dim(), data.format.block_bytes() as u64, &levels)?;
         let key = SamplerKey {
             linear: info.mag_linear,
             mipmaps: info.mip_levels > 1,
@@ -668,6 +722,7 @@ fn reference_buffers(
         textures: next(),
         raster_materials: next(),
         media: next(),
+        texel_decode: TexelDecode::of(&tables.textures),
         emitter_count: tables.emitters.len() as u32,
         media_count: tables.media.len() as u32,
     })
@@ -692,6 +747,7 @@ pub fn sampled_desc(
         array: false,
         usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
         uploaded: true,
+        components: vk::ComponentMapping::default(),
     }
 }
 

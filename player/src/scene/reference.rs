@@ -4,7 +4,7 @@
 use glam::Vec3;
 use kiln_format::gpu::{EmitterKinds, GpuEmitter, GpuMedium, GpuTexture, TextureFlags};
 use kiln_format::manifest::{ColorSpace, LightKind, Manifest, Wrap};
-use kiln_format::sections::{GpuMaterial, Vertex};
+use kiln_format::sections::{GpuMaterial, PixelFormat, Swizzle, Vertex};
 
 /// The derived tables.
 #[derive(Debug, Default)]
@@ -55,6 +55,7 @@ pub fn tables(
     triangles: &[[u32; 3]],
     triangle_materials: &[u32],
     materials: &[GpuMaterial],
+    storage: &[(PixelFormat, [Swizzle; 4])],
 ) -> ReferenceTables {
     let b = &manifest.bounds;
     let radius = (Vec3::from(b.max) - Vec3::from(b.min)).length() * 0.5;
@@ -92,7 +93,9 @@ pub fn tables(
         }
     }
     tables.media = super::media::table(manifest);
-    for t in &manifest.textures {
+    for (i, t) in manifest.textures.iter().enumerate() {
+        // How the texels are stored (the section header): RGBA8 where unknown.
+        let (format, swizzle) = storage.get(i).copied().unwrap_or((PixelFormat::Rgba8, Swizzle::IDENTITY));
         let mut flags = wrap_bits(t.wrap_u) << TextureFlags::WRAP_U_SHIFT
             | wrap_bits(t.wrap_v) << TextureFlags::WRAP_V_SHIFT;
         if t.color_space == ColorSpace::Srgb {
@@ -102,15 +105,19 @@ pub fn tables(
             flags |= TextureFlags::LINEAR;
         }
         flags |= t.mip_levels.min(31) << TextureFlags::LEVELS_SHIFT;
+        flags |= (format as u32) << TextureFlags::FORMAT_SHIFT;
+        for (k, s) in swizzle.iter().enumerate() {
+            flags |= (*s as u32) << (TextureFlags::SWIZZLE_SHIFT + 3 * k as u32);
+        }
         tables.textures.push(GpuTexture {
             offset: tables.texel_words as u32,
             width: t.width,
             height: t.height,
             flags,
         });
-        // The manifest's level count was validated against the size when the file was opened.
-        tables.texel_words +=
-            kiln_format::scene::mip_chain_bytes(t.width, t.height, t.mip_levels).unwrap_or(0) / 4;
+        // The manifest's level count was validated against the size when the file was opened;
+        // every chain is a whole number of words (BC4's 8-byte blocks included).
+        tables.texel_words += format.chain_bytes(t.width, t.height, t.mip_levels).unwrap_or(0) / 4;
     }
     tables
 }
@@ -143,8 +150,14 @@ mod tests {
         let v = |x: f32, z: f32| Vertex { position: [x, 0.0, z], normal: [0.0, 1.0, 0.0] };
         let vertices = vec![v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
         let glow = GpuMaterial { emission: [1.0; 3], ..Default::default() };
-        let t =
-            tables(&manifest, &vertices, &[[0, 1, 2], [0, 2, 1]], &[0, 1], &[GpuMaterial::default(), glow]);
+        let t = tables(
+            &manifest,
+            &vertices,
+            &[[0, 1, 2], [0, 2, 1]],
+            &[0, 1],
+            &[GpuMaterial::default(), glow],
+            &[],
+        );
         assert_eq!(t.emitters.len(), 3, "the dark light is dropped");
         let p: Vec<f32> = t.emitters.iter().map(|e| e.pdf).collect();
         assert!((p[1] / p[0] - 3.0).abs() < 1e-5);

@@ -152,33 +152,52 @@ impl<'g> Uploader<'g> {
     /// Uploads an image's texels: `levels` lists (mip, layer, width, height, bytes) with rows
     /// tightly packed, `texel` bytes per texel. The image ends in SHADER_READ_ONLY layout.
     pub fn image(&mut self, image: &Image, texel: u64, levels: &[(u32, u32, u32, u32, &[u8])]) -> PlayResult {
+        self.image_blocks(image, 1, texel, levels)
+    }
+
+    /// Uploads an image stored in `block × block` texel blocks of `block_bytes` each (1 and the
+    /// texel size for uncompressed images): each level's rows of blocks tightly packed, the
+    /// last row and column of blocks partial where the level's size is not a multiple of the
+    /// block. Copies split at block-row boundaries. The image ends in SHADER_READ_ONLY layout.
+    pub fn image_blocks(
+        &mut self,
+        image: &Image,
+        block: u32,
+        block_bytes: u64,
+        levels: &[(u32, u32, u32, u32, &[u8])],
+    ) -> PlayResult {
         self.recorder()?.transition(image, Use::DISCARD, Use::TRANSFER_DST);
         for &(mip, layer, width, height, bytes) in levels {
-            let row = width as u64 * texel;
-            if bytes.len() as u64 != row * height as u64 {
+            let row = width.div_ceil(block) as u64 * block_bytes;
+            let block_rows = height.div_ceil(block);
+            if bytes.len() as u64 != row * block_rows as u64 {
                 return Err(PlayError::new(
                     Exit::BadInput,
                     format!(
                         "image level of {width}x{height} has {} bytes, expected {}",
                         bytes.len(),
-                        row * height as u64
+                        row * block_rows as u64
                     ),
                 ));
             }
             let mut y = 0u32;
-            while y < height {
-                let (offset, n) = self.reserve(row * (height - y) as u64, row)?;
+            while y < block_rows {
+                let (offset, n) = self.reserve(row * (block_rows - y) as u64, row)?;
                 let rows = (n / row) as u32;
                 // Give back the partial row the reservation may include.
                 self.halves[self.current].used = offset + rows as u64 * row;
                 let start = y as u64 * row;
                 self.stage(offset, &bytes[start as usize..(start + rows as u64 * row) as usize])?;
                 let half = &self.halves[self.current];
+                // In texels: a copy's extent may end at the level's edge mid-block (Vulkan's rule
+                // for block formats), and the buffer rows are whole blocks.
+                let texel_y = y * block;
+                let texel_rows = (rows * block).min(height - texel_y);
                 Recorder::continuing(self.gpu, half.pool.cmd).copy_to_image(
                     &half.staging,
                     offset,
                     image,
-                    ImageRows { mip, layer, y, width, rows },
+                    ImageRows { mip, layer, y: texel_y, width, rows: texel_rows },
                 );
                 y += rows;
             }

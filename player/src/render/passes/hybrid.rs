@@ -11,6 +11,7 @@ use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
 use super::{FrameCtx, Shared, rt_ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
+use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::scene::bindings as scene_bindings;
 use crate::scene::linespace::LineSpaceBuffers;
@@ -34,6 +35,8 @@ pub fn bound() -> Vec<TargetDecl> {
 #[derive(Debug)]
 pub struct HybridSet {
     layout: SetLayout,
+    /// How the pipelines over it decode the texel buffer.
+    decode: TexelDecode,
     /// Whether the layout ends with the line space's bindings (at [`LINE_SPACE_BINDING`]).
     line_space: bool,
     /// The set (allocated by the first [`HybridSet::bind`]).
@@ -41,8 +44,9 @@ pub struct HybridSet {
 }
 
 impl HybridSet {
-    /// The layout; with `line_space`, followed by the line space's bindings.
-    pub fn new(gpu: &Gpu, line_space: bool) -> PlayResult<HybridSet> {
+    /// The layout; with `line_space`, followed by the line space's bindings. Its pipelines
+    /// decode the texel buffer as `decode` says.
+    pub fn new(gpu: &Gpu, line_space: bool, decode: TexelDecode) -> PlayResult<HybridSet> {
         use BindingKind::*;
         let mut bindings = vec![Binding::one(Uniform)];
         bindings.extend([Binding::one(Storage); 11]);
@@ -56,14 +60,22 @@ impl HybridSet {
         }
         Ok(HybridSet {
             layout: SetLayout::new(gpu, &bindings, 1)?,
+            decode,
             line_space,
             set: vk::DescriptorSet::null(),
         })
     }
 
-    /// A compute pipeline over this layout with the ray-traced passes' push constants.
+    /// A compute pipeline over this layout with the ray-traced passes' push constants,
+    /// specialized for the set's texel decode.
     pub fn pipeline(&self, gpu: &Gpu, spirv: &[u8]) -> PlayResult<ComputePipeline> {
-        ComputePipeline::new(gpu, spirv, &[&self.layout], std::mem::size_of::<RtConstants>() as u32)
+        ComputePipeline::specialized(
+            gpu,
+            spirv,
+            &[&self.layout],
+            std::mem::size_of::<RtConstants>() as u32,
+            &self.decode.constants(),
+        )
     }
 
     /// Allocates (once) and writes the set.
@@ -134,18 +146,19 @@ pub struct HybridKernel {
 }
 
 impl HybridKernel {
-    /// The kernel from SPIR-V; on failure nothing is left behind.
-    pub fn new(gpu: &Gpu, spirv: &[u8]) -> PlayResult<HybridKernel> {
-        Self::make(gpu, spirv, false)
+    /// The kernel from SPIR-V, decoding the texel buffer as `decode` says; on failure nothing
+    /// is left behind.
+    pub fn new(gpu: &Gpu, spirv: &[u8], decode: TexelDecode) -> PlayResult<HybridKernel> {
+        Self::make(gpu, spirv, false, decode)
     }
 
     /// A kernel that also reads the line space.
-    pub fn with_line_space(gpu: &Gpu, spirv: &[u8]) -> PlayResult<HybridKernel> {
-        Self::make(gpu, spirv, true)
+    pub fn with_line_space(gpu: &Gpu, spirv: &[u8], decode: TexelDecode) -> PlayResult<HybridKernel> {
+        Self::make(gpu, spirv, true, decode)
     }
 
-    fn make(gpu: &Gpu, spirv: &[u8], line_space: bool) -> PlayResult<HybridKernel> {
-        let mut set = HybridSet::new(gpu, line_space)?;
+    fn make(gpu: &Gpu, spirv: &[u8], line_space: bool, decode: TexelDecode) -> PlayResult<HybridKernel> {
+        let mut set = HybridSet::new(gpu, line_space, decode)?;
         match set.pipeline(gpu, spirv) {
             Ok(pipeline) => Ok(HybridKernel { set, pipeline }),
             Err(e) => {

@@ -3,8 +3,9 @@
 
 use crate::error::PlayResult;
 use crate::gpu::{Binding, ComputePipeline, Gpu, Recorder, SetLayout, Write, vk};
+use crate::render::TexelDecode;
 
-/// Layout, pipeline and set of one compute kernel.
+/// Layout, pipeline and sets of one compute kernel.
 #[derive(Debug)]
 pub struct Kernel {
     layout: SetLayout,
@@ -16,8 +17,29 @@ impl Kernel {
     /// A kernel from SPIR-V over a set of `bindings`, with `push_bytes` of push constants. On
     /// failure nothing is left behind.
     pub fn new(gpu: &Gpu, bindings: &[Binding], spirv: &[u8], push_bytes: u32) -> PlayResult<Kernel> {
+        Self::make(gpu, bindings, spirv, push_bytes, &[])
+    }
+
+    /// [`Kernel::new`] for a kernel that reads the texel buffer, specialized for `decode`.
+    pub fn reading_texels(
+        gpu: &Gpu,
+        bindings: &[Binding],
+        spirv: &[u8],
+        push_bytes: u32,
+        decode: TexelDecode,
+    ) -> PlayResult<Kernel> {
+        Self::make(gpu, bindings, spirv, push_bytes, &decode.constants())
+    }
+
+    fn make(
+        gpu: &Gpu,
+        bindings: &[Binding],
+        spirv: &[u8],
+        push_bytes: u32,
+        constants: &[u32],
+    ) -> PlayResult<Kernel> {
         let mut layout = SetLayout::new(gpu, bindings, 1)?;
-        match ComputePipeline::new(gpu, spirv, &[&layout], push_bytes) {
+        match ComputePipeline::specialized(gpu, spirv, &[&layout], push_bytes, constants) {
             Ok(pipeline) => Ok(Kernel { layout, pipeline, sets: Vec::new() }),
             Err(e) => {
                 layout.destroy(gpu);

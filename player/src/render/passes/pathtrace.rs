@@ -5,6 +5,7 @@
 use crate::gpu::vk;
 
 use super::kernel::Kernel;
+use crate::render::TexelDecode;
 
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, Buffer, Gpu, Use, Write};
@@ -28,14 +29,20 @@ pub const ACCUMULATION: TargetDecl = TargetDecl {
 pub struct PathTracePass(Kernel);
 
 impl PathTracePass {
-    /// Builds the pipeline.
-    pub fn new(gpu: &Gpu) -> PlayResult<PathTracePass> {
+    /// Builds the pipeline for a texel buffer that `decode` reads.
+    pub fn new(gpu: &Gpu, decode: TexelDecode) -> PlayResult<PathTracePass> {
         use BindingKind::*;
         let mut bindings = vec![Binding::one(Uniform)];
         bindings.extend([Binding::one(Storage); 12]);
         bindings.push(Binding::one(StorageImage));
         bindings.push(Binding::one(Storage));
-        Ok(PathTracePass(Kernel::new(gpu, &bindings, spirv::PATHTRACE, std::mem::size_of::<u32>() as u32)?))
+        Ok(PathTracePass(Kernel::reading_texels(
+            gpu,
+            &bindings,
+            spirv::PATHTRACE,
+            std::mem::size_of::<u32>() as u32,
+            decode,
+        )?))
     }
 
     /// Allocates and writes the set: `constants` holds `ReferenceConstants`, `lights` the

@@ -8,6 +8,7 @@ use super::kernel::Kernel;
 use super::{FrameCtx, Pass, Shared};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
+use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -19,14 +20,14 @@ const OUTPUTS: [TargetDecl; 4] = [NORMAL, ALBEDO, MATERIAL, EMISSION];
 pub struct ResolvePass(Kernel);
 
 impl ResolvePass {
-    /// Builds the pipeline.
-    pub fn new(gpu: &Gpu) -> PlayResult<ResolvePass> {
+    /// Builds the pipeline for a texel buffer that `decode` reads.
+    pub fn new(gpu: &Gpu, decode: TexelDecode) -> PlayResult<ResolvePass> {
         use BindingKind::*;
         let mut bindings = vec![Binding::one(Uniform)];
         bindings.extend([Binding::one(Storage); 7]);
         bindings.extend([Binding::one(StorageImage); 5]);
         bindings.push(Binding::one(Sampled));
-        Ok(ResolvePass(Kernel::new(gpu, &bindings, spirv::RESOLVE, 0)?))
+        Ok(ResolvePass(Kernel::reading_texels(gpu, &bindings, spirv::RESOLVE, 0, decode)?))
     }
 }
 

@@ -7,6 +7,7 @@ use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc, Use};
+use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -23,9 +24,9 @@ pub const AO: TargetDecl = TargetDecl {
 pub struct RtAoPass(HybridKernel);
 
 impl RtAoPass {
-    /// Builds the pipeline.
-    pub fn new(gpu: &Gpu) -> PlayResult<RtAoPass> {
-        Ok(RtAoPass(HybridKernel::new(gpu, spirv::RT_AO)?))
+    /// Builds the pipeline, decoding the texel buffer as `decode` says.
+    pub fn new(gpu: &Gpu, decode: TexelDecode) -> PlayResult<RtAoPass> {
+        Ok(RtAoPass(HybridKernel::new(gpu, spirv::RT_AO, decode)?))
     }
 }
 

@@ -13,6 +13,7 @@ use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc, Use};
+use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 
 /// Mean incoming radiance over the cosine-weighted hemisphere of each pixel's surface (rgb).
@@ -30,13 +31,14 @@ pub struct RtGiPass(HybridKernel);
 impl RtGiPass {
     /// Builds the pipeline of a GI kernel: `spirv` includes `shaders/rt/gi.glsl` with the hooks
     /// of its ray structure (e.g. [`crate::render::spirv::RT_GI`]).
-    pub fn new(gpu: &Gpu, spirv: &[u8]) -> PlayResult<RtGiPass> {
-        Ok(RtGiPass(HybridKernel::new(gpu, spirv)?))
+    /// The texel buffer is decoded as `decode` says.
+    pub fn new(gpu: &Gpu, spirv: &[u8], decode: TexelDecode) -> PlayResult<RtGiPass> {
+        Ok(RtGiPass(HybridKernel::new(gpu, spirv, decode)?))
     }
 
     /// A GI kernel whose hooks read the line space (`shaders/rt/gi_linespace*.comp`).
-    pub fn with_line_space(gpu: &Gpu, spirv: &[u8]) -> PlayResult<RtGiPass> {
-        Ok(RtGiPass(HybridKernel::with_line_space(gpu, spirv)?))
+    pub fn with_line_space(gpu: &Gpu, spirv: &[u8], decode: TexelDecode) -> PlayResult<RtGiPass> {
+        Ok(RtGiPass(HybridKernel::with_line_space(gpu, spirv, decode)?))
     }
 }
 

@@ -9,6 +9,7 @@ use super::hybrid::{self, HybridSet};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
+use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::technique::ReflectionRes;
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
@@ -52,9 +53,15 @@ pub struct RtReflectionsPass {
 }
 
 impl RtReflectionsPass {
-    /// Builds the pipelines for `resolution` and a scene of `lights` lights.
-    pub fn new(gpu: &Gpu, resolution: ReflectionRes, lights: usize) -> PlayResult<RtReflectionsPass> {
-        let mut set = HybridSet::new(gpu, false)?;
+    /// Builds the pipelines for `resolution` and a scene of `lights` lights, decoding the
+    /// texel buffer as `decode` says.
+    pub fn new(
+        gpu: &Gpu,
+        resolution: ReflectionRes,
+        lights: usize,
+        decode: TexelDecode,
+    ) -> PlayResult<RtReflectionsPass> {
+        let mut set = HybridSet::new(gpu, false, decode)?;
         let trace = match set.pipeline(gpu, spirv::RT_REFLECTIONS) {
             Ok(p) => p,
             Err(e) => {

@@ -9,6 +9,7 @@ use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc, Use};
+use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::technique::{LsShadowTest, Shadows};
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
@@ -35,16 +36,21 @@ pub struct RtShadowsPass {
 
 impl RtShadowsPass {
     /// Builds the pipeline of `technique` (its rays through the BVH or the line space) for a
-    /// scene of `lights` lights.
-    pub fn new(gpu: &Gpu, technique: Shadows, lights: usize) -> PlayResult<RtShadowsPass> {
+    /// scene of `lights` lights, decoding the texel buffer as `decode` says.
+    pub fn new(
+        gpu: &Gpu,
+        technique: Shadows,
+        lights: usize,
+        decode: TexelDecode,
+    ) -> PlayResult<RtShadowsPass> {
         let kernel = match technique {
             Shadows::LineSpace { test: LsShadowTest::Ends, .. } => {
-                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE)?
+                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE, decode)?
             }
             Shadows::LineSpace { test: LsShadowTest::Filled, .. } => {
-                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE_EXACT)?
+                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE_EXACT, decode)?
             }
-            _ => HybridKernel::new(gpu, spirv::RT_SHADOWS)?,
+            _ => HybridKernel::new(gpu, spirv::RT_SHADOWS, decode)?,
         };
         Ok(RtShadowsPass { kernel, layers: layers(lights) })
     }

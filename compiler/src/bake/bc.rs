@@ -1,0 +1,332 @@
+//! Block compression of textures: which format each texture becomes (from the material slots
+//! that read it), encoding through Intel's ISPC texture compressor (`intel_tex_2`), and the error
+//! of mip 0 against the RGBA8 texels, measured through an independent decoder (`bcdec_rs`).
+
+use intel_tex_2::{RSurface, RgSurface, RgbaSurface, bc4, bc5, bc7};
+use kiln_format::sections::{GpuMaterial, NO_TEXTURE, PixelFormat, Swizzle};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::ir::{Texture, TextureRole};
+use crate::settings::TextureFormat;
+
+/// Which material slots read a texture.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Usage {
+    /// Base colour or emissive (sRGB colour).
+    pub color: bool,
+    /// Metallic-roughness (G roughness, B metalness).
+    pub metallic_roughness: bool,
+    /// Tangent-space normal map.
+    pub normal: bool,
+    /// Occlusion (R).
+    pub occlusion: bool,
+}
+
+impl Usage {
+    /// The slots of texture `i` in `materials`.
+    pub fn of(materials: &[GpuMaterial], i: u32) -> Usage {
+        let mut u = Usage::default();
+        for m in materials {
+            u.color |= m.base_color_texture == i || m.emissive_texture == i;
+            u.metallic_roughness |= m.metallic_roughness_texture == i;
+            u.normal |= m.normal_texture == i;
+            u.occlusion |= m.occlusion_texture == i;
+        }
+        debug_assert!(i != NO_TEXTURE);
+        u
+    }
+
+    /// As bytes, for the stage key.
+    pub fn bits(self) -> u8 {
+        self.color as u8
+            | (self.metallic_roughness as u8) << 1
+            | (self.normal as u8) << 2
+            | (self.occlusion as u8) << 3
+    }
+}
+
+/// What a texture becomes: its pixel format, the swizzle that gives the shaders the channels
+/// where they read them, and which source channels (RGBA8 indices) are encoded, in stored order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Choice {
+    /// Stored format.
+    pub format: PixelFormat,
+    /// What sampled R, G, B, A return.
+    pub swizzle: [Swizzle; 4],
+    /// Source channel of each stored channel.
+    pub channels: Vec<usize>,
+    /// Why, for `kiln plan` and the report.
+    pub why: &'static str,
+}
+
+/// The format of a texture of `role` read by the slots in `usage`. One image used in two roles
+/// is two textures (the importer keys textures by image and role), so only a data texture can be
+/// read by two slots (an occlusion-roughness-metallic image): it keeps all three channels.
+pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
+    let rgba8 = |why| Choice {
+        format: PixelFormat::Rgba8,
+        swizzle: Swizzle::IDENTITY,
+        channels: vec![0, 1, 2, 3],
+        why,
+    };
+    if setting == TextureFormat::Rgba8 {
+        return rgba8("--texture-format rgba8");
+    }
+    use Swizzle::{G, One, R, Zero};
+    match t.role {
+        TextureRole::Color => Choice {
+            format: PixelFormat::Bc7,
+            swizzle: Swizzle::IDENTITY,
+            channels: vec![0, 1, 2, 3],
+            why: "colour: BC7 sRGB with alpha",
+        },
+        // x, y; the shaders reconstruct z = sqrt(1 - x² - y²) for every normal map.
+        TextureRole::Normal => Choice {
+            format: PixelFormat::Bc5,
+            swizzle: [R, G, Zero, One],
+            channels: vec![0, 1],
+            why: "normal map: BC5 of x, y (z reconstructed)",
+        },
+        TextureRole::Data => match (usage.metallic_roughness, usage.occlusion) {
+            (true, true) => Choice {
+                format: PixelFormat::Bc7,
+                swizzle: [R, G, Swizzle::B, One],
+                channels: vec![0, 1, 2],
+                why: "occlusion + metallic-roughness: BC7 linear of R, G, B",
+            },
+            (true, false) => Choice {
+                format: PixelFormat::Bc5,
+                swizzle: [Zero, R, G, One],
+                channels: vec![1, 2],
+                why: "metallic-roughness: BC5 of G (roughness), B (metalness)",
+            },
+            (false, true) => Choice {
+                format: PixelFormat::Bc4,
+                swizzle: [R, R, R, One],
+                channels: vec![0],
+                why: "occlusion: BC4 of R",
+            },
+            (false, false) => rgba8("read by no material slot: kept RGBA8"),
+        },
+    }
+}
+
+/// The channels `channels` of a `width × height` RGBA8 level, padded to whole 4×4 blocks by
+/// repeating the last column and row (what BC encoders expect; the padding is never sampled).
+fn padded(rgba: &[u8], width: u32, height: u32, channels: &[usize]) -> (Vec<u8>, u32, u32) {
+    let (pw, ph) = (width.div_ceil(4) * 4, height.div_ceil(4) * 4);
+    let n = channels.len();
+    let mut out = vec![0u8; pw as usize * ph as usize * n];
+    for y in 0..ph {
+        let sy = y.min(height - 1);
+        for x in 0..pw {
+            let sx = x.min(width - 1);
+            let src = ((sy * width + sx) * 4) as usize;
+            let dst = ((y * pw + x) as usize) * n;
+            for (k, &c) in channels.iter().enumerate() {
+                out[dst + k] = rgba[src + c];
+            }
+        }
+    }
+    (out, pw, ph)
+}
+
+/// Rows of blocks compressed per task: enough work per call to amortise it, small enough to
+/// spread a 2048² level over the worker threads. Blocks are independent, so the output does not
+/// depend on how the rows are split.
+const BLOCK_ROWS_PER_TASK: u32 = 8;
+
+/// Encodes one RGBA8 level of `width × height` as `choice` says.
+fn encode_level(choice: &Choice, rgba: &[u8], width: u32, height: u32, alpha: bool) -> Vec<u8> {
+    let (data, pw, ph) = padded(rgba, width, height, &choice.channels);
+    let n = choice.channels.len() as u32;
+    let block_rows = ph / 4;
+    let row_bytes = (pw / 4 * choice.format.block_bytes()) as usize;
+    let tasks: Vec<u32> = (0..block_rows.div_ceil(BLOCK_ROWS_PER_TASK)).collect();
+    let settings = if alpha { bc7::alpha_basic_settings() } else { bc7::opaque_basic_settings() };
+    let parts: Vec<Vec<u8>> = tasks
+        .par_iter()
+        .map(|&t| {
+            let first = t * BLOCK_ROWS_PER_TASK;
+            let rows = BLOCK_ROWS_PER_TASK.min(block_rows - first);
+            let stride = pw * n;
+            let bytes = &data[(first * 4 * stride) as usize..((first + rows) * 4 * stride) as usize];
+            let (w, h) = (pw, rows * 4);
+            match choice.format {
+                PixelFormat::Bc7 => {
+                    // BC7 needs RGBA input: data textures (three channels) get opaque alpha.
+                    let rgba: Vec<u8> = if n == 4 {
+                        bytes.to_vec()
+                    } else {
+                        bytes.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect()
+                    };
+                    bc7::compress_blocks(
+                        &settings,
+                        &RgbaSurface { data: &rgba, width: w, height: h, stride: w * 4 },
+                    )
+                }
+                PixelFormat::Bc5 => {
+                    bc5::compress_blocks(&RgSurface { data: bytes, width: w, height: h, stride: w * 2 })
+                }
+                PixelFormat::Bc4 => {
+                    bc4::compress_blocks(&RSurface { data: bytes, width: w, height: h, stride: w })
+                }
+                PixelFormat::Rgba8 => unreachable!("RGBA8 levels are stored as they are"),
+            }
+        })
+        .collect();
+    let out: Vec<u8> = parts.concat();
+    debug_assert_eq!(out.len(), row_bytes * block_rows as usize);
+    out
+}
+
+/// The stored mip chain of `t` (RGBA8 chain `chain`, level 0 first) in `choice`'s format.
+pub fn encode(t: &Texture, choice: &Choice, chain: Vec<u8>) -> Vec<u8> {
+    if choice.format == PixelFormat::Rgba8 {
+        return chain;
+    }
+    // Alpha settings spend bits on alpha only where the colour texture has some.
+    let alpha = choice.channels.len() == 4 && t.rgba.chunks_exact(4).any(|p| p[3] != 255);
+    let levels = kiln_format::scene::mip_levels(t.width, t.height);
+    let mut out = Vec::new();
+    let mut offset = 0usize;
+    for l in 0..levels {
+        let (w, h) = ((t.width >> l).max(1), (t.height >> l).max(1));
+        let n = (w * h * 4) as usize;
+        out.extend(encode_level(choice, &chain[offset..offset + n], w, h, alpha));
+        offset += n;
+    }
+    out
+}
+
+/// Decodes one stored level to RGBA8 of its stored channels (missing ones 0, alpha 255), through
+/// `bcdec_rs`, a decoder independent of the encoder.
+pub fn decode_level(format: PixelFormat, bytes: &[u8], width: u32, height: u32) -> Vec<u8> {
+    if format == PixelFormat::Rgba8 {
+        return bytes[..(width * height * 4) as usize].to_vec();
+    }
+    let (bw, bh) = (width.div_ceil(4) as usize, height.div_ceil(4) as usize);
+    let bb = format.block_bytes() as usize;
+    let mut out = vec![0u8; width as usize * height as usize * 4];
+    for by in 0..bh {
+        for bx in 0..bw {
+            let block = &bytes[(by * bw + bx) * bb..][..bb];
+            let mut px = [0u8; 64];
+            match format {
+                PixelFormat::Bc7 => bcdec_rs::bc7(block, &mut px, 16),
+                PixelFormat::Bc5 => {
+                    let mut rg = [0u8; 32];
+                    bcdec_rs::bc5(block, &mut rg, 8, false);
+                    for i in 0..16 {
+                        px[i * 4..i * 4 + 4].copy_from_slice(&[rg[i * 2], rg[i * 2 + 1], 0, 255]);
+                    }
+                }
+                PixelFormat::Bc4 => {
+                    let mut r = [0u8; 16];
+                    bcdec_rs::bc4(block, &mut r, 4, false);
+                    for i in 0..16 {
+                        px[i * 4..i * 4 + 4].copy_from_slice(&[r[i], 0, 0, 255]);
+                    }
+                }
+                PixelFormat::Rgba8 => unreachable!(),
+            }
+            for y in 0..4 {
+                for x in 0..4 {
+                    let (tx, ty) = (bx * 4 + x, by * 4 + y);
+                    if tx < width as usize && ty < height as usize {
+                        let dst = (ty * width as usize + tx) * 4;
+                        out[dst..dst + 4].copy_from_slice(&px[(y * 4 + x) * 4..][..4]);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A texture's line in the compile report.
+#[derive(Debug, Clone, Serialize)]
+pub struct TextureReport {
+    /// Texture number.
+    pub index: u32,
+    /// Image name.
+    pub name: String,
+    /// Mip 0 size.
+    pub width: u32,
+    /// Mip 0 size.
+    pub height: u32,
+    /// Stored format.
+    pub format: &'static str,
+    /// Why that format.
+    pub why: &'static str,
+    /// Bytes of the section.
+    pub bytes: u64,
+    /// Bytes the RGBA8 mip chain takes.
+    pub rgba8_bytes: u64,
+    /// PSNR (dB) of mip 0 over the stored channels against the RGBA8 texels; `None` when exact.
+    pub psnr_db: Option<f64>,
+    /// Mean LDR-FLIP of mip 0 against the RGBA8 texels (colour premultiplied by alpha, data as
+    /// linear values); 0 when exact.
+    pub mean_flip: f64,
+    /// Whether the error is within [`PSNR_BOUND_DB`] and [`FLIP_BOUND`].
+    pub within_bound: bool,
+}
+
+/// The smallest PSNR (dB) of a block-compressed mip 0 that passes without a warning. Measured on
+/// the shared scenes' textures (docs/testing.md): pica_pica's are 41 to 60 dB.
+pub const PSNR_BOUND_DB: f64 = 35.0;
+/// The largest mean LDR-FLIP of a block-compressed mip 0 that passes without a warning.
+pub const FLIP_BOUND: f64 = 0.05;
+
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// PSNR (dB) and mean LDR-FLIP of `decoded` mip 0 (stored channels, [`decode_level`]) against
+/// the source RGBA8 texels of `t`, over the channels `choice` stores.
+pub fn error(t: &Texture, choice: &Choice, decoded: &[u8]) -> (Option<f64>, f64) {
+    let n = choice.channels.len();
+    let mut sq = 0f64;
+    for (src, dec) in t.rgba.chunks_exact(4).zip(decoded.chunks_exact(4)) {
+        for (k, &c) in choice.channels.iter().enumerate() {
+            let d = src[c] as f64 - dec[k] as f64;
+            sq += d * d;
+        }
+    }
+    let mse = sq / (t.rgba.len() / 4 * n) as f64;
+    let psnr = (mse > 0.0).then(|| 10.0 * (255.0f64 * 255.0 / mse).log10());
+    // FLIP images: colour as seen (linear, premultiplied by alpha); data as linear values, two
+    // channels in R, G and one channel grey.
+    let image = |px: &mut dyn Iterator<Item = [u8; 4]>| -> Vec<f32> {
+        px.flat_map(|p| match (t.role, n) {
+            (TextureRole::Color, _) => {
+                let a = p[3] as f32 / 255.0;
+                [srgb_to_linear(p[0]) * a, srgb_to_linear(p[1]) * a, srgb_to_linear(p[2]) * a]
+            }
+            (_, 1) => [p[0] as f32 / 255.0; 3],
+            (_, 2) => [p[0] as f32 / 255.0, p[1] as f32 / 255.0, 0.0],
+            _ => [p[0] as f32 / 255.0, p[1] as f32 / 255.0, p[2] as f32 / 255.0],
+        })
+        .collect()
+    };
+    let reference = image(&mut t.rgba.chunks_exact(4).map(|s| {
+        let mut p = [0u8; 4];
+        for (k, &c) in choice.channels.iter().enumerate() {
+            p[k] = s[c];
+        }
+        if n < 4 {
+            p[3] = 255;
+        }
+        p
+    }));
+    let test =
+        image(&mut decoded.chunks_exact(4).map(|d| [d[0], d[1], d[2], if n < 4 { 255 } else { d[3] }]));
+    let flip = kiln_metrics::ldr_flip(
+        kiln_metrics::RgbImage { width: t.width, height: t.height, pixels: &reference },
+        kiln_metrics::RgbImage { width: t.width, height: t.height, pixels: &test },
+    )
+    .unwrap_or(f64::NAN);
+    (psnr, flip)
+}
