@@ -993,8 +993,8 @@ static CATALOGUE: [TechniqueInfo; 20] = [
         effect: Effect::Media,
         name: "mitchell",
         help: "Mitchell's god rays (seed 002): each light's emitter (the sky for a directional \
-               light, a small sphere for the others) blurred radially towards its screen \
-               position; image space, so no shafts from a light behind the camera or from what \
+               light, its rectangle for a rect light, a small sphere for point and spot lights) \
+               blurred radially towards its screen position; image space, so no shafts from a light behind the camera or from what \
                the screen does not show; see --media-samples, --media-res, --media-exposure",
         knobs: &[
             MEDIA_SAMPLES,
