@@ -3,7 +3,7 @@
 //! (The reference against an independent renderer with multiple scattering: `tests/mitsuba.rs`,
 //! the room full of fog.)
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{Bounds, LightKind, Medium, OrthographicCamera, Sky};
 use kiln_player::reference::{DEFAULT_SEED, Sampling, render_with};
@@ -394,5 +394,88 @@ fn the_shadow_map_march_matches_single_scattering_in_a_lit_slab() {
                 }
             }
         }
+    }
+}
+
+/// A point light 1.5 units above the lit slab (inverse-square falloff, the scattering angle and
+/// the light-side path changing along every view ray, its cube shadow map read at every sample):
+/// each pixel's single scattering is the integral over the slab's depth of
+/// σs p(θ) I/d² e^{−σt·ℓ_light} e^{−σt·(D − y)}, summed here by a 4000-step midpoint rule. `toth`
+/// without interleaving (60 samples) matches it per pixel within 1 %; `march` (64 steps, its
+/// source at a jittered point of each step) in the image's mean.
+#[test]
+fn the_marches_match_single_scattering_from_a_point_light() {
+    if !vulkan() {
+        return;
+    }
+    let Haze { sigma_a, sigma_s, g, depth, .. } = HAZE;
+    let (lamp, intensity) = (DVec3::new(0.3, depth as f64 + 1.5, 0.2), 20.0f64);
+    let mut scene = scene_of(&square(-0.5, 60.0));
+    scene.materials[0].gpu = lambert_material([0.0; 3]);
+    scene.lights.push(light(LightKind::Point, lamp.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity as f32));
+    scene.sky = Sky { radiance: [0.0; 3] };
+    scene.media.push(Medium {
+        bounds: Bounds { min: [-50.0, 0.0, -50.0], max: [50.0, depth, 50.0] },
+        sigma_a,
+        sigma_s,
+        g,
+    });
+    let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
+    scene.cameras.push(cam.file_camera());
+    let (xmag, ymag) = (0.5 * W as f32 / H as f32, 0.5f32);
+    scene.orthographic.push(OrthographicCamera { camera: 0, xmag, ymag });
+    let bytes = compile(scene, kiln_compiler::settings::Settings { media_volume_res: 8, ..fast_settings() });
+    // The expected image: straight down through pixel (px, py) at x, z.
+    let expected = |px: u32, py: u32, c: usize| {
+        let x = ((px as f64 + 0.5) / W as f64 * 2.0 - 1.0) * xmag as f64;
+        let z = -(1.0 - (py as f64 + 0.5) / H as f64 * 2.0) * ymag as f64;
+        let sigma_t = (sigma_a[c] + sigma_s[c]) as f64;
+        let d_slab = depth as f64;
+        let steps = 4000;
+        let dy = d_slab / steps as f64;
+        (0..steps)
+            .map(|i| {
+                let y = (i as f64 + 0.5) * dy;
+                let to = lamp - DVec3::new(x, y, z);
+                let d = to.length();
+                // The part of the way to the lamp below the slab's top.
+                let inside = d * (d_slab - y) / (lamp.y - y);
+                let cos_theta = -to.y / d;
+                sigma_s[c] as f64 * henyey_greenstein(g as f64, cos_theta) * intensity / (d * d)
+                    * (-sigma_t * inside).exp()
+                    * (-sigma_t * (d_slab - y)).exp()
+                    * dy
+            })
+            .sum::<f64>()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let toth = Media::Toth { samples: 60, block: 1, phase: Phase::Medium };
+    let (rgb, _) = render(dir.path(), "toth point", &bytes, |f| Options::new(f, W, H).media(toth));
+    let mut want_mean = [0.0f64; 3];
+    for py in 0..H {
+        for px in 0..W {
+            for c in 0..3 {
+                let want = expected(px, py, c);
+                want_mean[c] += want / (W * H) as f64;
+                let got = rgb[((py * W + px) * 3) as usize + c] as f64;
+                assert!(
+                    (got - want).abs() / want < 0.01,
+                    "toth: pixel ({px}, {py}) channel {c}: {got:.6} vs {want:.6}"
+                );
+            }
+        }
+    }
+    let (rgb, _) = render(dir.path(), "march point", &bytes, |f| {
+        Options::new(f, W, H).media(Media::March { steps: 64 })
+    });
+    let got = mean(&rgb);
+    for c in 0..3 {
+        eprintln!("point light: channel {c}: march mean {:.6} vs {:.6}", got[c], want_mean[c]);
+        assert!(
+            (got[c] - want_mean[c]).abs() / want_mean[c] < 0.01,
+            "march: channel {c}: mean {:.6} vs {:.6}",
+            got[c],
+            want_mean[c]
+        );
     }
 }
