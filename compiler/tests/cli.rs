@@ -26,6 +26,12 @@ fn demo_inspect_verify() {
     );
     assert_eq!(j["line_space"]["shaft_res"], 4);
     assert!(j["line_space"]["bytes_pnmt"].as_u64().unwrap() > 0);
+    // FORMAT.md's PNMT: a front and a back record of 16 bytes per filled shaft.
+    let filled = j["line_space"]["filled_shafts"].as_u64().unwrap();
+    assert_eq!(j["line_space"]["bytes_pnmt"].as_u64().unwrap(), 32 * filled);
+    let text = kiln(dir.path(), &["inspect", "demo.kiln"]);
+    assert!(text.stdout.contains("bytes per filled shaft: binary "), "{text:?}");
+    assert!(text.stdout.contains(", PNMT 32.00"), "{text:?}");
     assert!(j["sections"].as_array().unwrap().iter().all(|s| s["checksum_ok"] == true));
     assert_eq!(j["summary"]["triangles"], 30);
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");

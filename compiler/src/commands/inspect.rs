@@ -182,6 +182,15 @@ fn print_text(r: &InspectJson) {
             size(l.bytes_candidates),
             size(l.bytes_pnmt)
         );
+        if l.filled_shafts > 0 {
+            let per = |bytes: u64| bytes as f64 / l.filled_shafts as f64;
+            println!(
+                "  bytes per filled shaft: binary {:.2}, candidates {:.2}, PNMT {:.2}",
+                per(l.bytes_binary),
+                per(l.bytes_candidates),
+                per(l.bytes_pnmt)
+            );
+        }
     }
 }
 
