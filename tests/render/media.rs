@@ -60,20 +60,33 @@ fn slab_over(
     irradiance: f32,
     floor: f32,
 ) -> Vec<u8> {
+    let sun = light(LightKind::Directional, [0.0; 3], travel.to_array(), irradiance);
+    let medium = slab_medium(sigma_a, sigma_s, g, depth);
+    slab_lit_by(sun, medium, floor, 4)
+}
+
+/// The slab: |x|, |z| < 50, 0 < y < `depth`.
+fn slab_medium(sigma_a: [f32; 3], sigma_s: [f32; 3], g: f32, depth: f32) -> Medium {
+    Medium { bounds: Bounds { min: [-50.0, 0.0, -50.0], max: [50.0, depth, 50.0] }, sigma_a, sigma_s, g }
+}
+
+/// Half the width and half the height of the slab scenes' orthographic view.
+const SLAB_XMAG: f32 = 0.5 * W as f32 / H as f32;
+const SLAB_YMAG: f32 = 0.5;
+
+/// The slab scene: `medium` over a Lambertian floor of albedo `floor` at y = −0.5, lit by
+/// `light` under a black sky, seen straight down through the orthographic camera; the light's
+/// visibility volume `volume_res` cells on its longest axis.
+fn slab_lit_by(light: kiln_format::manifest::Light, medium: Medium, floor: f32, volume_res: u32) -> Vec<u8> {
     let mut scene = scene_of(&square(-0.5, 60.0));
     scene.materials[0].gpu = lambert_material([floor; 3]);
-    scene.lights.push(light(LightKind::Directional, [0.0; 3], travel.to_array(), irradiance));
+    scene.lights.push(light);
     scene.sky = Sky { radiance: [0.0; 3] };
-    scene.media.push(Medium {
-        bounds: Bounds { min: [-50.0, 0.0, -50.0], max: [50.0, depth, 50.0] },
-        sigma_a,
-        sigma_s,
-        g,
-    });
+    scene.media.push(medium);
     let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
     scene.cameras.push(cam.file_camera());
-    scene.orthographic.push(OrthographicCamera { camera: 0, xmag: 0.5 * W as f32 / H as f32, ymag: 0.5 });
-    compile(scene, kiln_compiler::settings::Settings { media_volume_res: 4, ..fast_settings() })
+    scene.orthographic.push(OrthographicCamera { camera: 0, xmag: SLAB_XMAG, ymag: SLAB_YMAG });
+    compile(scene, kiln_compiler::settings::Settings { media_volume_res: volume_res, ..fast_settings() })
 }
 
 /// The mean of an image.
@@ -410,21 +423,10 @@ fn the_marches_match_single_scattering_from_a_point_light() {
     }
     let Haze { sigma_a, sigma_s, g, depth, .. } = HAZE;
     let (lamp, intensity) = (DVec3::new(0.3, depth as f64 + 1.5, 0.2), 20.0f64);
-    let mut scene = scene_of(&square(-0.5, 60.0));
-    scene.materials[0].gpu = lambert_material([0.0; 3]);
-    scene.lights.push(light(LightKind::Point, lamp.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity as f32));
-    scene.sky = Sky { radiance: [0.0; 3] };
-    scene.media.push(Medium {
-        bounds: Bounds { min: [-50.0, 0.0, -50.0], max: [50.0, depth, 50.0] },
-        sigma_a,
-        sigma_s,
-        g,
-    });
-    let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
-    scene.cameras.push(cam.file_camera());
-    let (xmag, ymag) = (0.5 * W as f32 / H as f32, 0.5f32);
-    scene.orthographic.push(OrthographicCamera { camera: 0, xmag, ymag });
-    let bytes = compile(scene, kiln_compiler::settings::Settings { media_volume_res: 8, ..fast_settings() });
+    let lamp_light = light(LightKind::Point, lamp.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity as f32);
+    let medium = slab_medium(sigma_a, sigma_s, g, depth);
+    let bytes = slab_lit_by(lamp_light, medium, 0.0, 8);
+    let (xmag, ymag) = (SLAB_XMAG, SLAB_YMAG);
     // The expected image: straight down through pixel (px, py) at x, z.
     let expected = |px: u32, py: u32, c: usize| {
         let x = ((px as f64 + 0.5) / W as f64 * 2.0 - 1.0) * xmag as f64;

@@ -153,8 +153,7 @@ impl Renderer {
                 _ => 0.0,
             };
         }
-        let bounds = scene.manifest.bounds;
-        let diagonal = glam::Vec3::from(bounds.max).distance(glam::Vec3::from(bounds.min));
+        let diagonal = scene.diagonal();
         let lights_used = plan.lights_used as usize;
         let (reflection_step, reflection_lights, max_roughness) = match t.reflections {
             Reflections::Rt { resolution, max_roughness } => (

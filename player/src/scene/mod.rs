@@ -354,6 +354,13 @@ fn vertex_attributes(view: &SceneView) -> Vec<GpuVertexAttributes> {
 }
 
 impl GpuScene {
+    /// Length of the scene's bounding-box diagonal, in scene units (what sizes relative to the
+    /// scene are fractions of).
+    pub fn diagonal(&self) -> f32 {
+        let b = self.manifest.bounds;
+        glam::Vec3::from(b.max).distance(glam::Vec3::from(b.min))
+    }
+
     /// Uploads what `prepared` needs through `up`. Returns when everything is recorded; the
     /// caller flushes the uploader and waits on its timeline before drawing.
     pub fn load(gpu: &Gpu, file: &KilnFile, prepared: &Prepared, up: &mut Uploader) -> PlayResult<GpuScene> {

@@ -66,14 +66,7 @@ impl Pass for DirectPass {
         let (scene, dummies) = (shared.scene, shared.dummies);
         let near = scene.nearest_clamp;
         let lut = scene.brdf_lut.as_ref().map_or(dummies.white.view, |i| i.view);
-        let mut maps_2d = vec![(dummies.shadow_2d.view, near); MAX_SHADOW_MAPS];
-        let mut maps_cube = vec![(dummies.shadow_cube.view, near); MAX_SHADOW_MAPS];
-        for (slot, &i) in shared.plan.slots_2d.iter().enumerate() {
-            maps_2d[slot] = (scene.shadow_maps[i].image.view, near);
-        }
-        for (slot, &i) in shared.plan.slots_cube.iter().enumerate() {
-            maps_cube[slot] = (scene.shadow_maps[i].image.view, near);
-        }
+        let (maps_2d, maps_cube) = super::shadow_map_arrays(shared);
         let img = |t: &TargetDecl| shared.images.get(t).view;
         let mut writes = vec![
             Write::Buffer(0, shared.frame_ubo),

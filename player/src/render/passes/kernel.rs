@@ -20,6 +20,28 @@ impl Kernel {
         Self::make(gpu, bindings, spirv, push_bytes, &[])
     }
 
+    /// `N` kernels, one per (bindings, SPIR-V), all with `push_bytes` of push constants: the
+    /// pipelines of a pass made of several steps. On failure those already made are released.
+    pub fn several<const N: usize>(
+        gpu: &Gpu,
+        specs: [(&[Binding], &[u8]); N],
+        push_bytes: u32,
+    ) -> PlayResult<[Kernel; N]> {
+        let mut made = Vec::with_capacity(N);
+        for (bindings, spirv) in specs {
+            match Kernel::new(gpu, bindings, spirv, push_bytes) {
+                Ok(k) => made.push(k),
+                Err(e) => {
+                    for k in &mut made {
+                        k.destroy(gpu);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        Ok(made.try_into().unwrap_or_else(|_| unreachable!("one kernel per spec")))
+    }
+
     /// [`Kernel::new`] for a kernel that reads the texel buffer, specialized for `decode`.
     pub fn reading_texels(
         gpu: &Gpu,

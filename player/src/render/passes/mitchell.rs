@@ -57,37 +57,31 @@ impl MitchellPass {
     ) -> PlayResult<MitchellPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<GodRayConstants>() as u32;
-        let occlusion = Kernel::new(
+        let [occlusion, blur] = Kernel::several(
             gpu,
-            &[
-                Binding::one(Uniform),
-                Binding::one(Storage),
-                Binding::one(Sampled),
-                Binding::one(StorageImage),
+            [
+                (
+                    &[
+                        Binding::one(Uniform),
+                        Binding::one(Storage),
+                        Binding::one(Sampled),
+                        Binding::one(StorageImage),
+                    ],
+                    spirv::MITCHELL_OCCLUSION,
+                ),
+                (
+                    &[
+                        Binding::one(Uniform),
+                        Binding::one(Storage),
+                        Binding::one(Storage),
+                        Binding::one(Sampled),
+                        Binding::one(StorageImage),
+                    ],
+                    spirv::MITCHELL_BLUR,
+                ),
             ],
-            spirv::MITCHELL_OCCLUSION,
             push,
         )?;
-        let blur = Kernel::new(
-            gpu,
-            &[
-                Binding::one(Uniform),
-                Binding::one(Storage),
-                Binding::one(Storage),
-                Binding::one(Sampled),
-                Binding::one(StorageImage),
-            ],
-            spirv::MITCHELL_BLUR,
-            push,
-        );
-        let blur = match blur {
-            Ok(k) => k,
-            Err(e) => {
-                let mut occlusion = occlusion;
-                occlusion.destroy(gpu);
-                return Err(e);
-            }
-        };
         let samples = samples.max(1);
         let constants = GodRayConstants {
             samples,
@@ -120,9 +114,7 @@ impl Pass for MitchellPass {
             return Ok(());
         };
         self.lights = shared.plan.lights_used;
-        let bounds = shared.scene.manifest.bounds;
-        let diagonal = glam::Vec3::from(bounds.max).distance(glam::Vec3::from(bounds.min));
-        self.constants.extent = PROXY_RADIUS * diagonal;
+        self.constants.extent = PROXY_RADIUS * shared.scene.diagonal();
         self.constants.media = m.count;
         let img = |t: &TargetDecl| shared.images.get(t).view;
         self.occlusion.write(

@@ -53,6 +53,25 @@ pub struct Shared<'a> {
     pub images: &'a FrameImages,
 }
 
+/// A sampler array's descriptors: (view, sampler) per element.
+pub type SampledArray = Vec<(crate::gpu::vk::ImageView, crate::gpu::vk::Sampler)>;
+
+/// The shadow-map sampler arrays (2D, cube) of `MAX_SHADOW_MAPS` elements each, as the light
+/// plan binds them: each resident map in its slot, placeholders in the rest.
+pub fn shadow_map_arrays(shared: &Shared) -> (SampledArray, SampledArray) {
+    let (scene, dummies) = (shared.scene, shared.dummies);
+    let near = scene.nearest_clamp;
+    let mut maps_2d = vec![(dummies.shadow_2d.view, near); super::MAX_SHADOW_MAPS];
+    let mut maps_cube = vec![(dummies.shadow_cube.view, near); super::MAX_SHADOW_MAPS];
+    for (slot, &i) in shared.plan.slots_2d.iter().enumerate() {
+        maps_2d[slot] = (scene.shadow_maps[i].image.view, near);
+    }
+    for (slot, &i) in shared.plan.slots_cube.iter().enumerate() {
+        maps_cube[slot] = (scene.shadow_maps[i].image.view, near);
+    }
+    (maps_2d, maps_cube)
+}
+
 /// What a pass records with.
 #[derive(Debug)]
 pub struct FrameCtx<'a, 'r> {

@@ -61,25 +61,15 @@ fn kernels(gpu: &Gpu, push: u32) -> PlayResult<[Kernel; 3]> {
         Binding::one(Sampled),
         Binding::one(StorageImage),
     ];
-    let depth = Kernel::new(
+    Kernel::several(
         gpu,
-        &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)],
-        spirv::SOUSA_DEPTH,
+        [
+            (&[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)], spirv::SOUSA_DEPTH),
+            (&blur_bindings, spirv::SOUSA_BLUR),
+            (&blur_bindings, spirv::SOUSA_COMPOSITE),
+        ],
         push,
-    )?;
-    let mut made = vec![depth];
-    for code in [spirv::SOUSA_BLUR, spirv::SOUSA_COMPOSITE] {
-        match Kernel::new(gpu, &blur_bindings, code, push) {
-            Ok(k) => made.push(k),
-            Err(e) => {
-                for k in &mut made {
-                    k.destroy(gpu);
-                }
-                return Err(e);
-            }
-        }
-    }
-    Ok(made.try_into().expect("three kernels"))
+    )
 }
 
 impl SousaPass {
@@ -121,9 +111,7 @@ impl Pass for SousaPass {
             return Ok(());
         };
         self.lights = shared.plan.lights_used;
-        let bounds = shared.scene.manifest.bounds;
-        self.constants.extent =
-            glam::Vec3::from(bounds.max).distance(glam::Vec3::from(bounds.min)).max(f32::MIN_POSITIVE);
+        self.constants.extent = shared.scene.diagonal().max(f32::MIN_POSITIVE);
         self.constants.media = m.count;
         let img = |t: &TargetDecl| shared.images.get(t).view;
         let (near, linear) = (shared.scene.nearest_clamp, shared.scene.linear_clamp);

@@ -45,41 +45,35 @@ impl TothPass {
         use BindingKind::*;
         let push = std::mem::size_of::<TothConstants>() as u32;
         let maps = Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 };
-        let march = Kernel::new(
+        let [march, blur] = Kernel::several(
             gpu,
-            &[
-                Binding::one(Uniform),
-                Binding::one(Storage),
-                Binding::one(Storage),
-                maps,
-                maps,
-                Binding::one(Storage),
-                Binding::one(Sampled),
-                Binding::one(StorageImage),
+            [
+                (
+                    &[
+                        Binding::one(Uniform),
+                        Binding::one(Storage),
+                        Binding::one(Storage),
+                        maps,
+                        maps,
+                        Binding::one(Storage),
+                        Binding::one(Sampled),
+                        Binding::one(StorageImage),
+                    ],
+                    spirv::TOTH_MARCH,
+                ),
+                (
+                    &[
+                        Binding::one(Uniform),
+                        Binding::one(Storage),
+                        Binding::one(Sampled),
+                        Binding::one(Sampled),
+                        Binding::one(StorageImage),
+                    ],
+                    spirv::TOTH_BLUR,
+                ),
             ],
-            spirv::TOTH_MARCH,
             push,
         )?;
-        let blur = Kernel::new(
-            gpu,
-            &[
-                Binding::one(Uniform),
-                Binding::one(Storage),
-                Binding::one(Sampled),
-                Binding::one(Sampled),
-                Binding::one(StorageImage),
-            ],
-            spirv::TOTH_BLUR,
-            push,
-        );
-        let blur = match blur {
-            Ok(k) => k,
-            Err(e) => {
-                let mut march = march;
-                march.destroy(gpu);
-                return Err(e);
-            }
-        };
         let constants = TothConstants {
             samples: samples.max(1),
             block: block.max(1),
@@ -113,16 +107,8 @@ impl Pass for TothPass {
         };
         self.active = true;
         self.constants.media = m.count;
-        let (scene, dummies) = (shared.scene, shared.dummies);
-        let near = scene.nearest_clamp;
-        let mut maps_2d = vec![(dummies.shadow_2d.view, near); MAX_SHADOW_MAPS];
-        let mut maps_cube = vec![(dummies.shadow_cube.view, near); MAX_SHADOW_MAPS];
-        for (slot, &i) in shared.plan.slots_2d.iter().enumerate() {
-            maps_2d[slot] = (scene.shadow_maps[i].image.view, near);
-        }
-        for (slot, &i) in shared.plan.slots_cube.iter().enumerate() {
-            maps_cube[slot] = (scene.shadow_maps[i].image.view, near);
-        }
+        let near = shared.scene.nearest_clamp;
+        let (maps_2d, maps_cube) = super::shadow_map_arrays(shared);
         let img = |t: &TargetDecl| shared.images.get(t).view;
         self.march.write(
             gpu,
