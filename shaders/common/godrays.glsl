@@ -37,26 +37,10 @@ vec3 shaft_radiance(GpuLight l, vec3 d, uint media_count) {
         return vec3(0.0);
     }
     vec3 towards;
+    float dist;
     vec3 e;
-    if (l.kind == LIGHT_DIRECTIONAL) {
-        towards = -l.direction;
-        e = l.radiance;
-    } else {
-        vec3 to = l.position - frame.camera.xyz;
-        float d2 = dot(to, to);
-        if (!(d2 > 0.0)) {
-            return vec3(0.0);
-        }
-        if (l.range > 0.0 && d2 > l.range * l.range) {
-            return vec3(0.0);
-        }
-        towards = to * inversesqrt(d2);
-        e = l.radiance / d2;
-        if (l.kind == LIGHT_SPOT) {
-            e *= spot_cone(l, towards);
-        } else if (l.kind == LIGHT_RECT) {
-            e *= l.width * l.height * max(dot(-towards, l.direction), 0.0);
-        }
+    if (!light_at_point(l, frame.camera.xyz, towards, dist, e)) {
+        return vec3(0.0);
     }
     vec3 albedo = media[0].sigma_s.rgb / max(medium_sigma_t(0u), vec3(1e-30));
     return e * albedo * hg(media[0].min.w, dot(towards, d));

@@ -11,6 +11,36 @@ float spot_cone(GpuLight light, vec3 l) {
     return t * t * (3.0 - 2.0 * t);
 }
 
+// The light of `l` arriving unoccluded at point p, as the media passes take it: `wl` the unit
+// direction towards the light, `dist` the distance to it (3.4e38 for a directional light), and
+// the irradiance on a surface facing it: a directional light's radiance, I/d² for point and
+// spot lights (times the cone), and a rect light as a point of intensity L·A·cos at its centre.
+// False where nothing arrives: at the light itself, or beyond its range.
+bool light_at_point(GpuLight l, vec3 p, out vec3 wl, out float dist, out vec3 e) {
+    if (l.kind == LIGHT_DIRECTIONAL) {
+        wl = -l.direction;
+        dist = 3.4e38;
+        e = l.radiance;
+        return true;
+    }
+    vec3 to = l.position - p;
+    float d2 = dot(to, to);
+    dist = sqrt(d2);
+    wl = vec3(0.0);
+    e = vec3(0.0);
+    if (!(dist > 0.0) || (l.range > 0.0 && dist > l.range)) {
+        return false;
+    }
+    wl = to / dist;
+    e = l.radiance / d2;
+    if (l.kind == LIGHT_SPOT) {
+        e *= spot_cone(l, wl);
+    } else if (l.kind == LIGHT_RECT) {
+        e *= l.width * l.height * max(dot(-wl, l.direction), 0.0);
+    }
+    return true;
+}
+
 // Where the ray origin + t·dir meets the emitting (front) side of rect light `light`: t, if
 // within (0, tmax) and the light's range; -1 otherwise. `dir` need not be unit length (t and
 // the range are then in its units).

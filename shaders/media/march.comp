@@ -68,24 +68,8 @@ vec3 in_scattered(uint m, vec3 p, vec3 d) {
         vec3 wl;
         float dist;
         vec3 li;
-        if (l.kind == LIGHT_DIRECTIONAL) {
-            wl = -l.direction;
-            dist = SKY_DISTANCE;
-            li = l.radiance;
-        } else {
-            vec3 to = l.position - p;
-            float d2 = dot(to, to);
-            dist = sqrt(d2);
-            if (!(dist > 0.0) || (l.range > 0.0 && dist > l.range)) {
-                continue;
-            }
-            wl = to / dist;
-            li = l.radiance / d2;
-            if (l.kind == LIGHT_SPOT) {
-                li *= spot_cone(l, wl);
-            } else if (l.kind == LIGHT_RECT) {
-                li *= l.width * l.height * max(dot(-wl, l.direction), 0.0);
-            }
+        if (!light_at_point(l, p, wl, dist, li)) {
+            continue;
         }
         if (all(equal(li, vec3(0.0)))) {
             continue;

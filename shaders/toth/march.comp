@@ -93,24 +93,8 @@ vec3 in_scattered(vec3 x, vec3 d) {
         vec3 wl;
         float dist;
         vec3 e;
-        if (l.kind == LIGHT_DIRECTIONAL) {
-            wl = -l.direction;
-            dist = SKY_DISTANCE;
-            e = l.radiance;
-        } else {
-            vec3 to = l.position - x;
-            float d2 = dot(to, to);
-            dist = sqrt(d2);
-            if (!(dist > 0.0) || (l.range > 0.0 && dist > l.range)) {
-                continue;
-            }
-            wl = to / dist;
-            e = l.radiance / d2;
-            if (l.kind == LIGHT_SPOT) {
-                e *= spot_cone(l, wl);
-            } else if (l.kind == LIGHT_RECT) {
-                e *= l.width * l.height * max(dot(-wl, l.direction), 0.0);
-            }
+        if (!light_at_point(l, x, wl, dist, e)) {
+            continue;
         }
         if (all(equal(e, vec3(0.0))) || visibility(l, x) == 0.0) {
             continue;
