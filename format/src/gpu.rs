@@ -132,7 +132,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Per-frame constants (std140 uniform block, 240 bytes).
+    /// Per-frame constants (std140 uniform block, 320 bytes).
     pub struct FrameConstants {
         /// World to clip, column-major.
         pub view_proj: [f32; 16] => "mat4",
@@ -155,6 +155,15 @@ gpu_struct! {
         pub camera_up: [f32; 4] => "vec4",
         /// Unit forward vector, w unused.
         pub camera_forward: [f32; 4] => "vec4",
+        /// This frame's clip coordinates (of `view_proj`, jitter included) to the previous
+        /// frame's clip coordinates without its jitter (computed in f64): where a pixel's surface
+        /// point was seen last frame.
+        pub reproject: [f32; 16] => "mat4",
+        /// x, y: where this frame's sample of each pixel lies relative to the pixel's centre, in
+        /// pixels (the sub-pixel jitter of `--aa taa`; 0 otherwise); z: 1 when the camera has
+        /// not moved since the previous frame (`reproject` is then the jitter alone), else 0;
+        /// w: 1 when there is no previous frame (history is invalid), else 0.
+        pub jitter: [f32; 4] => "vec4",
     }
 }
 

@@ -74,16 +74,19 @@ pub fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
     }
 }
 
-/// Runs the benchmark: `warmup` frames, then `frames` measured ones, each waited for.
+/// Runs the benchmark: `warmup` frames, then `frames` measured ones, each waited for (along the
+/// options' camera path, when given: the warm-up at its first pose).
 pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -> PlayResult<BenchReport> {
     let mut session = Session::open(options, start)?;
+    session.follow(options, 0, frames)?;
     for _ in 0..warmup.max(1) {
         session.frame(false)?;
     }
     let frames = frames.max(1);
     let names: Vec<&str> = session.renderer.pass_names().into_iter().chain(["total"]).collect();
     let mut per_pass: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-    for _ in 0..frames {
+    for f in 0..frames {
+        session.follow(options, f, frames)?;
         let t = session.frame(false)?;
         for (i, (_, ms)) in t.iter().enumerate() {
             per_pass[i].push(*ms);

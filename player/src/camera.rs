@@ -74,6 +74,69 @@ impl std::str::FromStr for CameraOverride {
     }
 }
 
+/// A `--camera-path` file: poses (each as a `--camera` value, one per line; blank lines and
+/// `#` comments skipped) that a run of N frames moves through at an even pace, frame i at
+/// i / (N − 1) of the way, position, target and field of view interpolated linearly between
+/// neighbouring poses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CameraPath {
+    poses: Vec<CameraOverride>,
+}
+
+impl CameraPath {
+    /// Parses a path's text; errors name the line.
+    pub fn parse(text: &str) -> Result<CameraPath, String> {
+        let mut poses = Vec::new();
+        for (i, line) in text.lines().enumerate() {
+            let line = line.split('#').next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let pose: CameraOverride = line.parse().map_err(|e| format!("line {}: {e}", i + 1))?;
+            if let Some(first) = poses.first().map(|p: &CameraOverride| p.vfov_degrees.is_some())
+                && first != pose.vfov_degrees.is_some()
+            {
+                return Err(format!(
+                    "line {}: give a field of view on every pose or on none (the first pose {})",
+                    i + 1,
+                    if first { "has one" } else { "has none" }
+                ));
+            }
+            poses.push(pose);
+        }
+        if poses.is_empty() {
+            return Err("no pose: write one `px,py,pz,tx,ty,tz[,vfov]` per line".into());
+        }
+        Ok(CameraPath { poses })
+    }
+
+    /// Reads and parses a path file.
+    pub fn load(path: &std::path::Path) -> PlayResult<CameraPath> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| PlayError::new(Exit::Io, format!("--camera-path {}: {e}", path.display())))?;
+        CameraPath::parse(&text)
+            .map_err(|e| PlayError::new(Exit::Usage, format!("--camera-path {}: {e}", path.display())))
+    }
+
+    /// The pose of frame `i` of `frames`.
+    pub fn at(&self, i: u32, frames: u32) -> CameraOverride {
+        let last = self.poses.len() - 1;
+        let s = if frames > 1 { i.min(frames - 1) as f64 / (frames - 1) as f64 * last as f64 } else { 0.0 };
+        let k = (s.floor() as usize).min(last.saturating_sub(1));
+        let (a, b) = (&self.poses[k], &self.poses[(k + 1).min(last)]);
+        let t = s - k as f64;
+        let mix = |x: [f64; 3], y: [f64; 3]| std::array::from_fn(|j| x[j] + (y[j] - x[j]) * t);
+        let (position, target) = (mix(a.position, b.position), mix(a.target, b.target));
+        // Equal positions and targets are refused per pose; a blend of two can still meet.
+        let target = if position == target { a.target } else { target };
+        CameraOverride {
+            position,
+            target,
+            vfov_degrees: a.vfov_degrees.zip(b.vfov_degrees).map(|(x, y)| x + (y - x) * t),
+        }
+    }
+}
+
 fn d3(v: [f32; 3]) -> DVec3 {
     Vec3::from_array(v).as_dvec3()
 }
@@ -193,10 +256,15 @@ impl Camera {
         }
     }
 
+    /// World to clip for an image of `width` × `height`.
+    pub fn view_projection(&self, width: u32, height: u32) -> DMat4 {
+        let aspect = width.max(1) as f64 / height.max(1) as f64;
+        self.projection(aspect) * self.view()
+    }
+
     /// World to clip and its inverse, as f32 column-major arrays.
     pub fn matrices(&self, width: u32, height: u32) -> ([f32; 16], [f32; 16]) {
-        let aspect = width.max(1) as f64 / height.max(1) as f64;
-        let vp = self.projection(aspect) * self.view();
+        let vp = self.view_projection(width, height);
         (vp.as_mat4().to_cols_array(), vp.inverse().as_mat4().to_cols_array())
     }
 
@@ -225,6 +293,28 @@ mod tests {
 
     fn bounds() -> Bounds {
         Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] }
+    }
+
+    #[test]
+    fn camera_paths_interpolate_evenly_and_name_bad_lines() {
+        let path =
+            CameraPath::parse("# a dolly\n0,0,0, 0,0,-1, 40\n\n4,0,0, 4,0,-1, 60 # end\n8,2,0,8,2,-1,60")
+                .unwrap();
+        // 9 frames over 3 poses: frame 2 halfway to the second pose, frame 8 the last pose.
+        let p = path.at(2, 9);
+        assert_eq!(p.position, [2.0, 0.0, 0.0]);
+        assert_eq!(p.target, [2.0, 0.0, -1.0]);
+        assert_eq!(p.vfov_degrees, Some(50.0));
+        assert_eq!(path.at(8, 9).position, [8.0, 2.0, 0.0]);
+        assert_eq!(path.at(0, 9).position, [0.0; 3]);
+        assert_eq!(path.at(0, 1).position, [0.0; 3]);
+        let one = CameraPath::parse("1,2,3,0,0,0").unwrap();
+        assert_eq!(one.at(5, 10).position, [1.0, 2.0, 3.0]);
+        let e = CameraPath::parse("0,0,0,0,0,-1\n1,2").unwrap_err();
+        assert!(e.starts_with("line 2:"), "{e}");
+        let e = CameraPath::parse("0,0,0,0,0,-1,40\n1,0,0,0,0,-1").unwrap_err();
+        assert!(e.contains("line 2") && e.contains("field of view"), "{e}");
+        assert!(CameraPath::parse("# nothing\n").unwrap_err().contains("no pose"));
     }
 
     #[test]

@@ -7,12 +7,12 @@ use clap::builder::{PossibleValue, PossibleValuesParser};
 use clap::{Parser, ValueEnum};
 
 use crate::bench;
-use crate::camera::CameraOverride;
+use crate::camera::{CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
 use crate::render::technique::{Effect, KnobValue, Techniques, catalogue, techniques_of};
-use crate::render::{Aa, Purpose, RenderSettings};
+use crate::render::{Purpose, RenderSettings};
 use crate::session::SessionOptions;
 use crate::window;
 
@@ -111,6 +111,15 @@ pub enum MediaPhaseArg {
     Rayleigh,
 }
 
+/// `--taa-weights` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TaaWeightsArg {
+    /// c / (1 + luma) (Karis's, the seed's).
+    Luma,
+    /// The radiance itself.
+    Linear,
+}
+
 /// kiln-play renders .kiln files with Vulkan 1.3: in a window, headless to PNG or EXR, or as a
 /// benchmark.
 #[derive(Debug, Parser)]
@@ -157,6 +166,11 @@ pub struct Args {
     /// Camera override: position, target and optionally the vertical field of view in degrees.
     #[arg(long, value_name = "PX,PY,PZ,TX,TY,TZ[,VFOV]", allow_hyphen_values = true)]
     pub camera: Option<CameraOverride>,
+    /// With -o, --headless or --bench: move the camera through the poses of FILE over the
+    /// frames (one `px,py,pz,tx,ty,tz[,vfov]` per line, `#` comments; frame i at i/(N−1) of
+    /// the way, linear between poses): a fly-through, for timing and error with a moving camera.
+    #[arg(long, value_name = "FILE", conflicts_with = "camera")]
+    pub camera_path: Option<PathBuf>,
     /// Exposure in stops (radiance × 2^EV before tone mapping; PNG and window only).
     #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
@@ -197,9 +211,23 @@ pub struct Args {
     /// filled: exact tests wherever the shaft is filled (exact).
     #[arg(long, value_enum, default_value = "ends")]
     pub ls_shadow_test: LsShadowTestArg,
-    /// Do not average the ray-traced passes over frames (every frame shows one sample).
-    #[arg(long)]
+    /// Do not average the ray-traced passes over frames (every frame shows one sample): the
+    /// same as --aa none.
+    #[arg(long, conflicts_with = "aa")]
     pub no_accumulate: bool,
+    /// What happens to samples across frames. accumulate: the ray-traced passes keep a running
+    /// mean while the camera is still; taa: also temporal anti-aliasing (a sub-pixel jitter per
+    /// frame, a reprojected, neighbourhood-clamped history); none: every frame its own.
+    #[arg(long, value_parser = techniques(Effect::Aa), default_value = "accumulate")]
+    pub aa: String,
+    /// With --aa taa: the longest history in frames, 1 to 1024 (default 16): a new frame weighs
+    /// at least 1/N; longer converges further on a still camera, smears more on a moving one.
+    #[arg(long, value_name = "N")]
+    pub taa_frames: Option<u32>,
+    /// With --aa taa: how frames are blended (default luma: c / (1 + luma), the seed's,
+    /// damping fireflies; linear: the radiance itself, converging to the supersampled image).
+    #[arg(long, value_enum, value_name = "WEIGHTS")]
+    pub taa_weights: Option<TaaWeightsArg>,
     /// Global illumination technique.
     #[arg(long, value_parser = techniques(Effect::Gi), default_value = "none")]
     pub gi: String,
@@ -278,6 +306,8 @@ impl Args {
             "media-brightness" => self.media_brightness.map(KnobValue::Number),
             "media-block" => self.media_block.map(|n| KnobValue::Number(n as f32)),
             "media-phase" => self.media_phase.map(|p| KnobValue::Choice(p as usize)),
+            "taa-frames" => self.taa_frames.map(|n| KnobValue::Number(n as f32)),
+            "taa-weights" => self.taa_weights.map(|w| KnobValue::Choice(w as usize)),
             _ => None,
         }
     }
@@ -294,6 +324,7 @@ impl Args {
             }
         }
         let mut t = Techniques::default();
+        let none = String::from("none");
         let chosen = [
             (Effect::GBuffer, &self.gbuffer),
             (Effect::Shadows, &self.shadows),
@@ -301,6 +332,7 @@ impl Args {
             (Effect::Reflections, &self.reflections),
             (Effect::Gi, &self.gi),
             (Effect::Media, &self.media),
+            (Effect::Aa, if self.no_accumulate { &none } else { &self.aa }),
         ];
         for (effect, name) in chosen {
             let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
@@ -309,7 +341,6 @@ impl Args {
                 .unwrap_or_default();
             t.set(effect, name, &knobs).map_err(usage)?;
         }
-        t.aa = if self.no_accumulate { Aa::None } else { Aa::Accumulate };
         Ok(t)
     }
 
@@ -340,6 +371,7 @@ impl Args {
             width: self.size.width,
             height: self.size.height,
             camera: self.camera,
+            camera_path: self.camera_path.as_deref().map(CameraPath::load).transpose()?,
             readback: None,
         })
     }
@@ -453,7 +485,7 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{Ao, GBuffer, Gi, ReflectionRes, Reflections, Shadows};
+    use crate::render::{Aa, Ao, GBuffer, Gi, ReflectionRes, Reflections, Shadows};
 
     fn parse(args: &[&str]) -> Result<Args, clap::Error> {
         Args::try_parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))
@@ -502,6 +534,18 @@ mod tests {
         let d = techniques(&["f.kiln"]);
         assert_eq!(d, Techniques::default());
         assert_eq!(d.shadows, Shadows::ShadowMap);
+    }
+
+    #[test]
+    fn aa_flags_choose_taa_with_its_knobs() {
+        let t = techniques(&["f.kiln", "--aa", "taa", "--taa-frames", "8", "--taa-weights", "luma"]);
+        assert_eq!(t.aa, Aa::Taa { frames: 8, luma_weights: true });
+        assert_eq!(techniques(&["f.kiln", "--aa", "taa"]).aa, Aa::Taa { frames: 16, luma_weights: false });
+        assert_eq!(techniques(&["f.kiln", "--aa", "none"]).aa, Aa::None);
+        let e = parse(&["f.kiln", "--aa", "taa", "--taa-frames", "0"]).unwrap().techniques().unwrap_err();
+        assert!(e.message.contains("--taa-frames"), "{}", e.message);
+        let e = parse(&["f.kiln", "--aa", "taa", "--no-accumulate"]).unwrap_err().to_string();
+        assert!(e.contains("--no-accumulate") && e.contains("--aa"), "{e}");
     }
 
     #[test]

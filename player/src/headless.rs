@@ -17,7 +17,8 @@ pub struct HeadlessResult {
     pub non_finite: usize,
 }
 
-/// Renders `frames` frames (at least one) and writes the last to `output`, if given.
+/// Renders `frames` frames (at least one; along the options' camera path, when given) and
+/// writes the last to `output`, if given.
 pub fn run(
     options: &SessionOptions,
     frames: u32,
@@ -31,6 +32,7 @@ pub fn run(
     let mut session = Session::open(&options, start)?;
     let frames = frames.max(1);
     for f in 0..frames {
+        session.follow(&options, f, frames)?;
         session.frame(f + 1 == frames && output.is_some())?;
     }
     let (Some(path), Some(kind)) = (output, kind) else {

@@ -8,7 +8,7 @@ use crate::gpu::vk;
 use kiln_format::error::ErrorKind;
 use kiln_format::read::{Checksums, KilnFile};
 
-use crate::camera::{Camera, CameraOverride};
+use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
 use crate::render::frame::Frame;
@@ -31,6 +31,8 @@ pub struct SessionOptions {
     pub height: u32,
     /// Camera override.
     pub camera: Option<CameraOverride>,
+    /// Poses the frames of a headless or benchmark run move through (instead of `camera`).
+    pub camera_path: Option<CameraPath>,
     /// The image frames can be copied back from (headless output).
     pub readback: Option<Readable>,
 }
@@ -45,6 +47,7 @@ impl SessionOptions {
             width,
             height,
             camera: None,
+            camera_path: None,
             readback: None,
         }
     }
@@ -359,6 +362,23 @@ impl Session {
             self.waited = true;
         }
         self.pool.submit(&self.gpu, &waits, signal)
+    }
+
+    /// Looks through `pose` (the file's camera moved as `--camera` moves it; `None`: the file's
+    /// camera itself).
+    pub fn look(&mut self, pose: Option<CameraOverride>) -> PlayResult {
+        let m = &self.scene.manifest;
+        self.camera = Camera::initial(&m.cameras, m.orthographic(0), &m.bounds, pose)?;
+        Ok(())
+    }
+
+    /// For frame `i` of `frames` of a run along `options`' camera path, looks through its pose
+    /// (nothing without a path).
+    pub fn follow(&mut self, options: &SessionOptions, i: u32, frames: u32) -> PlayResult {
+        match &options.camera_path {
+            Some(path) => self.look(Some(path.at(i, frames))),
+            None => Ok(()),
+        }
     }
 
     /// Waits for the last submitted frame.

@@ -40,7 +40,9 @@ struct FrameConstants {
     vec4 camera_right; // offset 192
     vec4 camera_up; // offset 208
     vec4 camera_forward; // offset 224
-}; // 240 bytes
+    mat4 reproject; // offset 240
+    vec4 jitter; // offset 304
+}; // 320 bytes
 
 struct GpuMaterialLayout {
     vec4 base_color; // offset 0

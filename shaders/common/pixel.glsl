@@ -12,8 +12,10 @@ bool camera_orthographic() {
 }
 
 // The offset in the image plane of image point `at` (pixel units, (0.5, 0.5) the first pixel's
-// centre), by the projection's own mapping.
+// centre), by the projection's own mapping, moved by this frame's sub-pixel jitter (what the
+// jittered `view_proj` rasterises at `at`).
 vec3 pixel_offset(vec2 at) {
+    at += frame.jitter.xy;
     vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
     return frame.camera_right.xyz * (ndc.x * frame.camera_right.w) + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
 }

@@ -7,10 +7,10 @@ use glam::Vec3;
 use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
 use kiln_format::sections::Vertex;
-use kiln_player::camera::CameraOverride;
+use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::gpu::GpuOptions;
 use kiln_player::render::{
-    Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose, ReflectionRes,
+    Aa, Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose, ReflectionRes,
     Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::session::SessionOptions;
@@ -180,6 +180,18 @@ impl Options {
     /// Participating media by `media` (any technique).
     pub fn media(mut self, media: Media) -> Options {
         self.0.render.techniques.media = media;
+        self
+    }
+
+    /// Samples across frames by `aa` (`--aa`).
+    pub fn aa(mut self, aa: Aa) -> Options {
+        self.0.render.techniques.aa = aa;
+        self
+    }
+
+    /// Moves the camera through `path` over the frames (`--camera-path`).
+    pub fn camera_path(mut self, path: CameraPath) -> Options {
+        self.0.camera_path = Some(path);
         self
     }
 

@@ -3,7 +3,8 @@
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
 //! reflections, GI (each when chosen) → direct light and composition → participating media
-//! (march, mitchell, sousa or toth, when chosen) → tone mapping.
+//! (march, mitchell, sousa or toth, when chosen) → temporal anti-aliasing (when chosen) → tone
+//! mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
@@ -17,11 +18,12 @@ use super::passes::rt_gi::RtGiPass;
 use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::sousa::SousaPass;
+use super::passes::taa::TaaPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::toth::TothPass;
 use super::passes::visibility::VisibilityPass;
 use super::spirv;
-use super::technique::{Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
+use super::technique::{Aa, Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
 use super::texels::TexelDecode;
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc};
@@ -88,6 +90,9 @@ fn passes(
             Media::Toth { samples, block, phase } => {
                 made.push(Box::new(TothPass::new(gpu, samples, block, phase)?))
             }
+        }
+        if let Aa::Taa { frames, luma_weights } = techniques.aa {
+            made.push(Box::new(TaaPass::new(gpu, frames, luma_weights)?));
         }
         made.push(Box::new(TonemapPass::new(gpu)?));
         Ok(())

@@ -94,7 +94,9 @@ pub struct Renderer {
     rt_constants: RtConstants,
     /// Frames averaged at the current camera.
     accumulated: u32,
-    last_view_proj: Option<[f32; 16]>,
+    /// The previous frame's world to clip without jitter; `None` before the first frame and
+    /// after a resize (the history images then hold nothing).
+    last_view_proj: Option<glam::DMat4>,
     flags: u32,
     lut_resolution: u32,
     sky: [f32; 3],
@@ -306,17 +308,34 @@ impl Renderer {
     pub fn resize(&mut self, gpu: &Gpu, scene: &GpuScene, width: u32, height: u32) -> PlayResult {
         self.frame.resize(gpu, width.max(1), height.max(1))?;
         self.accumulated = 0;
+        self.last_view_proj = None;
         self.bind(gpu, scene)
     }
 
     /// Writes the frame constants for `camera` (the previous frame must have finished).
     pub fn update(&mut self, camera: &Camera) -> PlayResult {
         let (w, h) = (self.frame.images.width, self.frame.images.height);
-        let (view_proj, inv_view_proj) = camera.matrices(w, h);
-        if self.settings.techniques.aa != Aa::Accumulate || self.last_view_proj != Some(view_proj) {
+        let aa = self.settings.techniques.aa;
+        let unjittered = camera.view_projection(w, h);
+        let still = self.last_view_proj == Some(unjittered);
+        if !aa.accumulates() || !still {
             self.accumulated = 0;
         }
-        self.last_view_proj = Some(view_proj);
+        let jitter = if aa.temporal() { taa_jitter(self.frame_count) } else { [0.0; 2] };
+        // The sample of pixel p lies at p + ½ + jitter: the projection moves the image by
+        // −jitter (NDC x right, y up; image y down).
+        let shift = glam::DMat4::from_translation(glam::DVec3::new(
+            -2.0 * jitter[0] / w as f64,
+            2.0 * jitter[1] / h as f64,
+            0.0,
+        ));
+        let vp = shift * unjittered;
+        let inverse = vp.inverse();
+        let previous = self.last_view_proj.unwrap_or(unjittered);
+        let reproject = (previous * inverse).as_mat4().to_cols_array();
+        let history = self.last_view_proj.is_some();
+        self.last_view_proj = Some(unjittered);
+        let (view_proj, inv_view_proj) = (vp.as_mat4().to_cols_array(), inverse.as_mat4().to_cols_array());
         let p = camera.position.as_vec3();
         let (right, up, half) = camera.image_axes();
         let aspect = w as f64 / h as f64;
@@ -337,6 +356,13 @@ impl Renderer {
             camera_right: v4(right, half * aspect),
             camera_up: v4(up, half),
             camera_forward: v4(camera.forward, 0.0),
+            reproject,
+            jitter: [
+                jitter[0] as f32,
+                jitter[1] as f32,
+                if still { 1.0 } else { 0.0 },
+                if history { 0.0 } else { 1.0 },
+            ],
         };
         self.frame_ubo.write(bytemuck::bytes_of(&constants))
     }
@@ -394,6 +420,28 @@ impl Renderer {
         self.shadows.destroy(gpu);
         self.timestamps.destroy(gpu);
     }
+}
+
+/// Length of the jitter sequence: the Halton points of one cycle cover the pixel evenly.
+const JITTER_CYCLE: u64 = 16;
+
+/// The radical inverse of `i` in `base`: the Halton sequence's coordinate.
+fn radical_inverse(mut i: u64, base: u64) -> f64 {
+    let (mut value, mut scale) = (0.0, 1.0);
+    while i > 0 {
+        scale /= base as f64;
+        value += (i % base) as f64 * scale;
+        i /= base;
+    }
+    value
+}
+
+/// Frame `n`'s sample offset from the pixel centre in pixels: the Halton (2, 3) point
+/// 1 + n mod 16 in (−½, ½)² (the seed's Karis jitter spans ±⅛ pixel; the whole pixel is
+/// what makes the converged history the box-filtered, supersampled image).
+pub fn taa_jitter(n: u64) -> [f64; 2] {
+    let i = 1 + n % JITTER_CYCLE;
+    [radical_inverse(i, 2) - 0.5, radical_inverse(i, 3) - 0.5]
 }
 
 /// Which image of a frame to read back.

@@ -25,6 +25,8 @@ shaders! {
     DIRECT = "lighting" / "direct.comp";
     /// Tone mapping.
     TONEMAP = "post" / "tonemap.comp";
+    /// Temporal anti-aliasing.
+    TAA_RESOLVE = "taa" / "resolve.comp";
     /// Participating media by ray marching.
     MEDIA_MARCH = "media" / "march.comp";
     /// Mitchell's occlusion image.

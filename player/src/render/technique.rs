@@ -249,6 +249,31 @@ pub enum Aa {
     /// restarts it.
     #[default]
     Accumulate,
+    /// Temporal anti-aliasing (seed 000, after Karis 2014): the projection jittered by a
+    /// Halton (2, 3) sub-pixel offset each frame, the frame blended into a history reprojected
+    /// from the previous frame's camera, the history clamped to the current frame's
+    /// neighbourhood in YCoCg (`shaders/taa/`). The ray-traced passes keep their running mean
+    /// while the camera is still.
+    Taa {
+        /// The longest history in frames: a pixel's new sample weighs 1/min(n + 1, frames)
+        /// after n frames of history.
+        frames: u32,
+        /// Blend with Karis's luminance weights c / (1 + luma) (the seed's; damps fireflies,
+        /// darkens high-contrast edges) instead of linearly.
+        luma_weights: bool,
+    },
+}
+
+impl Aa {
+    /// Whether frames are jittered and resolved through a history.
+    pub fn temporal(&self) -> bool {
+        matches!(self, Aa::Taa { .. })
+    }
+
+    /// Whether the stochastic passes keep a running mean while the camera is still.
+    pub fn accumulates(&self) -> bool {
+        !matches!(self, Aa::None)
+    }
 }
 
 /// One technique per effect: what a frame renders.
@@ -533,6 +558,12 @@ impl Techniques {
             }
             (Effect::Aa, "none") => self.aa = Aa::None,
             (Effect::Aa, "accumulate") => self.aa = Aa::Accumulate,
+            (Effect::Aa, "taa") => {
+                self.aa = Aa::Taa {
+                    frames: whole(effect, name, "taa-frames", v(0))?,
+                    luma_weights: v(1) == KnobValue::Choice(0),
+                }
+            }
             _ => unreachable!("every catalogue entry is matched above (checked by a test)"),
         }
         Ok(())
@@ -574,6 +605,7 @@ impl Techniques {
             Effect::Aa => match self.aa {
                 Aa::None => "none",
                 Aa::Accumulate => "accumulate",
+                Aa::Taa { .. } => "taa",
             },
         }
     }
@@ -808,7 +840,7 @@ const fn artistic(knob: Knob) -> Knob {
     Knob { role: KnobRole::Scene, ..knob }
 }
 
-static CATALOGUE: [TechniqueInfo; 20] = [
+static CATALOGUE: [TechniqueInfo; 21] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -1073,6 +1105,36 @@ static CATALOGUE: [TechniqueInfo; 20] = [
         help: "a running mean of the stochastic passes while the camera is still",
         knobs: &[],
         stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Aa,
+        name: "taa",
+        help: "temporal anti-aliasing (seed 000): a Halton sub-pixel jitter per frame, each frame \
+               blended into a history reprojected from the last camera and clamped to the \
+               current neighbourhood (YCoCg); the ray-traced passes keep their running mean \
+               while the camera is still; see --taa-frames, --taa-weights",
+        knobs: &[
+            number(
+                "taa-frames",
+                "the longest history in frames: a new frame weighs at least 1/FRAMES (the seed's \
+                 blend 0.88–0.97 is 8–33 frames); longer converges further on a still camera and \
+                 smears more on a moving one",
+                1.0,
+                1024.0,
+                16.0,
+                &[4.0, 8.0, 16.0, 32.0],
+            ),
+            Knob {
+                name: "taa-weights",
+                help: "luma: blend c/(1 + luma) (Karis's, the seed's: damps fireflies, darkens \
+                       high-contrast edges); linear: blend the radiance itself (converges to the \
+                       supersampled image)",
+                range: KnobRange::Choice(&["luma", "linear"]),
+                default: KnobValue::Choice(1),
+                role: KnobRole::Quality,
+            },
+        ],
+        stochastic: true,
     },
 ];
 

@@ -314,6 +314,7 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             width: options.width,
             height: options.height,
             camera: *camera,
+            camera_path: None,
             readback: None,
         };
         let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;

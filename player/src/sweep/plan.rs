@@ -290,7 +290,7 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
     let mut configs = Vec::new();
     let mut skipped = Vec::new();
     let checkpoints = |stochastic: bool, t: &Techniques| {
-        if stochastic && t.aa == Aa::Accumulate { request.frames.clone() } else { vec![1] }
+        if stochastic && t.aa.accumulates() { request.frames.clone() } else { vec![1] }
     };
     for &target in &request.targets {
         match target {

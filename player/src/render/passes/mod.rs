@@ -21,6 +21,7 @@ pub mod rt_gi;
 pub mod rt_reflections;
 pub mod rt_shadows;
 pub mod sousa;
+pub mod taa;
 pub mod tonemap;
 pub mod toth;
 pub mod visibility;
