@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 
-use crate::camera::CameraOverride;
+use crate::camera::{CameraOverride, CameraPath};
 use crate::cli::Size;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::GpuOptions;
@@ -15,7 +15,7 @@ use crate::render::technique::{KnobRole, catalogue};
 use super::measure::Timing;
 use super::plan::{Request, Target, preset_help};
 use super::results::{self, Results};
-use super::{SweepOptions, report};
+use super::{PathSweep, SweepOptions, report};
 
 /// Every technique as a point of (GPU time, error against a path-traced reference).
 ///
@@ -51,6 +51,15 @@ pub struct Args {
     /// Frame counts at which accumulating techniques are measured.
     #[arg(long, value_delimiter = ',', default_value = "1,4,16,64")]
     pub frames_accumulated: Vec<u32>,
+    /// A moving camera: every configuration renders --path-frames frames along the poses of
+    /// FILE (as kiln-play --camera-path reads it) and is measured at the last one, against the
+    /// reference at the last pose (the accumulating passes restart while the camera moves;
+    /// --aa taa carries a reprojected history).
+    #[arg(long, value_name = "FILE", conflicts_with = "cameras")]
+    pub camera_path: Option<PathBuf>,
+    /// With --camera-path: the frames the path takes.
+    #[arg(long, value_name = "N", default_value_t = 60, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    pub path_frames: u32,
     /// Reference samples per pixel (rendered as two halves of half each).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(2..))]
     pub reference_spp: u32,
@@ -115,6 +124,14 @@ impl Args {
             width: self.size.width,
             height: self.size.height,
             cameras: self.cameras.iter().copied().map(Some).collect(),
+            camera_path: match &self.camera_path {
+                Some(file) => Some(PathSweep {
+                    path: CameraPath::load(file)?,
+                    frames: self.path_frames,
+                    name: file.file_stem().map_or("path".into(), |s| s.to_string_lossy().into_owned()),
+                }),
+                None => None,
+            },
             request,
             reference_spp: self.reference_spp,
             timing: Timing { warmup: self.warmup, frames: self.timing_frames },

@@ -28,7 +28,9 @@ pub struct Timing {
     pub frames: u32,
 }
 
-/// Renders `techniques` in a session of its own: every checkpoint's image, then `timing`.
+/// Renders `techniques` in a session of its own: every checkpoint's image (along the options'
+/// camera path, when given, over as many frames as the last checkpoint), then `timing` (at the
+/// path's last pose).
 pub fn measure(
     base: &SessionOptions,
     techniques: Techniques,
@@ -40,7 +42,7 @@ pub fn measure(
     options.render = RenderSettings { techniques, ..options.render };
     options.readback = Some(Readable::Radiance);
     let mut session = Session::open(&options, Instant::now())?;
-    let result = run(&mut session, checkpoints, timing, &mut tick);
+    let result = run(&mut session, &options, checkpoints, timing, &mut tick);
     let warnings = session.warnings.clone();
     let errors = session.close();
     let mut measured = result?;
@@ -53,6 +55,7 @@ pub fn measure(
 
 fn run(
     session: &mut Session,
+    options: &SessionOptions,
     checkpoints: &[u32],
     timing: Timing,
     tick: &mut dyn FnMut(),
@@ -61,6 +64,7 @@ fn run(
     let last = checkpoints.iter().copied().max().unwrap_or(1).max(1);
     let mut images = Vec::new();
     for frame in 1..=last {
+        session.follow(options, frame - 1, last)?;
         let read = checkpoints.contains(&frame);
         session.frame(read)?;
         if read {

@@ -24,7 +24,7 @@ use kiln_format::linespace::GridHeader;
 use kiln_format::sections::{BVH_NODES, GRID};
 use xxhash_rust::xxh3::Xxh3;
 
-use crate::camera::{Camera, CameraOverride};
+use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Gpu, GpuOptions};
 use crate::render::{Effect, Purpose, RenderSettings, Techniques};
@@ -49,6 +49,8 @@ pub struct SweepOptions {
     pub height: u32,
     /// Cameras (`None`: the file's camera); at least one.
     pub cameras: Vec<Option<CameraOverride>>,
+    /// A moving camera instead of `cameras`.
+    pub camera_path: Option<PathSweep>,
     /// What to sweep.
     pub request: Request,
     /// Reference samples per pixel (two halves of half each).
@@ -63,6 +65,25 @@ pub struct SweepOptions {
     pub keep_images: bool,
     /// Show progress bars.
     pub progress: bool,
+}
+
+/// A sweep along a camera path: every configuration renders `frames` frames along `path` and is
+/// measured at the last, against the reference at the last pose.
+#[derive(Debug, Clone)]
+pub struct PathSweep {
+    /// The poses.
+    pub path: CameraPath,
+    /// Frames the path takes.
+    pub frames: u32,
+    /// Its name in the report (the file's stem).
+    pub name: String,
+}
+
+impl PathSweep {
+    /// The pose of the last frame, where the images are compared.
+    pub fn last_pose(&self) -> CameraOverride {
+        self.path.at(self.frames - 1, self.frames)
+    }
 }
 
 /// A sweep's outcome: the results, and points that could not be measured.
@@ -297,8 +318,18 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
     let (offers, scene_name, content_hash, _) = inspect(options)?;
     let plan: Plan = plan::plan(&options.request, &offers);
     let device = Gpu::new(&options.gpu)?.identity();
-    let cameras: Vec<Option<CameraOverride>> =
-        if options.cameras.is_empty() { vec![None] } else { options.cameras.clone() };
+    let mut plan = plan;
+    let cameras: Vec<Option<CameraOverride>> = match &options.camera_path {
+        Some(p) => {
+            // One image per configuration: the path's last frame.
+            for c in &mut plan.configs {
+                c.checkpoints = vec![p.frames];
+            }
+            vec![Some(p.last_pose())]
+        }
+        None if options.cameras.is_empty() => vec![None],
+        None => options.cameras.clone(),
+    };
     let images_per_camera: u64 = plan.configs.iter().map(|c| c.checkpoints.len() as u64).sum::<u64>() + 3;
     let progress = bar(options.progress, images_per_camera * cameras.len() as u64);
     let mut points = Vec::new();
@@ -306,7 +337,11 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
     let mut warnings: Vec<String> = Vec::new();
     let mut failures = Vec::new();
     for camera in &cameras {
-        let name = camera_name(camera);
+        let name = match &options.camera_path {
+            // The reference is the last pose's: the name keys its cache.
+            Some(p) => format!("path {} to {}", p.name, camera_name(camera)),
+            None => camera_name(camera),
+        };
         let base = SessionOptions {
             file: options.file.clone(),
             gpu: options.gpu.clone(),
@@ -314,7 +349,7 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             width: options.width,
             height: options.height,
             camera: *camera,
-            camera_path: None,
+            camera_path: options.camera_path.as_ref().map(|p| p.path.clone()),
             readback: None,
         };
         let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;

@@ -226,15 +226,29 @@ pub fn names(target: Target) -> Vec<&'static str> {
 type Preset = (&'static str, &'static str, fn(&mut Techniques));
 
 /// The frame presets, each with both G-buffers.
-const PRESETS: [Preset; 3] = [
+const PRESETS: [Preset; 5] = [
     ("baked", "shadow maps, no AO, split-sum reflections", |t| {
         t.shadows = Shadows::ShadowMap;
+    }),
+    ("baked-taa", "as baked with temporal anti-aliasing (--aa taa)", |t| {
+        t.shadows = Shadows::ShadowMap;
+        set(t, Effect::Aa, "taa");
     }),
     ("rt", "ray-traced shadows, AO and full-resolution reflections (seed 001)", |t| {
         set(t, Effect::Shadows, "rt");
         set(t, Effect::Ao, "rt");
         set(t, Effect::Reflections, "rt");
     }),
+    (
+        "rt-taa",
+        "as rt with temporal anti-aliasing (--aa taa): its history is reprojected while the camera moves",
+        |t| {
+            set(t, Effect::Shadows, "rt");
+            set(t, Effect::Ao, "rt");
+            set(t, Effect::Reflections, "rt");
+            set(t, Effect::Aa, "taa");
+        },
+    ),
     ("rt-half", "as rt with half-resolution reflections", |t| {
         set(t, Effect::Shadows, "rt");
         set(t, Effect::Ao, "rt");
@@ -335,7 +349,7 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                             technique: format!("{}/{name}", gbuffer.name),
                             knobs: BTreeMap::new(),
                             techniques: t,
-                            checkpoints: checkpoints(t.ray_traced(), &t),
+                            checkpoints: checkpoints(t.ray_traced() || t.aa.temporal(), &t),
                         });
                     }
                 }
