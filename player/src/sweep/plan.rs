@@ -21,12 +21,13 @@ pub enum Target {
 
 impl Target {
     /// Every target `--effects` accepts, in the order they are swept.
-    pub const ALL: [Target; 6] = [
+    pub const ALL: [Target; 7] = [
         Target::Effect(Effect::Shadows),
         Target::Effect(Effect::Ao),
         Target::Effect(Effect::Reflections),
         Target::Effect(Effect::Gi),
         Target::Effect(Effect::Media),
+        Target::Effect(Effect::Aa),
         Target::Frame,
     ];
 
@@ -64,7 +65,9 @@ impl fmt::Display for Target {
 /// techniques.
 pub fn bounces(target: Target) -> u32 {
     match target {
-        Target::Effect(Effect::Shadows | Effect::Ao | Effect::Media) => 1,
+        // The anti-aliasing chart holds the frame at shadow maps and the sky's ambient: direct
+        // light.
+        Target::Effect(Effect::Shadows | Effect::Ao | Effect::Media | Effect::Aa) => 1,
         Target::Effect(Effect::Reflections) => 2,
         _ => 0,
     }
