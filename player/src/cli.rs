@@ -216,10 +216,16 @@ pub struct Args {
     #[arg(long, conflicts_with = "aa")]
     pub no_accumulate: bool,
     /// What happens to samples across frames. accumulate: the ray-traced passes keep a running
-    /// mean while the camera is still; taa: also temporal anti-aliasing (a sub-pixel jitter per
-    /// frame, a reprojected, neighbourhood-clamped history); none: every frame its own.
+    /// mean while the camera is still (a move restarts it); reproject: the mean follows the
+    /// camera (reprojected, restarted only where a point was hidden); taa: that and temporal
+    /// anti-aliasing (a sub-pixel jitter per frame, a reprojected, neighbourhood-clipped
+    /// history); none: every frame its own.
     #[arg(long, value_parser = techniques(Effect::Aa), default_value = "accumulate")]
     pub aa: String,
+    /// With --aa reproject: the longest history of the ray-traced passes while the camera
+    /// moves, 1 to 1024 (default 32; a still camera's running mean is unbounded).
+    #[arg(long, value_name = "N")]
+    pub history_frames: Option<u32>,
     /// With --aa taa: the longest history in frames, 1 to 1024 (default 16): a new frame weighs
     /// at least 1/N; longer converges further on a still camera, smears more on a moving one.
     #[arg(long, value_name = "N")]
@@ -307,6 +313,7 @@ impl Args {
             "media-block" => self.media_block.map(|n| KnobValue::Number(n as f32)),
             "media-phase" => self.media_phase.map(|p| KnobValue::Choice(p as usize)),
             "taa-frames" => self.taa_frames.map(|n| KnobValue::Number(n as f32)),
+            "history-frames" => self.history_frames.map(|n| KnobValue::Number(n as f32)),
             "taa-weights" => self.taa_weights.map(|w| KnobValue::Choice(w as usize)),
             _ => None,
         }
@@ -542,6 +549,9 @@ mod tests {
         assert_eq!(t.aa, Aa::Taa { frames: 8, luma_weights: true });
         assert_eq!(techniques(&["f.kiln", "--aa", "taa"]).aa, Aa::Taa { frames: 16, luma_weights: false });
         assert_eq!(techniques(&["f.kiln", "--aa", "none"]).aa, Aa::None);
+        let t = techniques(&["f.kiln", "--aa", "reproject", "--history-frames", "8"]);
+        assert_eq!(t.aa, Aa::Reproject { frames: 8 });
+        assert_eq!(t.aa.reprojected(), Some(8));
         let e = parse(&["f.kiln", "--aa", "taa", "--taa-frames", "0"]).unwrap().techniques().unwrap_err();
         assert!(e.message.contains("--taa-frames"), "{}", e.message);
         let e = parse(&["f.kiln", "--aa", "taa", "--no-accumulate"]).unwrap_err().to_string();

@@ -18,6 +18,7 @@ mod media; // single scattering in a lit slab against its closed form (reference
 mod raytraced; // ray-traced AO and reflections against closed forms, accumulation
 mod rect; // a rect light against the polygon irradiance: direct pass, RT shadows, reference
 mod reference; // the reference path tracer's GGX in a white furnace
+mod reproject; // the ray-traced running mean carried along a moving camera, restarted where disoccluded
 mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipelines agree
 mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows
 mod taa; // temporal anti-aliasing against 16× supersampling, still and moving, no ghosts

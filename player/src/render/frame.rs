@@ -2,7 +2,7 @@
 //! images they make and bind.
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
-//! reflections, GI (each when chosen) → direct light and composition → participating media
+//! reflections, GI (each when chosen) → their reprojected accumulation (with `--aa taa`) → direct light and composition → participating media
 //! (march, mitchell, sousa or toth, when chosen) → temporal anti-aliasing (when chosen) → tone
 //! mapping.
 
@@ -15,6 +15,7 @@ use super::passes::mitchell::MitchellPass;
 use super::passes::resolve::ResolvePass;
 use super::passes::rt_ao::RtAoPass;
 use super::passes::rt_gi::RtGiPass;
+use super::passes::rt_history::RtHistoryPass;
 use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::sousa::SousaPass;
@@ -76,6 +77,11 @@ fn passes(
                 made.push(Box::new(RtGiPass::with_line_space(gpu, code, decode)?));
             }
             Gi::None => {}
+        }
+        if let Some(frames) = techniques.aa.reprojected()
+            && techniques.ray_traced()
+        {
+            made.push(Box::new(RtHistoryPass::new(gpu, techniques, lights, frames)?));
         }
         made.push(Box::new(DirectPass::new(gpu)?));
         match techniques.media {

@@ -371,7 +371,11 @@ impl Renderer {
     pub fn record(&mut self, rec: &Recorder, scene: &GpuScene) {
         rec.reset_timestamps(&self.timestamps);
         rec.timestamp(&self.timestamps, 0);
-        self.rt_constants.accumulated = self.accumulated;
+        // With reprojected accumulation the passes write this frame's sample; the history pass
+        // blends it.
+        let t = self.settings.techniques;
+        self.rt_constants.accumulated =
+            if t.aa.reprojected().is_some() && t.ray_traced() { 0 } else { self.accumulated };
         self.rt_constants.seed = self.frame_count as u32;
         let Frame { passes, images, .. } = &mut self.frame;
         let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants };

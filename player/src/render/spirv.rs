@@ -27,6 +27,14 @@ shaders! {
     TONEMAP = "post" / "tonemap.comp";
     /// Temporal anti-aliasing.
     TAA_RESOLVE = "taa" / "resolve.comp";
+    /// Reprojected accumulation: where each pixel's point was, its frames of history.
+    HISTORY_MOTION = "history" / "motion.comp";
+    /// Reprojected accumulation of a layered one-channel target (shadows).
+    HISTORY_BLEND_LAYERS = "history" / "blend_layers.comp";
+    /// Reprojected accumulation of a one-channel target (AO).
+    HISTORY_BLEND_R = "history" / "blend_r.comp";
+    /// Reprojected accumulation of a four-channel target (reflections, GI).
+    HISTORY_BLEND_RGBA = "history" / "blend_rgba.comp";
     /// Participating media by ray marching.
     MEDIA_MARCH = "media" / "march.comp";
     /// Mitchell's occlusion image.

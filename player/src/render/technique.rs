@@ -249,11 +249,18 @@ pub enum Aa {
     /// restarts it.
     #[default]
     Accumulate,
+    /// The running mean of the ray-traced passes carried along while the camera moves: each
+    /// pixel's history read where its surface point was last frame, restarted only where that
+    /// point was hidden (`passes/rt_history.rs`).
+    Reproject {
+        /// The longest history while the camera moves (a still camera's is unbounded).
+        frames: u32,
+    },
     /// Temporal anti-aliasing (seed 000, after Karis 2014): the projection jittered by a
     /// Halton (2, 3) sub-pixel offset each frame, the frame blended into a history reprojected
     /// from the previous frame's camera, the history clamped to the current frame's
-    /// neighbourhood in YCoCg (`shaders/taa/`). The ray-traced passes keep their running mean
-    /// while the camera is still.
+    /// neighbourhood in YCoCg (`shaders/taa/`). The ray-traced passes' running mean is
+    /// reprojected as with [`Aa::Reproject`], capped at the same length.
     Taa {
         /// The longest history in frames: a pixel's new sample weighs 1/min(n + 1, frames)
         /// after n frames of history.
@@ -273,6 +280,15 @@ impl Aa {
     /// Whether the stochastic passes keep a running mean while the camera is still.
     pub fn accumulates(&self) -> bool {
         !matches!(self, Aa::None)
+    }
+
+    /// The longest history of the ray-traced passes while the camera moves, when it is
+    /// reprojected (`None`: it restarts at every move, or there is none).
+    pub fn reprojected(&self) -> Option<u32> {
+        match *self {
+            Aa::Reproject { frames } | Aa::Taa { frames, .. } => Some(frames),
+            Aa::None | Aa::Accumulate => None,
+        }
     }
 }
 
@@ -558,6 +574,9 @@ impl Techniques {
             }
             (Effect::Aa, "none") => self.aa = Aa::None,
             (Effect::Aa, "accumulate") => self.aa = Aa::Accumulate,
+            (Effect::Aa, "reproject") => {
+                self.aa = Aa::Reproject { frames: whole(effect, name, "history-frames", v(0))? }
+            }
             (Effect::Aa, "taa") => {
                 self.aa = Aa::Taa {
                     frames: whole(effect, name, "taa-frames", v(0))?,
@@ -605,6 +624,7 @@ impl Techniques {
             Effect::Aa => match self.aa {
                 Aa::None => "none",
                 Aa::Accumulate => "accumulate",
+                Aa::Reproject { .. } => "reproject",
                 Aa::Taa { .. } => "taa",
             },
         }
@@ -840,7 +860,7 @@ const fn artistic(knob: Knob) -> Knob {
     Knob { role: KnobRole::Scene, ..knob }
 }
 
-static CATALOGUE: [TechniqueInfo; 21] = [
+static CATALOGUE: [TechniqueInfo; 22] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -1108,11 +1128,29 @@ static CATALOGUE: [TechniqueInfo; 21] = [
     },
     TechniqueInfo {
         effect: Effect::Aa,
+        name: "reproject",
+        help: "the running mean of the ray-traced passes carried along while the camera moves: \
+               each pixel's history read where its surface point was last frame, restarted only \
+               where that point was hidden (see --history-frames)",
+        knobs: &[number(
+            "history-frames",
+            "the longest history while the camera moves: a new frame weighs at least 1/FRAMES \
+             (a still camera's running mean is unbounded)",
+            1.0,
+            1024.0,
+            32.0,
+            &[8.0, 32.0],
+        )],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Aa,
         name: "taa",
         help: "temporal anti-aliasing (seed 000): a Halton sub-pixel jitter per frame, each frame \
                blended into a history reprojected from the last camera and clamped to the \
-               current neighbourhood (YCoCg); the ray-traced passes keep their running mean \
-               while the camera is still; see --taa-frames, --taa-weights",
+               current neighbourhood (YCoCg); the ray-traced passes' running mean reprojected \
+               as with reproject, at most --taa-frames long while moving; see --taa-frames, \
+               --taa-weights",
         knobs: &[
             number(
                 "taa-frames",

@@ -18,6 +18,7 @@ pub mod pathtrace;
 pub mod resolve;
 pub mod rt_ao;
 pub mod rt_gi;
+pub mod rt_history;
 pub mod rt_reflections;
 pub mod rt_shadows;
 pub mod sousa;
