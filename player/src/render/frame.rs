@@ -1,14 +1,16 @@
 //! Wires the passes of a run: which passes the chosen techniques need, in frame order, and the
 //! images they make and bind.
 //!
-//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
-//! reflections, GI (each when chosen) → direct light and composition → participating media
+//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO
+//! (ray-traced, or the depth pyramid and SAO or GTAO), reflections, GI (each when chosen) → direct light and composition → participating media
 //! (march, mitchell, sousa or toth, when chosen) → tone mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
+use super::passes::depth_pyramid::DepthPyramidPass;
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
+use super::passes::{gtao, sao};
 use super::passes::media::MediaMarchPass;
 use super::passes::mitchell::MitchellPass;
 use super::passes::resolve::ResolvePass;
@@ -57,8 +59,17 @@ fn passes(
         if techniques.shadows.traced().is_some() {
             made.push(Box::new(RtShadowsPass::new(gpu, techniques.shadows, lights, decode)?));
         }
-        if let Ao::Rt { .. } = techniques.ao {
-            made.push(Box::new(RtAoPass::new(gpu, decode)?));
+        match techniques.ao {
+            Ao::None => {}
+            Ao::Rt { .. } => made.push(Box::new(RtAoPass::new(gpu, decode)?)),
+            Ao::Sao { .. } | Ao::Gtao { .. } => {
+                made.push(Box::new(DepthPyramidPass::new(gpu)?));
+                made.push(Box::new(if let Ao::Sao { .. } = techniques.ao {
+                    sao::pass(gpu, techniques.ao)?
+                } else {
+                    gtao::pass(gpu, techniques.ao)?
+                }));
+            }
         }
         if let Reflections::Rt { resolution, .. } = techniques.reflections {
             made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?));
