@@ -551,15 +551,43 @@ mod tests {
             Ao::Sao { radius: None, reach: 0.05, samples: 16, turns: 7.0, resolution: ScreenFraction::Half }
         );
         let t = techniques(&[
-            "f.kiln", "--ao", "sao", "--ao-radius", "1.8", "--ao-samples", "8", "--ao-turns", "5", "--ao-res",
+            "f.kiln",
+            "--ao",
+            "sao",
+            "--ao-radius",
+            "1.8",
+            "--ao-samples",
+            "8",
+            "--ao-turns",
+            "5",
+            "--ao-res",
             "full",
         ]);
         assert_eq!(
             t.ao,
-            Ao::Sao { radius: Some(1.8), reach: 0.05, samples: 8, turns: 5.0, resolution: ScreenFraction::Full }
+            Ao::Sao {
+                radius: Some(1.8),
+                reach: 0.05,
+                samples: 8,
+                turns: 5.0,
+                resolution: ScreenFraction::Full
+            }
         );
-        assert_eq!(techniques(&["f.kiln", "--ao", "gtao"]).ao, Ao::Gtao { radius: None, reach: 0.05, slices: 3, steps: 3 });
-        let t = techniques(&["f.kiln", "--ao", "gtao", "--ao-slices", "9", "--ao-steps", "4", "--ao-reach", "0.2"]);
+        assert_eq!(
+            techniques(&["f.kiln", "--ao", "gtao"]).ao,
+            Ao::Gtao { radius: None, reach: 0.05, slices: 3, steps: 3 }
+        );
+        let t = techniques(&[
+            "f.kiln",
+            "--ao",
+            "gtao",
+            "--ao-slices",
+            "9",
+            "--ao-steps",
+            "4",
+            "--ao-reach",
+            "0.2",
+        ]);
         assert_eq!(t.ao, Ao::Gtao { radius: None, reach: 0.2, slices: 9, steps: 4 });
         // --ao-reach keeps each technique's own default when not given.
         assert_eq!(techniques(&["f.kiln", "--ao", "rt"]).ao, Ao::Rt { radius: None, reach: 0.1 });

@@ -973,7 +973,14 @@ static CATALOGUE: [TechniqueInfo; 22] = [
         knobs: &[
             AO_RADIUS,
             ao_reach(0.05, &[0.05]),
-            number("ao-samples", "samples per AO pixel on the spiral (the seed's N)", 1.0, 64.0, 16.0, &[8.0, 16.0, 32.0]),
+            number(
+                "ao-samples",
+                "samples per AO pixel on the spiral (the seed's N)",
+                1.0,
+                64.0,
+                16.0,
+                &[8.0, 16.0, 32.0],
+            ),
             number(
                 "ao-turns",
                 "turns of the sample spiral (τ; 7: McGuire et al.'s prime for few samples)",
@@ -1003,8 +1010,22 @@ static CATALOGUE: [TechniqueInfo; 22] = [
         knobs: &[
             AO_RADIUS,
             ao_reach(0.05, &[0.05]),
-            number("ao-slices", "screen directions per pixel (XeGTAO High: 3)", 1.0, 32.0, 3.0, &[2.0, 3.0, 9.0]),
-            number("ao-steps", "samples along each side of a slice (XeGTAO High: 3)", 1.0, 64.0, 3.0, &[2.0, 3.0, 8.0]),
+            number(
+                "ao-slices",
+                "screen directions per pixel (XeGTAO High: 3)",
+                1.0,
+                32.0,
+                3.0,
+                &[2.0, 3.0, 9.0],
+            ),
+            number(
+                "ao-steps",
+                "samples along each side of a slice (XeGTAO High: 3)",
+                1.0,
+                64.0,
+                3.0,
+                &[2.0, 3.0, 8.0],
+            ),
         ],
         stochastic: false,
     },

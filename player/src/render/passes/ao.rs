@@ -9,11 +9,11 @@ use kiln_format::gpu::ScreenAoConstants;
 use super::depth_pyramid::PYRAMID;
 use super::kernel::Kernel;
 use super::{FrameCtx, Pass, Shared};
-use crate::render::technique::Ao;
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
+use crate::render::technique::Ao;
 
 /// Ambient openness in [0, 1] per screen pixel (1: nothing occludes).
 pub const AO: TargetDecl = TargetDecl {
@@ -34,10 +34,7 @@ pub const RAW: TargetDecl = TargetDecl {
 /// The targets of a screen-space technique computing one AO pixel per `step` × `step` screen
 /// pixels: its raw image and the AO image.
 fn targets(width: u32, height: u32, step: u32) -> Vec<(TargetDecl, ImageDesc)> {
-    vec![
-        (RAW, RAW.sized(width.div_ceil(step), height.div_ceil(step), 1)),
-        (AO, AO.sized(width, height, 1)),
-    ]
+    vec![(RAW, RAW.sized(width.div_ceil(step), height.div_ceil(step), 1)), (AO, AO.sized(width, height, 1))]
 }
 
 /// The bindings of a screen-space AO kernel (`shaders/sao/sao.comp`, `shaders/gtao/gtao.comp`):
@@ -102,7 +99,6 @@ impl ScreenAoPass {
         )?;
         Ok(ScreenAoPass { estimator, blur, constants, technique })
     }
-
 }
 
 impl Pass for ScreenAoPass {

@@ -113,10 +113,8 @@ impl Pass for DepthPyramidPass {
 
     fn record(&mut self, ctx: &mut FrameCtx) {
         let (width, height) = (ctx.images.width, ctx.images.height);
-        ctx.images.access(
-            ctx.rec,
-            &[(DEPTH, Access::Read(Use::SAMPLED)), (PYRAMID, Access::Write(Use::STORAGE))],
-        );
+        ctx.images
+            .access(ctx.rec, &[(DEPTH, Access::Read(Use::SAMPLED)), (PYRAMID, Access::Write(Use::STORAGE))]);
         let push = ScreenAoConstants::default();
         self.linear.dispatch(ctx.rec, bytemuck::bytes_of(&push), width, height);
         for (level, &(w, h)) in levels(width, height).iter().enumerate().skip(1) {

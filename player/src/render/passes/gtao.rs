@@ -6,7 +6,6 @@
 //! blur ([`super::ao::ScreenAoPass`]). Full resolution, as Intel's XeGTAO (whose "High" preset is 3
 //! slices × 3 steps, the defaults here). Deterministic per frame.
 
-
 use kiln_format::gpu::ScreenAoConstants;
 
 use super::ao::ScreenAoPass;
