@@ -241,3 +241,50 @@ fn gtao_of_an_inside_corner_matches_the_closed_form_visibility() {
         );
     }
 }
+
+#[test]
+fn screen_space_ao_does_not_bleed_across_depth_edges() {
+    if !vulkan() {
+        return;
+    }
+    // A plate at height 0.5 over the floor, its top facing up: every sample beside it lands on
+    // the floor below its tangent plane, so its top is unoccluded up to its edges (as the flat
+    // floor), while the floor seen under it, just past its near edge on the screen, is strongly
+    // occluded and some 40 % farther from the camera. A blur that mixed them would darken the
+    // top's edge pixels.
+    let dir = tempfile::tempdir().unwrap();
+    let (y0, x0, z0, z1) = (0.5f32, 0.7f32, 0.6f32, 1.6f32);
+    let p = |x: f32, z: f32| Vec3::new(x, y0, z);
+    let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
+    tris.extend([[p(-x0, z0), p(-x0, z1), p(x0, z1)], [p(-x0, z0), p(x0, z1), p(x0, z0)]]);
+    let mut scene = scene_of(&tris);
+    scene.sky = Sky { radiance: [1.0; 3] };
+    let cam = camera();
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    let top = |x: u32, y: u32| {
+        let d = cam.ray(x, y, W, H);
+        let q = cam.eye + d * ((y0 as f64 - cam.eye.y) / d.y);
+        (q.x.abs() < x0 as f64 && q.z > z0 as f64 && q.z < z1 as f64).then_some(1.0)
+    };
+    for (name, ao, tolerance) in [
+        ("sao-plate", sao(ScreenFraction::Full), 1e-3),
+        ("sao-plate-half", sao(ScreenFraction::Half), 1e-3),
+        ("gtao-plate", Ao::Gtao { radius: Some(RADIUS as f32), reach: 0.05, slices: 3, steps: 3 }, 0.03),
+    ] {
+        let img = ao_image(dir.path(), name, &bytes, ao);
+        let (mean, worst, n) = compare(&img, top);
+        // The floor under the plate, for the record: it is occluded.
+        let (under, _, _) = compare(&img, |x, y| {
+            let d = cam.ray(x, y, W, H);
+            let q = cam.eye + d * (-cam.eye.y / d.y);
+            (top(x, y).is_none() && q.x.abs() < 0.5 && q.z > 1.0 && q.z < 1.4).then_some(1.0)
+        });
+        eprintln!(
+            "{name}: plate top AO mean {mean:.4}, largest deviation {worst:.4} over {n} pixels; floor under it {under:.3}"
+        );
+        assert!(n > 300);
+        assert!(under < 0.8, "{name}: the floor under the plate is not occluded ({under})");
+        assert!((mean - 1.0).abs() < tolerance && worst < 2.0 * tolerance, "{name}: mean {mean}, worst {worst}");
+    }
+}
