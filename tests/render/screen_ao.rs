@@ -177,6 +177,38 @@ fn corner_pixels(cam: &Pinhole, d_min: f64, d_max: f64) -> impl Fn(u32, u32) -> 
     }
 }
 
+/// Renders `ao` on the corner scene `bytes` and checks its AO at the floor pixels 0.15 to 1.2
+/// from the wall against `expected` (what `reference` names): the mean ratio within
+/// `tolerance` of 1 and every pixel within `worst_allowed`.
+#[allow(clippy::too_many_arguments)]
+fn check_corner(
+    dir: &Path,
+    bytes: &[u8],
+    name: &str,
+    ao: Ao,
+    reference: &str,
+    expected: impl Fn(u32, u32, DVec3) -> f64,
+    tolerance: f64,
+    worst_allowed: f64,
+) {
+    let cam = camera();
+    let (pick, pick_near) = (corner_pixels(&cam, 0.15, 1.2), corner_pixels(&cam, 0.15, 0.4));
+    let img = ao_image(dir, name, bytes, ao);
+    let (mean, worst, n) = compare(&img, |x, y| pick(x, y).map(|p| expected(x, y, p)));
+    // The expected AO's own mean within 0.4 of the wall (how much occlusion there is to find).
+    let (near, _, _) =
+        compare(&vec![1.0; (W * H) as usize], |x, y| pick_near(x, y).map(|p| 1.0 / expected(x, y, p)));
+    eprintln!(
+        "{name}: mean ratio to {reference} {mean:.4}, largest deviation {worst:.4} over {n} pixels \
+         (its mean within 0.4 of the wall: {near:.3})"
+    );
+    assert!(n > 300);
+    assert!(
+        (mean - 1.0).abs() < tolerance && worst < worst_allowed,
+        "{name}: mean ratio {mean}, worst {worst}"
+    );
+}
+
 #[test]
 fn sao_of_an_inside_corner_matches_its_estimator_integrated_here() {
     if !vulkan() {
@@ -184,35 +216,29 @@ fn sao_of_an_inside_corner_matches_its_estimator_integrated_here() {
     }
     // The player's per-pixel rotations (16, one per pixel of a 4 × 4 block) and its blur
     // approximate the mean over φ that `sao_expected` integrates; the blur also mixes
-    // neighbours a few pixels apart in d. Full resolution: one AO pixel per screen pixel.
+    // neighbours a few pixels apart in d. Radius 4 projects to 60 to 120 pixels: most samples
+    // read pyramid levels 1 to 2 (m = ⌊log₂(r'α/16)⌋), whose nearest depths rebuilt at the
+    // sample's pixel lie off the surface by up to a few pixels' worth of depth; the estimator
+    // here reads the exact surface.
     let dir = tempfile::tempdir().unwrap();
     let bytes = scene(true);
     let cam = camera();
-    let pick = corner_pixels(&cam, 0.15, 1.2);
-    // Radius 4 projects to 60 to 120 pixels: most samples read pyramid levels 1 to 2
-    // (m = ⌊log₂(r'α/16)⌋), whose nearest depths rebuilt at the sample's pixel lie off the
-    // surface by up to a few pixels' worth of depth; the estimator here reads the exact surface.
-    for (name, radius, res, tolerance, worst_allowed) in [
+    for (name, radius, resolution, tolerance, worst_allowed) in [
         ("sao-corner-full", RADIUS, ScreenFraction::Full, 0.02, 0.08),
         ("sao-corner-half", RADIUS, ScreenFraction::Half, 0.04, 0.15),
         ("sao-corner-r4", 4.0, ScreenFraction::Full, 0.02, 0.05),
     ] {
-        let expected = |x: u32, y: u32| pick(x, y).map(|_| sao_expected(&cam, x, y, radius, 64));
-        let (m_near, _, _) = compare(&vec![1.0; (W * H) as usize], |x, y| {
-            pick(x, y).filter(|p| p.z < 0.4).map(|_| 1.0 / sao_expected(&cam, x, y, radius, 64))
-        });
-        let ao =
-            Ao::Sao { radius: Some(radius as f32), reach: 0.05, samples: 16, turns: 7.0, resolution: res };
-        let img = ao_image(dir.path(), name, &bytes, ao);
-        let (mean, worst, n) = compare(&img, expected);
-        eprintln!(
-            "{name}: mean ratio to the integrated estimator {mean:.4}, largest deviation {worst:.4} over {n} \
-             pixels (the estimator's mean within 0.4 of the wall: {m_near:.3})"
-        );
-        assert!(n > 300);
-        assert!(
-            (mean - 1.0).abs() < tolerance && worst < worst_allowed,
-            "{name}: mean ratio {mean}, worst {worst}"
+        let ao = Ao::Sao { radius: Some(radius as f32), reach: 0.05, samples: 16, turns: 7.0, resolution };
+        let expected = |x, y, _| sao_expected(&cam, x, y, radius, 64);
+        check_corner(
+            dir.path(),
+            &bytes,
+            name,
+            ao,
+            "the integrated estimator",
+            expected,
+            tolerance,
+            worst_allowed,
         );
     }
 }
@@ -224,27 +250,12 @@ fn gtao_of_an_inside_corner_matches_the_closed_form_visibility() {
     }
     let dir = tempfile::tempdir().unwrap();
     let bytes = scene(true);
-    let cam = camera();
-    let pick = corner_pixels(&cam, 0.15, 1.2);
-    let expected = |x: u32, y: u32| pick(x, y).map(|p| wall_visibility(p.z, RADIUS));
-    let (m_near, _, _) = compare(&vec![1.0; (W * H) as usize], |x, y| {
-        pick(x, y).filter(|p| p.z < 0.4).map(|p| 1.0 / wall_visibility(p.z, RADIUS))
-    });
     for (name, slices, steps, tolerance, worst_allowed) in
         [("gtao-corner-8x24", 8, 24, 0.02, 0.05), ("gtao-corner-3x3", 3, 3, 0.05, 0.15)]
     {
         let ao = Ao::Gtao { radius: Some(RADIUS as f32), reach: 0.05, slices, steps };
-        let img = ao_image(dir.path(), name, &bytes, ao);
-        let (mean, worst, n) = compare(&img, expected);
-        eprintln!(
-            "{name}: mean ratio to the closed form {mean:.4}, largest deviation {worst:.4} over {n} pixels \
-             (the closed form's mean within 0.4 of the wall: {m_near:.3})"
-        );
-        assert!(n > 300);
-        assert!(
-            (mean - 1.0).abs() < tolerance && worst < worst_allowed,
-            "{name}: mean ratio {mean}, worst {worst}"
-        );
+        let expected = |_, _, p: DVec3| wall_visibility(p.z, RADIUS);
+        check_corner(dir.path(), &bytes, name, ao, "the closed form", expected, tolerance, worst_allowed);
     }
 }
 
