@@ -266,6 +266,27 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of the screen-space AO passes (`shaders/pyramid/*`, `shaders/sao/*`,
+    /// `shaders/gtao/*`, `shaders/ao/*`; 32 bytes).
+    pub struct ScreenAoConstants {
+        /// AO radius in world units.
+        pub radius: f32 => "float",
+        /// SAO: turns of the sample spiral (τ).
+        pub turns: f32 => "float",
+        /// SAO: samples per pixel (N); GTAO: slices per pixel.
+        pub count: u32 => "uint",
+        /// GTAO: steps along each side of a slice.
+        pub steps: u32 => "uint",
+        /// Screen pixels per AO pixel along each axis (1 full resolution, 2 half).
+        pub step: u32 => "uint",
+        /// Depth pyramid: the level this dispatch writes.
+        pub level: u32 => "uint",
+        /// Padding.
+        pub pad: [u32; 2] => "uvec2",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
@@ -452,6 +473,7 @@ pub fn glsl_layout() -> String {
     declare::<MarchConstants>(&mut s);
     declare::<GodRayConstants>(&mut s);
     declare::<TothConstants>(&mut s);
+    declare::<ScreenAoConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -615,6 +637,7 @@ mod tests {
         check::<MarchConstants>();
         check::<GodRayConstants>();
         check::<TothConstants>();
+        check::<ScreenAoConstants>();
         check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {

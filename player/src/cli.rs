@@ -91,6 +91,15 @@ pub enum LsShadowTestArg {
     Filled,
 }
 
+/// `--ao-res` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AoResArg {
+    /// One sample set per pixel.
+    Full,
+    /// One per 2 × 2 pixels.
+    Half,
+}
+
 /// `--media-res` (order as the catalogue's choices).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MediaResArg {
@@ -183,13 +192,31 @@ pub struct Args {
     /// Ambient occlusion technique.
     #[arg(long, value_parser = techniques(Effect::Ao), default_value = "none")]
     pub ao: String,
-    /// With --ao rt: ray length in scene units (default: --ao-reach times the scene's diagonal).
+    /// With --ao rt, sao or gtao: the AO radius in scene units (rt: the ray length; sao, gtao:
+    /// the samples' world radius; default: --ao-reach times the scene's diagonal).
     #[arg(long, value_name = "R")]
     pub ao_radius: Option<f32>,
-    /// With --ao rt: ray length as a fraction of the scene's bounding-box diagonal, when no
-    /// --ao-radius is given (≥ 10: every hit occludes fully, the sky's true visibility).
-    #[arg(long, value_name = "FRACTION", default_value_t = 0.1)]
-    pub ao_reach: f32,
+    /// With --ao rt, sao or gtao: the AO radius as a fraction of the scene's bounding-box
+    /// diagonal, when no --ao-radius is given (default: rt 0.1, ≥ 10 making every hit occlude
+    /// fully, the sky's true visibility; sao and gtao 0.05, about the seed's 1.8 m in Sponza).
+    #[arg(long, value_name = "FRACTION")]
+    pub ao_reach: Option<f32>,
+    /// With --ao sao: samples per AO pixel on the spiral, 1 to 64 (default 16, the seed's N).
+    #[arg(long, value_name = "N")]
+    pub ao_samples: Option<u32>,
+    /// With --ao sao: turns of the sample spiral, τ (default 7).
+    #[arg(long, value_name = "TURNS")]
+    pub ao_turns: Option<f32>,
+    /// With --ao sao: resolution of the samples (default half, the seed's; the depth-aware blur
+    /// upsamples).
+    #[arg(long, value_enum, value_name = "RES")]
+    pub ao_res: Option<AoResArg>,
+    /// With --ao gtao: screen directions (slices) per pixel, 1 to 32 (default 3, XeGTAO's High).
+    #[arg(long, value_name = "N")]
+    pub ao_slices: Option<u32>,
+    /// With --ao gtao: samples along each side of a slice, 1 to 64 (default 3, XeGTAO's High).
+    #[arg(long, value_name = "N")]
+    pub ao_steps: Option<u32>,
     /// Reflections technique.
     #[arg(long, value_parser = techniques(Effect::Reflections), default_value = "none")]
     pub reflections: String,
@@ -299,7 +326,12 @@ impl Args {
             "sun-angle" => Some(KnobValue::Number(self.sun_angle)),
             "ls-shadow-test" => Some(KnobValue::Choice(self.ls_shadow_test as usize)),
             "ao-radius" => self.ao_radius.map(KnobValue::Number),
-            "ao-reach" => Some(KnobValue::Number(self.ao_reach)),
+            "ao-reach" => self.ao_reach.map(KnobValue::Number),
+            "ao-samples" => self.ao_samples.map(|n| KnobValue::Number(n as f32)),
+            "ao-turns" => self.ao_turns.map(KnobValue::Number),
+            "ao-res" => self.ao_res.map(|r| KnobValue::Choice(r as usize)),
+            "ao-slices" => self.ao_slices.map(|n| KnobValue::Number(n as f32)),
+            "ao-steps" => self.ao_steps.map(|n| KnobValue::Number(n as f32)),
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
@@ -492,7 +524,7 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{Aa, Ao, GBuffer, Gi, ReflectionRes, Reflections, Shadows};
+    use crate::render::{Aa, Ao, GBuffer, Gi, ReflectionRes, Reflections, ScreenFraction, Shadows};
 
     fn parse(args: &[&str]) -> Result<Args, clap::Error> {
         Args::try_parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))
@@ -563,6 +595,73 @@ mod tests {
         assert_eq!(techniques(&["f.kiln", "--shadows", "rt", "--shadows", "none"]).shadows, Shadows::None);
         let t = techniques(&["f.kiln", "--ao", "rt", "--ao-radius", "2", "--ao-radius", "3"]);
         assert_eq!(t.ao, Ao::Rt { radius: Some(3.0), reach: 0.1 });
+    }
+
+    #[test]
+    fn screen_space_ao_flags_set_their_knobs_with_the_techniques_defaults() {
+        let sao = techniques(&["f.kiln", "--ao", "sao"]);
+        assert_eq!(
+            sao.ao,
+            Ao::Sao { radius: None, reach: 0.05, samples: 16, turns: 7.0, resolution: ScreenFraction::Half }
+        );
+        let t = techniques(&[
+            "f.kiln",
+            "--ao",
+            "sao",
+            "--ao-radius",
+            "1.8",
+            "--ao-samples",
+            "8",
+            "--ao-turns",
+            "5",
+            "--ao-res",
+            "full",
+        ]);
+        assert_eq!(
+            t.ao,
+            Ao::Sao {
+                radius: Some(1.8),
+                reach: 0.05,
+                samples: 8,
+                turns: 5.0,
+                resolution: ScreenFraction::Full
+            }
+        );
+        assert_eq!(
+            techniques(&["f.kiln", "--ao", "gtao"]).ao,
+            Ao::Gtao { radius: None, reach: 0.05, slices: 3, steps: 3 }
+        );
+        let t = techniques(&[
+            "f.kiln",
+            "--ao",
+            "gtao",
+            "--ao-slices",
+            "9",
+            "--ao-steps",
+            "4",
+            "--ao-reach",
+            "0.2",
+        ]);
+        assert_eq!(t.ao, Ao::Gtao { radius: None, reach: 0.2, slices: 9, steps: 4 });
+        // --ao-reach keeps each technique's own default when not given.
+        assert_eq!(techniques(&["f.kiln", "--ao", "rt"]).ao, Ao::Rt { radius: None, reach: 0.1 });
+        // Out of range, fractional or unknown values name the flag.
+        for bad in [
+            &["--ao", "sao", "--ao-samples", "0"][..],
+            &["--ao", "sao", "--ao-samples", "65"],
+            &["--ao", "gtao", "--ao-slices", "33"],
+            &["--ao", "gtao", "--ao-steps", "0"],
+            &["--ao", "sao", "--ao-turns=-1"],
+            &["--ao", "sao", "--ao-reach", "0"],
+        ] {
+            let args: Vec<&str> = std::iter::once("f.kiln").chain(bad.iter().copied()).collect();
+            let e = parse(&args).unwrap().techniques().unwrap_err();
+            assert_eq!(e.exit, Exit::Usage);
+            let flag = bad[2].split('=').next().unwrap();
+            assert!(e.message.contains(flag), "{bad:?}: {}", e.message);
+        }
+        let e = parse(&["f.kiln", "--ao", "sao", "--ao-res", "quarter"]).unwrap_err().to_string();
+        assert!(e.contains("full") && e.contains("half"), "{e}");
     }
 
     #[test]

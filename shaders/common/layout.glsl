@@ -137,6 +137,16 @@ struct TothConstants {
     uint media; // offset 12
 }; // 16 bytes
 
+struct ScreenAoConstants {
+    float radius; // offset 0
+    float turns; // offset 4
+    uint count; // offset 8
+    uint steps; // offset 12
+    uint step; // offset 16
+    uint level; // offset 20
+    uvec2 pad; // offset 24
+}; // 32 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;

@@ -20,6 +20,7 @@ mod rect; // a rect light against the polygon irradiance: direct pass, RT shadow
 mod reference; // the reference path tracer's GGX in a white furnace
 mod reproject; // the ray-traced running mean carried along a moving camera, restarted where disoccluded
 mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipelines agree
+mod screen_ao; // SAO and GTAO: a flat floor unoccluded, an inside corner against the estimator and the closed form
 mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows
 mod taa; // temporal anti-aliasing against 16× supersampling, still and moving, no ghosts
 mod textures; // BC textures render within a small FLIP of RGBA8; RGBA8-only passes refuse them

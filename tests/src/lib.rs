@@ -147,6 +147,12 @@ impl Options {
         self
     }
 
+    /// Ambient occlusion by `ao` (any technique).
+    pub fn ao(mut self, ao: Ao) -> Options {
+        self.0.render.techniques.ao = ao;
+        self
+    }
+
     /// Ray-traced reflections at the given resolution.
     pub fn rt_reflections(mut self, res: Reflections) -> Options {
         let res = match res {

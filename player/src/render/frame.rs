@@ -1,13 +1,15 @@
 //! Wires the passes of a run: which passes the chosen techniques need, in frame order, and the
 //! images they make and bind.
 //!
-//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO,
-//! reflections, GI (each when chosen) → their reprojected accumulation (with `--aa taa`) → direct light and composition → participating media
-//! (march, mitchell, sousa or toth, when chosen) → temporal anti-aliasing (when chosen) → tone
-//! mapping.
+//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO
+//! (ray-traced, or the depth pyramid and SAO or GTAO), reflections, GI (each when chosen) → the
+//! ray-traced passes' reprojected accumulation (with `--aa reproject` or `taa`) → direct light
+//! and composition → participating media (march, mitchell, sousa or toth, when chosen) →
+//! temporal anti-aliasing (when chosen) → tone mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
+use super::passes::depth_pyramid::DepthPyramidPass;
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
 use super::passes::media::MediaMarchPass;
@@ -23,6 +25,7 @@ use super::passes::taa::TaaPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::toth::TothPass;
 use super::passes::visibility::VisibilityPass;
+use super::passes::{gtao, sao};
 use super::spirv;
 use super::technique::{Aa, Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
 use super::texels::TexelDecode;
@@ -60,8 +63,17 @@ fn passes(
         if techniques.shadows.traced().is_some() {
             made.push(Box::new(RtShadowsPass::new(gpu, techniques.shadows, lights, decode)?));
         }
-        if let Ao::Rt { .. } = techniques.ao {
-            made.push(Box::new(RtAoPass::new(gpu, decode)?));
+        match techniques.ao {
+            Ao::None => {}
+            Ao::Rt { .. } => made.push(Box::new(RtAoPass::new(gpu, decode)?)),
+            Ao::Sao { .. } | Ao::Gtao { .. } => {
+                made.push(Box::new(DepthPyramidPass::new(gpu)?));
+                made.push(Box::new(if let Ao::Sao { .. } = techniques.ao {
+                    sao::pass(gpu, techniques.ao)?
+                } else {
+                    gtao::pass(gpu, techniques.ao)?
+                }));
+            }
         }
         if let Reflections::Rt { resolution, .. } = techniques.reflections {
             made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?));

@@ -167,11 +167,7 @@ impl Renderer {
         };
         let shadow_layers = if rt_shadows { passes::rt_shadows::layers(lights_used) } else { 0 };
         let rt_constants = RtConstants {
-            ao_radius: match t.ao {
-                Ao::Rt { radius, reach } => radius.unwrap_or(reach * diagonal),
-                Ao::None => 0.1 * diagonal,
-            }
-            .max(1e-6),
+            ao_radius: t.ao.world_radius(diagonal).max(1e-6),
             max_roughness,
             shadow_lights: shadow_layers.min(plan.lights_used),
             reflection_step,
@@ -187,7 +183,9 @@ impl Renderer {
         if rt_shadows {
             flags |= FrameFlags::RT_SHADOWS;
         }
-        if matches!(t.ao, Ao::Rt { .. }) {
+        // The direct pass multiplies the sky's ambient by the AO image, whichever technique
+        // makes it (the flag's name predates the screen-space ones).
+        if t.ao != Ao::None {
             flags |= FrameFlags::RT_AO;
         }
         if t.gi.bounces().is_some() {

@@ -47,6 +47,16 @@ shaders! {
     SOUSA_BLUR = "sousa" / "blur.comp";
     /// Sousa's last radial blur, added to the radiance.
     SOUSA_COMPOSITE = "sousa" / "composite.comp";
+    /// Level 0 of the camera-space depth pyramid.
+    PYRAMID_LINEAR = "pyramid" / "linear.comp";
+    /// A level of the depth pyramid from the one below.
+    PYRAMID_REDUCE = "pyramid" / "reduce.comp";
+    /// Scalable ambient obscurance (the seed's).
+    SAO = "sao" / "sao.comp";
+    /// Ground-truth ambient occlusion.
+    GTAO = "gtao" / "gtao.comp";
+    /// The screen-space AO's depth-aware blur and upsampling.
+    AO_BLUR = "ao" / "blur.comp";
     /// Tóth & Umenhoffer's shadow-map ray march.
     TOTH_MARCH = "toth" / "march.comp";
     /// The blur that joins Tóth's interleaved samples.

@@ -94,6 +94,46 @@ pub enum Ao {
         /// values (≥ 10) make every hit occlude fully: the sky's visibility.
         reach: f32,
     },
+    /// Scalable ambient obscurance as the seed modifies it (seed 000 §2.3): spiral samples of
+    /// a camera-space depth pyramid and the G-buffer normals, blurred with depth weights.
+    Sao {
+        /// World radius r in scene units; `None`: `reach` times the scene's diagonal.
+        radius: Option<f32>,
+        /// r as a fraction of the scene's bounding-box diagonal (when `radius` is `None`).
+        reach: f32,
+        /// Samples per AO pixel (the seed's N = 16).
+        samples: u32,
+        /// Turns of the sample spiral (τ).
+        turns: f32,
+        /// Full or half resolution (the seed's default: half).
+        resolution: ScreenFraction,
+    },
+    /// Ground-truth AO (Jimenez et al. 2016): horizons searched along screen-space slices, the
+    /// cosine-weighted visibility between them integrated with the projected normal.
+    Gtao {
+        /// World radius R in scene units; `None`: `reach` times the scene's diagonal.
+        radius: Option<f32>,
+        /// R as a fraction of the scene's bounding-box diagonal (when `radius` is `None`).
+        reach: f32,
+        /// Slices (screen directions) per pixel.
+        slices: u32,
+        /// Samples along each side of a slice.
+        steps: u32,
+    },
+}
+
+impl Ao {
+    /// The radius in scene units for a scene of bounding-box diagonal `diagonal` (the ray
+    /// length of `Rt`, the world radius of the screen-space techniques); without AO, 0.1 times
+    /// the diagonal (what the ray-traced passes' constants then hold, unread).
+    pub fn world_radius(&self, diagonal: f32) -> f32 {
+        match *self {
+            Ao::Rt { radius, reach } | Ao::Sao { radius, reach, .. } | Ao::Gtao { radius, reach, .. } => {
+                radius.unwrap_or(reach * diagonal)
+            }
+            Ao::None => 0.1 * diagonal,
+        }
+    }
 }
 
 /// Specular reflections beyond the split-sum ambient.
@@ -461,7 +501,7 @@ impl Techniques {
     pub fn without_rays(self) -> Techniques {
         Techniques {
             shadows: if self.shadows.traced().is_some() { Shadows::None } else { self.shadows },
-            ao: Ao::None,
+            ao: if matches!(self.ao, Ao::Rt { .. }) { Ao::None } else { self.ao },
             reflections: Reflections::None,
             gi: Gi::None,
             ..self
@@ -512,9 +552,25 @@ impl Techniques {
                 }
             }
             (Effect::Ao, "none") => self.ao = Ao::None,
-            (Effect::Ao, "rt") => {
+            (Effect::Ao, "rt" | "sao" | "gtao") => {
                 let r = v(0).number();
-                self.ao = Ao::Rt { radius: (r > 0.0).then_some(r), reach: v(1).number() };
+                let (radius, reach) = ((r > 0.0).then_some(r), v(1).number());
+                self.ao = match name {
+                    "rt" => Ao::Rt { radius, reach },
+                    "sao" => Ao::Sao {
+                        radius,
+                        reach,
+                        samples: whole(effect, name, "ao-samples", v(2))?,
+                        turns: v(3).number(),
+                        resolution: fraction(v(4)),
+                    },
+                    _ => Ao::Gtao {
+                        radius,
+                        reach,
+                        slices: whole(effect, name, "ao-slices", v(2))?,
+                        steps: whole(effect, name, "ao-steps", v(3))?,
+                    },
+                };
             }
             (Effect::Reflections, "none") => self.reflections = Reflections::None,
             (Effect::Reflections, "rt") => {
@@ -604,6 +660,8 @@ impl Techniques {
             Effect::Ao => match self.ao {
                 Ao::None => "none",
                 Ao::Rt { .. } => "rt",
+                Ao::Sao { .. } => "sao",
+                Ao::Gtao { .. } => "gtao",
             },
             Effect::Reflections => match self.reflections {
                 Reflections::None => "none",
@@ -803,6 +861,31 @@ const fn light_size(knob: Knob) -> Knob {
 /// The upper end of an open range.
 const UNBOUNDED: f32 = f32::INFINITY;
 
+/// The AO radius in scene units, for every AO technique.
+const AO_RADIUS: Knob = number(
+    "ao-radius",
+    "AO radius in scene units (rt: the ray length; sao, gtao: the world radius of the samples); \
+     0: --ao-reach times the scene's diagonal",
+    0.0,
+    UNBOUNDED,
+    0.0,
+    &[0.0],
+);
+
+/// The AO radius as a fraction of the scene's diagonal, with a technique's default and sweep.
+const fn ao_reach(default: f32, sweep: &'static [f32]) -> Knob {
+    number(
+        "ao-reach",
+        "AO radius as a fraction of the scene's bounding-box diagonal, when --ao-radius is 0 (rt: \
+         0.1, ≥ 10 makes every hit occlude fully, the sky's true visibility; sao, gtao: 0.05, about \
+         the seed's 1.8 m in Sponza's 40 m)",
+        1e-4,
+        UNBOUNDED,
+        default,
+        sweep,
+    )
+}
+
 /// Bounces of the path-traced GI techniques.
 const GI_BOUNCES: Knob = number(
     "gi-bounces",
@@ -860,7 +943,7 @@ const fn artistic(knob: Knob) -> Knob {
     Knob { role: KnobRole::Scene, ..knob }
 }
 
-static CATALOGUE: [TechniqueInfo; 22] = [
+static CATALOGUE: [TechniqueInfo; 24] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -929,26 +1012,74 @@ static CATALOGUE: [TechniqueInfo; 22] = [
         effect: Effect::Ao,
         name: "rt",
         help: "ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius (or --ao-reach)",
+        knobs: &[AO_RADIUS, ao_reach(0.1, &[0.03, 0.1, 0.3, 100.0])],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Ao,
+        name: "sao",
+        help: "scalable ambient obscurance as seed 000 modifies it: --ao-samples spiral samples of a \
+               camera-space depth pyramid and the G-buffer normals within --ao-radius (or \
+               --ao-reach), at --ao-res, blurred with depth weights; screen space (what the screen \
+               does not show does not occlude)",
         knobs: &[
+            AO_RADIUS,
+            ao_reach(0.05, &[0.05]),
             number(
-                "ao-radius",
-                "ray length in scene units (0: --ao-reach times the scene's diagonal)",
-                0.0,
-                UNBOUNDED,
-                0.0,
-                &[0.0],
+                "ao-samples",
+                "samples per AO pixel on the spiral (the seed's N)",
+                1.0,
+                64.0,
+                16.0,
+                &[8.0, 16.0, 32.0],
             ),
             number(
-                "ao-reach",
-                "ray length as a fraction of the scene's bounding-box diagonal, when --ao-radius is 0 \
-                 (≥ 10: every hit occludes fully, the sky's true visibility)",
-                1e-4,
+                "ao-turns",
+                "turns of the sample spiral (τ; 7: McGuire et al.'s prime for few samples)",
+                0.0,
                 UNBOUNDED,
-                0.1,
-                &[0.03, 0.1, 0.3, 100.0],
+                7.0,
+                &[],
+            ),
+            Knob {
+                name: "ao-res",
+                help: "resolution of sao's samples: full, or half on each axis (the seed's default), \
+                       upsampled by the depth-aware blur",
+                range: KnobRange::Choice(&["full", "half"]),
+                default: KnobValue::Choice(1),
+                role: KnobRole::Quality,
+            },
+        ],
+        stochastic: false,
+    },
+    TechniqueInfo {
+        effect: Effect::Ao,
+        name: "gtao",
+        help: "ground-truth AO (Jimenez et al. 2016): per pixel, --ao-slices screen directions, each \
+               side's horizon found by --ao-steps samples of the depth pyramid within --ao-radius \
+               (or --ao-reach), the cosine-weighted visibility between the horizons integrated with \
+               the projected normal; blurred with depth weights; screen space",
+        knobs: &[
+            AO_RADIUS,
+            ao_reach(0.05, &[0.05]),
+            number(
+                "ao-slices",
+                "screen directions per pixel (XeGTAO High: 3)",
+                1.0,
+                32.0,
+                3.0,
+                &[2.0, 3.0, 9.0],
+            ),
+            number(
+                "ao-steps",
+                "samples along each side of a slice (XeGTAO High: 3)",
+                1.0,
+                64.0,
+                3.0,
+                &[2.0, 3.0, 8.0],
             ),
         ],
-        stochastic: true,
+        stochastic: false,
     },
     TechniqueInfo {
         effect: Effect::Reflections,
@@ -1213,7 +1344,7 @@ mod tests {
         let e = t.set(Effect::Shadows, "rt", &[("radius", KnobValue::Number(1.0))]).unwrap_err();
         assert!(e.contains("light-radius, sun-angle"), "{e}");
         let e = t.set(Effect::Ao, "ssao", &[]).unwrap_err();
-        assert!(e.contains("none, rt"), "{e}");
+        assert!(e.contains("none, rt, sao, gtao"), "{e}");
         t.set(Effect::Reflections, "rt", &[("reflection-res", KnobValue::Choice(1))]).unwrap();
         assert_eq!(t.reflections, Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 1.0 });
     }
@@ -1229,6 +1360,19 @@ mod tests {
         let gi = Techniques { gi: Gi::Rt { bounces: 1 }, ..d };
         assert!(gi.ray_traced() && gi.needs().bvh && gi.needs().scene_buffers);
         assert_eq!(gi.without_rays().gi, Gi::None);
+        // The screen-space AO techniques read the G-buffer only, and survive a file without
+        // a BVH.
+        for ao in [
+            Ao::Sao { radius: None, reach: 0.05, samples: 16, turns: 7.0, resolution: ScreenFraction::Half },
+            Ao::Gtao { radius: Some(2.0), reach: 0.05, slices: 3, steps: 3 },
+        ] {
+            let t = Techniques { ao, ..d };
+            assert_eq!(t.needs(), d.needs(), "{ao:?}");
+            assert!(!t.ray_traced());
+            assert_eq!(t.without_rays().ao, ao);
+        }
+        assert_eq!(Ao::Gtao { radius: Some(2.0), reach: 0.05, slices: 3, steps: 3 }.world_radius(10.0), 2.0);
+        assert_eq!(Ao::Rt { radius: None, reach: 0.1 }.world_radius(10.0), 1.0);
     }
 
     #[test]

@@ -414,11 +414,17 @@ mod tests {
         assert_eq!(r.configs.len(), 4);
         assert!(r.configs.iter().all(|c| c.techniques.shadows == Shadows::ShadowMap));
         let ao = plan(&request(vec![Target::Effect(Effect::Ao)], &[]), &ALL_OFFERED);
-        // none, and rt at each reach (the absolute radius has one sweep value: not varied)
-        assert_eq!(
-            ao.configs.iter().map(|c| c.label(1)).collect::<Vec<_>>(),
-            ["none", "rt 0.03 1f", "rt 0.1 1f", "rt 0.3 1f", "rt 100 1f"]
-        );
+        // none, rt at each reach (the absolute radius has one sweep value: not varied), sao's
+        // samples × resolutions and gtao's slices × steps (their reach held at 0.05)
+        let mut expected = vec!["none".to_string()];
+        expected.extend(["0.03", "0.1", "0.3", "100"].map(|r| format!("rt {r} 1f")));
+        for n in [8, 16, 32] {
+            expected.extend(["full", "half"].map(|res| format!("sao {res} {n}")));
+        }
+        for slices in [2, 3, 9] {
+            expected.extend([2, 3, 8].map(|steps| format!("gtao {slices} {steps}")));
+        }
+        assert_eq!(ao.configs.iter().map(|c| c.label(1)).collect::<Vec<_>>(), expected);
     }
 
     #[test]

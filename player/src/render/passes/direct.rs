@@ -9,7 +9,7 @@ use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, rt_ao, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -31,7 +31,7 @@ pub const RADIANCE: TargetDecl = TargetDecl {
 const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
 
 /// The ray-traced results it composites, in binding order (12–15).
-const RAY_TRACED: [TargetDecl; 4] = [rt_shadows::SHADOWS, rt_ao::AO, rt_reflections::REFLECTIONS, rt_gi::GI];
+const RAY_TRACED: [TargetDecl; 4] = [rt_shadows::SHADOWS, ao::AO, rt_reflections::REFLECTIONS, rt_gi::GI];
 
 /// The direct-light pass.
 #[derive(Debug)]

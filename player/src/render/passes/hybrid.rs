@@ -8,7 +8,7 @@ use crate::gpu::vk;
 use kiln_format::gpu::RtConstants;
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
-use super::{FrameCtx, Shared, rt_ao, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Shared, ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::TexelDecode;
@@ -25,7 +25,7 @@ pub const GBUFFER_READS: [TargetDecl; 4] = [TRIANGLE, NORMAL, ALBEDO, MATERIAL];
 /// Every target the table binds.
 pub fn bound() -> Vec<TargetDecl> {
     let mut t = GBUFFER_READS.to_vec();
-    t.extend([rt_shadows::SHADOWS, rt_ao::AO]);
+    t.extend([rt_shadows::SHADOWS, ao::AO]);
     t.extend(rt_reflections::TARGETS);
     t.push(rt_gi::GI);
     t
@@ -104,7 +104,7 @@ impl HybridSet {
             Write::Sampled(14, sampled(&ALBEDO)),
             Write::Sampled(15, sampled(&MATERIAL)),
             Write::StorageImage(16, img(&rt_shadows::SHADOWS)),
-            Write::StorageImage(17, img(&rt_ao::AO)),
+            Write::StorageImage(17, img(&ao::AO)),
         ]);
         for (i, t) in rt_reflections::TARGETS.iter().enumerate() {
             writes.push(Write::StorageImage(18 + i as u32, img(t)));

@@ -7,8 +7,11 @@
 //! scene is resident (pipelines compile while the file uploads), then [`Pass::bind`] points
 //! their descriptor sets at the scene and the frame's images (again after every resize).
 
+pub mod ao;
+pub mod depth_pyramid;
 pub mod direct;
 pub mod gbuffer;
+pub mod gtao;
 pub mod hybrid;
 pub mod kernel;
 pub mod materials;
@@ -21,6 +24,7 @@ pub mod rt_gi;
 pub mod rt_history;
 pub mod rt_reflections;
 pub mod rt_shadows;
+pub mod sao;
 pub mod sousa;
 pub mod taa;
 pub mod tonemap;

@@ -1,8 +1,8 @@
 //! Ray-traced ambient occlusion (`shaders/rt/ao.comp`): one cosine-weighted ray per pixel per
-//! frame within the AO radius, a hit at t weighing (t/R)², averaged.
+//! frame within the AO radius, a hit at t weighing (t/R)², averaged into the AO image
+//! ([`super::ao::AO`]).
 
-use crate::gpu::vk;
-
+use super::ao::AO;
 use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
@@ -10,14 +10,6 @@ use crate::gpu::{Gpu, ImageDesc, Use};
 use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-
-/// Ambient openness.
-pub const AO: TargetDecl = TargetDecl {
-    name: "rt ao",
-    format: vk::Format::R32_SFLOAT,
-    usage: vk::ImageUsageFlags::STORAGE,
-    array: false,
-};
 
 /// The ray-traced AO pass.
 #[derive(Debug)]

@@ -16,7 +16,7 @@
 
 use super::gbuffer::DEPTH;
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, rt_ao, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
@@ -128,7 +128,7 @@ impl RtHistoryPass {
             });
         }
         if let Ao::Rt { .. } = techniques.ao {
-            let t = rt_ao::AO;
+            let t = ao::AO;
             targets.push(Accumulated {
                 target: t,
                 histories: history(t, "rt ao history a", "rt ao history b"),

@@ -1,0 +1,27 @@
+#version 460
+// Level 0 of the camera-space depth pyramid: each pixel's reversed-Z depth turned into its
+// distance along the camera's forward axis (0 where the pixel shows the sky).
+#include "../common/layout.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
+layout(set = 0, binding = 1) uniform sampler2D depth_tex;
+layout(set = 0, binding = 2, r32f) uniform writeonly image2D pyramid;
+
+#include "../common/screen_ao.glsl"
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(uvec2(p), frame.size.xy))) {
+        return;
+    }
+    float depth = texelFetch(depth_tex, p, 0).r;
+    float z = 0.0;
+    if (depth > 0.0) {
+        vec2 at = vec2(p) + 0.5;
+        vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
+        vec4 w = frame.inv_view_proj * vec4(ndc, depth, 1.0);
+        z = max(dot(w.xyz / w.w - pixel_origin(at), frame.camera_forward.xyz), 1e-6);
+    }
+    imageStore(pyramid, p, vec4(z));
+}
