@@ -229,7 +229,7 @@ pub fn names(target: Target) -> Vec<&'static str> {
 type Preset = (&'static str, &'static str, fn(&mut Techniques));
 
 /// The frame presets, each with both G-buffers.
-const PRESETS: [Preset; 5] = [
+const PRESETS: [Preset; 6] = [
     ("baked", "shadow maps, no AO, split-sum reflections", |t| {
         t.shadows = Shadows::ShadowMap;
     }),
@@ -241,6 +241,12 @@ const PRESETS: [Preset; 5] = [
         set(t, Effect::Shadows, "rt");
         set(t, Effect::Ao, "rt");
         set(t, Effect::Reflections, "rt");
+    }),
+    ("rt-reproject", "as rt with the running mean following a moving camera (--aa reproject)", |t| {
+        set(t, Effect::Shadows, "rt");
+        set(t, Effect::Ao, "rt");
+        set(t, Effect::Reflections, "rt");
+        set(t, Effect::Aa, "reproject");
     }),
     (
         "rt-taa",
