@@ -11,12 +11,28 @@ bool camera_orthographic() {
     return frame.camera.w != 0.0;
 }
 
+// Normalised device coordinates (x right, y up, [-1, 1]) of image point `at` (pixels, row 0 at
+// the top, (0.5, 0.5) the first pixel's centre), and back.
+vec2 image_to_ndc(vec2 at) {
+    return vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
+}
+
+vec2 ndc_to_image(vec2 ndc) {
+    return vec2((ndc.x + 1.0) * 0.5 * float(frame.size.x), (1.0 - ndc.y) * 0.5 * float(frame.size.y));
+}
+
+// The world point at image point `at` and reversed-Z `depth`, through `frame.inv_view_proj`
+// (the jittered projection the G-buffer was drawn with).
+vec3 world_at_depth(vec2 at, float depth) {
+    vec4 w = frame.inv_view_proj * vec4(image_to_ndc(at), depth, 1.0);
+    return w.xyz / w.w;
+}
+
 // The offset in the image plane of image point `at` (pixel units, (0.5, 0.5) the first pixel's
 // centre), by the projection's own mapping, moved by this frame's sub-pixel jitter (what the
 // jittered `view_proj` rasterises at `at`).
 vec3 pixel_offset(vec2 at) {
-    at += frame.jitter.xy;
-    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
+    vec2 ndc = image_to_ndc(at + frame.jitter.xy);
     return frame.camera_right.xyz * (ndc.x * frame.camera_right.w) + frame.camera_up.xyz * (ndc.y * frame.camera_up.w);
 }
 
@@ -44,9 +60,7 @@ float surface_distance(vec2 at, float depth, vec3 o, vec3 d) {
     if (!(depth > 0.0)) {
         return SKY_DISTANCE;
     }
-    vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
-    vec4 w = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-    return max(dot(w.xyz / w.w - o, d), 0.0);
+    return max(dot(world_at_depth(at, depth) - o, d), 0.0);
 }
 
 // Barycentrics (of corners 1 and 2) where the camera ray from `origin` along `dir` meets the

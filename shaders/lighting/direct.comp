@@ -141,9 +141,7 @@ float shadow_factor(uint index, GpuLight light, vec3 p, vec3 n, vec3 l, float an
 
 // The world position of a pixel's centre at the given (reversed-Z) depth.
 vec3 world_at(ivec2 pixel, float depth) {
-    vec2 ndc = vec2((float(pixel.x) + 0.5) / float(frame.size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + 0.5) / float(frame.size.y) * 2.0);
-    vec4 world = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-    return world.xyz / world.w;
+    return world_at_depth(vec2(pixel) + 0.5, depth);
 }
 
 // The ray-traced reflection at a pixel (rgb, a > 0 where traced). Half resolution: the four

@@ -19,9 +19,7 @@ void main() {
     float z = 0.0;
     if (depth > 0.0) {
         vec2 at = vec2(p) + 0.5;
-        vec2 ndc = vec2(at.x / float(frame.size.x) * 2.0 - 1.0, 1.0 - at.y / float(frame.size.y) * 2.0);
-        vec4 w = frame.inv_view_proj * vec4(ndc, depth, 1.0);
-        z = max(dot(w.xyz / w.w - pixel_origin(at), frame.camera_forward.xyz), 1e-6);
+        z = max(dot(world_at_depth(at, depth) - pixel_origin(at), frame.camera_forward.xyz), 1e-6);
     }
     imageStore(pyramid, p, vec4(z));
 }
