@@ -32,8 +32,10 @@ void main() {
     }
     vec4 m = imageLoad(motion, cell * int(push.step));
     float frames = m.z;
-    // The reprojected point in target texels (pixel centres k + ½ map to texel centres).
-    vec2 at = frame.jitter.z != 0.0 ? vec2(cell) + 0.5 : m.xy / float(push.step);
+    // The reprojected point in target texels: texel c holds the sample of pixel c · step, whose
+    // centre c · step + ½ maps to the texel's centre c + ½ (a still camera's motion is the
+    // pixel's own centre, so it reads its own texel).
+    vec2 at = (m.xy - 0.5) / float(push.step) + 0.5;
     vec2 uv = at / vec2(size);
     float w = 1.0 / (frames + 1.0);
 #ifdef LAYERED
