@@ -90,9 +90,7 @@ fn passes(
             }
             Gi::None => {}
         }
-        if let Some(frames) = techniques.aa.reprojected()
-            && techniques.ray_traced()
-        {
+        if let Some(frames) = techniques.reprojected_rays() {
             made.push(Box::new(RtHistoryPass::new(gpu, techniques, lights, frames)?));
         }
         made.push(Box::new(DirectPass::new(gpu)?));

@@ -371,9 +371,8 @@ impl Renderer {
         rec.timestamp(&self.timestamps, 0);
         // With reprojected accumulation the passes write this frame's sample; the history pass
         // blends it.
-        let t = self.settings.techniques;
         self.rt_constants.accumulated =
-            if t.aa.reprojected().is_some() && t.ray_traced() { 0 } else { self.accumulated };
+            if self.settings.techniques.reprojected_rays().is_some() { 0 } else { self.accumulated };
         self.rt_constants.seed = self.frame_count as u32;
         let Frame { passes, images, .. } = &mut self.frame;
         let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants };

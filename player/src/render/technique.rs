@@ -488,6 +488,13 @@ impl Techniques {
         n
     }
 
+    /// The longest history of the ray-traced passes' reprojected accumulation while the camera
+    /// moves, when it runs (a ray-traced pass and `--aa reproject` or `taa`): the passes then
+    /// write each frame's sample and the history pass blends it.
+    pub fn reprojected_rays(&self) -> Option<u32> {
+        self.aa.reprojected().filter(|_| self.ray_traced())
+    }
+
     /// Whether any ray-traced pass runs.
     pub fn ray_traced(&self) -> bool {
         self.shadows.traced().is_some()

@@ -316,9 +316,8 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
         ));
     }
     let (offers, scene_name, content_hash, _) = inspect(options)?;
-    let plan: Plan = plan::plan(&options.request, &offers);
+    let mut plan: Plan = plan::plan(&options.request, &offers);
     let device = Gpu::new(&options.gpu)?.identity();
-    let mut plan = plan;
     let cameras: Vec<Option<CameraOverride>> = match &options.camera_path {
         Some(p) => {
             // One image per configuration: the path's last frame.
