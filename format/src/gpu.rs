@@ -312,8 +312,12 @@ gpu_struct! {
         /// Seed 000's distance fall-off (r² → r^2.5 beyond one unit) in place of visibility:
         /// 1 on, 0 off.
         pub falloff: u32 => "uint",
+        /// 1: every 8 × 8 block of texels turns its spirals by one random angle (neighbours read
+        /// neighbouring texels: coherent fetches, noise correlated within the block); 0: every
+        /// texel by its own, as the seed.
+        pub tiled: u32 => "uint",
         /// Padding.
-        pub pad: [u32; 3] => "uvec3",
+        pub pad: [u32; 2] => "uvec2",
     }
 }
 

@@ -120,6 +120,15 @@ pub enum SsgiMipArg {
     Voting,
 }
 
+/// `--ssgi-rotation` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SsgiRotationArg {
+    /// A random angle per texel (the seed's).
+    Pixel,
+    /// One per 8 × 8 texels (coherent reads).
+    Tile,
+}
+
 /// `--ssgi-falloff` (order as the catalogue's choices).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum OffOnArg {
@@ -314,6 +323,11 @@ pub struct Args {
     /// 1 to 4096 (default 16).
     #[arg(long, value_name = "N")]
     pub ssgi_frames: Option<u32>,
+    /// With --gi ssgi: how the sample spirals turn: pixel (a random angle per texel, the seed's;
+    /// default) or tile (one per 8 × 8 texels: coherent reads, faster, noise correlated within
+    /// a tile until frames average it).
+    #[arg(long, value_enum, value_name = "HOW")]
+    pub ssgi_rotation: Option<SsgiRotationArg>,
     /// Participating media technique.
     #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
     pub media: String,
@@ -383,6 +397,7 @@ impl Args {
             "ssgi-mip" => self.ssgi_mip.map(|m| KnobValue::Choice(m as usize)),
             "ssgi-falloff" => self.ssgi_falloff.map(|f| KnobValue::Choice(f as usize)),
             "ssgi-frames" => self.ssgi_frames.map(|n| KnobValue::Number(n as f32)),
+            "ssgi-rotation" => self.ssgi_rotation.map(|r| KnobValue::Choice(r as usize)),
             "media-steps" => Some(KnobValue::Number(self.media_steps as f32)),
             "media-samples" => self.media_samples.map(|n| KnobValue::Number(n as f32)),
             "media-res" => self.media_res.map(|r| KnobValue::Choice(r as usize)),

@@ -158,7 +158,8 @@ struct ScreenGiConstants {
     uint seed; // offset 24
     uint cap; // offset 28
     uint falloff; // offset 32
-    uvec3 pad; // offset 36
+    uint tiled; // offset 36
+    uvec2 pad; // offset 40
 }; // 48 bytes
 
 const uint LIGHT_POINT = 0u;

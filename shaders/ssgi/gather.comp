@@ -25,7 +25,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 0, binding = 1, r32f) uniform readonly image2D pyramid;
 layout(set = 0, binding = 2, rg16f) uniform readonly image2D normal_pyramid;
-layout(set = 0, binding = 3, rgba16f) uniform readonly image2D lit;
+layout(set = 0, binding = 3, rgba32ui) uniform readonly uimage2D packed;  // pack.comp, packed.glsl
 layout(set = 0, binding = 4, rgba16f) uniform image2D gi_levels;
 layout(push_constant) uniform Push { ScreenGiConstants gi; };
 
@@ -53,12 +53,13 @@ void main() {
     }
     vec2 n_enc = imageLoad(normal_pyramid, origin + q).rg;
     vec3 n = oct_decode(n_enc);
-    vec3 x = level_point(q, level, z);
+    // Points relative to the camera (packed.glsl).
+    vec3 x = level_point(q, level, z) - frame.camera.xyz;
     // Light from the side the camera sees.
-    if (dot(n, towards_camera(x)) < 0.0) {
+    if (dot(n, towards_camera(x + frame.camera.xyz)) < 0.0) {
         n = -n;
     }
-    vec3 result = level < int(gi.top) ? upsample(q, level, level + 1, z, x, n_enc) : vec3(0.0);
+    vec3 result = level < int(gi.top) ? upsample(q, level, level + 1, z, x, n_enc, true) : vec3(0.0);
 
     bool finest = level == int(gi.base);
     float r0 = finest ? 1.0 : 0.5 * gi.radius;
@@ -66,24 +67,29 @@ void main() {
     float count = float(max(gi.samples, 1u));
     // Screen area per unit of radius, in full-resolution pixels (see the header).
     float area = 2.0 * PI * (r1 - r0) / count * float(1 << (2 * level));
-    rng = hash(hash(uint(q.x) + 0x9e3779b9u * uint(q.y)) ^ gi.seed ^ uint(level) * 0x85ebca6bu);
+    // The spiral's rotation: random per texel (the seed's), or per 8 × 8 block (gi.tiled), each
+    // frame anew.
+    uvec2 key = gi.tiled != 0u ? gl_WorkGroupID.xy : uvec2(q);
+    rng = hash(hash(key.x + 0x9e3779b9u * key.y) ^ gi.seed ^ uint(level) * 0x85ebca6bu);
     float angle0 = 2.0 * PI * rnd();
+    // The spiral's direction turns by a fixed angle per sample: rotated, not recomputed.
+    float step = 2.0 * PI * TURNS / count;
+    mat2 turn = mat2(cos(step), sin(step), -sin(step), cos(step));
+    vec2 along = vec2(cos(angle0 + 0.5 * step), sin(angle0 + 0.5 * step));
     vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < gi.samples; i++) {
-        float t = (float(i) + 0.5) / count;
-        float r = mix(r0, r1, t);
-        float a = angle0 + 2.0 * PI * TURNS * t;
-        ivec2 s = ivec2(floor(vec2(q) + 0.5 + r * vec2(cos(a), sin(a))));
+    for (uint i = 0u; i < gi.samples; i++, along = turn * along) {
+        float r = mix(r0, r1, (float(i) + 0.5) / count);
+        ivec2 s = ivec2(floor(vec2(q) + 0.5 + r * along));
         if (any(lessThan(s, ivec2(0))) || any(greaterThanEqual(s, size))) {
             continue;
         }
-        vec4 light = imageLoad(lit, origin + s);
-        float zs = imageLoad(pyramid, origin + s).r;
-        if (light.a <= 0.0 || zs <= 0.0) {
+        uvec4 texel = imageLoad(packed, origin + s);
+        vec3 y = packed_point(texel);
+        vec3 light = packed_light(texel);
+        if (!packed_surface(y) || all(equal(light, vec3(0.0)))) {
             continue;
         }
-        vec3 ns = oct_decode(imageLoad(normal_pyramid, origin + s).rg);
-        vec3 y = level_point(s, level, zs);
+        vec3 ns = oct_decode(packed_normal(texel));
         vec3 diff = x - y;
         float r2 = dot(diff, diff);
         if (r2 <= 0.0) {
@@ -93,17 +99,17 @@ void main() {
         if (gi.falloff != 0u) {
             r2 = mix(r2, pow(r2, 1.25), clamp((r2 - 1.0) * 0.5, 0.0, 1.0));
         }
-        vec3 view = -towards_camera(y);
-        if (dot(ns, view) > 0.0) {
+        // The normal on the side the camera sees.
+        if (dot(ns, y) > 0.0) {
             ns = -ns;
         }
         float cos_source = max(dot(ns, dir), 0.0);
         float cos_receiver = max(dot(n, -dir), 0.0);
-        float cos_alpha = camera_orthographic() ? 1.0 : dot(view, frame.camera_forward.xyz);
-        float cos_beta = abs(dot(view, ns));
-        float unit = 1.0 / pixels_per_unit(zs);
-        float ds = unit * unit * clamp(cos_alpha / max(cos_beta, 1e-6), 0.001, 1000.0);
-        sum += light.rgb * light.a * (cos_source * cos_receiver * ds / (r2 + SINGULARITY) * r);
+        // World size of a full-resolution pixel at the sample's camera depth.
+        float unit = 2.0 * frame.camera_up.w * (camera_orthographic() ? 1.0 : dot(y, frame.camera_forward.xyz))
+            / float(frame.size.y);
+        float ds = unit * unit * packed_tilt(texel);
+        sum += light * (cos_source * cos_receiver * ds / (r2 + SINGULARITY) * r);
     }
     result += sum * area;
     imageStore(gi_levels, origin + q, vec4(min(result, vec3(65000.0)), 1.0));

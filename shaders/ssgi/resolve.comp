@@ -12,6 +12,7 @@ layout(set = 0, binding = 1, r32f) uniform readonly image2D pyramid;
 layout(set = 0, binding = 2, rg16f) uniform readonly image2D normal_pyramid;
 layout(set = 0, binding = 3, rgba16f) uniform readonly image2D gi_levels;
 layout(set = 0, binding = 4, rgba32f) uniform image2D gi_out;
+layout(set = 0, binding = 5, rgba32ui) uniform readonly uimage2D packed;  // pack.comp
 layout(push_constant) uniform Push { ScreenGiConstants gi; };
 
 #include "../common/screen_ao.glsl"
@@ -30,7 +31,7 @@ void main() {
         vec2 n_enc = imageLoad(normal_pyramid, p).rg;
         vec3 irradiance = gi.base == 0u
             ? imageLoad(gi_levels, p).rgb
-            : upsample(p, 0, int(gi.base), z, level_point(p, 0, z), n_enc);
+            : upsample(p, 0, int(gi.base), z, level_point(p, 0, z) - frame.camera.xyz, n_enc, false);
         mean_in = irradiance / PI;
     }
     if (gi.accumulated > 0u) {

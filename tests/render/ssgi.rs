@@ -102,6 +102,7 @@ fn ssgi() -> Gi {
         voting: true,
         falloff: false,
         frames: 16,
+        tiled: false,
     }
 }
 

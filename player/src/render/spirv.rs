@@ -55,6 +55,8 @@ shaders! {
     LIT_REPROJECT = "lit" / "reproject.comp";
     /// A level of the lit-radiance pyramid from the one below.
     LIT_REDUCE = "lit" / "reduce.comp";
+    /// Screen-space GI: depth, normal and light packed into one texel.
+    SSGI_PACK = "ssgi" / "pack.comp";
     /// Screen-space GI: one level's gather plus the coarser levels upsampled.
     SSGI_GATHER = "ssgi" / "gather.comp";
     /// Screen-space GI: the finest level upsampled to the screen, averaged over frames.

@@ -187,6 +187,8 @@ pub enum Gi {
         falloff: bool,
         /// The most frames the running mean averages while the camera is still.
         frames: u32,
+        /// One spiral rotation per 8 × 8 block of texels instead of per texel.
+        tiled: bool,
     },
 }
 
@@ -629,6 +631,7 @@ impl Techniques {
                     voting: v(3) == KnobValue::Choice(1),
                     falloff: v(4) == KnobValue::Choice(1),
                     frames: whole(effect, name, "ssgi-frames", v(5))?,
+                    tiled: v(6) == KnobValue::Choice(1),
                 };
             }
             (Effect::Media, "none") => self.media = Media::None,
@@ -1244,6 +1247,15 @@ static CATALOGUE: [TechniqueInfo; 25] = [
                 16.0,
                 &[],
             ),
+            Knob {
+                name: "ssgi-rotation",
+                help: "how the sample spirals turn: pixel (a random angle per texel, the seed's) or \
+                       tile (one per 8 × 8 texels: neighbours read neighbouring texels, faster, the \
+                       noise correlated within a tile until frames average it)",
+                range: KnobRange::Choice(&["pixel", "tile"]),
+                default: KnobValue::Choice(0),
+                role: KnobRole::Quality,
+            },
         ],
         stochastic: true,
     },

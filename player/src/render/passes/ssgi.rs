@@ -2,10 +2,11 @@
 //!
 //! Reads the depth and normal pyramids ([`super::depth_pyramid`], voting or nearest) and the
 //! lit-radiance pyramid ([`super::lit_pyramid`], the previous frame's light), and:
-//! 1. `gather.comp`, once per level from the coarsest needed down to the GI resolution: each
+//! 1. `pack.comp`: depth, normal and light packed into one texel (one fetch per sample);
+//! 2. `gather.comp`, once per level from the coarsest needed down to the GI resolution: each
 //!    texel gathers spiral samples of that level's light within R texels and adds the coarser
 //!    level's result, joint-bilaterally upsampled (`upsample.glsl`);
-//! 2. `resolve.comp`: the finest result upsampled to the screen the same way, as mean incoming
+//! 3. `resolve.comp`: the finest result upsampled to the screen the same way, as mean incoming
 //!    radiance, averaged over the frames the camera has been still, into the GI image that the
 //!    direct pass adds to the sky's ambient (`FrameFlags::SCREEN_GI`).
 //!
@@ -33,6 +34,14 @@ pub const GI_LEVELS: TargetDecl = TargetDecl {
     array: false,
 };
 
+/// The depth, normal and light pyramids packed into one texel each (`pack.comp`).
+pub const PACKED: TargetDecl = TargetDecl {
+    name: "ssgi packed",
+    format: vk::Format::R32G32B32A32_UINT,
+    usage: vk::ImageUsageFlags::STORAGE,
+    array: false,
+};
+
 /// The levels gathered on a `width` × `height` screen: from `base` up to the first level whose
 /// diagonal `radius` texels span (at least `base`, at most [`TOP`]).
 pub fn gathered_levels(width: u32, height: u32, base: u32, radius: f32) -> (u32, u32) {
@@ -50,6 +59,7 @@ pub fn gathered_levels(width: u32, height: u32, base: u32, radius: f32) -> (u32,
 /// The pass.
 #[derive(Debug)]
 pub struct SsgiPass {
+    pack: Kernel,
     gather: Kernel,
     resolve: Kernel,
     constants: ScreenGiConstants,
@@ -58,7 +68,7 @@ pub struct SsgiPass {
 impl SsgiPass {
     /// Builds the pipelines of `technique` (a [`Gi::Ssgi`]).
     pub fn new(gpu: &Gpu, technique: Gi) -> PlayResult<SsgiPass> {
-        let Gi::Ssgi { samples, resolution, radius, falloff, frames, .. } = technique else {
+        let Gi::Ssgi { samples, resolution, radius, falloff, frames, tiled, .. } = technique else {
             unreachable!("the frame builds the SSGI pass for --gi ssgi only")
         };
         use BindingKind::*;
@@ -70,17 +80,28 @@ impl SsgiPass {
             Binding::one(StorageImage),
             Binding::one(StorageImage),
         ];
-        let [gather, resolve] =
-            Kernel::several(gpu, [(&bindings, spirv::SSGI_GATHER), (&bindings, spirv::SSGI_RESOLVE)], push)?;
+        // The resolve reads the packed pyramid too (binding 5).
+        let mut resolve_bindings = bindings.to_vec();
+        resolve_bindings.push(Binding::one(StorageImage));
+        let [pack, gather, resolve] = Kernel::several(
+            gpu,
+            [
+                (&bindings, spirv::SSGI_PACK),
+                (&bindings, spirv::SSGI_GATHER),
+                (&resolve_bindings, spirv::SSGI_RESOLVE),
+            ],
+            push,
+        )?;
         let constants = ScreenGiConstants {
             base: resolution.divisor().trailing_zeros(),
             samples: samples.max(1),
             radius: radius.max(1) as f32,
             cap: frames.max(1),
             falloff: falloff as u32,
+            tiled: tiled as u32,
             ..Default::default()
         };
-        Ok(SsgiPass { gather, resolve, constants })
+        Ok(SsgiPass { pack, gather, resolve, constants })
     }
 }
 
@@ -91,7 +112,11 @@ impl Pass for SsgiPass {
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
         let (w, h) = image_size(width, height);
-        vec![(GI_LEVELS, GI_LEVELS.sized(w, h, 1)), (GI, GI.sized(width, height, 1))]
+        vec![
+            (PACKED, PACKED.sized(w, h, 1)),
+            (GI_LEVELS, GI_LEVELS.sized(w, h, 1)),
+            (GI, GI.sized(width, height, 1)),
+        ]
     }
 
     fn binds(&self) -> Vec<TargetDecl> {
@@ -100,7 +125,7 @@ impl Pass for SsgiPass {
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
         let img = |t: &TargetDecl| shared.images.get(t).view;
-        // Both kernels: frame constants, depth and normal pyramids, what they read, what they write.
+        // Every kernel: frame constants, depth and normal pyramids, what it reads, what it writes.
         let writes = |read: &TargetDecl, written: &TargetDecl| {
             [
                 Write::Buffer(0, shared.frame_ubo),
@@ -110,8 +135,11 @@ impl Pass for SsgiPass {
                 Write::StorageImage(4, img(written)),
             ]
         };
-        self.gather.write(gpu, &writes(&LIT_PYRAMID, &GI_LEVELS))?;
-        self.resolve.write(gpu, &writes(&GI_LEVELS, &GI))
+        self.pack.write(gpu, &writes(&LIT_PYRAMID, &PACKED))?;
+        self.gather.write(gpu, &writes(&PACKED, &GI_LEVELS))?;
+        let mut resolve = Vec::from(writes(&GI_LEVELS, &GI));
+        resolve.push(Write::StorageImage(5, img(&PACKED)));
+        self.resolve.write(gpu, &resolve)
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
@@ -125,6 +153,19 @@ impl Pass for SsgiPass {
             seed: ctx.rt.seed,
             ..self.constants
         };
+        ctx.images.access(
+            ctx.rec,
+            &[
+                (PYRAMID, Access::Read(Use::STORAGE)),
+                (NORMAL_PYRAMID, Access::Read(Use::STORAGE)),
+                (LIT_PYRAMID, Access::Read(Use::STORAGE)),
+                (PACKED, Access::Write(Use::STORAGE)),
+            ],
+        );
+        // The whole pyramid image, or (gathering from level 1 up) the column of levels 1...
+        let (w, h) = image_size(width, height);
+        let packed_width = if base == 0 { w } else { w - width };
+        self.pack.dispatch(ctx.rec, bytemuck::bytes_of(&push), packed_width, h);
         for level in (base..=top).rev() {
             // Each level reads the coarser one the previous dispatch wrote.
             ctx.images.access(
@@ -132,7 +173,7 @@ impl Pass for SsgiPass {
                 &[
                     (PYRAMID, Access::Read(Use::STORAGE)),
                     (NORMAL_PYRAMID, Access::Read(Use::STORAGE)),
-                    (LIT_PYRAMID, Access::Read(Use::STORAGE)),
+                    (PACKED, Access::Read(Use::STORAGE)),
                     (GI_LEVELS, Access::ReadWrite(Use::STORAGE)),
                 ],
             );
@@ -145,6 +186,7 @@ impl Pass for SsgiPass {
             &[
                 (PYRAMID, Access::Read(Use::STORAGE)),
                 (NORMAL_PYRAMID, Access::Read(Use::STORAGE)),
+                (PACKED, Access::Read(Use::STORAGE)),
                 (GI_LEVELS, Access::Read(Use::STORAGE)),
                 (GI, Access::ReadWrite(Use::STORAGE)),
             ],
@@ -153,6 +195,7 @@ impl Pass for SsgiPass {
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
+        self.pack.destroy(gpu);
         self.gather.destroy(gpu);
         self.resolve.destroy(gpu);
     }
