@@ -287,6 +287,24 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of the screen-space reflections (`shaders/hiz/*`, `shaders/ssr/*`;
+    /// 20 bytes).
+    pub struct SsrConstants {
+        /// The most iterations of the hierarchical march per pixel.
+        pub steps: u32 => "uint",
+        /// Surfaces rougher than this keep the split-sum ambient (confidence 0).
+        pub max_roughness: f32 => "float",
+        /// How far a ray may pass behind the surface the depth buffer holds and still hit it, as
+        /// a fraction of that surface's camera depth.
+        pub thickness: f32 => "float",
+        /// The pyramid's coarsest level.
+        pub top: u32 => "uint",
+        /// Hi-Z: the level this dispatch writes.
+        pub level: u32 => "uint",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
@@ -407,6 +425,9 @@ impl FrameFlags {
     /// Diffuse global illumination from the ray-traced GI image: it replaces the sky's diffuse
     /// ambient (and the AO that would darken it).
     pub const RT_GI: u32 = 1 << 5;
+    /// Screen-space reflections in the reflection image: rgb the incoming radiance along the
+    /// mirror direction, a the confidence in it; the split-sum ambient makes up the rest.
+    pub const SCREEN_REFLECTIONS: u32 = 1 << 7;
 }
 
 /// Shadow maps of each kind (2D and cube) the direct-light pass can bind: the length of its
@@ -474,6 +495,7 @@ pub fn glsl_layout() -> String {
     declare::<GodRayConstants>(&mut s);
     declare::<TothConstants>(&mut s);
     declare::<ScreenAoConstants>(&mut s);
+    declare::<SsrConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -490,6 +512,7 @@ pub fn glsl_layout() -> String {
         ("FRAME_RT_REFLECTIONS", FrameFlags::RT_REFLECTIONS),
         ("FRAME_REFLECTIONS_HALF", FrameFlags::REFLECTIONS_HALF),
         ("FRAME_RT_GI", FrameFlags::RT_GI),
+        ("FRAME_SCREEN_REFLECTIONS", FrameFlags::SCREEN_REFLECTIONS),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),
@@ -638,6 +661,7 @@ mod tests {
         check::<GodRayConstants>();
         check::<TothConstants>();
         check::<ScreenAoConstants>();
+        check::<SsrConstants>();
         check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {

@@ -226,6 +226,16 @@ pub struct Args {
     /// With --reflections rt: surfaces rougher than this keep the split-sum ambient.
     #[arg(long, value_name = "ROUGHNESS", default_value_t = 1.0)]
     pub reflection_max_roughness: f32,
+    /// With --reflections ssr: most iterations of the hierarchical march per pixel, 1 to 1024
+    /// (default 48: each skips a cell of empty space a level up or refines a potential hit a
+    /// level down; 48 crosses a 1080p screen with room to refine, fewer lose distant hits).
+    #[arg(long, value_name = "N")]
+    pub ssr_steps: Option<u32>,
+    /// With --reflections ssr: surfaces rougher than this keep the split-sum ambient, 0 to 1
+    /// (default 0.6: beyond it the reflection cone covers much of the screen, where one ray says
+    /// little; faded over the last fifth below it).
+    #[arg(long, value_name = "ROUGHNESS")]
+    pub ssr_max_roughness: Option<f32>,
     /// With --shadows rt: sphere radius of point and spot lights in scene units (0: hard
     /// shadows, as the file's punctual lights imply).
     #[arg(long, value_name = "R", default_value_t = 0.0)]
@@ -334,6 +344,8 @@ impl Args {
             "ao-steps" => self.ao_steps.map(|n| KnobValue::Number(n as f32)),
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
+            "ssr-steps" => self.ssr_steps.map(|n| KnobValue::Number(n as f32)),
+            "ssr-max-roughness" => self.ssr_max_roughness.map(KnobValue::Number),
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
             "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
             "media-steps" => Some(KnobValue::Number(self.media_steps as f32)),

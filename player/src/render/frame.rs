@@ -2,7 +2,9 @@
 //! images they make and bind.
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO
-//! (ray-traced, or the depth pyramid and SAO or GTAO), reflections, GI (each when chosen) → the
+//! (ray-traced, or the depth pyramid and SAO or GTAO), reflections (ray-traced, or the Hi-Z
+//! pyramid and SSR, which reads the previous frame's radiance before the direct pass overwrites
+//! it), GI (each when chosen) → the
 //! ray-traced passes' reprojected accumulation (with `--aa reproject` or `taa`) → direct light
 //! and composition → participating media (march, mitchell, sousa or toth, when chosen) →
 //! temporal anti-aliasing (when chosen) → tone mapping.
@@ -12,6 +14,7 @@ use super::passes::Pass;
 use super::passes::depth_pyramid::DepthPyramidPass;
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
+use super::passes::hiz::HizPass;
 use super::passes::media::MediaMarchPass;
 use super::passes::mitchell::MitchellPass;
 use super::passes::resolve::ResolvePass;
@@ -21,6 +24,7 @@ use super::passes::rt_history::RtHistoryPass;
 use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::sousa::SousaPass;
+use super::passes::ssr::SsrPass;
 use super::passes::taa::TaaPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::toth::TothPass;
@@ -75,8 +79,15 @@ fn passes(
                 }));
             }
         }
-        if let Reflections::Rt { resolution, .. } = techniques.reflections {
-            made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?));
+        match techniques.reflections {
+            Reflections::None => {}
+            Reflections::Rt { resolution, .. } => {
+                made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?))
+            }
+            Reflections::Ssr { .. } => {
+                made.push(Box::new(HizPass::new(gpu)?));
+                made.push(Box::new(SsrPass::new(gpu, techniques.reflections)?));
+            }
         }
         match techniques.gi {
             Gi::Rt { .. } => made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI, decode)?)),
