@@ -281,8 +281,39 @@ gpu_struct! {
         pub step: u32 => "uint",
         /// Depth pyramid: the level this dispatch writes.
         pub level: u32 => "uint",
+        /// Depth pyramid: 1 to pick each texel by the seed's voting filter (the child agreeing
+        /// best with its 4 × 4 neighbourhood), 0 for nearest on the rotated grid.
+        pub voting: u32 => "uint",
+        /// Depth pyramid: 1 to build the normals pyramid beside it.
+        pub normals: u32 => "uint",
+    }
+}
+
+gpu_struct! {
+    /// Push constants of screen-space GI and the lit-radiance pyramid (`shaders/ssgi/*`,
+    /// `shaders/lit/*`; 48 bytes).
+    pub struct ScreenGiConstants {
+        /// The pyramid level this dispatch reads or writes.
+        pub level: u32 => "uint",
+        /// The finest level gathered (the GI resolution: 0 full, 1 half, 2 quarter).
+        pub base: u32 => "uint",
+        /// The coarsest level gathered.
+        pub top: u32 => "uint",
+        /// Spiral samples per pixel and level.
+        pub samples: u32 => "uint",
+        /// Sample radius in pixels of the level gathered.
+        pub radius: f32 => "float",
+        /// Frames already averaged into the GI at this camera (0: this frame replaces them).
+        pub accumulated: u32 => "uint",
+        /// Per-frame random seed.
+        pub seed: u32 => "uint",
+        /// The most frames the running mean averages (later frames weigh 1/cap).
+        pub cap: u32 => "uint",
+        /// Seed 000's distance fall-off (r² → r^2.5 beyond one unit) in place of visibility:
+        /// 1 on, 0 off.
+        pub falloff: u32 => "uint",
         /// Padding.
-        pub pad: [u32; 2] => "uvec2",
+        pub pad: [u32; 3] => "uvec3",
     }
 }
 
@@ -425,6 +456,9 @@ impl FrameFlags {
     /// Diffuse global illumination from the ray-traced GI image: it replaces the sky's diffuse
     /// ambient (and the AO that would darken it).
     pub const RT_GI: u32 = 1 << 5;
+    /// Diffuse light gathered in screen space (the GI image): added to the sky's diffuse
+    /// ambient, which AO still darkens.
+    pub const SCREEN_GI: u32 = 1 << 6;
     /// Screen-space reflections in the reflection image: rgb the incoming radiance along the
     /// mirror direction, a the confidence in it; the split-sum ambient makes up the rest.
     pub const SCREEN_REFLECTIONS: u32 = 1 << 7;
@@ -495,6 +529,7 @@ pub fn glsl_layout() -> String {
     declare::<GodRayConstants>(&mut s);
     declare::<TothConstants>(&mut s);
     declare::<ScreenAoConstants>(&mut s);
+    declare::<ScreenGiConstants>(&mut s);
     declare::<SsrConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
@@ -512,6 +547,7 @@ pub fn glsl_layout() -> String {
         ("FRAME_RT_REFLECTIONS", FrameFlags::RT_REFLECTIONS),
         ("FRAME_REFLECTIONS_HALF", FrameFlags::REFLECTIONS_HALF),
         ("FRAME_RT_GI", FrameFlags::RT_GI),
+        ("FRAME_SCREEN_GI", FrameFlags::SCREEN_GI),
         ("FRAME_SCREEN_REFLECTIONS", FrameFlags::SCREEN_REFLECTIONS),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),

@@ -111,6 +111,24 @@ pub enum MediaResArg {
     Quarter,
 }
 
+/// `--ssgi-mip` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SsgiMipArg {
+    /// One of each 2 × 2 block's texels, on a rotated grid (the seed's "fast").
+    Nearest,
+    /// The texel agreeing best with its neighbourhood (the seed's "precise").
+    Voting,
+}
+
+/// `--ssgi-falloff` (order as the catalogue's choices).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OffOnArg {
+    /// Off.
+    Off,
+    /// On.
+    On,
+}
+
 /// `--media-phase` (order as the catalogue's choices).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MediaPhaseArg {
@@ -283,6 +301,29 @@ pub struct Args {
     /// stored hit's baked radiance (one bounce, no shading).
     #[arg(long, value_enum, default_value = "pnmt")]
     pub gi_structure: GiStructureArg,
+    /// With --gi ssgi: spiral samples per pixel on each level, 1 to 1024 (default 128, the
+    /// seed's).
+    #[arg(long, value_name = "N")]
+    pub ssgi_samples: Option<u32>,
+    /// With --gi ssgi: the finest level gathered (default half, the seed's ~540p at 1080p),
+    /// upsampled to the screen with depth and normal weights.
+    #[arg(long, value_enum, value_name = "RES")]
+    pub ssgi_res: Option<MediaResArg>,
+    /// With --gi ssgi: sample radius in pixels of each level, 4 to 256 (default 40, the seed's).
+    #[arg(long, value_name = "PIXELS")]
+    pub ssgi_radius: Option<u32>,
+    /// With --gi ssgi: how the depth and normal pyramids are reduced (default voting, the
+    /// seed's precise MIP mapping).
+    #[arg(long, value_enum, value_name = "REDUCTION")]
+    pub ssgi_mip: Option<SsgiMipArg>,
+    /// With --gi ssgi: the seed's distance fall-off (1/r² → 1/r^2.5 beyond one scene unit) in
+    /// place of visibility (default off).
+    #[arg(long, value_enum, value_name = "ON")]
+    pub ssgi_falloff: Option<OffOnArg>,
+    /// With --gi ssgi: the most frames its running mean averages while the camera is still,
+    /// 1 to 4096 (default 16).
+    #[arg(long, value_name = "N")]
+    pub ssgi_frames: Option<u32>,
     /// Participating media technique.
     #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
     pub media: String,
@@ -348,6 +389,12 @@ impl Args {
             "ssr-max-roughness" => self.ssr_max_roughness.map(KnobValue::Number),
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
             "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
+            "ssgi-samples" => self.ssgi_samples.map(|n| KnobValue::Number(n as f32)),
+            "ssgi-res" => self.ssgi_res.map(|r| KnobValue::Choice(r as usize)),
+            "ssgi-radius" => self.ssgi_radius.map(|n| KnobValue::Number(n as f32)),
+            "ssgi-mip" => self.ssgi_mip.map(|m| KnobValue::Choice(m as usize)),
+            "ssgi-falloff" => self.ssgi_falloff.map(|f| KnobValue::Choice(f as usize)),
+            "ssgi-frames" => self.ssgi_frames.map(|n| KnobValue::Number(n as f32)),
             "media-steps" => Some(KnobValue::Number(self.media_steps as f32)),
             "media-samples" => self.media_samples.map(|n| KnobValue::Number(n as f32)),
             "media-res" => self.media_res.map(|r| KnobValue::Choice(r as usize)),

@@ -144,8 +144,22 @@ struct ScreenAoConstants {
     uint steps; // offset 12
     uint step; // offset 16
     uint level; // offset 20
-    uvec2 pad; // offset 24
+    uint voting; // offset 24
+    uint normals; // offset 28
 }; // 32 bytes
+
+struct ScreenGiConstants {
+    uint level; // offset 0
+    uint base; // offset 4
+    uint top; // offset 8
+    uint samples; // offset 12
+    float radius; // offset 16
+    uint accumulated; // offset 20
+    uint seed; // offset 24
+    uint cap; // offset 28
+    uint falloff; // offset 32
+    uvec3 pad; // offset 36
+}; // 48 bytes
 
 struct SsrConstants {
     uint steps; // offset 0
@@ -170,6 +184,7 @@ const uint FRAME_RT_AO = 4u;
 const uint FRAME_RT_REFLECTIONS = 8u;
 const uint FRAME_REFLECTIONS_HALF = 16u;
 const uint FRAME_RT_GI = 32u;
+const uint FRAME_SCREEN_GI = 64u;
 const uint FRAME_SCREEN_REFLECTIONS = 128u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;

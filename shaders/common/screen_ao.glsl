@@ -7,9 +7,10 @@
 
 #include "pixel.glsl"
 
-// Levels of the pyramid: 0 (the screen's size) to PYRAMID_TOP, each side halved (rounded up).
-// MIP level per sample m = ⌊log₂(h / q')⌋ stops here (McGuire et al. 2012 stop at 5 too).
-const int PYRAMID_TOP = 5;
+// Levels of the pyramids: 0 (the screen's size) to PYRAMID_TOP, each side halved (rounded up);
+// seven halvings take 1920 × 1080 to 15 × 9, whose diagonal screen-space GI's 40-pixel radius
+// spans.
+const int PYRAMID_TOP = 7;
 
 // Where level `level` starts in the pyramid image: level 0 at the origin, levels 1.. stacked in
 // one column to its right (x = the screen's width, y = the heights of the levels above it).

@@ -241,8 +241,13 @@ void main() {
     // With GI the diffuse part is the diffuse weight times the traced mean incoming radiance,
     // which holds the sky (its misses), the emissive surfaces and the indirect light, occluded
     // by the scene itself: no AO or occlusion texture multiplies it.
+    // Screen-space GI gathers what the screen shows: the sky's ambient (darkened by AO) stays,
+    // and the gathered light adds to it.
     bool gi = (frame.size.w & FRAME_RT_GI) != 0u;
     vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : frame.sky.rgb * occlusion;
+    if ((frame.size.w & FRAME_SCREEN_GI) != 0u) {
+        diffuse_in += imageLoad(rt_gi, pixel).rgb;
+    }
     if (m.diffuse_only) {
         radiance += m.base * diffuse_in;
     } else {

@@ -29,6 +29,8 @@ const float K = 2.0;
 const float EPSILON = 0.01;
 // log₂ q': below a screen radius of 16 pixels samples read level 0.
 const float LOG2_Q = 4.0;
+// The coarsest level a sample reads (McGuire et al. 2012 stop at 5).
+const int SAO_TOP = 5;
 
 // The seed's smoothstep S_ss(l, r, x) (eq. 2.22).
 float smooth_step(float l, float r, float x) {
@@ -68,7 +70,7 @@ void main() {
         if (any(lessThan(s, ivec2(0))) || any(greaterThanEqual(s, ivec2(frame.size.xy)))) {
             continue;
         }
-        int m = clamp(int(floor(log2(h) - LOG2_Q)), 0, PYRAMID_TOP);
+        int m = clamp(int(floor(log2(h) - LOG2_Q)), 0, SAO_TOP);
         float zs = imageLoad(pyramid, pyramid_origin(m) + (s >> m)).r;
         if (zs <= 0.0) {
             continue;

@@ -7,7 +7,9 @@
 // depth inside the cell it steps down a level (a potential hit), until a hit at a level whose cells
 // fit in the reflection cone's footprint: level 0 for a mirror, coarser for rough surfaces (seed
 // 000 §3.9/§10: cone half-angle θ = acos(0.244^(1/(power + 1)))/2, power = clamp(2/max(1e-4, r²)
-// − 2, 4, 16384) for roughness r). The hit shows the previous frame's lit radiance.
+// − 2, 4, 16384) for roughness r). The hit shows the previous frame's lit radiance, reprojected
+// (shaders/lit/), at the level of that pyramid the cone's footprint at the hit covers (seed 000
+// §10: log₂ of the footprint in pixels).
 // Output: rgb the incoming radiance along the mirror direction, a the confidence in it (0 where
 // the ray misses, leaves the image or the surface is too rough; faded near the image's edges):
 // the direct pass makes up the rest with the split-sum ambient.
@@ -19,8 +21,8 @@ layout(set = 0, binding = 1) uniform sampler2D g_depth;
 layout(set = 0, binding = 2) uniform sampler2D g_normal;
 layout(set = 0, binding = 3) uniform sampler2D g_material;
 layout(set = 0, binding = 4, r32f) uniform readonly image2D hiz;
-// The previous frame's final linear radiance, in the previous frame's pixels.
-layout(set = 0, binding = 5, rgba32f) uniform readonly image2D lit;
+// The lit pyramid: the previous frame's radiance in this frame's pixels (alpha the lit fraction).
+layout(set = 0, binding = 5, rgba16f) uniform readonly image2D lit;
 layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D reflections;
 layout(push_constant) uniform Push { SsrConstants ssr; };
 
@@ -71,18 +73,30 @@ float exit_distance(vec3 s0, vec3 d) {
     return min(t.x, min(t.y, t.z));
 }
 
-// The previous frame's radiance of the surface at image point `at` (this frame) and depth
-// `depth`, found by reprojection; alpha 0 where that point lay outside the previous image.
-vec4 previous_radiance(vec2 at, float depth) {
-    vec4 prev = frame.reproject * vec4(image_to_ndc(at), depth, 1.0);
-    if (prev.w <= 0.0) {
-        return vec4(0.0);
+// The lit pyramid's level `level` at image point `at` (pixels of level 0), bilinear over the
+// level's lit texels; alpha the lit fraction (0 on the sky and where there is no history).
+vec4 lit_at_level(vec2 at, int level) {
+    ivec2 size = pyramid_size(level);
+    vec2 x = at / float(1 << level) - 0.5;
+    ivec2 base = ivec2(floor(x));
+    vec2 f = x - vec2(base);
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < 4; i++) {
+        ivec2 o = ivec2(i & 1, i >> 1);
+        float w = (o.x == 0 ? 1.0 - f.x : f.x) * (o.y == 0 ? 1.0 - f.y : f.y);
+        vec4 l = imageLoad(lit, origins[level] + clamp(base + o, ivec2(0), size - 1));
+        sum += w * vec4(l.rgb * l.a, l.a);
     }
-    ivec2 q = ivec2(floor(ndc_to_image(prev.xy / prev.w)));
-    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(frame.size.xy)))) {
-        return vec4(0.0);
-    }
-    return vec4(imageLoad(lit, q).rgb, 1.0);
+    return sum.a > 0.0 ? vec4(sum.rgb / sum.a, sum.a) : vec4(0.0);
+}
+
+// The lit radiance at image point `at` over a footprint `level` levels wide (fractional: the two
+// levels around it, blended).
+vec4 lit_radiance(vec2 at, float level) {
+    level = clamp(level, 0.0, float(PYRAMID_TOP));
+    int lo = int(floor(level));
+    int hi = min(lo + 1, PYRAMID_TOP);
+    return mix(lit_at_level(at, lo), lit_at_level(at, hi), level - float(lo));
 }
 
 vec4 reflection(ivec2 p) {
@@ -125,7 +139,7 @@ vec4 reflection(ivec2 p) {
     vec2 heading = step(0.0, dxy);
 
     int top = min(int(ssr.top), MAX_LEVELS - 1);
-    for (int l = 0; l <= top; l++) {
+    for (int l = 0; l <= max(top, PYRAMID_TOP); l++) {
         origins[l] = pyramid_origin(l);
     }
     float k = cone_inradius(roughness);
@@ -190,7 +204,9 @@ vec4 reflection(ivec2 p) {
     if (dot(nq, r) >= 0.0) {
         return vec4(0.0);
     }
-    vec4 radiance = previous_radiance(h_at, h_depth);
+    // The cone's footprint at the hit (its diameter in pixels there) picks the level.
+    float footprint = 2.0 * k * distance(pos, q) * pixels_per_unit(camera_depth(h_at, h_depth));
+    vec4 radiance = lit_radiance(s.xy, log2(max(footprint, 1.0)));
     vec2 size = vec2(frame.size.xy);
     vec2 border = min(s.xy, size - s.xy) / size;
     float confidence = radiance.a * smoothstep(0.0, EDGE_FADE, min(border.x, border.y));

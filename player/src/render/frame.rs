@@ -1,20 +1,22 @@
 //! Wires the passes of a run: which passes the chosen techniques need, in frame order, and the
 //! images they make and bind.
 //!
-//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, AO
-//! (ray-traced, or the depth pyramid and SAO or GTAO), reflections (ray-traced, or the Hi-Z
-//! pyramid and SSR, which reads the previous frame's radiance before the direct pass overwrites
-//! it), GI (each when chosen) → the
+//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, the
+//! depth pyramid (for screen-space AO or GI), AO (ray-traced, SAO or GTAO), reflections
+//! (ray-traced, or the Hi-Z pyramid and SSR, which reads the previous frame's radiance before the
+//! direct pass overwrites it), GI (ray-traced, or the lit pyramid and screen-space GI) (each when
+//! chosen) → the
 //! ray-traced passes' reprojected accumulation (with `--aa reproject` or `taa`) → direct light
 //! and composition → participating media (march, mitchell, sousa or toth, when chosen) →
 //! temporal anti-aliasing (when chosen) → tone mapping.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
-use super::passes::depth_pyramid::DepthPyramidPass;
+use super::passes::depth_pyramid::{DepthPyramidPass, Reduction};
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
 use super::passes::hiz::HizPass;
+use super::passes::lit_pyramid::LitPyramidPass;
 use super::passes::media::MediaMarchPass;
 use super::passes::mitchell::MitchellPass;
 use super::passes::resolve::ResolvePass;
@@ -24,6 +26,7 @@ use super::passes::rt_history::RtHistoryPass;
 use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::sousa::SousaPass;
+use super::passes::ssgi::SsgiPass;
 use super::passes::ssr::SsrPass;
 use super::passes::taa::TaaPass;
 use super::passes::tonemap::TonemapPass;
@@ -67,17 +70,31 @@ fn passes(
         if techniques.shadows.traced().is_some() {
             made.push(Box::new(RtShadowsPass::new(gpu, techniques.shadows, lights, decode)?));
         }
+        // The depth pyramid, for screen-space AO and GI (GI's with normals, reduced as it says).
+        let screen_ao = matches!(techniques.ao, Ao::Sao { .. } | Ao::Gtao { .. });
+        if let Gi::Ssgi { voting, .. } = techniques.gi {
+            let reduction = if voting { Reduction::Voting } else { Reduction::Nearest };
+            made.push(Box::new(DepthPyramidPass::new(gpu, reduction, true)?));
+        } else if screen_ao {
+            made.push(Box::new(DepthPyramidPass::new(gpu, Reduction::Nearest, false)?));
+        }
         match techniques.ao {
             Ao::None => {}
             Ao::Rt { .. } => made.push(Box::new(RtAoPass::new(gpu, decode)?)),
             Ao::Sao { .. } | Ao::Gtao { .. } => {
-                made.push(Box::new(DepthPyramidPass::new(gpu)?));
                 made.push(Box::new(if let Ao::Sao { .. } = techniques.ao {
                     sao::pass(gpu, techniques.ao)?
                 } else {
                     gtao::pass(gpu, techniques.ao)?
                 }));
             }
+        }
+        // The lit pyramid (the previous frame's radiance), for screen-space reflections and GI:
+        // made once, before either reads it.
+        if matches!(techniques.reflections, Reflections::Ssr { .. })
+            || matches!(techniques.gi, Gi::Ssgi { .. })
+        {
+            made.push(Box::new(LitPyramidPass::new(gpu)?));
         }
         match techniques.reflections {
             Reflections::None => {}
@@ -99,6 +116,7 @@ fn passes(
                 };
                 made.push(Box::new(RtGiPass::with_line_space(gpu, code, decode)?));
             }
+            Gi::Ssgi { .. } => made.push(Box::new(SsgiPass::new(gpu, techniques.gi)?)),
             Gi::None => {}
         }
         if let Some(frames) = techniques.reprojected_rays() {

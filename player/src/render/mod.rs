@@ -174,7 +174,7 @@ impl Renderer {
             reflection_lights,
             gi_bounces: match t.gi {
                 Gi::Rt { bounces } | Gi::LineSpace { bounces, .. } => bounces,
-                Gi::None => 0,
+                Gi::None | Gi::Ssgi { .. } => 0,
             },
             emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count),
             ..Default::default()
@@ -190,6 +190,9 @@ impl Renderer {
         }
         if t.gi.bounces().is_some() {
             flags |= FrameFlags::RT_GI;
+        }
+        if let Gi::Ssgi { .. } = t.gi {
+            flags |= FrameFlags::SCREEN_GI;
         }
         match t.reflections {
             Reflections::Rt { resolution: ReflectionRes::Full, .. } => flags |= FrameFlags::RT_REFLECTIONS,

@@ -57,6 +57,14 @@ shaders! {
     HIZ_REDUCE = "hiz" / "reduce.comp";
     /// Screen-space reflections: the hierarchical march.
     SSR_TRACE = "ssr" / "trace.comp";
+    /// Level 0 of the lit-radiance pyramid: the previous frame's light, reprojected.
+    LIT_REPROJECT = "lit" / "reproject.comp";
+    /// A level of the lit-radiance pyramid from the one below.
+    LIT_REDUCE = "lit" / "reduce.comp";
+    /// Screen-space GI: one level's gather plus the coarser levels upsampled.
+    SSGI_GATHER = "ssgi" / "gather.comp";
+    /// Screen-space GI: the finest level upsampled to the screen, averaged over frames.
+    SSGI_RESOLVE = "ssgi" / "resolve.comp";
     /// Scalable ambient obscurance (the seed's).
     SAO = "sao" / "sao.comp";
     /// Ground-truth ambient occlusion.

@@ -182,6 +182,23 @@ pub enum Gi {
         /// What answers the bounce rays.
         structure: GiStructure,
     },
+    /// Screen-space diffuse GI (seed 000): the previous frame's lit radiance gathered on
+    /// spirals over a MIP hierarchy of depth, normals and light, joint-bilaterally upsampled;
+    /// added to the sky's ambient.
+    Ssgi {
+        /// Spiral samples per pixel and level (the seed's 128).
+        samples: u32,
+        /// The finest level gathered: full, half (the seed's default, ~540p at 1080p) or quarter.
+        resolution: ScreenFraction,
+        /// Sample radius R in pixels of each level (the seed's 40).
+        radius: u32,
+        /// The depth and normal pyramids reduced by the seed's voting filter (else nearest).
+        voting: bool,
+        /// The seed's distance fall-off in place of visibility.
+        falloff: bool,
+        /// The most frames the running mean averages while the camera is still.
+        frames: u32,
+    },
 }
 
 /// What answers the bounce rays of `--gi linespace` (shadow rays: the binary line space).
@@ -200,7 +217,7 @@ impl Gi {
     pub fn bounces(&self) -> Option<u32> {
         match *self {
             Gi::Rt { bounces } | Gi::LineSpace { bounces, .. } => Some(bounces),
-            Gi::None => None,
+            Gi::None | Gi::Ssgi { .. } => None,
         }
     }
 }
@@ -625,6 +642,16 @@ impl Techniques {
                     Gi::LineSpace { bounces, structure }
                 };
             }
+            (Effect::Gi, "ssgi") => {
+                self.gi = Gi::Ssgi {
+                    samples: whole(effect, name, "ssgi-samples", v(0))?,
+                    resolution: fraction(v(1)),
+                    radius: whole(effect, name, "ssgi-radius", v(2))?,
+                    voting: v(3) == KnobValue::Choice(1),
+                    falloff: v(4) == KnobValue::Choice(1),
+                    frames: whole(effect, name, "ssgi-frames", v(5))?,
+                };
+            }
             (Effect::Media, "none") => self.media = Media::None,
             (Effect::Media, "march") => {
                 self.media = Media::March { steps: whole(effect, name, "media-steps", v(0))? };
@@ -700,6 +727,7 @@ impl Techniques {
                 Gi::None => "none",
                 Gi::Rt { .. } => "rt",
                 Gi::LineSpace { .. } => "linespace",
+                Gi::Ssgi { .. } => "ssgi",
             },
             Effect::Media => match self.media {
                 Media::None => "none",
@@ -972,7 +1000,7 @@ const fn artistic(knob: Knob) -> Knob {
     Knob { role: KnobRole::Scene, ..knob }
 }
 
-static CATALOGUE: [TechniqueInfo; 25] = [
+static CATALOGUE: [TechniqueInfo; 26] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -1207,6 +1235,69 @@ static CATALOGUE: [TechniqueInfo; 25] = [
                 default: KnobValue::Choice(0),
                 role: KnobRole::Quality,
             },
+        ],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Gi,
+        name: "ssgi",
+        help: "screen-space diffuse GI (seed 000): the previous frame's lit radiance gathered on \
+               --ssgi-samples spiral points per pixel on each level of a depth/normal/light MIP \
+               hierarchy (near light from fine levels, far light from coarse ones), \
+               joint-bilaterally upsampled, averaged over --ssgi-frames while the camera is \
+               still; added to the sky's ambient. No visibility: light passes through what the \
+               screen shows, and what it does not show (off screen, hidden) gives none",
+        knobs: &[
+            number(
+                "ssgi-samples",
+                "spiral samples per pixel on each level (the seed's 128; tested 16 to 256)",
+                1.0,
+                1024.0,
+                128.0,
+                &[16.0, 32.0, 64.0, 128.0, 256.0],
+            ),
+            Knob {
+                name: "ssgi-res",
+                help: "the finest level gathered, upsampled to the screen: full, half (the seed's \
+                       default, ~540p at 1080p) or quarter",
+                range: KnobRange::Choice(&["full", "half", "quarter"]),
+                default: KnobValue::Choice(1),
+                role: KnobRole::Quality,
+            },
+            number(
+                "ssgi-radius",
+                "sample radius R in pixels of each level (the seed's 40); levels go up until one \
+                 radius spans the screen",
+                4.0,
+                256.0,
+                40.0,
+                &[],
+            ),
+            Knob {
+                name: "ssgi-mip",
+                help: "how the depth and normal pyramids pick each coarser texel: nearest (the \
+                       seed's fast) or voting (the seed's precise, its default)",
+                range: KnobRange::Choice(&["nearest", "voting"]),
+                default: KnobValue::Choice(1),
+                role: KnobRole::Quality,
+            },
+            Knob {
+                name: "ssgi-falloff",
+                help: "the seed's distance fall-off (1/r² becomes 1/r^2.5 beyond one scene unit) \
+                       standing in for the visibility it does not test: off or on",
+                range: KnobRange::Choice(&["off", "on"]),
+                default: KnobValue::Choice(0),
+                role: KnobRole::Quality,
+            },
+            number(
+                "ssgi-frames",
+                "the most frames the GI's running mean averages while the camera is still (then \
+                 exponential, as the bounces build up)",
+                1.0,
+                4096.0,
+                16.0,
+                &[],
+            ),
         ],
         stochastic: true,
     },

@@ -6,9 +6,11 @@
 //! **nearest**: a level's pixel copies one of its 2 × 2 children unchanged, picked on McGuire
 //! et al.'s rotated grid (2012, §2.2: child (1 − y mod 2, 1 − x mod 2)), so that no level
 //! invents a depth between two surfaces (an average would, at every silhouette) and successive
-//! levels do not all keep the same corner. The seed's voting filter (seed 000 §3.8: the child
-//! whose depth and normal agree best with the 4 × 4 neighbourhood's means) is not implemented;
-//! it needs the normals pyramid too and buys temporal stability, not correctness.
+//! levels do not all keep the same corner. Screen-space GI (`--ssgi-mip voting`, its default)
+//! picks the child by the seed's **voting** filter instead (seed 000 §3.8: the child whose depth
+//! and normal agree best with the 4 × 4 neighbourhood's means), which keeps the large
+//! consistent regions and flickers less; it reads the **normals pyramid** that GI builds beside
+//! the depths (octahedral normals, the same child copied).
 //!
 //! All levels live in one `r32f` image (level 0 at the origin, levels 1.. in a column to its
 //! right; `shaders/common/screen_ao.glsl` spells the layout), so the graph tracks one image.
@@ -19,7 +21,7 @@
 
 use kiln_format::gpu::ScreenAoConstants;
 
-use super::gbuffer::DEPTH;
+use super::gbuffer::{DEPTH, NORMAL};
 use super::kernel::Kernel;
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
@@ -27,8 +29,9 @@ use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
-/// The coarsest level (`PYRAMID_TOP` in `shaders/common/screen_ao.glsl`).
-pub const TOP: u32 = 5;
+/// The coarsest level (`PYRAMID_TOP` in `shaders/common/screen_ao.glsl`): seven halvings take
+/// 1920 × 1080 to 15 × 9.
+pub const TOP: u32 = 7;
 
 /// The pyramid's levels in one image.
 pub const PYRAMID: TargetDecl = TargetDecl {
@@ -37,6 +40,23 @@ pub const PYRAMID: TargetDecl = TargetDecl {
     usage: vk::ImageUsageFlags::STORAGE,
     array: false,
 };
+
+/// The normals pyramid (octahedral world normals), in the same layout.
+pub const NORMAL_PYRAMID: TargetDecl = TargetDecl {
+    name: "normal pyramid",
+    format: vk::Format::R16G16_SFLOAT,
+    usage: vk::ImageUsageFlags::STORAGE,
+    array: false,
+};
+
+/// How a level picks each texel among its 2 × 2 children.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reduction {
+    /// McGuire et al.'s rotated grid.
+    Nearest,
+    /// Seed 000's voting filter (needs the normals pyramid, which it then builds).
+    Voting,
+}
 
 /// The size of every level, 0 to [`TOP`], for a `width` × `height` screen.
 pub fn levels(width: u32, height: u32) -> Vec<(u32, u32)> {
@@ -62,25 +82,47 @@ pub fn image_size(width: u32, height: u32) -> (u32, u32) {
 pub struct DepthPyramidPass {
     linear: Kernel,
     reduce: Kernel,
+    reduction: Reduction,
+    normals: bool,
 }
 
 impl DepthPyramidPass {
-    /// Builds the pipelines.
-    pub fn new(gpu: &Gpu) -> PlayResult<DepthPyramidPass> {
+    /// Builds the pipelines of a pyramid reduced as `reduction` says, with the normals pyramid
+    /// when `normals` (always with [`Reduction::Voting`]).
+    pub fn new(gpu: &Gpu, reduction: Reduction, normals: bool) -> PlayResult<DepthPyramidPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<ScreenAoConstants>() as u32;
         let [linear, reduce] = Kernel::several(
             gpu,
             [
                 (
-                    &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)],
+                    &[
+                        Binding::one(Uniform),
+                        Binding::one(Sampled),
+                        Binding::one(StorageImage),
+                        Binding::one(Sampled),
+                        Binding::one(StorageImage),
+                    ],
                     spirv::PYRAMID_LINEAR,
                 ),
-                (&[Binding::one(Uniform), Binding::one(StorageImage)], spirv::PYRAMID_REDUCE),
+                (
+                    &[Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)],
+                    spirv::PYRAMID_REDUCE,
+                ),
             ],
             push,
         )?;
-        Ok(DepthPyramidPass { linear, reduce })
+        let normals = normals || reduction == Reduction::Voting;
+        Ok(DepthPyramidPass { linear, reduce, reduction, normals })
+    }
+
+    fn push(&self, level: u32) -> ScreenAoConstants {
+        ScreenAoConstants {
+            level,
+            voting: (self.reduction == Reduction::Voting) as u32,
+            normals: self.normals as u32,
+            ..Default::default()
+        }
     }
 }
 
@@ -91,11 +133,15 @@ impl Pass for DepthPyramidPass {
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
         let (w, h) = image_size(width, height);
-        vec![(PYRAMID, PYRAMID.sized(w, h, 1))]
+        let mut made = vec![(PYRAMID, PYRAMID.sized(w, h, 1))];
+        if self.normals {
+            made.push((NORMAL_PYRAMID, NORMAL_PYRAMID.sized(w, h, 1)));
+        }
+        made
     }
 
     fn binds(&self) -> Vec<TargetDecl> {
-        vec![DEPTH]
+        vec![DEPTH, NORMAL, NORMAL_PYRAMID]
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
@@ -106,22 +152,35 @@ impl Pass for DepthPyramidPass {
                 Write::Buffer(0, shared.frame_ubo),
                 Write::Sampled(1, vec![(img(&DEPTH), shared.scene.nearest_clamp)]),
                 Write::StorageImage(2, img(&PYRAMID)),
+                Write::Sampled(3, vec![(img(&NORMAL), shared.scene.nearest_clamp)]),
+                Write::StorageImage(4, img(&NORMAL_PYRAMID)),
             ],
         )?;
-        self.reduce.write(gpu, &[Write::Buffer(0, shared.frame_ubo), Write::StorageImage(1, img(&PYRAMID))])
+        self.reduce.write(
+            gpu,
+            &[
+                Write::Buffer(0, shared.frame_ubo),
+                Write::StorageImage(1, img(&PYRAMID)),
+                Write::StorageImage(2, img(&NORMAL_PYRAMID)),
+            ],
+        )
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
         let (width, height) = (ctx.images.width, ctx.images.height);
-        ctx.images
-            .access(ctx.rec, &[(DEPTH, Access::Read(Use::SAMPLED)), (PYRAMID, Access::Write(Use::STORAGE))]);
-        let push = ScreenAoConstants::default();
-        self.linear.dispatch(ctx.rec, bytemuck::bytes_of(&push), width, height);
+        let mut written = vec![(PYRAMID, Access::Write(Use::STORAGE))];
+        if self.normals {
+            written.push((NORMAL_PYRAMID, Access::Write(Use::STORAGE)));
+        }
+        let mut first = vec![(DEPTH, Access::Read(Use::SAMPLED)), (NORMAL, Access::Read(Use::SAMPLED))];
+        first.extend(&written);
+        ctx.images.access(ctx.rec, &first);
+        self.linear.dispatch(ctx.rec, bytemuck::bytes_of(&self.push(0)), width, height);
         for (level, &(w, h)) in levels(width, height).iter().enumerate().skip(1) {
             // Reads the level below, written by the previous dispatch: a barrier between them.
-            ctx.images.access(ctx.rec, &[(PYRAMID, Access::ReadWrite(Use::STORAGE))]);
-            let push = ScreenAoConstants { level: level as u32, ..Default::default() };
-            self.reduce.dispatch(ctx.rec, bytemuck::bytes_of(&push), w, h);
+            let again: Vec<_> = written.iter().map(|&(t, _)| (t, Access::ReadWrite(Use::STORAGE))).collect();
+            ctx.images.access(ctx.rec, &again);
+            self.reduce.dispatch(ctx.rec, bytemuck::bytes_of(&self.push(level as u32)), w, h);
         }
     }
 
@@ -137,10 +196,13 @@ mod tests {
 
     #[test]
     fn levels_halve_rounding_up_and_fit_in_the_image() {
-        assert_eq!(levels(96, 72), vec![(96, 72), (48, 36), (24, 18), (12, 9), (6, 5), (3, 3)]);
-        assert_eq!(image_size(96, 72), (144, 72));
-        // Odd sizes: the column of levels 1.. is taller than level 0 (1 + 1 + 1 + 1 + 1 > 3).
-        assert_eq!(levels(3, 3)[1..], [(2, 2), (1, 1), (1, 1), (1, 1), (1, 1)]);
-        assert_eq!(image_size(3, 3), (5, 6));
+        assert_eq!(
+            levels(96, 72),
+            vec![(96, 72), (48, 36), (24, 18), (12, 9), (6, 5), (3, 3), (2, 2), (1, 1)]
+        );
+        assert_eq!(image_size(96, 72), (144, 74));
+        // Odd sizes: the column of levels 1.. is taller than level 0 (2 + 1 + … + 1 > 3).
+        assert_eq!(levels(3, 3)[1..], [(2, 2), (1, 1), (1, 1), (1, 1), (1, 1), (1, 1), (1, 1)]);
+        assert_eq!(image_size(3, 3), (5, 8));
     }
 }

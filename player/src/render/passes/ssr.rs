@@ -2,7 +2,9 @@
 //! mirror direction marched through the Hi-Z pyramid ([`super::hiz`]), skipping empty space a
 //! level up at a time and stepping down where the ray may meet a surface, accepting a hit at the
 //! coarsest level that fits in the reflection cone's footprint (rougher: coarser, fewer steps).
-//! The hit shows the previous frame's lit radiance; the result is the incoming radiance with a
+//! The hit shows the previous frame's lit radiance ([`super::lit_pyramid`], reprojected into this
+//! frame's pixels) at the pyramid level that the cone's footprint there covers (seed 000 §3.9);
+//! the result is the incoming radiance with a
 //! confidence, 0 where the ray misses or leaves the image, faded near its edges, which the direct
 //! pass blends with the split-sum ambient (`FrameFlags::SCREEN_REFLECTIONS`). Deterministic: the
 //! image is overwritten every frame.
@@ -12,10 +14,10 @@
 
 use kiln_format::gpu::SsrConstants;
 
-use super::direct::RADIANCE;
 use super::gbuffer::{DEPTH, MATERIAL, NORMAL};
 use super::hiz::{HIZ, TOP};
 use super::kernel::Kernel;
+use super::lit_pyramid::LIT_PYRAMID;
 use super::rt_reflections::REFLECTIONS;
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
@@ -78,7 +80,7 @@ impl Pass for SsrPass {
 
     fn binds(&self) -> Vec<TargetDecl> {
         let mut b = GBUFFER.to_vec();
-        b.extend([HIZ, RADIANCE]);
+        b.extend([HIZ, LIT_PYRAMID]);
         b
     }
 
@@ -90,7 +92,7 @@ impl Pass for SsrPass {
         }
         writes.extend([
             Write::StorageImage(4, img(&HIZ)),
-            Write::StorageImage(5, img(&RADIANCE)),
+            Write::StorageImage(5, img(&LIT_PYRAMID)),
             Write::StorageImage(6, img(&REFLECTIONS)),
         ]);
         self.kernel.write(gpu, &writes)
@@ -100,8 +102,7 @@ impl Pass for SsrPass {
         let mut io = super::gbuffer::sampled(&GBUFFER);
         io.extend([
             (HIZ, Access::Read(Use::STORAGE)),
-            // Before the direct pass overwrites it: the previous frame's final radiance.
-            (RADIANCE, Access::Read(Use::STORAGE)),
+            (LIT_PYRAMID, Access::Read(Use::STORAGE)),
             (REFLECTIONS, Access::Write(Use::STORAGE)),
         ]);
         ctx.images.access(ctx.rec, &io);

@@ -1,0 +1,177 @@
+//! Screen-space diffuse GI (`--gi ssgi`; seed 000 §2.1, §3.5–3.7; `shaders/ssgi/`).
+//!
+//! Reads the depth and normal pyramids ([`super::depth_pyramid`], voting or nearest) and the
+//! lit-radiance pyramid ([`super::lit_pyramid`], the previous frame's light), and:
+//! 1. `gather.comp`, once per level from the coarsest needed down to the GI resolution: each
+//!    texel gathers spiral samples of that level's light within R texels and adds the coarser
+//!    level's result, joint-bilaterally upsampled (`upsample.glsl`);
+//! 2. `resolve.comp`: the finest result upsampled to the screen the same way, as mean incoming
+//!    radiance, averaged over the frames the camera has been still, into the GI image that the
+//!    direct pass adds to the sky's ambient (`FrameFlags::SCREEN_GI`).
+//!
+//! The coarsest level is the first whose diagonal one radius spans (seed 000 §3.6: the whole
+//! screen is then within reach of every pixel), at most [`super::depth_pyramid::TOP`].
+
+use kiln_format::gpu::ScreenGiConstants;
+
+use super::depth_pyramid::{NORMAL_PYRAMID, PYRAMID, TOP, image_size, levels};
+use super::kernel::Kernel;
+use super::lit_pyramid::LIT_PYRAMID;
+use super::rt_gi::GI;
+use super::{FrameCtx, Pass, Shared};
+use crate::error::PlayResult;
+use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
+use crate::render::graph::{Access, TargetDecl};
+use crate::render::spirv;
+use crate::render::technique::Gi;
+
+/// Each level's gathered irradiance (plus everything coarser), in the pyramids' layout.
+pub const GI_LEVELS: TargetDecl = TargetDecl {
+    name: "ssgi levels",
+    format: vk::Format::R16G16B16A16_SFLOAT,
+    usage: vk::ImageUsageFlags::STORAGE,
+    array: false,
+};
+
+/// The levels gathered on a `width` × `height` screen: from `base` up to the first level whose
+/// diagonal `radius` texels span (at least `base`, at most [`TOP`]).
+pub fn gathered_levels(width: u32, height: u32, base: u32, radius: f32) -> (u32, u32) {
+    let base = base.min(TOP);
+    let sizes = levels(width, height);
+    let top = (base..=TOP)
+        .find(|&k| {
+            let (w, h) = sizes[k as usize];
+            ((w as f32).powi(2) + (h as f32).powi(2)).sqrt() <= radius
+        })
+        .unwrap_or(TOP);
+    (base, top)
+}
+
+/// The pass.
+#[derive(Debug)]
+pub struct SsgiPass {
+    gather: Kernel,
+    resolve: Kernel,
+    constants: ScreenGiConstants,
+}
+
+impl SsgiPass {
+    /// Builds the pipelines of `technique` (a [`Gi::Ssgi`]).
+    pub fn new(gpu: &Gpu, technique: Gi) -> PlayResult<SsgiPass> {
+        let Gi::Ssgi { samples, resolution, radius, falloff, frames, .. } = technique else {
+            unreachable!("the frame builds the SSGI pass for --gi ssgi only")
+        };
+        use BindingKind::*;
+        let push = std::mem::size_of::<ScreenGiConstants>() as u32;
+        let bindings = [
+            Binding::one(Uniform),
+            Binding::one(StorageImage),
+            Binding::one(StorageImage),
+            Binding::one(StorageImage),
+            Binding::one(StorageImage),
+        ];
+        let [gather, resolve] =
+            Kernel::several(gpu, [(&bindings, spirv::SSGI_GATHER), (&bindings, spirv::SSGI_RESOLVE)], push)?;
+        let constants = ScreenGiConstants {
+            base: resolution.divisor().trailing_zeros(),
+            samples: samples.max(1),
+            radius: radius.max(1) as f32,
+            cap: frames.max(1),
+            falloff: falloff as u32,
+            ..Default::default()
+        };
+        Ok(SsgiPass { gather, resolve, constants })
+    }
+}
+
+impl Pass for SsgiPass {
+    fn name(&self) -> &'static str {
+        "ssgi"
+    }
+
+    fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
+        let (w, h) = image_size(width, height);
+        vec![(GI_LEVELS, GI_LEVELS.sized(w, h, 1)), (GI, GI.sized(width, height, 1))]
+    }
+
+    fn binds(&self) -> Vec<TargetDecl> {
+        vec![PYRAMID, NORMAL_PYRAMID, LIT_PYRAMID]
+    }
+
+    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+        let img = |t: &TargetDecl| shared.images.get(t).view;
+        // Both kernels: frame constants, depth and normal pyramids, what they read, what they write.
+        let writes = |read: &TargetDecl, written: &TargetDecl| {
+            [
+                Write::Buffer(0, shared.frame_ubo),
+                Write::StorageImage(1, img(&PYRAMID)),
+                Write::StorageImage(2, img(&NORMAL_PYRAMID)),
+                Write::StorageImage(3, img(read)),
+                Write::StorageImage(4, img(written)),
+            ]
+        };
+        self.gather.write(gpu, &writes(&LIT_PYRAMID, &GI_LEVELS))?;
+        self.resolve.write(gpu, &writes(&GI_LEVELS, &GI))
+    }
+
+    fn record(&mut self, ctx: &mut FrameCtx) {
+        let (width, height) = (ctx.images.width, ctx.images.height);
+        let (base, top) = gathered_levels(width, height, self.constants.base, self.constants.radius);
+        let sizes = levels(width, height);
+        let mut push = ScreenGiConstants {
+            base,
+            top,
+            accumulated: ctx.rt.accumulated,
+            seed: ctx.rt.seed,
+            ..self.constants
+        };
+        for level in (base..=top).rev() {
+            // Each level reads the coarser one the previous dispatch wrote.
+            ctx.images.access(
+                ctx.rec,
+                &[
+                    (PYRAMID, Access::Read(Use::STORAGE)),
+                    (NORMAL_PYRAMID, Access::Read(Use::STORAGE)),
+                    (LIT_PYRAMID, Access::Read(Use::STORAGE)),
+                    (GI_LEVELS, Access::ReadWrite(Use::STORAGE)),
+                ],
+            );
+            push.level = level;
+            let (w, h) = sizes[level as usize];
+            self.gather.dispatch(ctx.rec, bytemuck::bytes_of(&push), w, h);
+        }
+        ctx.images.access(
+            ctx.rec,
+            &[
+                (PYRAMID, Access::Read(Use::STORAGE)),
+                (NORMAL_PYRAMID, Access::Read(Use::STORAGE)),
+                (GI_LEVELS, Access::Read(Use::STORAGE)),
+                (GI, Access::ReadWrite(Use::STORAGE)),
+            ],
+        );
+        self.resolve.dispatch(ctx.rec, bytemuck::bytes_of(&push), width, height);
+    }
+
+    fn destroy(&mut self, gpu: &Gpu) {
+        self.gather.destroy(gpu);
+        self.resolve.destroy(gpu);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_coarsest_level_is_the_first_one_radius_spans() {
+        // 1920 × 1080: level 6 is 30 × 17 (diagonal 34.5), level 5 60 × 34 (69).
+        assert_eq!(gathered_levels(1920, 1080, 1, 40.0), (1, 6));
+        // A small screen stops early: 96 × 72 has level 2 at 24 × 18 (diagonal 30).
+        assert_eq!(gathered_levels(96, 72, 1, 40.0), (1, 2));
+        assert_eq!(gathered_levels(96, 72, 0, 40.0), (0, 2));
+        // The base level is always gathered.
+        assert_eq!(gathered_levels(16, 16, 2, 40.0), (2, 2));
+        // A tiny radius never spans the screen: the top of the pyramid.
+        assert_eq!(gathered_levels(1920, 1080, 0, 4.0), (0, TOP));
+    }
+}
