@@ -650,6 +650,31 @@ mod tests {
     }
 
     #[test]
+    fn ssr_flags_set_its_knobs_with_their_defaults() {
+        assert_eq!(
+            techniques(&["f.kiln", "--reflections", "ssr"]).reflections,
+            Reflections::Ssr { steps: 48, max_roughness: 0.6 }
+        );
+        let t = techniques(&[
+            "f.kiln",
+            "--reflections",
+            "ssr",
+            "--ssr-steps",
+            "96",
+            "--ssr-max-roughness",
+            "0.3",
+        ]);
+        assert_eq!(t.reflections, Reflections::Ssr { steps: 96, max_roughness: 0.3 });
+        for bad in [&["--ssr-steps", "0"][..], &["--ssr-max-roughness", "1.5"]] {
+            let args: Vec<&str> =
+                ["f.kiln", "--reflections", "ssr"].into_iter().chain(bad.iter().copied()).collect();
+            let e = parse(&args).unwrap().techniques().unwrap_err();
+            assert_eq!(e.exit, Exit::Usage);
+            assert!(e.message.contains(bad[0]), "{bad:?}: {}", e.message);
+        }
+    }
+
+    #[test]
     fn the_last_flag_wins() {
         assert_eq!(techniques(&["f.kiln", "--shadows", "rt", "--shadows", "none"]).shadows, Shadows::None);
         let t = techniques(&["f.kiln", "--ao", "rt", "--ao-radius", "2", "--ao-radius", "3"]);

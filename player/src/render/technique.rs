@@ -1556,6 +1556,29 @@ mod tests {
     }
 
     #[test]
+    fn the_catalogue_builds_ssr_with_its_knobs_and_it_needs_no_rays() {
+        let mut t = Techniques::default();
+        t.set(Effect::Reflections, "ssr", &[]).unwrap();
+        assert_eq!(t.reflections, Reflections::Ssr { steps: 48, max_roughness: 0.6 });
+        assert_eq!(t.name_of(Effect::Reflections), "ssr");
+        t.set(
+            Effect::Reflections,
+            "ssr",
+            &[("ssr-steps", KnobValue::Number(16.0)), ("ssr-max-roughness", KnobValue::Number(0.3))],
+        )
+        .unwrap();
+        assert_eq!(t.reflections, Reflections::Ssr { steps: 16, max_roughness: 0.3 });
+        // Screen space: the G-buffer only, kept on a file without a BVH.
+        assert!(!t.ray_traced());
+        assert_eq!(t.needs(), Techniques { reflections: Reflections::None, ..t }.needs());
+        assert_eq!(t.without_rays().reflections, t.reflections);
+        for (knob, bad) in [("ssr-steps", 1.5), ("ssr-steps", 0.0), ("ssr-max-roughness", 1.5)] {
+            let e = t.set(Effect::Reflections, "ssr", &[(knob, KnobValue::Number(bad))]).unwrap_err();
+            assert!(e.contains(knob), "{e}");
+        }
+    }
+
+    #[test]
     fn the_catalogue_builds_gi_rt_with_its_bounces() {
         let mut t = Techniques::default();
         t.set(Effect::Gi, "rt", &[]).unwrap();
