@@ -523,6 +523,12 @@ impl Techniques {
         self.aa.reprojected().filter(|_| self.ray_traced())
     }
 
+    /// Whether a pass shows the previous frame's radiance (the screen-space reflections and GI
+    /// read the lit pyramid): the first frame lacks it, so the image depends on the frame count.
+    pub fn reads_previous_frame(&self) -> bool {
+        matches!(self.reflections, Reflections::Ssr { .. }) || matches!(self.gi, Gi::Ssgi { .. })
+    }
+
     /// Whether any ray-traced pass runs.
     pub fn ray_traced(&self) -> bool {
         self.shadows.traced().is_some()
