@@ -1,7 +1,7 @@
 #version 460
 // Screen-space diffuse GI (seed 000 §2.1, §3.6), one level of the hierarchy: each texel of level
 // `level` gathers `samples` points of the lit-radiance pyramid on a 19-turn spiral around it,
-// on the ring between R/2 and R texels (between 4 and R on the finest level, `base`), and adds
+// on the ring between R/2 and R texels (between 1 and R on the finest level, `base`), and adds
 // the joint-bilateral upsampling of the coarser level's result (none above `top`). Coarse levels
 // thus carry the far light, blurred, and fine ones the near light: each level's ring is the next
 // finer level's ring doubled, so the rings tile the screen around the pixel.
@@ -15,7 +15,10 @@
 // "prioritise near samples" 0.6), each sample weighs the screen area it stands for: with radii
 // spread evenly over [r₀, R], 2π r (R − r₀) / N texels of the level, 4^level full-resolution
 // pixels each — the Monte Carlo estimate of the on-screen integral. The sum is irradiance; the
-// texel stores it.
+// texel stores it. The finest ring starts 1 texel out, not the seed's 4: the 0.1 term already
+// bounds the singularity, and the 4-texel hole left out a quarter of the light a floor receives
+// within half a unit of a glowing wall (tests/render/ssgi.rs: 0.71 of the closed form, 0.95
+// with 1).
 #include "../common/layout.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -58,7 +61,7 @@ void main() {
     vec3 result = level < int(gi.top) ? upsample(q, level, level + 1, z, x, n_enc) : vec3(0.0);
 
     bool finest = level == int(gi.base);
-    float r0 = finest ? 4.0 : 0.5 * gi.radius;
+    float r0 = finest ? 1.0 : 0.5 * gi.radius;
     float r1 = max(gi.radius, r0);
     float count = float(max(gi.samples, 1u));
     // Screen area per unit of radius, in full-resolution pixels (see the header).

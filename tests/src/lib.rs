@@ -183,6 +183,12 @@ impl Options {
         self
     }
 
+    /// Global illumination by `gi` (any technique).
+    pub fn gi(mut self, gi: Gi) -> Options {
+        self.0.render.techniques.gi = gi;
+        self
+    }
+
     /// Participating media by ray marching (`--media march`) with `steps` steps per medium.
     pub fn media_march(mut self, steps: u32) -> Options {
         self.0.render.techniques.media = Media::March { steps };
