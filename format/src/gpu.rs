@@ -322,6 +322,24 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of the screen-space reflections (`shaders/hiz/*`, `shaders/ssr/*`;
+    /// 20 bytes).
+    pub struct SsrConstants {
+        /// The most iterations of the hierarchical march per pixel.
+        pub steps: u32 => "uint",
+        /// Surfaces rougher than this keep the split-sum ambient (confidence 0).
+        pub max_roughness: f32 => "float",
+        /// How far a ray may pass behind the surface the depth buffer holds and still hit it, as
+        /// a fraction of that surface's camera depth.
+        pub thickness: f32 => "float",
+        /// The pyramid's coarsest level.
+        pub top: u32 => "uint",
+        /// Hi-Z: the level this dispatch writes.
+        pub level: u32 => "uint",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
@@ -445,6 +463,9 @@ impl FrameFlags {
     /// Diffuse light gathered in screen space (the GI image): added to the sky's diffuse
     /// ambient, which AO still darkens.
     pub const SCREEN_GI: u32 = 1 << 6;
+    /// Screen-space reflections in the reflection image: rgb the incoming radiance along the
+    /// mirror direction, a the confidence in it; the split-sum ambient makes up the rest.
+    pub const SCREEN_REFLECTIONS: u32 = 1 << 7;
 }
 
 /// Shadow maps of each kind (2D and cube) the direct-light pass can bind: the length of its
@@ -513,6 +534,7 @@ pub fn glsl_layout() -> String {
     declare::<TothConstants>(&mut s);
     declare::<ScreenAoConstants>(&mut s);
     declare::<ScreenGiConstants>(&mut s);
+    declare::<SsrConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -530,6 +552,7 @@ pub fn glsl_layout() -> String {
         ("FRAME_REFLECTIONS_HALF", FrameFlags::REFLECTIONS_HALF),
         ("FRAME_RT_GI", FrameFlags::RT_GI),
         ("FRAME_SCREEN_GI", FrameFlags::SCREEN_GI),
+        ("FRAME_SCREEN_REFLECTIONS", FrameFlags::SCREEN_REFLECTIONS),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),
@@ -678,6 +701,7 @@ mod tests {
         check::<GodRayConstants>();
         check::<TothConstants>();
         check::<ScreenAoConstants>();
+        check::<SsrConstants>();
         check::<GpuGrid>();
         // The material section and its GLSL view are the same bytes.
         let m = crate::sections::GpuMaterial {

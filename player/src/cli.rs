@@ -253,6 +253,16 @@ pub struct Args {
     /// With --reflections rt: surfaces rougher than this keep the split-sum ambient.
     #[arg(long, value_name = "ROUGHNESS", default_value_t = 1.0)]
     pub reflection_max_roughness: f32,
+    /// With --reflections ssr: most iterations of the hierarchical march per pixel, 1 to 1024
+    /// (default 48: each skips a cell of empty space a level up or refines a potential hit a
+    /// level down; 48 crosses a 1080p screen with room to refine, fewer lose distant hits).
+    #[arg(long, value_name = "N")]
+    pub ssr_steps: Option<u32>,
+    /// With --reflections ssr: surfaces rougher than this keep the split-sum ambient, 0 to 1
+    /// (default 0.6: beyond it the reflection cone covers much of the screen, where one ray says
+    /// little; faded over the last fifth below it).
+    #[arg(long, value_name = "ROUGHNESS")]
+    pub ssr_max_roughness: Option<f32>,
     /// With --shadows rt: sphere radius of point and spot lights in scene units (0: hard
     /// shadows, as the file's punctual lights imply).
     #[arg(long, value_name = "R", default_value_t = 0.0)]
@@ -389,6 +399,8 @@ impl Args {
             "ao-steps" => self.ao_steps.map(|n| KnobValue::Number(n as f32)),
             "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
             "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
+            "ssr-steps" => self.ssr_steps.map(|n| KnobValue::Number(n as f32)),
+            "ssr-max-roughness" => self.ssr_max_roughness.map(KnobValue::Number),
             "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
             "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
             "ssgi-samples" => self.ssgi_samples.map(|n| KnobValue::Number(n as f32)),
@@ -650,6 +662,31 @@ mod tests {
         assert!(e.message.contains("--taa-frames"), "{}", e.message);
         let e = parse(&["f.kiln", "--aa", "taa", "--no-accumulate"]).unwrap_err().to_string();
         assert!(e.contains("--no-accumulate") && e.contains("--aa"), "{e}");
+    }
+
+    #[test]
+    fn ssr_flags_set_its_knobs_with_their_defaults() {
+        assert_eq!(
+            techniques(&["f.kiln", "--reflections", "ssr"]).reflections,
+            Reflections::Ssr { steps: 48, max_roughness: 0.6 }
+        );
+        let t = techniques(&[
+            "f.kiln",
+            "--reflections",
+            "ssr",
+            "--ssr-steps",
+            "96",
+            "--ssr-max-roughness",
+            "0.3",
+        ]);
+        assert_eq!(t.reflections, Reflections::Ssr { steps: 96, max_roughness: 0.3 });
+        for bad in [&["--ssr-steps", "0"][..], &["--ssr-max-roughness", "1.5"]] {
+            let args: Vec<&str> =
+                ["f.kiln", "--reflections", "ssr"].into_iter().chain(bad.iter().copied()).collect();
+            let e = parse(&args).unwrap().techniques().unwrap_err();
+            assert_eq!(e.exit, Exit::Usage);
+            assert!(e.message.contains(bad[0]), "{bad:?}: {}", e.message);
+        }
     }
 
     #[test]

@@ -162,6 +162,14 @@ struct ScreenGiConstants {
     uvec2 pad; // offset 40
 }; // 48 bytes
 
+struct SsrConstants {
+    uint steps; // offset 0
+    float max_roughness; // offset 4
+    float thickness; // offset 8
+    uint top; // offset 12
+    uint level; // offset 16
+}; // 20 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;
@@ -178,6 +186,7 @@ const uint FRAME_RT_REFLECTIONS = 8u;
 const uint FRAME_REFLECTIONS_HALF = 16u;
 const uint FRAME_RT_GI = 32u;
 const uint FRAME_SCREEN_GI = 64u;
+const uint FRAME_SCREEN_REFLECTIONS = 128u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;

@@ -4,7 +4,8 @@
 // shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, plus the constant sky
 // through the split-sum table (its diffuse part times the ray-traced AO, or replaced by the
 // ray-traced GI; its specular part replaced by the ray-traced reflections where they were
-// traced) and emission.
+// traced, or blended with the screen-space reflections' radiance by their confidence) and
+// emission.
 // Output: linear scene radiance (before exposure and tone mapping).
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
@@ -32,6 +33,8 @@ layout(set = 0, binding = 10) uniform sampler2D g_emission;
 layout(set = 0, binding = 11, rgba32f) uniform writeonly image2D radiance_out;
 layout(set = 0, binding = 12, r32f) uniform readonly image2DArray rt_shadows;
 layout(set = 0, binding = 13, r32f) uniform readonly image2D rt_ao;
+// Ray-traced reflections (rgb, a > 0 where traced) or, with FRAME_SCREEN_REFLECTIONS, the
+// screen-space ones (rgb the incoming radiance along the mirror direction, a the confidence).
 layout(set = 0, binding = 14, rgba32f) uniform readonly image2D rt_reflections;
 layout(set = 0, binding = 15, rgba32f) uniform readonly image2D rt_gi;
 // Participating media between surfaces and lights (`frame.sky.w` boxes: with a media technique).
@@ -255,7 +258,15 @@ void main() {
         radiance += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
-        vec3 split_sum = (f0 * rg.r + rg.g) * frame.sky.rgb * occlusion;
+        vec3 sky_in = frame.sky.rgb * occlusion;
+        if ((frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {
+            // The split sum's prefiltered incoming radiance: what the screen showed along the
+            // mirror direction, the sky (occluded) where it showed nothing; the same table weighs
+            // both (seed 000 eq. 2.19).
+            vec4 screen = imageLoad(rt_reflections, pixel);
+            sky_in = mix(sky_in, screen.rgb, clamp(screen.a, 0.0, 1.0));
+        }
+        vec3 split_sum = (f0 * rg.r + rg.g) * sky_in;
         radiance += compensation * (traced.a > 0.0 ? traced.rgb / traced.a : split_sum);
     }
 

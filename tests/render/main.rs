@@ -23,5 +23,6 @@ mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipe
 mod screen_ao; // SAO and GTAO: a flat floor unoccluded, an inside corner against the estimator and the closed form
 mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows
 mod ssgi; // screen-space GI: a red wall's bleed onto the floor against its closed form, none from off screen
+mod ssr; // screen-space reflections of an emitter in a mirror floor, the split sum where they leave the screen
 mod taa; // temporal anti-aliasing against 16× supersampling, still and moving, no ghosts
 mod textures; // BC textures render within a small FLIP of RGBA8; RGBA8-only passes refuse them

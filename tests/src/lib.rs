@@ -164,6 +164,12 @@ impl Options {
         self
     }
 
+    /// Reflections by `reflections` (any technique).
+    pub fn reflections(mut self, reflections: ReflectionsTechnique) -> Options {
+        self.0.render.techniques.reflections = reflections;
+        self
+    }
+
     /// Path-traced diffuse GI counting `bounces` scattering events after the visible surface.
     pub fn rt_gi(mut self, bounces: u32) -> Options {
         self.0.render.techniques.gi = Gi::Rt { bounces };

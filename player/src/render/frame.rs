@@ -2,8 +2,10 @@
 //! images they make and bind.
 //!
 //! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, the
-//! depth pyramid (for screen-space AO or GI), AO (ray-traced, SAO or GTAO), reflections, GI
-//! (ray-traced, or the lit pyramid and screen-space GI) (each when chosen) → the
+//! depth pyramid (for screen-space AO or GI), AO (ray-traced, SAO or GTAO), reflections
+//! (ray-traced, or the Hi-Z pyramid and SSR, which reads the previous frame's radiance before the
+//! direct pass overwrites it), GI (ray-traced, or the lit pyramid and screen-space GI) (each when
+//! chosen) → the
 //! ray-traced passes' reprojected accumulation (with `--aa reproject` or `taa`) → direct light
 //! and composition → participating media (march, mitchell, sousa or toth, when chosen) →
 //! temporal anti-aliasing (when chosen) → tone mapping.
@@ -13,6 +15,7 @@ use super::passes::Pass;
 use super::passes::depth_pyramid::{DepthPyramidPass, Reduction};
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
+use super::passes::hiz::HizPass;
 use super::passes::lit_pyramid::LitPyramidPass;
 use super::passes::media::MediaMarchPass;
 use super::passes::mitchell::MitchellPass;
@@ -24,6 +27,7 @@ use super::passes::rt_reflections::RtReflectionsPass;
 use super::passes::rt_shadows::RtShadowsPass;
 use super::passes::sousa::SousaPass;
 use super::passes::ssgi::SsgiPass;
+use super::passes::ssr::SsrPass;
 use super::passes::taa::TaaPass;
 use super::passes::tonemap::TonemapPass;
 use super::passes::toth::TothPass;
@@ -85,8 +89,22 @@ fn passes(
                 }));
             }
         }
-        if let Reflections::Rt { resolution, .. } = techniques.reflections {
-            made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?));
+        // The lit pyramid (the previous frame's radiance), for screen-space reflections and GI:
+        // made once, before either reads it.
+        if matches!(techniques.reflections, Reflections::Ssr { .. })
+            || matches!(techniques.gi, Gi::Ssgi { .. })
+        {
+            made.push(Box::new(LitPyramidPass::new(gpu)?));
+        }
+        match techniques.reflections {
+            Reflections::None => {}
+            Reflections::Rt { resolution, .. } => {
+                made.push(Box::new(RtReflectionsPass::new(gpu, resolution, lights, decode)?))
+            }
+            Reflections::Ssr { .. } => {
+                made.push(Box::new(HizPass::new(gpu)?));
+                made.push(Box::new(SsrPass::new(gpu, techniques.reflections)?));
+            }
         }
         match techniques.gi {
             Gi::Rt { .. } => made.push(Box::new(RtGiPass::new(gpu, spirv::RT_GI, decode)?)),
@@ -98,10 +116,7 @@ fn passes(
                 };
                 made.push(Box::new(RtGiPass::with_line_space(gpu, code, decode)?));
             }
-            Gi::Ssgi { .. } => {
-                made.push(Box::new(LitPyramidPass::new(gpu)?));
-                made.push(Box::new(SsgiPass::new(gpu, techniques.gi)?));
-            }
+            Gi::Ssgi { .. } => made.push(Box::new(SsgiPass::new(gpu, techniques.gi)?)),
             Gi::None => {}
         }
         if let Some(frames) = techniques.reprojected_rays() {

@@ -163,7 +163,7 @@ impl Renderer {
                 passes::rt_reflections::lights(lights_used),
                 max_roughness,
             ),
-            Reflections::None => (1, 0, 1.0),
+            Reflections::None | Reflections::Ssr { .. } => (1, 0, 1.0),
         };
         let shadow_layers = if rt_shadows { passes::rt_shadows::layers(lights_used) } else { 0 };
         let rt_constants = RtConstants {
@@ -199,6 +199,7 @@ impl Renderer {
             Reflections::Rt { resolution: ReflectionRes::Half, .. } => {
                 flags |= FrameFlags::RT_REFLECTIONS | FrameFlags::REFLECTIONS_HALF
             }
+            Reflections::Ssr { .. } => flags |= FrameFlags::SCREEN_REFLECTIONS,
             Reflections::None => {}
         }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;

@@ -51,6 +51,12 @@ shaders! {
     PYRAMID_LINEAR = "pyramid" / "linear.comp";
     /// A level of the depth pyramid from the one below.
     PYRAMID_REDUCE = "pyramid" / "reduce.comp";
+    /// Level 0 of the Hi-Z pyramid of the screen-space reflections.
+    HIZ_COPY = "hiz" / "copy.comp";
+    /// A level of the Hi-Z pyramid from the one below (closest surface).
+    HIZ_REDUCE = "hiz" / "reduce.comp";
+    /// Screen-space reflections: the hierarchical march.
+    SSR_TRACE = "ssr" / "trace.comp";
     /// Level 0 of the lit-radiance pyramid: the previous frame's light, reprojected.
     LIT_REPROJECT = "lit" / "reproject.comp";
     /// A level of the lit-radiance pyramid from the one below.

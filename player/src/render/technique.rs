@@ -149,6 +149,17 @@ pub enum Reflections {
         /// Surfaces rougher than this keep the split-sum ambient.
         max_roughness: f32,
     },
+    /// Screen-space reflections (seed 000 §3.9, traced hierarchically after McGuire & Mara 2014
+    /// and AMD's FidelityFX SSSR): the mirror direction marched through a closest-depth (Hi-Z)
+    /// pyramid, a hit accepted at the coarsest level the roughness's cone covers, showing the
+    /// previous frame's lit radiance; the split-sum ambient where the ray misses or leaves the
+    /// screen (`passes/ssr.rs`).
+    Ssr {
+        /// The most iterations of the hierarchical march per pixel.
+        steps: u32,
+        /// Surfaces rougher than this keep the split-sum ambient.
+        max_roughness: f32,
+    },
 }
 
 /// Indirect diffuse light: what replaces the sky's diffuse ambient.
@@ -514,6 +525,12 @@ impl Techniques {
         self.aa.reprojected().filter(|_| self.ray_traced())
     }
 
+    /// Whether a pass shows the previous frame's radiance (the screen-space reflections and GI
+    /// read the lit pyramid): the first frame lacks it, so the image depends on the frame count.
+    pub fn reads_previous_frame(&self) -> bool {
+        matches!(self.reflections, Reflections::Ssr { .. }) || matches!(self.gi, Gi::Ssgi { .. })
+    }
+
     /// Whether any ray-traced pass runs.
     pub fn ray_traced(&self) -> bool {
         self.shadows.traced().is_some()
@@ -528,7 +545,11 @@ impl Techniques {
         Techniques {
             shadows: if self.shadows.traced().is_some() { Shadows::None } else { self.shadows },
             ao: if matches!(self.ao, Ao::Rt { .. }) { Ao::None } else { self.ao },
-            reflections: Reflections::None,
+            reflections: if matches!(self.reflections, Reflections::Rt { .. }) {
+                Reflections::None
+            } else {
+                self.reflections
+            },
             gi: Gi::None,
             ..self
         }
@@ -606,6 +627,12 @@ impl Techniques {
                     } else {
                         ReflectionRes::Full
                     },
+                    max_roughness: v(1).number(),
+                }
+            }
+            (Effect::Reflections, "ssr") => {
+                self.reflections = Reflections::Ssr {
+                    steps: whole(effect, name, "ssr-steps", v(0))?,
                     max_roughness: v(1).number(),
                 }
             }
@@ -703,6 +730,7 @@ impl Techniques {
             Effect::Reflections => match self.reflections {
                 Reflections::None => "none",
                 Reflections::Rt { .. } => "rt",
+                Reflections::Ssr { .. } => "ssr",
             },
             Effect::Gi => match self.gi {
                 Gi::None => "none",
@@ -981,7 +1009,7 @@ const fn artistic(knob: Knob) -> Knob {
     Knob { role: KnobRole::Scene, ..knob }
 }
 
-static CATALOGUE: [TechniqueInfo; 25] = [
+static CATALOGUE: [TechniqueInfo; 26] = [
     TechniqueInfo {
         effect: Effect::GBuffer,
         name: "raster",
@@ -1148,6 +1176,38 @@ static CATALOGUE: [TechniqueInfo; 25] = [
                 &[0.4, 1.0],
             ),
         ],
+        stochastic: true,
+    },
+    TechniqueInfo {
+        effect: Effect::Reflections,
+        name: "ssr",
+        help: "screen-space reflections (seed 000, traced hierarchically after McGuire & Mara 2014 and \
+               AMD's SSSR): the mirror direction marched through a closest-depth pyramid, showing \
+               the previous frame's lit radiance at the hit; rougher surfaces accept coarser hits; \
+               the split-sum ambient where the ray misses or leaves the screen (faded near its \
+               edges) and above --ssr-max-roughness; see --ssr-steps",
+        knobs: &[
+            number(
+                "ssr-steps",
+                "most iterations of the hierarchical march per pixel: each skips a cell of empty space \
+                 (a level up) or refines a potential hit (a level down); 48 crosses a 1080p screen \
+                 with room to refine, fewer lose distant hits",
+                1.0,
+                1024.0,
+                48.0,
+                &[16.0, 32.0, 48.0, 96.0],
+            ),
+            number(
+                "ssr-max-roughness",
+                "surfaces rougher than this keep the split-sum ambient (faded over the last fifth): \
+                 above about 0.6 the cone covers much of the screen, where one ray says little",
+                0.0,
+                1.0,
+                0.6,
+                &[0.3, 0.6],
+            ),
+        ],
+        // Not noisy, but it shows the previous frame's radiance: none in the first frame.
         stochastic: true,
     },
     TechniqueInfo {
@@ -1511,6 +1571,29 @@ mod tests {
         assert!(e.contains("media-block 4") && e.contains("16"), "{e}");
         t.set(Effect::Media, "toth", &[("media-phase", KnobValue::Choice(1))]).unwrap();
         assert_eq!(t.media, Media::Toth { samples: 60, block: 4, phase: Phase::Rayleigh });
+    }
+
+    #[test]
+    fn the_catalogue_builds_ssr_with_its_knobs_and_it_needs_no_rays() {
+        let mut t = Techniques::default();
+        t.set(Effect::Reflections, "ssr", &[]).unwrap();
+        assert_eq!(t.reflections, Reflections::Ssr { steps: 48, max_roughness: 0.6 });
+        assert_eq!(t.name_of(Effect::Reflections), "ssr");
+        t.set(
+            Effect::Reflections,
+            "ssr",
+            &[("ssr-steps", KnobValue::Number(16.0)), ("ssr-max-roughness", KnobValue::Number(0.3))],
+        )
+        .unwrap();
+        assert_eq!(t.reflections, Reflections::Ssr { steps: 16, max_roughness: 0.3 });
+        // Screen space: the G-buffer only, kept on a file without a BVH.
+        assert!(!t.ray_traced());
+        assert_eq!(t.needs(), Techniques { reflections: Reflections::None, ..t }.needs());
+        assert_eq!(t.without_rays().reflections, t.reflections);
+        for (knob, bad) in [("ssr-steps", 1.5), ("ssr-steps", 0.0), ("ssr-max-roughness", 1.5)] {
+            let e = t.set(Effect::Reflections, "ssr", &[(knob, KnobValue::Number(bad))]).unwrap_err();
+            assert!(e.contains(knob), "{e}");
+        }
     }
 
     #[test]

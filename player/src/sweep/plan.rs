@@ -229,9 +229,13 @@ pub fn names(target: Target) -> Vec<&'static str> {
 type Preset = (&'static str, &'static str, fn(&mut Techniques));
 
 /// The frame presets, each with both G-buffers.
-const PRESETS: [Preset; 6] = [
+const PRESETS: [Preset; 7] = [
     ("baked", "shadow maps, no AO, split-sum reflections", |t| {
         t.shadows = Shadows::ShadowMap;
+    }),
+    ("baked-ssr", "as baked with screen-space reflections (--reflections ssr)", |t| {
+        t.shadows = Shadows::ShadowMap;
+        set(t, Effect::Reflections, "ssr");
     }),
     ("baked-taa", "as baked with temporal anti-aliasing (--aa taa)", |t| {
         t.shadows = Shadows::ShadowMap;
@@ -358,7 +362,10 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                             technique: format!("{}/{name}", gbuffer.name),
                             knobs: BTreeMap::new(),
                             techniques: t,
-                            checkpoints: checkpoints(t.ray_traced() || t.aa.temporal(), &t),
+                            checkpoints: checkpoints(
+                                t.ray_traced() || t.aa.temporal() || t.reads_previous_frame(),
+                                &t,
+                            ),
                         });
                     }
                 }
