@@ -94,7 +94,7 @@ fn floor_point(cam: &Pinhole, x: u32, y: u32) -> Option<DVec3> {
     (p.z > 0.0 && p.x.abs() < 8.0 && p.z < 8.0).then_some(p)
 }
 
-fn ssgi() -> Gi {
+fn ssgi(tiled: bool) -> Gi {
     Gi::Ssgi {
         samples: 128,
         resolution: ScreenFraction::Half,
@@ -102,16 +102,17 @@ fn ssgi() -> Gi {
         voting: true,
         falloff: false,
         frames: 16,
-        tiled: false,
+        tiled,
     }
 }
 
-/// Per-channel radiance with SSGI minus without, for `cam`'s scene.
-fn gathered(name: &str, cam: &Pinhole) -> Vec<f64> {
+/// Per-channel radiance with SSGI (spirals turned per texel or per tile) minus without, for
+/// `cam`'s scene.
+fn gathered(name: &str, cam: &Pinhole, tiled: bool) -> Vec<f64> {
     let dir = tempfile::tempdir().unwrap();
     let bytes = scene(cam);
     let opts = |gi: Gi| move |f: &std::path::Path| Options::new(f, W, H).unshadowed().gi(gi);
-    let (with, _) = render_frames(dir.path(), name, &bytes, FRAMES, opts(ssgi()));
+    let (with, _) = render_frames(dir.path(), name, &bytes, FRAMES, opts(ssgi(tiled)));
     let (without, _) = render_frames(dir.path(), &format!("{name}-off"), &bytes, 1, opts(Gi::None));
     with.iter().zip(&without).map(|(&a, &b)| a as f64 - b as f64).collect()
 }
@@ -122,13 +123,20 @@ fn ssgi_bleeds_a_red_wall_onto_the_floor_as_the_closed_form_says() {
         return;
     }
     let cam = facing();
-    let gain = gathered("ssgi-facing", &cam);
+    for tiled in [false, true] {
+        bleed(&cam, tiled);
+    }
+}
+
+fn bleed(cam: &Pinhole, tiled: bool) {
+    let gain = gathered("ssgi-facing", cam, tiled);
+    eprintln!("tiled rotation: {tiled}");
     // Two bands of floor before the wall: near (0.3 to 1 unit) and far (1.5 to 3): their
     // ratio checks the fall-off with distance, each its level.
     let mut bands = [(0.0, 0.0, 0.0, 0usize); 2]; // (got red, expected red, got green, pixels)
     for i in 0..(W * H) as usize {
         let (x, y) = pixel_xy(3 * i);
-        let Some(p) = floor_point(&cam, x, y) else { continue };
+        let Some(p) = floor_point(cam, x, y) else { continue };
         if p.x.abs() > 2.0 {
             continue;
         }
@@ -175,7 +183,7 @@ fn ssgi_gives_nothing_from_a_wall_off_screen() {
     // the wall would receive the wall's red (the closed form below), but the camera looks down
     // at the sunlit floor alone, and coplanar floor points light each other with cos θ = 0.
     let cam = away();
-    let gain = gathered("ssgi-away", &cam);
+    let gain = gathered("ssgi-away", &cam, true);
     let (mut got, mut expected, mut n) = (0.0, 0.0, 0);
     for i in 0..(W * H) as usize {
         let (x, y) = pixel_xy(3 * i);
