@@ -60,7 +60,8 @@ vec3 from_ycocg(vec3 c) {
 // The history at image point `at` (pixels) through a Catmull–Rom filter: bilinear reads,
 // resampled every frame, would blur the history a little more each frame the camera moves.
 // Five bilinear taps (the 4 × 4 kernel's corners dropped, their weight renormalised); at a
-// texel centre it returns that texel exactly. Alpha (the history length) read bilinearly.
+// texel centre it returns that texel exactly. Alpha (the history length) from the middle tap: a
+// bilinear read of the 2 × 2 texels nearest the point.
 vec4 history_at(vec2 at) {
     vec2 size = vec2(textureSize(history, 0));
     vec2 centre = floor(at - 0.5) + 0.5;
@@ -73,13 +74,14 @@ vec4 history_at(vec2 at) {
     vec2 t0 = (centre - 1.0) / size;
     vec2 t3 = (centre + 2.0) / size;
     vec2 t12 = (centre + w2 / w12) / size;
+    vec4 middle = textureLod(history, t12, 0.0);
     vec3 c = textureLod(history, vec2(t12.x, t0.y), 0.0).rgb * (w12.x * w0.y)
            + textureLod(history, vec2(t0.x, t12.y), 0.0).rgb * (w0.x * w12.y)
-           + textureLod(history, t12, 0.0).rgb * (w12.x * w12.y)
+           + middle.rgb * (w12.x * w12.y)
            + textureLod(history, vec2(t3.x, t12.y), 0.0).rgb * (w3.x * w12.y)
            + textureLod(history, vec2(t12.x, t3.y), 0.0).rgb * (w12.x * w3.y);
     float total = w12.x * w0.y + w0.x * w12.y + w12.x * w12.y + w3.x * w12.y + w12.x * w3.y;
-    return vec4(max(c / total, vec3(0.0)), textureLod(history, at / size, 0.0).a);
+    return vec4(max(c / total, vec3(0.0)), middle.a);
 }
 
 // `c` moved along the line to the box's centre until it lies in the box (Playdead's clip: a
@@ -92,26 +94,39 @@ vec3 clip_to_box(vec3 c, vec3 lo, vec3 hi) {
     return reach > 1.0 ? mid + (c - mid) / reach : c;
 }
 
+// This workgroup's 8 × 8 pixels and a one-pixel border: each pixel's weighted YCoCg colour and
+// depth, loaded once into shared memory (the 3 × 3 neighbourhoods overlap nine-fold).
+shared vec3 tile_colour[10][10];
+shared float tile_depth[10][10];
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(frame.size.xy);
+    ivec2 origin = ivec2(gl_WorkGroupID.xy) * 8 - 1;
+    for (uint i = gl_LocalInvocationIndex; i < 100u; i += 64u) {
+        ivec2 t = ivec2(i % 10u, i / 10u);
+        ivec2 q = clamp(origin + t, ivec2(0), size - 1);
+        tile_colour[t.y][t.x] = to_ycocg(weigh(imageLoad(current, q).rgb));
+        tile_depth[t.y][t.x] = texelFetch(depth, q, 0).r;
+    }
+    barrier();
     if (any(greaterThanEqual(pixel, size))) {
         return;
     }
-    vec3 centre = weigh(imageLoad(current, pixel).rgb);
-    vec3 lo = to_ycocg(centre), hi = lo;
+    ivec2 local = ivec2(gl_LocalInvocationID.xy) + 1;
+    vec3 centre = from_ycocg(tile_colour[local.y][local.x]);
+    vec3 lo = tile_colour[local.y][local.x], hi = lo;
     vec3 sum = vec3(0.0), sum2 = vec3(0.0);
     float nearest = 0.0;
     [[unroll]] for (int dy = -1; dy <= 1; ++dy) {
         [[unroll]] for (int dx = -1; dx <= 1; ++dx) {
-            ivec2 q = clamp(pixel + ivec2(dx, dy), ivec2(0), size - 1);
-            vec3 c = to_ycocg(weigh(imageLoad(current, q).rgb));
+            vec3 c = tile_colour[local.y + dy][local.x + dx];
             lo = min(lo, c);
             hi = max(hi, c);
             sum += c;
             sum2 += c * c;
             // Reversed Z: the nearest surface has the largest depth.
-            nearest = max(nearest, texelFetch(depth, q, 0).r);
+            nearest = max(nearest, tile_depth[local.y + dy][local.x + dx]);
         }
     }
     // Variance clipping (Salvi 2016) inside the min/max box: the box of mean ± σ, tighter where

@@ -12,7 +12,7 @@
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
-use super::passes::depth_pyramid::{DepthPyramidPass, Reduction};
+use super::passes::depth_pyramid::{self, DepthPyramidPass, Reduction};
 use super::passes::direct::DirectPass;
 use super::passes::gbuffer::GBufferPass;
 use super::passes::hiz::HizPass;
@@ -72,11 +72,13 @@ fn passes(
         }
         // The depth pyramid, for screen-space AO and GI (GI's with normals, reduced as it says).
         let screen_ao = matches!(techniques.ao, Ao::Sao { .. } | Ao::Gtao { .. });
+        // Levels: GI gathers up to the top; SAO's samples read up to level 5; GTAO reads level 0.
+        let ao_top = if matches!(techniques.ao, Ao::Sao { .. }) { sao::TOP_LEVEL } else { 0 };
         if let Gi::Ssgi { voting, .. } = techniques.gi {
             let reduction = if voting { Reduction::Voting } else { Reduction::Nearest };
-            made.push(Box::new(DepthPyramidPass::new(gpu, reduction, true)?));
+            made.push(Box::new(DepthPyramidPass::new(gpu, reduction, true, depth_pyramid::TOP)?));
         } else if screen_ao {
-            made.push(Box::new(DepthPyramidPass::new(gpu, Reduction::Nearest, false)?));
+            made.push(Box::new(DepthPyramidPass::new(gpu, Reduction::Nearest, false, ao_top)?));
         }
         match techniques.ao {
             Ao::None => {}

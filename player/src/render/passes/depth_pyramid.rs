@@ -84,12 +84,15 @@ pub struct DepthPyramidPass {
     reduce: Kernel,
     reduction: Reduction,
     normals: bool,
+    /// The coarsest level built (the readers need no coarser one).
+    top: u32,
 }
 
 impl DepthPyramidPass {
-    /// Builds the pipelines of a pyramid reduced as `reduction` says, with the normals pyramid
-    /// when `normals` (always with [`Reduction::Voting`]).
-    pub fn new(gpu: &Gpu, reduction: Reduction, normals: bool) -> PlayResult<DepthPyramidPass> {
+    /// Builds the pipelines of a pyramid of levels 0 to `top` (at most [`TOP`]; the image always
+    /// has room for all), reduced as `reduction` says, with the normals pyramid when `normals`
+    /// (always with [`Reduction::Voting`]).
+    pub fn new(gpu: &Gpu, reduction: Reduction, normals: bool, top: u32) -> PlayResult<DepthPyramidPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<ScreenAoConstants>() as u32;
         let [linear, reduce] = Kernel::several(
@@ -113,7 +116,7 @@ impl DepthPyramidPass {
             push,
         )?;
         let normals = normals || reduction == Reduction::Voting;
-        Ok(DepthPyramidPass { linear, reduce, reduction, normals })
+        Ok(DepthPyramidPass { linear, reduce, reduction, normals, top: top.min(TOP) })
     }
 
     fn push(&self, level: u32) -> ScreenAoConstants {
@@ -168,15 +171,13 @@ impl Pass for DepthPyramidPass {
 
     fn record(&mut self, ctx: &mut FrameCtx) {
         let (width, height) = (ctx.images.width, ctx.images.height);
-        let mut written = vec![(PYRAMID, Access::Write(Use::STORAGE))];
-        if self.normals {
-            written.push((NORMAL_PYRAMID, Access::Write(Use::STORAGE)));
-        }
+        // The normals pyramid too when it is a placeholder: its descriptor needs the layout.
+        let written = [(PYRAMID, Access::Write(Use::STORAGE)), (NORMAL_PYRAMID, Access::Write(Use::STORAGE))];
         let mut first = vec![(DEPTH, Access::Read(Use::SAMPLED)), (NORMAL, Access::Read(Use::SAMPLED))];
         first.extend(&written);
         ctx.images.access(ctx.rec, &first);
         self.linear.dispatch(ctx.rec, bytemuck::bytes_of(&self.push(0)), width, height);
-        for (level, &(w, h)) in levels(width, height).iter().enumerate().skip(1) {
+        for (level, &(w, h)) in levels(width, height).iter().enumerate().skip(1).take(self.top as usize) {
             // Reads the level below, written by the previous dispatch: a barrier between them.
             let again: Vec<_> = written.iter().map(|&(t, _)| (t, Access::ReadWrite(Use::STORAGE))).collect();
             ctx.images.access(ctx.rec, &again);

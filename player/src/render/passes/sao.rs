@@ -12,6 +12,10 @@ use crate::gpu::Gpu;
 use crate::render::spirv;
 use crate::render::technique::Ao;
 
+/// The coarsest depth-pyramid level SAO's samples read (`SAO_TOP` in `shaders/sao/sao.comp`;
+/// McGuire et al. 2012 stop at 5).
+pub const TOP_LEVEL: u32 = 5;
+
 /// The pass of `technique` (an [`Ao::Sao`]).
 pub fn pass(gpu: &Gpu, technique: Ao) -> PlayResult<ScreenAoPass> {
     let Ao::Sao { samples, turns, resolution, .. } = technique else {
