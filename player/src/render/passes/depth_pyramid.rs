@@ -60,19 +60,31 @@ pub enum Reduction {
 
 /// The size of every level, 0 to [`TOP`], for a `width` × `height` screen.
 pub fn levels(width: u32, height: u32) -> Vec<(u32, u32)> {
+    levels_up_to(width, height, TOP)
+}
+
+/// The size of every level, 0 to `top`, each side halved from the one below (rounded up, so
+/// that every child's parent is child / 2): the layout every atlas pyramid shares (this one,
+/// the lit and GI pyramids, SSR's Hi-Z).
+pub fn levels_up_to(width: u32, height: u32, top: u32) -> Vec<(u32, u32)> {
     let mut s = (width.max(1), height.max(1));
     let mut out = vec![s];
-    for _ in 0..TOP {
+    for _ in 0..top {
         s = (s.0.div_ceil(2), s.1.div_ceil(2));
         out.push(s);
     }
     out
 }
 
-/// The image holding all levels: level 0's width plus level 1's, and the taller of level 0
-/// and the column of levels 1 to [`TOP`].
+/// The image holding levels 0 to [`TOP`].
 pub fn image_size(width: u32, height: u32) -> (u32, u32) {
-    let l = levels(width, height);
+    atlas_size(width, height, TOP)
+}
+
+/// The image holding levels 0 to `top` (at least 1): level 0's width plus level 1's, and the
+/// taller of level 0 and the column of levels 1 to `top`.
+pub fn atlas_size(width: u32, height: u32, top: u32) -> (u32, u32) {
+    let l = levels_up_to(width, height, top.max(1));
     let column: u32 = l[1..].iter().map(|s| s.1).sum();
     (l[0].0 + l[1].0, l[0].1.max(column))
 }

@@ -16,6 +16,7 @@
 
 use kiln_format::gpu::SsrConstants;
 
+use super::depth_pyramid;
 use super::gbuffer::DEPTH;
 use super::kernel::Kernel;
 use super::{FrameCtx, Pass, Shared};
@@ -36,23 +37,15 @@ pub const HIZ: TargetDecl = TargetDecl {
     array: false,
 };
 
-/// The size of every level, 0 to [`TOP`], for a `width` × `height` screen.
+/// The size of every level, 0 to [`TOP`], for a `width` × `height` screen (the layout of the
+/// depth pyramid's atlas, two levels deeper).
 pub fn levels(width: u32, height: u32) -> Vec<(u32, u32)> {
-    let mut s = (width.max(1), height.max(1));
-    let mut out = vec![s];
-    for _ in 0..TOP {
-        s = (s.0.div_ceil(2), s.1.div_ceil(2));
-        out.push(s);
-    }
-    out
+    depth_pyramid::levels_up_to(width, height, TOP)
 }
 
-/// The image holding all levels: level 0's width plus level 1's, and the taller of level 0 and
-/// the column of levels 1 to [`TOP`].
+/// The image holding all levels.
 pub fn image_size(width: u32, height: u32) -> (u32, u32) {
-    let l = levels(width, height);
-    let column: u32 = l[1..].iter().map(|s| s.1).sum();
-    (l[0].0 + l[1].0, l[0].1.max(column))
+    depth_pyramid::atlas_size(width, height, TOP)
 }
 
 /// The pass.
