@@ -49,6 +49,8 @@ shaders! {
     SOUSA_COMPOSITE = "sousa" / "composite.comp";
     /// Level 0 of the camera-space depth pyramid.
     PYRAMID_LINEAR = "pyramid" / "linear.comp";
+    /// Levels 0 to 5 of a nearest depth pyramid in one dispatch.
+    PYRAMID_SINGLE = "pyramid" / "single.comp";
     /// A level of the depth pyramid from the one below.
     PYRAMID_REDUCE = "pyramid" / "reduce.comp";
     /// Level 0 of the Hi-Z pyramid of the screen-space reflections.

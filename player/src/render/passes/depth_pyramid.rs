@@ -94,6 +94,8 @@ pub fn atlas_size(width: u32, height: u32, top: u32) -> (u32, u32) {
 pub struct DepthPyramidPass {
     linear: Kernel,
     reduce: Kernel,
+    /// Levels 0 to 5 in one dispatch (nearest, no normals: SAO's pyramid).
+    single: Kernel,
     reduction: Reduction,
     normals: bool,
     /// The coarsest level built (the readers need no coarser one).
@@ -107,7 +109,7 @@ impl DepthPyramidPass {
     pub fn new(gpu: &Gpu, reduction: Reduction, normals: bool, top: u32) -> PlayResult<DepthPyramidPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<ScreenAoConstants>() as u32;
-        let [linear, reduce] = Kernel::several(
+        let [linear, reduce, single] = Kernel::several(
             gpu,
             [
                 (
@@ -124,11 +126,21 @@ impl DepthPyramidPass {
                     &[Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)],
                     spirv::PYRAMID_REDUCE,
                 ),
+                (
+                    &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)],
+                    spirv::PYRAMID_SINGLE,
+                ),
             ],
             push,
         )?;
         let normals = normals || reduction == Reduction::Voting;
-        Ok(DepthPyramidPass { linear, reduce, reduction, normals, top: top.min(TOP) })
+        Ok(DepthPyramidPass { linear, reduce, single, reduction, normals, top: top.min(TOP) })
+    }
+
+    /// Whether one dispatch makes the whole pyramid (`shaders/pyramid/single.comp`): a nearest
+    /// reduction without normals to at most level 5, whose 32 × 32-pixel blocks reduce alone.
+    fn single_pass(&self) -> bool {
+        self.reduction == Reduction::Nearest && !self.normals && (1..=5).contains(&self.top)
     }
 
     fn push(&self, level: u32) -> ScreenAoConstants {
@@ -171,6 +183,14 @@ impl Pass for DepthPyramidPass {
                 Write::StorageImage(4, img(&NORMAL_PYRAMID)),
             ],
         )?;
+        self.single.write(
+            gpu,
+            &[
+                Write::Buffer(0, shared.frame_ubo),
+                Write::Sampled(1, vec![(img(&DEPTH), shared.scene.nearest_clamp)]),
+                Write::StorageImage(2, img(&PYRAMID)),
+            ],
+        )?;
         self.reduce.write(
             gpu,
             &[
@@ -183,6 +203,16 @@ impl Pass for DepthPyramidPass {
 
     fn record(&mut self, ctx: &mut FrameCtx) {
         let (width, height) = (ctx.images.width, ctx.images.height);
+        if self.single_pass() {
+            ctx.images.access(
+                ctx.rec,
+                &[(DEPTH, Access::Read(Use::SAMPLED)), (PYRAMID, Access::Write(Use::STORAGE))],
+            );
+            let push = ScreenAoConstants { level: self.top, ..Default::default() };
+            // 16 × 16 threads per 32 × 32 pixels: the dispatch helper counts 8 × 8 groups.
+            self.single.dispatch(ctx.rec, bytemuck::bytes_of(&push), width.div_ceil(4), height.div_ceil(4));
+            return;
+        }
         // The normals pyramid too when it is a placeholder: its descriptor needs the layout.
         let written = [(PYRAMID, Access::Write(Use::STORAGE)), (NORMAL_PYRAMID, Access::Write(Use::STORAGE))];
         let mut first = vec![(DEPTH, Access::Read(Use::SAMPLED)), (NORMAL, Access::Read(Use::SAMPLED))];
@@ -200,6 +230,7 @@ impl Pass for DepthPyramidPass {
     fn destroy(&mut self, gpu: &Gpu) {
         self.linear.destroy(gpu);
         self.reduce.destroy(gpu);
+        self.single.destroy(gpu);
     }
 }
 
