@@ -27,13 +27,16 @@ layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D current;
 layout(set = 0, binding = 2) uniform sampler2D history;
 layout(set = 0, binding = 3) uniform sampler2D depth;
-layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D resolved;
+// Half floats: the history is read five times per pixel (Catmull–Rom) and written once; half the
+// bytes of 32-bit floats, and 2^-11 relative precision, below what a frame's blend changes.
+layout(set = 0, binding = 4, rgba16f) uniform writeonly image2D resolved;
 layout(push_constant) uniform Push {
     float frames;       // the longest history
     uint luma_weights;  // 1: blend c / (1 + luma)
 } taa;
 
 #include "../common/reproject.glsl"
+#include "../common/random.glsl"
 
 float luma(vec3 c) {
     return sqrt(max(0.299 * c.r * c.r + 0.587 * c.g * c.g + 0.114 * c.b * c.b, 0.0));
@@ -150,5 +153,12 @@ void main() {
         float w = 1.0 / min(n + 1.0, taa.frames);
         blended = mix(clamped, centre, w);
     }
-    imageStore(resolved, pixel, vec4(unweigh(blended), min(n + 1.0, 65536.0)));
+    // Half floats round a blend's small steps away (a step below half a unit in the last place is
+    // lost every frame, so the mean stalls short of its value); a random offset of up to half a
+    // unit in the last place makes the rounding right on average.
+    vec3 result = min(unweigh(blended), vec3(65000.0));
+    uint h = hash(uint(pixel.x) * 1973u + uint(pixel.y) * 9277u + uint(frame.params.z) * 26699u);
+    vec3 ulp = exp2(floor(log2(max(result, vec3(6.1e-5)))) - 10.0);
+    result = max(result + ulp * (float(h & 0xffffu) / 65536.0 - 0.5), vec3(0.0));
+    imageStore(resolved, pixel, vec4(result, min(n + 1.0, 65000.0)));
 }

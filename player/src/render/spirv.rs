@@ -27,6 +27,8 @@ shaders! {
     TONEMAP = "post" / "tonemap.comp";
     /// Temporal anti-aliasing.
     TAA_RESOLVE = "taa" / "resolve.comp";
+    /// Temporal anti-aliasing: the history written over the radiance.
+    TAA_OUTPUT = "taa" / "output.comp";
     /// Reprojected accumulation: where each pixel's point was, its frames of history.
     HISTORY_MOTION = "history" / "motion.comp";
     /// Reprojected accumulation of a layered one-channel target (shadows).

@@ -2,10 +2,10 @@
 //! rendered through a jittered projection ([`crate::render::taa_jitter`]), blended into the
 //! history reprojected from the previous camera and clamped to the frame's neighbourhood.
 //!
-//! Two history images take turns: frame n reads the one frame n − 1 wrote and writes the
-//! other. The result is then copied over the radiance, so that tone mapping and read-back see
-//! the anti-aliased image without knowing which history holds it (its alpha carries the
-//! history length).
+//! Two history images (half floats) take turns: frame n reads the one frame n − 1 wrote and
+//! writes the other. The result is then written over the radiance (`output.comp`), so that tone
+//! mapping and read-back see the anti-aliased image without knowing which history holds it (its
+//! alpha carries the history length).
 
 use super::direct::RADIANCE;
 use super::gbuffer::DEPTH;
@@ -19,11 +19,9 @@ use crate::render::spirv;
 const fn history(name: &'static str) -> TargetDecl {
     TargetDecl {
         name,
-        format: vk::Format::R32G32B32A32_SFLOAT,
+        format: vk::Format::R16G16B16A16_SFLOAT,
         usage: vk::ImageUsageFlags::from_raw(
-            vk::ImageUsageFlags::STORAGE.as_raw()
-                | vk::ImageUsageFlags::SAMPLED.as_raw()
-                | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
+            vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::SAMPLED.as_raw(),
         ),
         array: false,
     }
@@ -44,6 +42,8 @@ struct Push {
 #[derive(Debug)]
 pub struct TaaPass {
     kernel: Kernel,
+    /// History → radiance (`output.comp`); set i reads history i.
+    output: Kernel,
     push: Push,
     /// Which history the next frame writes.
     turn: usize,
@@ -62,8 +62,13 @@ impl TaaPass {
             Binding::one(StorageImage),
         ];
         let push = Push { frames: frames.max(1) as f32, luma_weights: luma_weights as u32 };
-        let kernel = Kernel::new(gpu, &bindings, spirv::TAA_RESOLVE, std::mem::size_of::<Push>() as u32)?;
-        Ok(TaaPass { kernel, push, turn: 0 })
+        let output_bindings = [Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)];
+        let [kernel, output] = Kernel::several(
+            gpu,
+            [(&bindings, spirv::TAA_RESOLVE), (&output_bindings, spirv::TAA_OUTPUT)],
+            std::mem::size_of::<Push>() as u32,
+        )?;
+        Ok(TaaPass { kernel, output, push, turn: 0 })
     }
 }
 
@@ -96,6 +101,15 @@ impl Pass for TaaPass {
                     Write::StorageImage(4, img(written)),
                 ],
             )?;
+            self.output.write_set(
+                gpu,
+                i,
+                &[
+                    Write::Buffer(0, shared.frame_ubo),
+                    Write::StorageImage(1, img(written)),
+                    Write::StorageImage(2, img(&RADIANCE)),
+                ],
+            )?;
         }
         // New images: the renderer marks the history invalid for the next frame.
         self.turn = 0;
@@ -122,13 +136,20 @@ impl Pass for TaaPass {
         );
         ctx.images.access(
             ctx.rec,
-            &[(written, Access::Read(Use::TRANSFER_SRC)), (RADIANCE, Access::Write(Use::TRANSFER_DST))],
+            &[(written, Access::Read(Use::STORAGE)), (RADIANCE, Access::Write(Use::STORAGE))],
         );
-        ctx.rec.copy_image(ctx.images.get(&written), ctx.images.get(&RADIANCE));
+        self.output.dispatch_set(
+            ctx.rec,
+            self.turn,
+            bytemuck::bytes_of(&self.push),
+            ctx.images.width,
+            ctx.images.height,
+        );
         self.turn = 1 - self.turn;
     }
 
     fn destroy(&mut self, gpu: &Gpu) {
         self.kernel.destroy(gpu);
+        self.output.destroy(gpu);
     }
 }
