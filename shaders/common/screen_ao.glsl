@@ -36,14 +36,36 @@ ivec2 pyramid_size(int level) {
     return s;
 }
 
-// The world point of screen pixel `pixel` (full resolution) at camera depth z (the distance
-// along the camera's forward axis): pixel_ray has a forward component of 1.
-vec3 point_at_depth(ivec2 pixel, float z) {
-    vec2 at = vec2(pixel) + 0.5;
+// The rotated-grid child of level texel q in the level below, of size `below` (McGuire et al.
+// 2012, §2.2: child (1 − y mod 2, 1 − x mod 2), clamped into the level).
+ivec2 pyramid_child(ivec2 q, ivec2 below) {
+    return min(2 * q + ivec2((q.y & 1) ^ 1, (q.x & 1) ^ 1), below - 1);
+}
+
+// The camera depth (distance along the camera's forward axis) of image point `at` at reversed-Z
+// `depth`.
+float camera_depth(vec2 at, float depth) {
+    return dot(world_at_depth(at, depth) - pixel_origin(at), frame.camera_forward.xyz);
+}
+
+// The world point of level `level`'s texel `t` at camera depth z: through the centre of the
+// texel's block of full-resolution pixels (pixel_ray has a forward component of 1).
+vec3 level_point(ivec2 t, int level, float z) {
+    vec2 at = (vec2(t) + 0.5) * float(1 << level);
     return pixel_origin(at) + pixel_ray(at) * z;
 }
 
-// Screen pixels per world unit at camera depth z (across the image plane), the seed's S'/z.
+// The world point of screen pixel `pixel` (full resolution) at camera depth z.
+vec3 point_at_depth(ivec2 pixel, float z) {
+    return level_point(pixel, 0, z);
+}
+
+// World units per screen pixel at camera depth z (across the image plane).
+float units_per_pixel(float z) {
+    return 2.0 * frame.camera_up.w * (camera_orthographic() ? 1.0 : z) / float(frame.size.y);
+}
+
+// Screen pixels per world unit at camera depth z, the seed's S'/z (its inverse).
 float pixels_per_unit(float z) {
     float half_height = frame.camera_up.w * (camera_orthographic() ? 1.0 : z);
     return float(frame.size.y) / (2.0 * half_height);

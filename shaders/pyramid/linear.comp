@@ -22,8 +22,7 @@ void main() {
     float depth = texelFetch(depth_tex, p, 0).r;
     float z = 0.0;
     if (depth > 0.0) {
-        vec2 at = vec2(p) + 0.5;
-        z = max(dot(world_at_depth(at, depth) - pixel_origin(at), frame.camera_forward.xyz), 1e-6);
+        z = max(camera_depth(vec2(p) + 0.5, depth), 1e-6);
     }
     imageStore(pyramid, p, vec4(z));
     if (ao.normals != 0u) {

@@ -35,7 +35,7 @@ void main() {
     }
     ivec2 below = pyramid_size(level - 1);
     ivec2 origin = pyramid_origin(level - 1);
-    ivec2 child = min(2 * q + ivec2((q.y & 1) ^ 1, (q.x & 1) ^ 1), below - 1);
+    ivec2 child = pyramid_child(q, below);
     if (ao.voting != 0u) {
         // Means over the 4 × 4 children around the block (sky texels left out).
         float z_sum = 0.0;

@@ -17,18 +17,10 @@ layout(push_constant) uniform Push { ScreenAoConstants ao; };
 
 shared float level_z[16][16];
 
-float camera_depth(ivec2 p) {
+// Level 0 at pixel p (as linear.comp): its camera depth, 0 on the sky.
+float level0(ivec2 p) {
     float depth = texelFetch(depth_tex, p, 0).r;
-    if (depth <= 0.0) {
-        return 0.0;
-    }
-    vec2 at = vec2(p) + 0.5;
-    return max(dot(world_at_depth(at, depth) - pixel_origin(at), frame.camera_forward.xyz), 1e-6);
-}
-
-// The rotated-grid child of texel q (McGuire et al. 2012), clamped into the level below.
-ivec2 child_of(ivec2 q, ivec2 below) {
-    return min(2 * q + ivec2((q.y & 1) ^ 1, (q.x & 1) ^ 1), below - 1);
+    return depth > 0.0 ? max(camera_depth(vec2(p) + 0.5, depth), 1e-6) : 0.0;
 }
 
 void main() {
@@ -42,7 +34,7 @@ void main() {
         ivec2 p = 2 * q + ivec2(k & 1, k >> 1);
         z[k] = 0.0;
         if (all(lessThan(p, screen))) {
-            z[k] = camera_depth(p);
+            z[k] = level0(p);
             imageStore(pyramid, p, vec4(z[k]));
         }
     }
@@ -54,7 +46,7 @@ void main() {
     // would lie in another block.
     float z1 = 0.0;
     if (all(lessThan(q, pyramid_size(1)))) {
-        ivec2 c = child_of(q, screen) - 2 * q;
+        ivec2 c = pyramid_child(q, screen) - 2 * q;
         z1 = z[c.x + 2 * c.y];
         imageStore(pyramid, pyramid_origin(1) + q, vec4(z1));
     }
@@ -68,7 +60,7 @@ void main() {
         bool working = all(lessThan(lid, ivec2(side)));
         bool inside = working && all(lessThan(ql, pyramid_size(level)));
         if (inside) {
-            ivec2 cl = child_of(ql, pyramid_size(level - 1)) - 2 * block * side;
+            ivec2 cl = pyramid_child(ql, pyramid_size(level - 1)) - 2 * block * side;
             zl = level_z[cl.y][cl.x];
         }
         barrier();

@@ -106,8 +106,7 @@ void main() {
         float cos_source = max(dot(ns, dir), 0.0);
         float cos_receiver = max(dot(n, -dir), 0.0);
         // World size of a full-resolution pixel at the sample's camera depth.
-        float unit = 2.0 * frame.camera_up.w * (camera_orthographic() ? 1.0 : dot(y, frame.camera_forward.xyz))
-            / float(frame.size.y);
+        float unit = units_per_pixel(dot(y, frame.camera_forward.xyz));
         float ds = unit * unit * packed_tilt(texel);
         sum += light * (cos_source * cos_receiver * ds / (r2 + SINGULARITY) * r);
     }

@@ -12,13 +12,6 @@
 #ifndef KILN_SSGI_PACKED_GLSL
 #define KILN_SSGI_PACKED_GLSL
 
-// The world point of level `level`'s texel `t` at camera depth z: through the centre of the
-// texel's block of full-resolution pixels.
-vec3 level_point(ivec2 t, int level, float z) {
-    vec2 at = (vec2(t) + 0.5) * float(1 << level);
-    return pixel_origin(at) + pixel_ray(at) * z;
-}
-
 uvec4 pack_texel(vec3 p, vec3 light, float tilt, vec2 n_enc) {
     uint last = (packHalf2x16(vec2(tilt, 0.0)) & 0xffffu) | (packSnorm4x8(vec4(n_enc, 0.0, 0.0)) << 16);
     return uvec4(packHalf2x16(p.xy), packHalf2x16(vec2(p.z, light.r)), packHalf2x16(light.gb), last);

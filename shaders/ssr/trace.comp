@@ -49,11 +49,6 @@ vec3 to_image(vec3 w) {
     return vec3(ndc_to_image(c.xy / c.w), c.z / c.w);
 }
 
-// Distance along the camera's forward axis of the point at image point `at` and depth `depth`.
-float camera_depth(vec2 at, float depth) {
-    return dot(world_at_depth(at, depth) - pixel_origin(at), frame.camera_forward.xyz);
-}
-
 // sin θ / (1 + sin θ) for the cone of roughness r (seed 000 §10): the inradius of the cone's
 // isosceles cross-section per unit of its length (HFK16), so that the footprint's diameter at
 // distance L is 2 L times this.

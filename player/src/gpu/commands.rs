@@ -369,34 +369,6 @@ impl<'a> Recorder<'a> {
         };
     }
 
-    /// Copies mip 0, layer 0 of `src` (TRANSFER_SRC) over `dst` (TRANSFER_DST) of the same size
-    /// and texel size.
-    pub fn copy_image(&self, src: &Image, dst: &Image) {
-        let sub = vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        };
-        let region = [vk::ImageCopy {
-            src_subresource: sub,
-            src_offset: vk::Offset3D::default(),
-            dst_subresource: sub,
-            dst_offset: vk::Offset3D::default(),
-            extent: vk::Extent3D { width: src.desc.width, height: src.desc.height, depth: 1 },
-        }];
-        unsafe {
-            self.gpu.device.cmd_copy_image(
-                self.cmd,
-                src.raw,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                dst.raw,
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &region,
-            )
-        };
-    }
-
     /// Blits `src` (TRANSFER_SRC) over the whole of `dst` (TRANSFER_DST), nearest filtering.
     pub fn blit(&self, src: &Image, dst: vk::Image, width: u32, height: u32) {
         let sub = vk::ImageSubresourceLayers {

@@ -20,9 +20,7 @@ pub const RADIANCE: TargetDecl = TargetDecl {
     name: "radiance",
     format: vk::Format::R32G32B32A32_SFLOAT,
     usage: vk::ImageUsageFlags::from_raw(
-        vk::ImageUsageFlags::STORAGE.as_raw()
-            | vk::ImageUsageFlags::TRANSFER_SRC.as_raw()
-            | vk::ImageUsageFlags::TRANSFER_DST.as_raw(),
+        vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
     ),
     array: false,
 };
