@@ -101,7 +101,7 @@ pub struct LineSpaceStats {
     pub candidate_entries: u64,
     /// Triangles of the fullest cell.
     pub max_cell_triangles: u32,
-    /// Shaft–triangle overlap tests run by the hierarchical search.
+    /// (Triangle, shaft) pairs tested exactly: the shafts within each triangle's projected reach.
     pub overlap_tests: u64,
     /// Filled shafts with a missing front or back PNMT record.
     pub pnmt_missing_records: u64,

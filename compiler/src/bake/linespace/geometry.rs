@@ -12,13 +12,11 @@
 //! conservative against the rounding of the single-precision ray–triangle test.
 
 use glam::DVec3;
+use kiln_format::linespace::index::{face_axis, face_uv_axes};
 
 /// A triangle prepared for overlap tests: its 13 separating axes and its projection on each.
 #[derive(Debug, Clone)]
 pub struct Prepared {
-    v: [DVec3; 3],
-    normal: DVec3,
-    plane: f64,
     /// The 13 axes in structure-of-arrays form, padded to 16 lanes with neutral ones
     /// (L = 0, interval [−1, 1]), so that the sweep test vectorises.
     lanes: Lanes,
@@ -63,7 +61,7 @@ impl Prepared {
             lanes.t0[i] = p[0].min(p[1]).min(p[2]);
             lanes.t1[i] = p[0].max(p[1]).max(p[2]);
         }
-        Prepared { v, normal, plane: normal.dot(v[0]), lanes }
+        Prepared { lanes }
     }
 
     /// Whether the triangle meets the box `centre ± half`.
@@ -74,60 +72,49 @@ impl Prepared {
     /// Whether the triangle meets ∪ₛ∈[0,1] box(c0 + s·c1, h0 + s·h1 + margin).
     pub fn overlaps_sweep(&self, c0: DVec3, c1: DVec3, h0: DVec3, h1: DVec3, margin: f64) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports the features the function is compiled for.
             return unsafe { sweep_avx2(&self.lanes, c0, c1, h0, h1, margin) };
         }
         sweep(&self.lanes, c0, c1, h0, h1, margin)
     }
 
-    /// Whether the triangle's plane strictly separates the boxes `ca ± ha` and `cb ± hb` (a
-    /// cheap necessary condition of [`Prepared::covers`]).
-    pub fn separates(&self, ca: DVec3, ha: DVec3, cb: DVec3, hb: DVec3, margin: f64) -> bool {
-        let n = self.normal;
-        let tol = margin * n.length();
-        let (da, ra) = (n.dot(ca) - self.plane, n.abs().dot(ha));
-        let (db, rb) = (n.dot(cb) - self.plane, n.abs().dot(hb));
-        (da - ra > tol && db + rb < -tol) || (da + ra < -tol && db - rb > tol)
-    }
-
-    /// Whether every segment from the rectangle `pa` to the rectangle `pb` (each given by its
-    /// four corners) crosses the triangle, shrunk by `margin`: then every shaft between them is
-    /// filled and need not be tested one by one. The plane of the triangle must separate the two
-    /// rectangles strictly, and the hull's cross-section in that plane (the hull of the 16
-    /// corner-to-corner crossings) must lie inside the triangle.
-    pub fn covers(&self, pa: &[DVec3; 4], pb: &[DVec3; 4], margin: f64) -> bool {
-        let (n, d) = (self.normal, self.plane);
-        let side = |p: &DVec3| n.dot(*p) - d;
-        let sa: [f64; 4] = pa.map(|p| side(&p));
-        let sb: [f64; 4] = pb.map(|p| side(&p));
-        let tol = margin * n.length();
-        let separated = (sa.iter().all(|&x| x > tol) && sb.iter().all(|&x| x < -tol))
-            || (sa.iter().all(|&x| x < -tol) && sb.iter().all(|&x| x > tol));
-        if !separated {
-            return false;
-        }
-        for (i, a) in pa.iter().enumerate() {
-            for (j, b) in pb.iter().enumerate() {
-                let t = sa[i] / (sa[i] - sb[j]);
-                let p = *a + (*b - *a) * t;
-                if !self.contains_shrunk(p, margin) {
-                    return false;
-                }
+    /// The triangle's separations for the shafts of face pair (`fa`, `fb`) at resolution `n`,
+    /// ready for [`PairAxes::shafts_from`].
+    pub fn pair_axes(&self, fa: u32, fb: u32, n: u32, margin: f64) -> PairAxes {
+        let l = &self.lanes;
+        let s = 1.0 / n as f64;
+        let half = 0.5 * s;
+        let mut p = PairAxes {
+            a: [[0.0; LANES]; 2],
+            a_du: [0.0; LANES],
+            a_dv: [0.0; LANES],
+            b: [[0.0; LANES]; 2],
+            b_du: [0.0; LANES],
+            b_dv: [0.0; LANES],
+        };
+        // A patch of face f at indices (u, v) is the box with centre (f mod 2) on f's axis and
+        // (index + 1/2)·s on the other two, half extent s/2 on those. So on every axis the
+        // centre's projection is affine in (u, v) and the box's radius is one number.
+        for (face, sep, du, dv) in
+            [(fa, &mut p.a, &mut p.a_du, &mut p.a_dv), (fb, &mut p.b, &mut p.b_du, &mut p.b_dv)]
+        {
+            let (j, plane) = (face_axis(face), (face % 2) as f64);
+            let (ua, va) = face_uv_axes(face);
+            for i in 0..LANES {
+                let lv = [l.l[0][i], l.l[1][i], l.l[2][i]];
+                let av = [l.a[0][i], l.a[1][i], l.a[2][i]];
+                let k = lv[j] * plane + (lv[ua] + lv[va]) * half;
+                let r = (av[ua] + av[va]) * half + margin * l.l1[i];
+                // Positive: separated. Box minimum minus triangle maximum is k − r − t1 plus
+                // (u·du + v·dv); triangle minimum minus box maximum is t0 − k − r minus it.
+                sep[0][i] = k - r - l.t1[i];
+                sep[1][i] = l.t0[i] - k - r;
+                du[i] = lv[ua] * s;
+                dv[i] = lv[va] * s;
             }
         }
-        true
-    }
-
-    /// Whether `p` (on the triangle's plane) lies inside the triangle by more than `margin`.
-    fn contains_shrunk(&self, p: DVec3, margin: f64) -> bool {
-        (0..3).all(|k| {
-            let e = self.v[(k + 1) % 3] - self.v[k];
-            // Signed distance of p from edge k, positive inside.
-            let inward = self.normal.cross(e);
-            let len = inward.length();
-            len > 0.0 && inward.dot(p - self.v[k]) / len > margin * 2.0
-        })
+        p
     }
 }
 
@@ -169,11 +156,334 @@ fn sweep(l: &Lanes, c0: DVec3, c1: DVec3, h0: DVec3, h1: DVec3, margin: f64) -> 
     lo <= hi
 }
 
-/// [`sweep`] compiled for AVX2 and FMA.
+/// One triangle's separations from the patches of two faces (see [`Prepared::pair_axes`]): on
+/// each of the 16 lanes (13 axes and padding) and for each of the two sides, `a[side] ±
+/// (u·a_du + v·a_dv)` for the patch (u, v) of face a (+ for side 0), the same with `b` for face b.
+#[derive(Debug, Clone)]
+pub struct PairAxes {
+    a: [[f64; LANES]; 2],
+    a_du: [f64; LANES],
+    a_dv: [f64; LANES],
+    b: [[f64; LANES]; 2],
+    b_du: [f64; LANES],
+    b_dv: [f64; LANES],
+}
+
+impl PairAxes {
+    /// The shafts from patch (`au`, `av`) of face a to the patches `rect` = [u0, u1) × [v0, v1)
+    /// of face b (at most 64) that meet the triangle, as a bit mask: bit (u − u0)·(v1 − v0) +
+    /// (v − v0) stands for patch (u, v). The sweep test of [`Prepared::overlaps_sweep`] for
+    /// every shaft at once.
+    ///
+    /// At the a end (s = 0) each axis's separation is one number for all the shafts; at the b
+    /// end it is affine in the patch indices, so its extremes over the rectangle are at corners:
+    /// an axis that separates the a end and every b corner rejects all shafts, one that separates
+    /// neither end anywhere is skipped, and only the rest run per shaft, comparing the roots as
+    /// fractions, without dividing.
+    pub fn shafts_from(&self, au: u32, av: u32, rect: [u32; 4]) -> u64 {
+        debug_assert!((rect[1] - rect[0]) * (rect[3] - rect[2]) <= 64);
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports the features the function is compiled for.
+            return unsafe { shafts_avx2(self, au, av, rect) };
+        }
+        shafts(self, au, av, rect)
+    }
+}
+
+/// See [`PairAxes::shafts_from`]. Plain arithmetic (no fused multiply-adds), so that the AVX2
+/// build and the portable one give the same bits.
+#[inline(always)]
+fn shafts(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
+    let [u0, u1, v0, v1] = rect;
+    if u0 >= u1 || v0 >= v1 {
+        return 0;
+    }
+    let w = (v1 - v0) as usize;
+    let count = (u1 - u0) as usize * w;
+    let all = if count == 64 { u64::MAX } else { (1u64 << count) - 1 };
+    let (au, av) = (au as f64, av as f64);
+    let (bu0, bu1, bv0, bv1) = (u0 as f64, (u1 - 1) as f64, v0 as f64, (v1 - 1) as f64);
+    // Per lane and side: the a end's separation and the least and greatest of the b end's.
+    let mut sa = [[0.0f64; LANES]; 2];
+    let mut bmin = [[0.0f64; LANES]; 2];
+    let mut bmax = [[0.0f64; LANES]; 2];
+    for i in 0..LANES {
+        let ta = au * p.a_du[i] + av * p.a_dv[i];
+        sa[0][i] = p.a[0][i] + ta;
+        sa[1][i] = p.a[1][i] - ta;
+        let (lu, hu) = (bu0 * p.b_du[i], bu1 * p.b_du[i]);
+        let (lv, hv) = (bv0 * p.b_dv[i], bv1 * p.b_dv[i]);
+        // Written as the AVX2 minimum and maximum behave.
+        let lo = (if lu < hu { lu } else { hu }) + (if lv < hv { lv } else { hv });
+        let hi = (if lu > hu { lu } else { hu }) + (if lv > hv { lv } else { hv });
+        bmin[0][i] = p.b[0][i] + lo;
+        bmax[0][i] = p.b[0][i] + hi;
+        bmin[1][i] = p.b[1][i] - hi;
+        bmax[1][i] = p.b[1][i] - lo;
+    }
+    // Which (side, lane) pairs need the per-shaft work.
+    let mut active = 0u32;
+    for side in 0..2 {
+        for i in 0..LANES {
+            let a = sa[side][i];
+            if a > 0.0 && bmin[side][i] > 0.0 {
+                return 0;
+            }
+            if a > 0.0 || bmax[side][i] > 0.0 {
+                active |= 1 << (side * LANES + i);
+            }
+        }
+    }
+    if active == 0 {
+        return all;
+    }
+    if count <= 16 {
+        per_shaft::<4>(p, &sa, active, rect, count)
+    } else {
+        per_shaft::<16>(p, &sa, active, rect, count)
+    }
+}
+
+/// The per-shaft part of [`shafts`] for the (side, lane) pairs in `active`, with room for `CAP`
+/// groups of four shafts. Written without branches over the shafts, so that it vectorises.
+#[inline(always)]
+fn per_shaft<const CAP: usize>(
+    p: &PairAxes,
+    sa: &[[f64; LANES]; 2],
+    mut active: u32,
+    rect: [u32; 4],
+    count: usize,
+) -> u64 {
+    let [u0, _, v0, v1] = rect;
+    let w = (v1 - v0) as usize;
+    // Groups of four shafts; the padding repeats the last patch.
+    let groups = count.div_ceil(4);
+    let mut bu = [[0.0f64; 4]; CAP];
+    let mut bv = [[0.0f64; 4]; CAP];
+    for g in 0..groups {
+        for q in 0..4 {
+            let k = (4 * g + q).min(count - 1);
+            bu[g][q] = (u0 as usize + k / w) as f64;
+            bv[g][q] = (v0 as usize + k % w) as f64;
+        }
+    }
+    // Roots as fractions num/den (den > 0): the interval [lo, hi] of s each shaft leaves. A
+    // shaft separated at both ends gets lo = 2 (> 1 ≥ hi), which later roots cannot lower.
+    let mut lo_n = [[0.0f64; 4]; CAP];
+    let mut lo_d = [[1.0f64; 4]; CAP];
+    let mut hi_n = [[1.0f64; 4]; CAP];
+    let mut hi_d = [[1.0f64; 4]; CAP];
+    while active != 0 {
+        let bit = active.trailing_zeros() as usize;
+        active &= active - 1;
+        let (side, i) = (bit / LANES, bit % LANES);
+        let a = sa[side][i];
+        // b = base ± (u·du + v·dv); negating du and dv gives the same bits as subtracting.
+        let (base, du, dv) =
+            if side == 0 { (p.b[0][i], p.b_du[i], p.b_dv[i]) } else { (p.b[1][i], -p.b_du[i], -p.b_dv[i]) };
+        if a > 0.0 {
+            // Separated at the a end: s ≥ a/(a − b) where b ≤ 0, and no s where b > 0.
+            for g in 0..groups {
+                for q in 0..4 {
+                    let b = base + (bu[g][q] * du + bv[g][q] * dv);
+                    let both = b > 0.0;
+                    let (num, den) = (if both { 2.0 } else { a }, if both { 1.0 } else { a - b });
+                    let later = num * lo_d[g][q] > lo_n[g][q] * den;
+                    lo_n[g][q] = if later { num } else { lo_n[g][q] };
+                    lo_d[g][q] = if later { den } else { lo_d[g][q] };
+                }
+            }
+        } else {
+            // Separated at the b end only: s ≤ a/(a − b) = −a/(b − a).
+            for g in 0..groups {
+                for q in 0..4 {
+                    let b = base + (bu[g][q] * du + bv[g][q] * dv);
+                    let (num, den) = (-a, b - a);
+                    let earlier = b > 0.0 && num * hi_d[g][q] < hi_n[g][q] * den;
+                    hi_n[g][q] = if earlier { num } else { hi_n[g][q] };
+                    hi_d[g][q] = if earlier { den } else { hi_d[g][q] };
+                }
+            }
+        }
+    }
+    let mut mask = 0u64;
+    for k in 0..count {
+        let (g, q) = (k / 4, k % 4);
+        if lo_n[g][q] * hi_d[g][q] <= hi_n[g][q] * lo_d[g][q] {
+            mask |= 1 << k;
+        }
+    }
+    mask
+}
+
+/// [`shafts`] in AVX2 intrinsics, four lanes or shafts at a time, with the same arithmetic
+/// operation for operation (the same bits).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2")]
+unsafe fn shafts_avx2(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
+    use std::arch::x86_64::*;
+    let [u0, u1, v0, v1] = rect;
+    if u0 >= u1 || v0 >= v1 {
+        return 0;
+    }
+    let w = (v1 - v0) as usize;
+    let count = (u1 - u0) as usize * w;
+    let all = if count == 64 { u64::MAX } else { (1u64 << count) - 1 };
+    let s = |x: f64| _mm256_set1_pd(x);
+    let (zero, one, two) = (_mm256_setzero_pd(), s(1.0), s(2.0));
+    let gt = |x: __m256d, y: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, y);
+    let (au, av) = (s(au as f64), s(av as f64));
+    let (bu0, bu1, bv0, bv1) = (s(u0 as f64), s((u1 - 1) as f64), s(v0 as f64), s((v1 - 1) as f64));
+    let mut sa = [[0.0f64; LANES]; 2];
+    let mut reject = zero;
+    let mut active = 0u32;
+    for g in (0..LANES).step_by(4) {
+        // SAFETY: g + 4 <= LANES, the arrays' length.
+        let ld = |x: &[f64; LANES]| unsafe { _mm256_loadu_pd(x.as_ptr().add(g)) };
+        let ta = _mm256_add_pd(_mm256_mul_pd(au, ld(&p.a_du)), _mm256_mul_pd(av, ld(&p.a_dv)));
+        let sa0 = _mm256_add_pd(ld(&p.a[0]), ta);
+        let sa1 = _mm256_sub_pd(ld(&p.a[1]), ta);
+        let (bdu, bdv) = (ld(&p.b_du), ld(&p.b_dv));
+        let (lu, hu) = (_mm256_mul_pd(bu0, bdu), _mm256_mul_pd(bu1, bdu));
+        let (lv, hv) = (_mm256_mul_pd(bv0, bdv), _mm256_mul_pd(bv1, bdv));
+        let lo = _mm256_add_pd(_mm256_min_pd(lu, hu), _mm256_min_pd(lv, hv));
+        let hi = _mm256_add_pd(_mm256_max_pd(lu, hu), _mm256_max_pd(lv, hv));
+        let (b0, b1) = (ld(&p.b[0]), ld(&p.b[1]));
+        let (bmin0, bmax0) = (_mm256_add_pd(b0, lo), _mm256_add_pd(b0, hi));
+        let (bmin1, bmax1) = (_mm256_sub_pd(b1, hi), _mm256_sub_pd(b1, lo));
+        let (pa0, pa1) = (gt(sa0, zero), gt(sa1, zero));
+        reject = _mm256_or_pd(reject, _mm256_and_pd(pa0, gt(bmin0, zero)));
+        reject = _mm256_or_pd(reject, _mm256_and_pd(pa1, gt(bmin1, zero)));
+        active |= (_mm256_movemask_pd(_mm256_or_pd(pa0, gt(bmax0, zero))) as u32) << g;
+        active |= (_mm256_movemask_pd(_mm256_or_pd(pa1, gt(bmax1, zero))) as u32) << (LANES + g);
+        // SAFETY: g + 4 <= LANES.
+        unsafe {
+            _mm256_storeu_pd(sa[0].as_mut_ptr().add(g), sa0);
+            _mm256_storeu_pd(sa[1].as_mut_ptr().add(g), sa1);
+        }
+    }
+    if _mm256_movemask_pd(reject) != 0 {
+        return 0;
+    }
+    if active == 0 {
+        return all;
+    }
+    let groups = count.div_ceil(4);
+    let mut bu = [zero; 16];
+    let mut bv = [zero; 16];
+    for g in 0..groups {
+        let at = |q: usize| {
+            let k = (4 * g + q).min(count - 1);
+            ((u0 as usize + k / w) as f64, (v0 as usize + k % w) as f64)
+        };
+        let [(a0, c0), (a1, c1), (a2, c2), (a3, c3)] = [at(0), at(1), at(2), at(3)];
+        bu[g] = _mm256_set_pd(a3, a2, a1, a0);
+        bv[g] = _mm256_set_pd(c3, c2, c1, c0);
+    }
+    let mut lo_n = [zero; 16];
+    let mut lo_d = [one; 16];
+    let mut hi_n = [one; 16];
+    let mut hi_d = [one; 16];
+    while active != 0 {
+        let bit = active.trailing_zeros() as usize;
+        active &= active - 1;
+        let (side, i) = (bit / LANES, bit % LANES);
+        let a = sa[side][i];
+        let (base, du, dv) =
+            if side == 0 { (p.b[0][i], p.b_du[i], p.b_dv[i]) } else { (p.b[1][i], -p.b_du[i], -p.b_dv[i]) };
+        let (base, du, dv) = (s(base), s(du), s(dv));
+        let va = s(a);
+        if a > 0.0 {
+            for g in 0..groups {
+                let b =
+                    _mm256_add_pd(base, _mm256_add_pd(_mm256_mul_pd(bu[g], du), _mm256_mul_pd(bv[g], dv)));
+                let both = gt(b, zero);
+                let num = _mm256_blendv_pd(va, two, both);
+                let den = _mm256_blendv_pd(_mm256_sub_pd(va, b), one, both);
+                let later = gt(_mm256_mul_pd(num, lo_d[g]), _mm256_mul_pd(lo_n[g], den));
+                lo_n[g] = _mm256_blendv_pd(lo_n[g], num, later);
+                lo_d[g] = _mm256_blendv_pd(lo_d[g], den, later);
+            }
+        } else {
+            let num = s(-a);
+            for g in 0..groups {
+                let b =
+                    _mm256_add_pd(base, _mm256_add_pd(_mm256_mul_pd(bu[g], du), _mm256_mul_pd(bv[g], dv)));
+                let den = _mm256_sub_pd(b, va);
+                let earlier = _mm256_and_pd(
+                    gt(b, zero),
+                    _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_mul_pd(num, hi_d[g]), _mm256_mul_pd(hi_n[g], den)),
+                );
+                hi_n[g] = _mm256_blendv_pd(hi_n[g], num, earlier);
+                hi_d[g] = _mm256_blendv_pd(hi_d[g], den, earlier);
+            }
+        }
+    }
+    let mut mask = 0u64;
+    for g in 0..groups {
+        let ok =
+            _mm256_cmp_pd::<_CMP_LE_OQ>(_mm256_mul_pd(lo_n[g], hi_d[g]), _mm256_mul_pd(hi_n[g], lo_d[g]));
+        mask |= (_mm256_movemask_pd(ok) as u64) << (4 * g);
+    }
+    mask & all
+}
+
+/// [`sweep`] in AVX2, four lanes at a time and without branches: every separation's root is
+/// computed and masked, and the interval's ends are reduced at the end. The arithmetic is the
+/// scalar version's, operation for operation (no fused multiply-adds), so both give the same
+/// answer bit for bit.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
 unsafe fn sweep_avx2(l: &Lanes, c0: DVec3, c1: DVec3, h0: DVec3, h1: DVec3, margin: f64) -> bool {
-    sweep(l, c0, c1, h0, h1, margin)
+    use std::arch::x86_64::*;
+    let s = |x: f64| _mm256_set1_pd(x);
+    let (c0x, c0y, c0z) = (s(c0.x), s(c0.y), s(c0.z));
+    let (c1x, c1y, c1z) = (s(c1.x), s(c1.y), s(c1.z));
+    let (h0x, h0y, h0z) = (s(h0.x), s(h0.y), s(h0.z));
+    let (h1x, h1y, h1z) = (s(h1.x), s(h1.y), s(h1.z));
+    let m = s(margin);
+    let (zero, one) = (_mm256_setzero_pd(), s(1.0));
+    let (mut lo, mut hi, mut reject) = (zero, one, zero);
+    for g in (0..LANES).step_by(4) {
+        // SAFETY: g + 4 <= LANES, the arrays' length.
+        let ld = |a: &[f64; LANES]| unsafe { _mm256_loadu_pd(a.as_ptr().add(g)) };
+        let (lx, ly, lz) = (ld(&l.l[0]), ld(&l.l[1]), ld(&l.l[2]));
+        let (ax, ay, az) = (ld(&l.a[0]), ld(&l.a[1]), ld(&l.a[2]));
+        let (l1, t0, t1) = (ld(&l.l1), ld(&l.t0), ld(&l.t1));
+        let dot = |x: __m256d, y: __m256d, z: __m256d, u: __m256d, v: __m256d, w: __m256d| {
+            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, u), _mm256_mul_pd(y, v)), _mm256_mul_pd(z, w))
+        };
+        let m0 = dot(lx, ly, lz, c0x, c0y, c0z);
+        let m1 = dot(lx, ly, lz, c1x, c1y, c1z);
+        let r0 = _mm256_add_pd(dot(ax, ay, az, h0x, h0y, h0z), _mm256_mul_pd(m, l1));
+        let r1 = dot(ax, ay, az, h1x, h1y, h1z);
+        let f0a = _mm256_sub_pd(_mm256_sub_pd(m0, r0), t1);
+        let f1a = _mm256_sub_pd(_mm256_sub_pd(_mm256_sub_pd(_mm256_add_pd(m0, m1), r0), r1), t1);
+        let f0b = _mm256_sub_pd(_mm256_sub_pd(t0, m0), r0);
+        let f1b = _mm256_sub_pd(_mm256_sub_pd(_mm256_sub_pd(_mm256_sub_pd(t0, m0), m1), r0), r1);
+        for (a, b) in [(f0a, f1a), (f0b, f1b)] {
+            let pa = _mm256_cmp_pd::<_CMP_GT_OQ>(a, zero);
+            let pb = _mm256_cmp_pd::<_CMP_GT_OQ>(b, zero);
+            reject = _mm256_or_pd(reject, _mm256_and_pd(pa, pb));
+            let root = _mm256_div_pd(a, _mm256_sub_pd(a, b));
+            // Masked-off lanes give 0 to the maximum and 1 to the minimum: neutral, as lo ≥ 0
+            // and hi ≤ 1.
+            lo = _mm256_max_pd(lo, _mm256_and_pd(pa, root));
+            hi = _mm256_min_pd(hi, _mm256_blendv_pd(one, root, _mm256_andnot_pd(pa, pb)));
+        }
+    }
+    if _mm256_movemask_pd(reject) != 0 {
+        return false;
+    }
+    let mut los = [0.0f64; 4];
+    let mut his = [0.0f64; 4];
+    // SAFETY: four f64 each.
+    unsafe {
+        _mm256_storeu_pd(los.as_mut_ptr(), lo);
+        _mm256_storeu_pd(his.as_mut_ptr(), hi);
+    }
+    los.iter().fold(0.0f64, |x, &y| x.max(y)) <= his.iter().fold(1.0f64, |x, &y| x.min(y))
 }
 
 /// The triangle clipped to the box [lo, hi] (Sutherland–Hodgman); empty if they do not meet.
@@ -252,6 +562,148 @@ mod tests {
             agree += (sampled == exact) as u32;
         }
         assert!(agree > 280, "exact and sampled tests disagree too often: {agree}/300");
+    }
+
+    /// The AVX2 sweep is an optimisation of the scalar one: same answer on every test, including
+    /// boxes that only graze the triangle (found by bisecting each sweep's boundary).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_sweep_matches_the_scalar_one() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let mut state = 99u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut met, mut missed) = (0, 0);
+        for _ in 0..20_000 {
+            let v = [0; 3].map(|_| DVec3::new(rnd(), rnd(), rnd()) * 1.4 - 0.2);
+            let tri = Prepared::new(v);
+            let c0 = DVec3::new(rnd(), rnd(), 0.0);
+            let c1 = DVec3::new(rnd(), rnd(), 1.0) - c0;
+            let h0 = DVec3::new(rnd(), rnd(), 0.0) * 0.3;
+            let h1 = DVec3::new(rnd(), rnd(), 0.0) * 0.3 - h0;
+            // Scale the boxes to the edge of touching: the bisection ends on the two sides of it.
+            let (mut a, mut b) = (0.0f64, 1.0f64);
+            for _ in 0..40 {
+                let k = 0.5 * (a + b);
+                if sweep(&tri.lanes, c0, c1, h0 * k, h1 * k, 1e-6) {
+                    b = k;
+                } else {
+                    a = k;
+                }
+            }
+            for k in [a, b, 1.0, 0.0] {
+                let scalar = sweep(&tri.lanes, c0, c1, h0 * k, h1 * k, 1e-6);
+                // SAFETY: AVX2 was detected above.
+                let simd = unsafe { sweep_avx2(&tri.lanes, c0, c1, h0 * k, h1 * k, 1e-6) };
+                assert_eq!(scalar, simd, "{v:?} {c0} {c1} {h0} {h1} {k}");
+                if scalar { met += 1 } else { missed += 1 }
+            }
+        }
+        assert!(met > 10_000 && missed > 10_000, "{met} met, {missed} missed");
+    }
+
+    /// The AVX2 many-shaft test and the portable one give the same masks (a compile on a CPU
+    /// without AVX2 writes the same bytes).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_shaft_lanes_match_the_portable_ones() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let mut state = 5u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut nonzero = 0;
+        for case in 0..20_000u32 {
+            let n = 1 + case % 8;
+            let c = DVec3::new(rnd(), rnd(), rnd());
+            let size = [0.05, 0.5, 2.0][(case % 3) as usize];
+            let tri = Prepared::new([0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size));
+            let pair = case % 15;
+            let (fa, fb) = kiln_format::linespace::index::pair_faces(pair);
+            let axes = tri.pair_axes(fa, fb, n, [0.0, 1e-5, 1e-2][(case % 5 % 3) as usize]);
+            let r = |k: f64| (k * n as f64) as u32;
+            let (u0, v0) = (r(rnd()), r(rnd()));
+            let rect = [u0, (u0 + 1 + r(rnd())).min(n), v0, (v0 + 1 + r(rnd())).min(n)];
+            let (au, av) = (r(rnd()), r(rnd()));
+            let portable = shafts(&axes, au, av, rect);
+            // SAFETY: AVX2 was detected above.
+            let simd = unsafe { shafts_avx2(&axes, au, av, rect) };
+            assert_eq!(portable, simd, "case {case}");
+            nonzero += (portable != 0) as u32;
+        }
+        assert!(nonzero > 2000, "{nonzero}");
+    }
+
+    /// The many-shaft test against the one-shaft sweep, shaft by shaft: random triangles (some
+    /// leaving the cell), every face pair, random source patches and target rectangles, N = 1…8.
+    #[test]
+    fn shaft_lanes_agree_with_the_sweep() {
+        use kiln_format::linespace::index::{FACE_PAIRS, pair_faces};
+        let mut state = 7u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut met, mut tested) = (0u64, 0u64);
+        for case in 0..3000 {
+            let n = 1 + case % 8;
+            let size = if case % 3 == 0 { 0.2 } else { 1.2 };
+            let c = DVec3::new(rnd(), rnd(), rnd());
+            let v = [0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size);
+            let tri = Prepared::new(v);
+            let margin = if case % 2 == 0 { 0.0 } else { 1e-3 };
+            for pair in 0..FACE_PAIRS {
+                let (fa, fb) = pair_faces(pair);
+                let (au, av) = ((rnd() * n as f64) as u32, (rnd() * n as f64) as u32);
+                let u0 = (rnd() * n as f64) as u32;
+                let v0 = (rnd() * n as f64) as u32;
+                let rect = [
+                    u0,
+                    u0 + 1 + (rnd() * (n - u0) as f64) as u32,
+                    v0,
+                    v0 + 1 + (rnd() * (n - v0) as f64) as u32,
+                ];
+                let rect = [rect[0], rect[1].min(n), rect[2], rect[3].min(n)];
+                // The face boxes, written out here: a face is the plane axis = 0 or 1.
+                let face_box = |face: u32, iu: u32, iv: u32| {
+                    let (x, (ua, va)) = (face_axis(face), face_uv_axes(face));
+                    let s = 1.0 / n as f64;
+                    let mut c = DVec3::ZERO;
+                    let mut h = DVec3::ZERO;
+                    c[x] = (face % 2) as f64;
+                    c[ua] = (iu as f64 + 0.5) * s;
+                    c[va] = (iv as f64 + 0.5) * s;
+                    h[ua] = 0.5 * s;
+                    h[va] = 0.5 * s;
+                    (c, h)
+                };
+                let (ca, ha) = face_box(fa, au, av);
+                let mask = tri.pair_axes(fa, fb, n, margin).shafts_from(au, av, rect);
+                let w = rect[3] - rect[2];
+                for u in rect[0]..rect[1] {
+                    for vv in rect[2]..rect[3] {
+                        let (cb, hb) = face_box(fb, u, vv);
+                        let one = tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin);
+                        let bit = (u - rect[0]) * w + (vv - rect[2]);
+                        assert_eq!(
+                            mask >> bit & 1 == 1,
+                            one,
+                            "case {case} pair {pair} a ({au},{av}) b ({u},{vv}) {v:?}"
+                        );
+                        met += one as u64;
+                        tested += 1;
+                    }
+                }
+            }
+        }
+        assert!(met > tested / 10 && met < tested * 9 / 10, "{met} of {tested}");
     }
 
     #[test]

@@ -41,7 +41,7 @@ pub struct BakedLineSpace {
     pub pnmt: Vec<PnmtRecord>,
     /// Pre-illuminated radiance per filled shaft.
     pub preillum: Vec<[u16; 8]>,
-    /// Shaft–triangle overlap tests run.
+    /// (Triangle, shaft) pairs tested exactly.
     pub tests: u64,
     /// Filled shafts whose PNMT sample rays all missed (no record).
     pub pnmt_missing: u64,

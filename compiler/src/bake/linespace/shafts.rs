@@ -1,7 +1,7 @@
-//! Filling the shafts of one cell: for each triangle and face pair, a hierarchical search over
-//! patch ranges (a range pair is the hull of two rectangles, tested exactly by
-//! [`Prepared::overlaps_sweep`]) finds every shaft the triangle meets without testing each
-//! (triangle, shaft) pair; then the bits, the sorted candidate lists and the PNMT records.
+//! Filling the shafts of one cell: for each triangle, face pair and patch on the first face, the
+//! patches on the second face that the triangle's projection can reach are tested together
+//! ([`PairAxes::shafts_from`], exact against the widened shaft); then the bits, the sorted
+//! candidate lists and the PNMT records.
 
 use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::{
@@ -9,6 +9,8 @@ use kiln_format::linespace::index::{
 };
 use kiln_format::linespace::{PnmtRecord, entry, words_per_slot};
 
+#[cfg(doc)]
+use super::geometry::PairAxes;
 use super::geometry::{Prepared, clip_to_box};
 
 /// What one cell contributes to the line space.
@@ -80,55 +82,167 @@ fn index_range(a: f64, b: f64, pad: f64, n: u32) -> (u32, u32) {
     (lo.min(n), hi.max(lo).min(n))
 }
 
-/// Patch ranges on face `to` that segments from the rectangle `from_rect` (corners on face `from`)
-/// through `poly` can reach: the bounding rectangle of the central projections of every polygon
-/// vertex from every rectangle corner onto `to`'s plane. The union of segments through the
-/// polygon lies in the convex hull of these projections when `p_j − x_j` has one sign for all
-/// corners x and vertices p (j = `to`'s axis): the projection is then monotone in each corner
-/// coordinate and linear-fractional in the vertex. `None` when that condition fails or the
-/// projection degenerates (a vertex on the source plane): callers fall back to exact tests.
-fn reach(from_rect: &[DVec3; 4], poly: &[DVec3], to: u32, n: u32, pad: f64) -> Option<[u32; 4]> {
+/// Patch ranges on face `to` that the widened shafts from the rectangle `from` (its four
+/// corners, on another face) can meet inside `poly` (the triangle clipped to the widened cell),
+/// or `None` for "any patch".
+///
+/// Let j be `to`'s axis and σ the sign of the way from `from` to `to` along j. The polygon is cut
+/// at σ·p_j = max σ·x_j + g (x over the corners, g = [`REACH_GAP`] of a patch):
+/// - **The part beyond the cut** has a central projection from every point x of `from` onto
+///   `to`'s plane; the projections of a convex set from a rectangle lie in the convex hull of
+///   the projections of its vertices from the rectangle's corners (each is projective with a
+///   positive denominator), so their bounding rectangle bounds what segments can reach. A point
+///   within the margin m of a segment x → y and beyond the cut projects from x to within
+///   m·(L + 1)/g ≤ 2m/g of y (L ≤ 1: the segment's extent along j), which pads the rectangle.
+/// - **The part behind the rectangle**, σ·p_j below every σ·x_j by more than m, lies on no
+///   widened segment (σ·(w_j − x_j) ≥ 0 along a segment).
+/// - **The part before the cut** can lie on a widened segment from x only near x: a segment point
+///   whose σ·(w_j − x_j) is below g + (the rectangle's extent along j) + m has moved at most that
+///   over L_min (the least corner-to-plane distance along j) in every coordinate. When the part's
+///   bounding box stays farther than that (plus m) from the rectangle's, it meets no shaft;
+///   otherwise every patch may be reached (`None`).
+fn reach(
+    from_face: u32,
+    from: &[DVec3; 4],
+    poly: &[DVec3],
+    to: u32,
+    n: u32,
+    margin: f64,
+) -> Option<[u32; 4]> {
     let j = face_axis(to);
     let bj = (to % 2) as f64;
+    let sigma = if to % 2 == 1 { 1.0 } else { -1.0 };
     let (ua, va) = face_uv_axes(to);
+    let l_min = from.iter().map(|x| sigma * (bj - x[j])).fold(f64::INFINITY, f64::min);
+    if !(l_min > 0.0) {
+        return None;
+    }
+    let (xlo, xhi) = from
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(sigma * x[j]), hi.max(sigma * x[j])));
+    let gap = REACH_GAP / n as f64;
+    let cut = xhi + gap;
+    // The polygon in three bands along σ·j: behind the rectangle (below its least σ·x_j by more
+    // than the margin: no segment from it goes there), before the cut (kept as a bounding box)
+    // and beyond it (kept as vertices).
+    let planes = [xlo - margin, cut];
+    let band = |d: f64| (d >= planes[0]) as usize + (d >= planes[1]) as usize;
+    let (mut near_lo, mut near_hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    let mut beyond = [DVec3::ZERO; 18];
+    let mut count = 0;
+    // For a pair of adjacent faces: the least of D_k(z) − (σ·z_j − min σ·x_j + m)/L_min − m over
+    // the band, D_k the distance from `from`'s plane (see below).
+    let k = face_axis(from_face);
+    let plane_k = (from_face % 2) as f64;
+    let mut slack = f64::INFINITY;
+    let mut add = |x: DVec3, b: usize, near_lo: &mut DVec3, near_hi: &mut DVec3| {
+        if b == 2 {
+            beyond[count] = x;
+            count += 1;
+        } else if b == 1 {
+            *near_lo = near_lo.min(x);
+            *near_hi = near_hi.max(x);
+            slack = slack.min((x[k] - plane_k).abs() - (sigma * x[j] - xlo + margin) / l_min - margin);
+        }
+    };
+    for (i, &p) in poly.iter().enumerate() {
+        let q = poly[(i + 1) % poly.len()];
+        let (dp, dq) = (sigma * p[j], sigma * q[j]);
+        let (bp, bq) = (band(dp), band(dq));
+        add(p, bp, &mut near_lo, &mut near_hi);
+        for (k, &plane) in planes.iter().enumerate() {
+            // The edge crosses plane k (between bands k and k + 1).
+            if (bp <= k) != (bq <= k) {
+                let mut x = p + (q - p) * ((plane - dp) / (dq - dp));
+                x[j] = sigma * plane;
+                add(x, k, &mut near_lo, &mut near_hi);
+                add(x, k + 1, &mut near_lo, &mut near_hi);
+            }
+        }
+    }
+    // A band point z within m of a segment point w = x + t·(y − x) has σ·(w_j − x_j) = t·L ≥
+    // t·L_min and |w_k − x_k| ≤ t (k: `from`'s axis): so D_k(z) ≤ (σ·z_j − min σ·x_j + m)/L_min + m,
+    // linear in z, which the band (convex) breaks everywhere if it breaks it at every vertex.
+    if near_lo.x <= near_hi.x && !(k != j && slack > 0.0) {
+        let r = (gap + (xhi - xlo) + margin) / l_min + margin;
+        let (from_lo, from_hi) =
+            from.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
+        let apart = (near_lo - from_hi).max(from_lo - near_hi).max_element();
+        if !(apart > r) {
+            return None;
+        }
+    }
+    if count == 0 {
+        return Some([0, 0, 0, 0]);
+    }
     let (mut umin, mut umax, mut vmin, mut vmax) =
         (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    let mut sign = 0.0f64;
-    for x in from_rect {
+    for x in from {
         let reach = bj - x[j];
-        for p in poly {
-            let d = p[j] - x[j];
-            // d and reach must share one strict sign, with |d| not tiny (else the image is far away).
-            if d * reach <= 1e-9 || (sign != 0.0 && d.signum() != sign) {
-                return None;
-            }
-            sign = d.signum();
-            let y = *x + (*p - *x) * (reach / d);
+        for p in &beyond[..count] {
+            let y = *x + (*p - *x) * (reach / (p[j] - x[j]));
             umin = umin.min(y[ua]);
             umax = umax.max(y[ua]);
             vmin = vmin.min(y[va]);
             vmax = vmax.max(y[va]);
         }
     }
+    // The margin's image, with room for the rounding of the projections.
+    let pad = 2.0 * margin / gap * (1.0 + 1e-6) + 1e-9;
     let (u0, u1) = index_range(umin, umax, pad, n);
     let (v0, v1) = index_range(vmin, vmax, pad, n);
     Some([u0, u1, v0, v1])
 }
 
+/// Patch ranges on face `to` that widened segments from the rectangle `from` (on `from_face`)
+/// through `poly` can end in, from monotonicity alone (where [`reach`] gives up): along a
+/// segment x → y every coordinate moves one way. So a point z within m of it has
+/// - on `from`'s axis k: |y_k − x_k| ≥ |z_k − x_k| − m (k is one of `to`'s axes when the faces
+///   are adjacent);
+/// - on an axis c of both faces: y_c ≥ z_c − m where every z_c ≥ max x_c + m, and
+///   y_c ≤ z_c + m where every z_c ≤ min x_c − m.
+fn reach_bound(from_face: u32, from: &[DVec3; 4], poly: &[DVec3], to: u32, n: u32, margin: f64) -> [u32; 4] {
+    let (k, plane_k) = (face_axis(from_face), (from_face % 2) as f64);
+    let (from_lo, from_hi) =
+        from.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
+    let (lo, hi) =
+        poly.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), z| (lo.min(*z), hi.max(*z)));
+    let (ua, va) = face_uv_axes(to);
+    let range = |c: usize| -> (u32, u32) {
+        let (mut a, mut b) = (0.0f64, 1.0f64);
+        if c == k {
+            let d = poly.iter().map(|z| (z[k] - plane_k).abs()).fold(f64::INFINITY, f64::min) - margin;
+            if plane_k == 0.0 {
+                a = d;
+            } else {
+                b = 1.0 - d;
+            }
+        } else if lo[c] >= from_hi[c] + margin {
+            a = lo[c] - margin;
+        } else if hi[c] <= from_lo[c] - margin {
+            b = hi[c] + margin;
+        }
+        index_range(a, b, 1e-9, n)
+    };
+    let ((u0, u1), (v0, v1)) = (range(ua), range(va));
+    [u0, u1, v0, v1]
+}
+
+/// Where [`reach`] cuts the polygon, in patches beyond the source rectangle's far side: a wider
+/// cut pads the projections less (2m/g) but leaves more of the polygon to the cruder bound.
+const REACH_GAP: f64 = 0.25;
+
 /// Calls `found(shaft)` for every shaft of face pair `pair` that the triangle `tri` (clipped to
-/// the widened cell: `poly`) meets, and possibly for a few it only nearly meets (see
-/// [`reach`]): for each patch on face a that the triangle can be seen through, the patches
-/// on face b its projection reaches. Where the projection is undefined or reaches many patches,
-/// exact tests decide (a hierarchical search over patch ranges, see [`exact_search`]).
-#[allow(clippy::too_many_arguments)]
+/// the widened cell: `poly`) meets. For each patch on face a, the projections of the polygon
+/// from the patch's corners bound the patches on face b it can reach (see [`reach`]; all of
+/// them where the projection is undefined), and one many-shaft test
+/// ([`PairAxes::shafts_from`]) decides each of those shafts exactly.
 fn search(
     tri: &Prepared,
     poly: &[DVec3],
     pair: u32,
     n: u32,
     margin: f64,
-    direct_limit: u32,
-    stack: &mut Vec<[u32; 8]>,
     tests: &mut u64,
     found: &mut impl FnMut(u32),
 ) {
@@ -138,115 +252,29 @@ fn search(
     }
     let s = 1.0 / n as f64;
     let n2 = n * n;
-    let prange = reach(&corners(fb, (0.0, 1.0), (0.0, 1.0)), poly, fa, n, margin).unwrap_or([0, n, 0, n]);
+    let axes = tri.pair_axes(fa, fb, n, margin);
+    let prange = {
+        let whole = corners(fb, (0.0, 1.0), (0.0, 1.0));
+        reach(fb, &whole, poly, fa, n, margin).unwrap_or_else(|| reach_bound(fb, &whole, poly, fa, n, margin))
+    };
     for au in prange[0]..prange[1] {
         for av in prange[2]..prange[3] {
-            let p_rect =
-                corners(fa, (au as f64 * s, (au + 1) as f64 * s), (av as f64 * s, (av + 1) as f64 * s));
-            match reach(&p_rect, poly, fb, n, margin) {
-                Some(q) if (q[1] - q[0]) * (q[3] - q[2]) <= direct_limit => {
-                    for bu in q[0]..q[1] {
-                        for bv in q[2]..q[3] {
-                            found(pair * n2 * n2 + (au * n + av) * n2 + bu * n + bv);
-                        }
-                    }
-                }
-                q => {
-                    let q = q.unwrap_or([0, n, 0, n]);
-                    exact_search(
-                        tri,
-                        pair,
-                        n,
-                        margin,
-                        [au, au + 1, av, av + 1, q[0], q[1], q[2], q[3]],
-                        stack,
-                        tests,
-                        found,
-                    );
-                }
+            let (ua, va) = ((au as f64 * s, (au + 1) as f64 * s), (av as f64 * s, (av + 1) as f64 * s));
+            let from = corners(fa, ua, va);
+            let q = reach(fa, &from, poly, fb, n, margin)
+                .unwrap_or_else(|| reach_bound(fa, &from, poly, fb, n, margin));
+            let mut mask = axes.shafts_from(au, av, q);
+            *tests += ((q[1] - q[0]) * (q[3] - q[2])) as u64;
+            let w = q[3] - q[2];
+            while mask != 0 {
+                let k = mask.trailing_zeros();
+                mask &= mask - 1;
+                let (bu, bv) = (q[0] + k / w, q[2] + k % w);
+                found(pair * n2 * n2 + (au * n + av) * n2 + bu * n + bv);
             }
         }
     }
 }
-
-/// Exact hierarchical search from the range pair `start`: ranges whose hull misses the
-/// triangle are dropped, ranges it covers are emitted whole, others split.
-#[allow(clippy::too_many_arguments)]
-fn exact_search(
-    tri: &Prepared,
-    pair: u32,
-    n: u32,
-    margin: f64,
-    start: [u32; 8],
-    stack: &mut Vec<[u32; 8]>,
-    tests: &mut u64,
-    found: &mut impl FnMut(u32),
-) {
-    let (fa, fb) = pair_faces(pair);
-    let s = 1.0 / n as f64;
-    let n2 = n * n;
-    let emit = |r: &[u32; 8], found: &mut dyn FnMut(u32)| {
-        for au in r[0]..r[1] {
-            for av in r[2]..r[3] {
-                for bu in r[4]..r[5] {
-                    for bv in r[6]..r[7] {
-                        found(pair * n2 * n2 + (au * n + av) * n2 + bu * n + bv);
-                    }
-                }
-            }
-        }
-    };
-    stack.clear();
-    stack.push(start);
-    while let Some(r) = stack.pop() {
-        if (0..4).any(|k| r[2 * k] >= r[2 * k + 1]) {
-            continue;
-        }
-        let ua = (r[0] as f64 * s, r[1] as f64 * s);
-        let va = (r[2] as f64 * s, r[3] as f64 * s);
-        let ub = (r[4] as f64 * s, r[5] as f64 * s);
-        let vb = (r[6] as f64 * s, r[7] as f64 * s);
-        let (ca, ha) = face_box(fa, ua, va);
-        let (cb, hb) = face_box(fb, ub, vb);
-        *tests += 1;
-        if !tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
-            continue;
-        }
-        // Split the widest of the four ranges (the first on ties); a pair of single patches is
-        // a shaft. Ranges of four or more shafts are first checked for full coverage.
-        let mut widest = 0;
-        for k in 1..4 {
-            if r[2 * k + 1] - r[2 * k] > r[2 * widest + 1] - r[2 * widest] {
-                widest = k;
-            }
-        }
-        let (lo, hi) = (r[2 * widest], r[2 * widest + 1]);
-        if hi - lo == 1 {
-            emit(&r, found);
-            continue;
-        }
-        let leaves = (r[1] - r[0]) * (r[3] - r[2]) * (r[5] - r[4]) * (r[7] - r[6]);
-        if leaves >= 4
-            && tri.separates(ca, ha, cb, hb, margin)
-            && tri.covers(&corners(fa, ua, va), &corners(fb, ub, vb), margin)
-        {
-            emit(&r, found);
-            continue;
-        }
-        let mid = (lo + hi) / 2;
-        let mut left = r;
-        left[2 * widest + 1] = mid;
-        let mut right = r;
-        right[2 * widest] = mid;
-        stack.push(right);
-        stack.push(left);
-    }
-}
-
-/// Largest number of face-b patches a projection may reach and still be taken without exact
-/// tests. Small reaches come from triangles small against a patch, where the bounding rectangle of
-/// the projection is nearly exact; larger ones are tested shaft by shaft.
-pub const DIRECT_LIMIT: u32 = 4;
 
 /// Quantises a key in [lo, lo + 2] to 0..=255, rounding down (`up` false) or up.
 fn quantise(key: f64, lo: f64, up: bool) -> u32 {
@@ -274,7 +302,6 @@ struct End {
 /// page faults on every cell).
 #[derive(Debug, Default)]
 pub struct Scratch {
-    stack: Vec<[u32; 8]>,
     hits: Vec<(u32, u8, u8, u16)>,
     sorted: Vec<(u32, u8, u8, u16)>,
     counts: Vec<u32>,
@@ -308,7 +335,7 @@ pub fn bake_cell(
     let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
-    let Scratch { stack, hits, sorted, counts, ends, polys } = scratch;
+    let Scratch { hits, sorted, counts, ends, polys } = scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
     ends.clear();
@@ -351,7 +378,7 @@ pub fn bake_cell(
             };
             let (qmin, qmax) =
                 (quantise(kmin - 2.0 * margin, key_lo, false), quantise(kmax + 2.0 * margin, key_lo, true));
-            search(&prep, &poly, pair, n, margin, DIRECT_LIMIT, stack, &mut out.tests, &mut |shaft| {
+            search(&prep, &poly, pair, n, margin, &mut out.tests, &mut |shaft| {
                 out.bits[(shaft / 32) as usize] |= 1 << (shaft % 32);
                 if candidates {
                     hits.push((shaft, qmin as u8, qmax as u8, li as u16));
@@ -572,4 +599,74 @@ pub fn meets_exactly(
             margin,
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The search against every shaft of the pair tested one by one with the sweep test: the
+    /// reach bounds must never leave out a shaft the triangle meets, and nothing else may be
+    /// found. Triangles of every size, crossing the cell's faces, lying just inside and just
+    /// outside them, and tiny ones next to a face (where projections blow up).
+    #[test]
+    fn search_finds_exactly_the_shafts_the_sweep_test_finds() {
+        let mut state = 11u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut found_total, mut tested) = (0u64, 0u64);
+        for case in 0..1500u32 {
+            let n = 1 + case % 8;
+            let margin = [0.0, 1e-5, 1e-3][(case / 8 % 3) as usize];
+            let (centre, size) = match case % 5 {
+                0 => (DVec3::new(rnd(), rnd(), rnd()), 0.05),
+                1 => (DVec3::new(rnd(), rnd(), rnd()) * 1.4 - 0.2, 1.0),
+                2 => {
+                    // Tiny, within a hair of a face (inside or out).
+                    let mut c = DVec3::new(rnd(), rnd(), rnd());
+                    c[(case as usize / 5) % 3] = if rnd() < 0.5 { 0.0 } else { 1.0 } + (rnd() - 0.5) * 4e-3;
+                    (c, 0.01)
+                }
+                3 => (DVec3::new(rnd(), rnd(), rnd()), 0.4),
+                _ => (DVec3::new(rnd(), rnd(), rnd()), 3.0),
+            };
+            let v = [0; 3].map(|_| centre + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size);
+            let tri = Prepared::new(v);
+            let poly = clip_to_box(v, DVec3::splat(-margin), DVec3::splat(1.0 + margin));
+            let s = 1.0 / n as f64;
+            let n2 = n * n;
+            for pair in 0..FACE_PAIRS {
+                let mut found = Vec::new();
+                let mut tests = 0;
+                search(&tri, &poly, pair, n, margin, &mut tests, &mut |shaft| found.push(shaft));
+                found.sort_unstable();
+                let (fa, fb) = pair_faces(pair);
+                let mut brute = Vec::new();
+                for pa in 0..n2 {
+                    for pb in 0..n2 {
+                        let r = |p: u32| {
+                            (
+                                (p / n) as f64 * s,
+                                (p / n + 1) as f64 * s,
+                                (p % n) as f64 * s,
+                                (p % n + 1) as f64 * s,
+                            )
+                        };
+                        let (a, b) = (r(pa), r(pb));
+                        let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
+                        let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
+                        if !poly.is_empty() && tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
+                            brute.push(pair * n2 * n2 + pa * n2 + pb);
+                        }
+                    }
+                }
+                tested += (n2 * n2) as u64;
+                found_total += brute.len() as u64;
+                assert_eq!(found, brute, "case {case}, pair {pair}, n {n}, margin {margin}: {v:?}");
+            }
+        }
+        assert!(found_total > tested / 20, "{found_total} of {tested}");
+    }
 }
