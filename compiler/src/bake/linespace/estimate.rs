@@ -110,7 +110,7 @@ pub fn sample(voxels: &Voxels, n: u32, max_cells: usize) -> FillSample {
                 scratch,
             );
             let filled: u64 = r.bits.iter().map(|w| w.count_ones() as u64).sum();
-            (filled, r.lists.iter().map(|l| l.len() as u64).sum())
+            (filled, r.entries.len() as u64)
         })
         .collect();
     FillSample { occupied: occupied.len() as u64, cells }

@@ -487,32 +487,40 @@ unsafe fn sweep_avx2(l: &Lanes, c0: DVec3, c1: DVec3, h0: DVec3, h1: DVec3, marg
 }
 
 /// The triangle clipped to the box [lo, hi] (Sutherland–Hodgman); empty if they do not meet.
+#[cfg(test)]
 pub fn clip_to_box(v: [DVec3; 3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
-    let mut poly: Vec<DVec3> = v.to_vec();
+    let (mut out, mut tmp) = (Vec::new(), Vec::new());
+    clip_to_box_into(v, lo, hi, &mut out, &mut tmp);
+    out
+}
+
+/// [`clip_to_box`] into `out`, with `tmp` as the second buffer (both reused, not allocated).
+pub fn clip_to_box_into(v: [DVec3; 3], lo: DVec3, hi: DVec3, out: &mut Vec<DVec3>, tmp: &mut Vec<DVec3>) {
+    out.clear();
+    out.extend_from_slice(&v);
     for axis in 0..3 {
         for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
-            if poly.is_empty() {
-                return poly;
+            if out.is_empty() {
+                return;
             }
             let inside = |p: &DVec3| if keep_below { p[axis] <= bound } else { p[axis] >= bound };
-            let mut out = Vec::with_capacity(poly.len() + 2);
-            for i in 0..poly.len() {
-                let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            tmp.clear();
+            for i in 0..out.len() {
+                let (a, b) = (out[i], out[(i + 1) % out.len()]);
                 let (ia, ib) = (inside(&a), inside(&b));
                 if ia {
-                    out.push(a);
+                    tmp.push(a);
                 }
                 if ia != ib {
                     let t = (bound - a[axis]) / (b[axis] - a[axis]);
                     let mut p = a + (b - a) * t;
                     p[axis] = bound;
-                    out.push(p);
+                    tmp.push(p);
                 }
             }
-            poly = out;
+            std::mem::swap(out, tmp);
         }
     }
-    poly
 }
 
 #[cfg(test)]

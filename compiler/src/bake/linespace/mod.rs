@@ -177,7 +177,7 @@ pub fn bake(
     }
     header.filled = rank;
     if candidates {
-        let entries: usize = per_cell.iter().flat_map(|c| &c.lists).map(Vec::len).sum();
+        let entries: usize = per_cell.iter().map(|c| c.entries.len()).sum();
         out.candidates.reserve_exact(entries);
         out.candidate_offsets.reserve_exact(rank as usize + 1);
         out.candidate_offsets.push(0);
@@ -190,9 +190,10 @@ pub fn bake(
     }
     // Consume the cells one by one, so that their memory is freed as it is copied.
     for cell in per_cell {
-        for list in cell.lists {
-            out.candidates.extend_from_slice(&list);
-            out.candidate_offsets.push(u32::try_from(out.candidates.len()).map_err(|_| too_many())?);
+        let base = out.candidates.len();
+        out.candidates.extend_from_slice(&cell.entries);
+        for &end in &cell.list_ends {
+            out.candidate_offsets.push(u32::try_from(base + end as usize).map_err(|_| too_many())?);
         }
         for r in cell.pnmt {
             out.pnmt_missing += (!r[0].is_some() || !r[1].is_some()) as u64;

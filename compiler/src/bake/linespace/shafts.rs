@@ -5,21 +5,24 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::{
-    FACE_PAIRS, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel,
+    FACE_PAIRS, MAX_SHAFT_RES, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel,
 };
 use kiln_format::linespace::{PnmtRecord, entry, words_per_slot};
 
 #[cfg(doc)]
 use super::geometry::PairAxes;
-use super::geometry::{Prepared, clip_to_box};
+use super::geometry::{Prepared, clip_to_box_into};
 
 /// What one cell contributes to the line space.
 #[derive(Debug, Clone, Default)]
 pub struct CellShafts {
     /// Bit words of the slot.
     pub bits: Vec<u32>,
-    /// Candidate entries of each filled shaft, in shaft order (empty without candidates).
-    pub lists: Vec<Vec<u32>>,
+    /// Candidate entries of the filled shafts, list after list in shaft order (empty without
+    /// candidates).
+    pub entries: Vec<u32>,
+    /// Where each filled shaft's list ends in `entries` (empty without candidates).
+    pub list_ends: Vec<u32>,
     /// Front and back records of each filled shaft, in shaft order (empty without PNMT).
     pub pnmt: Vec<[PnmtRecord; 2]>,
     /// Front and back radiance (binary16 RGB, 0) of each filled shaft (empty without it).
@@ -307,7 +310,11 @@ pub struct Scratch {
     counts: Vec<u32>,
     ends: Vec<[End; 2]>,
     polys: Vec<Vec<DVec3>>,
+    clip_tmp: Vec<DVec3>,
 }
+
+/// Patches per face at the largest shaft resolution.
+const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
 
 const NO_END: End = End { t: f32::NAN, triangle: u32::MAX, u: 0.0, v: 0.0, key: f64::NAN, local: u32::MAX };
 
@@ -335,35 +342,40 @@ pub fn bake_cell(
     let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
-    let Scratch { hits, sorted, counts, ends, polys } = scratch;
+    let Scratch { hits, sorted, counts, ends, polys, clip_tmp } = scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
-    ends.clear();
-    if records_needed {
+    // A shaft's ends are reset when it is first filled (resetting every shaft of every cell costs
+    // more than the bake of a sparse cell).
+    if records_needed && ends.len() < shafts {
         ends.resize(shafts, [NO_END; 2]);
     }
-    polys.clear();
     let lo_box = DVec3::splat(-margin);
     let hi_box = DVec3::splat(1.0 + margin);
     // Midpoint segments: patch centres in world space, per face and patch.
-    let centres: Vec<Vec<Vec3>> = (0..6)
-        .map(|face| {
-            (0..n * n)
-                .map(|patch| {
-                    let (ua, va) = face_uv_axes(face);
-                    let mut p = DVec3::ZERO;
-                    p[face_axis(face)] = (face % 2) as f64;
-                    p[ua] = ((patch / n) as f64 + 0.5) / n as f64;
-                    p[va] = ((patch % n) as f64 + 0.5) / n as f64;
-                    (world_cell_min + p * cell).as_vec3()
-                })
-                .collect()
-        })
-        .collect();
+    let mut centres = [[Vec3::ZERO; MAX_PATCHES]; 6];
+    for (face, row) in centres.iter_mut().enumerate() {
+        let face = face as u32;
+        let (ua, va) = face_uv_axes(face);
+        for (patch, c) in row.iter_mut().enumerate().take((n * n) as usize) {
+            let patch = patch as u32;
+            let mut p = DVec3::ZERO;
+            p[face_axis(face)] = (face % 2) as f64;
+            p[ua] = ((patch / n) as f64 + 0.5) / n as f64;
+            p[va] = ((patch % n) as f64 + 0.5) / n as f64;
+            *c = (world_cell_min + p * cell).as_vec3();
+        }
+    }
+    // The clipped polygons of the cell's triangles (kept for the PNMT fallback), their buffers
+    // reused from cell to cell.
+    if polys.len() < tris.len() {
+        polys.resize_with(tris.len(), Vec::new);
+    }
     for (li, &t) in tris.iter().enumerate() {
         let v = local[t as usize].map(|p| p - cell_min);
         let prep = Prepared::new(v);
-        let poly = clip_to_box(v, lo_box, hi_box);
+        clip_to_box_into(v, lo_box, hi_box, &mut polys[li], clip_tmp);
+        let poly = &polys[li];
         let seg = SegmentTest::new(if records_needed { attrs.corners(t) } else { [Vec3::ZERO; 3] });
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
@@ -378,8 +390,10 @@ pub fn bake_cell(
             };
             let (qmin, qmax) =
                 (quantise(kmin - 2.0 * margin, key_lo, false), quantise(kmax + 2.0 * margin, key_lo, true));
-            search(&prep, &poly, pair, n, margin, &mut out.tests, &mut |shaft| {
-                out.bits[(shaft / 32) as usize] |= 1 << (shaft % 32);
+            search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft| {
+                let (word, bit) = ((shaft / 32) as usize, 1 << (shaft % 32));
+                let first = out.bits[word] & bit == 0;
+                out.bits[word] |= bit;
                 if candidates {
                     hits.push((shaft, qmin as u8, qmax as u8, li as u16));
                 }
@@ -387,6 +401,9 @@ pub fn bake_cell(
                     let (_, pa, _, pb) = shaft_parts(shaft, n);
                     let (o, e) = (centres[fa as usize][pa as usize], centres[fb as usize][pb as usize]);
                     let end = &mut ends[shaft as usize];
+                    if first {
+                        *end = [NO_END; 2];
+                    }
                     if let Some(h) = seg.hit(o, e) {
                         if !(h.t >= end[0].t) {
                             end[0] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[0] };
@@ -406,7 +423,6 @@ pub fn bake_cell(
                 }
             });
         }
-        polys.push(poly);
     }
     if candidates {
         // Bucket by shaft (stable: triangle order), then order each bucket by key.
@@ -434,22 +450,26 @@ pub fn bake_cell(
             }
             group.sort_unstable_by_key(|h| (h.1, h.2, h.3));
             let mut running = 0u32;
-            out.lists.push(
-                group
-                    .iter()
-                    .map(|&(_, kmin, kmax, li)| {
-                        running = running.max(kmax as u32);
-                        entry::pack(li as u32, kmin as u32, running)
-                    })
-                    .collect(),
-            );
+            out.entries.extend(group.iter().map(|&(_, kmin, kmax, li)| {
+                running = running.max(kmax as u32);
+                entry::pack(li as u32, kmin as u32, running)
+            }));
+            out.list_ends.push(out.entries.len() as u32);
         }
     }
     if records_needed {
-        for (shaft, end) in ends.iter().enumerate() {
-            if out.bits[shaft / 32] & (1 << (shaft % 32)) == 0 {
-                continue;
-            }
+        let filled = out.bits.iter().enumerate().flat_map(|(w, &word)| {
+            let mut word = word;
+            std::iter::from_fn(move || {
+                (word != 0).then(|| {
+                    let bit = word.trailing_zeros() as usize;
+                    word &= word - 1;
+                    w * 32 + bit
+                })
+            })
+        });
+        for shaft in filled {
+            let end = &ends[shaft];
             let pair = shaft as u32 / (n * n * n * n);
             let (fa, fb) = pair_faces(pair);
             let w = outward(fb) - outward(fa);
@@ -604,6 +624,7 @@ pub fn meets_exactly(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bake::linespace::geometry::clip_to_box;
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the
     /// reach bounds must never leave out a shaft the triangle meets, and nothing else may be
