@@ -458,6 +458,13 @@ pub fn bake_cell(
         }
     }
     if records_needed {
+        let count = out.bits.iter().map(|w| w.count_ones() as usize).sum();
+        if pnmt {
+            out.pnmt.reserve_exact(count);
+        }
+        if shade.is_some() {
+            out.preillum.reserve_exact(count);
+        }
         let filled = out.bits.iter().enumerate().flat_map(|(w, &word)| {
             let mut word = word;
             std::iter::from_fn(move || {
