@@ -224,9 +224,9 @@ pub fn bake(
     Ok(out)
 }
 
-/// Fraction of filled shafts that no triangle meets exactly (the price of taking small
-/// triangles' projected reach without exact tests), estimated from up to `samples` filled shafts
-/// spread evenly over the line space.
+/// Fraction of filled shafts that no triangle meets by the one-shaft sweep test (0 while every
+/// shaft is decided exactly; kept as a check of the bake), estimated from up to `samples` filled
+/// shafts spread evenly over the line space.
 pub fn false_fill_rate(attrs: &SceneAttributes, ls: &BakedLineSpace, samples: usize) -> f64 {
     let h = &ls.header;
     if h.filled == 0 {
