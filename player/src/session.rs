@@ -520,12 +520,13 @@ impl Session {
         }
         submitted?;
         self.pool.wait(&self.gpu)?;
+        let since_start = ms(self.start);
         if self.times.first_frame_gpu_ms == 0.0 {
             self.times.first_frame_gpu_ms = ms(t);
-            self.times.first_frame_since_start_ms = ms(self.start);
+            self.times.first_frame_since_start_ms = since_start;
         }
         if self.upgrade.is_none() && self.times.full_frame_since_start_ms == 0.0 {
-            self.times.full_frame_since_start_ms = ms(self.start);
+            self.times.full_frame_since_start_ms = since_start;
         }
         self.renderer.pass_times(&self.gpu)
     }
