@@ -168,6 +168,13 @@ impl BenchReport {
                 l.fallback_shown_ms
             ));
         }
+        if !l.after_first_frame.is_empty() {
+            s.push_str(&format!(
+                "  after first frame    {:>8.1}  (uploading {})\n",
+                l.rest_upload_ms,
+                l.after_first_frame.join(", ")
+            ));
+        }
         s.push_str(&format!(
             "  chosen pipelines     {:>8.1}\n  chosen ready after start {:>4.1}\n  chosen frame after start {:>4.1}\n",
             l.full_pipelines_ms, l.full_ready_since_start_ms, l.full_frame_since_start_ms

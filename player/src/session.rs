@@ -19,6 +19,7 @@ use kiln_format::read::{Checksums, KilnFile};
 use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
+use crate::render::Needs;
 use crate::render::background::{Built, FrameBuild};
 use crate::render::frame::Frame;
 use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer};
@@ -107,8 +108,15 @@ pub struct LoadTimes {
     /// Building the chosen techniques' pipelines and targets: `pipelines_ms` without a
     /// fallback; with one, on their own thread, from the device's creation on.
     pub full_pipelines_ms: f64,
-    /// Recording and submitting every upload, until the GPU finished them.
+    /// Recording and submitting every upload before the first frame, until the GPU finished
+    /// them.
     pub upload_ms: f64,
+    /// Sections (as `kiln inspect` names them) that only the chosen techniques read, uploaded
+    /// after the fallback's first frame instead of before it (empty without a fallback: the
+    /// first frame reads every section uploaded).
+    pub after_first_frame: Vec<String>,
+    /// Preparing and uploading those sections after the first frame, until the GPU finished.
+    pub rest_upload_ms: f64,
     /// Bytes uploaded.
     pub upload_bytes: u64,
     /// Sections uploaded / skipped.
@@ -117,7 +125,8 @@ pub struct LoadTimes {
     pub sections_skipped: usize,
     /// Rendering the first frame (submit to done).
     pub first_frame_gpu_ms: f64,
-    /// From process start until everything the passes read was resident.
+    /// From process start until everything the passes read was resident (after the first
+    /// frame when sections were left for after it).
     pub resident_since_start_ms: f64,
     /// From process start until the first frame finished on the GPU.
     pub first_frame_since_start_ms: f64,
@@ -165,6 +174,8 @@ pub struct Session {
     _file: KilnFile,
     start: Instant,
     resident: Instant,
+    /// What the passes read, when sections of it wait for [`Session::upload_rest`].
+    rest: Option<Needs>,
     fallback_since: Option<Instant>,
     /// The device (dropped last; shared with the thread that builds pipelines).
     pub gpu: Arc<Gpu>,
@@ -260,6 +271,11 @@ impl Session {
             None => None,
         };
         let first = fallback.unwrap_or(requested);
+        // The first frame waits only for what it reads; the rest uploads after it.
+        let first_needs = match fallback {
+            Some(f) => RenderSettings { techniques: f, ..render }.needs(),
+            None => needs,
+        };
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
@@ -274,11 +290,10 @@ impl Session {
                 }
             });
             let loaded = (|| -> PlayResult<(GpuScene, Dummies, u64, u64)> {
-                let ring = if gpu.is_cpu() { 8 << 20 } else { 16 << 20 };
-                let mut up = Uploader::new(&gpu, ring, timeline)?;
+                let mut up = Uploader::new(&gpu, ring_bytes(&gpu), timeline)?;
                 let result = (|| {
                     let dummies = Dummies::new(&gpu, &mut up)?;
-                    match GpuScene::load(&gpu, &file, &prepared, &mut up) {
+                    match GpuScene::load(&gpu, &file, &prepared, first_needs, &mut up) {
                         Ok(scene) => Ok((scene, dummies)),
                         Err(e) => {
                             let mut d = dummies;
@@ -302,6 +317,7 @@ impl Session {
             (pipes, loaded)
         });
         let cleanup = |gpu: &Gpu| gpu.destroy_semaphore(timeline);
+        let scene_deferred = loaded.as_ref().is_ok_and(|(scene, ..)| scene.deferred());
         let (scene, dummies, ready, bytes) = match loaded {
             Ok(l) => l,
             Err(e) => {
@@ -320,6 +336,8 @@ impl Session {
         times.upload_bytes = bytes;
         times.sections_uploaded = scene.sections.iter().filter(|s| s.uploaded).count();
         times.sections_skipped = scene.sections.len() - times.sections_uploaded;
+        times.after_first_frame =
+            scene.sections.iter().filter(|s| s.after_first_frame).map(|s| s.section.clone()).collect();
         times.resident_since_start_ms = ms(start);
         let resident = Instant::now();
         let mut scene = scene;
@@ -393,6 +411,12 @@ impl Session {
                 "the ray-traced passes' pipelines compile in the background; until they are ready frames show {}",
                 substitutes(&times.fallback)
             ));
+            if !times.after_first_frame.is_empty() {
+                notes.push(format!(
+                    "the first frame does not wait for the sections only the chosen techniques read: {}",
+                    times.after_first_frame.join(", ")
+                ));
+            }
         }
         if render.techniques.shadows == crate::render::Shadows::ShadowMap
             && scene.manifest.shadow_maps.is_empty()
@@ -437,9 +461,34 @@ impl Session {
             _file: file,
             start,
             resident,
+            rest: scene_deferred.then_some(needs),
             fallback_since: None,
             gpu,
         })
+    }
+
+    /// Uploads the sections the first frame did not wait for, if any are left (each frame
+    /// calls it after the first, and the switch to the chosen techniques before it); returns
+    /// when they are resident. The next frame waits for them on the GPU too.
+    pub fn upload_rest(&mut self) -> PlayResult {
+        let Some(needs) = self.rest.take() else { return Ok(()) };
+        let t = Instant::now();
+        let prepared = Prepared::new(&self._file, needs)?;
+        let mut up = Uploader::new(&self.gpu, ring_bytes(&self.gpu), self.timeline)?.after(self.ready);
+        let loaded = self.scene.load_rest(&self.gpu, &self._file, &prepared, &mut up);
+        let flushed = up.flush();
+        let bytes = up.bytes;
+        let destroyed = up.destroy();
+        loaded?;
+        self.ready = flushed?;
+        destroyed?;
+        // Made visible to the frames' queue by the timeline, as the first upload is.
+        self.waited = false;
+        self.times.rest_upload_ms = ms(t);
+        self.times.upload_bytes += bytes;
+        self.times.resident_since_start_ms = ms(self.start);
+        self.resident = Instant::now();
+        Ok(())
     }
 
     /// Whether frames come from the fallback (the chosen techniques' pipelines are still
@@ -463,6 +512,7 @@ impl Session {
             Some(u) if wait || u.build.is_finished() => {}
             _ => return Ok(()),
         }
+        self.upload_rest()?;
         let Some(Upgrade { build, settings }) = self.upgrade.take() else { return Ok(()) };
         let Built { mut frame, ms: built_ms, done } = build.join()?;
         let images = self.renderer.images();
@@ -528,7 +578,9 @@ impl Session {
         if self.upgrade.is_none() && self.times.full_frame_since_start_ms == 0.0 {
             self.times.full_frame_since_start_ms = since_start;
         }
-        self.renderer.pass_times(&self.gpu)
+        let times = self.renderer.pass_times(&self.gpu);
+        self.upload_rest()?;
+        times
     }
 
     /// Records a frame plus `extra` commands and submits it with extra semaphores (the window
@@ -630,4 +682,9 @@ fn substitutes(list: &[Substitute]) -> String {
     let each: Vec<String> =
         list.iter().map(|s| format!("{} {} for {}", s.effect, s.shown, s.requested)).collect();
     each.join(", ")
+}
+
+/// Bytes of each half of the staging ring.
+fn ring_bytes(gpu: &Gpu) -> u64 {
+    if gpu.is_cpu() { 8 << 20 } else { 16 << 20 }
 }

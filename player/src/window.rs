@@ -192,6 +192,8 @@ impl App {
         if !r.swapchain.present(&r.session.gpu, index)? {
             r.resized = true;
         }
+        // What the first frame did not wait for uploads after it.
+        r.session.upload_rest()?;
         // The switch from the fallback to the chosen techniques says so.
         for n in &r.session.notes[r.notes_shown..] {
             eprintln!("note: {n}");

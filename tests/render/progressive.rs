@@ -1,7 +1,8 @@
 //! Progressive pipelines (`PipelineStart::Progressive`): the first frames come from a fallback
 //! without ray-traced passes while the chosen techniques' pipelines compile on another thread.
 //! Headless output and benchmark frames must still come from the chosen techniques, the session
-//! must switch by itself, and no path may leak what the pipeline thread built.
+//! must switch by itself, and no path may leak what the pipeline thread built. The sections only
+//! the chosen techniques read are uploaded after the fallback's first frame.
 
 use std::time::{Duration, Instant};
 
@@ -76,7 +77,7 @@ fn headless_output_behind_a_fallback_is_bit_identical_to_waiting_for_every_pipel
 }
 
 #[test]
-fn bench_reports_the_first_frame_and_the_chosen_techniques_separately_and_measures_only_them() {
+fn bench_reports_the_first_frame_the_chosen_techniques_and_residency_separately_and_measures_only_them() {
     if !vulkan() {
         return;
     }
@@ -109,12 +110,32 @@ fn bench_reports_the_first_frame_and_the_chosen_techniques_separately_and_measur
     assert!(ms("full_ready_since_start_ms") > 0.0 && ms("full_pipelines_ms") > 0.0);
     assert!(ms("full_frame_since_start_ms") > ms("first_frame_since_start_ms"));
     assert_eq!(load["fallback_frames"].as_u64(), Some(1));
+    // The first frame did not wait for what only the ray-traced passes read (the BVH, and the
+    // triangles and materials as storage buffers): the scene became resident after it.
+    let later: Vec<&str> =
+        load["after_first_frame"].as_array().unwrap().iter().map(|s| s.as_str().unwrap()).collect();
+    assert_eq!(later, ["materials", "triangles", "triangle-materials", "bvh"]);
+    assert!(ms("resident_since_start_ms") > ms("first_frame_since_start_ms"));
+    assert!(ms("rest_upload_ms") > 0.0);
+    let sections = json["sections"].as_array().unwrap();
+    let flagged: Vec<&str> = sections
+        .iter()
+        .filter(|s| s["after_first_frame"] == true)
+        .map(|s| s["section"].as_str().unwrap())
+        .collect();
+    assert_eq!(flagged, later);
     // Without a ray-traced technique there is nothing to fall back from.
     let plain = bench::run(&Options::new(&file, 48, 32).progressive().build(), 1, 2, Instant::now()).unwrap();
     let load = serde_json::to_value(&plain).unwrap()["load"].clone();
     assert_eq!(load["fallback"].as_array().map(Vec::len), Some(0), "{load}");
     assert_eq!(load["fallback_frames"].as_u64(), Some(0));
     assert_eq!(load["full_frame_since_start_ms"], load["first_frame_since_start_ms"]);
+    assert_eq!(load["after_first_frame"].as_array().map(Vec::len), Some(0), "{load}");
+    let (resident, first) = (
+        load["resident_since_start_ms"].as_f64().unwrap(),
+        load["first_frame_since_start_ms"].as_f64().unwrap(),
+    );
+    assert!(resident < first, "without a fallback the first frame waits for everything: {resident} {first}");
 }
 
 #[test]

@@ -418,6 +418,20 @@ impl Needs {
         }
     }
 
+    /// What `self` reads beyond `o`.
+    pub fn minus(self, o: Needs) -> Needs {
+        Needs {
+            textures: self.textures && !o.textures,
+            brdf_lut: self.brdf_lut && !o.brdf_lut,
+            shadow_maps: self.shadow_maps && !o.shadow_maps,
+            bvh: self.bvh && !o.bvh,
+            scene_buffers: self.scene_buffers && !o.scene_buffers,
+            line_space: self.line_space & !o.line_space,
+            media: self.media && !o.media,
+            media_volumes: self.media_volumes && !o.media_volumes,
+        }
+    }
+
     /// What ray queries through the BVH read.
     pub const RAYS: Needs = Needs {
         textures: false,
