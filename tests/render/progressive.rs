@@ -49,14 +49,16 @@ fn headless_output_behind_a_fallback_is_bit_identical_to_waiting_for_every_pipel
     let dir = tempfile::tempdir().unwrap();
     let file = demo(dir.path());
     let (w, h, frames) = (64, 48, 3);
+    // GI too: its bounces shade hits with the materials and triangles that upload after the
+    // first frame (the box's Lambertian walls give the other passes no use for them).
+    let all = |o: Options| traced(o).rt_gi(1);
     let (progressive, times, behind) =
-        exr(dir.path(), "progressive", traced(Options::new(&file, w, h)).progressive(), frames);
-    let (complete, complete_times, _) =
-        exr(dir.path(), "complete", traced(Options::new(&file, w, h)), frames);
+        exr(dir.path(), "progressive", all(Options::new(&file, w, h)).progressive(), frames);
+    let (complete, complete_times, _) = exr(dir.path(), "complete", all(Options::new(&file, w, h)), frames);
     // What the fallback shows differs from the chosen techniques, so that the comparison below
     // would see a fallback frame written.
     let (fallback, _, _) =
-        exr(dir.path(), "fallback", traced(Options::new(&file, w, h)).as_fallback(true), frames);
+        exr(dir.path(), "fallback", all(Options::new(&file, w, h)).as_fallback(true), frames);
     assert_ne!(
         fallback, complete,
         "the fallback renders what the chosen techniques render: the test sees nothing"
@@ -66,7 +68,16 @@ fn headless_output_behind_a_fallback_is_bit_identical_to_waiting_for_every_pipel
     // One fallback frame was rendered (timed) before the written ones.
     let names: Vec<(&str, &str, &str)> =
         times.fallback.iter().map(|s| (s.effect, s.requested, s.shown)).collect();
-    assert_eq!(names, [("shadows", "rt", "shadowmap"), ("ao", "rt", "none"), ("reflections", "rt", "none")]);
+    assert_eq!(
+        names,
+        [
+            ("shadows", "rt", "shadowmap"),
+            ("ao", "rt", "none"),
+            ("reflections", "rt", "none"),
+            ("gi", "rt", "none")
+        ]
+    );
+    assert_eq!(times.after_first_frame, ["materials", "triangles", "triangle-materials", "bvh"]);
     assert_eq!(times.fallback_frames, 1);
     assert!(times.first_frame_since_start_ms > 0.0);
     assert!(times.full_frame_since_start_ms > times.first_frame_since_start_ms);
