@@ -606,9 +606,9 @@ impl GpuScene {
                     }
                     _ => fate.after_first_frame = first,
                 }
-            } else if kind == sections::BRDF_LUT && all.brdf_lut && !now.brdf_lut {
-                fate.after_first_frame = first;
-            } else if kind == sections::SHADOW_MAP && all.shadow_maps && !now.shadow_maps {
+            } else if (kind == sections::BRDF_LUT && all.brdf_lut && !now.brdf_lut)
+                || (kind == sections::SHADOW_MAP && all.shadow_maps && !now.shadow_maps)
+            {
                 fate.after_first_frame = first;
             } else if kind == sections::BRDF_LUT && now.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
