@@ -79,6 +79,12 @@ pub fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
 pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -> PlayResult<BenchReport> {
     let mut session = Session::open(options, start)?;
     session.follow(options, 0, frames)?;
+    // Behind a fallback: its first frame for the time to the first frame, then every frame
+    // measured (warm-up included) shows the chosen techniques.
+    if session.showing_fallback() {
+        session.frame(false)?;
+        session.finish_pipelines()?;
+    }
     for _ in 0..warmup.max(1) {
         session.frame(false)?;
     }
@@ -149,6 +155,29 @@ impl BenchReport {
             l.first_frame_gpu_ms,
             l.resident_since_start_ms,
             l.first_frame_since_start_ms,
+        ));
+        if l.fallback.is_empty() {
+            s.push_str("  every frame showed the chosen techniques (no fallback)\n");
+        } else {
+            let shown: Vec<String> =
+                l.fallback.iter().map(|f| format!("{} {} for {}", f.effect, f.shown, f.requested)).collect();
+            s.push_str(&format!(
+                "  fallback shown       {}: {} frame(s) over {:.1} ms\n",
+                shown.join(", "),
+                l.fallback_frames,
+                l.fallback_shown_ms
+            ));
+        }
+        if !l.after_first_frame.is_empty() {
+            s.push_str(&format!(
+                "  after first frame    {:>8.1}  (uploading {})\n",
+                l.rest_upload_ms,
+                l.after_first_frame.join(", ")
+            ));
+        }
+        s.push_str(&format!(
+            "  chosen pipelines     {:>8.1}\n  chosen ready after start {:>4.1}\n  chosen frame after start {:>4.1}\n",
+            l.full_pipelines_ms, l.full_ready_since_start_ms, l.full_frame_since_start_ms
         ));
         s
     }

@@ -13,7 +13,7 @@ use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
 use crate::render::technique::{Effect, KnobValue, Techniques, catalogue, techniques_of};
 use crate::render::{Purpose, RenderSettings};
-use crate::session::SessionOptions;
+use crate::session::{PipelineStart, SessionOptions};
 use crate::window;
 
 const AFTER_HELP: &str = "\
@@ -381,6 +381,17 @@ pub struct Args {
     /// Do not read or write the pipeline cache (~/.cache/kiln/pipelines.bin).
     #[arg(long)]
     pub no_pipeline_cache: bool,
+    /// Wait for every pipeline before the first frame. By default, with ray-traced techniques
+    /// (--shadows, --ao, --reflections or --gi rt or linespace), the first frames show a
+    /// fallback whose pipelines compile in milliseconds (shadow maps for ray-traced shadows
+    /// when the file has them, the split-sum ambient for reflections, no AO, the sky's ambient
+    /// for GI) while the ray-traced pipelines compile in the background (seconds on a first
+    /// run, without a driver or pipeline cache); frames switch when they are ready and a note
+    /// says what was shown instead and for how long. Only the window shows fallback frames:
+    /// headless output and every --bench frame come from the chosen techniques (--bench
+    /// times the fallback's first frame and the chosen techniques' separately).
+    #[arg(long)]
+    pub no_progressive_pipelines: bool,
 }
 
 impl Args {
@@ -486,6 +497,11 @@ impl Args {
             camera: self.camera,
             camera_path: self.camera_path.as_deref().map(CameraPath::load).transpose()?,
             readback: None,
+            pipelines: if self.no_progressive_pipelines {
+                PipelineStart::Complete
+            } else {
+                PipelineStart::Progressive
+            },
         })
     }
 }
@@ -572,9 +588,18 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
         for w in &s.warnings {
             eprintln!("warning: {w}");
         }
+        for n in &s.notes {
+            eprintln!("note: {n}");
+        }
         if let Some(out) = &args.output {
+            // Behind a fallback, its first frame and the chosen techniques' are both timed.
+            let chosen = if s.times.fallback.is_empty() {
+                String::new()
+            } else {
+                format!(", {:.0} ms with the chosen techniques", s.times.full_frame_since_start_ms)
+            };
             eprintln!(
-                "wrote {} ({}x{}, {}) in {:.0} ms (first frame {:.0} ms after start; device {})",
+                "wrote {} ({}x{}, {}) in {:.0} ms (first frame {:.0} ms after start{chosen}; device {})",
                 out.display(),
                 options.width,
                 options.height,

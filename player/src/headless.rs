@@ -18,7 +18,8 @@ pub struct HeadlessResult {
 }
 
 /// Renders `frames` frames (at least one; along the options' camera path, when given) and
-/// writes the last to `output`, if given.
+/// writes the last to `output`, if given. With a fallback ([`crate::session::PipelineStart`]),
+/// one fallback frame comes first, for its time only.
 pub fn run(
     options: &SessionOptions,
     frames: u32,
@@ -31,6 +32,13 @@ pub fn run(
         kind.map(|k| if k == OutputKind::Exr { Readable::Radiance } else { Readable::Display });
     let mut session = Session::open(&options, start)?;
     let frames = frames.max(1);
+    // Behind a fallback, its first frame is rendered and timed (what a window shows first) but
+    // not written: every frame below waits for the chosen techniques.
+    if session.showing_fallback() {
+        session.follow(&options, 0, frames)?;
+        session.frame(false)?;
+        session.finish_pipelines()?;
+    }
     for f in 0..frames {
         session.follow(&options, f, frames)?;
         session.frame(f + 1 == frames && output.is_some())?;

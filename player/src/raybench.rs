@@ -170,6 +170,7 @@ pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult
     let mut o = options.clone();
     o.render.purpose = crate::render::Purpose::RayQueries;
     o.readback = None;
+    o.pipelines = crate::session::PipelineStart::Complete;
     let session = Session::open(&o, start)?;
     let mut query = RayQuery::new(&session.gpu)?;
     query.warmup = WARMUP_TRACES;

@@ -82,6 +82,8 @@ pub fn render_with(
     let mut options = options.clone();
     options.render.purpose = crate::render::Purpose::Reference;
     options.readback = None;
+    // The path tracer renders no frame of the techniques: nothing to show before them.
+    options.pipelines = crate::session::PipelineStart::Complete;
     let session = Session::open(&options, start)?;
     let result = sample(&session, sampling);
     let errors = session.close();

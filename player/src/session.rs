@@ -1,7 +1,15 @@
 //! Opening a file for playback: device, pipelines and upload (the last two in parallel), then
 //! frames. Every front end goes through here, and so does the load-time breakdown.
+//!
+//! With [`PipelineStart::Progressive`] and ray-traced techniques, the first frames come from a
+//! fallback ([`crate::render::Techniques::fallback`]: no ray-traced pass, so its pipelines compile in
+//! milliseconds) while the requested techniques' pipelines compile on a thread of their own
+//! ([`FrameBuild`]); the session switches to them at the first frame after they are ready, or
+//! when asked to wait ([`Session::finish_pipelines`]: headless output and benchmarks, whose
+//! frames must all show the requested techniques).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use crate::gpu::vk;
@@ -11,6 +19,8 @@ use kiln_format::read::{Checksums, KilnFile};
 use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
+use crate::render::Needs;
+use crate::render::background::{Built, FrameBuild};
 use crate::render::frame::Frame;
 use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer};
 use crate::scene::upload::Uploader;
@@ -35,6 +45,20 @@ pub struct SessionOptions {
     pub camera_path: Option<CameraPath>,
     /// The image frames can be copied back from (headless output).
     pub readback: Option<Readable>,
+    /// Whether the first frames wait for every pipeline.
+    pub pipelines: PipelineStart,
+}
+
+/// When the first frame is rendered, relative to the pipelines of the chosen techniques.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PipelineStart {
+    /// After every pipeline of the chosen techniques is built.
+    #[default]
+    Complete,
+    /// When ray-traced techniques are chosen, from their fallback while their pipelines compile
+    /// on another thread (`kiln-play`'s default; the first run on a machine compiles them for
+    /// seconds). Frames switch to the chosen techniques when the pipelines are ready.
+    Progressive,
 }
 
 impl SessionOptions {
@@ -49,8 +73,20 @@ impl SessionOptions {
             camera: None,
             camera_path: None,
             readback: None,
+            pipelines: PipelineStart::default(),
         }
     }
+}
+
+/// An effect the first frames showed with another technique than the chosen one.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct Substitute {
+    /// The effect (`shadows`, `ao`, ...).
+    pub effect: &'static str,
+    /// The chosen technique.
+    pub requested: &'static str,
+    /// The technique shown until the chosen one's pipelines were ready.
+    pub shown: &'static str,
 }
 
 /// Milliseconds spent in each step of loading (wall clock, this process).
@@ -66,10 +102,21 @@ pub struct LoadTimes {
     /// Decoding compressed sections (each once, within `prepare_ms` and `upload_ms`; 0 when the
     /// file stores every section as is).
     pub decode_ms: f64,
-    /// Building pipelines and allocating the frame's targets (parallel with the upload).
+    /// Building the first frame's pipelines and allocating its targets (parallel with the
+    /// upload): the fallback's when there is one.
     pub pipelines_ms: f64,
-    /// Recording and submitting every upload, until the GPU finished them.
+    /// Building the chosen techniques' pipelines and targets: `pipelines_ms` without a
+    /// fallback; with one, on their own thread, from the device's creation on.
+    pub full_pipelines_ms: f64,
+    /// Recording and submitting every upload before the first frame, until the GPU finished
+    /// them.
     pub upload_ms: f64,
+    /// Sections (as `kiln inspect` names them) that only the chosen techniques read, uploaded
+    /// after the fallback's first frame instead of before it (empty without a fallback: the
+    /// first frame reads every section uploaded).
+    pub after_first_frame: Vec<String>,
+    /// Preparing and uploading those sections after the first frame, until the GPU finished.
+    pub rest_upload_ms: f64,
     /// Bytes uploaded.
     pub upload_bytes: u64,
     /// Sections uploaded / skipped.
@@ -78,12 +125,26 @@ pub struct LoadTimes {
     pub sections_skipped: usize,
     /// Rendering the first frame (submit to done).
     pub first_frame_gpu_ms: f64,
-    /// From process start until everything the passes read was resident.
+    /// From process start until everything the passes read was resident (after the first
+    /// frame when sections were left for after it).
     pub resident_since_start_ms: f64,
     /// From process start until the first frame finished on the GPU.
     pub first_frame_since_start_ms: f64,
     /// From process start until the first frame's output was written (headless).
     pub first_output_since_start_ms: f64,
+    /// From process start until the chosen techniques could render: their pipelines built and
+    /// the scene resident.
+    pub full_ready_since_start_ms: f64,
+    /// From process start until the first frame of the chosen techniques finished on the GPU
+    /// (`first_frame_since_start_ms` without a fallback).
+    pub full_frame_since_start_ms: f64,
+    /// The effects the first frames showed with other techniques (empty: every frame showed
+    /// the chosen ones).
+    pub fallback: Vec<Substitute>,
+    /// Frames rendered with the fallback.
+    pub fallback_frames: u32,
+    /// From the first fallback frame's submission until the switch to the chosen techniques.
+    pub fallback_shown_ms: f64,
 }
 
 /// An open file, ready to render.
@@ -94,20 +155,37 @@ pub struct Session {
     pub times: LoadTimes,
     /// Notes for the user.
     pub warnings: Vec<String>,
+    /// What happened while loading that is no problem (the fallback shown, the switch from it),
+    /// in order.
+    pub notes: Vec<String>,
     /// The scene.
     pub scene: GpuScene,
-    /// The renderer.
+    /// The renderer: the fallback's while [`Session::showing_fallback`].
     pub renderer: Renderer,
     /// Where [`Session::frame`] copies the frame when asked to.
     pub readback: Option<Readback>,
+    /// The chosen techniques' frame being built while the fallback renders.
+    upgrade: Option<Upgrade>,
+    dummies: Dummies,
     pool: CommandPool,
     timeline: vk::Semaphore,
     ready: u64,
     waited: bool,
     _file: KilnFile,
     start: Instant,
-    /// The device (dropped last).
-    pub gpu: Gpu,
+    resident: Instant,
+    /// What the passes read, when sections of it wait for [`Session::upload_rest`].
+    rest: Option<Needs>,
+    fallback_since: Option<Instant>,
+    /// The device (dropped last; shared with the thread that builds pipelines).
+    pub gpu: Arc<Gpu>,
+}
+
+/// The chosen techniques' frame, building, and the settings to render it with.
+#[derive(Debug)]
+struct Upgrade {
+    build: FrameBuild,
+    settings: RenderSettings,
 }
 
 impl std::fmt::Debug for Session {
@@ -139,7 +217,13 @@ impl Session {
         let file = open_file(&options.file)?;
         times.open_file_ms = ms(t);
         let mut render = options.render;
-        let needs = render.needs();
+        let progressive = options.pipelines == PipelineStart::Progressive;
+        // The fallback's sections are uploaded too (the shadow maps that stand in for
+        // ray-traced shadows); whether the file has maps is known once it is validated.
+        let needs = match render.techniques.fallback(true) {
+            Some(f) if progressive => render.needs().union(f.needs()),
+            _ => render.needs(),
+        };
         // The CPU side of loading (validation, checksums, index sorting) runs while the driver
         // creates the device, which on some drivers takes well over 100 ms.
         let (gpu, prepared) = std::thread::scope(|s| {
@@ -155,6 +239,7 @@ impl Session {
             (gpu, prepared)
         });
         let (gpu, device_ms) = gpu?;
+        let gpu = Arc::new(gpu);
         times.instance_and_device_ms = device_ms;
         let (prepared, prepare_ms) = prepared?;
         times.prepare_ms = prepare_ms;
@@ -167,16 +252,37 @@ impl Session {
             warnings.push("the ray-traced passes are off: the file has no BVH".to_string());
             render.techniques = render.techniques.without_rays();
         }
-        let techniques = render.techniques;
+        let requested = render.techniques;
+        let fallback =
+            if progressive { requested.fallback(!prepared.manifest().shadow_maps.is_empty()) } else { None };
         let lights = prepared.manifest().lights.len();
         let decode = prepared.texel_decode();
+        // The chosen techniques' pipelines behind a fallback compile on a thread of their own,
+        // started first: they take longest. Dropped on an error below, it waits for the thread
+        // and releases what it built.
+        let background = match fallback {
+            Some(_) => match FrameBuild::spawn(&gpu, requested, lights, decode, width, height) {
+                Ok(b) => Some(b),
+                Err(e) => {
+                    gpu.destroy_semaphore(timeline);
+                    return Err(e);
+                }
+            },
+            None => None,
+        };
+        let first = fallback.unwrap_or(requested);
+        // The first frame waits only for what it reads; the rest uploads after it.
+        let first_needs = match fallback {
+            Some(f) => RenderSettings { techniques: f, ..render }.needs(),
+            None => needs,
+        };
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
                 // The frame's targets too: allocating them costs milliseconds on some drivers.
-                let mut frame = Frame::new(&gpu, &techniques, lights, decode, width, height)?;
+                let mut frame = Frame::new(&gpu, &first, lights, decode, width, height)?;
                 match readback.map(|r| Readback::new(&gpu, r, width, height)).transpose() {
-                    Ok(rb) => Ok((frame, rb, ms(t))),
+                    Ok(rb) => Ok((frame, rb, ms(t), Instant::now())),
                     Err(e) => {
                         frame.destroy(&gpu);
                         Err(e)
@@ -184,11 +290,10 @@ impl Session {
                 }
             });
             let loaded = (|| -> PlayResult<(GpuScene, Dummies, u64, u64)> {
-                let ring = if gpu.is_cpu() { 8 << 20 } else { 16 << 20 };
-                let mut up = Uploader::new(&gpu, ring, timeline)?;
+                let mut up = Uploader::new(&gpu, ring_bytes(&gpu), timeline)?;
                 let result = (|| {
                     let dummies = Dummies::new(&gpu, &mut up)?;
-                    match GpuScene::load(&gpu, &file, &prepared, &mut up) {
+                    match GpuScene::load(&gpu, &file, &prepared, first_needs, &mut up) {
                         Ok(scene) => Ok((scene, dummies)),
                         Err(e) => {
                             let mut d = dummies;
@@ -212,10 +317,11 @@ impl Session {
             (pipes, loaded)
         });
         let cleanup = |gpu: &Gpu| gpu.destroy_semaphore(timeline);
+        let scene_deferred = loaded.as_ref().is_ok_and(|(scene, ..)| scene.deferred());
         let (scene, dummies, ready, bytes) = match loaded {
             Ok(l) => l,
             Err(e) => {
-                if let Ok((mut f, rb, _)) = pipelines {
+                if let Ok((mut f, rb, _, _)) = pipelines {
                     f.destroy(&gpu);
                     if let Some(mut rb) = rb {
                         rb.destroy(&gpu);
@@ -230,9 +336,12 @@ impl Session {
         times.upload_bytes = bytes;
         times.sections_uploaded = scene.sections.iter().filter(|s| s.uploaded).count();
         times.sections_skipped = scene.sections.len() - times.sections_uploaded;
+        times.after_first_frame =
+            scene.sections.iter().filter(|s| s.after_first_frame).map(|s| s.section.clone()).collect();
         times.resident_since_start_ms = ms(start);
+        let resident = Instant::now();
         let mut scene = scene;
-        let (frame, readback, pipelines_ms) = match pipelines {
+        let (frame, readback, pipelines_ms, pipelines_done) = match pipelines {
             Ok(p) => p,
             Err(e) => {
                 let mut d = dummies;
@@ -243,6 +352,11 @@ impl Session {
             }
         };
         times.pipelines_ms = pipelines_ms;
+        if background.is_none() {
+            times.full_pipelines_ms = pipelines_ms;
+            times.full_ready_since_start_ms =
+                pipelines_done.max(resident).duration_since(start).as_secs_f64() * 1e3;
+        }
         let camera = match Camera::initial(
             &scene.manifest.cameras,
             scene.manifest.orthographic(0),
@@ -262,19 +376,48 @@ impl Session {
                 return Err(e);
             }
         };
-        let renderer = match Renderer::new(&gpu, frame, dummies, &scene, render) {
-            Ok(r) => r,
+        let mut dummies = dummies;
+        let made =
+            Renderer::new(&gpu, frame, &dummies, &scene, RenderSettings { techniques: first, ..render })
+                .and_then(|r| match CommandPool::new(&gpu, gpu.family) {
+                    Ok(pool) => Ok((r, pool)),
+                    Err(e) => {
+                        let mut r = r;
+                        r.destroy(&gpu);
+                        Err(e)
+                    }
+                });
+        let (renderer, pool) = match made {
+            Ok(made) => made,
             Err(e) => {
                 if let Some(mut rb) = readback {
                     rb.destroy(&gpu);
                 }
+                dummies.destroy(&gpu);
                 scene.destroy(&gpu);
                 cleanup(&gpu);
                 return Err(e);
             }
         };
-        let pool = CommandPool::new(&gpu, gpu.family)?;
         warnings.extend(renderer.warnings.iter().cloned());
+        let mut notes = Vec::new();
+        if let Some(f) = &fallback {
+            times.fallback = requested
+                .differences(f)
+                .into_iter()
+                .map(|(effect, requested, shown)| Substitute { effect: effect.name(), requested, shown })
+                .collect();
+            notes.push(format!(
+                "the ray-traced passes' pipelines compile in the background; until they are ready frames show {}",
+                substitutes(&times.fallback)
+            ));
+            if !times.after_first_frame.is_empty() {
+                notes.push(format!(
+                    "the first frame does not wait for the sections only the chosen techniques read: {}",
+                    times.after_first_frame.join(", ")
+                ));
+            }
+        }
         if render.techniques.shadows == crate::render::Shadows::ShadowMap
             && scene.manifest.shadow_maps.is_empty()
             && !scene.manifest.lights.is_empty()
@@ -305,17 +448,107 @@ impl Session {
             camera,
             times,
             warnings,
+            notes,
             scene,
             renderer,
             readback,
+            upgrade: background.map(|build| Upgrade { build, settings: render }),
+            dummies,
             pool,
             timeline,
             ready,
             waited: false,
             _file: file,
             start,
+            resident,
+            rest: scene_deferred.then_some(needs),
+            fallback_since: None,
             gpu,
         })
+    }
+
+    /// Uploads the sections the first frame did not wait for, if any are left (each frame
+    /// calls it after the first, and the switch to the chosen techniques before it); returns
+    /// when they are resident. The next frame waits for them on the GPU too.
+    pub fn upload_rest(&mut self) -> PlayResult {
+        let Some(needs) = self.rest.take() else { return Ok(()) };
+        let t = Instant::now();
+        let prepared = Prepared::new(&self._file, needs)?;
+        let mut up = Uploader::new(&self.gpu, ring_bytes(&self.gpu), self.timeline)?.after(self.ready);
+        let loaded = self.scene.load_rest(&self.gpu, &self._file, &prepared, &mut up);
+        let flushed = up.flush();
+        let bytes = up.bytes;
+        let destroyed = up.destroy();
+        loaded?;
+        self.ready = flushed?;
+        destroyed?;
+        // Made visible to the frames' queue by the timeline, as the first upload is.
+        self.waited = false;
+        self.times.rest_upload_ms = ms(t);
+        self.times.upload_bytes += bytes;
+        self.times.resident_since_start_ms = ms(self.start);
+        self.resident = Instant::now();
+        Ok(())
+    }
+
+    /// Whether frames come from the fallback (the chosen techniques' pipelines are still
+    /// building, or built but not yet switched to).
+    pub fn showing_fallback(&self) -> bool {
+        self.upgrade.is_some()
+    }
+
+    /// Waits for the chosen techniques' pipelines, if they are still building, and switches to
+    /// them: every frame after this shows the chosen techniques.
+    pub fn finish_pipelines(&mut self) -> PlayResult {
+        self.switch(true)
+    }
+
+    /// Switches from the fallback to the chosen techniques when their frame is built (with
+    /// `wait`, waiting for it): waits for the GPU, binds the new frame at the current size,
+    /// releases the fallback's. The running average and histories start anew, as after a
+    /// resize. An error building the chosen techniques' pipelines is returned here.
+    fn switch(&mut self, wait: bool) -> PlayResult {
+        match &self.upgrade {
+            Some(u) if wait || u.build.is_finished() => {}
+            _ => return Ok(()),
+        }
+        self.upload_rest()?;
+        let Some(Upgrade { build, settings }) = self.upgrade.take() else { return Ok(()) };
+        let Built { mut frame, ms: built_ms, done } = build.join()?;
+        let images = self.renderer.images();
+        let (width, height) = (images.width, images.height);
+        let sized = self.gpu.wait_idle().and_then(|()| {
+            if (frame.images.width, frame.images.height) == (width, height) {
+                Ok(())
+            } else {
+                frame.resize(&self.gpu, width, height)
+            }
+        });
+        if let Err(e) = sized {
+            frame.destroy(&self.gpu);
+            return Err(e);
+        }
+        let full = Renderer::new(&self.gpu, frame, &self.dummies, &self.scene, settings)?;
+        let mut fallback = std::mem::replace(&mut self.renderer, full);
+        fallback.destroy(&self.gpu);
+        let t = &mut self.times;
+        t.full_pipelines_ms = built_ms;
+        t.full_ready_since_start_ms = done.max(self.resident).duration_since(self.start).as_secs_f64() * 1e3;
+        t.fallback_shown_ms = self.fallback_since.map_or(0.0, ms);
+        for w in &self.renderer.warnings {
+            if !self.warnings.contains(w) {
+                self.warnings.push(w.clone());
+            }
+        }
+        self.notes.push(format!(
+            "the ray-traced passes' pipelines were ready {:.0} ms after start ({:.0} ms to build); {} frame(s) over {:.0} ms showed {}",
+            t.full_ready_since_start_ms,
+            t.full_pipelines_ms,
+            t.fallback_frames,
+            t.fallback_shown_ms,
+            substitutes(&t.fallback)
+        ));
+        Ok(())
     }
 
     /// Renders one frame and waits for it; with `read`, copies it into [`Session::readback`].
@@ -337,21 +570,33 @@ impl Session {
         }
         submitted?;
         self.pool.wait(&self.gpu)?;
+        let since_start = ms(self.start);
         if self.times.first_frame_gpu_ms == 0.0 {
             self.times.first_frame_gpu_ms = ms(t);
-            self.times.first_frame_since_start_ms = ms(self.start);
+            self.times.first_frame_since_start_ms = since_start;
         }
-        self.renderer.pass_times(&self.gpu)
+        if self.upgrade.is_none() && self.times.full_frame_since_start_ms == 0.0 {
+            self.times.full_frame_since_start_ms = since_start;
+        }
+        let times = self.renderer.pass_times(&self.gpu);
+        self.upload_rest()?;
+        times
     }
 
     /// Records a frame plus `extra` commands and submits it with extra semaphores (the window
-    /// adds its swapchain's); the first frame also waits for the upload.
+    /// adds its swapchain's); the first frame also waits for the upload. Switches from the
+    /// fallback first when the chosen techniques' pipelines are ready.
     pub fn record_and_submit(
         &mut self,
         extra: impl FnOnce(&Recorder, &mut Renderer),
         wait: &[SemaphoreOp],
         signal: &[SemaphoreOp],
     ) -> PlayResult {
+        self.switch(false)?;
+        if self.upgrade.is_some() {
+            self.times.fallback_frames += 1;
+            self.fallback_since.get_or_insert_with(Instant::now);
+        }
         let rec = self.pool.begin(&self.gpu)?;
         self.renderer.update(&self.camera)?;
         self.renderer.record(&rec, &self.scene);
@@ -399,7 +644,7 @@ impl Session {
     /// Changes the image size (waits for the GPU).
     pub fn resize(&mut self, width: u32, height: u32) -> PlayResult {
         self.gpu.wait_idle()?;
-        self.renderer.resize(&self.gpu, &self.scene, width, height)
+        self.renderer.resize(&self.gpu, &self.scene, &self.dummies, width, height)
     }
 
     /// Validation-layer errors so far.
@@ -419,12 +664,27 @@ impl Session {
 impl Drop for Session {
     fn drop(&mut self) {
         let _ = self.gpu.wait_idle();
+        // Waits for the pipeline thread and releases what it built.
+        self.upgrade = None;
         self.pool.destroy(&self.gpu);
         if let Some(r) = &mut self.readback {
             r.destroy(&self.gpu);
         }
         self.renderer.destroy(&self.gpu);
+        self.dummies.destroy(&self.gpu);
         self.scene.destroy(&self.gpu);
         self.gpu.destroy_semaphore(self.timeline);
     }
+}
+
+/// "shadows shadowmap for rt, ao none for rt": what stood in for what.
+fn substitutes(list: &[Substitute]) -> String {
+    let each: Vec<String> =
+        list.iter().map(|s| format!("{} {} for {}", s.effect, s.shown, s.requested)).collect();
+    each.join(", ")
+}
+
+/// Bytes of each half of the staging ring.
+fn ring_bytes(gpu: &Gpu) -> u64 {
+    if gpu.is_cpu() { 8 << 20 } else { 16 << 20 }
 }

@@ -25,6 +25,8 @@ struct Running {
     session: Session,
     window: Arc<Window>,
     resized: bool,
+    /// The session's notes printed so far.
+    notes_shown: usize,
 }
 
 impl Drop for Running {
@@ -115,10 +117,14 @@ impl App {
         for w in &session.warnings {
             eprintln!("warning: {w}");
         }
+        for n in &session.notes {
+            eprintln!("note: {n}");
+        }
+        let notes_shown = session.notes.len();
         let b = &session.scene.manifest.bounds;
         let diagonal = DVec3::from_array(b.max.map(f64::from)) - DVec3::from_array(b.min.map(f64::from));
         self.speed = if diagonal.is_finite() { (diagonal.length() * 0.2).max(1e-3) } else { 1.0 };
-        Ok(Running { swapchain, session, window, resized: false })
+        Ok(Running { swapchain, session, window, resized: false, notes_shown })
     }
 
     fn draw(&mut self) -> PlayResult {
@@ -186,6 +192,13 @@ impl App {
         if !r.swapchain.present(&r.session.gpu, index)? {
             r.resized = true;
         }
+        // What the first frame did not wait for uploads after it.
+        r.session.upload_rest()?;
+        // The switch from the fallback to the chosen techniques says so.
+        for n in &r.session.notes[r.notes_shown..] {
+            eprintln!("note: {n}");
+        }
+        r.notes_shown = r.session.notes.len();
         self.frame_ms = 0.9 * self.frame_ms + 0.1 * t.elapsed().as_secs_f64() * 1e3;
         if self.title_at.elapsed().as_secs_f64() > 0.5 {
             self.title_at = Instant::now();

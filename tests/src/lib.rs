@@ -13,7 +13,7 @@ use kiln_player::render::{
     Aa, Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose, ReflectionRes,
     Reflections as ReflectionsTechnique, Shadows,
 };
-use kiln_player::session::SessionOptions;
+use kiln_player::session::{PipelineStart, SessionOptions};
 
 pub mod exact;
 
@@ -210,6 +210,21 @@ impl Options {
     /// Moves the camera through `path` over the frames (`--camera-path`).
     pub fn camera_path(mut self, path: CameraPath) -> Options {
         self.0.camera_path = Some(path);
+        self
+    }
+
+    /// The first frames from the fallback while the ray-traced pipelines compile (what
+    /// `kiln-play` does without `--no-progressive-pipelines`).
+    pub fn progressive(mut self) -> Options {
+        self.0.pipelines = PipelineStart::Progressive;
+        self
+    }
+
+    /// The techniques a session shows while the ray-traced pipelines compile, chosen instead
+    /// (to render what the fallback renders, with every pipeline built first).
+    pub fn as_fallback(mut self, file_has_shadow_maps: bool) -> Options {
+        let t = &mut self.0.render.techniques;
+        *t = t.fallback(file_has_shadow_maps).expect("a ray-traced technique is chosen");
         self
     }
 

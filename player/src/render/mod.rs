@@ -7,6 +7,7 @@
 //! camera is still (a running mean, [`technique::Aa::Accumulate`]); any change of the view or
 //! projection restarts the average (no reprojection: a moving camera sees the one-sample image).
 
+pub mod background;
 pub mod dummies;
 pub mod frame;
 pub mod graph;
@@ -86,7 +87,6 @@ pub type PassTimes = Vec<(&'static str, f64)>;
 /// Renders a resident scene.
 pub struct Renderer {
     frame: Frame,
-    dummies: Dummies,
     frame_ubo: Buffer,
     lights: Buffer,
     shadows: Buffer,
@@ -126,11 +126,12 @@ fn host_buffer(gpu: &Gpu, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags)
 }
 
 impl Renderer {
-    /// Binds `scene` to the passes of `frame`. On failure everything given is released.
+    /// Binds `scene` to the passes of `frame`, with `dummies` where nothing else is bound (the
+    /// session's: they must outlive the renderer). On failure the frame is released.
     pub fn new(
         gpu: &Gpu,
         frame: Frame,
-        dummies: Dummies,
+        dummies: &Dummies,
         scene: &GpuScene,
         settings: RenderSettings,
     ) -> PlayResult<Renderer> {
@@ -203,7 +204,7 @@ impl Renderer {
             Reflections::None => {}
         }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let (mut frame, mut dummies) = (frame, dummies);
+        let mut frame = frame;
         let buffers = (|| {
             let lights = host_buffer(gpu, "lights", bytemuck::cast_slice(&plan.lights), storage)?;
             let shadows = host_buffer(gpu, "shadows", bytemuck::cast_slice(&plan.shadows), storage);
@@ -238,14 +239,12 @@ impl Renderer {
             Ok(b) => b,
             Err(e) => {
                 frame.destroy(gpu);
-                dummies.destroy(gpu);
                 return Err(e);
             }
         };
         let warnings = plan.warnings.clone();
         let mut renderer = Renderer {
             frame,
-            dummies,
             frame_ubo,
             lights,
             shadows,
@@ -266,7 +265,7 @@ impl Renderer {
             frame_count: 0,
             warnings,
         };
-        if let Err(e) = renderer.bind(gpu, scene) {
+        if let Err(e) = renderer.bind(gpu, scene, dummies) {
             renderer.destroy(gpu);
             return Err(e);
         }
@@ -274,14 +273,14 @@ impl Renderer {
     }
 
     /// Points every pass at the scene and the current images.
-    fn bind(&mut self, gpu: &Gpu, scene: &GpuScene) -> PlayResult {
+    fn bind(&mut self, gpu: &Gpu, scene: &GpuScene, dummies: &Dummies) -> PlayResult {
         let shared = Shared {
             scene,
             frame_ubo: &self.frame_ubo,
             lights: &self.lights,
             shadows: &self.shadows,
             plan: &self.plan,
-            dummies: &self.dummies,
+            dummies,
             images: &self.frame.images,
         };
         for p in &mut self.frame.passes {
@@ -307,11 +306,18 @@ impl Renderer {
     }
 
     /// Recreates the targets for a new size (the GPU must be idle).
-    pub fn resize(&mut self, gpu: &Gpu, scene: &GpuScene, width: u32, height: u32) -> PlayResult {
+    pub fn resize(
+        &mut self,
+        gpu: &Gpu,
+        scene: &GpuScene,
+        dummies: &Dummies,
+        width: u32,
+        height: u32,
+    ) -> PlayResult {
         self.frame.resize(gpu, width.max(1), height.max(1))?;
         self.accumulated = 0;
         self.last_view_proj = None;
-        self.bind(gpu, scene)
+        self.bind(gpu, scene, dummies)
     }
 
     /// Writes the frame constants for `camera` (the previous frame must have finished).
@@ -419,7 +425,6 @@ impl Renderer {
     /// Releases everything the renderer owns (the GPU must be idle).
     pub fn destroy(&mut self, gpu: &Gpu) {
         self.frame.destroy(gpu);
-        self.dummies.destroy(gpu);
         self.frame_ubo.destroy(gpu);
         self.lights.destroy(gpu);
         self.shadows.destroy(gpu);

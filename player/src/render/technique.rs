@@ -418,6 +418,20 @@ impl Needs {
         }
     }
 
+    /// What `self` reads beyond `o`.
+    pub fn minus(self, o: Needs) -> Needs {
+        Needs {
+            textures: self.textures && !o.textures,
+            brdf_lut: self.brdf_lut && !o.brdf_lut,
+            shadow_maps: self.shadow_maps && !o.shadow_maps,
+            bvh: self.bvh && !o.bvh,
+            scene_buffers: self.scene_buffers && !o.scene_buffers,
+            line_space: self.line_space & !o.line_space,
+            media: self.media && !o.media,
+            media_volumes: self.media_volumes && !o.media_volumes,
+        }
+    }
+
     /// What ray queries through the BVH read.
     pub const RAYS: Needs = Needs {
         textures: false,
@@ -553,6 +567,43 @@ impl Techniques {
             gi: Gi::None,
             ..self
         }
+    }
+
+    /// What a session shows while the ray-traced passes' pipelines compile (`None`: no pass is
+    /// ray traced, nothing to wait for). Each ray-traced technique is replaced by what keeps its
+    /// effect from baked data without rays: shadows from the file's shadow maps (when it has
+    /// them, `shadow_maps`; else unshadowed), reflections by the split-sum ambient, AO off (the
+    /// materials' occlusion textures still apply), GI by the sky's ambient. The other effects
+    /// keep their techniques.
+    pub fn fallback(&self, shadow_maps: bool) -> Option<Techniques> {
+        if !self.ray_traced() {
+            return None;
+        }
+        let shadows = match self.shadows {
+            Shadows::Rt { .. } | Shadows::LineSpace { .. } if shadow_maps => Shadows::ShadowMap,
+            Shadows::Rt { .. } | Shadows::LineSpace { .. } => Shadows::None,
+            s => s,
+        };
+        Some(Techniques {
+            shadows,
+            ao: if matches!(self.ao, Ao::Rt { .. }) { Ao::None } else { self.ao },
+            reflections: if matches!(self.reflections, Reflections::Rt { .. }) {
+                Reflections::None
+            } else {
+                self.reflections
+            },
+            gi: if self.gi.bounces().is_some() { Gi::None } else { self.gi },
+            ..*self
+        })
+    }
+
+    /// The effects whose technique differs in `other`: (effect, this one's name, `other`'s).
+    pub fn differences(&self, other: &Techniques) -> Vec<(Effect, &'static str, &'static str)> {
+        Effect::ALL
+            .into_iter()
+            .filter(|&e| self.name_of(e) != other.name_of(e))
+            .map(|e| (e, self.name_of(e), other.name_of(e)))
+            .collect()
     }
 
     /// The technique `name` for `effect` with `knobs` (name, value) set, the others at their
@@ -1544,6 +1595,67 @@ mod tests {
         }
         assert_eq!(Ao::Gtao { radius: Some(2.0), reach: 0.05, slices: 3, steps: 3 }.world_radius(10.0), 2.0);
         assert_eq!(Ao::Rt { radius: None, reach: 0.1 }.world_radius(10.0), 1.0);
+    }
+
+    #[test]
+    fn the_fallback_keeps_effects_from_baked_data_and_compiles_no_ray_traced_pass() {
+        let d = Techniques::default();
+        assert_eq!(d.fallback(true), None, "nothing ray traced: no fallback");
+        let ssgi = Gi::Ssgi {
+            samples: 8,
+            resolution: ScreenFraction::Half,
+            radius: 40,
+            voting: true,
+            falloff: false,
+            frames: 16,
+            tiled: true,
+        };
+        let gtao = Ao::Gtao { radius: None, reach: 0.05, slices: 3, steps: 3 };
+        let all = Techniques {
+            shadows: Shadows::Rt { light_radius: 0.1, sun_degrees: 0.5 },
+            ao: Ao::Rt { radius: None, reach: 0.1 },
+            reflections: Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 1.0 },
+            gi: Gi::Rt { bounces: 2 },
+            aa: Aa::Taa { frames: 8, luma_weights: false },
+            ..d
+        };
+        let f = all.fallback(true).unwrap();
+        assert!(!f.ray_traced() && f.reprojected_rays().is_none());
+        assert_eq!(
+            (f.shadows, f.ao, f.reflections, f.gi, f.aa),
+            (Shadows::ShadowMap, Ao::None, Reflections::None, Gi::None, all.aa)
+        );
+        assert_eq!(all.fallback(false).unwrap().shadows, Shadows::None, "no shadow maps in the file");
+        assert_eq!(
+            all.differences(&f),
+            vec![
+                (Effect::Shadows, "rt", "shadowmap"),
+                (Effect::Ao, "rt", "none"),
+                (Effect::Reflections, "rt", "none"),
+                (Effect::Gi, "rt", "none")
+            ]
+        );
+        // Techniques that are not ray traced are kept, screen-space ones included.
+        let mixed = Techniques {
+            shadows: Shadows::LineSpace { light_radius: 0.0, sun_degrees: 0.0, test: LsShadowTest::Ends },
+            ao: gtao,
+            reflections: Reflections::Ssr { steps: 48, max_roughness: 0.6 },
+            gi: ssgi,
+            ..d
+        };
+        let f = mixed.fallback(true).unwrap();
+        assert_eq!(
+            (f.shadows, f.ao, f.reflections, f.gi),
+            (Shadows::ShadowMap, gtao, mixed.reflections, ssgi)
+        );
+        assert_eq!(mixed.differences(&f), vec![(Effect::Shadows, "linespace", "shadowmap")]);
+        let gi = Techniques { gi: Gi::LineSpace { bounces: 1, structure: GiStructure::Pnmt }, ..d };
+        assert_eq!(gi.fallback(true), Some(Techniques { gi: Gi::None, ..d }));
+        // What the fallback reads beyond the requested techniques: the shadow maps at most.
+        for t in [all, mixed, gi] {
+            let (n, f) = (t.needs(), t.fallback(true).unwrap().needs());
+            assert_eq!(n.union(f), Needs { shadow_maps: true, ..n }, "{t:?}");
+        }
     }
 
     #[test]

@@ -1,5 +1,9 @@
 //! A `.kiln` file made resident on the GPU: its sections uploaded in file order through the
 //! staging ring, only those the enabled passes read. The rest are skipped and listed.
+//!
+//! The upload can come in two parts: first what the first frame reads (its [`Needs`]: a
+//! fallback's, while the chosen techniques' pipelines compile), then, after that frame, the
+//! sections only the chosen techniques read ([`GpuScene::load_rest`]).
 
 pub mod bindings;
 pub mod linespace;
@@ -52,6 +56,10 @@ pub struct SectionFate {
     pub uploaded: bool,
     /// Why it was skipped (empty when uploaded or read on the CPU).
     pub reason: String,
+    /// Uploaded after the first frame, which does not read it (or reads only a part that
+    /// was uploaded before it: the triangles and texture of a file whose ray-traced passes
+    /// read them again as storage buffers).
+    pub after_first_frame: bool,
 }
 
 /// The CPU side of loading, done while the device is being created: the file validated, the
@@ -74,6 +82,14 @@ impl std::fmt::Debug for Prepared<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Prepared").field("draws", &self.draws.len()).finish()
     }
+}
+
+/// What one pass of the upload makes resident: the sections `now` reads, and the geometry
+/// (vertices, attributes, sorted indices) in the first pass.
+#[derive(Debug, Clone, Copy)]
+struct Part {
+    now: Needs,
+    geometry: bool,
 }
 
 /// Whether a section of `kind` is uploaded under `needs` (geometry always).
@@ -286,6 +302,8 @@ pub struct GpuScene {
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
     pub uploaded_bytes: u64,
+    /// What is resident (of what the passes read; geometry always).
+    pub resident: Needs,
     samplers: HashMap<SamplerKey, Sampler>,
 }
 
@@ -361,9 +379,17 @@ impl GpuScene {
         glam::Vec3::from(b.max).distance(glam::Vec3::from(b.min))
     }
 
-    /// Uploads what `prepared` needs through `up`. Returns when everything is recorded; the
-    /// caller flushes the uploader and waits on its timeline before drawing.
-    pub fn load(gpu: &Gpu, file: &KilnFile, prepared: &Prepared, up: &mut Uploader) -> PlayResult<GpuScene> {
+    /// Uploads what `prepared` needs through `up`, of the sections beyond the geometry only
+    /// those `first` reads (`prepared`'s own needs: all of them); the others are listed as
+    /// uploaded after the first frame, for [`GpuScene::load_rest`]. Returns when everything is
+    /// recorded; the caller flushes the uploader and waits on its timeline before drawing.
+    pub fn load(
+        gpu: &Gpu,
+        file: &KilnFile,
+        prepared: &Prepared,
+        first: Needs,
+        up: &mut Uploader,
+    ) -> PlayResult<GpuScene> {
         let view = &prepared.view;
         let sampler = |key| Sampler::new(gpu, key);
         let clamp = vk::SamplerAddressMode::CLAMP_TO_EDGE;
@@ -407,9 +433,11 @@ impl GpuScene {
             media: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
+            resident: Needs::default(),
             samplers,
         };
-        match scene.upload_sections(gpu, file, prepared, up) {
+        let part = Part { now: prepared.needs.minus(prepared.needs.minus(first)), geometry: true };
+        match scene.upload_sections(gpu, file, prepared, part, up) {
             Ok(()) => {
                 scene.uploaded_bytes = up.bytes;
                 Ok(scene)
@@ -424,22 +452,47 @@ impl GpuScene {
         }
     }
 
-    fn upload_sections(
+    /// Uploads the sections the first part left ([`GpuScene::load`] with fewer needs than
+    /// `prepared`'s; `prepared` made again from the same file, with the same needs). Returns
+    /// when everything is recorded; the caller flushes the uploader and waits for it.
+    pub fn load_rest(
         &mut self,
         gpu: &Gpu,
         file: &KilnFile,
         prepared: &Prepared,
         up: &mut Uploader,
     ) -> PlayResult {
-        let (view, needs) = (&prepared.view, prepared.needs);
-        if let Some(tables) = &prepared.reference {
+        let part = Part { now: prepared.needs.minus(self.resident), geometry: false };
+        self.upload_sections(gpu, file, prepared, part, up)?;
+        self.uploaded_bytes += up.bytes;
+        Ok(())
+    }
+
+    /// Whether sections the passes read wait for [`GpuScene::load_rest`].
+    pub fn deferred(&self) -> bool {
+        self.sections.iter().any(|s| s.after_first_frame)
+    }
+
+    fn upload_sections(
+        &mut self,
+        gpu: &Gpu,
+        file: &KilnFile,
+        prepared: &Prepared,
+        part: Part,
+        up: &mut Uploader,
+    ) -> PlayResult {
+        let (view, all, now) = (&prepared.view, prepared.needs, part.now);
+        // The first part lists every section's fate; a later one only uploads.
+        let first = part.geometry;
+        self.resident = self.resident.union(now);
+        if let (Some(tables), true) = (&prepared.reference, now.scene_buffers) {
             self.reference = Some(reference_buffers(gpu, view, tables)?);
         }
-        if let Some(layout) = &prepared.line_space {
+        if let (Some(layout), true) = (&prepared.line_space, now.line_space != 0) {
             self.line_space = Some(linespace::LineSpaceBuffers::new(gpu, layout, up)?);
         }
-        if needs.media && !view.manifest.media.is_empty() {
-            self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, needs.media_volumes, up)?);
+        if now.media && !view.manifest.media.is_empty() {
+            self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, all.media_volumes, up)?);
         }
         for s in file.sections() {
             let kind = s.entry.kind;
@@ -449,17 +502,37 @@ impl GpuScene {
                 Some(k) => k.name.to_string(),
                 None => format!("{kind} (unknown to this player)"),
             };
-            let mut fate =
-                SectionFate { section: name, bytes: s.entry.raw_size, uploaded: true, reason: String::new() };
+            let mut fate = SectionFate {
+                section: name,
+                bytes: s.entry.raw_size,
+                uploaded: true,
+                reason: String::new(),
+                after_first_frame: false,
+            };
+            // Sections (or parts of them) that a later part uploads.
+            let scene_buffers_later = all.scene_buffers && !now.scene_buffers && first;
             if s.known.is_none() {
                 fate.uploaded = false;
                 fate.reason = "unknown kind or newer version".into();
-            } else if let Some(ls) = self.line_space.as_ref().filter(|l| l.uploads(kind)) {
-                ls.upload(kind, &file.section_bytes(s).map_err(bad)?, up)?;
-            } else if let (Some(r), true) = (&self.reference, kind == sections::MATERIALS) {
+            } else if prepared.line_space.as_ref().is_some_and(|l| l.uploads(kind)) {
+                match &self.line_space {
+                    Some(ls) if now.line_space != 0 => {
+                        ls.upload(kind, &file.section_bytes(s).map_err(bad)?, up)?
+                    }
+                    _ => fate.after_first_frame = true,
+                }
+            } else if let (Some(r), true) =
+                (&self.reference, now.scene_buffers && kind == sections::MATERIALS)
+            {
                 up.buffer(&r.materials, 0, bytemuck::cast_slice(view.materials))?;
-            } else if let (Some(r), true) = (&self.reference, kind == sections::TRIANGLE_MATERIALS) {
+            } else if let (Some(r), true) =
+                (&self.reference, now.scene_buffers && kind == sections::TRIANGLE_MATERIALS)
+            {
                 up.buffer(&r.triangle_materials, 0, bytemuck::cast_slice(view.triangle_materials))?;
+            } else if (kind == sections::MATERIALS || kind == sections::TRIANGLE_MATERIALS)
+                && scene_buffers_later
+            {
+                fate.after_first_frame = true;
             } else if kind == sections::MANIFEST
                 || kind == sections::MATERIALS
                 || kind == sections::TRIANGLE_MATERIALS
@@ -467,16 +540,25 @@ impl GpuScene {
                 fate.uploaded = false;
                 fate.reason = "read on the CPU".into();
             } else if kind == sections::VERTICES {
-                up.buffer(&self.vertices, 0, bytemuck::cast_slice(view.vertices))?;
+                if part.geometry {
+                    up.buffer(&self.vertices, 0, bytemuck::cast_slice(view.vertices))?;
+                }
             } else if kind == sections::UVS || kind == sections::COLORS {
                 // Interleaved with the other into one stream (below).
             } else if kind == sections::TRIANGLES {
                 // Uploaded re-sorted by material, so that each material is one draw.
-                up.buffer(&self.indices, 0, bytemuck::cast_slice(&prepared.indices))?;
-                if let Some(r) = &self.reference {
-                    up.buffer(&r.indices, 0, bytemuck::cast_slice(view.triangles))?;
+                if part.geometry {
+                    up.buffer(&self.indices, 0, bytemuck::cast_slice(&prepared.indices))?;
                 }
-            } else if kind == sections::BVH_NODES && needs.bvh && !view.bvh.is_empty() {
+                match &self.reference {
+                    Some(r) if now.scene_buffers => {
+                        up.buffer(&r.indices, 0, bytemuck::cast_slice(view.triangles))?
+                    }
+                    _ => fate.after_first_frame = scene_buffers_later,
+                }
+            } else if kind == sections::BVH_NODES && all.bvh && !view.bvh.is_empty() && !now.bvh {
+                fate.after_first_frame = first;
+            } else if kind == sections::BVH_NODES && now.bvh && !view.bvh.is_empty() {
                 let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
                 let nodes =
                     Buffer::uploaded(gpu, "bvh nodes", std::mem::size_of_val(view.bvh) as u64, storage)?;
@@ -500,21 +582,35 @@ impl GpuScene {
                     .and_then(|()| up.buffer(&bvh.triangles, 0, corners));
                 self.bvh = Some(bvh);
                 uploaded?;
-            } else if kind == sections::TEXTURE && needs.textures {
-                self.upload_texture(gpu, view, index as usize, up)?;
-                if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
-                    let t = tables.textures[index as usize];
-                    up.buffer(
-                        &r.texels,
-                        t.offset as u64 * 4,
-                        view.texture(index as usize).map_err(bad)?.levels,
-                    )?;
+            } else if kind == sections::TEXTURE && all.textures {
+                if now.textures {
+                    self.upload_texture(gpu, view, index as usize, up)?;
+                } else {
+                    fate.after_first_frame = first;
                 }
-            } else if let (Some(m), true) =
-                (&self.media, kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
+                match (&self.reference, &prepared.reference) {
+                    (Some(r), Some(tables)) if now.scene_buffers => {
+                        let t = tables.textures[index as usize];
+                        up.buffer(
+                            &r.texels,
+                            t.offset as u64 * 4,
+                            view.texture(index as usize).map_err(bad)?.levels,
+                        )?;
+                    }
+                    _ => fate.after_first_frame |= scene_buffers_later,
+                }
+            } else if kind == sections::MEDIA_VISIBILITY && all.media_volumes && self.media.is_some() {
+                match &self.media {
+                    Some(m) if now.media => {
+                        m.upload_volume(index, &file.section_bytes(s).map_err(bad)?, up)?
+                    }
+                    _ => fate.after_first_frame = first,
+                }
+            } else if (kind == sections::BRDF_LUT && all.brdf_lut && !now.brdf_lut)
+                || (kind == sections::SHADOW_MAP && all.shadow_maps && !now.shadow_maps)
             {
-                m.upload_volume(index, &file.section_bytes(s).map_err(bad)?, up)?;
-            } else if kind == sections::BRDF_LUT && needs.brdf_lut {
+                fate.after_first_frame = first;
+            } else if kind == sections::BRDF_LUT && now.brdf_lut {
                 let res = view.manifest.brdf_lut.as_ref().map_or(0, |b| b.resolution);
                 let texels: &[[u16; 2]] = file.pod(sections::BRDF_LUT, 0).map_err(bad)?.unwrap_or(&[]);
                 let image = Image::new(
@@ -524,7 +620,7 @@ impl GpuScene {
                 )?;
                 up.image(&image, 4, &[(0, 0, res, res, bytemuck::cast_slice(texels))])?;
                 self.brdf_lut = Some(image);
-            } else if kind == sections::SHADOW_MAP && needs.shadow_maps {
+            } else if kind == sections::SHADOW_MAP && now.shadow_maps {
                 let info = &view.manifest.shadow_maps[index as usize];
                 let depths: &[f32] = file.pod(sections::SHADOW_MAP, index).map_err(bad)?.unwrap_or(&[]);
                 let n = info.resolution;
@@ -556,10 +652,14 @@ impl GpuScene {
                     "no enabled pass reads it".into()
                 };
             }
-            self.sections.push(fate);
+            if first {
+                self.sections.push(fate);
+            }
         }
-        up.buffer(&self.attributes, 0, bytemuck::cast_slice(&vertex_attributes(view)))?;
-        if let (Some(r), Some(tables)) = (&self.reference, &prepared.reference) {
+        if part.geometry {
+            up.buffer(&self.attributes, 0, bytemuck::cast_slice(&vertex_attributes(view)))?;
+        }
+        if let (Some(r), Some(tables), true) = (&self.reference, &prepared.reference, now.scene_buffers) {
             up.buffer(&r.emitters, 0, bytemuck::cast_slice(&tables.emitters))?;
             up.buffer(&r.triangle_emitter, 0, bytemuck::cast_slice(&tables.triangle_emitter))?;
             up.buffer(&r.textures, 0, bytemuck::cast_slice(&tables.textures))?;

@@ -59,6 +59,13 @@ impl<'g> Uploader<'g> {
         Ok(Uploader { gpu, halves, current: 0, timeline, signalled: 0, bytes: 0 })
     }
 
+    /// The same ring signalling values after `value` (a second upload on a timeline that an
+    /// earlier one already advanced to `value`).
+    pub fn after(mut self, value: u64) -> Uploader<'g> {
+        self.signalled = value;
+        self
+    }
+
     fn capacity(&self) -> u64 {
         self.halves[0].staging.size
     }

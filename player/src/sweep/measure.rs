@@ -60,6 +60,9 @@ fn run(
     timing: Timing,
     tick: &mut dyn FnMut(),
 ) -> PlayResult<Measured> {
+    // Every measured frame shows the chosen techniques (a no-op unless the options ask for a
+    // fallback).
+    session.finish_pipelines()?;
     let (w, h) = (session.renderer.images().width as usize, session.renderer.images().height as usize);
     let last = checkpoints.iter().copied().max().unwrap_or(1).max(1);
     let mut images = Vec::new();

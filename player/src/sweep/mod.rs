@@ -28,7 +28,7 @@ use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Gpu, GpuOptions};
 use crate::render::{Effect, Purpose, RenderSettings, Techniques};
-use crate::session::{SessionOptions, open_file};
+use crate::session::{PipelineStart, SessionOptions, open_file};
 
 use measure::{Measured, Timing, measure};
 use plan::{Offers, Plan, Request, Skipped, Target};
@@ -350,6 +350,8 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             camera: *camera,
             camera_path: options.camera_path.as_ref().map(|p| p.path.clone()),
             readback: None,
+            // Every frame is measured: none from a fallback, and none compiled for one.
+            pipelines: PipelineStart::Complete,
         };
         let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;
         references.extend(refs.values().map(|r| r.info.clone()));
