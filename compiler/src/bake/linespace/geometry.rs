@@ -524,18 +524,23 @@ pub fn clip_to_box_into(v: [DVec3; 3], lo: DVec3, hi: DVec3, out: &mut Vec<DVec3
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `state` (the tests' own, so that
+    /// their cases do not change with a crate's version).
+    pub(crate) fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
 
     /// Random sampling of hull points: any sampled point inside the triangle's slab-thin
     /// neighbourhood must be found by the exact test (it may find more: it is exact, sampling is not).
     #[test]
     fn sweep_test_agrees_with_dense_sampling() {
-        let mut state = 12345u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(12345);
         let mut agree = 0;
         for _ in 0..300 {
             let v = [0; 3].map(|_| DVec3::new(rnd(), rnd(), rnd()));
@@ -580,11 +585,7 @@ mod tests {
         if !std::arch::is_x86_feature_detected!("avx2") {
             return;
         }
-        let mut state = 99u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(99);
         let (mut met, mut missed) = (0, 0);
         for _ in 0..20_000 {
             let v = [0; 3].map(|_| DVec3::new(rnd(), rnd(), rnd()) * 1.4 - 0.2);
@@ -622,11 +623,7 @@ mod tests {
         if !std::arch::is_x86_feature_detected!("avx2") {
             return;
         }
-        let mut state = 5u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(5);
         let mut nonzero = 0;
         for case in 0..20_000u32 {
             let n = 1 + case % 8;
@@ -654,11 +651,7 @@ mod tests {
     #[test]
     fn shaft_lanes_agree_with_the_sweep() {
         use kiln_format::linespace::index::{FACE_PAIRS, pair_faces};
-        let mut state = 7u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(7);
         let (mut met, mut tested) = (0u64, 0u64);
         for case in 0..3000 {
             let n = 1 + case % 8;

@@ -632,6 +632,7 @@ pub fn meets_exactly(
 mod tests {
     use super::*;
     use crate::bake::linespace::geometry::clip_to_box;
+    use crate::bake::linespace::geometry::tests::uniform;
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the
     /// reach bounds must never leave out a shaft the triangle meets, and nothing else may be
@@ -639,11 +640,7 @@ mod tests {
     /// outside them, and tiny ones next to a face (where projections blow up).
     #[test]
     fn search_finds_exactly_the_shafts_the_sweep_test_finds() {
-        let mut state = 11u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(11);
         let (mut found_total, mut tested) = (0u64, 0u64);
         for case in 0..1500u32 {
             let n = 1 + case % 8;
