@@ -191,17 +191,39 @@ impl PairAxes {
     }
 }
 
+/// The shafts of a target rectangle, shared by [`shafts`] and its AVX2 twin: the rectangle's
+/// width, its number of patches and the mask of them all; `None` when it is empty.
+#[inline(always)]
+fn rect_shafts(rect: [u32; 4]) -> Option<(usize, usize, u64)> {
+    let [u0, u1, v0, v1] = rect;
+    if u0 >= u1 || v0 >= v1 {
+        return None;
+    }
+    let w = (v1 - v0) as usize;
+    let count = (u1 - u0) as usize * w;
+    Some((w, count, if count == 64 { u64::MAX } else { (1u64 << count) - 1 }))
+}
+
+/// The patch indices of shaft `k` of the rectangle (padding beyond `count` repeats the last).
+#[inline(always)]
+fn shaft_patch(rect: [u32; 4], w: usize, count: usize, k: usize) -> (f64, f64) {
+    let k = k.min(count - 1);
+    ((rect[0] as usize + k / w) as f64, (rect[2] as usize + k % w) as f64)
+}
+
+/// The b end's separation on lane `i` of `side` as base + u·du + v·dv (negating du and dv gives
+/// the same bits as subtracting for side 1).
+#[inline(always)]
+fn b_end(p: &PairAxes, side: usize, i: usize) -> (f64, f64, f64) {
+    if side == 0 { (p.b[0][i], p.b_du[i], p.b_dv[i]) } else { (p.b[1][i], -p.b_du[i], -p.b_dv[i]) }
+}
+
 /// See [`PairAxes::shafts_from`]. Plain arithmetic (no fused multiply-adds), so that the AVX2
 /// build and the portable one give the same bits.
 #[inline(always)]
 fn shafts(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
+    let Some((w, count, all)) = rect_shafts(rect) else { return 0 };
     let [u0, u1, v0, v1] = rect;
-    if u0 >= u1 || v0 >= v1 {
-        return 0;
-    }
-    let w = (v1 - v0) as usize;
-    let count = (u1 - u0) as usize * w;
-    let all = if count == 64 { u64::MAX } else { (1u64 << count) - 1 };
     let (au, av) = (au as f64, av as f64);
     let (bu0, bu1, bv0, bv1) = (u0 as f64, (u1 - 1) as f64, v0 as f64, (v1 - 1) as f64);
     // Per lane and side: the a end's separation and the least and greatest of the b end's.
@@ -239,9 +261,9 @@ fn shafts(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
         return all;
     }
     if count <= 16 {
-        per_shaft::<4>(p, &sa, active, rect, count)
+        per_shaft::<4>(p, &sa, active, rect, w, count)
     } else {
-        per_shaft::<16>(p, &sa, active, rect, count)
+        per_shaft::<16>(p, &sa, active, rect, w, count)
     }
 }
 
@@ -253,19 +275,16 @@ fn per_shaft<const CAP: usize>(
     sa: &[[f64; LANES]; 2],
     mut active: u32,
     rect: [u32; 4],
+    w: usize,
     count: usize,
 ) -> u64 {
-    let [u0, _, v0, v1] = rect;
-    let w = (v1 - v0) as usize;
     // Groups of four shafts; the padding repeats the last patch.
     let groups = count.div_ceil(4);
     let mut bu = [[0.0f64; 4]; CAP];
     let mut bv = [[0.0f64; 4]; CAP];
     for g in 0..groups {
         for q in 0..4 {
-            let k = (4 * g + q).min(count - 1);
-            bu[g][q] = (u0 as usize + k / w) as f64;
-            bv[g][q] = (v0 as usize + k % w) as f64;
+            (bu[g][q], bv[g][q]) = shaft_patch(rect, w, count, 4 * g + q);
         }
     }
     // Roots as fractions num/den (den > 0): the interval [lo, hi] of s each shaft leaves. A
@@ -279,9 +298,7 @@ fn per_shaft<const CAP: usize>(
         active &= active - 1;
         let (side, i) = (bit / LANES, bit % LANES);
         let a = sa[side][i];
-        // b = base ± (u·du + v·dv); negating du and dv gives the same bits as subtracting.
-        let (base, du, dv) =
-            if side == 0 { (p.b[0][i], p.b_du[i], p.b_dv[i]) } else { (p.b[1][i], -p.b_du[i], -p.b_dv[i]) };
+        let (base, du, dv) = b_end(p, side, i);
         if a > 0.0 {
             // Separated at the a end: s ≥ a/(a − b) where b ≤ 0, and no s where b > 0.
             for g in 0..groups {
@@ -323,13 +340,8 @@ fn per_shaft<const CAP: usize>(
 #[target_feature(enable = "avx2")]
 unsafe fn shafts_avx2(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
     use std::arch::x86_64::*;
+    let Some((w, count, all)) = rect_shafts(rect) else { return 0 };
     let [u0, u1, v0, v1] = rect;
-    if u0 >= u1 || v0 >= v1 {
-        return 0;
-    }
-    let w = (v1 - v0) as usize;
-    let count = (u1 - u0) as usize * w;
-    let all = if count == 64 { u64::MAX } else { (1u64 << count) - 1 };
     let s = |x: f64| _mm256_set1_pd(x);
     let (zero, one, two) = (_mm256_setzero_pd(), s(1.0), s(2.0));
     let gt = |x: __m256d, y: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, y);
@@ -373,10 +385,7 @@ unsafe fn shafts_avx2(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
     let mut bu = [zero; 16];
     let mut bv = [zero; 16];
     for g in 0..groups {
-        let at = |q: usize| {
-            let k = (4 * g + q).min(count - 1);
-            ((u0 as usize + k / w) as f64, (v0 as usize + k % w) as f64)
-        };
+        let at = |q: usize| shaft_patch(rect, w, count, 4 * g + q);
         let [(a0, c0), (a1, c1), (a2, c2), (a3, c3)] = [at(0), at(1), at(2), at(3)];
         bu[g] = _mm256_set_pd(a3, a2, a1, a0);
         bv[g] = _mm256_set_pd(c3, c2, c1, c0);
@@ -390,8 +399,7 @@ unsafe fn shafts_avx2(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
         active &= active - 1;
         let (side, i) = (bit / LANES, bit % LANES);
         let a = sa[side][i];
-        let (base, du, dv) =
-            if side == 0 { (p.b[0][i], p.b_du[i], p.b_dv[i]) } else { (p.b[1][i], -p.b_du[i], -p.b_dv[i]) };
+        let (base, du, dv) = b_end(p, side, i);
         let (base, du, dv) = (s(base), s(du), s(dv));
         let va = s(a);
         if a > 0.0 {
