@@ -249,8 +249,8 @@ impl Normals {
 /// Which sections the output file stores compressed (FORMAT.md "Codecs").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Codec {
-    /// zstd for the kinds the player decodes on the CPU anyway
-    /// ([`kiln_format::sections::COMPRESSED_BY_DEFAULT`]), none for those it maps zero-copy.
+    /// zstd for every section it shrinks by at least [`kiln_format::DEFAULT_MIN_SAVING`]; the
+    /// rest stays as is (zero-copy).
     #[default]
     Auto,
     /// Every section stored as is.

@@ -107,33 +107,36 @@ fn exit_codes() {
 
 #[test]
 fn codec_option_and_sidecar_key() {
-    // Which sections are compressed, as `kiln inspect --json` reports them: auto compresses the
-    // CPU-read kinds that shrink and nothing the player uploads zero-copy; zstd (command line or
-    // sidecar) every section that shrinks, the sidecar overridden by the command line; a bad
-    // value is a usage error naming the choices.
+    // Which sections are compressed, as `kiln inspect --json` reports them: auto those whose
+    // frame (its size in the zstd file) saves at least an eighth, and no other; zstd (command
+    // line or sidecar) every section that shrinks, the sidecar overridden by the command line; a
+    // bad value is a usage error naming the choices.
     let dir = tempfile::tempdir().unwrap();
-    let codecs = |file: &str| -> Vec<(String, String)> {
+    let sections = |file: &str| -> Vec<serde_json::Value> {
         let run = kiln(dir.path(), &["inspect", file, "--json"]);
         run.expect(0);
         let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
-        j["sections"]
-            .as_array()
-            .unwrap()
+        j["sections"].as_array().unwrap().clone()
+    };
+    let codecs = |file: &str| -> Vec<(String, String)> {
+        sections(file)
             .iter()
             .map(|s| (s["kind"].as_str().unwrap().to_string(), s["codec"].as_str().unwrap().to_string()))
             .collect()
     };
     kiln(dir.path(), &["demo", "-o", "auto.kiln", "-q"]).expect(0);
-    let zero_copy =
-        ["VERT", "CWBV", "SHDW", "VGRD", "VOXO", "VOXT", "LSLT", "LSBN", "LSRK", "LSCO", "LSCE", "LSPN"];
-    for (kind, codec) in codecs("auto.kiln") {
-        if zero_copy.contains(&kind.as_str()) {
-            assert_eq!(codec, "none", "{kind} compressed by default");
-        }
-        if kind == "TRIS" || kind == "MATL" {
-            assert_eq!(codec, "zstd", "{kind} not compressed by default");
-        }
+    kiln(dir.path(), &["demo", "-o", "all.kiln", "-q", "--codec", "zstd"]).expect(0);
+    let (auto, all) = (sections("auto.kiln"), sections("all.kiln"));
+    assert_eq!(auto.len(), all.len());
+    let mut kept = 0;
+    for (a, z) in auto.iter().zip(&all) {
+        assert_eq!(a["kind"], z["kind"]);
+        let (raw, frame) = (z["raw_size"].as_u64().unwrap(), z["size"].as_u64().unwrap());
+        let expect = if frame * 8 <= raw * 7 { "zstd" } else { "none" };
+        assert_eq!(a["codec"], expect, "{}: {frame} of {raw} bytes compressed", a["kind"]);
+        kept += (expect == "zstd") as usize;
     }
+    assert!(kept >= 10, "the demo's sections hardly compress: {kept}");
     kiln(dir.path(), &["demo", "-o", "none.kiln", "-q", "--codec", "none"]).expect(0);
     assert!(codecs("none.kiln").iter().all(|(_, c)| c == "none"));
     std::fs::write(dir.path().join("z.toml"), "[bake]\ncodec = \"zstd\"\n").unwrap();

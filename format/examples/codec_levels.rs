@@ -1,6 +1,6 @@
 //! Measures zstd on every section of a `.kiln` file at several levels: stored bytes and
 //! compression / decompression time per section kind. Used to pick `codec::ZSTD_LEVEL` and
-//! `sections::COMPRESSED_BY_DEFAULT` (docs/testing.md "zstd level and default kinds").
+//! what `--codec auto` compresses (docs/testing.md "zstd level and default kinds").
 //!
 //! `cargo run --release -p kiln-format --example codec_levels -- FILE.kiln [LEVEL...]`
 

@@ -39,4 +39,4 @@ pub use manifest::Manifest;
 pub use read::{Checksums, KilnFile, Section};
 pub use scene::SceneView;
 pub use table::{SectionEntry, SectionKind};
-pub use write::{Compression, FileWriter, WriteError};
+pub use write::{Compression, DEFAULT_MIN_SAVING, FileWriter, WriteError};

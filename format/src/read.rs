@@ -223,6 +223,31 @@ impl KilnFile {
         self.decoded_bytes(&self.sections[position]).map(|b| b.len() as u64)
     }
 
+    /// Verifies and decodes the sections at `positions` now, on up to as many threads as the
+    /// machine has, largest first (a zstd frame decodes on one thread, so the largest section
+    /// bounds the wall time); later reads of them are free. Sections stored as is are only
+    /// verified. Returns the first error in `positions` order.
+    pub fn decode_sections(&self, positions: &[usize]) -> Result<()> {
+        let mut todo: Vec<usize> = positions.iter().copied().filter(|&p| p < self.sections.len()).collect();
+        todo.sort_by_key(|&p| std::cmp::Reverse(self.sections[p].entry.raw_size));
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(todo.len());
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        std::thread::scope(|scope| {
+            for _ in 0..threads {
+                scope.spawn(|| {
+                    while let Some(&p) = todo.get(next.fetch_add(1, Ordering::Relaxed)) {
+                        // Errors stay cached in the section's cells; reported below, in order.
+                        let _ = self.decoded_bytes(&self.sections[p]);
+                    }
+                });
+            }
+        });
+        positions
+            .iter()
+            .filter(|&&p| p < self.sections.len())
+            .try_for_each(|&p| self.decode_section(p).map(|_| ()))
+    }
+
     /// Wall time spent decoding compressed sections so far (each is decoded once).
     pub fn decode_time(&self) -> std::time::Duration {
         std::time::Duration::from_nanos(self.decode_nanos.load(Ordering::Relaxed))

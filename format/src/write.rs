@@ -76,20 +76,30 @@ pub enum Compression {
     /// Every section stored as is.
     #[default]
     None,
-    /// The kinds in [`sections::COMPRESSED_BY_DEFAULT`]: those a reader decodes on the CPU
-    /// anyway; sections a player hands from the memory map to the GPU stay as is.
+    /// Every section whose frame saves at least [`DEFAULT_MIN_SAVING`] of it. Sections that
+    /// barely shrink stay as is (zero-copy); the player decodes the others on all cores while
+    /// the driver creates the device, where it costs no time to the first frame.
     Default,
-    /// Every section.
+    /// Every section that shrinks at all.
     All,
 }
 
+/// The fraction of a section that [`Compression::Default`] must save to store it compressed:
+/// below it, a zero-copy read is worth more than the bytes.
+pub const DEFAULT_MIN_SAVING: f64 = 0.125;
+
 impl Compression {
-    /// Whether a section of `kind` is to be compressed.
-    pub fn compresses(self, kind: SectionKind) -> bool {
+    /// Whether a section is to be compressed at all.
+    pub fn compresses(self) -> bool {
+        self != Compression::None
+    }
+
+    /// Whether a frame of `frame` bytes is kept for a section of `raw` bytes.
+    pub fn keeps(self, frame: usize, raw: usize) -> bool {
         match self {
             Compression::None => false,
-            Compression::Default => sections::COMPRESSED_BY_DEFAULT.contains(&kind),
-            Compression::All => true,
+            Compression::Default => (frame as f64) <= raw as f64 * (1.0 - DEFAULT_MIN_SAVING),
+            Compression::All => frame < raw,
         }
     }
 }
@@ -231,13 +241,13 @@ impl<'a> FileWriter<'a> {
 
     /// Compresses the sections the policy selects, on as many threads as the machine has (each
     /// section by one thread, so the bytes do not depend on the thread count); keeps a frame only
-    /// when it is smaller than the section.
+    /// when the policy finds it small enough.
     fn compress(&mut self) -> Result<(), WriteError> {
         let policy = self.compression;
         let todo: Vec<&mut Pending<'a>> = self
             .pending
             .iter_mut()
-            .filter(|p| p.compressed.is_none() && !p.bytes.is_empty() && policy.compresses(p.kind))
+            .filter(|p| p.compressed.is_none() && !p.bytes.is_empty() && policy.compresses())
             .collect();
         if todo.is_empty() {
             return Ok(());
@@ -255,7 +265,7 @@ impl<'a> FileWriter<'a> {
                             let frame = crate::codec::compress_zstd(&p.bytes).map_err(|source| {
                                 WriteError::Compress { kind: p.kind, index: p.index, source }
                             })?;
-                            if frame.len() < p.bytes.len() {
+                            if policy.keeps(frame.len(), p.bytes.len()) {
                                 p.compressed = Some(frame);
                             }
                         }

@@ -168,10 +168,6 @@ fn compressed_sections_decode_to_the_uncompressed_files_bytes() {
     assert_eq!(pv.texture(0).unwrap(), zv.texture(0).unwrap());
     assert_eq!(bytemuck::cast_slice::<_, u8>(pv.vertices), bytemuck::cast_slice::<_, u8>(zv.vertices));
     assert_eq!(pv.triangles, zv.triangles);
-    // The default policy compresses only the kinds the player reads on the CPU.
-    let default = common::small_file_with(32, Compression::Default);
-    let d = KilnFile::from_bytes(&default, Checksums::Eager).unwrap();
-    assert_eq!(d.find(sections::TEXTURE, 0).unwrap().entry.codec, Codec::None as u8);
     // Writing is deterministic.
     assert_eq!(packed, common::small_file_with(32, Compression::All));
 }
@@ -355,4 +351,87 @@ proptest! {
             prop_assert_eq!(b.len() as u64, raw_size);
         }
     }
+}
+
+/// `n` bytes of which the fraction `random` are pseudo-random (xorshift, incompressible) and
+/// the rest zeros, interleaved in 64-byte runs so that zstd sees both throughout.
+fn partly_random(n: usize, random: f64, seed: u64) -> Vec<u8> {
+    let mut x = seed | 1;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    (0..n)
+        .map(|i| {
+            let run = i / 64;
+            let v = next();
+            if (run as f64 * random).fract() + random >= 1.0 || random >= 1.0 { v as u8 } else { 0 }
+        })
+        .collect()
+}
+
+#[test]
+fn the_default_policy_keeps_a_frame_only_when_it_saves_an_eighth() {
+    // Three shadow-map-sized sections: zeros (saves ~all), 30 % zeros (saves ~30 %), 5 % zeros
+    // (saves ~5 %). Whether each frame saves an eighth is judged from zstd's own level-9 frame
+    // (a few header bytes apart from the writer's; the margins are kilobytes).
+    let n = 64 << 10;
+    let parts = [partly_random(n, 0.0, 1), partly_random(n, 0.7, 2), partly_random(n, 0.95, 3)];
+    let saves_an_eighth: Vec<bool> =
+        parts.iter().map(|p| zstd::bulk::compress(p, 9).unwrap().len() * 8 <= p.len() * 7).collect();
+    assert_eq!(saves_an_eighth, [true, true, false], "the test's data is not what it means to be");
+    let write = |compression| {
+        let mut w = kiln_format::FileWriter::new();
+        w.compression(compression);
+        w.manifest(&Manifest { generator: "test".into(), ..Default::default() }, ContentHash::of(b"m"))
+            .unwrap();
+        for (i, p) in parts.iter().enumerate() {
+            w.bytes(sections::SHADOW_MAP, i as u32, p.as_slice(), ContentHash::of(&[i as u8])).unwrap();
+        }
+        w.to_bytes().unwrap()
+    };
+    let codecs = |bytes: &[u8]| -> Vec<bool> {
+        let f = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
+        (0..3).map(|i| f.find(sections::SHADOW_MAP, i).unwrap().entry.codec == Codec::Zstd as u8).collect()
+    };
+    assert_eq!(codecs(&write(Compression::Default)), saves_an_eighth);
+    // `All` keeps every frame that is smaller at all; `None` none.
+    assert_eq!(codecs(&write(Compression::All)), [true, true, true]);
+    assert_eq!(codecs(&write(Compression::None)), [false, false, false]);
+    // Either way the decoded bytes are the section's.
+    let f = write(Compression::Default);
+    let f = KilnFile::from_bytes(&f, Checksums::Eager).unwrap();
+    for (i, p) in parts.iter().enumerate() {
+        let s = f.find(sections::SHADOW_MAP, i as u32).unwrap();
+        assert_eq!(&*f.section_bytes(s).unwrap(), p.as_slice());
+    }
+}
+
+#[test]
+fn decoding_sections_in_parallel_gives_each_section_and_reports_damage() {
+    // Every section of a compressed file decoded at once on all cores equals its bytes read one
+    // by one from an uncompressed copy; a damaged section is reported, not skipped.
+    let z = common::small_file_with(32, Compression::All);
+    let p = common::small_file_with(32, Compression::None);
+    let (zf, pf) = (
+        KilnFile::from_bytes(&z, Checksums::OnAccess).unwrap(),
+        KilnFile::from_bytes(&p, Checksums::Eager).unwrap(),
+    );
+    let all: Vec<usize> = (0..zf.sections().len()).collect();
+    zf.decode_sections(&all).unwrap();
+    for (zs, ps) in zf.sections().iter().zip(pf.sections()) {
+        assert_eq!(
+            &*zf.section_bytes(zs).unwrap(),
+            &p[ps.entry.offset as usize..(ps.entry.offset + ps.entry.size) as usize]
+        );
+    }
+    let tex = zf.find(sections::TEXTURE, 0).unwrap();
+    assert_eq!(tex.entry.codec, Codec::Zstd as u8);
+    let mut bad = z.clone();
+    bad[(tex.entry.offset + tex.entry.size / 2) as usize] ^= 0x40;
+    let bf = KilnFile::from_bytes(&bad, Checksums::OnAccess).unwrap();
+    let err = bf.decode_sections(&all).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::Checksum { .. }), "{err}");
 }

@@ -15,6 +15,7 @@ use std::time::Instant;
 use crate::gpu::vk;
 use kiln_format::error::ErrorKind;
 use kiln_format::read::{Checksums, KilnFile};
+use kiln_format::sections;
 
 use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
@@ -22,7 +23,7 @@ use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
 use crate::render::Needs;
 use crate::render::background::{Built, FrameBuild};
 use crate::render::frame::Frame;
-use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer};
+use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer, Techniques};
 use crate::scene::upload::Uploader;
 use crate::scene::{GpuScene, Prepared};
 
@@ -89,6 +90,15 @@ pub struct Substitute {
     pub shown: &'static str,
 }
 
+/// One pass's pipeline build.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PassBuild {
+    /// The pass.
+    pub pass: &'static str,
+    /// Milliseconds its constructor took (on a thread of its own).
+    pub ms: f64,
+}
+
 /// Milliseconds spent in each step of loading (wall clock, this process).
 #[derive(Debug, Clone, Default, serde::Serialize)]
 pub struct LoadTimes {
@@ -99,12 +109,18 @@ pub struct LoadTimes {
     /// Validating the file, verifying the checksums of what is uploaded, sorting indices
     /// (parallel with instance and device creation).
     pub prepare_ms: f64,
-    /// Decoding compressed sections (each once, within `prepare_ms` and `upload_ms`; 0 when the
-    /// file stores every section as is).
+    /// Decoding compressed sections, summed over threads (each once, within `prepare_ms` and
+    /// later uploads; 0 when the file stores every section as is).
     pub decode_ms: f64,
+    /// Wall time of verifying and decoding the sections the first frame reads, on all cores
+    /// (within `prepare_ms`, so parallel with instance and device creation).
+    pub decode_wall_ms: f64,
     /// Building the first frame's pipelines and allocating its targets (parallel with the
     /// upload): the fallback's when there is one.
     pub pipelines_ms: f64,
+    /// Each pass of the first frame and the milliseconds its pipelines took to build on their
+    /// own thread (the slowest bounds `pipelines_ms`).
+    pub pipelines_by_pass: Vec<PassBuild>,
     /// Building the chosen techniques' pipelines and targets: `pipelines_ms` without a
     /// fallback; with one, on their own thread, from the device's creation on.
     pub full_pipelines_ms: f64,
@@ -194,6 +210,38 @@ impl std::fmt::Debug for Session {
     }
 }
 
+/// What the first frame shows and reads, decided once the file is validated.
+struct Plan {
+    /// The chosen techniques, less the ray-traced ones when the file has no BVH.
+    requested: Techniques,
+    /// What stands in for them while their pipelines compile, if anything.
+    fallback: Option<Techniques>,
+    /// What the first frame reads (the fallback's needs when there is one).
+    first_needs: Needs,
+    warnings: Vec<String>,
+}
+
+impl Plan {
+    fn of(render: &RenderSettings, progressive: bool, file: &KilnFile) -> PlayResult<Plan> {
+        let manifest = file.manifest().map_err(|e| PlayError::new(Exit::BadInput, e.to_string()))?;
+        let has_bvh = file.find(sections::BVH_NODES, 0).is_some_and(|s| s.entry.raw_size > 0);
+        let mut warnings = Vec::new();
+        let mut render = *render;
+        if render.techniques.ray_traced() && !has_bvh {
+            warnings.push("the ray-traced passes are off: the file has no BVH".to_string());
+            render.techniques = render.techniques.without_rays();
+        }
+        let requested = render.techniques;
+        let fallback = if progressive { requested.fallback(!manifest.shadow_maps.is_empty()) } else { None };
+        // The first frame waits only for what it reads; the rest uploads after it.
+        let first_needs = match fallback {
+            Some(f) => RenderSettings { techniques: f, ..render }.needs(),
+            None => render.needs(),
+        };
+        Ok(Plan { requested, fallback, first_needs, warnings })
+    }
+}
+
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
@@ -224,12 +272,15 @@ impl Session {
             Some(f) if progressive => render.needs().union(f.needs()),
             _ => render.needs(),
         };
-        // The CPU side of loading (validation, checksums, index sorting) runs while the driver
-        // creates the device, which on some drivers takes well over 100 ms.
+        // The CPU side of loading (validation, checksums, index sorting, decoding what the first
+        // frame reads) runs while the driver creates the device, which on some drivers takes
+        // well over 100 ms.
         let (gpu, prepared) = std::thread::scope(|s| {
             let prep = s.spawn(|| {
                 let t = Instant::now();
-                Prepared::new(&file, needs).map(|p| (p, ms(t)))
+                let plan = Plan::of(&render, progressive, &file)?;
+                let (prepared, decode_ms) = Prepared::new(&file, needs, plan.first_needs)?;
+                Ok::<_, PlayError>((prepared, plan, ms(t), decode_ms))
             });
             let t = Instant::now();
             let gpu = Gpu::new(&options.gpu).map(|g| (g, ms(t)));
@@ -241,20 +292,15 @@ impl Session {
         let (gpu, device_ms) = gpu?;
         let gpu = Arc::new(gpu);
         times.instance_and_device_ms = device_ms;
-        let (prepared, prepare_ms) = prepared?;
+        let (prepared, plan, prepare_ms, decode_wall_ms) = prepared?;
         times.prepare_ms = prepare_ms;
+        times.decode_wall_ms = decode_wall_ms;
         let timeline = gpu.timeline_semaphore()?;
         let upload_start = Instant::now();
         // Pipelines compile on one thread while the other streams the file to the GPU.
         let (width, height, readback) = (options.width, options.height, options.readback);
-        let mut warnings = Vec::new();
-        if render.techniques.ray_traced() && !prepared.has_bvh() {
-            warnings.push("the ray-traced passes are off: the file has no BVH".to_string());
-            render.techniques = render.techniques.without_rays();
-        }
-        let requested = render.techniques;
-        let fallback =
-            if progressive { requested.fallback(!prepared.manifest().shadow_maps.is_empty()) } else { None };
+        let Plan { requested, fallback, first_needs, mut warnings } = plan;
+        render.techniques = requested;
         let lights = prepared.manifest().lights.len();
         let decode = prepared.texel_decode();
         // The chosen techniques' pipelines behind a fallback compile on a thread of their own,
@@ -271,11 +317,6 @@ impl Session {
             None => None,
         };
         let first = fallback.unwrap_or(requested);
-        // The first frame waits only for what it reads; the rest uploads after it.
-        let first_needs = match fallback {
-            Some(f) => RenderSettings { techniques: f, ..render }.needs(),
-            None => needs,
-        };
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
@@ -352,6 +393,7 @@ impl Session {
             }
         };
         times.pipelines_ms = pipelines_ms;
+        times.pipelines_by_pass = frame.build_ms.iter().map(|&(pass, ms)| PassBuild { pass, ms }).collect();
         if background.is_none() {
             times.full_pipelines_ms = pipelines_ms;
             times.full_ready_since_start_ms =
@@ -473,7 +515,7 @@ impl Session {
     pub fn upload_rest(&mut self) -> PlayResult {
         let Some(needs) = self.rest.take() else { return Ok(()) };
         let t = Instant::now();
-        let prepared = Prepared::new(&self._file, needs)?;
+        let (prepared, _) = Prepared::new(&self._file, needs, needs)?;
         let mut up = Uploader::new(&self.gpu, ring_bytes(&self.gpu), self.timeline)?.after(self.ready);
         let loaded = self.scene.load_rest(&self.gpu, &self._file, &prepared, &mut up);
         let flushed = up.flush();

@@ -170,11 +170,10 @@ than ANGLE degrees) [default: asset: glTF flat as its spec says, OBJ by its smoo
     pub normals: Option<Normals>,
     /// Which sections are stored compressed.
     #[arg(long, value_name = "auto|none|zstd", value_parser = Codec::parse, help_heading = "Output",
-          help = "Section compression: auto (zstd for the sections the player decodes on the CPU anyway: \
-manifest, materials, triangles, triangle materials, texture coordinates, vertex colours; everything it \
-maps and uploads zero-copy stays as is), none (every section as is: fastest to load), zstd (every section \
-that shrinks: smallest file, for distribution; the player decodes each section once while loading) \
-[default: auto, or the sidecar's bake.codec]")]
+          help = "Section compression: auto (zstd for every section it shrinks by at least 1/8: the player \
+decodes them on all cores while the driver creates the device; sections that barely shrink stay as is, \
+zero-copy), none (every section as is: no decoding at all), zstd (every section that shrinks: smallest \
+file, for distribution) [default: auto, or the sidecar's bake.codec]")]
     pub codec: Option<Codec>,
     /// How textures are stored.
     #[arg(

@@ -225,11 +225,3 @@ pub fn by_name(name: &str) -> Option<&'static KindInfo> {
 pub fn stream_rank(kind: SectionKind) -> usize {
     KNOWN.iter().position(|k| k.kind == kind).unwrap_or(KNOWN.len())
 }
-
-/// Kinds a writer compresses by default ([`crate::write::Compression::Default`]): those the
-/// player reads on the CPU (the manifest, materials and triangle materials) or rearranges before
-/// upload (triangles are re-sorted by material, texture coordinates and colours interleaved), so
-/// that decoding them costs no zero-copy upload. Everything the player hands from the memory map
-/// to a staging buffer stays as is unless compression is asked for.
-pub const COMPRESSED_BY_DEFAULT: &[SectionKind] =
-    &[MANIFEST, MATERIALS, TRIANGLE_MATERIALS, TRIANGLES, UVS, COLORS];

@@ -48,6 +48,9 @@ pub struct Frame {
     pub images: FrameImages,
     /// How the passes that read the texel buffer decode it.
     pub decode: TexelDecode,
+    /// Each pass's name and the milliseconds its constructor (mostly pipeline creation) took
+    /// on its own thread, in frame order.
+    pub build_ms: Vec<(&'static str, f64)>,
 }
 
 /// Builds the passes `techniques` need, in frame order, for a scene of `lights` lights whose
@@ -57,7 +60,7 @@ fn passes(
     techniques: &Techniques,
     lights: usize,
     decode: TexelDecode,
-) -> PlayResult<Vec<Box<dyn Pass>>> {
+) -> PlayResult<Vec<(Box<dyn Pass>, f64)>> {
     // Each pass builds its pipelines on a thread of its own: a driver compiles a call's
     // pipelines one after another, and on a cold cache the default frame's took 350 ms in a row
     // on the H100.
@@ -145,8 +148,16 @@ fn passes(
         }
         makers.push(maker(move || TonemapPass::new(gpu)));
     }
-    let results: Vec<PlayResult<Box<dyn Pass>>> = std::thread::scope(|s| {
-        let threads: Vec<_> = makers.into_iter().map(|m| s.spawn(m)).collect();
+    let results: Vec<PlayResult<(Box<dyn Pass>, f64)>> = std::thread::scope(|s| {
+        let threads: Vec<_> = makers
+            .into_iter()
+            .map(|m| {
+                s.spawn(move || {
+                    let t = std::time::Instant::now();
+                    m().map(|p| (p, t.elapsed().as_secs_f64() * 1e3))
+                })
+            })
+            .collect();
         threads
             .into_iter()
             .map(|t| {
@@ -163,7 +174,7 @@ fn passes(
         }
     }
     if let Some(e) = failed {
-        for p in &mut made {
+        for (p, _) in &mut made {
             p.destroy(gpu);
         }
         return Err(e);
@@ -197,9 +208,15 @@ impl Frame {
         width: u32,
         height: u32,
     ) -> PlayResult<Frame> {
-        let mut passes = passes(gpu, techniques, lights, decode)?;
+        let (mut passes, build_ms): (Vec<_>, Vec<_>) = passes(gpu, techniques, lights, decode)?
+            .into_iter()
+            .map(|(p, ms)| {
+                let name = p.name();
+                (p, (name, ms))
+            })
+            .unzip();
         match make_images(gpu, &passes, width, height) {
-            Ok(images) => Ok(Frame { passes, images, decode }),
+            Ok(images) => Ok(Frame { passes, images, decode, build_ms }),
             Err(e) => {
                 for p in &mut passes {
                     p.destroy(gpu);

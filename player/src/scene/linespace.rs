@@ -176,6 +176,12 @@ impl LineSpaceLayout {
     pub fn uploads(&self, kind: SectionKind) -> bool {
         self.base_of(kind).is_some()
     }
+
+    /// Whether a section of `kind` is one of the arrays that `wanted` ([`LsArrays`] bits) asks
+    /// for, known before the layout is read.
+    pub fn may_upload(kind: SectionKind, wanted: u32) -> bool {
+        SECTIONS.iter().zip(ARRAY_BITS).any(|(k, bit)| *k == kind && wanted & bit != 0)
+    }
 }
 
 fn missing(what: &str, wanted: u32) -> PlayError {

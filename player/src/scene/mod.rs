@@ -106,9 +106,28 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
+/// Whether `kind` is one of the line-space arrays `needs` asks for.
+fn first_line_space(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
+    linespace::LineSpaceLayout::may_upload(kind, needs.line_space)
+}
+
 impl<'f> Prepared<'f> {
-    /// Validates `file` and prepares what the upload copies.
-    pub fn new(file: &'f KilnFile, needs: Needs) -> PlayResult<Prepared<'f>> {
+    /// Validates `file` and prepares what the upload of `needs` copies. First verifies and
+    /// decodes, on all cores, the compressed sections that an upload of `first` reads (the rest
+    /// decode when first read), and returns the wall time of that too: run while the driver
+    /// creates the device, it leaves the upload only copies.
+    pub fn new(file: &'f KilnFile, needs: Needs, first: Needs) -> PlayResult<(Prepared<'f>, f64)> {
+        let t = std::time::Instant::now();
+        let positions: Vec<usize> = file
+            .sections()
+            .iter()
+            .filter(|s| {
+                s.known.is_some() && (uploads(s.entry.kind, first) || first_line_space(s.entry.kind, first))
+            })
+            .map(|s| s.position)
+            .collect();
+        file.decode_sections(&positions).map_err(bad)?;
+        let decode_ms = t.elapsed().as_secs_f64() * 1e3;
         let view = SceneView::new(file).map_err(bad)?;
         let line_space = if needs.line_space & linespace::LsArrays::ALL != 0 {
             linespace::LineSpaceLayout::new(
@@ -150,7 +169,7 @@ impl<'f> Prepared<'f> {
                 &storage,
             )
         });
-        Ok(Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space })
+        Ok((Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space }, decode_ms))
     }
 
     /// How the passes that read the texel buffer must decode it: from the texture table they

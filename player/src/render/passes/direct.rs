@@ -38,6 +38,11 @@ pub struct DirectPass(Kernel);
 impl DirectPass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<DirectPass> {
+        Ok(DirectPass(Kernel::new(gpu, &Self::bindings(), spirv::DIRECT, 0)?))
+    }
+
+    /// The bindings of `direct.comp`, in order.
+    pub fn bindings() -> Vec<Binding> {
         use BindingKind::*;
         let maps = Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 };
         let mut bindings = vec![Binding::one(Uniform), Binding::one(Storage), Binding::one(Storage)];
@@ -45,7 +50,7 @@ impl DirectPass {
         bindings.extend([Binding::one(Sampled); 5]);
         bindings.extend([Binding::one(StorageImage); 5]);
         bindings.push(Binding::one(Storage));
-        Ok(DirectPass(Kernel::new(gpu, &bindings, spirv::DIRECT, 0)?))
+        bindings
     }
 }
 

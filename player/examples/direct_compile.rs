@@ -1,0 +1,38 @@
+//! Times the driver's compilation of variants of the direct-light shader (`direct.comp`, the
+//! pass whose pipeline bounds the default first frame on a cold cache): each SPIR-V file given
+//! is made into a compute pipeline with the pass's bindings and no pipeline cache, and the
+//! milliseconds are printed. Run one process per variant with the driver's own shader cache off
+//! (`__GL_SHADER_DISK_CACHE=0` on NVIDIA), so that nothing is reused.
+//!
+//! `cargo run --release -p kiln-player --example direct_compile -- A.spv [B.spv ...]`
+
+use kiln_player::gpu::{Gpu, GpuOptions};
+use kiln_player::render::passes::direct::DirectPass;
+use kiln_player::render::passes::kernel::Kernel;
+
+fn main() {
+    let paths: Vec<String> = std::env::args().skip(1).collect();
+    if paths.is_empty() {
+        eprintln!("usage: direct_compile A.spv [B.spv ...]");
+        std::process::exit(2);
+    }
+    let options = GpuOptions { pipeline_cache: None, ..GpuOptions::default() };
+    let gpu = Gpu::new(&options).unwrap_or_else(|e| {
+        eprintln!("no device: {e}");
+        std::process::exit(1)
+    });
+    for path in &paths {
+        let code = std::fs::read(path).unwrap_or_else(|e| {
+            eprintln!("{path}: {e}");
+            std::process::exit(1)
+        });
+        let t = std::time::Instant::now();
+        match Kernel::new(&gpu, &DirectPass::bindings(), &code, 0) {
+            Ok(mut k) => {
+                println!("{path} {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+                k.destroy(&gpu);
+            }
+            Err(e) => println!("{path} failed: {e}"),
+        }
+    }
+}
