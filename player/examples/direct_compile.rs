@@ -1,17 +1,28 @@
 //! Times the driver's compilation of variants of the direct-light shader (`direct.comp`, the
 //! pass whose pipeline bounds the default first frame on a cold cache): each SPIR-V file given
-//! is made into a compute pipeline with the pass's bindings and no pipeline cache, and the
-//! milliseconds are printed. Run one process per variant with the driver's own shader cache off
+//! (or the embedded one, `-`) is made into a compute pipeline with the pass's bindings and no
+//! pipeline cache, with every path (no specialization constants) or, with `--default`,
+//! specialised for the default techniques and no rect lights; the milliseconds are printed. Run one process per variant with the driver's own shader cache off
 //! (`__GL_SHADER_DISK_CACHE=0` on NVIDIA), so that nothing is reused.
 //!
-//! `cargo run --release -p kiln-player --example direct_compile -- A.spv [B.spv ...]`
+//! `cargo run --release -p kiln-player --example direct_compile -- [--default] A.spv|- [B.spv ...]`
 
 use kiln_player::gpu::{Gpu, GpuOptions};
 use kiln_player::render::passes::direct::DirectPass;
 use kiln_player::render::passes::kernel::Kernel;
+use kiln_player::render::{Techniques, spirv, technique_flags};
 
 fn main() {
-    let paths: Vec<String> = std::env::args().skip(1).collect();
+    let mut paths: Vec<String> = std::env::args().skip(1).collect();
+    let default = paths.first().is_some_and(|a| a == "--default");
+    if default {
+        paths.remove(0);
+    }
+    let constants: Vec<u32> = if default {
+        DirectPass::constants(technique_flags(&Techniques::default()), false, false).to_vec()
+    } else {
+        Vec::new()
+    };
     if paths.is_empty() {
         eprintln!("usage: direct_compile A.spv [B.spv ...]");
         std::process::exit(2);
@@ -22,14 +33,19 @@ fn main() {
         std::process::exit(1)
     });
     for path in &paths {
-        let code = std::fs::read(path).unwrap_or_else(|e| {
-            eprintln!("{path}: {e}");
-            std::process::exit(1)
-        });
+        let code = if path == "-" {
+            spirv::DIRECT.to_vec()
+        } else {
+            std::fs::read(path).unwrap_or_else(|e| {
+                eprintln!("{path}: {e}");
+                std::process::exit(1)
+            })
+        };
         let t = std::time::Instant::now();
-        match Kernel::new(&gpu, &DirectPass::bindings(), &code, 0) {
+        match Kernel::specialized(&gpu, &DirectPass::bindings(), &code, 0, &constants) {
             Ok(mut k) => {
-                println!("{path} {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+                let how = if default { "specialised for the defaults" } else { "every path" };
+                println!("{path} {how} {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
                 k.destroy(&gpu);
             }
             Err(e) => println!("{path} failed: {e}"),

@@ -22,7 +22,7 @@ use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
 use crate::render::Needs;
 use crate::render::background::{Built, FrameBuild};
-use crate::render::frame::Frame;
+use crate::render::frame::{Frame, SceneLights};
 use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer, Techniques};
 use crate::scene::upload::Uploader;
 use crate::scene::{GpuScene, Prepared};
@@ -301,7 +301,7 @@ impl Session {
         let (width, height, readback) = (options.width, options.height, options.readback);
         let Plan { requested, fallback, first_needs, mut warnings } = plan;
         render.techniques = requested;
-        let lights = prepared.manifest().lights.len();
+        let lights = SceneLights::of(prepared.manifest());
         let decode = prepared.texel_decode();
         // The chosen techniques' pipelines behind a fallback compile on a thread of their own,
         // started first: they take longest. Dropped on an error below, it waits for the thread

@@ -14,6 +14,18 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// Specialization (DirectPass::new, SPEC_INPUTS): whether the frame's techniques can provide each
+// input, and whether the scene has rect lights. The code for what cannot happen is left out of
+// the pipeline, which halved the driver's cold compile of this pass; a pipeline made without
+// constants has every path.
+layout(constant_id = 1) const bool DIRECT_RT_SHADOWS = true;
+layout(constant_id = 2) const bool DIRECT_AO = true;
+layout(constant_id = 3) const bool DIRECT_RT_REFLECTIONS = true;
+layout(constant_id = 4) const bool DIRECT_GI = true;
+layout(constant_id = 5) const bool DIRECT_SCREEN_REFLECTIONS = true;
+layout(constant_id = 6) const bool DIRECT_MEDIA = true;
+layout(constant_id = 7) const bool DIRECT_RECT_LIGHTS = true;
+
 // Shadow maps: MAX_SHADOW_MAPS (layout.glsl) of each kind, indexed by `GpuShadow::slot`.
 // The shadow tap loops are [[dont_unroll]]: each tap samples through a dynamically indexed
 // sampler array, which CPU drivers (lavapipe) expand into one sampling routine per array element;
@@ -127,7 +139,7 @@ float shadow_cube_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float light_radius
 }
 
 float shadow_factor(uint index, GpuLight light, vec3 p, vec3 n, vec3 l, float angle) {
-    if ((frame.size.w & FRAME_RT_SHADOWS) != 0u) {
+    if (DIRECT_RT_SHADOWS && (frame.size.w & FRAME_RT_SHADOWS) != 0u) {
         ivec3 at = ivec3(gl_GlobalInvocationID.xy, int(index));
         return index < uint(imageSize(rt_shadows).z) ? imageLoad(rt_shadows, at).r : 1.0;
     }
@@ -136,7 +148,7 @@ float shadow_factor(uint index, GpuLight light, vec3 p, vec3 n, vec3 l, float an
     }
     GpuShadow s = shadows[light.shadow];
     if (s.projection == SHADOW_CUBE) {
-        float radius = light.kind == LIGHT_RECT ? 0.5 * length(vec2(light.width, light.height)) : 0.0;
+        float radius = DIRECT_RECT_LIGHTS && light.kind == LIGHT_RECT ? 0.5 * length(vec2(light.width, light.height)) : 0.0;
         return shadow_cube_factor(s, p, n, l, radius, angle);
     }
     return shadow_2d_factor(s, p, n, l, angle);
@@ -201,7 +213,7 @@ void main() {
     float t_seen = depth > 0.0 ? 1.0 : 3.4e38;
     vec3 seen = frame.sky.rgb;
     for (uint i = 0u; i < frame.size.z; i++) {
-        if (lights[i].kind == LIGHT_RECT) {
+        if (DIRECT_RECT_LIGHTS && lights[i].kind == LIGHT_RECT) {
             float t = rect_light_hit(lights[i], eye, toward, t_seen);
             if (t > 0.0) {
                 t_seen = t;
@@ -228,13 +240,13 @@ void main() {
 
     vec3 radiance = texelFetch(g_emission, pixel, 0).rgb;
     float occlusion = mat.a;
-    if ((frame.size.w & FRAME_RT_AO) != 0u) {
+    if (DIRECT_AO && (frame.size.w & FRAME_RT_AO) != 0u) {
         occlusion *= imageLoad(rt_ao, pixel).r;
     }
     vec4 traced = vec4(0.0);
     // Surfaces rougher than the limit keep the split sum, also where half-resolution upsampling
     // would borrow a smoother neighbour's traced reflection.
-    if ((frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !m.diffuse_only && m.roughness <= frame.params.w) {
+    if (DIRECT_RT_REFLECTIONS && (frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !m.diffuse_only && m.roughness <= frame.params.w) {
         traced = reflection_at(pixel, p, n);
     }
     // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.
@@ -243,9 +255,9 @@ void main() {
     // by the scene itself: no AO or occlusion texture multiplies it.
     // Screen-space GI gathers what the screen shows: the sky's ambient (darkened by AO) stays,
     // and the gathered light adds to it.
-    bool gi = (frame.size.w & FRAME_RT_GI) != 0u;
+    bool gi = DIRECT_GI && (frame.size.w & FRAME_RT_GI) != 0u;
     vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : frame.sky.rgb * occlusion;
-    if ((frame.size.w & FRAME_SCREEN_GI) != 0u) {
+    if (DIRECT_GI && (frame.size.w & FRAME_SCREEN_GI) != 0u) {
         diffuse_in += imageLoad(rt_gi, pixel).rgb;
     }
     if (m.diffuse_only) {
@@ -259,7 +271,7 @@ void main() {
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
         vec3 sky_in = frame.sky.rgb * occlusion;
-        if ((frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {
+        if (DIRECT_SCREEN_REFLECTIONS && (frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {
             // The split sum's prefiltered incoming radiance: what the screen showed along the
             // mirror direction, the sky (occluded) where it showed nothing; the same table weighs
             // both (seed 000 eq. 2.19).
@@ -281,7 +293,7 @@ void main() {
             if (n_l > 0.0) {
                 contribution = brdf(m, n, v, l, e_albedo) * light.radiance * n_l;
             }
-        } else if (light.kind == LIGHT_RECT) {
+        } else if (DIRECT_RECT_LIGHTS && light.kind == LIGHT_RECT) {
             vec3 up = cross(light.direction, light.right);
             float area = light.width * light.height;
             shadow_dir = normalize(light.position - p);
@@ -322,7 +334,7 @@ void main() {
             // Light through participating media arrives dimmed (towards the light's position,
             // a rect light's centre; out of every box for directional lights).
             uint media_count = uint(frame.sky.w);
-            if (media_count > 0u) {
+            if (DIRECT_MEDIA && media_count > 0u) {
                 float reach = light.kind == LIGHT_DIRECTIONAL ? 3.4e38 : length(light.position - p);
                 contribution *= exp(-optical_depth(media_count, p, shadow_dir, 0.0, reach));
             }

@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-use super::frame::Frame;
+use super::frame::{Frame, SceneLights};
 use super::technique::Techniques;
 use super::texels::TexelDecode;
 use crate::error::{Exit, PlayError, PlayResult};
@@ -42,7 +42,7 @@ impl FrameBuild {
     pub fn spawn(
         gpu: &Arc<Gpu>,
         techniques: Techniques,
-        lights: usize,
+        lights: SceneLights,
         decode: TexelDecode,
         width: u32,
         height: u32,

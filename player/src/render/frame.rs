@@ -53,14 +53,37 @@ pub struct Frame {
     pub build_ms: Vec<(&'static str, f64)>,
 }
 
-/// Builds the passes `techniques` need, in frame order, for a scene of `lights` lights whose
-/// texel buffer is decoded as `decode` says.
+/// What the passes of a frame are specialised for: the scene's lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SceneLights {
+    /// How many analytic lights the scene has.
+    pub count: usize,
+    /// Whether one of them is a rect light (the direct pass leaves their code out otherwise).
+    pub rect: bool,
+}
+
+impl SceneLights {
+    /// The lights of `manifest`.
+    pub fn of(manifest: &kiln_format::Manifest) -> SceneLights {
+        SceneLights {
+            count: manifest.lights.len(),
+            rect: manifest
+                .lights
+                .iter()
+                .any(|l| matches!(l.kind, kiln_format::manifest::LightKind::Rect { .. })),
+        }
+    }
+}
+
+/// Builds the passes `techniques` need, in frame order, for a scene of `lights` whose texel
+/// buffer is decoded as `decode` says.
 fn passes(
     gpu: &Gpu,
     techniques: &Techniques,
-    lights: usize,
+    scene_lights: SceneLights,
     decode: TexelDecode,
 ) -> PlayResult<Vec<(Box<dyn Pass>, f64)>> {
+    let lights = scene_lights.count;
     // Each pass builds its pipelines on a thread of its own: a driver compiles a call's
     // pipelines one after another, and on a cold cache the default frame's took 350 ms in a row
     // on the H100.
@@ -129,7 +152,7 @@ fn passes(
         if let Some(frames) = techniques.reprojected_rays() {
             makers.push(maker(move || RtHistoryPass::new(gpu, techniques, lights, frames)));
         }
-        makers.push(maker(move || DirectPass::new(gpu)));
+        makers.push(maker(move || DirectPass::new(gpu, techniques, scene_lights.rect)));
         match techniques.media {
             Media::None => {}
             Media::March { steps } => makers.push(maker(move || MediaMarchPass::new(gpu, steps))),
@@ -197,13 +220,13 @@ fn make_images(gpu: &Gpu, passes: &[Box<dyn Pass>], width: u32, height: u32) -> 
 
 impl Frame {
     /// The passes of `techniques` and their images at `width` × `height`, for a scene of
-    /// `lights` lights whose texel buffer `decode` reads (known from the file's tables before
+    /// `lights` whose texel buffer `decode` reads (known from the file's tables before
     /// its sections upload: the pipelines are built while the scene uploads). On failure
     /// everything made is released.
     pub fn new(
         gpu: &Gpu,
         techniques: &Techniques,
-        lights: usize,
+        lights: SceneLights,
         decode: TexelDecode,
         width: u32,
         height: u32,

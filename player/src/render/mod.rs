@@ -63,6 +63,35 @@ pub struct RenderSettings {
     pub purpose: Purpose,
 }
 
+/// The frame flags (`FrameFlags`) that `t` sets: all but `SHADOW_MAPS`, which also depends on
+/// the file. The direct pass is specialised for these ([`passes::direct::DirectPass::new`]).
+pub fn technique_flags(t: &Techniques) -> u32 {
+    let mut flags = 0;
+    if t.shadows.traced().is_some() {
+        flags |= FrameFlags::RT_SHADOWS;
+    }
+    // The direct pass multiplies the sky's ambient by the AO image, whichever technique makes it
+    // (the flag's name predates the screen-space ones).
+    if t.ao != Ao::None {
+        flags |= FrameFlags::RT_AO;
+    }
+    if t.gi.bounces().is_some() {
+        flags |= FrameFlags::RT_GI;
+    }
+    if let Gi::Ssgi { .. } = t.gi {
+        flags |= FrameFlags::SCREEN_GI;
+    }
+    match t.reflections {
+        Reflections::Rt { resolution: ReflectionRes::Full, .. } => flags |= FrameFlags::RT_REFLECTIONS,
+        Reflections::Rt { resolution: ReflectionRes::Half, .. } => {
+            flags |= FrameFlags::RT_REFLECTIONS | FrameFlags::REFLECTIONS_HALF
+        }
+        Reflections::Ssr { .. } => flags |= FrameFlags::SCREEN_REFLECTIONS,
+        Reflections::None => {}
+    }
+    flags
+}
+
 impl RenderSettings {
     /// The sections of the file the run reads: the union of the techniques' needs and the
     /// purpose's, decided here once.
@@ -181,28 +210,7 @@ impl Renderer {
             ..Default::default()
         };
         let mut flags = if plan.shadows_bound && surface_maps { FrameFlags::SHADOW_MAPS } else { 0 };
-        if rt_shadows {
-            flags |= FrameFlags::RT_SHADOWS;
-        }
-        // The direct pass multiplies the sky's ambient by the AO image, whichever technique
-        // makes it (the flag's name predates the screen-space ones).
-        if t.ao != Ao::None {
-            flags |= FrameFlags::RT_AO;
-        }
-        if t.gi.bounces().is_some() {
-            flags |= FrameFlags::RT_GI;
-        }
-        if let Gi::Ssgi { .. } = t.gi {
-            flags |= FrameFlags::SCREEN_GI;
-        }
-        match t.reflections {
-            Reflections::Rt { resolution: ReflectionRes::Full, .. } => flags |= FrameFlags::RT_REFLECTIONS,
-            Reflections::Rt { resolution: ReflectionRes::Half, .. } => {
-                flags |= FrameFlags::RT_REFLECTIONS | FrameFlags::REFLECTIONS_HALF
-            }
-            Reflections::Ssr { .. } => flags |= FrameFlags::SCREEN_REFLECTIONS,
-            Reflections::None => {}
-        }
+        flags |= technique_flags(&t);
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let mut frame = frame;
         let buffers = (|| {

@@ -78,7 +78,8 @@ mod tests {
     /// Every shader with the BC decoders in its SPIR-V declares `TEXELS_BC` with the id the
     /// player sets, as a bool that defaults to false (so a pipeline built without the constant
     /// compiles the decoders out rather than in by accident), and no shader declares another
-    /// specialization constant that the player's constants would set.
+    /// specialization constant that the player's constants would set (but the direct pass,
+    /// whose own constants it sets).
     #[test]
     fn shaders_with_the_decoders_declare_the_constant() {
         let mut decoding = 0;
@@ -87,6 +88,14 @@ mod tests {
             if decoders {
                 assert_eq!(consts, [(TEXELS_BC_ID, false)], "{source}: TEXELS_BC");
                 decoding += 1;
+            } else if *source == "lighting/direct.comp" {
+                // The direct pass's own constants (passes/direct.rs checks their names).
+                let ids: Vec<(u32, bool)> = (1..=crate::render::passes::direct::SPEC_INPUTS.len() as u32)
+                    .map(|id| (id, true))
+                    .collect();
+                let mut consts = consts;
+                consts.sort();
+                assert_eq!(consts, ids, "{source}");
             } else {
                 assert!(consts.iter().all(|&c| c == (TEXELS_BC_ID, false)), "{source}: {consts:?}");
             }

@@ -13,7 +13,8 @@ use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::{MAX_SHADOW_MAPS, spirv};
+use crate::render::{MAX_SHADOW_MAPS, Techniques, spirv, technique_flags};
+use kiln_format::gpu::FrameFlags;
 
 /// Linear scene radiance (what `-o x.exr` writes).
 pub const RADIANCE: TargetDecl = TargetDecl {
@@ -24,6 +25,29 @@ pub const RADIANCE: TargetDecl = TargetDecl {
     ),
     array: false,
 };
+
+/// What a specialization constant of `direct.comp` says may happen in the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpecInput {
+    /// This frame flag may be set.
+    Flag(u32),
+    /// A media technique may dim the light reaching surfaces.
+    Media,
+    /// The scene has rect lights.
+    RectLights,
+}
+
+/// The inputs of `direct.comp`'s specialization constants, by id from 1 (`DIRECT_*` there; each
+/// a bool defaulting to true, so that a pipeline made without constants has every path).
+pub const SPEC_INPUTS: [(SpecInput, &str); 7] = [
+    (SpecInput::Flag(FrameFlags::RT_SHADOWS), "DIRECT_RT_SHADOWS"),
+    (SpecInput::Flag(FrameFlags::RT_AO), "DIRECT_AO"),
+    (SpecInput::Flag(FrameFlags::RT_REFLECTIONS), "DIRECT_RT_REFLECTIONS"),
+    (SpecInput::Flag(FrameFlags::RT_GI | FrameFlags::SCREEN_GI), "DIRECT_GI"),
+    (SpecInput::Flag(FrameFlags::SCREEN_REFLECTIONS), "DIRECT_SCREEN_REFLECTIONS"),
+    (SpecInput::Media, "DIRECT_MEDIA"),
+    (SpecInput::RectLights, "DIRECT_RECT_LIGHTS"),
+];
 
 /// The G-buffer targets it samples, in binding order (6–10).
 const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
@@ -36,9 +60,27 @@ const RAY_TRACED: [TargetDecl; 4] = [rt_shadows::SHADOWS, ao::AO, rt_reflections
 pub struct DirectPass(Kernel);
 
 impl DirectPass {
-    /// Builds the pipeline.
-    pub fn new(gpu: &Gpu) -> PlayResult<DirectPass> {
-        Ok(DirectPass(Kernel::new(gpu, &Self::bindings(), spirv::DIRECT, 0)?))
+    /// Builds the pipeline, specialised for `techniques` (and rect lights or none): the code for
+    /// inputs they never provide is left out, which halved the driver's cold compile of this
+    /// pass on the H100 (docs/benchmarks/codec-default).
+    pub fn new(gpu: &Gpu, techniques: &Techniques, rect_lights: bool) -> PlayResult<DirectPass> {
+        let constants =
+            Self::constants(technique_flags(techniques), techniques.media.dims_surfaces(), rect_lights);
+        Ok(DirectPass(Kernel::specialized(gpu, &Self::bindings(), spirv::DIRECT, 0, &constants)?))
+    }
+
+    /// Specialization constants by id (`direct.comp`): 0 is unused (the texel decoders' id), then
+    /// one boolean per input in [`SPEC_INPUTS`] order.
+    pub fn constants(flags: u32, media: bool, rect_lights: bool) -> [u32; 1 + SPEC_INPUTS.len()] {
+        let mut c = [0; 1 + SPEC_INPUTS.len()];
+        for (i, (input, _)) in SPEC_INPUTS.iter().enumerate() {
+            c[1 + i] = match input {
+                SpecInput::Flag(f) => flags & f != 0,
+                SpecInput::Media => media,
+                SpecInput::RectLights => rect_lights,
+            } as u32;
+        }
+        c
     }
 
     /// The bindings of `direct.comp`, in order.
@@ -104,5 +146,48 @@ impl Pass for DirectPass {
 
     fn destroy(&mut self, gpu: &Gpu) {
         self.0.destroy(gpu);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shader's source declares exactly the constants `SPEC_INPUTS` sets, by name and id,
+    /// each a bool defaulting to true (the SPIR-V's ids and defaults: `texels.rs`; the SPIR-V
+    /// against the source: `tests/spirv.rs`).
+    #[test]
+    fn the_shaders_constants_are_the_ones_the_pass_sets() {
+        let source = include_str!("../../../../shaders/lighting/direct.comp");
+        let found: Vec<String> = source
+            .lines()
+            .filter(|l| l.contains("constant_id"))
+            .map(|l| l.split_whitespace().collect::<Vec<_>>().join(" "))
+            .collect();
+        let expected: Vec<String> = SPEC_INPUTS
+            .iter()
+            .enumerate()
+            .map(|(i, (_, name))| format!("layout(constant_id = {}) const bool {name} = true;", i + 1))
+            .collect();
+        assert_eq!(found, expected);
+    }
+
+    /// Each input's constant is on exactly when the frame may need it: every flag a set of
+    /// techniques can raise keeps its code, and the default techniques keep only the shadow maps.
+    #[test]
+    fn constants_follow_the_flags_media_and_rect_lights() {
+        let all = FrameFlags::RT_SHADOWS
+            | FrameFlags::RT_AO
+            | FrameFlags::RT_REFLECTIONS
+            | FrameFlags::REFLECTIONS_HALF
+            | FrameFlags::RT_GI
+            | FrameFlags::SCREEN_GI
+            | FrameFlags::SCREEN_REFLECTIONS;
+        assert_eq!(DirectPass::constants(all, true, true), [0, 1, 1, 1, 1, 1, 1, 1]);
+        assert_eq!(DirectPass::constants(0, false, false), [0; 8]);
+        assert_eq!(DirectPass::constants(FrameFlags::SCREEN_GI, false, true), [0, 0, 0, 0, 1, 0, 0, 1]);
+        assert_eq!(DirectPass::constants(FrameFlags::RT_GI, true, false), [0, 0, 0, 0, 1, 0, 1, 0]);
+        let defaults = technique_flags(&Techniques::default());
+        assert_eq!(DirectPass::constants(defaults, false, false), [0; 8], "default flags {defaults:#x}");
     }
 }

@@ -53,6 +53,17 @@ impl Kernel {
         Self::make(gpu, bindings, spirv, push_bytes, &decode.constants())
     }
 
+    /// [`Kernel::new`] with specialization constants: `constants[i]` for constant id `i`.
+    pub fn specialized(
+        gpu: &Gpu,
+        bindings: &[Binding],
+        spirv: &[u8],
+        push_bytes: u32,
+        constants: &[u32],
+    ) -> PlayResult<Kernel> {
+        Self::make(gpu, bindings, spirv, push_bytes, constants)
+    }
+
     fn make(
         gpu: &Gpu,
         bindings: &[Binding],
