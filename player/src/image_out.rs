@@ -63,13 +63,25 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> PlayResul
     write_atomic(path, &out)
 }
 
-/// Writes RGBA32F pixels (alpha ignored) as a float RGB OpenEXR file.
+/// Writes RGBA32F pixels (alpha ignored) as a float RGB OpenEXR file. The blocks are
+/// compressed and written one after another, in increasing line order: the same pixels always
+/// give the same bytes (the `image` crate's encoder compresses blocks on several threads and
+/// writes them in the order they finish).
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[f32]) -> PlayResult {
-    let rgb: Vec<f32> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
-    let img = image::Rgb32FImage::from_raw(width, height, rgb)
-        .ok_or_else(|| PlayError::new(Exit::Gpu, "readback size mismatch"))?;
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    let (w, h) = (width as usize, height as usize);
+    if rgba.len() != w * h * 4 {
+        return Err(PlayError::new(Exit::Gpu, "readback size mismatch"));
+    }
+    let pixels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let i = (p.y() * w + p.x()) * 4;
+        (rgba[i], rgba[i + 1], rgba[i + 2])
+    });
     let mut out = Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::OpenExr)
+    Image::from_channels((w, h), pixels)
+        .write()
+        .non_parallel()
+        .to_buffered(&mut out)
         .map_err(|e| PlayError::new(Exit::Io, format!("encoding EXR: {e}")))?;
     write_atomic(path, &out.into_inner())
 }
@@ -85,6 +97,34 @@ pub fn read_exr(path: &Path) -> PlayResult<(u32, u32, Vec<f32>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The same pixels give the same file, byte for byte, however many blocks it has (format
+    /// round-trip tests and bit-identical comparisons rely on it).
+    #[test]
+    fn exr_bytes_depend_only_on_the_pixels() {
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h) = (96u32, 200u32);
+        let mut x = 0x9e37_79b9_u32;
+        let px: Vec<f32> = (0..w * h * 4)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                (x % 1000) as f32 / 250.0
+            })
+            .collect();
+        let first = dir.path().join("0.exr");
+        write_exr(&first, w, h, &px).unwrap();
+        let expected = std::fs::read(&first).unwrap();
+        for k in 1..8 {
+            let path = dir.path().join(format!("{k}.exr"));
+            write_exr(&path, w, h, &px).unwrap();
+            assert!(std::fs::read(&path).unwrap() == expected, "write {k} differs");
+        }
+        let (rw, rh, rgb) = read_exr(&first).unwrap();
+        assert_eq!((rw, rh), (w, h));
+        assert!(rgb.iter().zip(px.chunks_exact(4).flat_map(|p| &p[..3])).all(|(a, b)| a == b));
+    }
 
     #[test]
     fn exr_round_trips_linear_values_exactly() {
