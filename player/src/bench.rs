@@ -79,9 +79,10 @@ pub fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
 pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -> PlayResult<BenchReport> {
     let mut session = Session::open(options, start)?;
     session.follow(options, 0, frames)?;
-    // Behind a fallback: its first frame for the time to the first frame, then every frame
-    // measured (warm-up included) shows the chosen techniques.
-    if session.showing_fallback() {
+    // Behind a fallback or with textures streaming: the first frame for the time to the first
+    // frame, then every frame measured (warm-up included) shows the chosen techniques and every
+    // texture level.
+    if session.provisional() {
         session.frame(false)?;
         session.finish_pipelines()?;
     }
