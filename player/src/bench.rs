@@ -176,6 +176,14 @@ impl BenchReport {
                 l.after_first_frame.join(", ")
             ));
         }
+        if l.refined_texture_bytes > 0 {
+            s.push_str(&format!(
+                "  textures refined after start {:>4.1}  ({:.1} MiB coarse before the first frame, {:.1} MiB finer after it)\n",
+                l.textures_refined_since_start_ms,
+                l.coarse_texture_bytes as f64 / (1 << 20) as f64,
+                l.refined_texture_bytes as f64 / (1 << 20) as f64
+            ));
+        }
         s.push_str(&format!(
             "  chosen pipelines     {:>8.1}\n  chosen ready after start {:>4.1}\n  chosen frame after start {:>4.1}\n",
             l.full_pipelines_ms, l.full_ready_since_start_ms, l.full_frame_since_start_ms

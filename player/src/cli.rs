@@ -512,7 +512,11 @@ impl Args {
             } else {
                 PipelineStart::Progressive
             },
-            textures: if self.no_texture_streaming { TextureUpload::Whole } else { TextureUpload::CoarseFirst },
+            textures: if self.no_texture_streaming {
+                TextureUpload::Whole
+            } else {
+                TextureUpload::CoarseFirst
+            },
         })
     }
 }

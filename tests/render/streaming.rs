@@ -73,7 +73,8 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
 /// asserting a clean run (teardown included).
 fn exr(dir: &Path, name: &str, o: Options, frames: u32) -> (Vec<u8>, kiln_player::session::LoadTimes) {
     let out = dir.join(format!("{name}.exr"));
-    let r = headless::run(&o.build(), frames, Some(&out), Instant::now()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let r = headless::run(&o.build(), frames, Some(&out), Instant::now())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(r.non_finite, 0, "{name}: NaN or Inf in the frame");
     let times = r.session.times.clone();
     assert_eq!(r.session.close(), 0, "{name}: validation errors");
@@ -135,7 +136,8 @@ fn headless_output_with_streamed_textures_is_bit_identical_to_a_whole_load() {
     for (format, name) in [(TextureFormat::Rgba8, "rgba8"), (TextureFormat::Bc, "bc")] {
         let file = write(dir.path(), name, &checker_floor(format));
         // Two frames: the second reads the first's history, which the refinement must restart.
-        let (streamed, times) = exr(dir.path(), &format!("{name}-streamed"), Options::new(&file, W, H).streaming(), 2);
+        let (streamed, times) =
+            exr(dir.path(), &format!("{name}-streamed"), Options::new(&file, W, H).streaming(), 2);
         let (whole, whole_times) = exr(dir.path(), &format!("{name}-whole"), Options::new(&file, W, H), 2);
         assert!(streamed == whole, "{name}: the streamed output differs from the whole load's");
         // The comparison saw a streamed load: its first frame did not wait for levels 0 and 1.
@@ -153,13 +155,18 @@ fn behind_a_fallback_streamed_textures_still_give_the_chosen_techniques_output()
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "rt", &checker_floor(TextureFormat::Rgba8));
     let traced = |o: Options| o.rt_shadows(0.05, 0.0).rt_ao(None).rt_reflections(Reflections::Half);
-    let (both, times) = exr(dir.path(), "both", traced(Options::new(&file, W, H)).progressive().streaming(), 2);
+    let (both, times) =
+        exr(dir.path(), "both", traced(Options::new(&file, W, H)).progressive().streaming(), 2);
     let (complete, _) = exr(dir.path(), "complete", traced(Options::new(&file, W, H)), 2);
     assert!(both == complete, "behind a fallback with streamed textures the output differs");
     // The texture's finer levels and its texels for the ray-traced passes came after the
     // fallback's first frame, with the sections only those passes read.
     assert_eq!(times.fallback_frames, 1);
-    assert!(times.after_first_frame.contains(&"texture#0 mips 0-1".to_string()), "{:?}", times.after_first_frame);
+    assert!(
+        times.after_first_frame.contains(&"texture#0 mips 0-1".to_string()),
+        "{:?}",
+        times.after_first_frame
+    );
     assert!(times.after_first_frame.contains(&"bvh".to_string()), "{:?}", times.after_first_frame);
 }
 
@@ -218,7 +225,8 @@ fn bench_counts_the_coarse_and_fine_texture_bytes_and_times_the_refinement() {
         // Levels 0 and 1 are over 256 texels wide; level 2 (129 × 65) is the first coarse one.
         let (fine, coarse): (u64, u64) = (levels[..2].iter().sum(), levels[2..].iter().sum());
         let file = write(dir.path(), name, &bytes);
-        let report = bench::run(&Options::new(&file, 48, 32).streaming().build(), 1, 2, Instant::now()).unwrap();
+        let report =
+            bench::run(&Options::new(&file, 48, 32).streaming().build(), 1, 2, Instant::now()).unwrap();
         assert_eq!(report.validation_errors, 0, "{name}");
         let json = serde_json::to_value(&report).unwrap();
         let load = &json["load"];

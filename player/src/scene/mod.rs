@@ -534,8 +534,11 @@ impl GpuScene {
         prepared: &Prepared,
         up: &mut Uploader,
     ) -> PlayResult {
-        let part =
-            Part { now: prepared.needs.minus(self.resident), geometry: false, textures: TextureUpload::Whole };
+        let part = Part {
+            now: prepared.needs.minus(self.resident),
+            geometry: false,
+            textures: TextureUpload::Whole,
+        };
         self.upload_sections(gpu, file, prepared, part, up)?;
         self.uploaded_bytes += up.bytes;
         Ok(())
@@ -818,12 +821,14 @@ impl GpuScene {
             a: swizzle(data.swizzle[3]),
         };
         let image = Image::new(gpu, &info.name, desc)?;
-        let first = if coarse_first { first_coarse_level(info.width, info.height, info.mip_levels) } else { 0 };
+        let first =
+            if coarse_first { first_coarse_level(info.width, info.height, info.mip_levels) } else { 0 };
         let slices = data.level_slices(info.width, info.height, info.mip_levels);
         let levels = texture_levels(info.width, info.height, &slices);
         let resident = &levels[(first as usize).min(levels.len())..];
         // Uploaded as stored: blocks go to the GPU as they are in the file.
-        let uploaded = up.image_blocks(&image, data.format.block_dim(), data.format.block_bytes() as u64, resident);
+        let uploaded =
+            up.image_blocks(&image, data.format.block_dim(), data.format.block_bytes() as u64, resident);
         // Pushed first, so that the scene releases it on any error below. Textures arrive in
         // index order (file order), so position == texture number.
         debug_assert_eq!(self.textures.len(), i);

@@ -176,8 +176,7 @@ impl<'g> Uploader<'g> {
         block_bytes: u64,
         levels: &[(u32, u32, u32, u32, &[u8])],
     ) -> PlayResult {
-        let (Some(low), Some(high)) =
-            (levels.iter().map(|l| l.0).min(), levels.iter().map(|l| l.0).max())
+        let (Some(low), Some(high)) = (levels.iter().map(|l| l.0).min(), levels.iter().map(|l| l.0).max())
         else {
             return Ok(());
         };
