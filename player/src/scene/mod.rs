@@ -107,9 +107,10 @@ pub struct SectionFate {
 
 impl SectionFate {
     /// The section as `after_first_frame` lists it: a streamed texture with the levels that
-    /// come later (`texture#0 mips 0-2`).
+    /// come later (`texture#0 mips 0-2`, `texture#1 mip 0`).
     pub fn later_name(&self) -> String {
         match self.fine_mips {
+            Some([a, b]) if a == b => format!("{} mip {a}", self.section),
             Some([a, b]) => format!("{} mips {a}-{b}", self.section),
             None => self.section.clone(),
         }
