@@ -79,9 +79,10 @@ pub fn stats(pass: &str, mut v: Vec<f64>) -> PassStats {
 pub fn run(options: &SessionOptions, warmup: u32, frames: u32, start: Instant) -> PlayResult<BenchReport> {
     let mut session = Session::open(options, start)?;
     session.follow(options, 0, frames)?;
-    // Behind a fallback: its first frame for the time to the first frame, then every frame
-    // measured (warm-up included) shows the chosen techniques.
-    if session.showing_fallback() {
+    // Behind a fallback or with textures streaming: the first frame for the time to the first
+    // frame, then every frame measured (warm-up included) shows the chosen techniques and every
+    // texture level.
+    if session.provisional() {
         session.frame(false)?;
         session.finish_pipelines()?;
     }
@@ -173,6 +174,14 @@ impl BenchReport {
                 "  after first frame    {:>8.1}  (uploading {})\n",
                 l.rest_upload_ms,
                 l.after_first_frame.join(", ")
+            ));
+        }
+        if l.refined_texture_bytes > 0 {
+            s.push_str(&format!(
+                "  textures refined after start {:>4.1}  ({:.1} MiB coarse before the first frame, {:.1} MiB finer after it)\n",
+                l.textures_refined_since_start_ms,
+                l.coarse_texture_bytes as f64 / (1 << 20) as f64,
+                l.refined_texture_bytes as f64 / (1 << 20) as f64
             ));
         }
         s.push_str(&format!(

@@ -13,6 +13,7 @@ use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
 use crate::render::technique::{Effect, KnobValue, Techniques, catalogue, techniques_of};
 use crate::render::{Purpose, RenderSettings};
+use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions};
 use crate::window;
 
@@ -392,6 +393,15 @@ pub struct Args {
     /// times the fallback's first frame and the chosen techniques' separately).
     #[arg(long)]
     pub no_progressive_pipelines: bool,
+    /// Upload every texture level before the first frame. By default textures stream: the
+    /// first frame samples only each texture's levels from the first at most 256 texels on a
+    /// side down to 1x1 (a 2048x2048 texture's first part is 1/64 of its bytes), and the finer
+    /// levels upload after it, coarse to fine, the frames switching to them once they are all
+    /// resident. Only the window shows coarse frames: headless output and every --bench frame
+    /// come from the refined textures (--bench times the first frame and the refinement
+    /// separately).
+    #[arg(long)]
+    pub no_texture_streaming: bool,
 }
 
 impl Args {
@@ -501,6 +511,11 @@ impl Args {
                 PipelineStart::Complete
             } else {
                 PipelineStart::Progressive
+            },
+            textures: if self.no_texture_streaming {
+                TextureUpload::Whole
+            } else {
+                TextureUpload::CoarseFirst
             },
         })
     }

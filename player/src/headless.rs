@@ -18,8 +18,9 @@ pub struct HeadlessResult {
 }
 
 /// Renders `frames` frames (at least one; along the options' camera path, when given) and
-/// writes the last to `output`, if given. With a fallback ([`crate::session::PipelineStart`]),
-/// one fallback frame comes first, for its time only.
+/// writes the last to `output`, if given. With a fallback ([`crate::session::PipelineStart`])
+/// or textures streaming ([`crate::scene::TextureUpload`]), the first frame comes first, for its
+/// time only.
 pub fn run(
     options: &SessionOptions,
     frames: u32,
@@ -32,9 +33,10 @@ pub fn run(
         kind.map(|k| if k == OutputKind::Exr { Readable::Radiance } else { Readable::Display });
     let mut session = Session::open(&options, start)?;
     let frames = frames.max(1);
-    // Behind a fallback, its first frame is rendered and timed (what a window shows first) but
-    // not written: every frame below waits for the chosen techniques.
-    if session.showing_fallback() {
+    // Behind a fallback, or with textures streaming, the first frame is rendered and timed (what
+    // a window shows first) but not written: every frame below shows the chosen techniques and
+    // every texture level.
+    if session.provisional() {
         session.follow(&options, 0, frames)?;
         session.frame(false)?;
         session.finish_pipelines()?;

@@ -171,6 +171,8 @@ pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult
     o.render.purpose = crate::render::Purpose::RayQueries;
     o.readback = None;
     o.pipelines = crate::session::PipelineStart::Complete;
+    // Nor any frame sampling coarse texture levels: every level before the first trace.
+    o.textures = crate::scene::TextureUpload::Whole;
     let session = Session::open(&o, start)?;
     let mut query = RayQuery::new(&session.gpu)?;
     query.warmup = WARMUP_TRACES;

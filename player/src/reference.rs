@@ -84,6 +84,8 @@ pub fn render_with(
     options.readback = None;
     // The path tracer renders no frame of the techniques: nothing to show before them.
     options.pipelines = crate::session::PipelineStart::Complete;
+    // Nor any frame sampling coarse texture levels: every level before the first trace.
+    options.textures = crate::scene::TextureUpload::Whole;
     let session = Session::open(&options, start)?;
     let result = sample(&session, sampling);
     let errors = session.close();

@@ -25,7 +25,7 @@ use crate::render::background::{Built, FrameBuild};
 use crate::render::frame::{Frame, SceneLights};
 use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer, Techniques};
 use crate::scene::upload::Uploader;
-use crate::scene::{GpuScene, Prepared};
+use crate::scene::{GpuScene, Prepared, TextureUpload};
 
 /// What to open and how.
 #[derive(Debug, Clone)]
@@ -48,6 +48,8 @@ pub struct SessionOptions {
     pub readback: Option<Readable>,
     /// Whether the first frames wait for every pipeline.
     pub pipelines: PipelineStart,
+    /// Whether the first frame waits for every texture level.
+    pub textures: TextureUpload,
 }
 
 /// When the first frame is rendered, relative to the pipelines of the chosen techniques.
@@ -75,6 +77,7 @@ impl SessionOptions {
             camera_path: None,
             readback: None,
             pipelines: PipelineStart::default(),
+            textures: TextureUpload::default(),
         }
     }
 }
@@ -133,6 +136,15 @@ pub struct LoadTimes {
     pub after_first_frame: Vec<String>,
     /// Preparing and uploading those sections after the first frame, until the GPU finished.
     pub rest_upload_ms: f64,
+    /// Bytes of texture levels uploaded before the first frame: with streaming, each
+    /// texture's levels from the first at most `COARSE_SIDE` (256) texels on a side down to
+    /// 1×1; without, every level.
+    pub coarse_texture_bytes: u64,
+    /// Bytes of the finer texture levels uploaded after the first frame (0 without streaming).
+    pub refined_texture_bytes: u64,
+    /// From process start until every texture level was resident and the raster passes
+    /// sampled the full chains (with streaming, after the first frame).
+    pub textures_refined_since_start_ms: f64,
     /// Bytes uploaded.
     pub upload_bytes: u64,
     /// Sections uploaded / skipped.
@@ -334,7 +346,7 @@ impl Session {
                 let mut up = Uploader::new(&gpu, ring_bytes(&gpu), timeline)?;
                 let result = (|| {
                     let dummies = Dummies::new(&gpu, &mut up)?;
-                    match GpuScene::load(&gpu, &file, &prepared, first_needs, &mut up) {
+                    match GpuScene::load(&gpu, &file, &prepared, first_needs, options.textures, &mut up) {
                         Ok(scene) => Ok((scene, dummies)),
                         Err(e) => {
                             let mut d = dummies;
@@ -378,8 +390,12 @@ impl Session {
         times.sections_uploaded = scene.sections.iter().filter(|s| s.uploaded).count();
         times.sections_skipped = scene.sections.len() - times.sections_uploaded;
         times.after_first_frame =
-            scene.sections.iter().filter(|s| s.after_first_frame).map(|s| s.section.clone()).collect();
+            scene.sections.iter().filter(|s| s.after_first_frame).map(|s| s.later_name()).collect();
         times.resident_since_start_ms = ms(start);
+        times.coarse_texture_bytes = scene.coarse_texture_bytes;
+        if !scene.coarse_views() {
+            times.textures_refined_since_start_ms = times.resident_since_start_ms;
+        }
         let resident = Instant::now();
         let mut scene = scene;
         let (frame, readback, pipelines_ms, pipelines_done) = match pipelines {
@@ -530,7 +546,38 @@ impl Session {
         self.times.upload_bytes += bytes;
         self.times.resident_since_start_ms = ms(self.start);
         self.resident = Instant::now();
+        if self.scene.coarse_views() {
+            self.use_refined_textures()?;
+        }
         Ok(())
+    }
+
+    /// Switches the raster passes from the textures' coarse views to their full chains, whose
+    /// finer levels [`Session::upload_rest`] made resident. The material sets are rewritten in
+    /// place (they are not update-after-bind), so no submitted frame may still read them: this
+    /// waits, once, for the frame in flight (there is one at most: each frame's `begin` waits
+    /// for the previous), and only then releases the coarse views.
+    fn use_refined_textures(&mut self) -> PlayResult {
+        self.pool.wait(&self.gpu)?;
+        self.scene.use_refined_views(&self.gpu);
+        self.renderer.textures_refined(&self.gpu, &self.scene, &self.dummies)?;
+        let t = &mut self.times;
+        t.refined_texture_bytes = self.scene.fine_texture_bytes;
+        t.textures_refined_since_start_ms = ms(self.start);
+        self.notes.push(format!(
+            "textures streamed: the first frame sampled their coarse levels ({:.1} MiB); the finer ones ({:.1} MiB) were resident {:.0} ms after start",
+            t.coarse_texture_bytes as f64 / (1 << 20) as f64,
+            t.refined_texture_bytes as f64 / (1 << 20) as f64,
+            t.textures_refined_since_start_ms
+        ));
+        Ok(())
+    }
+
+    /// Whether the next frame is not yet what every later frame shows: it would come from a
+    /// fallback, or sections (a texture's finer levels) are still to upload after it.
+    /// Headless output and benchmarks render one such frame, then [`Session::finish_pipelines`].
+    pub fn provisional(&self) -> bool {
+        self.upgrade.is_some() || self.rest.is_some()
     }
 
     /// Whether frames come from the fallback (the chosen techniques' pipelines are still
@@ -540,9 +587,11 @@ impl Session {
     }
 
     /// Waits for the chosen techniques' pipelines, if they are still building, and switches to
-    /// them: every frame after this shows the chosen techniques.
+    /// them, and uploads what the first frame did not wait for: every frame after this shows
+    /// the chosen techniques with every texture level.
     pub fn finish_pipelines(&mut self) -> PlayResult {
-        self.switch(true)
+        self.switch(true)?;
+        self.upload_rest()
     }
 
     /// Switches from the fallback to the chosen techniques when their frame is built (with

@@ -13,6 +13,7 @@ use kiln_player::render::{
     Aa, Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose, ReflectionRes,
     Reflections as ReflectionsTechnique, Shadows,
 };
+use kiln_player::scene::TextureUpload;
 use kiln_player::session::{PipelineStart, SessionOptions};
 
 pub mod exact;
@@ -210,6 +211,13 @@ impl Options {
     /// Moves the camera through `path` over the frames (`--camera-path`).
     pub fn camera_path(mut self, path: CameraPath) -> Options {
         self.0.camera_path = Some(path);
+        self
+    }
+
+    /// Textures streamed: the first frame samples their coarse levels, the finer ones upload
+    /// after it (what `kiln-play` does without `--no-texture-streaming`).
+    pub fn streaming(mut self) -> Options {
+        self.0.textures = TextureUpload::CoarseFirst;
         self
     }
 

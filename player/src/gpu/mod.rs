@@ -15,7 +15,7 @@ pub use pipelines::{
     Binding, BindingKind, ComputePipeline, GraphicsDesc, GraphicsPipeline, SetLayout, Write,
 };
 pub use raytracing::{AccelerationStructures, RayTracingPipeline, RayTracingShaders};
-pub use resources::{Buffer, Image, ImageDesc, Sampler, SamplerKey};
+pub use resources::{Buffer, Image, ImageDesc, Sampler, SamplerKey, View};
 pub use swapchain::{Swapchain, surface_extensions};
 
 use std::ffi::{CStr, CString, c_void};

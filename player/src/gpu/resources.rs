@@ -188,28 +188,19 @@ impl Image {
             })?;
         unsafe { gpu.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }
             .map_err(|e| vk_err("binding image memory", e))?;
-        let aspect = aspect_of(desc.format);
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(if desc.cube {
-                vk::ImageViewType::CUBE
-            } else if desc.array {
-                vk::ImageViewType::TYPE_2D_ARRAY
-            } else {
-                vk::ImageViewType::TYPE_2D
-            })
-            .format(desc.format)
-            .components(desc.components)
-            .subresource_range(vk::ImageSubresourceRange {
-                aspect_mask: aspect,
-                base_mip_level: 0,
-                level_count: desc.mips.max(1),
-                base_array_layer: 0,
-                layer_count: desc.layers.max(1),
-            });
-        let view = unsafe { gpu.device.create_image_view(&view_info, None) }
-            .map_err(|e| vk_err("creating an image view", e))?;
+        let view = create_view(gpu, raw, &desc, 0)?;
         Ok(Image { raw, view, desc, allocation: Some(allocation) })
+    }
+
+    /// A view of mips `base` to the last (every layer), for sampling while only those levels
+    /// hold data: a sampler never reads a level outside its view.
+    pub fn view_from_mip(&self, gpu: &Gpu, base: u32) -> PlayResult<View> {
+        Ok(View { raw: create_view(gpu, self.raw, &self.desc, base.min(self.desc.mips.max(1) - 1))? })
+    }
+
+    /// Range covering `count` mips from `base` and every layer.
+    pub fn mips(&self, base: u32, count: u32) -> vk::ImageSubresourceRange {
+        vk::ImageSubresourceRange { base_mip_level: base, level_count: count, ..self.range() }
     }
 
     /// Range covering every mip and layer.
@@ -231,6 +222,49 @@ impl Image {
                 gpu.device.destroy_image(self.raw, None);
             }
             let _ = gpu.allocator().free(a);
+        }
+    }
+}
+
+/// A view of `desc`'s image `raw` over mips `base` to the last and every layer (cube view for
+/// cube maps), with `desc`'s swizzle.
+fn create_view(gpu: &Gpu, raw: vk::Image, desc: &ImageDesc, base: u32) -> PlayResult<vk::ImageView> {
+    let mips = desc.mips.max(1);
+    let view_info = vk::ImageViewCreateInfo::default()
+        .image(raw)
+        .view_type(if desc.cube {
+            vk::ImageViewType::CUBE
+        } else if desc.array {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        })
+        .format(desc.format)
+        .components(desc.components)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: aspect_of(desc.format),
+            base_mip_level: base,
+            level_count: mips - base,
+            base_array_layer: 0,
+            layer_count: desc.layers.max(1),
+        });
+    unsafe { gpu.device.create_image_view(&view_info, None) }.map_err(|e| vk_err("creating an image view", e))
+}
+
+/// An extra view of an image (the image's own is [`Image::view`]), released by its owner
+/// before the image.
+#[derive(Debug)]
+pub struct View {
+    /// Handle (null once destroyed).
+    pub raw: vk::ImageView,
+}
+
+impl View {
+    /// Releases the view (no submitted work may still use it).
+    pub fn destroy(&mut self, gpu: &Gpu) {
+        if self.raw != vk::ImageView::null() {
+            unsafe { gpu.device.destroy_image_view(self.raw, None) };
+            self.raw = vk::ImageView::null();
         }
     }
 }

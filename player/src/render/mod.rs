@@ -297,6 +297,17 @@ impl Renderer {
         Ok(())
     }
 
+    /// Points the passes at the scene's textures again once their finer levels are resident
+    /// ([`GpuScene::use_refined_views`]; no submitted frame may still read the sets), and
+    /// restarts the frame count, running average and histories: the frames after it are those
+    /// of a scene loaded whole (bit for bit), none blending in a coarse one.
+    pub fn textures_refined(&mut self, gpu: &Gpu, scene: &GpuScene, dummies: &Dummies) -> PlayResult {
+        self.accumulated = 0;
+        self.last_view_proj = None;
+        self.frame_count = 0;
+        self.bind(gpu, scene, dummies)
+    }
+
     /// The frame's images.
     pub fn images(&self) -> &FrameImages {
         &self.frame.images

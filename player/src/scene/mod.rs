@@ -4,6 +4,11 @@
 //! The upload can come in two parts: first what the first frame reads (its [`Needs`]: a
 //! fallback's, while the chosen techniques' pipelines compile), then, after that frame, the
 //! sections only the chosen techniques read ([`GpuScene::load_rest`]).
+//!
+//! Textures can come in two parts as well ([`TextureUpload::CoarseFirst`]): their coarse levels
+//! before the first frame, which samples them through views that start at the first level
+//! uploaded, and their finer levels after it, in [`GpuScene::load_rest`]; then
+//! [`GpuScene::use_refined_views`] hands the raster passes the full chains.
 
 pub mod bindings;
 pub mod linespace;
@@ -21,7 +26,7 @@ use kiln_format::scene::SceneView;
 use kiln_format::sections::{self, GpuMaterial, PixelFormat, Swizzle, Vertex};
 
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, Write};
+use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, View, Write};
 use crate::render::{Needs, TexelDecode};
 use upload::Uploader;
 
@@ -45,6 +50,41 @@ pub struct ShadowImage {
     pub image: Image,
 }
 
+/// The largest side, in texels, of the finest level a streamed texture uploads before the first
+/// frame: its levels from the first this small down to 1×1 come first. 256 keeps that part a
+/// small fraction of the bytes (1/64 of a 2048² texture's chain, PICA PICA's size: 1.6 %),
+/// while a level of 256 texels is sharp wherever the texture spans up to 256 pixels on screen,
+/// the common case in a first frame over a scene with many textures.
+pub const COARSE_SIDE: u32 = 256;
+
+/// How textures reach the GPU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TextureUpload {
+    /// Every level before the first frame.
+    #[default]
+    Whole,
+    /// Each texture's levels from the first at most [`COARSE_SIDE`] texels on a side before the
+    /// first frame, the finer ones after it ([`GpuScene::load_rest`]).
+    CoarseFirst,
+}
+
+/// The first level of a `width` × `height` texture with `mips` levels that a streamed upload
+/// sends before the first frame: the first whose larger side is at most [`COARSE_SIDE`] (the
+/// last level when none is: a chain cut short), 0 for a texture already that small.
+pub fn first_coarse_level(width: u32, height: u32, mips: u32) -> u32 {
+    let last = mips.max(1) - 1;
+    (0..=last).find(|&l| (width >> l).max(height >> l).max(1) <= COARSE_SIDE).unwrap_or(last)
+}
+
+/// A texture whose finer levels are still to come: the raster passes sample it through `view`,
+/// which starts at `first`, the finest level uploaded.
+#[derive(Debug)]
+struct CoarseTexture {
+    texture: usize,
+    first: u32,
+    view: View,
+}
+
 /// A section and what happened to it.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct SectionFate {
@@ -60,6 +100,21 @@ pub struct SectionFate {
     /// was uploaded before it: the triangles and texture of a file whose ray-traced passes
     /// read them again as storage buffers).
     pub after_first_frame: bool,
+    /// For a streamed texture, its finer levels (finest, coarsest) that upload after the first
+    /// frame; the first frame samples the levels after them.
+    pub fine_mips: Option<[u32; 2]>,
+}
+
+impl SectionFate {
+    /// The section as `after_first_frame` lists it: a streamed texture with the levels that
+    /// come later (`texture#0 mips 0-2`, `texture#1 mip 0`).
+    pub fn later_name(&self) -> String {
+        match self.fine_mips {
+            Some([a, b]) if a == b => format!("{} mip {a}", self.section),
+            Some([a, b]) => format!("{} mips {a}-{b}", self.section),
+            None => self.section.clone(),
+        }
+    }
 }
 
 /// The CPU side of loading, done while the device is being created: the file validated, the
@@ -90,6 +145,9 @@ impl std::fmt::Debug for Prepared<'_> {
 struct Part {
     now: Needs,
     geometry: bool,
+    /// How the textures uploaded in the first part go (a later part sends the finer levels
+    /// of the textures the first left coarse).
+    textures: TextureUpload,
 }
 
 /// Whether a section of `kind` is uploaded under `needs` (geometry always).
@@ -299,6 +357,15 @@ pub struct GpuScene {
     pub materials: Vec<GpuMaterial>,
     /// Material textures (empty when textures are not needed).
     pub textures: Vec<Image>,
+    /// The view the raster passes sample each texture through: the image's own (every level)
+    /// or, until its finer levels arrive, one of its coarse levels only.
+    pub texture_views: Vec<vk::ImageView>,
+    /// Textures sampled through a coarse view, waiting for their finer levels.
+    coarse: Vec<CoarseTexture>,
+    /// Bytes of texture levels uploaded before the first frame (every level without streaming).
+    pub coarse_texture_bytes: u64,
+    /// Bytes of texture levels uploaded after it (the finer levels of streamed textures).
+    pub fine_texture_bytes: u64,
     /// The sampler of each texture.
     pub texture_samplers: Vec<vk::Sampler>,
     /// The BRDF table, when the file has one and a pass needs it.
@@ -400,13 +467,15 @@ impl GpuScene {
 
     /// Uploads what `prepared` needs through `up`, of the sections beyond the geometry only
     /// those `first` reads (`prepared`'s own needs: all of them); the others are listed as
-    /// uploaded after the first frame, for [`GpuScene::load_rest`]. Returns when everything is
-    /// recorded; the caller flushes the uploader and waits on its timeline before drawing.
+    /// uploaded after the first frame, for [`GpuScene::load_rest`]; so are the finer levels of
+    /// the textures with [`TextureUpload::CoarseFirst`]. Returns when everything is recorded;
+    /// the caller flushes the uploader and waits on its timeline before drawing.
     pub fn load(
         gpu: &Gpu,
         file: &KilnFile,
         prepared: &Prepared,
         first: Needs,
+        textures: TextureUpload,
         up: &mut Uploader,
     ) -> PlayResult<GpuScene> {
         let view = &prepared.view;
@@ -441,6 +510,10 @@ impl GpuScene {
             draws: prepared.draws.clone(),
             materials: view.materials.to_vec(),
             textures: Vec::new(),
+            texture_views: Vec::new(),
+            coarse: Vec::new(),
+            coarse_texture_bytes: 0,
+            fine_texture_bytes: 0,
             texture_samplers: Vec::new(),
             brdf_lut: None,
             linear_clamp: samplers[&linear_key].raw,
@@ -455,7 +528,7 @@ impl GpuScene {
             resident: Needs::default(),
             samplers,
         };
-        let part = Part { now: prepared.needs.minus(prepared.needs.minus(first)), geometry: true };
+        let part = Part { now: prepared.needs.minus(prepared.needs.minus(first)), geometry: true, textures };
         match scene.upload_sections(gpu, file, prepared, part, up) {
             Ok(()) => {
                 scene.uploaded_bytes = up.bytes;
@@ -481,7 +554,11 @@ impl GpuScene {
         prepared: &Prepared,
         up: &mut Uploader,
     ) -> PlayResult {
-        let part = Part { now: prepared.needs.minus(self.resident), geometry: false };
+        let part = Part {
+            now: prepared.needs.minus(self.resident),
+            geometry: false,
+            textures: TextureUpload::Whole,
+        };
         self.upload_sections(gpu, file, prepared, part, up)?;
         self.uploaded_bytes += up.bytes;
         Ok(())
@@ -490,6 +567,23 @@ impl GpuScene {
     /// Whether sections the passes read wait for [`GpuScene::load_rest`].
     pub fn deferred(&self) -> bool {
         self.sections.iter().any(|s| s.after_first_frame)
+    }
+
+    /// Whether the raster passes sample some texture through a coarse view (its finer levels
+    /// wait for [`GpuScene::load_rest`], or are resident and wait for
+    /// [`GpuScene::use_refined_views`]).
+    pub fn coarse_views(&self) -> bool {
+        !self.coarse.is_empty()
+    }
+
+    /// Makes every texture's view its full chain and releases the coarse views, once
+    /// [`GpuScene::load_rest`]'s finer levels are resident. No submitted work may still use the
+    /// coarse views, and the caller rewrites the descriptor sets that named them.
+    pub fn use_refined_views(&mut self, gpu: &Gpu) {
+        for mut c in self.coarse.drain(..) {
+            self.texture_views[c.texture] = self.textures[c.texture].view;
+            c.view.destroy(gpu);
+        }
     }
 
     fn upload_sections(
@@ -527,6 +621,7 @@ impl GpuScene {
                 uploaded: true,
                 reason: String::new(),
                 after_first_frame: false,
+                fine_mips: None,
             };
             // Sections (or parts of them) that a later part uploads.
             let scene_buffers_later = all.scene_buffers && !now.scene_buffers && first;
@@ -602,10 +697,17 @@ impl GpuScene {
                 self.bvh = Some(bvh);
                 uploaded?;
             } else if kind == sections::TEXTURE && all.textures {
+                let i = index as usize;
                 if now.textures {
-                    self.upload_texture(gpu, view, index as usize, up)?;
+                    let coarse_first = first && part.textures == TextureUpload::CoarseFirst;
+                    if let Some(fine) = self.upload_texture(gpu, view, i, up, coarse_first)? {
+                        fate.fine_mips = Some(fine);
+                        fate.after_first_frame = true;
+                    }
+                } else if first {
+                    fate.after_first_frame = true;
                 } else {
-                    fate.after_first_frame = first;
+                    self.refine_texture(view, i, up)?;
                 }
                 match (&self.reference, &prepared.reference) {
                     (Some(r), Some(tables)) if now.scene_buffers => {
@@ -688,7 +790,17 @@ impl GpuScene {
         Ok(())
     }
 
-    fn upload_texture(&mut self, gpu: &Gpu, view: &SceneView, i: usize, up: &mut Uploader) -> PlayResult {
+    /// Creates texture `i` with its full chain and uploads its levels: all of them, or with
+    /// `coarse_first` those from [`first_coarse_level`] on; returns the finer levels left for
+    /// [`GpuScene::refine_texture`] (finest, coarsest), if any.
+    fn upload_texture(
+        &mut self,
+        gpu: &Gpu,
+        view: &SceneView,
+        i: usize,
+        up: &mut Uploader,
+        coarse_first: bool,
+    ) -> PlayResult<Option<[u32; 2]>> {
         let info = &view.manifest.textures[i];
         let data = view.texture(i).map_err(bad)?;
         let srgb = info.color_space == ColorSpace::Srgb;
@@ -729,17 +841,26 @@ impl GpuScene {
             a: swizzle(data.swizzle[3]),
         };
         let image = Image::new(gpu, &info.name, desc)?;
+        let first =
+            if coarse_first { first_coarse_level(info.width, info.height, info.mip_levels) } else { 0 };
         let slices = data.level_slices(info.width, info.height, info.mip_levels);
-        let levels: Vec<(u32, u32, u32, u32, &[u8])> = slices
-            .iter()
-            .enumerate()
-            .map(|(mip, bytes)| {
-                let mip = mip as u32;
-                (mip, 0, (info.width >> mip).max(1), (info.height >> mip).max(1), *bytes)
-            })
-            .collect();
+        let levels = texture_levels(info.width, info.height, &slices);
+        let resident = &levels[(first as usize).min(levels.len())..];
         // Uploaded as stored: blocks go to the GPU as they are in the file.
-        up.image_blocks(&image, data.format.block_dim(), data.format.block_bytes() as u64, &levels)?;
+        let uploaded =
+            up.image_blocks(&image, data.format.block_dim(), data.format.block_bytes() as u64, resident);
+        // Pushed first, so that the scene releases it on any error below. Textures arrive in
+        // index order (file order), so position == texture number.
+        debug_assert_eq!(self.textures.len(), i);
+        self.texture_views.push(image.view);
+        self.textures.push(image);
+        uploaded?;
+        self.coarse_texture_bytes += resident.iter().map(|l| l.4.len() as u64).sum::<u64>();
+        if first > 0 {
+            let coarse = self.textures[i].view_from_mip(gpu, first)?;
+            self.texture_views[i] = coarse.raw;
+            self.coarse.push(CoarseTexture { texture: i, first, view: coarse });
+        }
         let key = SamplerKey {
             linear: info.mag_linear,
             mipmaps: info.mip_levels > 1,
@@ -755,10 +876,24 @@ impl GpuScene {
                 raw
             }
         };
-        // Textures arrive in index order (file order), so position == texture number.
-        debug_assert_eq!(self.textures.len(), i);
-        self.textures.push(image);
         self.texture_samplers.push(raw);
+        Ok((first > 0).then(|| [0, first - 1]))
+    }
+
+    /// Uploads the finer levels that [`GpuScene::upload_texture`] left out of texture `i`,
+    /// coarse to fine (nothing when it uploaded them all). Only those levels change layout:
+    /// the coarse ones stay as they are, possibly sampled by a frame in flight.
+    fn refine_texture(&mut self, view: &SceneView, i: usize, up: &mut Uploader) -> PlayResult {
+        let Some(first) = self.coarse.iter().find(|c| c.texture == i).map(|c| c.first) else {
+            return Ok(());
+        };
+        let info = &view.manifest.textures[i];
+        let data = view.texture(i).map_err(bad)?;
+        let slices = data.level_slices(info.width, info.height, info.mip_levels);
+        let levels = texture_levels(info.width, info.height, &slices);
+        let fine: Vec<_> = levels[..(first as usize).min(levels.len())].iter().rev().copied().collect();
+        up.image_blocks(&self.textures[i], data.format.block_dim(), data.format.block_bytes() as u64, &fine)?;
+        self.fine_texture_bytes += fine.iter().map(|l| l.4.len() as u64).sum::<u64>();
         Ok(())
     }
 
@@ -767,6 +902,11 @@ impl GpuScene {
         self.vertices.destroy(gpu);
         self.attributes.destroy(gpu);
         self.indices.destroy(gpu);
+        // The coarse views before their images.
+        for c in &mut self.coarse {
+            c.view.destroy(gpu);
+        }
+        self.coarse.clear();
         for t in &mut self.textures {
             t.destroy(gpu);
         }
@@ -794,6 +934,19 @@ impl GpuScene {
         }
         self.samplers.clear();
     }
+}
+
+/// A texture's levels as the uploader takes them, finest first: (mip, layer 0, width, height,
+/// bytes as stored).
+fn texture_levels<'a>(width: u32, height: u32, slices: &[&'a [u8]]) -> Vec<(u32, u32, u32, u32, &'a [u8])> {
+    slices
+        .iter()
+        .enumerate()
+        .map(|(mip, bytes)| {
+            let mip = mip as u32;
+            (mip, 0, (width >> mip).max(1), (height >> mip).max(1), *bytes)
+        })
+        .collect()
 }
 
 /// The material of each triangle in draw (index buffer) order.
@@ -880,6 +1033,18 @@ pub fn sampled_desc(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_first_coarse_level_is_the_first_at_most_coarse_side_texels() {
+        assert_eq!(first_coarse_level(2048, 2048, 12), 3);
+        assert_eq!(first_coarse_level(2048, 512, 12), 3);
+        assert_eq!(first_coarse_level(257, 3, 9), 1);
+        assert_eq!(first_coarse_level(256, 256, 9), 0);
+        assert_eq!(first_coarse_level(37, 29, 6), 0);
+        // A chain cut short: its last level is the coarsest there is.
+        assert_eq!(first_coarse_level(2048, 2048, 2), 1);
+        assert_eq!(first_coarse_level(2048, 2048, 1), 0);
+    }
 
     #[test]
     fn sorting_by_material_keeps_every_triangle_once() {

@@ -165,7 +165,10 @@ impl<'g> Uploader<'g> {
     /// Uploads an image stored in `block × block` texel blocks of `block_bytes` each (1 and the
     /// texel size for uncompressed images): each level's rows of blocks tightly packed, the
     /// last row and column of blocks partial where the level's size is not a multiple of the
-    /// block. Copies split at block-row boundaries. The image ends in SHADER_READ_ONLY layout.
+    /// block. Copies split at block-row boundaries. The mips from the lowest to the highest that
+    /// `levels` names (every layer) end in SHADER_READ_ONLY layout; `levels` must write each of
+    /// them. The other mips are left as they are: a texture's coarse levels, uploaded earlier and
+    /// perhaps being sampled, keep their contents and layout while its finer levels arrive.
     pub fn image_blocks(
         &mut self,
         image: &Image,
@@ -173,7 +176,13 @@ impl<'g> Uploader<'g> {
         block_bytes: u64,
         levels: &[(u32, u32, u32, u32, &[u8])],
     ) -> PlayResult {
-        self.recorder()?.transition(image, Use::DISCARD, Use::TRANSFER_DST);
+        let (Some(low), Some(high)) = (levels.iter().map(|l| l.0).min(), levels.iter().map(|l| l.0).max())
+        else {
+            return Ok(());
+        };
+        let written = image.mips(low, high - low + 1);
+        // Only the levels written are discarded: the barrier orders nothing else.
+        self.recorder()?.transition_raw(image.raw, written, Use::DISCARD, Use::TRANSFER_DST);
         for &(mip, layer, width, height, bytes) in levels {
             let row = width.div_ceil(block) as u64 * block_bytes;
             let block_rows = height.div_ceil(block);
@@ -209,7 +218,7 @@ impl<'g> Uploader<'g> {
                 y += rows;
             }
         }
-        self.recorder()?.transition(image, Use::TRANSFER_DST, Use::UPLOADED);
+        self.recorder()?.transition_raw(image.raw, written, Use::TRANSFER_DST, Use::UPLOADED);
         Ok(())
     }
 

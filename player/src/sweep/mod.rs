@@ -28,6 +28,7 @@ use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Gpu, GpuOptions};
 use crate::render::{Effect, Purpose, RenderSettings, Techniques};
+use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions, open_file};
 
 use measure::{Measured, Timing, measure};
@@ -352,6 +353,7 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             readback: None,
             // Every frame is measured: none from a fallback, and none compiled for one.
             pipelines: PipelineStart::Complete,
+            textures: TextureUpload::Whole,
         };
         let refs = camera_references(options, &plan, &content_hash, &name, &base, &progress)?;
         references.extend(refs.values().map(|r| r.info.clone()));

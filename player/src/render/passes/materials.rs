@@ -83,23 +83,39 @@ impl SceneDraws {
         )
     }
 
-    /// Allocates and writes the sets the first time (they depend on the scene only).
+    /// Allocates the sets the first time and writes them, each time: a texture's view changes
+    /// once its finer levels arrive ([`crate::scene::GpuScene::texture_views`]).
     pub fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
-        if self.frame_set != vk::DescriptorSet::null() {
-            return Ok(());
-        }
         let scene = shared.scene;
-        self.frame_set = self.frame_layout.allocate(gpu)?;
-        self.frame_layout.write(gpu, self.frame_set, &[Write::Buffer(0, shared.frame_ubo)]);
+        if self.frame_set == vk::DescriptorSet::null() {
+            self.frame_set = self.frame_layout.allocate(gpu)?;
+            self.frame_layout.write(gpu, self.frame_set, &[Write::Buffer(0, shared.frame_ubo)]);
+            for m in &scene.materials {
+                self.material_sets.push(self.material_layout.allocate(gpu)?);
+                let mut layout: GpuMaterialLayout = bytemuck::cast(*m);
+                // Textures the scene did not upload (textures off) read as absent.
+                for t in [
+                    &mut layout.base_color_texture,
+                    &mut layout.metallic_roughness_texture,
+                    &mut layout.normal_texture,
+                    &mut layout.occlusion_texture,
+                    &mut layout.emissive_texture,
+                ] {
+                    if *t as usize >= scene.textures.len() {
+                        *t = NO_TEXTURE;
+                    }
+                }
+                self.materials.push(layout);
+            }
+        }
         let white = (shared.dummies.white.view, scene.linear_clamp);
         let texture = |t: u32| -> (vk::ImageView, vk::Sampler) {
-            match scene.textures.get(t as usize) {
-                Some(img) if t != NO_TEXTURE => (img.view, scene.texture_samplers[t as usize]),
+            match scene.texture_views.get(t as usize) {
+                Some(&view) if t != NO_TEXTURE => (view, scene.texture_samplers[t as usize]),
                 _ => white,
             }
         };
-        for m in &scene.materials {
-            let set = self.material_layout.allocate(gpu)?;
+        for (m, &set) in scene.materials.iter().zip(&self.material_sets) {
             let writes: Vec<Write> = m
                 .textures()
                 .iter()
@@ -107,21 +123,6 @@ impl SceneDraws {
                 .map(|(i, &t)| Write::Sampled(i as u32, vec![texture(t)]))
                 .collect();
             self.material_layout.write(gpu, set, &writes);
-            self.material_sets.push(set);
-            let mut layout: GpuMaterialLayout = bytemuck::cast(*m);
-            // Textures the scene did not upload (textures off) read as absent.
-            for t in [
-                &mut layout.base_color_texture,
-                &mut layout.metallic_roughness_texture,
-                &mut layout.normal_texture,
-                &mut layout.occlusion_texture,
-                &mut layout.emissive_texture,
-            ] {
-                if *t as usize >= scene.textures.len() {
-                    *t = NO_TEXTURE;
-                }
-            }
-            self.materials.push(layout);
         }
         Ok(())
     }
