@@ -40,6 +40,10 @@ pub fn run(
         session.follow(&options, 0, frames)?;
         session.frame(false)?;
         session.finish_pipelines()?;
+        // When the chosen pipelines were ready before that frame, it was already theirs and
+        // nothing restarted after it: restart here, so that the written frame never depends on
+        // when the pipelines were ready.
+        session.restart();
     }
     for f in 0..frames {
         session.follow(&options, f, frames)?;

@@ -580,6 +580,12 @@ impl Session {
         self.upgrade.is_some() || self.rest.is_some()
     }
 
+    /// Starts accumulation and histories again: the next frame is rendered as the first of a
+    /// session that waited for everything.
+    pub fn restart(&mut self) {
+        self.renderer.restart();
+    }
+
     /// Whether frames come from the fallback (the chosen techniques' pipelines are still
     /// building, or built but not yet switched to).
     pub fn showing_fallback(&self) -> bool {

@@ -302,10 +302,16 @@ impl Renderer {
     /// restarts the frame count, running average and histories: the frames after it are those
     /// of a scene loaded whole (bit for bit), none blending in a coarse one.
     pub fn textures_refined(&mut self, gpu: &Gpu, scene: &GpuScene, dummies: &Dummies) -> PlayResult {
+        self.restart();
+        self.bind(gpu, scene, dummies)
+    }
+
+    /// Forgets every frame so far: accumulation, histories and the frame count start again,
+    /// so that the next frame is rendered as a session's first.
+    pub fn restart(&mut self) {
         self.accumulated = 0;
         self.last_view_proj = None;
         self.frame_count = 0;
-        self.bind(gpu, scene, dummies)
     }
 
     /// The frame's images.
