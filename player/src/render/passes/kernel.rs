@@ -17,7 +17,7 @@ impl Kernel {
     /// A kernel from SPIR-V over a set of `bindings`, with `push_bytes` of push constants. On
     /// failure nothing is left behind.
     pub fn new(gpu: &Gpu, bindings: &[Binding], spirv: &[u8], push_bytes: u32) -> PlayResult<Kernel> {
-        Self::make(gpu, bindings, spirv, push_bytes, &[])
+        Self::specialized(gpu, bindings, spirv, push_bytes, &[])
     }
 
     /// `N` kernels, one per (bindings, SPIR-V), all with `push_bytes` of push constants: the
@@ -50,21 +50,11 @@ impl Kernel {
         push_bytes: u32,
         decode: TexelDecode,
     ) -> PlayResult<Kernel> {
-        Self::make(gpu, bindings, spirv, push_bytes, &decode.constants())
+        Self::specialized(gpu, bindings, spirv, push_bytes, &decode.constants())
     }
 
     /// [`Kernel::new`] with specialization constants: `constants[i]` for constant id `i`.
     pub fn specialized(
-        gpu: &Gpu,
-        bindings: &[Binding],
-        spirv: &[u8],
-        push_bytes: u32,
-        constants: &[u32],
-    ) -> PlayResult<Kernel> {
-        Self::make(gpu, bindings, spirv, push_bytes, constants)
-    }
-
-    fn make(
         gpu: &Gpu,
         bindings: &[Binding],
         spirv: &[u8],
