@@ -14,6 +14,31 @@ use kiln_player::headless::{self, HeadlessResult};
 use kiln_player::image_out::read_exr;
 use kiln_tests::Options;
 
+/// Ray-traced shadows, AO and half-resolution reflections.
+pub fn traced(o: Options) -> Options {
+    o.rt_shadows(0.05, 0.0).rt_ao(None).rt_reflections(kiln_tests::Reflections::Half)
+}
+
+/// A headless run's written EXR (its bytes), the session's load breakdown and whether it still
+/// showed the fallback at the end.
+pub struct WrittenExr {
+    pub bytes: Vec<u8>,
+    pub times: kiln_player::session::LoadTimes,
+    pub behind: bool,
+}
+
+/// Renders `frames` frames of `o` headless to `dir/name.exr`, asserting finite radiance and no
+/// validation errors.
+pub fn written_exr(dir: &Path, name: &str, o: Options, frames: u32) -> WrittenExr {
+    let out = dir.join(format!("{name}.exr"));
+    let r = headless::run(&o.build(), frames, Some(&out), Instant::now())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(r.non_finite, 0, "{name}: NaN or Inf in the frame");
+    let (times, behind) = (r.session.times.clone(), r.session.showing_fallback());
+    assert_eq!(r.session.close(), 0, "{name}: validation errors");
+    WrittenExr { bytes: std::fs::read(out).unwrap(), times, behind }
+}
+
 /// Renders `bytes` headless to an EXR; returns the RGB radiance, asserting a clean run.
 pub fn render(
     dir: &Path,

@@ -7,38 +7,17 @@
 use std::time::{Duration, Instant};
 
 use kiln_compiler::import::demo::cornell_box;
+use kiln_player::bench;
 use kiln_player::session::Session;
-use kiln_player::{bench, headless};
-use kiln_tests::{Options, Reflections, compile, vulkan};
+use kiln_tests::{Options, compile, vulkan};
 
-use crate::harness::fast_settings;
+use crate::harness::{WrittenExr, fast_settings, traced, written_exr};
 
 /// The demo box (one rect light with its baked shadow map) written to `dir`.
 fn demo(dir: &std::path::Path) -> std::path::PathBuf {
     let file = dir.join("demo.kiln");
     std::fs::write(&file, compile(cornell_box(), fast_settings())).unwrap();
     file
-}
-
-/// Ray-traced shadows, AO and half-resolution reflections.
-fn traced(o: Options) -> Options {
-    o.rt_shadows(0.05, 0.0).rt_ao(None).rt_reflections(Reflections::Half)
-}
-
-/// Renders `frames` frames headless to an EXR and returns its bytes, the session's breakdown
-/// and whether it still showed the fallback at the end.
-fn exr(
-    dir: &std::path::Path,
-    name: &str,
-    o: Options,
-    frames: u32,
-) -> (Vec<u8>, kiln_player::session::LoadTimes, bool) {
-    let out = dir.join(format!("{name}.exr"));
-    let r = headless::run(&o.build(), frames, Some(&out), Instant::now())
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    let (times, behind) = (r.session.times.clone(), r.session.showing_fallback());
-    assert_eq!(r.session.close(), 0, "{name}: validation errors");
-    (std::fs::read(out).unwrap(), times, behind)
 }
 
 #[test]
@@ -52,13 +31,14 @@ fn headless_output_behind_a_fallback_is_bit_identical_to_waiting_for_every_pipel
     // GI too: its bounces shade hits with the materials and triangles that upload after the
     // first frame (the box's Lambertian walls give the other passes no use for them).
     let all = |o: Options| traced(o).rt_gi(1);
-    let (progressive, times, behind) =
-        exr(dir.path(), "progressive", all(Options::new(&file, w, h)).progressive(), frames);
-    let (complete, complete_times, _) = exr(dir.path(), "complete", all(Options::new(&file, w, h)), frames);
+    let WrittenExr { bytes: progressive, times, behind } =
+        written_exr(dir.path(), "progressive", all(Options::new(&file, w, h)).progressive(), frames);
+    let WrittenExr { bytes: complete, times: complete_times, .. } =
+        written_exr(dir.path(), "complete", all(Options::new(&file, w, h)), frames);
     // What the fallback shows differs from the chosen techniques, so that the comparison below
     // would see a fallback frame written.
-    let (fallback, _, _) =
-        exr(dir.path(), "fallback", all(Options::new(&file, w, h)).as_fallback(true), frames);
+    let fallback =
+        written_exr(dir.path(), "fallback", all(Options::new(&file, w, h)).as_fallback(true), frames).bytes;
     assert_ne!(
         fallback, complete,
         "the fallback renders what the chosen techniques render: the test sees nothing"

@@ -13,12 +13,12 @@ use kiln_compiler::settings::{Settings, TextureFormat};
 use kiln_format::manifest::{LightKind, Wrap};
 use kiln_format::sections::{self, PixelFormat};
 use kiln_format::{Checksums, KilnFile, SceneView};
+use kiln_player::bench;
 use kiln_player::render::Readable;
 use kiln_player::session::Session;
-use kiln_player::{bench, headless};
-use kiln_tests::{Options, Reflections, compile, scene_of, vulkan};
+use kiln_tests::{Options, compile, scene_of, vulkan};
 
-use crate::harness::{H, Pinhole, W, fast_settings, light, square};
+use crate::harness::{H, Pinhole, W, WrittenExr, fast_settings, light, square, traced, written_exr};
 
 /// The checker's size: over 256 texels on both sides, so that levels 0 and 1 (516 × 260 and
 /// 258 × 130) come after the first frame and level 2 (129 × 65) is the first one before it.
@@ -67,18 +67,6 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let file = dir.join(format!("{name}.kiln"));
     std::fs::write(&file, bytes).unwrap();
     file
-}
-
-/// Renders `frames` frames headless to an EXR and returns its bytes and the session's breakdown,
-/// asserting a clean run (teardown included).
-fn exr(dir: &Path, name: &str, o: Options, frames: u32) -> (Vec<u8>, kiln_player::session::LoadTimes) {
-    let out = dir.join(format!("{name}.exr"));
-    let r = headless::run(&o.build(), frames, Some(&out), Instant::now())
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    assert_eq!(r.non_finite, 0, "{name}: NaN or Inf in the frame");
-    let times = r.session.times.clone();
-    assert_eq!(r.session.close(), 0, "{name}: validation errors");
-    (std::fs::read(out).unwrap(), times)
 }
 
 /// Bytes of each level of a `w` × `h` texture down to 1 × 1, finest first, computed here from the
@@ -136,9 +124,10 @@ fn headless_output_with_streamed_textures_is_bit_identical_to_a_whole_load() {
     for (format, name) in [(TextureFormat::Rgba8, "rgba8"), (TextureFormat::Bc, "bc")] {
         let file = write(dir.path(), name, &checker_floor(format));
         // Two frames: the second reads the first's history, which the refinement must restart.
-        let (streamed, times) =
-            exr(dir.path(), &format!("{name}-streamed"), Options::new(&file, W, H).streaming(), 2);
-        let (whole, whole_times) = exr(dir.path(), &format!("{name}-whole"), Options::new(&file, W, H), 2);
+        let WrittenExr { bytes: streamed, times, .. } =
+            written_exr(dir.path(), &format!("{name}-streamed"), Options::new(&file, W, H).streaming(), 2);
+        let WrittenExr { bytes: whole, times: whole_times, .. } =
+            written_exr(dir.path(), &format!("{name}-whole"), Options::new(&file, W, H), 2);
         assert!(streamed == whole, "{name}: the streamed output differs from the whole load's");
         // The comparison saw a streamed load: its first frame did not wait for levels 0 and 1.
         assert_eq!(times.after_first_frame, ["texture#0 mips 0-1"], "{name}");
@@ -154,10 +143,9 @@ fn behind_a_fallback_streamed_textures_still_give_the_chosen_techniques_output()
     }
     let dir = tempfile::tempdir().unwrap();
     let file = write(dir.path(), "rt", &checker_floor(TextureFormat::Rgba8));
-    let traced = |o: Options| o.rt_shadows(0.05, 0.0).rt_ao(None).rt_reflections(Reflections::Half);
-    let (both, times) =
-        exr(dir.path(), "both", traced(Options::new(&file, W, H)).progressive().streaming(), 2);
-    let (complete, _) = exr(dir.path(), "complete", traced(Options::new(&file, W, H)), 2);
+    let WrittenExr { bytes: both, times, .. } =
+        written_exr(dir.path(), "both", traced(Options::new(&file, W, H)).progressive().streaming(), 2);
+    let complete = written_exr(dir.path(), "complete", traced(Options::new(&file, W, H)), 2).bytes;
     assert!(both == complete, "behind a fallback with streamed textures the output differs");
     // The texture's finer levels and its texels for the ray-traced passes came after the
     // fallback's first frame, with the sections only those passes read.
