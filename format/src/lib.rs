@@ -25,6 +25,7 @@ pub mod gpu;
 pub mod header;
 pub mod linespace;
 pub mod manifest;
+mod parallel;
 pub mod projection;
 pub mod query;
 pub mod read;

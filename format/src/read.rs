@@ -228,24 +228,14 @@ impl KilnFile {
     /// bounds the wall time); later reads of them are free. Sections stored as is are only
     /// verified. Returns the first error in `positions` order.
     pub fn decode_sections(&self, positions: &[usize]) -> Result<()> {
-        let mut todo: Vec<usize> = positions.iter().copied().filter(|&p| p < self.sections.len()).collect();
-        todo.sort_by_key(|&p| std::cmp::Reverse(self.sections[p].entry.raw_size));
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(todo.len());
-        let next = std::sync::atomic::AtomicUsize::new(0);
-        std::thread::scope(|scope| {
-            for _ in 0..threads {
-                scope.spawn(|| {
-                    while let Some(&p) = todo.get(next.fetch_add(1, Ordering::Relaxed)) {
-                        // Errors stay cached in the section's cells; reported below, in order.
-                        let _ = self.decoded_bytes(&self.sections[p]);
-                    }
-                });
-            }
+        let known: Vec<usize> = positions.iter().copied().filter(|&p| p < self.sections.len()).collect();
+        let mut largest_first = known.clone();
+        largest_first.sort_by_key(|&p| std::cmp::Reverse(self.sections[p].entry.raw_size));
+        // Errors stay cached in the sections' cells; reported below, in `positions` order.
+        crate::parallel::on_all_cores(largest_first, |p| {
+            let _ = self.decoded_bytes(&self.sections[p]);
         });
-        positions
-            .iter()
-            .filter(|&&p| p < self.sections.len())
-            .try_for_each(|&p| self.decode_section(p).map(|_| ()))
+        known.into_iter().try_for_each(|p| self.decode_section(p).map(|_| ()))
     }
 
     /// Wall time spent decoding compressed sections so far (each is decoded once).

@@ -249,33 +249,16 @@ impl<'a> FileWriter<'a> {
             .iter_mut()
             .filter(|p| p.compressed.is_none() && !p.bytes.is_empty() && policy.compresses())
             .collect();
-        if todo.is_empty() {
-            return Ok(());
-        }
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(todo.len());
-        let queue = std::sync::Mutex::new(todo);
-        let results: Vec<Result<(), WriteError>> = std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads)
-                .map(|_| {
-                    scope.spawn(|| {
-                        loop {
-                            let Some(p) = queue.lock().unwrap_or_else(|e| e.into_inner()).pop() else {
-                                return Ok(());
-                            };
-                            let frame = crate::codec::compress_zstd(&p.bytes).map_err(|source| {
-                                WriteError::Compress { kind: p.kind, index: p.index, source }
-                            })?;
-                            if policy.keeps(frame.len(), p.bytes.len()) {
-                                p.compressed = Some(frame);
-                            }
-                        }
-                    })
-                })
-                .collect();
-            workers
-                .into_iter()
-                .map(|w| w.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
-                .collect()
+        let results = crate::parallel::on_all_cores(todo, |p| {
+            let frame = crate::codec::compress_zstd(&p.bytes).map_err(|source| WriteError::Compress {
+                kind: p.kind,
+                index: p.index,
+                source,
+            })?;
+            if policy.keeps(frame.len(), p.bytes.len()) {
+                p.compressed = Some(frame);
+            }
+            Ok(())
         });
         results.into_iter().collect()
     }
