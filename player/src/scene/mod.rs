@@ -164,11 +164,6 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
-/// Whether `kind` is one of the line-space arrays `needs` asks for.
-fn first_line_space(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
-    linespace::LineSpaceLayout::may_upload(kind, needs.line_space)
-}
-
 impl<'f> Prepared<'f> {
     /// Validates `file` and prepares what the upload of `needs` copies. First verifies and
     /// decodes, on all cores, the compressed sections that an upload of `first` reads (the rest
@@ -180,7 +175,9 @@ impl<'f> Prepared<'f> {
             .sections()
             .iter()
             .filter(|s| {
-                s.known.is_some() && (uploads(s.entry.kind, first) || first_line_space(s.entry.kind, first))
+                s.known.is_some()
+                    && (uploads(s.entry.kind, first)
+                        || linespace::LineSpaceLayout::may_upload(s.entry.kind, first.line_space))
             })
             .map(|s| s.position)
             .collect();
@@ -258,11 +255,6 @@ impl Prepared<'_> {
     /// The file's manifest.
     pub fn manifest(&self) -> &kiln_format::Manifest {
         &self.view.manifest
-    }
-
-    /// Whether the file has a BVH to trace rays through.
-    pub fn has_bvh(&self) -> bool {
-        !self.view.bvh.is_empty()
     }
 }
 
