@@ -319,7 +319,14 @@ pub fn judge(origin: Vec3, direction: Vec3, tmin: f32, tmax: f32, p: [Vec3; 3]) 
     let t_last = (0..3).map(|i| along(i, 1.0)).fold(f64::NEG_INFINITY, f64::max);
     // Wholly before tmin or after tmax: no test in f32 reaches it, however near an edge.
     let outside = t_last < f64::from(tmin) || t_first >= f64::from(tmax);
-    let near = t.is_nan() || at_end || (line_meets && grazing) || (near_edge && !outside);
+    // Clear of the line: every point of the triangle lies within its longest edge of each
+    // corner, so at least ρ_i − that edge from the line; rounding moves the corners by NEAR
+    // times the reach and tilts the line by NEAR, which moves a point of the reach by as much
+    // again. A triangle smaller than NEAR of its distance has every edge volume within
+    // rounding reach, whichever way the line passes, and would otherwise be near every ray.
+    let longest = (0..3).map(|i| (a[(i + 1) % 3] - a[i]).length()).fold(0.0f64, f64::max);
+    let clear_of_line = rho.iter().fold(0.0f64, |m, &r| m.max(r)) - longest > 4.0 * NEAR * size;
+    let near = !clear_of_line && (t.is_nan() || at_end || (line_meets && grazing) || (near_edge && !outside));
     let on_boundary = line_meets && !in_plane && signs.contains(&Ordering::Equal);
     let t_reach = T_ROUNDING * size / (cos * dd.length());
     let t_reach = if t_reach.is_nan() { f64::INFINITY } else { t_reach };
@@ -418,5 +425,25 @@ mod tests {
         assert!(judge(Vec3::new(0.2, 0.2, 1.0), down, 0.0, 1.0000001, tri).closed_hit);
         let grazing = judge(Vec3::new(-1.0, 0.2, 0.0), Vec3::X, 0.0, f32::INFINITY, tri);
         assert!(!grazing.closed_hit && grazing.near && grazing.t.is_nan());
+    }
+
+    #[test]
+    fn tiny_triangles_are_near_only_to_rays_that_pass_by() {
+        // Edges of 3e-5 a unit away: below NEAR of their distance, so every edge volume is
+        // within rounding reach. A line half a unit away is still a clear miss; one through
+        // the triangle or a few of its sizes away is near.
+        let tri = [Vec3::new(0.0, 0.0, -1.0), Vec3::new(3e-5, 0.0, -1.0), Vec3::new(0.0, 3e-5, -1.0)];
+        let o = Vec3::ZERO;
+        let towards = |x: f32, y: f32| judge(o, Vec3::new(x, y, -1.0).normalize(), 0.0, f32::INFINITY, tri);
+        for (x, y) in [(0.5, 0.0), (-0.3, 0.4), (0.0, -0.01), (1e-3, 1e-3)] {
+            let j = towards(x, y);
+            assert!(!j.closed_hit && !j.near, "({x}, {y}): {j:?}");
+        }
+        for (x, y) in [(1e-5, 1e-5), (-1e-5, 0.0), (4e-5, 4e-5)] {
+            assert!(towards(x, y).near, "({x}, {y})");
+        }
+        // Crossing its plane beside it, at the ray's start: not near either.
+        let beside = judge(Vec3::new(0.5, 0.0, -1.0), Vec3::Z, 0.0, f32::INFINITY, tri);
+        assert!(!beside.near, "{beside:?}");
     }
 }
