@@ -9,9 +9,7 @@ use kiln_format::linespace::index::{
 };
 use kiln_format::linespace::{PnmtRecord, entry, words_per_slot};
 
-#[cfg(doc)]
-use super::geometry::PairAxes;
-use super::geometry::{Prepared, clip_to_box_into};
+use super::geometry::{PairAxes, Prepared, clip_to_box_into};
 
 /// What one cell contributes to the line space.
 #[derive(Debug, Clone, Default)]
@@ -235,26 +233,24 @@ fn reach_bound(from_face: u32, from: &[DVec3; 4], poly: &[DVec3], to: u32, n: u3
 /// cut pads the projections less (2m/g) but leaves more of the polygon to the cruder bound.
 const REACH_GAP: f64 = 0.25;
 
-/// Calls `found(shaft)` for every shaft of face pair `pair` that the triangle `tri` (clipped to
-/// the widened cell: `poly`) meets. For each patch on face a, the projections of the polygon
-/// from the patch's corners bound the patches on face b it can reach (see [`reach`]; all of
-/// them where the projection is undefined), and one many-shaft test
-/// ([`PairAxes::shafts_from`]) decides each of those shafts exactly.
-fn search(
+/// Calls `window(pa, q, axes)` for every patch `pa` of face a of pair `pair` from which the
+/// triangle `tri` (clipped to the widened cell: `poly`) may meet a shaft, with the patches `q` =
+/// [u0, u1) × [v0, v1) on face b that bound those shafts. The projections of the polygon from
+/// the patch's corners give `q` (see [`reach`]; all of face b where the projection is
+/// undefined); `axes.shafts_from` decides the shafts of `q` exactly.
+fn windows(
     tri: &Prepared,
     poly: &[DVec3],
     pair: u32,
     n: u32,
     margin: f64,
-    tests: &mut u64,
-    found: &mut impl FnMut(u32),
+    window: &mut impl FnMut(u32, [u32; 4], &PairAxes),
 ) {
     let (fa, fb) = pair_faces(pair);
     if poly.is_empty() {
         return;
     }
     let s = 1.0 / n as f64;
-    let n2 = n * n;
     let axes = tri.pair_axes(fa, fb, n, margin);
     let prange = {
         let whole = corners(fb, (0.0, 1.0), (0.0, 1.0));
@@ -266,16 +262,146 @@ fn search(
             let from = corners(fa, ua, va);
             let q = reach(fa, &from, poly, fb, n, margin)
                 .unwrap_or_else(|| reach_bound(fa, &from, poly, fb, n, margin));
-            let mut mask = axes.shafts_from(au, av, q);
-            *tests += ((q[1] - q[0]) * (q[3] - q[2])) as u64;
-            let w = q[3] - q[2];
-            while mask != 0 {
-                let k = mask.trailing_zeros();
-                mask &= mask - 1;
-                let (bu, bv) = (q[0] + k / w, q[2] + k % w);
-                found(pair * n2 * n2 + (au * n + av) * n2 + bu * n + bv);
+            if q[0] < q[1] && q[2] < q[3] {
+                window(au * n + av, q, &axes);
             }
         }
+    }
+}
+
+/// The shaft of pair `pair` from patch `pa` of face a to bit `k` of the window `q` (the bit
+/// layout of [`PairAxes::shafts_from`]).
+fn window_shaft(pair: u32, pa: u32, q: [u32; 4], k: u32, n: u32) -> u32 {
+    let w = q[3] - q[2];
+    let n2 = n * n;
+    pair * n2 * n2 + pa * n2 + (q[0] + k / w) * n + q[2] + k % w
+}
+
+/// Calls `found(shaft)` for every shaft of face pair `pair` that the triangle `tri` (clipped to
+/// the widened cell: `poly`) meets: every [`windows`] window decided by one many-shaft test
+/// ([`PairAxes::shafts_from`]).
+fn search(
+    tri: &Prepared,
+    poly: &[DVec3],
+    pair: u32,
+    n: u32,
+    margin: f64,
+    tests: &mut u64,
+    found: &mut impl FnMut(u32),
+) {
+    windows(tri, poly, pair, n, margin, &mut |pa, q, axes| {
+        let mut mask = axes.shafts_from(pa / n, pa % n, q);
+        *tests += ((q[1] - q[0]) * (q[3] - q[2])) as u64;
+        while mask != 0 {
+            let k = mask.trailing_zeros();
+            mask &= mask - 1;
+            found(window_shaft(pair, pa, q, k, n));
+        }
+    });
+}
+
+/// A triangle of the cell as it fills the shafts of one face pair.
+struct Filler<'a> {
+    /// Global triangle number.
+    triangle: u32,
+    /// Position in the cell's list.
+    local: u32,
+    seg: &'a SegmentTest,
+    faces: (u32, u32),
+    /// Quantised key bounds of the candidate entry.
+    qmin: u8,
+    qmax: u8,
+    /// Key bounds of the clipped polygon (the PNMT fallback's measure).
+    kmin: f64,
+    kmax: f64,
+}
+
+/// What a cell's shafts hold while its triangles fill them: bits, candidate hits and the
+/// records' ends.
+struct Fills<'s> {
+    bits: &'s mut Vec<u32>,
+    ends: &'s mut Vec<[End; 2]>,
+    hits: &'s mut Vec<(u32, u8, u8, u16)>,
+    centres: &'s [[Vec3; MAX_PATCHES]; 6],
+    n: u32,
+    candidates: bool,
+    records_needed: bool,
+}
+
+impl Fills<'_> {
+    fn filled(&self, shaft: u32) -> bool {
+        self.bits[(shaft / 32) as usize] & (1 << (shaft % 32)) != 0
+    }
+
+    /// The midpoint segment of `shaft`, front patch centre to back.
+    fn segment(&self, shaft: u32, f: &Filler) -> (Vec3, Vec3) {
+        let (_, pa, _, pb) = shaft_parts(shaft, self.n);
+        (self.centres[f.faces.0 as usize][pa as usize], self.centres[f.faces.1 as usize][pb as usize])
+    }
+
+    /// Records that `f` fills `shaft`: its bit, its candidate entry, and the records' ends (the
+    /// segment's nearest hits from either end; the fallback's key bounds). Strict comparisons
+    /// keep the earliest triangle of the list on ties.
+    fn fill(&mut self, shaft: u32, f: &Filler) {
+        let (word, bit) = ((shaft / 32) as usize, 1 << (shaft % 32));
+        let first = self.bits[word] & bit == 0;
+        self.bits[word] |= bit;
+        if self.candidates {
+            self.hits.push((shaft, f.qmin, f.qmax, f.local as u16));
+        }
+        if !self.records_needed {
+            return;
+        }
+        if first {
+            self.ends[shaft as usize] = [NO_END; 2];
+        }
+        let (o, e) = self.segment(shaft, f);
+        if let Some(h) = f.seg.hit(o, e) {
+            self.take_hit(shaft, h, f.triangle);
+        }
+        let end = &mut self.ends[shaft as usize];
+        if !(f.kmin >= end[0].key) {
+            end[0].key = f.kmin;
+            end[0].local = f.local;
+        }
+        if !(f.kmax <= end[1].key) {
+            end[1].key = f.kmax;
+            end[1].local = f.local;
+        }
+    }
+
+    /// Takes the hit `h` of triangle `t` where it is nearer either end than the shaft's.
+    fn take_hit(&mut self, shaft: u32, h: Intersection, t: u32) {
+        let end = &mut self.ends[shaft as usize];
+        if !(h.t >= end[0].t) {
+            end[0] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[0] };
+        }
+        if !(h.t <= end[1].t) {
+            end[1] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[1] };
+        }
+    }
+
+    /// Whether filling `shaft` by `f` could change anything [`fill`](Self::fill) keeps other
+    /// than a segment hit: its bit (not yet filled), or, while its segment has no hit, the
+    /// fallback's key bounds.
+    fn needs_test(&self, shaft: u32, f: &Filler) -> bool {
+        if !self.filled(shaft) {
+            return true;
+        }
+        if !self.records_needed {
+            return false;
+        }
+        let end = &self.ends[shaft as usize];
+        end[0].t.is_nan() && (!(f.kmin >= end[0].key) || !(f.kmax <= end[1].key))
+    }
+
+    /// The hit of the filled `shaft`'s midpoint segment on `f`'s triangle, where it is nearer
+    /// either end than the shaft's.
+    fn better_hit(&self, shaft: u32, f: &Filler) -> Option<Intersection> {
+        let (o, e) = self.segment(shaft, f);
+        let h = f.seg.hit(o, e)?;
+        let end = &self.ends[shaft as usize];
+        (!(h.t >= end[0].t) || !(h.t <= end[1].t)).then_some(h)
     }
 }
 
@@ -371,6 +497,12 @@ pub fn bake_cell(
     if polys.len() < tris.len() {
         polys.resize_with(tris.len(), Vec::new);
     }
+    let mut state =
+        Fills { bits: &mut out.bits, ends, hits, centres: &centres, n, candidates, records_needed };
+    // Without candidates, only the union of the triangles' shafts and the records are kept:
+    // a window whose shafts are all filled already, and whose records this triangle cannot
+    // change by filling them, needs no exact test (see `Fills::needs_test`).
+    let union = !candidates;
     for (li, &t) in tris.iter().enumerate() {
         let v = local[t as usize].map(|p| p - cell_min);
         let prep = Prepared::new(v);
@@ -388,37 +520,56 @@ pub fn bake_cell(
                     .map(|p| p.dot(w))
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
             };
-            let (qmin, qmax) =
-                (quantise(kmin - 2.0 * margin, key_lo, false), quantise(kmax + 2.0 * margin, key_lo, true));
-            search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft| {
-                let (word, bit) = ((shaft / 32) as usize, 1 << (shaft % 32));
-                let first = out.bits[word] & bit == 0;
-                out.bits[word] |= bit;
-                if candidates {
-                    hits.push((shaft, qmin as u8, qmax as u8, li as u16));
+            let filler = Filler {
+                triangle: t,
+                local: li as u32,
+                seg: &seg,
+                faces: (fa, fb),
+                qmin: quantise(kmin - 2.0 * margin, key_lo, false) as u8,
+                qmax: quantise(kmax + 2.0 * margin, key_lo, true) as u8,
+                kmin,
+                kmax,
+            };
+            if !union {
+                search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft| state.fill(shaft, &filler));
+                continue;
+            }
+            windows(&prep, poly, pair, n, margin, &mut |pa, q, axes| {
+                let w = q[3] - q[2];
+                let count = (q[1] - q[0]) * w;
+                // The rectangle of the window's shafts that need the exact test.
+                let mut sub = [u32::MAX, 0, u32::MAX, 0];
+                for k in 0..count {
+                    if state.needs_test(window_shaft(pair, pa, q, k, n), &filler) {
+                        let (u, v) = (q[0] + k / w, q[2] + k % w);
+                        sub = [sub[0].min(u), sub[1].max(u + 1), sub[2].min(v), sub[3].max(v + 1)];
+                    }
                 }
-                if records_needed {
-                    let (_, pa, _, pb) = shaft_parts(shaft, n);
-                    let (o, e) = (centres[fa as usize][pa as usize], centres[fb as usize][pb as usize]);
-                    let end = &mut ends[shaft as usize];
-                    if first {
-                        *end = [NO_END; 2];
+                if sub[0] < sub[1] {
+                    let mut mask = axes.shafts_from(pa / n, pa % n, sub);
+                    out.tests += ((sub[1] - sub[0]) * (sub[3] - sub[2])) as u64;
+                    while mask != 0 {
+                        let k = mask.trailing_zeros();
+                        mask &= mask - 1;
+                        state.fill(window_shaft(pair, pa, sub, k, n), &filler);
                     }
-                    if let Some(h) = seg.hit(o, e) {
-                        if !(h.t >= end[0].t) {
-                            end[0] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[0] };
+                }
+                if !records_needed {
+                    return;
+                }
+                // The rest are filled: only a better hit of a midpoint segment can change one,
+                // and counts if the triangle fills that shaft.
+                for k in 0..count {
+                    let (u, v) = (q[0] + k / w, q[2] + k % w);
+                    if (sub[0]..sub[1]).contains(&u) && (sub[2]..sub[3]).contains(&v) {
+                        continue;
+                    }
+                    let shaft = window_shaft(pair, pa, q, k, n);
+                    if let Some(h) = state.better_hit(shaft, &filler) {
+                        out.tests += 1;
+                        if axes.shafts_from(pa / n, pa % n, [u, u + 1, v, v + 1]) != 0 {
+                            state.take_hit(shaft, h, t);
                         }
-                        if !(h.t <= end[1].t) {
-                            end[1] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[1] };
-                        }
-                    }
-                    if !(kmin >= end[0].key) {
-                        end[0].key = kmin;
-                        end[0].local = li as u32;
-                    }
-                    if !(kmax <= end[1].key) {
-                        end[1].key = kmax;
-                        end[1].local = li as u32;
                     }
                 }
             });
@@ -633,6 +784,81 @@ mod tests {
     use super::*;
     use crate::bake::linespace::geometry::clip_to_box;
     use crate::bake::linespace::geometry::tests::uniform;
+
+    /// Corners from a list, geometric normals, barycentrics as texture coordinates.
+    struct ListAttributes(Vec<[Vec3; 3]>);
+
+    impl HitAttributes for ListAttributes {
+        fn corners(&self, t: u32) -> [Vec3; 3] {
+            self.0[t as usize]
+        }
+        fn normal(&self, t: u32, _: f32, _: f32) -> Vec3 {
+            let [a, b, c] = self.0[t as usize];
+            (b - a).cross(c - a)
+        }
+        fn uv(&self, _: u32, u: f32, v: f32) -> Vec2 {
+            Vec2::new(u, v)
+        }
+        fn material(&self, t: u32) -> u16 {
+            (t % 3) as u16
+        }
+    }
+
+    /// A bake without candidates keeps only the union of the triangles' shafts and skips the
+    /// exact tests that cannot change it; its bits and PNMT records must be those of the bake
+    /// that tests every triangle against every shaft it may reach (the candidate bake, which
+    /// keeps the records too). Cells of small triangles (where most windows are filled
+    /// already), large ones, a mix, and coincident copies (ties).
+    #[test]
+    fn union_bake_keeps_the_bits_and_records_of_the_all_pairs_bake() {
+        let mut rnd = uniform(5);
+        let mut skipped = (0u64, 0u64);
+        for case in 0..60u32 {
+            let n = 2 + case % 7;
+            let margin = [1e-5, 1e-3][(case % 2) as usize];
+            let count = 1 + (case as usize * 7) % 40;
+            let size = [0.05, 0.3, 1.5][(case / 2 % 3) as usize];
+            let mut tris: Vec<[DVec3; 3]> = (0..count)
+                .map(|_| {
+                    let c = DVec3::new(rnd(), rnd(), rnd()) * 1.2 - 0.1;
+                    [0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size)
+                })
+                .collect();
+            if case % 5 == 0 {
+                let copy = tris[0];
+                tris.push(copy);
+            }
+            let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| p.as_vec3())).collect());
+            let ids: Vec<u32> = (0..tris.len() as u32).collect();
+            let bake = |candidates: bool, pnmt: bool| {
+                bake_cell(
+                    &ids,
+                    &tris,
+                    DVec3::ZERO,
+                    DVec3::ZERO,
+                    1.0,
+                    n,
+                    margin,
+                    candidates,
+                    pnmt,
+                    &attrs,
+                    None,
+                    &mut Scratch::default(),
+                )
+            };
+            let all = bake(true, true);
+            let union = bake(false, true);
+            let binary = bake(false, false);
+            assert_eq!(union.bits, all.bits, "case {case}");
+            assert_eq!(binary.bits, all.bits, "case {case}");
+            assert_eq!(union.pnmt, all.pnmt, "case {case}");
+            skipped.0 += all.tests;
+            skipped.1 += union.tests;
+        }
+        // The union bake must run fewer exact tests (about 70 % here), or it is not taking its
+        // own path.
+        assert!(skipped.1 * 5 < skipped.0 * 4, "{skipped:?}");
+    }
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the
     /// reach bounds must never leave out a shaft the triangle meets, and nothing else may be
