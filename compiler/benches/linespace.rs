@@ -8,11 +8,12 @@
 
 use std::time::Instant;
 
+use glam::Vec2;
 use kiln_compiler::analyze::budget::Estimate;
 use kiln_compiler::bake::linespace::{self, SceneAttributes};
 use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
 use kiln_compiler::ir::Scene;
-use kiln_format::linespace::Variants;
+use kiln_format::linespace::{Variants, oct_decode, oct_encode};
 
 struct Row {
     scene: u32,
@@ -65,6 +66,67 @@ fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLine
     let progress = kiln_compiler::progress::Progress::hidden();
     let ls = linespace::bake(&attrs_of(scene), voxels, voxel_ms, n, variants, None, &progress).expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
+}
+
+/// Bytes per filled shaft of each variant, in memory and as the file's default codec stores it
+/// (estimated from samples of the larger sections),
+/// and what a 12-byte PNMT record (position 3 × 10 bits, octahedral normal 2 × 11 bits, material
+/// 12 bits, uv as now) would cost in error against today's 16-byte records, measured on every
+/// record of the bake.
+fn memory(ls: &linespace::BakedLineSpace, lc: &linespace::BakedLineSpace) {
+    let filled = ls.header.filled.max(1) as f64;
+    let binary = 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len());
+    let records: &[u8] = bytemuck::cast_slice(&ls.pnmt);
+    // The codec's compressed size, estimated from at most 16 evenly spaced 4 MiB pieces: the
+    // fine rows' sections are gigabytes, which the single-threaded level-9 encoder takes
+    // minutes over.
+    let zstd = |b: &[u8]| {
+        const PIECE: usize = 4 << 20;
+        let pieces = b.len().div_ceil(PIECE).max(1);
+        let (mut raw, mut framed) = (0usize, 0usize);
+        for i in (0..pieces).step_by(pieces.div_ceil(16)) {
+            let piece = &b[i * PIECE..((i + 1) * PIECE).min(b.len())];
+            raw += piece.len();
+            framed +=
+                kiln_format::codec::compress_zstd(piece).map_or(piece.len(), |f| f.len().min(piece.len()));
+        }
+        (b.len() as f64 * framed as f64 / raw.max(1) as f64) as usize
+    };
+    let entries: &[u8] = bytemuck::cast_slice(&lc.candidates);
+    let offsets: &[u8] = bytemuck::cast_slice(&lc.candidate_offsets);
+    let (mut pos_max, mut pos_sum, mut ang_max, mut ang_sum, mut count) = (0f64, 0f64, 0f64, 0f64, 0u64);
+    for r in ls.pnmt.iter().filter(|r| r.is_some()) {
+        let q = |x: u16| {
+            let v = f64::from(x) / 65535.0;
+            ((v * 1023.0).round() / 1023.0 - v).abs()
+        };
+        let e = r.position.iter().map(|&x| q(x)).fold(0.0, f64::max);
+        let e2 = |x: i16| f32::from(x) / 32767.0;
+        let now = oct_decode(Vec2::new(e2(r.normal[0]), e2(r.normal[1])));
+        let coarse = oct_encode(now).map(|x| (x.clamp(-1.0, 1.0) * 1023.0).round() / 1023.0);
+        // atan2(|a × b|, a · b) in f64: acos of an f32 dot product near 1 errs by 0.02°.
+        let (a, b) = (now.as_dvec3(), oct_decode(coarse).as_dvec3());
+        let angle = a.cross(b).length().atan2(a.dot(b)).to_degrees();
+        (pos_max, pos_sum, ang_max, ang_sum, count) =
+            (pos_max.max(e), pos_sum + e, ang_max.max(angle), ang_sum + angle, count + 1);
+    }
+    let n = count.max(1) as f64;
+    println!(
+        "      bytes per filled shaft: binary {:.2} ({:.2} zstd), PNMT {:.1} ({:.1} zstd), candidates {:.1} ({:.1} zstd); 12-byte PNMT records: position error max {:.2e} mean {:.2e} cells, normal max {:.3} mean {:.3} degrees",
+        binary as f64 / filled,
+        (zstd(bytemuck::cast_slice(&ls.bits))
+            + zstd(bytemuck::cast_slice(&ls.ranks))
+            + zstd(bytemuck::cast_slice(&ls.slots))) as f64
+            / filled,
+        records.len() as f64 / filled,
+        zstd(records) as f64 / filled,
+        (entries.len() + offsets.len()) as f64 / lc.header.filled.max(1) as f64,
+        (zstd(entries) + zstd(offsets)) as f64 / lc.header.filled.max(1) as f64,
+        pos_max,
+        pos_sum / n,
+        ang_max,
+        ang_sum / n,
+    );
 }
 
 fn main() {
@@ -136,6 +198,7 @@ fn main() {
                     + lc.ranks.len()
                     + lc.slots.len()) as u64),
         );
+        memory(&ls, &lc);
         let _ = row.thesis_voxel_ms;
         let t = Instant::now();
         let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);
@@ -158,9 +221,10 @@ fn main() {
             pct(bound.bytes.total(bc), with_cand),
         );
         println!(
-            "      tests {} ({:.2} per candidate entry), filled {} ({:.1}%), false fills {:.3}% (of 20,000 sampled), entries {}, PNMT records missing {}",
+            "      tests {} ({:.2} per candidate entry; the PNMT bake {}), filled {} ({:.1}%), false fills {:.3}% (of 20,000 sampled), entries {}, PNMT records missing {}",
             lc.tests,
             lc.tests as f64 / lc.header.entries.max(1) as f64,
+            ls.tests,
             ls.header.filled,
             100.0 * ls.header.filled as f64 / (ls.header.slots as f64 * 15.0 * (row.n as f64).powi(4)),
             100.0 * linespace::false_fill_rate(&attrs_of(&scene), &ls, 20_000),

@@ -329,11 +329,13 @@ struct Fills<'s> {
 }
 
 impl Fills<'_> {
+    #[inline(always)]
     fn filled(&self, shaft: u32) -> bool {
         self.bits[(shaft / 32) as usize] & (1 << (shaft % 32)) != 0
     }
 
     /// The midpoint segment of `shaft`, front patch centre to back.
+    #[inline(always)]
     fn segment(&self, shaft: u32, f: &Filler) -> (Vec3, Vec3) {
         let (_, pa, _, pb) = shaft_parts(shaft, self.n);
         (self.centres[f.faces.0 as usize][pa as usize], self.centres[f.faces.1 as usize][pb as usize])
@@ -342,6 +344,7 @@ impl Fills<'_> {
     /// Records that `f` fills `shaft`: its bit, its candidate entry, and the records' ends (the
     /// segment's nearest hits from either end; the fallback's key bounds). Strict comparisons
     /// keep the earliest triangle of the list on ties.
+    #[inline(always)]
     fn fill(&mut self, shaft: u32, f: &Filler) {
         let (word, bit) = ((shaft / 32) as usize, 1 << (shaft % 32));
         let first = self.bits[word] & bit == 0;
@@ -371,6 +374,7 @@ impl Fills<'_> {
     }
 
     /// Takes the hit `h` of triangle `t` where it is nearer either end than the shaft's.
+    #[inline(always)]
     fn take_hit(&mut self, shaft: u32, h: Intersection, t: u32) {
         let end = &mut self.ends[shaft as usize];
         if !(h.t >= end[0].t) {
@@ -384,6 +388,7 @@ impl Fills<'_> {
     /// Whether filling `shaft` by `f` could change anything [`fill`](Self::fill) keeps other
     /// than a segment hit: its bit (not yet filled), or, while its segment has no hit, the
     /// fallback's key bounds.
+    #[inline(always)]
     fn needs_test(&self, shaft: u32, f: &Filler) -> bool {
         if !self.filled(shaft) {
             return true;
@@ -397,6 +402,7 @@ impl Fills<'_> {
 
     /// The hit of the filled `shaft`'s midpoint segment on `f`'s triangle, where it is nearer
     /// either end than the shaft's.
+    #[inline(always)]
     fn better_hit(&self, shaft: u32, f: &Filler) -> Option<Intersection> {
         let (o, e) = self.segment(shaft, f);
         let h = f.seg.hit(o, e)?;
@@ -443,6 +449,12 @@ pub struct Scratch {
 const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
 
 const NO_END: End = End { t: f32::NAN, triangle: u32::MAX, u: 0.0, v: 0.0, key: f64::NAN, local: u32::MAX };
+
+/// The least number of triangles in a cell for which a bake without candidates keeps only the
+/// union. Measured on seed 004's table (16 threads, GPU machine's CPUs): the union bake took
+/// 0.79× and 0.85× the all-pairs time at 8³ (dragon, bunny: hundreds to thousands of triangles
+/// a cell) but 1.11–1.18× at 32³–72³ (a few to tens a cell).
+const UNION_MIN_TRIANGLES: usize = 64;
 
 /// Bakes one cell. `tris` are the cell's global triangle numbers, `local` their grid-local
 /// corners, `cell_min` the cell's grid-local minimum corner.
@@ -501,8 +513,10 @@ pub fn bake_cell(
         Fills { bits: &mut out.bits, ends, hits, centres: &centres, n, candidates, records_needed };
     // Without candidates, only the union of the triangles' shafts and the records are kept:
     // a window whose shafts are all filled already, and whose records this triangle cannot
-    // change by filling them, needs no exact test (see `Fills::needs_test`).
-    let union = !candidates;
+    // change by filling them, needs no exact test (see `Fills::needs_test`). That pays where
+    // many triangles share the cell's shafts; in sparse cells its bookkeeping costs more than
+    // the tests it saves.
+    let union = !candidates && tris.len() >= UNION_MIN_TRIANGLES;
     for (li, &t) in tris.iter().enumerate() {
         let v = local[t as usize].map(|p| p - cell_min);
         let prep = Prepared::new(v);
@@ -816,7 +830,7 @@ mod tests {
         for case in 0..60u32 {
             let n = 2 + case % 7;
             let margin = [1e-5, 1e-3][(case % 2) as usize];
-            let count = 1 + (case as usize * 7) % 40;
+            let count = UNION_MIN_TRIANGLES + (case as usize * 7) % 40;
             let size = [0.05, 0.3, 1.5][(case / 2 % 3) as usize];
             let mut tris: Vec<[DVec3; 3]> = (0..count)
                 .map(|_| {
