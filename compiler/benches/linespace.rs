@@ -58,6 +58,25 @@ fn attrs_of(scene: &Scene) -> SceneAttributes<'_> {
     }
 }
 
+/// A field of `/proc/self/status` in MiB (Linux; 0 elsewhere).
+fn status_mib(field: &str) -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix(field)?.trim().strip_suffix("kB")?.trim().parse::<f64>().ok())
+        .map_or(0.0, |kb| kb / 1024.0)
+}
+
+/// Bakes like [`bake`] and measures the resident memory the bake added at its peak, MiB: the
+/// kernel's high-water mark, reset before the bake (`clear_refs` 5), less the resident set
+/// before it.
+fn bake_measured(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64, f64) {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+    let before = status_mib("VmRSS:");
+    let (ls, ms) = bake(scene, res, n, variants);
+    (ls, ms, status_mib("VmHWM:") - before)
+}
+
 fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64) {
     let t = Instant::now();
     let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(scene);
@@ -165,12 +184,18 @@ fn main() {
         let mut voxel = Vec::new();
         let (mut pnmt_ms, mut cand_ms) = (Vec::new(), Vec::new());
         let mut last = None;
+        let mut peaks = (0.0f64, 0.0f64);
         for _ in 0..runs {
-            let (ls, ms) = bake(&scene, row.res, row.n, Variants::BINARY | Variants::PNMT);
+            // The previous run's results are dropped first, so that the peaks measure one bake.
+            drop(last.take());
+            let (ls, ms, peak_pnmt) =
+                bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::PNMT);
             voxel.push(ls.voxel_ms);
             pnmt_ms.push(ms - ls.voxel_ms);
-            let (lc, ms) = bake(&scene, row.res, row.n, Variants::BINARY | Variants::CANDIDATES);
+            let (lc, ms, peak_cand) =
+                bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::CANDIDATES);
             cand_ms.push(ms - lc.voxel_ms);
+            peaks = (peaks.0.max(peak_pnmt), peaks.1.max(peak_cand));
             last = Some((ls, lc));
         }
         let (ls, lc) = last.expect("runs >= 1");
@@ -199,6 +224,10 @@ fn main() {
                     + lc.slots.len()) as u64),
         );
         memory(&ls, &lc);
+        println!(
+            "      bake's peak resident memory above its start: PNMT {:.1} MiB, candidates {:.1} MiB",
+            peaks.0, peaks.1
+        );
         let _ = row.thesis_voxel_ms;
         let t = Instant::now();
         let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);

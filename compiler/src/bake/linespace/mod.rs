@@ -139,82 +139,72 @@ pub fn bake(
     header.slots = occupied.len() as u32;
     let margin_local = header.margin / header.cell;
     progress.count("line space: cells", occupied.len() as u64);
-    let per_cell: Vec<shafts::CellShafts> = occupied
-        .par_iter()
-        .map_init(shafts::Scratch::default, |scratch, &c| {
-            let cc = header.cell_coords(c);
-            let cell_min = DVec3::new(cc[0] as f64, cc[1] as f64, cc[2] as f64);
-            let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
-            let r = shafts::bake_cell(
-                tris,
-                &local,
-                cell_min,
-                header.cell_min(cc),
-                header.cell,
-                n,
-                margin_local,
-                candidates,
-                pnmt,
-                attrs,
-                shade,
-                scratch,
-            );
-            progress.inc(1);
-            r
-        })
-        .collect();
-    let words: usize = per_cell.iter().map(|c| c.bits.len()).sum();
-    out.bits.reserve_exact(words);
-    out.ranks.reserve_exact(words);
+    // Cells are baked a chunk at a time and each chunk's parts appended to the sections before
+    // the next: holding every cell's parts until the end doubled the bake's peak memory at the
+    // fine rows of seed 004's table (gigabytes of PNMT records).
     let mut rank = 0u64;
-    for cell in &per_cell {
-        out.tests += cell.tests;
-        for &w in &cell.bits {
-            out.ranks.push(u32::try_from(rank).map_err(|_| too_many())?);
-            rank += w.count_ones() as u64;
+    for chunk in occupied.chunks(CELLS_PER_CHUNK) {
+        let per_cell: Vec<shafts::CellShafts> = chunk
+            .par_iter()
+            .map_init(shafts::Scratch::default, |scratch, &c| {
+                let cc = header.cell_coords(c);
+                let cell_min = DVec3::new(cc[0] as f64, cc[1] as f64, cc[2] as f64);
+                let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
+                let r = shafts::bake_cell(
+                    tris,
+                    &local,
+                    cell_min,
+                    header.cell_min(cc),
+                    header.cell,
+                    n,
+                    margin_local,
+                    candidates,
+                    pnmt,
+                    attrs,
+                    shade,
+                    scratch,
+                );
+                progress.inc(1);
+                r
+            })
+            .collect();
+        for cell in &per_cell {
+            out.tests += cell.tests;
+            for &w in &cell.bits {
+                out.ranks.push(u32::try_from(rank).map_err(|_| too_many())?);
+                rank += w.count_ones() as u64;
+            }
+            out.bits.extend_from_slice(&cell.bits);
         }
-        out.bits.extend_from_slice(&cell.bits);
+        if candidates {
+            let mut base = out.candidates.len() as u64;
+            let mut bases = Vec::with_capacity(per_cell.len());
+            for c in &per_cell {
+                bases.push(u32::try_from(base).map_err(|_| too_many())?);
+                base += c.entries.len() as u64;
+            }
+            u32::try_from(base).map_err(|_| too_many())?;
+            append_par(&mut out.candidates, &per_cell, |c| c.entries.iter().copied());
+            if out.candidate_offsets.is_empty() {
+                out.candidate_offsets.push(0);
+            }
+            let cells: Vec<(&shafts::CellShafts, u32)> = per_cell.iter().zip(bases).collect();
+            append_par(&mut out.candidate_offsets, &cells, |&(c, base)| {
+                c.list_ends.iter().map(move |e| base + e)
+            });
+        }
+        if pnmt {
+            append_par(&mut out.pnmt, &per_cell, |c| c.pnmt.as_flattened().iter().copied());
+            out.pnmt_missing += per_cell
+                .par_iter()
+                .map(|c| c.pnmt.iter().filter(|r| !r[0].is_some() || !r[1].is_some()).count() as u64)
+                .sum::<u64>();
+        }
+        if shade.is_some() {
+            append_par(&mut out.preillum, &per_cell, |c| c.preillum.iter().copied());
+        }
     }
     header.filled = rank;
-    // The per-cell parts are copied into place in parallel: at the fine rows of seed 004's table
-    // they are gigabytes, and one thread copying them (and taking their page faults) was a third
-    // of the bake on 16 cores.
-    if candidates {
-        let entries: usize = per_cell.iter().map(|c| c.entries.len()).sum();
-        u32::try_from(entries).map_err(|_| too_many())?;
-        out.candidates = concat_par(&per_cell, |c| c.entries.len(), |c, dst| dst.copy_from_slice(&c.entries));
-        let mut bases = Vec::with_capacity(per_cell.len());
-        let mut base = 0u32;
-        for c in &per_cell {
-            bases.push(base);
-            base += c.entries.len() as u32;
-        }
-        out.candidate_offsets = Vec::with_capacity(rank as usize + 1);
-        out.candidate_offsets.push(0);
-        let cells: Vec<(&shafts::CellShafts, u32)> = per_cell.iter().zip(bases).collect();
-        let offsets = concat_par(
-            &cells,
-            |c| c.0.list_ends.len(),
-            |(c, base), dst| {
-                for (d, &end) in dst.iter_mut().zip(&c.list_ends) {
-                    *d = base + end;
-                }
-            },
-        );
-        out.candidate_offsets.extend_from_slice(&offsets);
-    }
-    if pnmt {
-        out.pnmt =
-            concat_par(&per_cell, |c| 2 * c.pnmt.len(), |c, dst| dst.copy_from_slice(c.pnmt.as_flattened()));
-        out.pnmt_missing = per_cell
-            .par_iter()
-            .map(|c| c.pnmt.iter().filter(|r| !r[0].is_some() || !r[1].is_some()).count() as u64)
-            .sum();
-    }
-    if shade.is_some() {
-        out.preillum = concat_par(&per_cell, |c| c.preillum.len(), |c, dst| dst.copy_from_slice(&c.preillum));
-    }
-    drop(per_cell);
     header.entries = out.candidates.len() as u64;
     out.header = header;
     out.voxel_offsets = voxel_offsets;
@@ -274,29 +264,60 @@ pub fn false_fill_rate(attrs: &SceneAttributes, ls: &BakedLineSpace, samples: us
     false_fills as f64 / picked.len().max(1) as f64
 }
 
-/// The parts of `items` (`len` elements each, written by `fill`) one after another, each part
-/// written by its own task straight into its place. The vector starts as zeroed pages from the
-/// allocator, so that their first touch is spread over the tasks too.
-fn concat_par<I: Sync, T: bytemuck::Zeroable + Send>(
-    items: &[I],
-    len: impl Fn(&I) -> usize,
-    fill: impl Fn(&I, &mut [T]) + Sync,
-) -> Vec<T> {
-    let lens: Vec<usize> = items.iter().map(&len).collect();
-    let mut out: Vec<T> = bytemuck::zeroed_vec(lens.iter().sum());
+/// Cells baked between two appends to the sections (see [`bake`]).
+const CELLS_PER_CHUNK: usize = 1024;
+
+/// Appends the parts of `items` (the elements `part` yields for each) to `out`, each part
+/// written by its own task straight into its place in the vector's spare capacity, so that the
+/// copying and the first touch of fresh pages are spread over the threads (one thread copying
+/// the gigabytes of the fine rows was a third of the bake on 16 cores). Growing the vector moves
+/// pages, not bytes, where the allocator maps large blocks (glibc's `mremap`).
+fn append_par<'a, I: Sync, T: Copy + Send, P: ExactSizeIterator<Item = T>>(
+    out: &mut Vec<T>,
+    items: &'a [I],
+    part: impl Fn(&'a I) -> P + Sync,
+) {
+    let lens: Vec<usize> = items.iter().map(|i| part(i).len()).collect();
+    let total: usize = lens.iter().sum();
+    out.reserve(total);
     let mut parts = Vec::with_capacity(items.len());
-    let mut rest = &mut out[..];
+    let mut rest = &mut out.spare_capacity_mut()[..total];
     for &n in &lens {
-        let (part, tail) = rest.split_at_mut(n);
-        parts.push(part);
+        let (p, tail) = rest.split_at_mut(n);
+        parts.push(p);
         rest = tail;
     }
-    parts.into_par_iter().zip(items.par_iter()).for_each(|(part, item)| fill(item, part));
-    out
+    parts.into_par_iter().zip(items.par_iter()).for_each(|(dst, item)| {
+        let src = part(item);
+        assert_eq!(src.len(), dst.len(), "a part changed its length");
+        for (d, v) in dst.iter_mut().zip(src) {
+            d.write(v);
+        }
+    });
+    // SAFETY: the `total` elements after the length were each written above (every part's
+    // iterator has exactly its slot's length, asserted).
+    unsafe { out.set_len(out.len() + total) };
 }
 
 fn too_many() -> CliError {
     CliError::input(
         "the line space has more than 2^32 filled shafts or candidate entries; lower --voxel-res or --shaft-res",
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::append_par;
+
+    /// Parts appended chunk after chunk, in parallel, against the standard library's concat.
+    #[test]
+    fn appending_in_parallel_concatenates() {
+        let parts: Vec<Vec<u32>> =
+            (0..300u32).map(|i| (0..(i * 37) % 101).map(|k| i * 1000 + k).collect()).collect();
+        let mut out = Vec::new();
+        for chunk in parts.chunks(7) {
+            append_par(&mut out, chunk, |p| p.iter().copied());
+        }
+        assert_eq!(out, parts.concat());
+    }
 }
