@@ -6,7 +6,7 @@
 use glam::Vec3;
 use kiln_compiler::raycheck::{Rng, check_line_space};
 use kiln_compiler::settings::{Settings, VoxelRes};
-use kiln_format::linespace::{LineSpace, Variants};
+use kiln_format::linespace::{LineSpace, PnmtRecord, Variants};
 use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile, SceneView, sections};
 use kiln_tests::shapes::{height_grid, soup};
 use kiln_tests::{compile, scene_of};
@@ -186,4 +186,96 @@ fn damaged_line_space_sections_are_refused() {
     w.raw(sections::PNMT, 0, 1, vec![0u8; 32], ContentHash::default()).unwrap();
     let msg = refused(&w.to_bytes().unwrap());
     assert!(msg.contains("PNMT"), "{msg}");
+}
+
+/// The grid sections of a compile of `tris` with `variants`: (bits, ranks, PNMT records).
+fn shafts_of(tris: &[[Vec3; 3]], res: u32, n: u32, variants: u32) -> (Vec<u32>, Vec<u32>, Vec<PnmtRecord>) {
+    let bytes = compile(scene_of(tris), Settings { shaft_variants: Some(variants), ..settings(res, n) });
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().unwrap();
+    let c = check_line_space(&view, &ls, 2000, 9);
+    assert_eq!(c.binary.false_misses, 0, "{:?}", c.binary.examples);
+    (ls.bits.to_vec(), ls.ranks.to_vec(), ls.pnmt.to_vec())
+}
+
+/// Without candidates, cells of many triangles keep only the union of their shafts and skip
+/// the exact tests that cannot change it: the bits and records must be those of the bake with
+/// candidates, which tests every triangle against every shaft it may reach. Dense soups (a few
+/// hundred triangles a cell), near the origin and far from it.
+#[test]
+fn pnmt_without_candidates_equals_pnmt_with_them() {
+    for offset in [Vec3::ZERO, Vec3::new(3e4, -2e4, 1e4)] {
+        let tris: Vec<[Vec3; 3]> =
+            soup(&mut Rng::new(17), 700, 0.4).iter().map(|t| t.map(|p| p + offset)).collect();
+        for (res, n) in [(2, 4), (3, 3)] {
+            let alone = shafts_of(&tris, res, n, Variants::BINARY | Variants::PNMT);
+            let with = shafts_of(&tris, res, n, Variants::BINARY | Variants::CANDIDATES | Variants::PNMT);
+            assert!(alone == with, "offset {offset}, {res} cells, N {n}: the two bakes differ");
+        }
+    }
+}
+
+/// A grid of thousands of occupied cells, which the bake lays out a chunk of cells at a time:
+/// every PNMT record must lie on a triangle of its own cell's list (within the margin by which
+/// a fallback point is clamped and the records' quantisation), which a record placed in
+/// another cell's run breaks; the candidates' exactness checks their offsets.
+#[test]
+fn records_lie_on_their_cells_triangles_across_chunks() {
+    let tris = height_grid(40, 0.3, &mut Rng::new(23));
+    let bytes = compile(scene_of(&tris), settings(72, 2));
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().unwrap();
+    let h = ls.header;
+    let occupied = ls.slots.iter().filter(|&&s| s != u32::MAX).count();
+    assert!(occupied > 3000, "{occupied} occupied cells: too few for several chunks");
+    let c = check_line_space(&view, &ls, 1000, 4);
+    assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
+    let corner = |t: u32, k: usize| {
+        let p = view.vertices[view.triangles[t as usize][k] as usize].position;
+        glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+    };
+    let tolerance = 2.0 * h.margin + 1e-4 * h.cell;
+    let mut rank = 0usize;
+    for (cell, &slot) in ls.slots.iter().enumerate() {
+        if slot == u32::MAX {
+            continue;
+        }
+        let filled: u32 = ls.bits[slot as usize * ls.words_per_slot..][..ls.words_per_slot]
+            .iter()
+            .map(|w| w.count_ones())
+            .sum();
+        let cell_min = h.cell_min(h.cell_coords(cell));
+        for r in rank..rank + filled as usize {
+            for record in &ls.pnmt[2 * r..2 * r + 2] {
+                let Some(hit) = record.decode(cell_min, h.cell) else { continue };
+                let nearest = ls
+                    .cell_triangles(cell)
+                    .iter()
+                    .map(|&t| distance_to_triangle(hit.position, [corner(t, 0), corner(t, 1), corner(t, 2)]))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(nearest <= tolerance, "cell {cell}, filled shaft {r}: {nearest} from its triangles");
+            }
+        }
+        rank += filled as usize;
+    }
+    assert_eq!(rank as u64, h.filled);
+}
+
+/// Distance from `p` to the triangle `t`: to its plane where the projection falls inside,
+/// else to the nearest edge.
+fn distance_to_triangle(p: glam::DVec3, t: [glam::DVec3; 3]) -> f64 {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    let inside = (0..3).all(|k| (t[(k + 1) % 3] - t[k]).cross(p - t[k]).dot(n) >= 0.0);
+    if inside && n.length_squared() > 0.0 {
+        return (p - t[0]).dot(n).abs() / n.length();
+    }
+    (0..3)
+        .map(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let s = ((p - a).dot(b - a) / (b - a).length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+            (p - (a + (b - a) * s)).length()
+        })
+        .fold(f64::INFINITY, f64::min)
 }

@@ -6,6 +6,9 @@
 //! `cargo bench -p kiln-compiler --bench linespace [-- ROWS]` (ROWS: comma-separated row numbers,
 //! default all; KILN_BENCH_RUNS: runs per row, default 3).
 
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::AtomicUsize;
+use std::sync::atomic::Ordering::Relaxed;
 use std::time::Instant;
 
 use glam::Vec2;
@@ -58,23 +61,61 @@ fn attrs_of(scene: &Scene) -> SceneAttributes<'_> {
     }
 }
 
-/// A field of `/proc/self/status` in MiB (Linux; 0 elsewhere).
-fn status_mib(field: &str) -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix(field)?.trim().strip_suffix("kB")?.trim().parse::<f64>().ok())
-        .map_or(0.0, |kb| kb / 1024.0)
+/// The system allocator, counting the bytes held and their high-water mark, so that a bake's
+/// peak is measured in bytes it holds (the resident set would miss memory the allocator kept
+/// from an earlier bake and hands out again).
+struct Counting;
+
+static HELD: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: every call forwards to the system allocator with the caller's layout; the counters
+// only observe.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: the caller's contract is forwarded.
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            PEAK.fetch_max(HELD.fetch_add(layout.size(), Relaxed) + layout.size(), Relaxed);
+        }
+        p
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: as above.
+        let p = unsafe { System.alloc_zeroed(layout) };
+        if !p.is_null() {
+            PEAK.fetch_max(HELD.fetch_add(layout.size(), Relaxed) + layout.size(), Relaxed);
+        }
+        p
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) };
+        HELD.fetch_sub(layout.size(), Relaxed);
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        // SAFETY: as above.
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
+        if !p.is_null() && new_size >= layout.size() {
+            let grown = new_size - layout.size();
+            PEAK.fetch_max(HELD.fetch_add(grown, Relaxed) + grown, Relaxed);
+        } else if !p.is_null() {
+            HELD.fetch_sub(layout.size() - new_size, Relaxed);
+        }
+        p
+    }
 }
 
-/// Bakes like [`bake`] and measures the resident memory the bake added at its peak, MiB: the
-/// kernel's high-water mark, reset before the bake (`clear_refs` 5), less the resident set
-/// before it.
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Bakes like [`bake`] and measures the most memory the bake held at once beyond what was held
+/// before it, MiB.
 fn bake_measured(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64, f64) {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-    let before = status_mib("VmRSS:");
+    let before = HELD.load(Relaxed);
+    PEAK.store(before, Relaxed);
     let (ls, ms) = bake(scene, res, n, variants);
-    (ls, ms, status_mib("VmHWM:") - before)
+    (ls, ms, mib((PEAK.load(Relaxed) - before) as u64))
 }
 
 fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64) {
@@ -225,7 +266,7 @@ fn main() {
         );
         memory(&ls, &lc);
         println!(
-            "      bake's peak resident memory above its start: PNMT {:.1} MiB, candidates {:.1} MiB",
+            "      bake's peak memory (bytes held beyond those before it): PNMT {:.1} MiB, candidates {:.1} MiB",
             peaks.0, peaks.1
         );
         let _ = row.thesis_voxel_ms;

@@ -143,7 +143,10 @@ pub fn bake(
     // the next: holding every cell's parts until the end doubled the bake's peak memory at the
     // fine rows of seed 004's table (gigabytes of PNMT records).
     let mut rank = 0u64;
+    let mut cells_done = 0usize;
     for chunk in occupied.chunks(CELLS_PER_CHUNK) {
+        cells_done += chunk.len();
+        let done = cells_done as f64 / occupied.len() as f64;
         let per_cell: Vec<shafts::CellShafts> = chunk
             .par_iter()
             .map_init(shafts::Scratch::default, |scratch, &c| {
@@ -184,27 +187,29 @@ pub fn bake(
                 base += c.entries.len() as u64;
             }
             u32::try_from(base).map_err(|_| too_many())?;
-            append_par(&mut out.candidates, &per_cell, |c| c.entries.iter().copied());
+            append_par(&mut out.candidates, &per_cell, |c| c.entries.iter().copied(), done);
             if out.candidate_offsets.is_empty() {
                 out.candidate_offsets.push(0);
             }
             let cells: Vec<(&shafts::CellShafts, u32)> = per_cell.iter().zip(bases).collect();
-            append_par(&mut out.candidate_offsets, &cells, |&(c, base)| {
-                c.list_ends.iter().map(move |e| base + e)
-            });
+            append_par(&mut out.candidate_offsets, &cells, list_ends, done);
         }
         if pnmt {
-            append_par(&mut out.pnmt, &per_cell, |c| c.pnmt.as_flattened().iter().copied());
+            append_par(&mut out.pnmt, &per_cell, |c| c.pnmt.as_flattened().iter().copied(), done);
             out.pnmt_missing += per_cell
                 .par_iter()
                 .map(|c| c.pnmt.iter().filter(|r| !r[0].is_some() || !r[1].is_some()).count() as u64)
                 .sum::<u64>();
         }
         if shade.is_some() {
-            append_par(&mut out.preillum, &per_cell, |c| c.preillum.iter().copied());
+            append_par(&mut out.preillum, &per_cell, |c| c.preillum.iter().copied(), done);
         }
     }
     header.filled = rank;
+    out.candidates.shrink_to_fit();
+    out.candidate_offsets.shrink_to_fit();
+    out.pnmt.shrink_to_fit();
+    out.preillum.shrink_to_fit();
     header.entries = out.candidates.len() as u64;
     out.header = header;
     out.voxel_offsets = voxel_offsets;
@@ -264,10 +269,18 @@ pub fn false_fill_rate(attrs: &SceneAttributes, ls: &BakedLineSpace, samples: us
     false_fills as f64 / picked.len().max(1) as f64
 }
 
+/// A cell's candidate list ends, offset by where its entries start.
+fn list_ends<'a>(
+    &(cell, base): &'a (&'a shafts::CellShafts, u32),
+) -> impl ExactSizeIterator<Item = u32> + 'a {
+    cell.list_ends.iter().map(move |e| base + e)
+}
+
 /// Cells baked between two appends to the sections (see [`bake`]).
 const CELLS_PER_CHUNK: usize = 1024;
 
-/// Appends the parts of `items` (the elements `part` yields for each) to `out`, each part
+/// Appends the parts of `items` (the elements `part` yields for each) to `out`, `done` the
+/// fraction of all the parts that `out` will hold once these are appended; each part
 /// written by its own task straight into its place in the vector's spare capacity, so that the
 /// copying and the first touch of fresh pages are spread over the threads (one thread copying
 /// the gigabytes of the fine rows was a third of the bake on 16 cores). Growing the vector moves
@@ -276,10 +289,17 @@ fn append_par<'a, I: Sync, T: Copy + Send, P: ExactSizeIterator<Item = T>>(
     out: &mut Vec<T>,
     items: &'a [I],
     part: impl Fn(&'a I) -> P + Sync,
+    done: f64,
 ) {
     let lens: Vec<usize> = items.iter().map(|i| part(i).len()).collect();
     let total: usize = lens.iter().sum();
-    out.reserve(total);
+    let needed = out.len() + total;
+    if out.capacity() < needed {
+        // Grown to what the parts so far extrapolate to (plus 5 %), not to twice the length as
+        // `reserve` would: the vector is most of the bake's peak memory.
+        let expected = (needed as f64 / done.clamp(1e-6, 1.0) * 1.05) as usize;
+        out.reserve_exact(expected.max(needed) - out.len());
+    }
     let mut parts = Vec::with_capacity(items.len());
     let mut rest = &mut out.spare_capacity_mut()[..total];
     for &n in &lens {
@@ -316,7 +336,7 @@ mod tests {
             (0..300u32).map(|i| (0..(i * 37) % 101).map(|k| i * 1000 + k).collect()).collect();
         let mut out = Vec::new();
         for chunk in parts.chunks(7) {
-            append_par(&mut out, chunk, |p| p.iter().copied());
+            append_par(&mut out, chunk, |p| p.iter().copied(), 0.5);
         }
         assert_eq!(out, parts.concat());
     }
