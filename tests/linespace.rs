@@ -188,15 +188,22 @@ fn damaged_line_space_sections_are_refused() {
     assert!(msg.contains("PNMT"), "{msg}");
 }
 
+/// Calls `f` with the scene and line space of a compiled file.
+fn with_line_space<R>(bytes: &[u8], f: impl FnOnce(&SceneView, &LineSpace) -> R) -> R {
+    let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().unwrap();
+    f(&view, &ls)
+}
+
 /// The grid sections of a compile of `tris` with `variants`: (bits, ranks, PNMT records).
 fn shafts_of(tris: &[[Vec3; 3]], res: u32, n: u32, variants: u32) -> (Vec<u32>, Vec<u32>, Vec<PnmtRecord>) {
     let bytes = compile(scene_of(tris), Settings { shaft_variants: Some(variants), ..settings(res, n) });
-    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
-    let view = SceneView::new(&file).unwrap();
-    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().unwrap();
-    let c = check_line_space(&view, &ls, 2000, 9);
-    assert_eq!(c.binary.false_misses, 0, "{:?}", c.binary.examples);
-    (ls.bits.to_vec(), ls.ranks.to_vec(), ls.pnmt.to_vec())
+    with_line_space(&bytes, |view, ls| {
+        let c = check_line_space(view, ls, 2000, 9);
+        assert_eq!(c.binary.false_misses, 0, "{:?}", c.binary.examples);
+        (ls.bits.to_vec(), ls.ranks.to_vec(), ls.pnmt.to_vec())
+    })
 }
 
 /// Without candidates, cells of many triangles keep only the union of their shafts and skip
@@ -224,13 +231,15 @@ fn pnmt_without_candidates_equals_pnmt_with_them() {
 fn records_lie_on_their_cells_triangles_across_chunks() {
     let tris = height_grid(40, 0.3, &mut Rng::new(23));
     let bytes = compile(scene_of(&tris), settings(72, 2));
-    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
-    let view = SceneView::new(&file).unwrap();
-    let ls = LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().unwrap();
+    with_line_space(&bytes, records_lie_on_their_cells_triangles);
+}
+
+/// The check of [`records_lie_on_their_cells_triangles_across_chunks`] on one file.
+fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
     let h = ls.header;
     let occupied = ls.slots.iter().filter(|&&s| s != u32::MAX).count();
     assert!(occupied > 3000, "{occupied} occupied cells: too few for several chunks");
-    let c = check_line_space(&view, &ls, 1000, 4);
+    let c = check_line_space(view, ls, 1000, 4);
     assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
     let corner = |t: u32, k: usize| {
         let p = view.vertices[view.triangles[t as usize][k] as usize].position;

@@ -69,6 +69,11 @@ struct Counting;
 static HELD: AtomicUsize = AtomicUsize::new(0);
 static PEAK: AtomicUsize = AtomicUsize::new(0);
 
+/// Counts `bytes` more held, raising the high-water mark.
+fn grow(bytes: usize) {
+    PEAK.fetch_max(HELD.fetch_add(bytes, Relaxed) + bytes, Relaxed);
+}
+
 // SAFETY: every call forwards to the system allocator with the caller's layout; the counters
 // only observe.
 unsafe impl GlobalAlloc for Counting {
@@ -76,7 +81,7 @@ unsafe impl GlobalAlloc for Counting {
         // SAFETY: the caller's contract is forwarded.
         let p = unsafe { System.alloc(layout) };
         if !p.is_null() {
-            PEAK.fetch_max(HELD.fetch_add(layout.size(), Relaxed) + layout.size(), Relaxed);
+            grow(layout.size());
         }
         p
     }
@@ -84,7 +89,7 @@ unsafe impl GlobalAlloc for Counting {
         // SAFETY: as above.
         let p = unsafe { System.alloc_zeroed(layout) };
         if !p.is_null() {
-            PEAK.fetch_max(HELD.fetch_add(layout.size(), Relaxed) + layout.size(), Relaxed);
+            grow(layout.size());
         }
         p
     }
@@ -97,8 +102,7 @@ unsafe impl GlobalAlloc for Counting {
         // SAFETY: as above.
         let p = unsafe { System.realloc(ptr, layout, new_size) };
         if !p.is_null() && new_size >= layout.size() {
-            let grown = new_size - layout.size();
-            PEAK.fetch_max(HELD.fetch_add(grown, Relaxed) + grown, Relaxed);
+            grow(new_size - layout.size());
         } else if !p.is_null() {
             HELD.fetch_sub(layout.size() - new_size, Relaxed);
         }

@@ -289,15 +289,36 @@ fn search(
     tests: &mut u64,
     found: &mut impl FnMut(u32),
 ) {
-    windows(tri, poly, pair, n, margin, &mut |pa, q, axes| {
-        let mut mask = axes.shafts_from(pa / n, pa % n, q);
-        *tests += ((q[1] - q[0]) * (q[3] - q[2])) as u64;
-        while mask != 0 {
+    windows(tri, poly, pair, n, margin, &mut |pa, q, axes| decide(axes, pair, pa, q, n, tests, found));
+}
+
+/// Decides the shafts of pair `pair` from patch `pa` to the patches `rect` on face b by one
+/// many-shaft test (counted in `tests`), and calls `found(shaft)` for each the triangle meets.
+fn decide(
+    axes: &PairAxes,
+    pair: u32,
+    pa: u32,
+    rect: [u32; 4],
+    n: u32,
+    tests: &mut u64,
+    found: &mut impl FnMut(u32),
+) {
+    *tests += ((rect[1] - rect[0]) * (rect[3] - rect[2])) as u64;
+    for k in set_bits(axes.shafts_from(pa / n, pa % n, rect)) {
+        found(window_shaft(pair, pa, rect, k, n));
+    }
+}
+
+/// The set bits of `mask`, lowest first.
+#[inline(always)]
+fn set_bits(mut mask: u64) -> impl Iterator<Item = u32> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
             let k = mask.trailing_zeros();
             mask &= mask - 1;
-            found(window_shaft(pair, pa, q, k, n));
-        }
-    });
+            k
+        })
+    })
 }
 
 /// A triangle of the cell as it fills the shafts of one face pair.
@@ -561,13 +582,7 @@ pub fn bake_cell(
                     }
                 }
                 if sub[0] < sub[1] {
-                    let mut mask = axes.shafts_from(pa / n, pa % n, sub);
-                    out.tests += ((sub[1] - sub[0]) * (sub[3] - sub[2])) as u64;
-                    while mask != 0 {
-                        let k = mask.trailing_zeros();
-                        mask &= mask - 1;
-                        state.fill(window_shaft(pair, pa, sub, k, n), &filler);
-                    }
+                    decide(axes, pair, pa, sub, n, &mut out.tests, &mut |shaft| state.fill(shaft, &filler));
                 }
                 if !records_needed {
                     return;
@@ -631,16 +646,11 @@ pub fn bake_cell(
         if shade.is_some() {
             out.preillum.reserve_exact(count);
         }
-        let filled = out.bits.iter().enumerate().flat_map(|(w, &word)| {
-            let mut word = word;
-            std::iter::from_fn(move || {
-                (word != 0).then(|| {
-                    let bit = word.trailing_zeros() as usize;
-                    word &= word - 1;
-                    w * 32 + bit
-                })
-            })
-        });
+        let filled = out
+            .bits
+            .iter()
+            .enumerate()
+            .flat_map(|(w, &word)| set_bits(word.into()).map(move |b| w * 32 + b as usize));
         for shaft in filled {
             let end = &ends[shaft];
             let pair = shaft as u32 / (n * n * n * n);
