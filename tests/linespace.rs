@@ -288,3 +288,192 @@ fn distance_to_triangle(p: glam::DVec3, t: [glam::DVec3; 3]) -> f64 {
         })
         .fold(f64::INFINITY, f64::min)
 }
+
+/// Every PNMT record against its shaft's own midpoint segment and candidate list (whose
+/// exactness `check_line_space` checks): where the segment clearly crosses listed triangles,
+/// the front (back) record is the crossing nearest the front (back) patch; where it clearly
+/// misses them all, the record is the listed triangles' point (clipped to the widened cell)
+/// reaching furthest towards that end along the pair's key. Shafts within rounding of either
+/// case are skipped; both cases must be checked hundreds of times.
+#[test]
+fn records_are_nearest_segment_crossings_or_the_furthest_reaching_points() {
+    let tris = soup(&mut Rng::new(41), 40, 0.7);
+    let bytes = compile(scene_of(&tris), settings(3, 3));
+    let (hits, fallbacks) = with_line_space(&bytes, |view, ls| {
+        let c = check_line_space(view, ls, 2000, 5);
+        assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
+        check_records(view, ls)
+    });
+    assert!(hits > 500 && fallbacks > 500, "{hits} crossings and {fallbacks} fallbacks checked: too few");
+}
+
+/// The check of [`records_are_nearest_segment_crossings_or_the_furthest_reaching_points`]:
+/// (records checked as crossings, records checked as fallbacks).
+fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
+    use glam::DVec3;
+    let h = ls.header;
+    let n = h.shaft_res;
+    let m = h.margin / h.cell;
+    let corner = |t: u32, k: usize| {
+        let p = view.vertices[view.triangles[t as usize][k] as usize].position;
+        DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+    };
+    // Cell-local point of a face's patch centre.
+    let centre = |face: u32, patch: u32| {
+        let mut p = DVec3::ZERO;
+        p[(face / 2) as usize] = (face % 2) as f64;
+        let (ua, va) = if face < 2 {
+            (1, 2)
+        } else if face < 4 {
+            (0, 2)
+        } else {
+            (0, 1)
+        };
+        p[ua] = ((patch / n) as f64 + 0.5) / n as f64;
+        p[va] = ((patch % n) as f64 + 0.5) / n as f64;
+        p
+    };
+    let outward = |face: u32| {
+        let mut d = DVec3::ZERO;
+        d[(face / 2) as usize] = if face.is_multiple_of(2) { -1.0 } else { 1.0 };
+        d
+    };
+    let (mut hits, mut fallbacks) = (0u64, 0u64);
+    for (cell, &slot) in ls.slots.iter().enumerate() {
+        if slot == u32::MAX {
+            continue;
+        }
+        let cell_min = h.cell_min(h.cell_coords(cell));
+        let local = |p: DVec3| (p - cell_min) / h.cell;
+        let list = ls.cell_triangles(cell);
+        for shaft in 0..15 * n.pow(4) {
+            let Some(rank) = ls.rank(slot, shaft) else { continue };
+            let n2 = n * n;
+            let pair = shaft / (n2 * n2);
+            let (fa, fb) =
+                (0..6u32).flat_map(|a| (a + 1..6).map(move |b| (a, b))).nth(pair as usize).unwrap();
+            let (pa, pb) = ((shaft % (n2 * n2)) / n2, shaft % n2);
+            let (o, e) = (centre(fa, pa), centre(fb, pb));
+            let w = outward(fb) - outward(fa);
+            let listed: Vec<[DVec3; 3]> = ls
+                .entries(rank)
+                .iter()
+                .map(|&en| {
+                    let t = list[kiln_format::linespace::entry::local(en) as usize];
+                    [0, 1, 2].map(|k| local(corner(t, k)))
+                })
+                .collect();
+            let crossings: Vec<Option<f64>> = listed.iter().map(|&t| crossing(o, e, t)).collect();
+            let records = [&ls.pnmt[2 * rank], &ls.pnmt[2 * rank + 1]];
+            let decoded = records.map(|r| r.decode(cell_min, h.cell).map(|x| local(x.position)));
+            if crossings.iter().all(|c| c.is_some_and(|t| t.is_finite())) && !crossings.is_empty() {
+                // Every listed triangle clearly crossed or clearly missed.
+                let ts: Vec<f64> = crossings.iter().filter_map(|c| c.filter(|t| *t >= 0.0)).collect();
+                if ts.is_empty() {
+                    // Clearly missed by all: the fallback.
+                    let keys = listed.iter().filter_map(|&t| {
+                        let poly = clip_to_cube(t, m);
+                        let k = poly.iter().map(|p| p.dot(w));
+                        (!poly.is_empty()).then(|| {
+                            (k.clone().fold(f64::INFINITY, f64::min), k.fold(f64::NEG_INFINITY, f64::max))
+                        })
+                    });
+                    let (lo, hi) =
+                        keys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (x, y)| (a.min(x), b.max(y)));
+                    let tolerance = 2.0 * m + 1e-3;
+                    let (Some(front), Some(back)) = (decoded[0], decoded[1]) else {
+                        panic!("cell {cell} shaft {shaft}: a fallback record is missing")
+                    };
+                    assert!(
+                        (front.dot(w) - lo).abs() <= tolerance,
+                        "cell {cell} shaft {shaft}: front key {} not {lo}",
+                        front.dot(w)
+                    );
+                    assert!(
+                        (back.dot(w) - hi).abs() <= tolerance,
+                        "cell {cell} shaft {shaft}: back key {} not {hi}",
+                        back.dot(w)
+                    );
+                    fallbacks += 2;
+                } else {
+                    let mut sorted = ts.clone();
+                    sorted.sort_by(f64::total_cmp);
+                    let distinct = |a: f64, b: f64| (a - b).abs() > 0.01;
+                    let (first, last) = (sorted[0], sorted[sorted.len() - 1]);
+                    let ends = [
+                        (first, sorted.get(1).is_none_or(|&t| distinct(t, first))),
+                        (last, sorted.len() < 2 || distinct(sorted[sorted.len() - 2], last)),
+                    ];
+                    for (k, (t, clear)) in ends.into_iter().enumerate() {
+                        if !clear {
+                            continue;
+                        }
+                        let want = o + (e - o) * t;
+                        let got = decoded[k]
+                            .unwrap_or_else(|| panic!("cell {cell} shaft {shaft}: record {k} missing"));
+                        assert!(
+                            (got - want).length() <= 1e-3,
+                            "cell {cell} shaft {shaft} end {k}: {got} not {want}"
+                        );
+                        hits += 1;
+                    }
+                }
+            }
+        }
+    }
+    (hits, fallbacks)
+}
+
+/// Where the segment o → e crosses the triangle t: `Some(t ∈ [0, 1])` clearly inside, `Some(−1)`
+/// clearly outside, `Some(NaN)` (or `None` for a degenerate triangle) within 1e-6 of either.
+fn crossing(o: glam::DVec3, e: glam::DVec3, t: [glam::DVec3; 3]) -> Option<f64> {
+    const NEAR: f64 = 1e-6;
+    let d = e - o;
+    let nrm = (t[1] - t[0]).cross(t[2] - t[0]);
+    let len = nrm.length();
+    if len < 1e-9 {
+        return None;
+    }
+    let denom = nrm.dot(d);
+    if denom.abs() < 1e-9 * len {
+        // Parallel to the plane: clearly outside unless within reach of it.
+        let dist = nrm.dot(o - t[0]).abs() / len;
+        return Some(if dist > NEAR { -1.0 } else { f64::NAN });
+    }
+    let s = nrm.dot(t[0] - o) / denom;
+    let p = o + d * s;
+    // Signed distances of p from the edges, within the plane.
+    let edge = (0..3)
+        .map(|k| (t[(k + 1) % 3] - t[k]).cross(p - t[k]).dot(nrm) / (len * (t[(k + 1) % 3] - t[k]).length()))
+        .fold(f64::INFINITY, f64::min);
+    let reach = NEAR * d.length() / (denom.abs() / len);
+    if !(-NEAR..=1.0 + NEAR).contains(&s) || edge < -reach - NEAR {
+        return Some(-1.0);
+    }
+    if !(NEAR..=1.0 - NEAR).contains(&s) || edge < reach + NEAR {
+        return Some(f64::NAN);
+    }
+    Some(s)
+}
+
+/// The triangle t clipped to the cube [−m, 1 + m]³ (Sutherland–Hodgman, one plane at a time).
+fn clip_to_cube(t: [glam::DVec3; 3], m: f64) -> Vec<glam::DVec3> {
+    let mut poly = t.to_vec();
+    for axis in 0..3 {
+        for (bound, keep_below) in [(-m, false), (1.0 + m, true)] {
+            let inside = |p: &glam::DVec3| if keep_below { p[axis] <= bound } else { p[axis] >= bound };
+            let mut out = Vec::new();
+            for (i, &p) in poly.iter().enumerate() {
+                let q = poly[(i + 1) % poly.len()];
+                if inside(&p) {
+                    out.push(p);
+                }
+                if inside(&p) != inside(&q) {
+                    out.push(p + (q - p) * ((bound - p[axis]) / (q[axis] - p[axis])));
+                }
+            }
+            poly = out;
+        }
+    }
+    poly
+}

@@ -464,7 +464,13 @@ pub struct Scratch {
     ends: Vec<[End; 2]>,
     polys: Vec<Vec<DVec3>>,
     clip_tmp: Vec<DVec3>,
+    /// The cell's fallback records by (triangle, pair, end), [`UNMADE`] until made.
+    fallbacks: Vec<PnmtRecord>,
 }
+
+/// A fallback record not made yet (no record the encoder makes: its material is the absent
+/// record's, its position is not).
+const UNMADE: PnmtRecord = PnmtRecord { position: [u16::MAX; 3], ..PnmtRecord::NONE };
 
 /// Patches per face at the largest shaft resolution.
 const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
@@ -485,7 +491,7 @@ const UNION_MIN_TRIANGLES: usize = 64;
 /// (bucketed by shaft, then ordered by key); and the nearest hits of its midpoint segment from
 /// either end (the PNMT records). No per-shaft list is needed for PNMT.
 #[allow(clippy::too_many_arguments)]
-pub fn bake_cell(
+pub fn bake_cell<A: HitAttributes + ?Sized>(
     tris: &[u32],
     local: &[[DVec3; 3]],
     cell_min: DVec3,
@@ -495,14 +501,14 @@ pub fn bake_cell(
     margin: f64,
     candidates: bool,
     pnmt: bool,
-    attrs: &dyn HitAttributes,
+    attrs: &A,
     shade: Option<&Shade<'_>>,
     scratch: &mut Scratch,
 ) -> CellShafts {
     let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
-    let Scratch { hits, sorted, counts, ends, polys, clip_tmp } = scratch;
+    let Scratch { hits, sorted, counts, ends, polys, clip_tmp, fallbacks } = scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
     // A shaft's ends are reset when it is first filled (resetting every shaft of every cell costs
@@ -646,6 +652,8 @@ pub fn bake_cell(
         if shade.is_some() {
             out.preillum.reserve_exact(count);
         }
+        fallbacks.clear();
+        fallbacks.resize(tris.len() * 2 * FACE_PAIRS as usize, UNMADE);
         let filled = out
             .bits
             .iter()
@@ -656,7 +664,7 @@ pub fn bake_cell(
             let pair = shaft as u32 / (n * n * n * n);
             let (fa, fb) = pair_faces(pair);
             let w = outward(fb) - outward(fa);
-            let record = |e: &End, front: bool| -> PnmtRecord {
+            let record = |e: &End, side: usize, fallbacks: &mut Vec<PnmtRecord>| -> PnmtRecord {
                 if e.t.is_finite() {
                     let [a, b, c] = attrs.corners(e.triangle);
                     let p = (a * (1.0 - e.u - e.v) + b * e.u + c * e.v).as_dvec3();
@@ -670,26 +678,33 @@ pub fn bake_cell(
                     );
                 }
                 // The midpoint segment missed: the triangle reaching furthest towards this end,
-                // at its clipped vertex nearest that end.
+                // at its clipped vertex nearest that end. That depends on the triangle, the pair
+                // and the end alone, so it is made once per cell (a third of the records of
+                // seed 004's scenes are fallbacks).
                 let Some(poly) = polys.get(e.local as usize) else { return PnmtRecord::NONE };
+                let slot = &mut fallbacks[(e.local * FACE_PAIRS + pair) as usize * 2 + side];
+                if *slot != UNMADE {
+                    return *slot;
+                }
                 let best = poly.iter().copied().min_by(|x, y| {
                     let (kx, ky) = (x.dot(w), y.dot(w));
-                    if front { kx.total_cmp(&ky) } else { ky.total_cmp(&kx) }
+                    if side == 0 { kx.total_cmp(&ky) } else { ky.total_cmp(&kx) }
                 });
                 let Some(q) = best else { return PnmtRecord::NONE };
                 let t = tris[e.local as usize];
                 let world = world_cell_min + q.clamp(DVec3::ZERO, DVec3::ONE) * cell;
                 let (u, v) = barycentric(attrs.corners(t), world.as_vec3());
-                PnmtRecord::encode(
+                *slot = PnmtRecord::encode(
                     world,
                     attrs.normal(t, u, v),
                     attrs.material(t),
                     attrs.uv(t, u, v),
                     world_cell_min,
                     cell,
-                )
+                );
+                *slot
             };
-            let pair_records = [record(&end[0], true), record(&end[1], false)];
+            let pair_records = [record(&end[0], 0, fallbacks), record(&end[1], 1, fallbacks)];
             if let Some(shade) = shade {
                 let (_, pa, _, pb) = shaft_parts(shaft as u32, n);
                 let mut rgb = [0u16; 8];
