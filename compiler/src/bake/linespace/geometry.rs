@@ -12,7 +12,7 @@
 //! conservative against the rounding of the single-precision ray–triangle test.
 
 use glam::DVec3;
-use kiln_format::linespace::index::{face_axis, face_uv_axes};
+use kiln_format::linespace::index::{MAX_SHAFT_RES, face_axis, face_uv_axes};
 
 /// A triangle prepared for overlap tests: its 13 separating axes and its projection on each.
 #[derive(Debug, Clone)]
@@ -207,9 +207,32 @@ fn rect_shafts(rect: [u32; 4]) -> Option<(usize, usize, u64)> {
 /// The patch indices of shaft `k` of the rectangle (padding beyond `count` repeats the last).
 #[inline(always)]
 fn shaft_patch(rect: [u32; 4], w: usize, count: usize, k: usize) -> (f64, f64) {
-    let k = k.min(count - 1);
-    ((rect[0] as usize + k / w) as f64, (rect[2] as usize + k % w) as f64)
+    let (du, dv) = window_offset(k.min(count - 1) as u32, w as u32);
+    ((rect[0] + du) as f64, (rect[2] + dv) as f64)
 }
+
+/// Bit `k` of a rectangle `w` patches wide (the bit layout of [`PairAxes::shafts_from`]) as its
+/// (row, column) offset, from a table: two integer divisions per shaft cost more than the rest
+/// of a small rectangle's test.
+#[inline(always)]
+pub fn window_offset(k: u32, w: u32) -> (u32, u32) {
+    let (row, column) = WINDOW_OFFSETS[w as usize][k as usize];
+    (row as u32, column as u32)
+}
+
+const WINDOW_OFFSETS: [[(u8, u8); 64]; MAX_SHAFT_RES as usize + 1] = {
+    let mut t = [[(0u8, 0u8); 64]; MAX_SHAFT_RES as usize + 1];
+    let mut w = 1;
+    while w <= MAX_SHAFT_RES as usize {
+        let mut k = 0;
+        while k < 64 {
+            t[w][k] = ((k / w) as u8, (k % w) as u8);
+            k += 1;
+        }
+        w += 1;
+    }
+    t
+};
 
 /// The b end's separation on lane `i` of `side` as base + u·du + v·dv (negating du and dv gives
 /// the same bits as subtracting for side 1).
@@ -381,57 +404,64 @@ unsafe fn shafts_avx2(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
     if active == 0 {
         return all;
     }
-    let groups = count.div_ceil(4);
-    let mut bu = [zero; 16];
-    let mut bv = [zero; 16];
-    for g in 0..groups {
-        let at = |q: usize| shaft_patch(rect, w, count, 4 * g + q);
-        let [(a0, c0), (a1, c1), (a2, c2), (a3, c3)] = [at(0), at(1), at(2), at(3)];
-        bu[g] = _mm256_set_pd(a3, a2, a1, a0);
-        bv[g] = _mm256_set_pd(c3, c2, c1, c0);
-    }
-    let mut lo_n = [zero; 16];
-    let mut lo_d = [one; 16];
-    let mut hi_n = [one; 16];
-    let mut hi_d = [one; 16];
+    // The active (side, lane) pairs in two lists, in ascending order: those separated at the a
+    // end bound each shaft's interval from below, the rest from above; the two bounds are kept
+    // apart, so the lists may run one after the other. Each group of four shafts then runs
+    // through both with its interval in registers (updating arrays of intervals lane by lane
+    // made the compiler write them with masked stores, which cost more than the arithmetic).
+    // (Left uninitialised: zeroing them cost a tenth of the test.)
+    let mut lower = [std::mem::MaybeUninit::<[f64; 4]>::uninit(); 2 * LANES];
+    let mut upper = [std::mem::MaybeUninit::<[f64; 4]>::uninit(); 2 * LANES];
+    let (mut n_lower, mut n_upper) = (0, 0);
     while active != 0 {
         let bit = active.trailing_zeros() as usize;
         active &= active - 1;
         let (side, i) = (bit / LANES, bit % LANES);
         let a = sa[side][i];
         let (base, du, dv) = b_end(p, side, i);
-        let (base, du, dv) = (s(base), s(du), s(dv));
-        let va = s(a);
         if a > 0.0 {
-            for g in 0..groups {
-                let b =
-                    _mm256_add_pd(base, _mm256_add_pd(_mm256_mul_pd(bu[g], du), _mm256_mul_pd(bv[g], dv)));
-                let both = gt(b, zero);
-                let num = _mm256_blendv_pd(va, two, both);
-                let den = _mm256_blendv_pd(_mm256_sub_pd(va, b), one, both);
-                let later = gt(_mm256_mul_pd(num, lo_d[g]), _mm256_mul_pd(lo_n[g], den));
-                lo_n[g] = _mm256_blendv_pd(lo_n[g], num, later);
-                lo_d[g] = _mm256_blendv_pd(lo_d[g], den, later);
-            }
+            lower[n_lower].write([a, base, du, dv]);
+            n_lower += 1;
         } else {
-            let num = s(-a);
-            for g in 0..groups {
-                let b =
-                    _mm256_add_pd(base, _mm256_add_pd(_mm256_mul_pd(bu[g], du), _mm256_mul_pd(bv[g], dv)));
-                let den = _mm256_sub_pd(b, va);
-                let earlier = _mm256_and_pd(
-                    gt(b, zero),
-                    _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_mul_pd(num, hi_d[g]), _mm256_mul_pd(hi_n[g], den)),
-                );
-                hi_n[g] = _mm256_blendv_pd(hi_n[g], num, earlier);
-                hi_d[g] = _mm256_blendv_pd(hi_d[g], den, earlier);
-            }
+            upper[n_upper].write([a, base, du, dv]);
+            n_upper += 1;
         }
     }
     let mut mask = 0u64;
-    for g in 0..groups {
-        let ok =
-            _mm256_cmp_pd::<_CMP_LE_OQ>(_mm256_mul_pd(lo_n[g], hi_d[g]), _mm256_mul_pd(hi_n[g], lo_d[g]));
+    for g in 0..count.div_ceil(4) {
+        let at = |q: usize| shaft_patch(rect, w, count, 4 * g + q);
+        let [(a0, c0), (a1, c1), (a2, c2), (a3, c3)] = [at(0), at(1), at(2), at(3)];
+        let bu = _mm256_set_pd(a3, a2, a1, a0);
+        let bv = _mm256_set_pd(c3, c2, c1, c0);
+        let (mut lo_n, mut lo_d, mut hi_n, mut hi_d) = (zero, one, one, one);
+        for lane in &lower[..n_lower] {
+            // SAFETY: the first `n_lower` entries are written above.
+            let [a, base, du, dv] = unsafe { lane.assume_init() };
+            // Separated at the a end: s ≥ a/(a − b) where b ≤ 0, and no s where b > 0.
+            let va = s(a);
+            let b = _mm256_add_pd(s(base), _mm256_add_pd(_mm256_mul_pd(bu, s(du)), _mm256_mul_pd(bv, s(dv))));
+            let both = gt(b, zero);
+            let num = _mm256_blendv_pd(va, two, both);
+            let den = _mm256_blendv_pd(_mm256_sub_pd(va, b), one, both);
+            let later = gt(_mm256_mul_pd(num, lo_d), _mm256_mul_pd(lo_n, den));
+            lo_n = _mm256_blendv_pd(lo_n, num, later);
+            lo_d = _mm256_blendv_pd(lo_d, den, later);
+        }
+        for lane in &upper[..n_upper] {
+            // SAFETY: the first `n_upper` entries are written above.
+            let [a, base, du, dv] = unsafe { lane.assume_init() };
+            // Separated at the b end only: s ≤ a/(a − b) = −a/(b − a).
+            let (va, num) = (s(a), s(-a));
+            let b = _mm256_add_pd(s(base), _mm256_add_pd(_mm256_mul_pd(bu, s(du)), _mm256_mul_pd(bv, s(dv))));
+            let den = _mm256_sub_pd(b, va);
+            let earlier = _mm256_and_pd(
+                gt(b, zero),
+                _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_mul_pd(num, hi_d), _mm256_mul_pd(hi_n, den)),
+            );
+            hi_n = _mm256_blendv_pd(hi_n, num, earlier);
+            hi_d = _mm256_blendv_pd(hi_d, den, earlier);
+        }
+        let ok = _mm256_cmp_pd::<_CMP_LE_OQ>(_mm256_mul_pd(lo_n, hi_d), _mm256_mul_pd(hi_n, lo_d));
         mask |= (_mm256_movemask_pd(ok) as u64) << (4 * g);
     }
     mask & all

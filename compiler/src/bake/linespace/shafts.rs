@@ -9,7 +9,7 @@ use kiln_format::linespace::index::{
 };
 use kiln_format::linespace::{PnmtRecord, entry, words_per_slot};
 
-use super::geometry::{PairAxes, Prepared, clip_to_box_into};
+use super::geometry::{PairAxes, Prepared, clip_to_box_into, window_offset};
 
 /// What one cell contributes to the line space.
 #[derive(Debug, Clone, Default)]
@@ -269,15 +269,14 @@ fn windows(
     }
 }
 
-/// The shaft of pair `pair` from patch `pa` of face a to bit `k` of the window `q` (the bit
-/// layout of [`PairAxes::shafts_from`]).
-fn window_shaft(pair: u32, pa: u32, q: [u32; 4], k: u32, n: u32) -> u32 {
-    let w = q[3] - q[2];
+/// The shaft of pair `pair` from patch `pa` of face a to patch `pb` of face b.
+#[inline(always)]
+fn shaft_of(pair: u32, pa: u32, pb: u32, n: u32) -> u32 {
     let n2 = n * n;
-    pair * n2 * n2 + pa * n2 + (q[0] + k / w) * n + q[2] + k % w
+    pair * n2 * n2 + pa * n2 + pb
 }
 
-/// Calls `found(shaft)` for every shaft of face pair `pair` that the triangle `tri` (clipped to
+/// Calls `found(shaft, pb)` for every shaft of face pair `pair` that the triangle `tri` (clipped to
 /// the widened cell: `poly`) meets: every [`windows`] window decided by one many-shaft test
 /// ([`PairAxes::shafts_from`]).
 fn search(
@@ -287,13 +286,14 @@ fn search(
     n: u32,
     margin: f64,
     tests: &mut u64,
-    found: &mut impl FnMut(u32),
+    found: &mut impl FnMut(u32, u32, u32),
 ) {
     windows(tri, poly, pair, n, margin, &mut |pa, q, axes| decide(axes, pair, pa, q, n, tests, found));
 }
 
 /// Decides the shafts of pair `pair` from patch `pa` to the patches `rect` on face b by one
-/// many-shaft test (counted in `tests`), and calls `found(shaft)` for each the triangle meets.
+/// many-shaft test (counted in `tests`), and calls `found(shaft, pa, pb)` for each the triangle
+/// meets.
 fn decide(
     axes: &PairAxes,
     pair: u32,
@@ -301,11 +301,13 @@ fn decide(
     rect: [u32; 4],
     n: u32,
     tests: &mut u64,
-    found: &mut impl FnMut(u32),
+    found: &mut impl FnMut(u32, u32, u32),
 ) {
     *tests += ((rect[1] - rect[0]) * (rect[3] - rect[2])) as u64;
     for k in set_bits(axes.shafts_from(pa / n, pa % n, rect)) {
-        found(window_shaft(pair, pa, rect, k, n));
+        let (du, dv) = window_offset(k, rect[3] - rect[2]);
+        let pb = (rect[0] + du) * n + rect[2] + dv;
+        found(shaft_of(pair, pa, pb, n), pa, pb);
     }
 }
 
@@ -344,7 +346,6 @@ struct Fills<'s> {
     ends: &'s mut Vec<[End; 2]>,
     hits: &'s mut Vec<(u32, u8, u8, u16)>,
     centres: &'s [[Vec3; MAX_PATCHES]; 6],
-    n: u32,
     candidates: bool,
     records_needed: bool,
 }
@@ -355,10 +356,9 @@ impl Fills<'_> {
         self.bits[(shaft / 32) as usize] & (1 << (shaft % 32)) != 0
     }
 
-    /// The midpoint segment of `shaft`, front patch centre to back.
+    /// The midpoint segment of the shaft from patch `pa` to `pb`, front patch centre to back.
     #[inline(always)]
-    fn segment(&self, shaft: u32, f: &Filler) -> (Vec3, Vec3) {
-        let (_, pa, _, pb) = shaft_parts(shaft, self.n);
+    fn segment(&self, pa: u32, pb: u32, f: &Filler) -> (Vec3, Vec3) {
         (self.centres[f.faces.0 as usize][pa as usize], self.centres[f.faces.1 as usize][pb as usize])
     }
 
@@ -366,7 +366,7 @@ impl Fills<'_> {
     /// segment's nearest hits from either end; the fallback's key bounds). Strict comparisons
     /// keep the earliest triangle of the list on ties.
     #[inline(always)]
-    fn fill(&mut self, shaft: u32, f: &Filler) {
+    fn fill(&mut self, shaft: u32, pa: u32, pb: u32, f: &Filler) {
         let (word, bit) = ((shaft / 32) as usize, 1 << (shaft % 32));
         let first = self.bits[word] & bit == 0;
         self.bits[word] |= bit;
@@ -379,7 +379,7 @@ impl Fills<'_> {
         if first {
             self.ends[shaft as usize] = [NO_END; 2];
         }
-        let (o, e) = self.segment(shaft, f);
+        let (o, e) = self.segment(pa, pb, f);
         if let Some(h) = f.seg.hit(o, e) {
             self.take_hit(shaft, h, f.triangle);
         }
@@ -421,11 +421,11 @@ impl Fills<'_> {
         end[0].t.is_nan() && (!(f.kmin >= end[0].key) || !(f.kmax <= end[1].key))
     }
 
-    /// The hit of the filled `shaft`'s midpoint segment on `f`'s triangle, where it is nearer
-    /// either end than the shaft's.
+    /// The hit of the filled `shaft`'s (from patch `pa` to `pb`) midpoint segment on `f`'s
+    /// triangle, where it is nearer either end than the shaft's.
     #[inline(always)]
-    fn better_hit(&self, shaft: u32, f: &Filler) -> Option<Intersection> {
-        let (o, e) = self.segment(shaft, f);
+    fn better_hit(&self, shaft: u32, pa: u32, pb: u32, f: &Filler) -> Option<Intersection> {
+        let (o, e) = self.segment(pa, pb, f);
         let h = f.seg.hit(o, e)?;
         let end = &self.ends[shaft as usize];
         (!(h.t >= end[0].t) || !(h.t <= end[1].t)).then_some(h)
@@ -537,8 +537,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     if polys.len() < tris.len() {
         polys.resize_with(tris.len(), Vec::new);
     }
-    let mut state =
-        Fills { bits: &mut out.bits, ends, hits, centres: &centres, n, candidates, records_needed };
+    let mut state = Fills { bits: &mut out.bits, ends, hits, centres: &centres, candidates, records_needed };
     // Without candidates, only the union of the triangles' shafts and the records are kept:
     // a window whose shafts are all filled already, and whose records this triangle cannot
     // change by filling them, needs no exact test (see `Fills::needs_test`). That pays where
@@ -573,38 +572,43 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 kmax,
             };
             if !union {
-                search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft| state.fill(shaft, &filler));
+                search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft, pa, pb| {
+                    state.fill(shaft, pa, pb, &filler)
+                });
                 continue;
             }
             windows(&prep, poly, pair, n, margin, &mut |pa, q, axes| {
-                let w = q[3] - q[2];
-                let count = (q[1] - q[0]) * w;
                 // The rectangle of the window's shafts that need the exact test.
                 let mut sub = [u32::MAX, 0, u32::MAX, 0];
-                for k in 0..count {
-                    if state.needs_test(window_shaft(pair, pa, q, k, n), &filler) {
-                        let (u, v) = (q[0] + k / w, q[2] + k % w);
-                        sub = [sub[0].min(u), sub[1].max(u + 1), sub[2].min(v), sub[3].max(v + 1)];
+                for u in q[0]..q[1] {
+                    for v in q[2]..q[3] {
+                        if state.needs_test(shaft_of(pair, pa, u * n + v, n), &filler) {
+                            sub = [sub[0].min(u), sub[1].max(u + 1), sub[2].min(v), sub[3].max(v + 1)];
+                        }
                     }
                 }
                 if sub[0] < sub[1] {
-                    decide(axes, pair, pa, sub, n, &mut out.tests, &mut |shaft| state.fill(shaft, &filler));
+                    decide(axes, pair, pa, sub, n, &mut out.tests, &mut |shaft, pa, pb| {
+                        state.fill(shaft, pa, pb, &filler)
+                    });
                 }
                 if !records_needed {
                     return;
                 }
                 // The rest are filled: only a better hit of a midpoint segment can change one,
                 // and counts if the triangle fills that shaft.
-                for k in 0..count {
-                    let (u, v) = (q[0] + k / w, q[2] + k % w);
-                    if (sub[0]..sub[1]).contains(&u) && (sub[2]..sub[3]).contains(&v) {
-                        continue;
-                    }
-                    let shaft = window_shaft(pair, pa, q, k, n);
-                    if let Some(h) = state.better_hit(shaft, &filler) {
-                        out.tests += 1;
-                        if axes.shafts_from(pa / n, pa % n, [u, u + 1, v, v + 1]) != 0 {
-                            state.take_hit(shaft, h, t);
+                for u in q[0]..q[1] {
+                    for v in q[2]..q[3] {
+                        if (sub[0]..sub[1]).contains(&u) && (sub[2]..sub[3]).contains(&v) {
+                            continue;
+                        }
+                        let pb = u * n + v;
+                        let shaft = shaft_of(pair, pa, pb, n);
+                        if let Some(h) = state.better_hit(shaft, pa, pb, &filler) {
+                            out.tests += 1;
+                            if axes.shafts_from(pa / n, pa % n, [u, u + 1, v, v + 1]) != 0 {
+                                state.take_hit(shaft, h, t);
+                            }
                         }
                     }
                 }
@@ -931,7 +935,7 @@ mod tests {
             for pair in 0..FACE_PAIRS {
                 let mut found = Vec::new();
                 let mut tests = 0;
-                search(&tri, &poly, pair, n, margin, &mut tests, &mut |shaft| found.push(shaft));
+                search(&tri, &poly, pair, n, margin, &mut tests, &mut |shaft, _, _| found.push(shaft));
                 found.sort_unstable();
                 let (fa, fb) = pair_faces(pair);
                 let mut brute = Vec::new();
