@@ -419,13 +419,12 @@ unsafe fn shafts_avx2(p: &PairAxes, au: u32, av: u32, rect: [u32; 4]) -> u64 {
         let (side, i) = (bit / LANES, bit % LANES);
         let a = sa[side][i];
         let (base, du, dv) = b_end(p, side, i);
-        if a > 0.0 {
-            lower[n_lower].write([a, base, du, dv]);
-            n_lower += 1;
-        } else {
-            upper[n_upper].write([a, base, du, dv]);
-            n_upper += 1;
-        }
+        // Written to both lists, kept by one (without a branch: the sign is unpredictable).
+        lower[n_lower].write([a, base, du, dv]);
+        upper[n_upper].write([a, base, du, dv]);
+        let below = (a > 0.0) as usize;
+        n_lower += below;
+        n_upper += 1 - below;
     }
     let mut mask = 0u64;
     for g in 0..count.div_ceil(4) {
