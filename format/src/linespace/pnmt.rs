@@ -85,7 +85,8 @@ fn round_signed(x: f32) -> i32 {
 }
 
 impl PnmtRecord {
-    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell`.
+    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell`. `normal` need
+    /// not be of unit length (+Z where it is zero or not finite).
     pub fn encode(
         position: DVec3,
         normal: Vec3,
@@ -96,7 +97,10 @@ impl PnmtRecord {
     ) -> PnmtRecord {
         let local = ((position - cell_min) / cell).clamp(DVec3::ZERO, DVec3::ONE);
         let q = |x: f64| round_unsigned(x * 65535.0) as u16;
-        let e = oct_encode(normal.try_normalize().unwrap_or(Vec3::Z));
+        // The octahedral map divides by the L1 norm, so any finite non-zero direction will do,
+        // unit or not (normalising it first was a tenth of the PNMT bake). A zero or non-finite
+        // one maps to NaN, which the rounding below makes 0: +Z.
+        let e = oct_encode(normal);
         let s = |x: f32| round_signed(x.clamp(-1.0, 1.0) * 32767.0) as i16;
         PnmtRecord {
             position: [q(local.x), q(local.y), q(local.z)],
@@ -151,6 +155,30 @@ mod tests {
             worst = worst.max(a.cross(b).length().atan2(a.dot(b)).to_degrees() as f32);
         }
         assert!(worst < 0.005, "worst normal error {worst} degrees");
+    }
+
+    /// Normals of any length encode their direction (scales from 1e-30 to 1e30, within the
+    /// round trip's 0.005°, the angle in f64); zero, infinite and NaN ones encode +Z.
+    #[test]
+    fn normals_of_any_length_encode_their_direction() {
+        let mut worst = 0.0f64;
+        for i in 0..500 {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / 500.0;
+            let phi = i as f64 * 2.399_963;
+            let r = (1.0 - z * z).sqrt();
+            let d = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+            for scale in [1e-30, 1e-3, 7.0, 1e30] {
+                let rec =
+                    PnmtRecord::encode(DVec3::ZERO, (d * scale).as_vec3(), 0, Vec2::ZERO, DVec3::ZERO, 1.0);
+                let back = rec.decode(DVec3::ZERO, 1.0).unwrap().normal.as_dvec3();
+                worst = worst.max(d.cross(back).length().atan2(d.dot(back)).to_degrees());
+            }
+        }
+        assert!(worst < 0.005, "worst normal error {worst} degrees");
+        for n in [Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0), Vec3::new(0.0, f32::NAN, 1.0)] {
+            let rec = PnmtRecord::encode(DVec3::ZERO, n, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
+            assert_eq!(rec.decode(DVec3::ZERO, 1.0).unwrap().normal, Vec3::Z, "{n}");
+        }
     }
 
     /// The quick roundings against the standard library's, at and beside every half step of

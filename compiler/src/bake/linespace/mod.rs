@@ -70,10 +70,13 @@ impl HitAttributes for SceneAttributes<'_> {
     }
     fn normal(&self, t: u32, u: f32, v: f32) -> Vec3 {
         let [a, b, c] = self.triangles[t as usize].map(|i| Vec3::from(self.vertices[i as usize].normal));
-        (a * (1.0 - u - v) + b * u + c * v).try_normalize().unwrap_or_else(|| {
-            let [p, q, r] = self.corners(t);
-            (q - p).cross(r - p).normalize_or(Vec3::Z)
-        })
+        let n = a * (1.0 - u - v) + b * u + c * v;
+        if n.is_finite() && n != Vec3::ZERO {
+            return n;
+        }
+        let [p, q, r] = self.corners(t);
+        let g = (q - p).cross(r - p);
+        if g.is_finite() && g != Vec3::ZERO { g } else { Vec3::Z }
     }
     fn uv(&self, t: u32, u: f32, v: f32) -> Vec2 {
         if self.uvs.is_empty() {

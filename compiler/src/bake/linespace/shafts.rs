@@ -33,7 +33,8 @@ pub struct CellShafts {
 pub trait HitAttributes: Sync {
     /// World corners.
     fn corners(&self, t: u32) -> [Vec3; 3];
-    /// Shading normal at barycentrics (u, v).
+    /// Shading normal at barycentrics (u, v): a finite non-zero direction, not necessarily of
+    /// unit length (the record's encoding needs none, and normalising was a tenth of the bake).
     fn normal(&self, t: u32, u: f32, v: f32) -> Vec3;
     /// Texture coordinates at barycentrics (u, v).
     fn uv(&self, t: u32, u: f32, v: f32) -> Vec2;
