@@ -241,10 +241,6 @@ fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
     assert!(occupied > 3000, "{occupied} occupied cells: too few for several chunks");
     let c = check_line_space(view, ls, 1000, 4);
     assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
-    let corner = |t: u32, k: usize| {
-        let p = view.vertices[view.triangles[t as usize][k] as usize].position;
-        glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
-    };
     let tolerance = 2.0 * h.margin + 1e-4 * h.cell;
     let mut rank = 0usize;
     for (cell, &slot) in ls.slots.iter().enumerate() {
@@ -262,7 +258,7 @@ fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
                 let nearest = ls
                     .cell_triangles(cell)
                     .iter()
-                    .map(|&t| distance_to_triangle(hit.position, [corner(t, 0), corner(t, 1), corner(t, 2)]))
+                    .map(|&t| distance_to_triangle(hit.position, [0, 1, 2].map(|k| corner(view, t, k))))
                     .fold(f64::INFINITY, f64::min);
                 assert!(nearest <= tolerance, "cell {cell}, filled shaft {r}: {nearest} from its triangles");
             }
@@ -270,6 +266,12 @@ fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
         rank += filled as usize;
     }
     assert_eq!(rank as u64, h.filled);
+}
+
+/// Corner `k` of triangle `t` of the scene, in double precision.
+fn corner(view: &SceneView, t: u32, k: usize) -> glam::DVec3 {
+    let p = view.vertices[view.triangles[t as usize][k] as usize].position;
+    glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
 }
 
 /// Distance from `p` to the triangle `t`: to its plane where the projection falls inside,
@@ -314,10 +316,6 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
     let h = ls.header;
     let n = h.shaft_res;
     let m = h.margin / h.cell;
-    let corner = |t: u32, k: usize| {
-        let p = view.vertices[view.triangles[t as usize][k] as usize].position;
-        DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
-    };
     // Cell-local point of a face's patch centre.
     let centre = |face: u32, patch: u32| {
         let mut p = DVec3::ZERO;
@@ -360,7 +358,7 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
                 .iter()
                 .map(|&en| {
                     let t = list[kiln_format::linespace::entry::local(en) as usize];
-                    [0, 1, 2].map(|k| local(corner(t, k)))
+                    [0, 1, 2].map(|k| local(corner(view, t, k)))
                 })
                 .collect();
             let crossings: Vec<Option<f64>> = listed.iter().map(|&t| crossing(o, e, t)).collect();
@@ -368,7 +366,7 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
             let decoded = records.map(|r| r.decode(cell_min, h.cell).map(|x| local(x.position)));
             if crossings.iter().all(|c| c.is_some_and(|t| t.is_finite())) && !crossings.is_empty() {
                 // Every listed triangle clearly crossed or clearly missed.
-                let ts: Vec<f64> = crossings.iter().filter_map(|c| c.filter(|t| *t >= 0.0)).collect();
+                let mut ts: Vec<f64> = crossings.iter().filter_map(|c| c.filter(|t| *t >= 0.0)).collect();
                 if ts.is_empty() {
                     // Clearly missed by all: the fallback.
                     let keys = listed.iter().filter_map(|&t| {
@@ -396,13 +394,12 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
                     );
                     fallbacks += 2;
                 } else {
-                    let mut sorted = ts.clone();
-                    sorted.sort_by(f64::total_cmp);
+                    ts.sort_by(f64::total_cmp);
                     let distinct = |a: f64, b: f64| (a - b).abs() > 0.01;
-                    let (first, last) = (sorted[0], sorted[sorted.len() - 1]);
+                    let (first, last) = (ts[0], ts[ts.len() - 1]);
                     let ends = [
-                        (first, sorted.get(1).is_none_or(|&t| distinct(t, first))),
-                        (last, sorted.len() < 2 || distinct(sorted[sorted.len() - 2], last)),
+                        (first, ts.get(1).is_none_or(|&t| distinct(t, first))),
+                        (last, ts.len() < 2 || distinct(ts[ts.len() - 2], last)),
                     ];
                     for (k, (t, clear)) in ends.into_iter().enumerate() {
                         if !clear {

@@ -47,7 +47,8 @@ pub struct PnmtHit {
     pub uv: Vec2,
 }
 
-/// Octahedral encoding of a unit vector into [-1, 1]².
+/// Octahedral encoding of a direction (of any length: it is divided by its L1 norm) into
+/// [-1, 1]².
 pub fn oct_encode(n: Vec3) -> Vec2 {
     let n = n / (n.x.abs() + n.y.abs() + n.z.abs());
     let p = Vec2::new(n.x, n.y);

@@ -291,8 +291,8 @@ fn shaft_of(pair: u32, pa: u32, pb: u32, n: u32) -> u32 {
     pair * n2 * n2 + pa * n2 + pb
 }
 
-/// Calls `found(shaft, pb)` for every shaft of face pair `pair` that the triangle `tri` (clipped to
-/// the widened cell: `poly`) meets: every [`windows`] window decided by one many-shaft test
+/// Calls `found(shaft, pa, pb)` for every shaft of face pair `pair` (from patch `pa` of face a to
+/// `pb` of face b) that the triangle `tri` (clipped to the widened cell: `poly`) meets: every [`windows`] window decided by one many-shaft test
 /// ([`PairAxes::shafts_from`]).
 fn search(
     tri: &Prepared,
@@ -863,11 +863,6 @@ mod tests {
         }
     }
 
-    /// A bake without candidates keeps only the union of the triangles' shafts and skips the
-    /// exact tests that cannot change it; its bits and PNMT records must be those of the bake
-    /// that tests every triangle against every shaft it may reach (the candidate bake, which
-    /// keeps the records too). Cells of small triangles (where most windows are filled
-    /// already), large ones, a mix, and coincident copies (ties).
     /// The quick floor against the standard library's at and beside integers, around 2⁵², on
     /// signed zeros, infinities and NaN, and on a sweep of fractions of both signs.
     #[test]
@@ -888,6 +883,11 @@ mod tests {
         assert!(floor(f64::NAN).is_nan());
     }
 
+    /// A bake without candidates keeps only the union of the triangles' shafts and skips the
+    /// exact tests that cannot change it; its bits and PNMT records must be those of the bake
+    /// that tests every triangle against every shaft it may reach (the candidate bake, which
+    /// keeps the records too). Cells of small triangles (where most windows are filled
+    /// already), large ones, a mix, and coincident copies (ties).
     #[test]
     fn union_bake_keeps_the_bits_and_records_of_the_all_pairs_bake() {
         let mut rnd = uniform(5);
