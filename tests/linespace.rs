@@ -5,8 +5,8 @@
 
 use glam::Vec3;
 use kiln_compiler::raycheck::{Rng, check_line_space};
-use kiln_compiler::settings::{Settings, VoxelRes};
-use kiln_format::linespace::{LineSpace, PnmtRecord, Variants};
+use kiln_compiler::settings::{PnmtRecords, Settings, VoxelRes};
+use kiln_format::linespace::{LineSpace, PnmtLayout, Variants};
 use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile, SceneView, sections};
 use kiln_tests::shapes::{height_grid, soup};
 use kiln_tests::{compile, scene_of};
@@ -160,9 +160,29 @@ fn damaged_line_space_sections_are_refused() {
     // A candidate entry naming a triangle beyond its cell.
     let msg = refused(&rewrite(&bytes, sections::CANDIDATES, |d| set_u32(d, 0, 0xffff)));
     assert!(msg.contains("candidate entry"), "{msg}");
-    // A PNMT record naming a missing material.
-    let msg = refused(&rewrite(&bytes, sections::PNMT, |d| d[6..8].copy_from_slice(&77u16.to_le_bytes())));
-    assert!(msg.contains("material"), "{msg}");
+    // A PNMT record naming a missing material: the compact record's material bits 0..10 are
+    // bits 22..32 of its second word.
+    assert_eq!(with_line_space(&bytes, |_, ls| ls.pnmt_layout), PnmtLayout::CompactNoUv);
+    let msg = refused(&rewrite(&bytes, sections::PNMT, |d| {
+        let w = u32::from_le_bytes(d[4..8].try_into().unwrap());
+        set_u32(d, 1, w & 0x3f_ffff | 77 << 22)
+    }));
+    assert!(msg.contains("material 77"), "{msg}");
+    // An undefined record layout (VGRD byte 84), and records one word short of the layout's.
+    let msg = refused(&rewrite(&bytes, sections::GRID, |d| d[84] = 3));
+    assert!(msg.contains("layout 3"), "{msg}");
+    let msg = refused(&rewrite(&bytes, sections::PNMT, |d| d.truncate(d.len() - 4)));
+    assert!(msg.contains("PNMT"), "{msg}");
+    // Compact records in a version-1 (format 1.2) PNMT section, which holds full ones only.
+    let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let mut w = FileWriter::new();
+    for s in f.sections() {
+        let version = if s.entry.kind == sections::PNMT { 1 } else { s.entry.version };
+        let data = f.section_bytes(s).unwrap().into_owned();
+        w.raw(s.entry.kind, s.entry.index, version, data, ContentHash::default()).unwrap();
+    }
+    let msg = refused(&w.to_bytes().unwrap());
+    assert!(msg.contains("version-1"), "{msg}");
     // A voxel triangle out of range.
     let msg = refused(&rewrite(&bytes, sections::VOXEL_TRIANGLES, |d| set_u32(d, 0, 1_000_000)));
     assert!(msg.contains("triangle numbers"), "{msg}");
@@ -197,7 +217,7 @@ fn with_line_space<R>(bytes: &[u8], f: impl FnOnce(&SceneView, &LineSpace) -> R)
 }
 
 /// The grid sections of a compile of `tris` with `variants`: (bits, ranks, PNMT records).
-fn shafts_of(tris: &[[Vec3; 3]], res: u32, n: u32, variants: u32) -> (Vec<u32>, Vec<u32>, Vec<PnmtRecord>) {
+fn shafts_of(tris: &[[Vec3; 3]], res: u32, n: u32, variants: u32) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     let bytes = compile(scene_of(tris), Settings { shaft_variants: Some(variants), ..settings(res, n) });
     with_line_space(&bytes, |view, ls| {
         let c = check_line_space(view, ls, 2000, 9);
@@ -241,7 +261,7 @@ fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
     assert!(occupied > 3000, "{occupied} occupied cells: too few for several chunks");
     let c = check_line_space(view, ls, 1000, 4);
     assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
-    let tolerance = 2.0 * h.margin + 1e-4 * h.cell;
+    let tolerance = 2.0 * h.margin + (1e-4 + quantisation(ls)) * h.cell;
     let mut rank = 0usize;
     for (cell, &slot) in ls.slots.iter().enumerate() {
         if slot == u32::MAX {
@@ -253,8 +273,8 @@ fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
             .sum();
         let cell_min = h.cell_min(h.cell_coords(cell));
         for r in rank..rank + filled as usize {
-            for record in &ls.pnmt[2 * r..2 * r + 2] {
-                let Some(hit) = record.decode(cell_min, h.cell) else { continue };
+            for back in [false, true] {
+                let Some(hit) = ls.pnmt_layout.decode(ls.record(r, back), cell_min, h.cell) else { continue };
                 let nearest = ls
                     .cell_triangles(cell)
                     .iter()
@@ -266,6 +286,16 @@ fn records_lie_on_their_cells_triangles(view: &SceneView, ls: &LineSpace) {
         rank += filled as usize;
     }
     assert_eq!(rank as u64, h.filled);
+}
+
+/// How far (cell units) a record's quantised position may lie from the point it stands for:
+/// half a step on each axis, from the layout's step count as FORMAT.md gives it.
+fn quantisation(ls: &LineSpace) -> f64 {
+    let steps = match ls.pnmt_layout {
+        PnmtLayout::Full => 65535.0,
+        PnmtLayout::Compact | PnmtLayout::CompactNoUv => 1023.0,
+    };
+    0.5 * 3f64.sqrt() / steps
 }
 
 /// Corner `k` of triangle `t` of the scene, in double precision.
@@ -300,13 +330,21 @@ fn distance_to_triangle(p: glam::DVec3, t: [glam::DVec3; 3]) -> f64 {
 #[test]
 fn records_are_nearest_segment_crossings_or_the_furthest_reaching_points() {
     let tris = soup(&mut Rng::new(41), 40, 0.7);
-    let bytes = compile(scene_of(&tris), settings(3, 3));
-    let (hits, fallbacks) = with_line_space(&bytes, |view, ls| {
-        let c = check_line_space(view, ls, 2000, 5);
-        assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
-        check_records(view, ls)
-    });
-    assert!(hits > 500 && fallbacks > 500, "{hits} crossings and {fallbacks} fallbacks checked: too few");
+    for (records, layout) in
+        [(PnmtRecords::Full, PnmtLayout::Full), (PnmtRecords::Compact, PnmtLayout::CompactNoUv)]
+    {
+        let bytes = compile(scene_of(&tris), Settings { pnmt_records: records, ..settings(3, 3) });
+        let (hits, fallbacks) = with_line_space(&bytes, |view, ls| {
+            assert_eq!(ls.pnmt_layout, layout, "an untextured scene's records");
+            let c = check_line_space(view, ls, 2000, 5);
+            assert_eq!(c.candidates.as_ref().map(|c| c.mismatches), Some(0));
+            check_records(view, ls)
+        });
+        assert!(
+            hits > 500 && fallbacks > 500,
+            "{layout:?}: {hits} crossings and {fallbacks} fallbacks checked: too few"
+        );
+    }
 }
 
 /// The check of [`records_are_nearest_segment_crossings_or_the_furthest_reaching_points`]:
@@ -316,6 +354,7 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
     let h = ls.header;
     let n = h.shaft_res;
     let m = h.margin / h.cell;
+    let q = quantisation(ls);
     // Cell-local point of a face's patch centre.
     let centre = |face: u32, patch: u32| {
         let mut p = DVec3::ZERO;
@@ -362,8 +401,9 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
                 })
                 .collect();
             let crossings: Vec<Option<f64>> = listed.iter().map(|&t| crossing(o, e, t)).collect();
-            let records = [&ls.pnmt[2 * rank], &ls.pnmt[2 * rank + 1]];
-            let decoded = records.map(|r| r.decode(cell_min, h.cell).map(|x| local(x.position)));
+            let decoded = [false, true].map(|back| {
+                ls.pnmt_layout.decode(ls.record(rank, back), cell_min, h.cell).map(|x| local(x.position))
+            });
             if crossings.iter().all(|c| c.is_some_and(|t| t.is_finite())) && !crossings.is_empty() {
                 // Every listed triangle clearly crossed or clearly missed.
                 let mut ts: Vec<f64> = crossings.iter().filter_map(|c| c.filter(|t| *t >= 0.0)).collect();
@@ -378,7 +418,7 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
                     });
                     let (lo, hi) =
                         keys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (x, y)| (a.min(x), b.max(y)));
-                    let tolerance = 2.0 * m + 1e-3;
+                    let tolerance = 2.0 * m + 1e-3 + q;
                     let (Some(front), Some(back)) = (decoded[0], decoded[1]) else {
                         panic!("cell {cell} shaft {shaft}: a fallback record is missing")
                     };
@@ -409,7 +449,7 @@ fn check_records(view: &SceneView, ls: &LineSpace) -> (u64, u64) {
                         let got = decoded[k]
                             .unwrap_or_else(|| panic!("cell {cell} shaft {shaft}: record {k} missing"));
                         assert!(
-                            (got - want).length() <= 1e-3,
+                            (got - want).length() <= 1e-3 + q,
                             "cell {cell} shaft {shaft} end {k}: {got} not {want}"
                         );
                         hits += 1;

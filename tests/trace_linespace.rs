@@ -10,7 +10,9 @@
 //!   few rays whose line passes within rounding of a patch border (bounded below);
 //! - binary with exact ends: between brute force and the binary answer;
 //! - binary with exact filled cells: exactly brute force;
-//! - PNMT: the CPU's record (hit or miss, `t`, material) on all but a few border rays.
+//! - PNMT: the CPU's record (hit or miss, `t`, material, uv) on all but a few border rays, in
+//!   each record layout: compact with uv (the textured soup), full (the far grid), compact
+//!   without uv (the Cornell box).
 //!
 //! Needs a Vulkan device; without one the tests say so and pass, unless `KILN_REQUIRE_VULKAN`
 //! is set (as `.ci/run` does).
@@ -19,8 +21,8 @@ use std::time::Instant;
 
 use glam::Vec3;
 use kiln_compiler::raycheck::{RayClass, RaySample, Rng, generate_grid};
-use kiln_compiler::settings::{Settings, VoxelRes};
-use kiln_format::linespace::{LineSpace, Variants};
+use kiln_compiler::settings::{PnmtRecords, Settings, VoxelRes};
+use kiln_format::linespace::{LineSpace, PnmtLayout, Variants};
 use kiln_format::query::{BruteForce, IndexedTriangles, Ray, TriangleSource, intersect_triangle};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::session::Session;
@@ -90,12 +92,13 @@ const GENERAL_SHARE: f64 = 0.005;
 /// every ray is a border case.
 const BORDER_SHARE: f64 = 0.15;
 
-fn check(bytes: &[u8], n: u64, seed: u64, what: &str) {
+fn check(bytes: &[u8], n: u64, seed: u64, what: &str, layout: PnmtLayout) {
     let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
     let view = SceneView::new(&file).unwrap();
     let tris = IndexedTriangles { vertices: view.vertices, triangles: view.triangles };
     let ls =
         LineSpace::new(&file, view.triangles.len(), view.materials.len()).unwrap().expect("a line space");
+    assert_eq!(ls.pnmt_layout, layout, "{what}: PNMT records");
     let (lo, hi) = (Vec3::from(view.manifest.bounds.min), Vec3::from(view.manifest.bounds.max));
     let samples: Vec<RaySample> = generate_grid(&tris, &ls, lo, hi, n, seed);
     let rays: Vec<Ray> = samples.iter().map(|s| s.ray).collect();
@@ -190,8 +193,10 @@ fn check(bytes: &[u8], n: u64, seed: u64, what: &str) {
                 // The same record: t within its single-precision rounding (a ten-thousandth of a
                 // cell, 6 times the position's quantisation step, or 1e-6 relative).
                 let tol = 1e-4 * ls.header.cell / ray.direction.length() as f64 + 1e-6 * w.t.abs();
-                let same =
-                    p.t != NO_HIT && (p.t as f64 - w.t).abs() <= tol && p.triangle == w.hit.material as u32;
+                let same = p.t != NO_HIT
+                    && (p.t as f64 - w.t).abs() <= tol
+                    && p.triangle == w.hit.material as u32
+                    && (p.u, p.v) == (w.hit.uv.x, w.hit.uv.y);
                 pnmt_differ[border] += !same as u32;
             }
         }
@@ -222,19 +227,46 @@ fn check(bytes: &[u8], n: u64, seed: u64, what: &str) {
     assert!(ends_extra <= binary_extra, "{what}: exact ends add false hits");
 }
 
+/// `scene` with texture coordinates (a different pair at every vertex) and a base-colour
+/// texture, so that its PNMT records keep their uv.
+fn textured(mut scene: kiln_compiler::ir::Scene) -> kiln_compiler::ir::Scene {
+    scene.uvs = scene
+        .vertices
+        .iter()
+        .map(|v| [v.position[0] * 3.0 - 1.0, v.position[1] + 0.5 * v.position[2]])
+        .collect();
+    scene.textures.push(kiln_compiler::ir::Texture {
+        name: "checker".into(),
+        width: 4,
+        height: 4,
+        rgba: (0..16).flat_map(|i| if (i + i / 4) % 2 == 0 { [230; 4] } else { [40, 40, 40, 255] }).collect(),
+        role: kiln_compiler::ir::TextureRole::Color,
+        wrap_u: kiln_format::manifest::Wrap::Repeat,
+        wrap_v: kiln_format::manifest::Wrap::Repeat,
+        mag_linear: true,
+    });
+    scene.materials[0].gpu.base_color_texture = 0;
+    scene
+}
+
 #[test]
 fn gpu_line_space_equals_the_cpu_queries_on_shapes() {
     if !vulkan() {
         return;
     }
     let mut rng = Rng::new(11);
-    check(&compile(scene_of(&soup(&mut rng, 1500, 0.15)), settings(8, 4)), 3000, 1, "soup");
+    let soup = textured(scene_of(&soup(&mut rng, 1500, 0.15)));
+    check(&compile(soup, settings(8, 4)), 3000, 1, "textured soup", PnmtLayout::Compact);
     let grid = height_grid(12, 0.2, &mut rng);
     check(
-        &compile(scene_of(&transformed(&grid, 1.0, Vec3::splat(1e5))), settings(6, 3)),
+        &compile(
+            scene_of(&transformed(&grid, 1.0, Vec3::splat(1e5))),
+            Settings { pnmt_records: PnmtRecords::Full, ..settings(6, 3) },
+        ),
         3000,
         2,
         "grid at 1e5",
+        PnmtLayout::Full,
     );
 }
 
@@ -247,5 +279,5 @@ fn gpu_line_space_equals_the_cpu_queries_on_the_cornell_box() {
         return;
     };
     let scene = kiln_compiler::import::import(&scenes.join("cornell_box").join("scene.gltf")).unwrap();
-    check(&compile(scene, settings(8, 4)), 4000, 5, "cornell_box");
+    check(&compile(scene, settings(8, 4)), 4000, 5, "cornell_box", PnmtLayout::CompactNoUv);
 }

@@ -3,6 +3,10 @@
 //! estimate (`analyze::budget`: central, and the two-standard-error bound the budget uses)
 //! against the baked bytes of the grid and each variant.
 //!
+//! PNMT is timed with the records the compiler stores for these untextured scenes by default
+//! (compact, without uv: 8 bytes); one more bake with full 16-byte records gives their time and
+//! the compact records' error against them, record by record.
+//!
 //! `cargo bench -p kiln-compiler --bench linespace [-- ROWS]` (ROWS: comma-separated row numbers,
 //! default all; KILN_BENCH_RUNS: runs per row, default 3).
 
@@ -11,12 +15,11 @@ use std::sync::atomic::AtomicUsize;
 use std::sync::atomic::Ordering::Relaxed;
 use std::time::Instant;
 
-use glam::Vec2;
 use kiln_compiler::analyze::budget::Estimate;
 use kiln_compiler::bake::linespace::{self, SceneAttributes};
 use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
 use kiln_compiler::ir::Scene;
-use kiln_format::linespace::{Variants, oct_decode, oct_encode};
+use kiln_format::linespace::{PnmtLayout, Variants};
 
 struct Row {
     scene: u32,
@@ -37,6 +40,9 @@ const ROWS: [Row; 8] = [
     Row { scene: 7, object: DRAGON, res: 8, n: 5, thesis_voxel_ms: 95.0, thesis_ls_ms: 94393.0 },
     Row { scene: 7, object: DRAGON, res: 72, n: 5, thesis_voxel_ms: 88.0, thesis_ls_ms: 53675.0 },
 ];
+
+/// The records the compiler stores for an untextured scene by default.
+const COMPACT: PnmtLayout = PnmtLayout::CompactNoUv;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -115,29 +121,40 @@ static ALLOCATOR: Counting = Counting;
 
 /// Bakes like [`bake`] and measures the most memory the bake held at once beyond what was held
 /// before it, MiB.
-fn bake_measured(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64, f64) {
+fn bake_measured(
+    scene: &Scene,
+    res: u32,
+    n: u32,
+    variants: u32,
+    layout: PnmtLayout,
+) -> (linespace::BakedLineSpace, f64, f64) {
     let before = HELD.load(Relaxed);
     PEAK.store(before, Relaxed);
-    let (ls, ms) = bake(scene, res, n, variants);
+    let (ls, ms) = bake(scene, res, n, variants, layout);
     (ls, ms, mib((PEAK.load(Relaxed) - before) as u64))
 }
 
-fn bake(scene: &Scene, res: u32, n: u32, variants: u32) -> (linespace::BakedLineSpace, f64) {
+fn bake(
+    scene: &Scene,
+    res: u32,
+    n: u32,
+    variants: u32,
+    layout: PnmtLayout,
+) -> (linespace::BakedLineSpace, f64) {
     let t = Instant::now();
     let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(scene);
     let voxels = geometry.voxels(res).clone();
     let voxel_ms = t.elapsed().as_secs_f64() * 1e3;
     let progress = kiln_compiler::progress::Progress::hidden();
-    let ls = linespace::bake(&attrs_of(scene), voxels, voxel_ms, n, variants, None, &progress).expect("bake");
+    let ls = linespace::bake(&attrs_of(scene), voxels, voxel_ms, n, variants, layout, None, &progress)
+        .expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
 }
 
 /// Bytes per filled shaft of each variant, in memory and as the file's default codec stores it
-/// (estimated from samples of the larger sections),
-/// and what a 12-byte PNMT record (position 3 × 10 bits, octahedral normal 2 × 11 bits, material
-/// 12 bits, uv as now) would cost in error against today's 16-byte records, measured on every
-/// record of the bake.
-fn memory(ls: &linespace::BakedLineSpace, lc: &linespace::BakedLineSpace) {
+/// (estimated from samples of the larger sections), and what the compact PNMT records of `ls`
+/// cost in error against the full records of `full`, measured on every record.
+fn memory(ls: &linespace::BakedLineSpace, full: &linespace::BakedLineSpace, lc: &linespace::BakedLineSpace) {
     let filled = ls.header.filled.max(1) as f64;
     let binary = 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len());
     let records: &[u8] = bytemuck::cast_slice(&ls.pnmt);
@@ -159,33 +176,44 @@ fn memory(ls: &linespace::BakedLineSpace, lc: &linespace::BakedLineSpace) {
     let entries: &[u8] = bytemuck::cast_slice(&lc.candidates);
     let offsets: &[u8] = bytemuck::cast_slice(&lc.candidate_offsets);
     let (mut pos_max, mut pos_sum, mut ang_max, mut ang_sum, mut count) = (0f64, 0f64, 0f64, 0f64, 0u64);
-    for r in ls.pnmt.iter().filter(|r| r.is_some()) {
-        let q = |x: u16| {
-            let v = f64::from(x) / 65535.0;
-            ((v * 1023.0).round() / 1023.0 - v).abs()
+    let mut differ = 0u64;
+    let (lw, fw) = (ls.pnmt_layout().words(), PnmtLayout::Full.words());
+    assert_eq!(ls.pnmt.len() / lw, full.pnmt.len() / fw, "the two bakes' record counts");
+    for (c, f) in ls.pnmt.chunks_exact(lw).zip(full.pnmt.chunks_exact(fw)) {
+        let (c, f) = (
+            ls.pnmt_layout().decode(c, glam::DVec3::ZERO, 1.0),
+            PnmtLayout::Full.decode(f, glam::DVec3::ZERO, 1.0),
+        );
+        let (Some(c), Some(f)) = (c, f) else {
+            differ += (c.is_some() != f.is_some()) as u64;
+            continue;
         };
-        let e = r.position.iter().map(|&x| q(x)).fold(0.0, f64::max);
-        let e2 = |x: i16| f32::from(x) / 32767.0;
-        let now = oct_decode(Vec2::new(e2(r.normal[0]), e2(r.normal[1])));
-        let coarse = oct_encode(now).map(|x| (x.clamp(-1.0, 1.0) * 1023.0).round() / 1023.0);
+        // Cell units (both decoded in the unit cell); the largest axis.
+        let e = (c.position - f.position).abs().max_element();
         // atan2(|a × b|, a · b) in f64: acos of an f32 dot product near 1 errs by 0.02°.
-        let (a, b) = (now.as_dvec3(), oct_decode(coarse).as_dvec3());
+        let (a, b) = (c.normal.as_dvec3(), f.normal.as_dvec3());
         let angle = a.cross(b).length().atan2(a.dot(b)).to_degrees();
+        differ += (c.material != f.material) as u64;
         (pos_max, pos_sum, ang_max, ang_sum, count) =
             (pos_max.max(e), pos_sum + e, ang_max.max(angle), ang_sum + angle, count + 1);
     }
     let n = count.max(1) as f64;
+    let full_bytes: &[u8] = bytemuck::cast_slice(&full.pnmt);
     println!(
-        "      bytes per filled shaft: binary {:.2} ({:.2} zstd), PNMT {:.1} ({:.1} zstd), candidates {:.1} ({:.1} zstd); 12-byte PNMT records: position error max {:.2e} mean {:.2e} cells, normal max {:.3} mean {:.3} degrees",
+        "      bytes per filled shaft: binary {:.2} ({:.2} zstd), PNMT {} {:.1} ({:.1} zstd), full {:.1} ({:.1} zstd), candidates {:.1} ({:.1} zstd); {} against full records: position error max {:.2e} mean {:.2e} cells, normal max {:.3} mean {:.3} degrees, {differ} records differing in presence or material",
         binary as f64 / filled,
         (zstd(bytemuck::cast_slice(&ls.bits))
             + zstd(bytemuck::cast_slice(&ls.ranks))
             + zstd(bytemuck::cast_slice(&ls.slots))) as f64
             / filled,
+        ls.pnmt_layout().name(),
         records.len() as f64 / filled,
         zstd(records) as f64 / filled,
+        full_bytes.len() as f64 / filled,
+        zstd(full_bytes) as f64 / filled,
         (entries.len() + offsets.len()) as f64 / lc.header.filled.max(1) as f64,
         (zstd(entries) + zstd(offsets)) as f64 / lc.header.filled.max(1) as f64,
+        ls.pnmt_layout().name(),
         pos_max,
         pos_sum / n,
         ang_max,
@@ -234,11 +262,11 @@ fn main() {
             // The previous run's results are dropped first, so that the peaks measure one bake.
             drop(last.take());
             let (ls, ms, peak_pnmt) =
-                bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::PNMT);
+                bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::PNMT, COMPACT);
             voxel.push(ls.voxel_ms);
             pnmt_ms.push(ms - ls.voxel_ms);
             let (lc, ms, peak_cand) =
-                bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::CANDIDATES);
+                bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::CANDIDATES, COMPACT);
             cand_ms.push(ms - lc.voxel_ms);
             peaks = (peaks.0.max(peak_pnmt), peaks.1.max(peak_cand));
             last = Some((ls, lc));
@@ -260,7 +288,7 @@ fn main() {
             row.thesis_ls_ms,
             c / row.thesis_ls_ms,
             ls.header.slots,
-            mib(16 * ls.pnmt.len() as u64 + 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len()) as u64),
+            mib(4 * (ls.pnmt.len() + ls.bits.len() + ls.ranks.len() + ls.slots.len()) as u64),
             mib(4
                 * (lc.candidates.len()
                     + lc.candidate_offsets.len()
@@ -268,20 +296,26 @@ fn main() {
                     + lc.ranks.len()
                     + lc.slots.len()) as u64),
         );
-        memory(&ls, &lc);
+        let (full, full_ms, peak_full) =
+            bake_measured(&scene, row.res, row.n, Variants::BINARY | Variants::PNMT, PnmtLayout::Full);
+        memory(&ls, &full, &lc);
         println!(
-            "      bake's peak memory (bytes held beyond those before it): PNMT {:.1} MiB, candidates {:.1} MiB",
-            peaks.0, peaks.1
+            "      bake's peak memory (bytes held beyond those before it): PNMT {:.1} MiB (full records {:.1} MiB), candidates {:.1} MiB; full records' bake {:.1} ms (1 run)",
+            peaks.0,
+            peak_full,
+            peaks.1,
+            full_ms - full.voxel_ms
         );
+        drop(full);
         let _ = row.thesis_voxel_ms;
         let t = Instant::now();
         let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);
-        let central = Estimate::with_errors(&geometry, row.res, row.n, 0.0);
-        let bound = Estimate::new(&geometry, row.res, row.n);
+        let central = Estimate::with_errors(&geometry, row.res, row.n, 0.0).with_pnmt_layout(COMPACT);
+        let bound = Estimate::new(&geometry, row.res, row.n).with_pnmt_layout(COMPACT);
         let estimate_ms = t.elapsed().as_secs_f64() * 1e3 / 2.0;
         let grid = 96 + 4 * (ls.voxel_offsets.len() + ls.voxel_triangles.len()) as u64;
         let binary = 4 * (ls.bits.len() + ls.ranks.len() + ls.slots.len()) as u64;
-        let with_pnmt = grid + binary + 16 * ls.pnmt.len() as u64;
+        let with_pnmt = grid + binary + 4 * ls.pnmt.len() as u64;
         let with_cand = grid + binary + 4 * (lc.candidates.len() + lc.candidate_offsets.len()) as u64;
         let pn = Variants::BINARY | Variants::PNMT;
         let bc = Variants::BINARY | Variants::CANDIDATES;

@@ -34,6 +34,32 @@ impl BvhPreset {
     }
 }
 
+/// How PNMT records are stored (`--pnmt-records`, `[bake] pnmt_records`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum PnmtRecords {
+    /// 12 bytes a record (8 where no material samples a texture): positions in 1/1023 of a
+    /// cell, normals within 0.12°, at most 4,094 materials (more fall back to full).
+    #[default]
+    Compact,
+    /// 16 bytes a record: positions in 1/65535 of a cell, normals within 0.005°.
+    Full,
+}
+
+impl PnmtRecords {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            PnmtRecords::Compact => "compact",
+            PnmtRecords::Full => "full",
+        }
+    }
+
+    /// Parses a sidecar value.
+    pub fn parse(s: &str) -> Option<PnmtRecords> {
+        <PnmtRecords as ValueEnum>::from_str(s, false).ok()
+    }
+}
+
 /// How textures are stored (`--texture-format`, `[bake] texture_format`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum TextureFormat {
@@ -317,6 +343,8 @@ pub struct Settings {
     pub codec: Codec,
     /// How textures are stored.
     pub texture_format: TextureFormat,
+    /// How PNMT records are stored.
+    pub pnmt_records: PnmtRecords,
 }
 
 impl Default for Settings {
@@ -333,6 +361,7 @@ impl Default for Settings {
             normals: Normals::Asset,
             codec: Codec::Auto,
             texture_format: TextureFormat::default(),
+            pnmt_records: PnmtRecords::default(),
         }
     }
 }
@@ -376,6 +405,10 @@ impl Settings {
             self.texture_format =
                 TextureFormat::parse(f).ok_or_else(|| format!("texture_format is '{f}'; use bc or rgba8"))?;
         }
+        if let Some(p) = &b.pnmt_records {
+            self.pnmt_records =
+                PnmtRecords::parse(p).ok_or_else(|| format!("pnmt_records is '{p}'; use compact or full"))?;
+        }
         if let Some(n) = &b.normals {
             self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;
         }
@@ -403,6 +436,7 @@ impl Settings {
             ("normals".into(), self.normals.name()),
             ("codec".into(), self.codec.name().into()),
             ("texture-format".into(), self.texture_format.name().into()),
+            ("pnmt-records".into(), self.pnmt_records.name().into()),
         ]
     }
 }

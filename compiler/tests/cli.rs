@@ -14,7 +14,7 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.2");
+    assert_eq!(j["format_version"], "1.3");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(

@@ -379,7 +379,7 @@ fn preilluminated_radiance_matches_direct_evaluation() {
                 }
                 let shaft = (w * 32 + bit) as u32;
                 let rank = ls.rank(slot, shaft).unwrap();
-                let Some(hit) = ls.pnmt[2 * rank].decode(cmin, h.cell) else { continue };
+                let Some(hit) = ls.pnmt_layout.decode(ls.record(rank, false), cmin, h.cell) else { continue };
                 // The viewer of a front record is the centre of the shaft's front patch.
                 let (fa, pa, _, _) = kiln_format::linespace::index::shaft_parts(shaft, h.shaft_res);
                 let (ua, va) = kiln_format::linespace::index::face_uv_axes(fa);

@@ -611,8 +611,10 @@ gpu_struct! {
         pub pnmt_step: f32 => "float",
         /// log2 of the words per chunk.
         pub chunk_shift: u32 => "uint",
+        /// How PNMT records are stored (`PnmtLayout` code).
+        pub pnmt_layout: u32 => "uint",
         /// Zero.
-        pub reserved: [u32; 2] => "uvec2",
+        pub reserved: u32 => "uint",
         /// First word of: cell triangle offsets, cell triangle lists, slots, shaft bits.
         pub bases_a: [u32; 4] => "uvec4",
         /// First word of: shaft ranks, candidate offsets, candidate entries, PNMT records.

@@ -429,13 +429,21 @@ bool ls_pnmt_hit(vec3 origin, vec3 dir, float tmin, float tmax, vec3 origin_norm
         if (rank < 0) {
             continue;
         }
-        uint base = grid.bases_b.w + 4u * (2u * uint(rank) + (l.front ? 0u : 1u));
-        uint w0 = ls_word(base), w1 = ls_word(base + 1u);
-        uint material = w1 >> 16;
-        if (material == LS_NO_RECORD) {
+        uint words = LS_PNMT_WORDS[grid.pnmt_layout];
+        uint base = grid.bases_b.w + words * (2u * uint(rank) + (l.front ? 0u : 1u));
+        uvec4 w = uvec4(ls_word(base), ls_word(base + 1u), 0u, 0u);
+        if (words > 2u) {
+            w.z = ls_word(base + 2u);
+        }
+        if (words > 3u) {
+            w.w = ls_word(base + 3u);
+        }
+        vec3 local;
+        vec2 oct, uv;
+        uint material;
+        if (!ls_pnmt_fields(grid.pnmt_layout, w, local, oct, material, uv)) {
             continue;
         }
-        vec3 local = vec3(float(w0 & 0xffffu), float(w0 >> 16), float(w1 & 0xffffu)) / 65535.0;
         // The record relative to the ray's origin, from grid coordinates: far from the world
         // origin, world positions in single precision would cancel to a few ulps of 1e5.
         vec3 rel = (vec3(cell) + local - s.o) * grid.cell;
@@ -443,9 +451,9 @@ bool ls_pnmt_hit(vec3 origin, vec3 dir, float tmin, float tmax, vec3 origin_norm
         bool in_front = !check_plane || dot(rel, origin_normal) > grid.pnmt_step;
         if (t >= tmin && t <= tmax && in_front) {
             rec.position = origin + rel;
-            rec.normal = ls_oct_decode(unpackSnorm2x16(ls_word(base + 2u)));
+            rec.normal = ls_oct_decode(oct);
             rec.material = material;
-            rec.uv = unpackHalf2x16(ls_word(base + 3u));
+            rec.uv = uv;
             rec.t = t;
             rec.rank = uint(rank);
             rec.front = l.front;

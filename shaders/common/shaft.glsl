@@ -7,6 +7,12 @@ const uint LS_FACE_PAIRS = 15u;
 const uint LS_MAX_SHAFT_RES = 8u;
 const uint LS_NO_SLOT = 4294967295u;
 const uint LS_NO_RECORD = 65535u;
+const uint LS_NO_RECORD_COMPACT = 4095u;
+// PNMT record layouts (GpuGrid.pnmt_layout; format/src/linespace/pnmt.rs) and their words.
+const uint LS_PNMT_FULL = 0u;
+const uint LS_PNMT_COMPACT = 1u;
+const uint LS_PNMT_COMPACT_NO_UV = 2u;
+const uint LS_PNMT_WORDS[3] = uint[3](4u, 3u, 2u);
 const uint LS_MAX_CELL_TRIANGLES = 65536u;
 const uint LS_MAX_CHUNKS = 8u;
 const uint LS_NO_BASE = 4294967295u;
@@ -28,7 +34,8 @@ struct GpuGrid {
     float key_eps; // offset 60
     float pnmt_step; // offset 64
     uint chunk_shift; // offset 68
-    uvec2 reserved; // offset 72
+    uint pnmt_layout; // offset 72
+    uint reserved; // offset 76
     uvec4 bases_a; // offset 80
     uvec4 bases_b; // offset 96
     uvec4 bases_c; // offset 112
@@ -67,7 +74,24 @@ uint ls_entry_local(uint e) { return e & 0xFFFFu; }
 uint ls_entry_key_min(uint e) { return (e >> 16) & 0xFFu; }
 uint ls_entry_prefix_key_max(uint e) { return e >> 24; }
 
-// Octahedral decoding of a unit normal from two snorm16 values.
+// A PNMT record's fields from its words w (w.x, w.y always; w.z, w.w where the layout has them)
+// in layout `kind` (LS_PNMT_*): false for an absent record. `local` is the position in the unit cell.
+bool ls_pnmt_fields(uint kind, uvec4 w, out vec3 local, out vec2 oct, out uint material, out vec2 uv) {
+    if (kind == LS_PNMT_FULL) {
+        material = w.y >> 16;
+        local = vec3(float(w.x & 0xFFFFu), float(w.x >> 16), float(w.y & 0xFFFFu)) / 65535.0;
+        oct = unpackSnorm2x16(w.z);
+        uv = unpackHalf2x16(w.w);
+        return material != LS_NO_RECORD;
+    }
+    material = (w.y >> 22) | ((w.x >> 30) << 10);
+    local = vec3(float(w.x & 0x3FFu), float((w.x >> 10) & 0x3FFu), float((w.x >> 20) & 0x3FFu)) / 1023.0;
+    oct = (vec2(float(w.y & 0x7FFu), float((w.y >> 11) & 0x7FFu)) - 1023.0) / 1023.0;
+    uv = kind == LS_PNMT_COMPACT ? unpackHalf2x16(w.z) : vec2(0.0);
+    return material != LS_NO_RECORD_COMPACT;
+}
+
+// Octahedral decoding of a unit normal from two snorm values.
 vec3 ls_oct_decode(vec2 e) {
     float z = 1.0 - abs(e.x) - abs(e.y);
     float t = max(-z, 0.0);

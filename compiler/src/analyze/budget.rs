@@ -27,7 +27,7 @@
 
 use serde::Serialize;
 
-use kiln_format::linespace::{MAX_CANDIDATE_CELL_TRIANGLES, Variants, words_per_slot};
+use kiln_format::linespace::{MAX_CANDIDATE_CELL_TRIANGLES, PnmtLayout, Variants, words_per_slot};
 
 use crate::analyze::geometry::SceneGeometry;
 use crate::bake::linespace::estimate;
@@ -135,10 +135,17 @@ impl Estimate {
                 grid: 96 + 4 * (cells + 1) + 4 * voxels.triangles.len() as u64,
                 binary: 4 * cells + 8 * words,
                 candidates: 4 * (filled + 1) + 4 * entries,
+                // Full records: see [`Estimate::with_pnmt_layout`].
                 pnmt: 32 * filled,
                 preillum: 16 * filled,
             },
         }
+    }
+
+    /// The estimate with PNMT records stored in `layout` (estimates are made for full ones).
+    pub fn with_pnmt_layout(mut self, layout: PnmtLayout) -> Estimate {
+        self.bytes.pnmt = self.filled * 2 * 4 * layout.words() as u64;
+        self
     }
 
     /// Patch edge in scene units (a cell's edge over N): the spatial resolution of a shaft's ends.
@@ -158,6 +165,8 @@ pub struct Request {
     pub variants: Option<u32>,
     /// Budget in MiB, and whether it was given.
     pub budget_mib: (u32, bool),
+    /// How PNMT records will be stored (their bytes per filled shaft).
+    pub pnmt_layout: PnmtLayout,
 }
 
 /// The configuration chosen.
@@ -191,7 +200,7 @@ pub fn choose(geometry: &SceneGeometry, req: Request) -> Result<Choice, String> 
         if let Some(e) = memo.iter().find(|e| e.voxel_res == res && e.shaft_res == n) {
             return *e;
         }
-        let e = Estimate::new(geometry, res, n);
+        let e = Estimate::new(geometry, res, n).with_pnmt_layout(req.pnmt_layout);
         memo.push(e);
         e
     };

@@ -9,7 +9,8 @@ use kiln_format::manifest::LightKind;
 use crate::analyze::budget::{self, Choice, Request};
 use crate::analyze::geometry::SceneGeometry;
 use crate::bake::linespace::voxelize::auto_resolution;
-use crate::settings::{SHAFT_RES, Settings, VoxelRes, variants_name};
+use crate::settings::{PnmtRecords, SHAFT_RES, Settings, VoxelRes, variants_name};
+use kiln_format::linespace::{PnmtLayout, Variants};
 
 /// The bake stages, in the order they run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -80,6 +81,10 @@ pub struct Plan {
     pub shaft_res: u32,
     /// Line-space variants to bake (0: none).
     pub shaft_variants: u32,
+    /// How PNMT records are stored (resolved from the setting: without uv where no material
+    /// samples a texture, full where materials outnumber the compact record's).
+    #[serde(skip)]
+    pub pnmt_layout: PnmtLayout,
     /// The line space's configuration, its estimated size and why (when baked).
     pub line_space: Option<Choice>,
 }
@@ -202,6 +207,22 @@ impl Plan {
         let geometry_bytes =
             scene.vertices.len() as u64 * vertex_bytes + scene.triangles.len() as u64 * (12 + 4);
         let default_budget = budget::default_budget_mib(geometry_bytes);
+        let (pnmt_layout, layout_why) = match settings.pnmt_records {
+            PnmtRecords::Full => (PnmtLayout::Full, String::new()),
+            PnmtRecords::Compact
+                if scene.materials.len() > PnmtLayout::Compact.max_material() as usize + 1 =>
+            {
+                (
+                    PnmtLayout::Full,
+                    format!(
+                        ", full PNMT records: {} materials are more than compact records address",
+                        scene.materials.len()
+                    ),
+                )
+            }
+            PnmtRecords::Compact if textured == 0 => (PnmtLayout::CompactNoUv, String::new()),
+            PnmtRecords::Compact => (PnmtLayout::Compact, String::new()),
+        };
         let choice = if wanted {
             Some(budget::choose(
                 geometry,
@@ -216,6 +237,7 @@ impl Plan {
                         settings.line_space_budget.unwrap_or(default_budget),
                         settings.line_space_budget.is_some(),
                     ),
+                    pnmt_layout,
                 },
             )?)
         } else {
@@ -272,17 +294,26 @@ impl Plan {
                 stages.push(run(
                     Stage::LineSpace,
                     format!(
-                        "N = {shaft_res} (shafts span 1/{shaft_res} of a cell: patches of {} scene units), {}, about {}{budget} ({}); \
+                        "N = {shaft_res} (shafts span 1/{shaft_res} of a cell: patches of {} scene units), {}{}, about {}{budget} ({}); \
                          read by kiln-play --shadows linespace and --gi linespace{default_why}",
                         short(e.patch()),
                         variants_name(shaft_variants),
+                        if shaft_variants & Variants::PNMT != 0 {
+                            format!(
+                                " ({} PNMT records of {} bytes{layout_why})",
+                                pnmt_layout.name(),
+                                4 * pnmt_layout.words()
+                            )
+                        } else {
+                            String::new()
+                        },
                         mib(c.bytes),
                         c.why
                     ),
                 ));
             }
         }
-        Ok(Plan { stages, voxel_res, shaft_res, shaft_variants, line_space: choice })
+        Ok(Plan { stages, voxel_res, shaft_res, shaft_variants, pnmt_layout, line_space: choice })
     }
 
     /// Whether `stage` runs.

@@ -312,6 +312,7 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
             h.part("voxel-res", &p.voxel_res.to_le_bytes())
                 .part("shaft-res", &p.shaft_res.to_le_bytes())
                 .part("variants", &p.shaft_variants.to_le_bytes())
+                .part("pnmt-layout", &p.pnmt_layout.code().to_le_bytes())
                 .part("bounds", &bounds(&ctx.geometry.bounds))
                 .hash("geometry", &ctx.geometry_key)
                 .part("triangle-materials", bytemuck::cast_slice(&ctx.triangle_materials))

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand};
 
 use crate::settings::{
-    BRDF_LUT_RES, BvhPreset, Codec, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, SHADOW_RES, SHAFT_RES,
-    Settings, TextureFormat, VOXEL_RES, VoxelRes, parse_variants,
+    BRDF_LUT_RES, BvhPreset, Codec, LINE_SPACE_BUDGET, MEDIA_VOLUME_RES, Normals, PnmtRecords, SHADOW_RES,
+    SHAFT_RES, Settings, TextureFormat, VOXEL_RES, VoxelRes, parse_variants,
 };
 
 /// kiln compiles glTF and OBJ scenes into .kiln files: geometry, textures, BVH and the baked
@@ -150,6 +150,18 @@ pub struct BakeArgs {
     #[arg(long, value_name = "MiB", value_parser = LINE_SPACE_BUDGET.parser(), help_heading = "Voxel grid and line space",
           help = format!("Size budget of the voxel grid and line space in MiB: lowers the voxel resolution, then N (those not given), and drops candidates, then PNMT (when --shaft-variants is not given), until the estimate fits; a usage error if nothing fits, {}..={}. [default: {}x the bytes of the geometry sections, within {}..={} MiB; it applies only when the plan chooses the variants]", LINE_SPACE_BUDGET.min, LINE_SPACE_BUDGET.max, crate::analyze::budget::DEFAULT_BUDGET_PER_GEOMETRY, crate::analyze::budget::DEFAULT_BUDGET_MIN_MIB, crate::analyze::budget::DEFAULT_BUDGET_MAX_MIB))]
     pub line_space_budget: Option<u32>,
+    /// How PNMT records are stored.
+    #[arg(
+        long,
+        value_enum,
+        help_heading = "Voxel grid and line space",
+        help = "How PNMT records are stored: compact (12 bytes a record, 8 where no material samples a \
+texture: positions to 1/1023 of a cell, normals within 0.12°, at most 4094 materials, beyond which full is \
+used) or full (16 bytes: positions to 1/65535 of a cell, normals within 0.005°). The compact error is far \
+below PNMT's own (a shaft's midpoint ray stands for rays up to a patch apart) [default: compact, or the \
+sidecar's bake.pnmt_records]"
+    )]
+    pub pnmt_records: Option<PnmtRecords>,
     /// BRDF lookup table size N.
     #[arg(long, value_name = "N", value_parser = BRDF_LUT_RES.parser(), help_heading = "Lighting bakes",
           help = BRDF_LUT_RES.help("BRDF lookup table size N (N × N texels)"))]
@@ -207,6 +219,7 @@ impl BakeArgs {
         set(&mut settings.normals, self.normals);
         set(&mut settings.codec, self.codec);
         set(&mut settings.texture_format, self.texture_format);
+        set(&mut settings.pnmt_records, self.pnmt_records);
     }
 }
 

@@ -58,6 +58,8 @@ struct LineSpaceJson {
     bytes_binary: u64,
     bytes_candidates: u64,
     bytes_pnmt: u64,
+    /// `full`, `compact` or `compact-no-uv` (null for an undefined layout code).
+    pnmt_records: Option<&'static str>,
 }
 
 #[derive(Serialize, Default)]
@@ -138,6 +140,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
                 bytes_binary: size(&[sections::SHAFT_SLOTS, sections::SHAFT_BITS, sections::SHAFT_RANKS]),
                 bytes_candidates: size(&[sections::CANDIDATE_OFFSETS, sections::CANDIDATES]),
                 bytes_pnmt: size(&[sections::PNMT]),
+                pnmt_records: kiln_format::linespace::PnmtLayout::from_code(g.pnmt_layout).map(|l| l.name()),
             }
         });
     let h = file.header();
@@ -176,11 +179,16 @@ fn print_text(r: &InspectJson) {
             l.candidate_entries
         );
         println!(
-            "  memory: voxel grid {}, binary {}, candidates {}, PNMT {}",
+            "  memory: voxel grid {}, binary {}, candidates {}, PNMT {}{}",
             size(l.bytes_voxel_grid),
             size(l.bytes_binary),
             size(l.bytes_candidates),
-            size(l.bytes_pnmt)
+            size(l.bytes_pnmt),
+            if l.bytes_pnmt > 0 {
+                format!(" ({} records)", l.pnmt_records.unwrap_or("undefined"))
+            } else {
+                String::new()
+            }
         );
         if l.filled_shafts > 0 {
             let per = |bytes: u64| bytes as f64 / l.filled_shafts as f64;

@@ -185,6 +185,8 @@ pub struct BakeToml {
     pub shaft_variants: Option<String>,
     /// Budget of the grid and line space, MiB.
     pub line_space_budget: Option<u32>,
+    /// `compact` or `full`.
+    pub pnmt_records: Option<String>,
     /// BRDF table size.
     pub brdf_lut_res: Option<u32>,
     /// Shadow map size.

@@ -3,7 +3,7 @@
 //! the committed file differs, so the two cannot drift.
 
 use super::index::{FACE_PAIRS, MAX_SHAFT_RES, face_uv_axes, pair_index};
-use super::{MAX_CANDIDATE_CELL_TRIANGLES, NO_RECORD, NO_SLOT, Variants};
+use super::{MAX_CANDIDATE_CELL_TRIANGLES, NO_RECORD, NO_RECORD_COMPACT, NO_SLOT, PnmtLayout, Variants};
 use crate::gpu::{GpuGrid, declare};
 
 /// Storage buffers ("chunks") the player's line-space queries bind: with chunks of the largest
@@ -40,6 +40,12 @@ const uint LS_FACE_PAIRS = {FACE_PAIRS}u;
 const uint LS_MAX_SHAFT_RES = {MAX_SHAFT_RES}u;
 const uint LS_NO_SLOT = {NO_SLOT}u;
 const uint LS_NO_RECORD = {NO_RECORD}u;
+const uint LS_NO_RECORD_COMPACT = {NO_RECORD_COMPACT}u;
+// PNMT record layouts (GpuGrid.pnmt_layout; format/src/linespace/pnmt.rs) and their words.
+const uint LS_PNMT_FULL = {full}u;
+const uint LS_PNMT_COMPACT = {compact}u;
+const uint LS_PNMT_COMPACT_NO_UV = {compact_no_uv}u;
+const uint LS_PNMT_WORDS[3] = uint[3]({words});
 const uint LS_MAX_CELL_TRIANGLES = {MAX_CANDIDATE_CELL_TRIANGLES}u;
 const uint LS_MAX_CHUNKS = {MAX_CHUNKS}u;
 const uint LS_NO_BASE = {NO_BASE}u;
@@ -81,7 +87,24 @@ uint ls_entry_local(uint e) {{ return e & 0xFFFFu; }}
 uint ls_entry_key_min(uint e) {{ return (e >> 16) & 0xFFu; }}
 uint ls_entry_prefix_key_max(uint e) {{ return e >> 24; }}
 
-// Octahedral decoding of a unit normal from two snorm16 values.
+// A PNMT record's fields from its words w (w.x, w.y always; w.z, w.w where the layout has them)
+// in layout `kind` (LS_PNMT_*): false for an absent record. `local` is the position in the unit cell.
+bool ls_pnmt_fields(uint kind, uvec4 w, out vec3 local, out vec2 oct, out uint material, out vec2 uv) {{
+    if (kind == LS_PNMT_FULL) {{
+        material = w.y >> 16;
+        local = vec3(float(w.x & 0xFFFFu), float(w.x >> 16), float(w.y & 0xFFFFu)) / 65535.0;
+        oct = unpackSnorm2x16(w.z);
+        uv = unpackHalf2x16(w.w);
+        return material != LS_NO_RECORD;
+    }}
+    material = (w.y >> 22) | ((w.x >> 30) << 10);
+    local = vec3(float(w.x & 0x3FFu), float((w.x >> 10) & 0x3FFu), float((w.x >> 20) & 0x3FFu)) / 1023.0;
+    oct = (vec2(float(w.y & 0x7FFu), float((w.y >> 11) & 0x7FFu)) - 1023.0) / 1023.0;
+    uv = kind == LS_PNMT_COMPACT ? unpackHalf2x16(w.z) : vec2(0.0);
+    return material != LS_NO_RECORD_COMPACT;
+}}
+
+// Octahedral decoding of a unit normal from two snorm values.
 vec3 ls_oct_decode(vec2 e) {{
     float z = 1.0 - abs(e.x) - abs(e.y);
     float t = max(-z, 0.0);
@@ -96,6 +119,14 @@ vec3 ls_oct_decode(vec2 e) {{
         candidates = Variants::CANDIDATES,
         pnmt = Variants::PNMT,
         preillum = Variants::PREILLUM,
+        full = PnmtLayout::Full.code(),
+        compact = PnmtLayout::Compact.code(),
+        compact_no_uv = PnmtLayout::CompactNoUv.code(),
+        words = {
+            let mut words: Vec<(u32, usize)> = PnmtLayout::ALL.iter().map(|l| (l.1, l.0.words())).collect();
+            words.sort();
+            words.iter().map(|(_, w)| format!("{w}u")).collect::<Vec<_>>().join(", ")
+        },
     )
 }
 

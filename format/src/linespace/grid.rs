@@ -62,8 +62,11 @@ pub struct GridHeader {
     pub entries: u64,
     /// Largest triangle count of one cell.
     pub max_cell_triangles: u32,
+    /// How PNMT records are stored: a [`crate::linespace::PnmtLayout`] code (0, the full
+    /// 16-byte record, in files from before the compact layouts).
+    pub pnmt_layout: u32,
     /// Zero.
-    pub reserved: [u32; 3],
+    pub reserved: [u32; 2],
 }
 
 const _: () = assert!(size_of::<GridHeader>() == 96);

@@ -17,7 +17,9 @@ mod pnmt;
 mod query;
 
 pub use grid::{CellVisit, Dda, GridHeader, Variants};
-pub use pnmt::{NO_RECORD, PnmtHit, PnmtRecord, oct_decode, oct_encode};
+pub use pnmt::{
+    NO_RECORD, NO_RECORD_COMPACT, PnmtHit, PnmtLayout, PnmtRecord, RecordWords, oct_decode, oct_encode,
+};
 pub use query::{PnmtQueryHit, ShaftLookup};
 
 use crate::error::{FormatError, Result};
@@ -94,8 +96,11 @@ pub struct LineSpace<'a> {
     pub candidate_offsets: &'a [u32],
     /// Candidate entries.
     pub candidates: &'a [u32],
-    /// PNMT records, 2 per filled shaft (empty without PNMT).
-    pub pnmt: &'a [PnmtRecord],
+    /// PNMT records, 2 per filled shaft, [`Self::pnmt_layout`]`.words()` words each (empty
+    /// without PNMT).
+    pub pnmt: &'a [u32],
+    /// How the PNMT records are stored.
+    pub pnmt_layout: PnmtLayout,
     /// Pre-illuminated radiance per filled shaft: front RGB, 0, back RGB, 0 as binary16
     /// (empty without the variant).
     pub preillum: &'a [[u16; 8]],
@@ -133,10 +138,20 @@ impl<'a> LineSpace<'a> {
             ranks: get(SHAFT_RANKS)?,
             candidate_offsets: get(CANDIDATE_OFFSETS)?,
             candidates: get(CANDIDATES)?,
-            pnmt: file.pod::<PnmtRecord>(PNMT, 0)?.unwrap_or(&[]),
+            pnmt: get(PNMT)?,
+            pnmt_layout: PnmtLayout::from_code(h.pnmt_layout)
+                .ok_or_else(|| bad(format!("PNMT layout {} is not defined", h.pnmt_layout)))?,
             preillum: file.pod::<[u16; 8]>(PREILLUM, 0)?.unwrap_or(&[]),
             words_per_slot: if h.shaft_res == 0 { 0 } else { words_per_slot(h.shaft_res.min(MAX_SHAFT_RES)) },
         };
+        // Version 1 of each (format 1.2 and before) knows only the full 16-byte records.
+        let version = |k| file.find(k, 0).map_or(2, |s| s.entry.version);
+        if (version(GRID) == 1 || version(PNMT) == 1) && ls.pnmt_layout != PnmtLayout::Full {
+            return Err(bad(format!(
+                "PNMT layout {} in a version-1 VGRD or LSPN, which hold full records only",
+                ls.pnmt_layout.name()
+            )));
+        }
         ls.check(triangles, materials)?;
         Ok(Some(ls))
     }
@@ -144,7 +159,7 @@ impl<'a> LineSpace<'a> {
     fn check(&self, triangles: usize, materials: usize) -> Result<()> {
         let h = &self.header;
         let finite = h.origin.iter().chain([&h.cell, &h.margin]).all(|v| v.is_finite());
-        if !finite || !(h.cell > 0.0) || !(h.margin >= 0.0) || h.dims.contains(&0) || h.reserved != [0; 3] {
+        if !finite || !(h.cell > 0.0) || !(h.margin >= 0.0) || h.dims.contains(&0) || h.reserved != [0; 2] {
             return Err(bad(format!("header is invalid: {h:?}")));
         }
         let cells = h.cell_count();
@@ -275,13 +290,24 @@ impl<'a> LineSpace<'a> {
             return Err(bad("candidate lists present but not in the header's variants".into()));
         }
         if has(Variants::PNMT) {
-            if self.pnmt.len() as u64 != 2 * h.filled {
-                return Err(bad(format!("{} PNMT records for {} filled shafts", self.pnmt.len(), h.filled)));
+            let words = self.pnmt_layout.words();
+            if self.pnmt.len() as u64 != 2 * h.filled * words as u64 {
+                return Err(bad(format!(
+                    "{} words of {} PNMT records for {} filled shafts",
+                    self.pnmt.len(),
+                    self.pnmt_layout.name(),
+                    h.filled
+                )));
             }
-            if let Some(r) =
-                self.pnmt.iter().find(|r| r.material != NO_RECORD && r.material as usize >= materials)
+            let layout = self.pnmt_layout;
+            let material = |r: &[u32]| layout.material(r);
+            if let Some(m) = self
+                .pnmt
+                .chunks_exact(words)
+                .map(material)
+                .find(|&m| m != NO_RECORD && m as usize >= materials)
             {
-                return Err(bad(format!("PNMT record names material {} of {materials}", r.material)));
+                return Err(bad(format!("PNMT record names material {m} of {materials}")));
             }
         } else if !self.pnmt.is_empty() {
             return Err(bad("PNMT records present but not in the header's variants".into()));
@@ -322,6 +348,14 @@ impl<'a> LineSpace<'a> {
         (word & bit != 0).then(|| self.ranks[w] as usize + (word & (bit - 1)).count_ones() as usize)
     }
 
+    /// The front (`back` false) or back PNMT record of a filled shaft: its
+    /// [`Self::pnmt_layout`] words.
+    pub fn record(&self, rank: usize, back: bool) -> &'a [u32] {
+        let words = self.pnmt_layout.words();
+        let i = (2 * rank + back as usize) * words;
+        &self.pnmt[i..i + words]
+    }
+
     /// Candidate entries of a filled shaft.
     pub fn entries(&self, rank: usize) -> &'a [u32] {
         &self.candidates[self.candidate_offsets[rank] as usize..self.candidate_offsets[rank + 1] as usize]
@@ -334,7 +368,7 @@ impl<'a> LineSpace<'a> {
             b(self.voxel_offsets) + b(self.voxel_triangles) + 96,
             b(self.slots) + b(self.bits) + b(self.ranks),
             b(self.candidate_offsets) + b(self.candidates),
-            (self.pnmt.len() * 16) as u64,
+            b(self.pnmt),
         )
     }
 }

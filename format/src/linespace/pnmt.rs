@@ -1,22 +1,182 @@
 //! PNMT records: position, normal, material and texture coordinates of the front or back hit
-//! of a shaft's midpoint ray, in 16 bytes.
+//! of a shaft's midpoint ray, in one of three layouts ([`PnmtLayout`], named by the grid
+//! header):
 //!
-//! | bytes | field | encoding | precision |
-//! |---|---|---|---|
-//! | 0..6 | position | u16 × 3, the voxel [0, 1]³ mapped to 0..65535 | cell / 65535 per axis |
-//! | 6..8 | material | u16; 0xFFFF = no record | exact |
-//! | 8..12 | normal | octahedral (Meyer et al. 2010), snorm16 × 2 | < 0.005° |
-//! | 12..16 | uv | f16 × 2 | 11-bit mantissa |
+//! | layout | bytes | position | normal (octahedral, Meyer et al. 2010) | material | uv |
+//! |---|---|---|---|---|---|
+//! | full | 16 | u16 × 3 (cell / 65535) | snorm16 × 2 (< 0.005°) | u16 | f16 × 2 |
+//! | compact | 12 | 10 bits × 3 (cell / 1023) | 11 bits × 2 (< 0.12°) | 12 bits | f16 × 2 |
+//! | compact without uv | 8 | as compact | as compact | as compact | none |
 //!
-//! The thesis stored 16 half floats per shaft (32 bytes, world positions in half precision); kiln
-//! stores the same 32 bytes per filled shaft (front and back), positions relative to the voxel.
+//! The full record's words (little-endian u32): position x | y << 16, position z | material <<
+//! 16, normal x | y << 16, uv x | y << 16 (binary16 bits). The compact record's: position x | y
+//! << 10 | z << 20 | material bits 10..12 << 30; normal x | y << 11 (each the snorm value plus
+//! 1023) | material bits 0..10 << 22; then the uv word unless it is left out.
+//!
+//! Positions are relative to the voxel ([0, 1]³ mapped to the steps). The thesis stored 16 half
+//! floats per shaft (32 bytes, world positions in half precision); kiln stores 16–32 bytes per
+//! filled shaft (front and back). The compact layouts' quantisation (at most half a step,
+//! 4.9e-4 cells, and 0.12°) is far below the record's own approximation: a midpoint ray stands
+//! for every ray of a shaft up to a patch wide.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Vec2, Vec3};
 use half::f16;
 
-/// Material value of an absent record.
+/// Material value of an absent record (full layout).
 pub const NO_RECORD: u16 = 0xffff;
+
+/// Material value of an absent record (compact layouts: 12 bits).
+pub const NO_RECORD_COMPACT: u16 = 0xfff;
+
+/// Words of the longest record: the encoders' output, of which a layout stores the first
+/// [`PnmtLayout::words`].
+pub type RecordWords = [u32; 4];
+
+/// How a file stores its PNMT records ([`crate::linespace::GridHeader::pnmt_layout`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PnmtLayout {
+    /// 16 bytes a record ([`PnmtRecord`]).
+    #[default]
+    Full,
+    /// 12 bytes: coarser position and normal, materials below [`NO_RECORD_COMPACT`].
+    Compact,
+    /// 8 bytes: compact without texture coordinates (for scenes that sample no texture; they
+    /// decode as zero).
+    CompactNoUv,
+}
+
+impl PnmtLayout {
+    /// Every layout with its header code and its name in settings.
+    pub const ALL: [(PnmtLayout, u32, &'static str); 3] =
+        [(Self::Full, 0, "full"), (Self::Compact, 1, "compact"), (Self::CompactNoUv, 2, "compact-no-uv")];
+
+    /// The layout of a header code, `None` for an undefined one.
+    pub fn from_code(code: u32) -> Option<PnmtLayout> {
+        Self::ALL.iter().find(|l| l.1 == code).map(|l| l.0)
+    }
+
+    /// The header code.
+    pub fn code(self) -> u32 {
+        Self::ALL.iter().find(|l| l.0 == self).map_or(0, |l| l.1)
+    }
+
+    /// The name in settings and reports.
+    pub fn name(self) -> &'static str {
+        Self::ALL.iter().find(|l| l.0 == self).map_or("full", |l| l.2)
+    }
+
+    /// 32-bit words a record.
+    pub const fn words(self) -> usize {
+        match self {
+            Self::Full => 4,
+            Self::Compact => 3,
+            Self::CompactNoUv => 2,
+        }
+    }
+
+    /// Quantisation steps of a position across a cell.
+    pub const fn position_steps(self) -> f64 {
+        match self {
+            Self::Full => 65535.0,
+            _ => 1023.0,
+        }
+    }
+
+    /// The largest material index a record can hold.
+    pub const fn max_material(self) -> u16 {
+        match self {
+            Self::Full => NO_RECORD - 1,
+            _ => NO_RECORD_COMPACT - 1,
+        }
+    }
+
+    /// The absent record.
+    pub fn none(self) -> RecordWords {
+        match self {
+            Self::Full => bytemuck::cast(PnmtRecord::NONE),
+            _ => [(NO_RECORD_COMPACT as u32 >> 10) << 30, (NO_RECORD_COMPACT as u32 & 0x3ff) << 22, 0, 0],
+        }
+    }
+
+    /// The material of a record (`words` at least [`Self::words`] long), [`NO_RECORD`] for an
+    /// absent one.
+    pub fn material(self, w: &[u32]) -> u16 {
+        match self {
+            Self::Full => (w[1] >> 16) as u16,
+            _ => {
+                let m = (w[1] >> 22 | (w[0] >> 30) << 10) as u16;
+                if m == NO_RECORD_COMPACT { NO_RECORD } else { m }
+            }
+        }
+    }
+
+    /// Whether a record holds a hit.
+    pub fn is_some(self, w: &[u32]) -> bool {
+        self.material(w) != NO_RECORD
+    }
+
+    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell` (see
+    /// [`PnmtRecord::encode`]); materials beyond [`Self::max_material`] are clamped to it.
+    pub fn encode(
+        self,
+        position: DVec3,
+        normal: Vec3,
+        material: u16,
+        uv: Vec2,
+        cell_min: DVec3,
+        cell: f64,
+    ) -> RecordWords {
+        if self == Self::Full {
+            return bytemuck::cast(PnmtRecord::encode(position, normal, material, uv, cell_min, cell));
+        }
+        let local = ((position - cell_min) * (1.0 / cell)).clamp(DVec3::ZERO, DVec3::ONE);
+        let q = |x: f64| round_unsigned(x * 1023.0);
+        let e = oct_encode(normal);
+        // snorm11: −1023..=1023, stored plus 1023.
+        let s = |x: f32| (round_signed(x.clamp(-1.0, 1.0) * 1023.0) + 1023) as u32;
+        let m = material.min(self.max_material()) as u32;
+        let uv = f16::from_f32(uv.x).to_bits() as u32 | (f16::from_f32(uv.y).to_bits() as u32) << 16;
+        [
+            q(local.x) | q(local.y) << 10 | q(local.z) << 20 | (m >> 10) << 30,
+            s(e.x) | s(e.y) << 11 | (m & 0x3ff) << 22,
+            if self == Self::Compact { uv } else { 0 },
+            0,
+        ]
+    }
+
+    /// Decodes a record (`words` at least [`Self::words`] long) of the voxel with minimum
+    /// corner `cell_min` and edge `cell`.
+    pub fn decode(self, w: &[u32], cell_min: DVec3, cell: f64) -> Option<PnmtHit> {
+        match self {
+            Self::Full => {
+                let r: PnmtRecord = bytemuck::cast([w[0], w[1], w[2], w[3]]);
+                r.decode(cell_min, cell)
+            }
+            _ => {
+                if !self.is_some(w) {
+                    return None;
+                }
+                let p = |k: u32| f64::from(w[0] >> (10 * k) & 0x3ff) / 1023.0;
+                let s = |k: u32| ((w[1] >> (11 * k) & 0x7ff) as f32 - 1023.0) / 1023.0;
+                let uv = if self == Self::Compact {
+                    Vec2::new(
+                        f16::from_bits(w[2] as u16).to_f32(),
+                        f16::from_bits((w[2] >> 16) as u16).to_f32(),
+                    )
+                } else {
+                    Vec2::ZERO
+                };
+                Some(PnmtHit {
+                    position: cell_min + DVec3::new(p(0), p(1), p(2)) * cell,
+                    normal: oct_decode(Vec2::new(s(0), s(1))),
+                    material: self.material(w),
+                    uv,
+                })
+            }
+        }
+    }
+}
 
 /// One hit record. 16 bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Pod, Zeroable)]
@@ -189,6 +349,74 @@ mod tests {
         for y in ys {
             assert_eq!(round_signed(y), y.round() as i32, "{y}");
         }
+    }
+
+    /// Compact records against the layout's own bounds: positions within half a step (1/2046
+    /// of the cell) on every axis, 1e5 from the origin too; normals within 0.12° (half an
+    /// 11-bit step of the octahedral square; the worst of these 20,000 directions is 0.116°);
+    /// materials exact up to 4094 and clamped there; uv exact in binary16 or dropped.
+    #[test]
+    fn compact_records_round_trip_within_their_steps() {
+        for layout in [PnmtLayout::Compact, PnmtLayout::CompactNoUv] {
+            for (min, cell) in [(DVec3::ZERO, 1.0), (DVec3::new(1e5, -3.0, 7.0), 0.037)] {
+                let mut worst = 0.0f64;
+                for i in 0..=4000u32 {
+                    let f = |k: u32| ((i * k) % 4001) as f64 / 4000.0;
+                    let p = min + DVec3::new(f(1), f(7), f(113)) * cell;
+                    let w = layout.encode(p, Vec3::Z, 0, Vec2::ZERO, min, cell);
+                    let hit = layout.decode(&w, min, cell).unwrap();
+                    worst = worst.max(((hit.position - p) / cell).abs().max_element());
+                }
+                assert!(worst <= 0.5 / 1023.0 + 1e-9, "{layout:?}: position error {worst} cells");
+            }
+            let mut worst = 0.0f64;
+            for i in 0..20000 {
+                let z = 1.0 - 2.0 * (i as f32 + 0.5) / 20000.0;
+                let phi = i as f32 * 2.399_963;
+                let r = (1.0 - z * z).sqrt();
+                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                let w = layout.encode(DVec3::ZERO, n * 3.0, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
+                let back = layout.decode(&w, DVec3::ZERO, 1.0).unwrap().normal;
+                let (a, b) = (n.as_dvec3(), back.as_dvec3());
+                worst = worst.max(a.cross(b).length().atan2(a.dot(b)).to_degrees());
+            }
+            assert!(worst < 0.12, "{layout:?}: normal error {worst} degrees");
+            for (m, want) in
+                [(0u16, 0u16), (1, 1), (1023, 1023), (1024, 1024), (4094, 4094), (4095, 4094), (60000, 4094)]
+            {
+                let w = layout.encode(DVec3::ZERO, Vec3::Z, m, Vec2::new(0.5, -2.0), DVec3::ZERO, 1.0);
+                let hit = layout.decode(&w, DVec3::ZERO, 1.0).unwrap();
+                let uv = if layout == PnmtLayout::Compact { Vec2::new(0.5, -2.0) } else { Vec2::ZERO };
+                assert_eq!((hit.material, hit.uv), (want, uv), "{layout:?}, material {m}");
+            }
+        }
+    }
+
+    /// The words of one record of each layout, worked out by hand from the module's table: the
+    /// GLSL decoder reads these bits.
+    #[test]
+    fn records_hold_the_documented_bits() {
+        let (p, m, uv) = (DVec3::new(0.5, 0.25, 1.0), 0xabc, Vec2::new(0.5, 2.0));
+        // Position 0.5·1023 = 511.5 rounds (away from zero) to 512, 0.25·1023 = 255.75 to 256;
+        // +Z is octahedral (0, 0), snorm11 0 stored as 1023; material 0xabc splits into 0b10
+        // (bits 10..12) and 0x2bc; uv 0.5 and 2.0 are binary16 0x3800 and 0x4000.
+        let compact =
+            [512 | 256 << 10 | 1023 << 20 | 0b10 << 30, 1023 | 1023 << 11 | 0x2bc << 22, 0x4000_3800];
+        let w = PnmtLayout::Compact.encode(p, Vec3::Z, m, uv, DVec3::ZERO, 1.0);
+        assert_eq!(w, [compact[0], compact[1], compact[2], 0]);
+        let w = PnmtLayout::CompactNoUv.encode(p, Vec3::Z, m, uv, DVec3::ZERO, 1.0);
+        assert_eq!(w, [compact[0], compact[1], 0, 0]);
+        // Full: 0.5·65535 = 32767.5 → 32768, 0.25·65535 = 16383.75 → 16384; snorm16 0 is 0.
+        let w = PnmtLayout::Full.encode(p, Vec3::Z, m, uv, DVec3::ZERO, 1.0);
+        assert_eq!(w, [32768 | 16384 << 16, 65535 | 0xabc << 16, 0, 0x4000_3800]);
+        // Absent records: material all ones, nothing else set.
+        assert_eq!(PnmtLayout::Full.none(), [0, 0xffff << 16, 0, 0]);
+        assert_eq!(PnmtLayout::Compact.none(), [0b11 << 30, 0x3ff << 22, 0, 0]);
+        for (layout, _, _) in PnmtLayout::ALL {
+            assert!(layout.decode(&layout.none(), DVec3::ZERO, 1.0).is_none(), "{layout:?}");
+            assert_eq!(PnmtLayout::from_code(layout.code()), Some(layout));
+        }
+        assert_eq!(PnmtLayout::from_code(3), None);
     }
 
     #[test]

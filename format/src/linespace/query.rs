@@ -12,7 +12,7 @@
 //! record is accepted only if its stored point `p` lies in the ray's interval
 //! (`tmin ≤ (p − o)·d / |d|² ≤ tmax`) and, for rays leaving a surface with geometric normal `n`
 //! (oriented to the side the ray leaves into), strictly in front of that surface's tangent plane:
-//! `(p − o)·n > q`, where `q` is the record's quantisation step (cell · √3 / 65535) plus the grid
+//! `(p − o)·n > q`, where `q` is the record's quantisation step (cell · √3 / 65535, or / 1023 in the compact layouts) plus the grid
 //! margin. Records of the origin's own plane are thus rejected, while other surfaces, including
 //! the far side of a concave one, are accepted.
 
@@ -55,7 +55,8 @@ impl super::GridHeader {
     /// How far in front of the origin's surface a PNMT record must lie to be accepted (the
     /// position quantisation step plus the margin; see the module documentation).
     pub fn pnmt_step(&self) -> f64 {
-        self.cell * 3f64.sqrt() / 65535.0 + self.margin
+        let steps = super::PnmtLayout::from_code(self.pnmt_layout).unwrap_or_default().position_steps();
+        self.cell * 3f64.sqrt() / steps + self.margin
     }
 }
 
@@ -204,8 +205,8 @@ impl LineSpace<'_> {
             }
             let Some(l) = self.lookup(visit.cell, ray) else { continue };
             let Some(rank) = self.rank(slot, l.shaft) else { continue };
-            let record = self.pnmt[2 * rank + (!l.front) as usize];
-            let Some(hit) = record.decode(h.cell_min(visit.cell), h.cell) else { continue };
+            let record = self.record(rank, !l.front);
+            let Some(hit) = self.pnmt_layout.decode(record, h.cell_min(visit.cell), h.cell) else { continue };
             let t = (hit.position - o).dot(d) / d.length_squared();
             let in_front = origin_normal.is_none_or(|n| (hit.position - o).dot(n.as_dvec3()) > q);
             if t >= ray.tmin as f64 && t <= ray.tmax as f64 && in_front {

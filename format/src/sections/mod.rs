@@ -55,7 +55,7 @@ pub const SHAFT_RANKS: SectionKind = SectionKind(*b"LSRK");
 pub const CANDIDATE_OFFSETS: SectionKind = SectionKind(*b"LSCO");
 /// Candidate list entries (`u32`: cell-local triangle, key bounds).
 pub const CANDIDATES: SectionKind = SectionKind(*b"LSCE");
-/// PNMT records ([`crate::linespace::PnmtRecord`]), front and back per filled shaft.
+/// PNMT records ([`crate::linespace::PnmtLayout`]), front and back per filled shaft.
 pub const PNMT: SectionKind = SectionKind(*b"LSPN");
 
 /// Pre-illuminated line space: front and back radiance per filled shaft (`[u16; 4]` binary16
@@ -189,7 +189,16 @@ pub const KNOWN: &[KindInfo] = &[
         indexed: true,
         description: "light visibility per medium cell (unorm8)",
     },
-    pod_kind(GRID, "voxel-grid", 96, "voxel grid and line-space header"),
+    // Version 2 (format 1.3): the PNMT record layout in the formerly reserved word at 84.
+    KindInfo {
+        kind: GRID,
+        name: "voxel-grid",
+        version: 2,
+        element_size: 96,
+        required: false,
+        indexed: false,
+        description: "voxel grid and line-space header",
+    },
     pod_kind(VOXEL_OFFSETS, "voxel-offsets", 4, "voxel triangle list offsets"),
     pod_kind(VOXEL_TRIANGLES, "voxel-triangles", 4, "voxel triangle lists"),
     pod_kind(SHAFT_SLOTS, "shaft-slots", 4, "line-space slot per voxel"),
@@ -197,7 +206,17 @@ pub const KNOWN: &[KindInfo] = &[
     pod_kind(SHAFT_RANKS, "shaft-ranks", 4, "filled-shaft prefix counts per bit word"),
     pod_kind(CANDIDATE_OFFSETS, "candidate-offsets", 4, "candidate list offsets per filled shaft"),
     pod_kind(CANDIDATES, "candidates", 4, "exact candidate lists per filled shaft"),
-    pod_kind(PNMT, "pnmt", 16, "front and back hit records per filled shaft"),
+    // Version 2 (format 1.3): u32 words of records in the header's layout (version 1: 16-byte
+    // records, the full layout).
+    KindInfo {
+        kind: PNMT,
+        name: "pnmt",
+        version: 2,
+        element_size: 4,
+        required: false,
+        indexed: false,
+        description: "front and back hit records per filled shaft",
+    },
     pod_kind(PREILLUM, "preillum", 16, "front and back radiance per filled shaft"),
 ];
 

@@ -136,7 +136,8 @@ impl LineSpaceLayout {
                 continue;
             }
             let n = file.find(*kind, 0).map_or(0, |s| s.entry.raw_size / 4);
-            // Aligned to 4 words: a 16-byte record never straddles two chunks.
+            // Aligned to 4 words: a full 16-byte record never straddles two chunks (compact ones
+            // may: every word is read on its own, through its chunk).
             words = words.next_multiple_of(4);
             bases[i] = u32::try_from(words).map_err(|_| too_large(words))?;
             words += n;
@@ -158,7 +159,8 @@ impl LineSpaceLayout {
             key_eps: (h.key_eps() + 1e-5) as f32,
             pnmt_step: h.pnmt_step() as f32,
             chunk_shift: 0,
-            reserved: [0; 2],
+            pnmt_layout: h.pnmt_layout,
+            reserved: 0,
             bases_a: [bases[0], bases[1], bases[2], bases[3]],
             bases_b: [bases[4], bases[5], bases[6], bases[7]],
             bases_c: [bases[8], 0, 0, 0],

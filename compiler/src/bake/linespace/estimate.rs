@@ -105,6 +105,7 @@ pub fn sample(voxels: &Voxels, n: u32, max_cells: usize) -> FillSample {
                 margin_local,
                 true,
                 false,
+                kiln_format::linespace::PnmtLayout::Full,
                 &NoAttributes,
                 None,
                 scratch,

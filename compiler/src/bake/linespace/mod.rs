@@ -9,7 +9,7 @@ pub mod voxelize;
 
 use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::MAX_SHAFT_RES;
-use kiln_format::linespace::{GridHeader, MAX_CANDIDATE_CELL_TRIANGLES, NO_SLOT, PnmtRecord, Variants};
+use kiln_format::linespace::{GridHeader, MAX_CANDIDATE_CELL_TRIANGLES, NO_SLOT, PnmtLayout, Variants};
 use kiln_format::sections::Vertex;
 use rayon::prelude::*;
 
@@ -37,8 +37,8 @@ pub struct BakedLineSpace {
     pub candidate_offsets: Vec<u32>,
     /// Candidate entries.
     pub candidates: Vec<u32>,
-    /// PNMT records.
-    pub pnmt: Vec<PnmtRecord>,
+    /// PNMT records, in the header's layout.
+    pub pnmt: Vec<u32>,
     /// Pre-illuminated radiance per filled shaft.
     pub preillum: Vec<[u16; 8]>,
     /// (Triangle, shaft) pairs tested exactly.
@@ -49,6 +49,13 @@ pub struct BakedLineSpace {
     pub voxel_ms: f64,
     /// Wall time of the whole bake, ms.
     pub total_ms: f64,
+}
+
+impl BakedLineSpace {
+    /// How the PNMT records are stored.
+    pub fn pnmt_layout(&self) -> PnmtLayout {
+        PnmtLayout::from_code(self.header.pnmt_layout).unwrap_or_default()
+    }
 }
 
 /// Scene attributes for PNMT records, over triangles in stored (BVH) order.
@@ -91,13 +98,16 @@ impl HitAttributes for SceneAttributes<'_> {
 }
 
 /// Bakes the line space over `voxels` (the voxel grid in `attrs`' triangle order, which took
-/// `voxel_ms` to build) at shaft resolution `n` with `variants` (0: grid only).
+/// `voxel_ms` to build) at shaft resolution `n` with `variants` (0: grid only), PNMT records
+/// in `layout`.
+#[allow(clippy::too_many_arguments)]
 pub fn bake(
     attrs: &SceneAttributes,
     voxels: voxelize::Voxels,
     voxel_ms: f64,
     n: u32,
     variants: u32,
+    layout: PnmtLayout,
     shade: Option<&Shade<'_>>,
     progress: &Progress,
 ) -> CliResult<BakedLineSpace> {
@@ -134,6 +144,7 @@ pub fn bake(
     }
     header.shaft_res = n;
     header.variants = variants;
+    header.pnmt_layout = layout.code();
     let occupied: Vec<usize> = (0..cells).filter(|&c| cell_len(c) > 0).collect();
     let mut slots = vec![NO_SLOT; cells];
     for (s, &c) in occupied.iter().enumerate() {
@@ -166,6 +177,7 @@ pub fn bake(
                     margin_local,
                     candidates,
                     pnmt,
+                    layout,
                     attrs,
                     shade,
                     scratch,
@@ -198,11 +210,8 @@ pub fn bake(
             append_par(&mut out.candidate_offsets, &cells, list_ends, done);
         }
         if pnmt {
-            append_par(&mut out.pnmt, &per_cell, |c| c.pnmt.as_flattened().iter().copied(), done);
-            out.pnmt_missing += per_cell
-                .par_iter()
-                .map(|c| c.pnmt.iter().filter(|r| !r[0].is_some() || !r[1].is_some()).count() as u64)
-                .sum::<u64>();
+            append_par(&mut out.pnmt, &per_cell, |c| c.pnmt.iter().copied(), done);
+            out.pnmt_missing += per_cell.iter().map(|c| c.pnmt_missing).sum::<u64>();
         }
         if shade.is_some() {
             append_par(&mut out.preillum, &per_cell, |c| c.preillum.iter().copied(), done);

@@ -7,7 +7,7 @@ use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::{
     FACE_PAIRS, MAX_SHAFT_RES, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel,
 };
-use kiln_format::linespace::{PnmtRecord, entry, words_per_slot};
+use kiln_format::linespace::{PnmtLayout, RecordWords, entry, words_per_slot};
 
 use super::geometry::{PairAxes, Prepared, clip_to_box_into, window_offset};
 
@@ -21,8 +21,11 @@ pub struct CellShafts {
     pub entries: Vec<u32>,
     /// Where each filled shaft's list ends in `entries` (empty without candidates).
     pub list_ends: Vec<u32>,
-    /// Front and back records of each filled shaft, in shaft order (empty without PNMT).
-    pub pnmt: Vec<[PnmtRecord; 2]>,
+    /// Front and back records of each filled shaft, in shaft order, as the layout's words
+    /// (empty without PNMT).
+    pub pnmt: Vec<u32>,
+    /// Filled shafts lacking a front or back record.
+    pub pnmt_missing: u64,
     /// Front and back radiance (binary16 RGB, 0) of each filled shaft (empty without it).
     pub preillum: Vec<[u16; 8]>,
     /// Overlap tests run (for the bake report).
@@ -480,12 +483,12 @@ pub struct Scratch {
     polys: Vec<Vec<DVec3>>,
     clip_tmp: Vec<DVec3>,
     /// The cell's fallback records by (triangle, pair, end), [`UNMADE`] until made.
-    fallbacks: Vec<PnmtRecord>,
+    fallbacks: Vec<RecordWords>,
 }
 
-/// A fallback record not made yet (no record the encoder makes: its material is the absent
-/// record's, its position is not).
-const UNMADE: PnmtRecord = PnmtRecord { position: [u16::MAX; 3], ..PnmtRecord::NONE };
+/// A fallback record not made yet: no layout's encoder makes it (the full record's material
+/// is clamped below all ones, the compact ones leave the fourth word zero).
+const UNMADE: RecordWords = [u32::MAX; 4];
 
 /// Patches per face at the largest shaft resolution.
 const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
@@ -516,6 +519,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     margin: f64,
     candidates: bool,
     pnmt: bool,
+    layout: PnmtLayout,
     attrs: &A,
     shade: Option<&Shade<'_>>,
     scratch: &mut Scratch,
@@ -666,7 +670,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     if records_needed {
         let count = out.bits.iter().map(|w| w.count_ones() as usize).sum();
         if pnmt {
-            out.pnmt.reserve_exact(count);
+            out.pnmt.reserve_exact(count * 2 * layout.words());
         }
         if shade.is_some() {
             out.preillum.reserve_exact(count);
@@ -683,11 +687,11 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
             let pair = shaft as u32 / (n * n * n * n);
             let (fa, fb) = pair_faces(pair);
             let w = outward(fb) - outward(fa);
-            let record = |e: &End, side: usize, fallbacks: &mut Vec<PnmtRecord>| -> PnmtRecord {
+            let record = |e: &End, side: usize, fallbacks: &mut Vec<RecordWords>| -> RecordWords {
                 if e.t.is_finite() {
                     let [a, b, c] = attrs.corners(e.triangle);
                     let p = (a * (1.0 - e.u - e.v) + b * e.u + c * e.v).as_dvec3();
-                    return PnmtRecord::encode(
+                    return layout.encode(
                         p,
                         attrs.normal(e.triangle, e.u, e.v),
                         attrs.material(e.triangle),
@@ -700,7 +704,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 // at its clipped vertex nearest that end. That depends on the triangle, the pair
                 // and the end alone, so it is made once per cell (a third of the records of
                 // seed 004's scenes are fallbacks).
-                let Some(poly) = polys.get(e.local as usize) else { return PnmtRecord::NONE };
+                let Some(poly) = polys.get(e.local as usize) else { return layout.none() };
                 let slot = &mut fallbacks[(e.local * FACE_PAIRS + pair) as usize * 2 + side];
                 if *slot != UNMADE {
                     return *slot;
@@ -709,11 +713,11 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                     let (kx, ky) = (x.dot(w), y.dot(w));
                     if side == 0 { kx.total_cmp(&ky) } else { ky.total_cmp(&kx) }
                 });
-                let Some(q) = best else { return PnmtRecord::NONE };
+                let Some(q) = best else { return layout.none() };
                 let t = tris[e.local as usize];
                 let world = world_cell_min + q.clamp(DVec3::ZERO, DVec3::ONE) * cell;
                 let (u, v) = barycentric(attrs.corners(t), world.as_vec3());
-                *slot = PnmtRecord::encode(
+                *slot = layout.encode(
                     world,
                     attrs.normal(t, u, v),
                     attrs.material(t),
@@ -728,7 +732,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 let (_, pa, _, pb) = shaft_parts(shaft as u32, n);
                 let mut rgb = [0u16; 8];
                 for (k, r) in pair_records.iter().enumerate() {
-                    let Some(hit) = r.decode(world_cell_min, cell) else { continue };
+                    let Some(hit) = layout.decode(r, world_cell_min, cell) else { continue };
                     // The viewer of the front record is at the front patch, of the back one at the back.
                     let eye = if k == 0 {
                         centres[fa as usize][pa as usize]
@@ -744,7 +748,10 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 out.preillum.push(rgb);
             }
             if pnmt {
-                out.pnmt.push(pair_records);
+                let words = layout.words();
+                out.pnmt.extend_from_slice(&pair_records[0][..words]);
+                out.pnmt.extend_from_slice(&pair_records[1][..words]);
+                out.pnmt_missing += pair_records.iter().any(|r| !layout.is_some(r)) as u64;
             }
         }
     }
@@ -920,6 +927,7 @@ mod tests {
                     margin,
                     candidates,
                     pnmt,
+                    PnmtLayout::Full,
                     &attrs,
                     None,
                     &mut Scratch::default(),

@@ -30,6 +30,7 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
         voxel_ms,
         ctx.plan.shaft_res,
         ctx.plan.shaft_variants,
+        ctx.plan.pnmt_layout,
         Some(&shade),
         ctx.progress,
     )?;
