@@ -26,12 +26,14 @@ fn demo_inspect_verify() {
     );
     assert_eq!(j["line_space"]["shaft_res"], 4);
     assert!(j["line_space"]["bytes_pnmt"].as_u64().unwrap() > 0);
-    // FORMAT.md's PNMT: a front and a back record of 16 bytes per filled shaft.
+    // FORMAT.md's PNMT: a front and a back record per filled shaft, 8 bytes each in the default
+    // (compact) layout of a scene that samples no texture.
     let filled = j["line_space"]["filled_shafts"].as_u64().unwrap();
-    assert_eq!(j["line_space"]["bytes_pnmt"].as_u64().unwrap(), 32 * filled);
+    assert_eq!(j["line_space"]["bytes_pnmt"].as_u64().unwrap(), 16 * filled);
+    assert_eq!(j["line_space"]["pnmt_records"], "compact-no-uv");
     let text = kiln(dir.path(), &["inspect", "demo.kiln"]);
     assert!(text.stdout.contains("bytes per filled shaft: binary "), "{text:?}");
-    assert!(text.stdout.contains(", PNMT 32.00"), "{text:?}");
+    assert!(text.stdout.contains(", PNMT 16.00"), "{text:?}");
     assert!(j["sections"].as_array().unwrap().iter().all(|s| s["checksum_ok"] == true));
     assert_eq!(j["summary"]["triangles"], 30);
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");
@@ -102,7 +104,7 @@ fn exit_codes() {
     let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
-    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.2").says("1.x");
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.3").says("1.x");
 }
 
 #[test]
