@@ -538,9 +538,11 @@ struct Grid {
     preillum: Vec<[u16; 8]>,
 }
 
-/// A PNMT record's fields by FORMAT.md ("`LSPN`: PNMT records"): cell-local position, material
-/// (`None`: no record), octahedral normal, uv.
-fn pnmt_fields(layout: u32, rec: &[u8]) -> Option<([f64; 3], u32, [f64; 3], [f32; 2])> {
+/// A PNMT record's cell-local position, material, normal and uv.
+type RecordFields = ([f64; 3], u32, [f64; 3], [f32; 2]);
+
+/// A PNMT record's fields by FORMAT.md ("`LSPN`: PNMT records"); `None`: no record.
+fn pnmt_fields(layout: u32, rec: &[u8]) -> Option<RecordFields> {
     use spec::*;
     if layout == 0 {
         let material = u16_at(rec, 6) as u32;
