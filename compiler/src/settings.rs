@@ -38,7 +38,8 @@ impl BvhPreset {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum PnmtRecords {
     /// 12 bytes a record (8 where no material samples a texture): positions in 1/1023 of a
-    /// cell, normals within 0.12°, at most 4,094 materials (more fall back to full).
+    /// cell, normals within 0.12°, material indices up to 4094 (scenes of more than 4,095
+    /// materials fall back to full).
     #[default]
     Compact,
     /// 16 bytes a record: positions in 1/65535 of a cell, normals within 0.005°.

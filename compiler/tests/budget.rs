@@ -45,6 +45,7 @@ fn a_budget_forces_a_smaller_configuration_that_fits() {
     let r = report(dir.path(), "full.json");
     assert_eq!(r["line_space_plan"]["estimate"]["shaft_res"], 4);
     assert_eq!(r["line_space"]["variants"], "binary,candidates,pnmt");
+    assert_eq!(r["line_space"]["pnmt_records"], "compact-no-uv");
     // Every cell of the demo is sampled, so the estimate is the baked size.
     assert_eq!(r["line_space_plan"]["bytes"].as_u64().unwrap(), full);
     // 1 MiB: the voxel resolution is at its floor (4), so N drops; candidates go first (binary

@@ -34,6 +34,19 @@ fn demo_inspect_verify() {
     let text = kiln(dir.path(), &["inspect", "demo.kiln"]);
     assert!(text.stdout.contains("bytes per filled shaft: binary "), "{text:?}");
     assert!(text.stdout.contains(", PNMT 16.00"), "{text:?}");
+    // FORMAT.md 1.3: compact records in VGRD and LSPN version 2; full ones (and their header) at
+    // version 1, which a 1.2 reader reads.
+    let version = |j: &serde_json::Value, kind: &str| {
+        j["sections"].as_array().unwrap().iter().find(|s| s["kind"] == kind).unwrap()["version"].clone()
+    };
+    assert_eq!((version(&j, "VGRD"), version(&j, "LSPN")), (2.into(), 2.into()));
+    kiln(dir.path(), &["demo", "-o", "full.kiln", "-q", "--pnmt-records", "full"]).expect(0);
+    let full: serde_json::Value =
+        serde_json::from_str(&kiln(dir.path(), &["inspect", "full.kiln", "--json"]).stdout).unwrap();
+    assert_eq!((version(&full, "VGRD"), version(&full, "LSPN")), (1.into(), 1.into()));
+    assert_eq!(full["line_space"]["pnmt_records"], "full");
+    assert_eq!(full["line_space"]["bytes_pnmt"].as_u64().unwrap(), 32 * filled);
+    kiln(dir.path(), &["verify", "full.kiln"]).expect(0);
     assert!(j["sections"].as_array().unwrap().iter().all(|s| s["checksum_ok"] == true));
     assert_eq!(j["summary"]["triangles"], 30);
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");

@@ -431,17 +431,10 @@ bool ls_pnmt_hit(vec3 origin, vec3 dir, float tmin, float tmax, vec3 origin_norm
         }
         uint words = LS_PNMT_WORDS[grid.pnmt_layout];
         uint base = grid.bases_b.w + words * (2u * uint(rank) + (l.front ? 0u : 1u));
-        uvec4 w = uvec4(ls_word(base), ls_word(base + 1u), 0u, 0u);
-        if (words > 2u) {
-            w.z = ls_word(base + 2u);
-        }
-        if (words > 3u) {
-            w.w = ls_word(base + 3u);
-        }
+        uint w1 = ls_word(base + 1u);
         vec3 local;
-        vec2 oct, uv;
         uint material;
-        if (!ls_pnmt_fields(grid.pnmt_layout, w, local, oct, material, uv)) {
+        if (!ls_pnmt_head(grid.pnmt_layout, ls_word(base), w1, local, material)) {
             continue;
         }
         // The record relative to the ray's origin, from grid coordinates: far from the world
@@ -451,9 +444,12 @@ bool ls_pnmt_hit(vec3 origin, vec3 dir, float tmin, float tmax, vec3 origin_norm
         bool in_front = !check_plane || dot(rel, origin_normal) > grid.pnmt_step;
         if (t >= tmin && t <= tmax && in_front) {
             rec.position = origin + rel;
+            uint w2 = words > 2u ? ls_word(base + 2u) : 0u;
+            uint w3 = words > 3u ? ls_word(base + 3u) : 0u;
+            vec2 oct;
+            ls_pnmt_tail(grid.pnmt_layout, w1, w2, w3, oct, rec.uv);
             rec.normal = ls_oct_decode(oct);
             rec.material = material;
-            rec.uv = uv;
             rec.t = t;
             rec.rank = uint(rank);
             rec.front = l.front;

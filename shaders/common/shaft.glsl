@@ -74,21 +74,30 @@ uint ls_entry_local(uint e) { return e & 0xFFFFu; }
 uint ls_entry_key_min(uint e) { return (e >> 16) & 0xFFu; }
 uint ls_entry_prefix_key_max(uint e) { return e >> 24; }
 
-// A PNMT record's fields from its words w (w.x, w.y always; w.z, w.w where the layout has them)
-// in layout `kind` (LS_PNMT_*): false for an absent record. `local` is the position in the unit cell.
-bool ls_pnmt_fields(uint kind, uvec4 w, out vec3 local, out vec2 oct, out uint material, out vec2 uv) {
+// A PNMT record's material and position in the unit cell from its first two words in layout
+// `kind` (LS_PNMT_*): false for an absent record. Every layout keeps both in those words, so a
+// record the query rejects costs two loads.
+bool ls_pnmt_head(uint kind, uint w0, uint w1, out vec3 local, out uint material) {
     if (kind == LS_PNMT_FULL) {
-        material = w.y >> 16;
-        local = vec3(float(w.x & 0xFFFFu), float(w.x >> 16), float(w.y & 0xFFFFu)) / 65535.0;
-        oct = unpackSnorm2x16(w.z);
-        uv = unpackHalf2x16(w.w);
+        material = w1 >> 16;
+        local = vec3(float(w0 & 0xFFFFu), float(w0 >> 16), float(w1 & 0xFFFFu)) / 65535.0;
         return material != LS_NO_RECORD;
     }
-    material = (w.y >> 22) | ((w.x >> 30) << 10);
-    local = vec3(float(w.x & 0x3FFu), float((w.x >> 10) & 0x3FFu), float((w.x >> 20) & 0x3FFu)) / 1023.0;
-    oct = (vec2(float(w.y & 0x7FFu), float((w.y >> 11) & 0x7FFu)) - 1023.0) / 1023.0;
-    uv = kind == LS_PNMT_COMPACT ? unpackHalf2x16(w.z) : vec2(0.0);
+    material = (w1 >> 22) | ((w0 >> 30) << 10);
+    local = vec3(float(w0 & 0x3FFu), float((w0 >> 10) & 0x3FFu), float((w0 >> 20) & 0x3FFu)) / 1023.0;
     return material != LS_NO_RECORD_COMPACT;
+}
+
+// The rest of a record: its octahedral normal and uv, from its second word w1 and the words after
+// it, w2 and w3 (read only where the layout has them; pass 0 otherwise).
+void ls_pnmt_tail(uint kind, uint w1, uint w2, uint w3, out vec2 oct, out vec2 uv) {
+    if (kind == LS_PNMT_FULL) {
+        oct = unpackSnorm2x16(w2);
+        uv = unpackHalf2x16(w3);
+        return;
+    }
+    oct = (vec2(float(w1 & 0x7FFu), float((w1 >> 11) & 0x7FFu)) - 1023.0) / 1023.0;
+    uv = kind == LS_PNMT_COMPACT ? unpackHalf2x16(w2) : vec2(0.0);
 }
 
 // Octahedral decoding of a unit normal from two snorm values.

@@ -113,6 +113,8 @@ pub struct LineSpaceStats {
     pub bytes_candidates: u64,
     /// Bytes of the PNMT records.
     pub bytes_pnmt: u64,
+    /// How the PNMT records are stored: `full`, `compact` or `compact-no-uv` (null without PNMT).
+    pub pnmt_records: Option<&'static str>,
 }
 
 /// Hash of the inputs: the contents of every file read, in reading order, or the scene data
@@ -312,11 +314,18 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
             h.part("voxel-res", &p.voxel_res.to_le_bytes())
                 .part("shaft-res", &p.shaft_res.to_le_bytes())
                 .part("variants", &p.shaft_variants.to_le_bytes())
-                .part("pnmt-layout", &p.pnmt_layout.code().to_le_bytes())
                 .part("bounds", &bounds(&ctx.geometry.bounds))
                 .hash("geometry", &ctx.geometry_key)
                 .part("triangle-materials", bytemuck::cast_slice(&ctx.triangle_materials))
                 .part("uvs", bytemuck::cast_slice(&scene.uvs));
+            // The records' layout only where records are baked (binary and candidates alone do
+            // not depend on it).
+            if p.shaft_variants
+                & (kiln_format::linespace::Variants::PNMT | kiln_format::linespace::Variants::PREILLUM)
+                != 0
+            {
+                h.part("pnmt-layout", &p.pnmt_layout.code().to_le_bytes());
+            }
             if p.shaft_variants & kiln_format::linespace::Variants::PREILLUM != 0 {
                 let lut = if p.runs(Stage::BrdfLut) { s.brdf_lut_res } else { 0 };
                 h.part("lights", &records_bytes(&scene.lights, &[]))
@@ -587,6 +596,9 @@ impl LineSpaceStats {
             bytes_binary: bytes(&[k::SHAFT_SLOTS, k::SHAFT_BITS, k::SHAFT_RANKS]),
             bytes_candidates: bytes(&[k::CANDIDATE_OFFSETS, k::CANDIDATES]),
             bytes_pnmt: bytes(&[k::PNMT]),
+            pnmt_records: (header.variants & kiln_format::linespace::Variants::PNMT != 0)
+                .then(|| kiln_format::linespace::PnmtLayout::from_code(header.pnmt_layout).map(|l| l.name()))
+                .flatten(),
         })
     }
 }
@@ -595,8 +607,20 @@ fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::Wri
     let mut w = kiln_format::FileWriter::new();
     w.compression(baked.codec.compression());
     w.manifest(&baked.manifest, baked.manifest_hash)?;
+    // Full PNMT records (or none) are what version 1 of VGRD and LSPN hold, byte for byte: written
+    // at version 1, such a file stays readable by format 1.2 readers. Compact ones need version 2.
+    let full = baked
+        .sections
+        .iter()
+        .find(|s| s.kind == kiln_format::sections::GRID)
+        .and_then(|s| bytemuck::try_pod_read_unaligned::<kiln_format::linespace::GridHeader>(&s.bytes).ok())
+        .is_some_and(|h| h.pnmt_layout == kiln_format::linespace::PnmtLayout::Full.code());
     for s in &baked.sections {
-        w.bytes(s.kind, s.index, s.bytes.as_slice(), s.hash)?;
+        if full && [kiln_format::sections::GRID, kiln_format::sections::PNMT].contains(&s.kind) {
+            w.raw(s.kind, s.index, 1, s.bytes.as_slice(), s.hash)?;
+        } else {
+            w.bytes(s.kind, s.index, s.bytes.as_slice(), s.hash)?;
+        }
     }
     Ok(w)
 }

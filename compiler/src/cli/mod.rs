@@ -156,7 +156,7 @@ pub struct BakeArgs {
         value_enum,
         help_heading = "Voxel grid and line space",
         help = "How PNMT records are stored: compact (12 bytes a record, 8 where no material samples a \
-texture: positions to 1/1023 of a cell, normals within 0.12°, at most 4094 materials, beyond which full is \
+texture: positions to 1/1023 of a cell, normals within 0.12°, up to 4,095 materials, beyond which full is \
 used) or full (16 bytes: positions to 1/65535 of a cell, normals within 0.005°). The compact error is far \
 below PNMT's own (a shaft's midpoint ray stands for rays up to a patch apart) [default: compact, or the \
 sidecar's bake.pnmt_records]"

@@ -12,9 +12,9 @@
 //! record is accepted only if its stored point `p` lies in the ray's interval
 //! (`tmin ≤ (p − o)·d / |d|² ≤ tmax`) and, for rays leaving a surface with geometric normal `n`
 //! (oriented to the side the ray leaves into), strictly in front of that surface's tangent plane:
-//! `(p − o)·n > q`, where `q` is the record's quantisation step (cell · √3 / 65535, or / 1023 in the compact layouts) plus the grid
-//! margin. Records of the origin's own plane are thus rejected, while other surfaces, including
-//! the far side of a concave one, are accepted.
+//! `(p − o)·n > q`, where `q` is the record's quantisation step (cell · √3 / 65535, or / 1023 in
+//! the compact layouts) plus the grid margin. Records of the origin's own plane are thus
+//! rejected, while other surfaces, including the far side of a concave one, are accepted.
 
 use glam::{DVec3, Vec3};
 
