@@ -116,8 +116,9 @@ impl PnmtLayout {
         self.material(w) != NO_RECORD
     }
 
-    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell` (see
-    /// [`PnmtRecord::encode`]); materials beyond [`Self::max_material`] are clamped to it.
+    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell`; materials
+    /// beyond [`Self::max_material`] are clamped to it. `normal` need not be of unit length (+Z
+    /// where it is zero or not finite).
     pub fn encode(
         self,
         position: DVec3,
@@ -127,22 +128,33 @@ impl PnmtLayout {
         cell_min: DVec3,
         cell: f64,
     ) -> RecordWords {
-        if self == Self::Full {
-            return bytemuck::cast(PnmtRecord::encode(position, normal, material, uv, cell_min, cell));
-        }
+        // One division, not three: they were a quarter of the encoding's time in the bake.
         let local = ((position - cell_min) * (1.0 / cell)).clamp(DVec3::ZERO, DVec3::ONE);
-        let q = |x: f64| round_unsigned(x * 1023.0);
+        let steps = self.position_steps();
+        let q = local.to_array().map(|x| round_unsigned(x * steps));
+        // The octahedral map divides by the L1 norm, so any finite non-zero direction will do,
+        // unit or not (normalising it first was a tenth of the PNMT bake). A zero or non-finite
+        // one maps to NaN, which the rounding below makes 0: +Z.
         let e = oct_encode(normal);
-        // snorm11: −1023..=1023, stored plus 1023.
-        let s = |x: f32| (round_signed(x.clamp(-1.0, 1.0) * 1023.0) + 1023) as u32;
+        let snorm = if self == Self::Full { 32767.0 } else { 1023.0 };
+        let s = [e.x, e.y].map(|x| round_signed(x.clamp(-1.0, 1.0) * snorm));
         let m = material.min(self.max_material()) as u32;
         let uv = f16::from_f32(uv.x).to_bits() as u32 | (f16::from_f32(uv.y).to_bits() as u32) << 16;
-        [
-            q(local.x) | q(local.y) << 10 | q(local.z) << 20 | (m >> 10) << 30,
-            s(e.x) | s(e.y) << 11 | (m & 0x3ff) << 22,
-            if self == Self::Compact { uv } else { 0 },
-            0,
-        ]
+        match self {
+            Self::Full => {
+                [q[0] | q[1] << 16, q[2] | m << 16, s[0] as u16 as u32 | (s[1] as u16 as u32) << 16, uv]
+            }
+            // snorm11: −1023..=1023, stored plus 1023.
+            _ => {
+                let s = s.map(|x| (x + 1023) as u32);
+                [
+                    q[0] | q[1] << 10 | q[2] << 20 | (m >> 10) << 30,
+                    s[0] | s[1] << 11 | (m & 0x3ff) << 22,
+                    if self == Self::Compact { uv } else { 0 },
+                    0,
+                ]
+            }
+        }
     }
 
     /// Decodes a record (`words` at least [`Self::words`] long) of the voxel with minimum
@@ -246,32 +258,6 @@ fn round_signed(x: f32) -> i32 {
 }
 
 impl PnmtRecord {
-    /// Encodes a hit in the voxel with minimum corner `cell_min` and edge `cell`. `normal` need
-    /// not be of unit length (+Z where it is zero or not finite).
-    pub fn encode(
-        position: DVec3,
-        normal: Vec3,
-        material: u16,
-        uv: Vec2,
-        cell_min: DVec3,
-        cell: f64,
-    ) -> PnmtRecord {
-        // One division, not three: they were a quarter of the encoding's time in the bake.
-        let local = ((position - cell_min) * (1.0 / cell)).clamp(DVec3::ZERO, DVec3::ONE);
-        let q = |x: f64| round_unsigned(x * 65535.0) as u16;
-        // The octahedral map divides by the L1 norm, so any finite non-zero direction will do,
-        // unit or not (normalising it first was a tenth of the PNMT bake). A zero or non-finite
-        // one maps to NaN, which the rounding below makes 0: +Z.
-        let e = oct_encode(normal);
-        let s = |x: f32| round_signed(x.clamp(-1.0, 1.0) * 32767.0) as i16;
-        PnmtRecord {
-            position: [q(local.x), q(local.y), q(local.z)],
-            material: material.min(NO_RECORD - 1),
-            normal: [s(e.x), s(e.y)],
-            uv: [f16::from_f32(uv.x).to_bits(), f16::from_f32(uv.y).to_bits()],
-        }
-    }
-
     /// Whether the record holds a hit.
     pub fn is_some(&self) -> bool {
         self.material != NO_RECORD
@@ -302,28 +288,39 @@ impl PnmtRecord {
 mod tests {
     use super::*;
 
+    /// `count` directions spread evenly over the sphere (a Fibonacci lattice).
+    fn sphere(count: u32) -> impl Iterator<Item = Vec3> {
+        (0..count).map(move |i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / count as f32;
+            let phi = i as f32 * 2.399_963;
+            let r = (1.0 - z * z).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        })
+    }
+
+    /// The angle between two directions in degrees: atan2(|a × b|, a · b) in f64 (acos of an
+    /// f32 dot product near 1 alone errs by 0.02°).
+    fn degrees(a: Vec3, b: Vec3) -> f64 {
+        let (a, b) = (a.as_dvec3(), b.as_dvec3());
+        a.cross(b).length().atan2(a.dot(b)).to_degrees()
+    }
+
     /// Normals of any length (unit, and scaled from 1e-30 to 1e30) come back within 0.005° of
     /// their direction; zero, infinite and NaN ones encode +Z.
     #[test]
     fn octahedral_round_trip_is_within_0_005_degrees() {
         let mut worst = 0.0f64;
-        for i in 0..2000 {
-            let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
-            let phi = i as f32 * 2.399_963;
-            let r = (1.0 - z * z).sqrt();
-            let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+        for n in sphere(2000) {
             for scale in [1.0, 1e-30, 1e-3, 7.0, 1e30] {
-                let rec = PnmtRecord::encode(DVec3::ZERO, n * scale, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
-                let back = rec.decode(DVec3::ZERO, 1.0).unwrap().normal;
-                // atan2(|a × b|, a · b) in f64: acos of an f32 dot product near 1 alone errs by 0.02°.
-                let (a, b) = (n.as_dvec3(), back.as_dvec3());
-                worst = worst.max(a.cross(b).length().atan2(a.dot(b)).to_degrees());
+                let w = PnmtLayout::Full.encode(DVec3::ZERO, n * scale, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
+                let back = PnmtLayout::Full.decode(&w, DVec3::ZERO, 1.0).unwrap().normal;
+                worst = worst.max(degrees(n, back));
             }
         }
         assert!(worst < 0.005, "worst normal error {worst} degrees");
         for n in [Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 1.0), Vec3::new(0.0, f32::NAN, 1.0)] {
-            let rec = PnmtRecord::encode(DVec3::ZERO, n, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
-            assert_eq!(rec.decode(DVec3::ZERO, 1.0).unwrap().normal, Vec3::Z, "{n}");
+            let w = PnmtLayout::Full.encode(DVec3::ZERO, n, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
+            assert_eq!(PnmtLayout::Full.decode(&w, DVec3::ZERO, 1.0).unwrap().normal, Vec3::Z, "{n}");
         }
     }
 
@@ -370,15 +367,10 @@ mod tests {
                 assert!(worst <= 0.5 / 1023.0 + 1e-9, "{layout:?}: position error {worst} cells");
             }
             let mut worst = 0.0f64;
-            for i in 0..20000 {
-                let z = 1.0 - 2.0 * (i as f32 + 0.5) / 20000.0;
-                let phi = i as f32 * 2.399_963;
-                let r = (1.0 - z * z).sqrt();
-                let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            for n in sphere(20000) {
                 let w = layout.encode(DVec3::ZERO, n * 3.0, 0, Vec2::ZERO, DVec3::ZERO, 1.0);
                 let back = layout.decode(&w, DVec3::ZERO, 1.0).unwrap().normal;
-                let (a, b) = (n.as_dvec3(), back.as_dvec3());
-                worst = worst.max(a.cross(b).length().atan2(a.dot(b)).to_degrees());
+                worst = worst.max(degrees(n, back));
             }
             assert!(worst < 0.12, "{layout:?}: normal error {worst} degrees");
             for (m, want) in
@@ -423,8 +415,8 @@ mod tests {
     fn positions_quantise_to_the_cell() {
         let min = DVec3::new(1e5, -3.0, 7.0);
         let p = min + DVec3::new(0.25, 0.5, 0.999) * 0.1;
-        let rec = PnmtRecord::encode(p, Vec3::X, 3, Vec2::new(0.5, 2.0), min, 0.1);
-        let hit = rec.decode(min, 0.1).unwrap();
+        let w = PnmtLayout::Full.encode(p, Vec3::X, 3, Vec2::new(0.5, 2.0), min, 0.1);
+        let hit = PnmtLayout::Full.decode(&w, min, 0.1).unwrap();
         assert!((hit.position - p).abs().max_element() <= 0.1 / 65535.0);
         assert_eq!((hit.material, hit.uv), (3, Vec2::new(0.5, 2.0)));
         assert!(PnmtRecord::NONE.decode(min, 0.1).is_none());
