@@ -139,10 +139,12 @@ impl PnmtLayout {
         let snorm = if self == Self::Full { 32767.0 } else { 1023.0 };
         let s = [e.x, e.y].map(|x| round_signed(x.clamp(-1.0, 1.0) * snorm));
         let m = material.min(self.max_material()) as u32;
-        let uv = f16::from_f32(uv.x).to_bits() as u32 | (f16::from_f32(uv.y).to_bits() as u32) << 16;
+        // Only for layouts that store it: baseline x86-64 has no F16C, so each conversion is a
+        // software routine.
+        let uv = || f16::from_f32(uv.x).to_bits() as u32 | (f16::from_f32(uv.y).to_bits() as u32) << 16;
         match self {
             Self::Full => {
-                [q[0] | q[1] << 16, q[2] | m << 16, s[0] as u16 as u32 | (s[1] as u16 as u32) << 16, uv]
+                [q[0] | q[1] << 16, q[2] | m << 16, s[0] as u16 as u32 | (s[1] as u16 as u32) << 16, uv()]
             }
             // snorm11: −1023..=1023, stored plus 1023.
             _ => {
@@ -150,7 +152,7 @@ impl PnmtLayout {
                 [
                     q[0] | q[1] << 10 | q[2] << 20 | (m >> 10) << 30,
                     s[0] | s[1] << 11 | (m & 0x3ff) << 22,
-                    if self == Self::Compact { uv } else { 0 },
+                    if self == Self::Compact { uv() } else { 0 },
                     0,
                 ]
             }
