@@ -769,12 +769,17 @@ struct SegmentTest {
     c: [Vec3; 3],
     n: Vec3,
     n2: f32,
+    /// n × (each edge), corner to next corner: an edge function n · (edge × (p − corner)) is
+    /// (n × edge) · (p − corner), one dot product per edge and hit instead of a cross product
+    /// and a dot.
+    m: [Vec3; 3],
 }
 
 impl SegmentTest {
     fn new(c: [Vec3; 3]) -> SegmentTest {
         let n = (c[1] - c[0]).cross(c[2] - c[0]);
-        SegmentTest { c, n, n2: n.length_squared() }
+        let m = [n.cross(c[1] - c[0]), n.cross(c[2] - c[1]), n.cross(c[0] - c[2])];
+        SegmentTest { c, n, n2: n.length_squared(), m }
     }
 
     /// (t, u, v) where the segment o → e crosses the triangle.
@@ -790,9 +795,9 @@ impl SegmentTest {
         }
         let p = o + d * t;
         let [a, b, c] = self.c;
-        let w0 = self.n.dot((b - a).cross(p - a));
-        let w1 = self.n.dot((c - b).cross(p - b));
-        let w2 = self.n.dot((a - c).cross(p - c));
+        let w0 = self.m[0].dot(p - a);
+        let w1 = self.m[1].dot(p - b);
+        let w2 = self.m[2].dot(p - c);
         (w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0).then(|| Intersection { t, u: w2 / self.n2, v: w0 / self.n2 })
     }
 }
