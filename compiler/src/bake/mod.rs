@@ -597,7 +597,7 @@ impl LineSpaceStats {
             bytes_candidates: bytes(&[k::CANDIDATE_OFFSETS, k::CANDIDATES]),
             bytes_pnmt: bytes(&[k::PNMT]),
             pnmt_records: (header.variants & kiln_format::linespace::Variants::PNMT != 0)
-                .then(|| kiln_format::linespace::PnmtLayout::from_code(header.pnmt_layout).map(|l| l.name()))
+                .then(|| header.pnmt_records().map(|l| l.name()))
                 .flatten(),
         })
     }

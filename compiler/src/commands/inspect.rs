@@ -140,7 +140,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
                 bytes_binary: size(&[sections::SHAFT_SLOTS, sections::SHAFT_BITS, sections::SHAFT_RANKS]),
                 bytes_candidates: size(&[sections::CANDIDATE_OFFSETS, sections::CANDIDATES]),
                 bytes_pnmt: size(&[sections::PNMT]),
-                pnmt_records: kiln_format::linespace::PnmtLayout::from_code(g.pnmt_layout).map(|l| l.name()),
+                pnmt_records: g.pnmt_records().map(|l| l.name()),
             }
         });
     let h = file.header();

@@ -72,6 +72,11 @@ pub struct GridHeader {
 const _: () = assert!(size_of::<GridHeader>() == 96);
 
 impl GridHeader {
+    /// The layout [`Self::pnmt_layout`] names, `None` for an undefined code.
+    pub fn pnmt_records(&self) -> Option<crate::linespace::PnmtLayout> {
+        crate::linespace::PnmtLayout::from_code(self.pnmt_layout)
+    }
+
     /// Number of cells.
     pub fn cell_count(&self) -> u64 {
         self.dims.iter().map(|&d| d as u64).product()

@@ -139,7 +139,8 @@ impl<'a> LineSpace<'a> {
             candidate_offsets: get(CANDIDATE_OFFSETS)?,
             candidates: get(CANDIDATES)?,
             pnmt: get(PNMT)?,
-            pnmt_layout: PnmtLayout::from_code(h.pnmt_layout)
+            pnmt_layout: h
+                .pnmt_records()
                 .ok_or_else(|| bad(format!("PNMT layout {} is not defined", h.pnmt_layout)))?,
             preillum: file.pod::<[u16; 8]>(PREILLUM, 0)?.unwrap_or(&[]),
             words_per_slot: if h.shaft_res == 0 { 0 } else { words_per_slot(h.shaft_res.min(MAX_SHAFT_RES)) },
@@ -299,12 +300,10 @@ impl<'a> LineSpace<'a> {
                     h.filled
                 )));
             }
-            let layout = self.pnmt_layout;
-            let material = |r: &[u32]| layout.material(r);
             if let Some(m) = self
                 .pnmt
                 .chunks_exact(words)
-                .map(material)
+                .map(|r| self.pnmt_layout.material(r))
                 .find(|&m| m != NO_RECORD && m as usize >= materials)
             {
                 return Err(bad(format!("PNMT record names material {m} of {materials}")));

@@ -55,7 +55,7 @@ impl super::GridHeader {
     /// How far in front of the origin's surface a PNMT record must lie to be accepted (the
     /// position quantisation step plus the margin; see the module documentation).
     pub fn pnmt_step(&self) -> f64 {
-        let steps = super::PnmtLayout::from_code(self.pnmt_layout).unwrap_or_default().position_steps();
+        let steps = self.pnmt_records().unwrap_or_default().position_steps();
         self.cell * 3f64.sqrt() / steps + self.margin
     }
 }

@@ -190,15 +190,7 @@ pub const KNOWN: &[KindInfo] = &[
         description: "light visibility per medium cell (unorm8)",
     },
     // Version 2 (format 1.3): the PNMT record layout in the formerly reserved word at 84.
-    KindInfo {
-        kind: GRID,
-        name: "voxel-grid",
-        version: 2,
-        element_size: 96,
-        required: false,
-        indexed: false,
-        description: "voxel grid and line-space header",
-    },
+    pod_kind_at(GRID, "voxel-grid", 2, 96, "voxel grid and line-space header"),
     pod_kind(VOXEL_OFFSETS, "voxel-offsets", 4, "voxel triangle list offsets"),
     pod_kind(VOXEL_TRIANGLES, "voxel-triangles", 4, "voxel triangle lists"),
     pod_kind(SHAFT_SLOTS, "shaft-slots", 4, "line-space slot per voxel"),
@@ -208,15 +200,7 @@ pub const KNOWN: &[KindInfo] = &[
     pod_kind(CANDIDATES, "candidates", 4, "exact candidate lists per filled shaft"),
     // Version 2 (format 1.3): u32 words of records in the header's layout (version 1: 16-byte
     // records, the full layout).
-    KindInfo {
-        kind: PNMT,
-        name: "pnmt",
-        version: 2,
-        element_size: 4,
-        required: false,
-        indexed: false,
-        description: "front and back hit records per filled shaft",
-    },
+    pod_kind_at(PNMT, "pnmt", 2, 4, "front and back hit records per filled shaft"),
     pod_kind(PREILLUM, "preillum", 16, "front and back radiance per filled shaft"),
 ];
 
@@ -227,7 +211,18 @@ const fn pod_kind(
     element_size: usize,
     description: &'static str,
 ) -> KindInfo {
-    KindInfo { kind, name, version: 1, element_size, required: false, indexed: false, description }
+    pod_kind_at(kind, name, 1, element_size, description)
+}
+
+/// A non-indexed, optional POD kind at `version`.
+const fn pod_kind_at(
+    kind: SectionKind,
+    name: &'static str,
+    version: u16,
+    element_size: usize,
+    description: &'static str,
+) -> KindInfo {
+    KindInfo { kind, name, version, element_size, required: false, indexed: false, description }
 }
 
 /// What this crate knows of `kind`, if anything.

@@ -54,7 +54,7 @@ pub struct BakedLineSpace {
 impl BakedLineSpace {
     /// How the PNMT records are stored.
     pub fn pnmt_layout(&self) -> PnmtLayout {
-        PnmtLayout::from_code(self.header.pnmt_layout).unwrap_or_default()
+        self.header.pnmt_records().unwrap_or_default()
     }
 }
 

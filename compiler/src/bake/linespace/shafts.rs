@@ -295,8 +295,8 @@ fn shaft_of(pair: u32, pa: u32, pb: u32, n: u32) -> u32 {
 }
 
 /// Calls `found(shaft, pa, pb)` for every shaft of face pair `pair` (from patch `pa` of face a to
-/// `pb` of face b) that the triangle `tri` (clipped to the widened cell: `poly`) meets: every [`windows`] window decided by one many-shaft test
-/// ([`PairAxes::shafts_from`]).
+/// `pb` of face b) that the triangle `tri` (clipped to the widened cell: `poly`) meets: every
+/// [`windows`] window decided by one many-shaft test ([`PairAxes::shafts_from`]).
 fn search(
     tri: &Prepared,
     poly: &[DVec3],
