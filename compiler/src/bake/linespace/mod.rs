@@ -4,6 +4,7 @@
 pub mod estimate;
 mod geometry;
 mod shafts;
+mod span;
 pub mod stages;
 pub mod voxelize;
 
@@ -41,7 +42,8 @@ pub struct BakedLineSpace {
     pub pnmt: Vec<u32>,
     /// Pre-illuminated radiance per filled shaft.
     pub preillum: Vec<[u16; 8]>,
-    /// (Triangle, shaft) pairs tested exactly.
+    /// (Triangle, shaft) pairs tested exactly by separating axes (spanning triangles decide
+    /// theirs in closed form, uncounted).
     pub tests: u64,
     /// Filled shafts whose PNMT sample rays all missed (no record).
     pub pnmt_missing: u64,

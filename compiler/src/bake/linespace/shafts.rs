@@ -10,6 +10,7 @@ use kiln_format::linespace::index::{
 use kiln_format::linespace::{PnmtLayout, RecordWords, entry, words_per_slot};
 
 use super::geometry::{PairAxes, Prepared, clip_to_box_into, window_offset};
+use super::span::{Sides, Span, met_from};
 
 /// What one cell contributes to the line space.
 #[derive(Debug, Clone, Default)]
@@ -329,6 +330,30 @@ fn decide(
     }
 }
 
+/// The sides of the plane of the triangle with cell-local corners `v` on which each face's patches
+/// lie, if the triangle spans the cell widened by `margin` and every patch's side is decided.
+fn spanning_sides(v: [DVec3; 3], margin: f64, n: u32) -> Option<[Sides; 6]> {
+    let span = Span::of(v, margin)?;
+    let mut sides = [Sides { above: 0, below: 0 }; 6];
+    for (face, s) in sides.iter_mut().enumerate() {
+        *s = span.sides(face as u32, n)?;
+    }
+    Some(sides)
+}
+
+/// Calls `found(shaft, pa, pb)` for every shaft of face pair `pair` that a spanning triangle
+/// meets, from the sides of its plane on which the patches of face a (`a`) and b (`b`) lie (no
+/// separating-axis test: the bake's count of tests leaves them out).
+fn spanned(a: &Sides, b: &Sides, pair: u32, n: u32, found: &mut impl FnMut(u32, u32, u32)) {
+    let n2 = n * n;
+    let all = if n2 == 64 { u64::MAX } else { (1u64 << n2) - 1 };
+    for pa in 0..n2 {
+        for pb in set_bits(met_from(1 << pa, a, b, all)) {
+            found(shaft_of(pair, pa, pb, n), pa, pb);
+        }
+    }
+}
+
 /// The set bits of `mask`, lowest first.
 #[inline(always)]
 fn set_bits(mut mask: u64) -> impl Iterator<Item = u32> {
@@ -472,6 +497,17 @@ struct End {
     local: u32,
 }
 
+impl End {
+    /// Whether `other` holds the same segment hit (the same record).
+    #[inline(always)]
+    fn same_hit(&self, other: &End) -> bool {
+        self.t.to_bits() == other.t.to_bits()
+            && self.triangle == other.triangle
+            && self.u.to_bits() == other.u.to_bits()
+            && self.v.to_bits() == other.v.to_bits()
+    }
+}
+
 /// Buffers reused across the cells one worker thread bakes (allocating them per cell costs
 /// page faults on every cell).
 #[derive(Debug, Default)]
@@ -569,6 +605,8 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         clip_to_box_into(v, lo_box, hi_box, &mut polys[li], clip_tmp);
         let poly = &polys[li];
         let seg = SegmentTest::new(if records_needed { attrs.corners(t) } else { [Vec3::ZERO; 3] });
+        // A triangle spanning the cell meets what its plane meets (see `span`).
+        let sides = spanning_sides(v, margin, n);
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let w = outward(fb) - outward(fa);
@@ -590,6 +628,13 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 kmin,
                 kmax,
             };
+            if let Some(sides) = &sides {
+                // Every shaft is decided: the all-pairs bake's fills, which the union's equal.
+                spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut |shaft, pa, pb| {
+                    state.fill(shaft, pa, pb, &filler)
+                });
+                continue;
+            }
             if !union {
                 search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft, pa, pb| {
                     state.fill(shaft, pa, pb, &filler)
@@ -727,7 +772,15 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 );
                 *slot
             };
-            let pair_records = [record(&end[0], 0, fallbacks), record(&end[1], 1, fallbacks)];
+            let front = record(&end[0], 0, fallbacks);
+            // A segment with one hit has it at both ends (every shaft of a cell of one triangle):
+            // one encoding, not two.
+            let back = if end[0].t.is_finite() && end[1].same_hit(&end[0]) {
+                front
+            } else {
+                record(&end[1], 1, fallbacks)
+            };
+            let pair_records = [front, back];
             if let Some(shade) = shade {
                 let (_, pa, _, pb) = shaft_parts(shaft as u32, n);
                 let mut rgb = [0u16; 8];
@@ -950,6 +1003,124 @@ mod tests {
         // The union bake must run fewer exact tests (about 70 % here), or it is not taking its
         // own path.
         assert!(skipped.1 * 5 < skipped.0 * 4, "{skipped:?}");
+    }
+
+    /// Triangles that may span the cell (large ones at every orientation; walls parallel to a
+    /// face at and within a few margins of it, as the Cornell box's lie in seed 004's grids;
+    /// planes through the cell's edges and corners; large triangles with a corner just inside or
+    /// just outside the widened cell, which must not pass for spanning): where the closed form
+    /// decides, its shafts must be those the one-shaft sweep test finds, every shaft of every pair.
+    #[test]
+    fn spanning_triangles_meet_the_shafts_the_sweep_test_finds() {
+        let mut rnd = uniform(29);
+        let (mut decided, mut cases, mut met) = (0, 0, 0u64);
+        for case in 0..900u32 {
+            let n = 1 + case % 8;
+            let margin = [0.0, 1e-6, 1e-3][(case / 8 % 3) as usize];
+            let random_dir = |rnd: &mut dyn FnMut() -> f64| {
+                DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(DVec3::X)
+            };
+            // A point of the plane and its normal.
+            let (point, normal) = match case % 6 {
+                0 | 1 => (DVec3::new(rnd(), rnd(), rnd()), random_dir(&mut rnd)),
+                2 => {
+                    // A wall parallel to a face, at it, within a few margins inside or outside, or
+                    // anywhere across the cell.
+                    let axis = (case as usize / 6) % 3;
+                    let mut p = DVec3::new(rnd(), rnd(), rnd());
+                    let face = if rnd() < 0.5 { 0.0 } else { 1.0 };
+                    p[axis] = match case / 18 % 4 {
+                        0 => face,
+                        1 => face + margin * (rnd() * 10.0 - 5.0),
+                        2 => face + margin * [-1.0, 1.0][(case / 72 % 2) as usize],
+                        _ => rnd(),
+                    };
+                    let mut nrm = DVec3::ZERO;
+                    nrm[axis] = 1.0;
+                    (p, nrm)
+                }
+                3 => {
+                    // Through a cell corner or edge midpoint.
+                    let c = DVec3::new(
+                        [0.0, 0.5, 1.0][(rnd() * 3.0) as usize],
+                        [0.0, 1.0][(rnd() * 2.0) as usize],
+                        [0.0, 1.0][(rnd() * 2.0) as usize],
+                    );
+                    (c, random_dir(&mut rnd))
+                }
+                _ => (DVec3::new(rnd(), rnd(), rnd()), random_dir(&mut rnd)),
+            };
+            // Two in-plane directions.
+            let t1 = normal.any_orthonormal_vector();
+            let t2 = normal.cross(t1);
+            let big = 40.0;
+            let mut v = [0.0f64, 2.1, 4.2].map(|a: f64| point + (t1 * a.cos() + t2 * a.sin()) * big);
+            if case % 6 == 5 {
+                // One corner pulled in: just inside the widened cell, or just outside the section,
+                // or well inside.
+                let target = point + (t1 * (rnd() - 0.5) + t2 * (rnd() - 0.5)) * 0.9;
+                let pull = [0.0, 1e-7, -1e-7, 0.3][(case / 6 % 4) as usize];
+                let away = (target - v[1]).normalize_or(DVec3::X);
+                v[0] = target + away * pull;
+            }
+            if case % 6 == 4 && margin > 0.0 {
+                // A corner in the widened cell's rim, half a margin beyond a face, opening a
+                // wedge of nearly 180° into the cell: it holds the unit cell's section of the
+                // plane (or nearly) but not the widened cell's.
+                let axis = (case as usize / 6) % 3;
+                let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut corner = DVec3::splat(0.5);
+                corner[axis] = rnd();
+                corner[b] = -0.5 * margin;
+                let (mut db, mut dc) = (DVec3::ZERO, DVec3::ZERO);
+                db[b] = 1.0;
+                dc[c] = 1e6;
+                v = [corner, corner + (db + dc) * big, corner + (db - dc) * big];
+            }
+            let tri = Prepared::new(v);
+            let Some(sides) = spanning_sides(v, margin, n) else { continue };
+            cases += 1;
+            // Independently: points of the plane in the widened cell lie in the triangle.
+            let nrm = (v[1] - v[0]).cross(v[2] - v[0]);
+            for _ in 0..200 {
+                let q = DVec3::new(rnd(), rnd(), rnd()) * (1.0 + 2.0 * margin) - margin;
+                let q = q - nrm * (nrm.dot(q - v[0]) / nrm.length_squared());
+                if q.cmplt(DVec3::splat(-margin)).any() || q.cmpgt(DVec3::splat(1.0 + margin)).any() {
+                    continue;
+                }
+                let inside = (0..3).all(|i| nrm.cross(v[(i + 1) % 3] - v[i]).dot(q - v[i]) >= -1e-9);
+                assert!(inside, "case {case}: {q:?} of the widened cell's section is outside {v:?}");
+            }
+            let s = 1.0 / n as f64;
+            let r = |p: u32| {
+                ((p / n) as f64 * s, (p / n + 1) as f64 * s, (p % n) as f64 * s, (p % n + 1) as f64 * s)
+            };
+            for pair in 0..FACE_PAIRS {
+                let (fa, fb) = pair_faces(pair);
+                let mut found = Vec::new();
+                spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut |shaft, _, _| {
+                    found.push(shaft)
+                });
+                let n2 = n * n;
+                let mut brute = Vec::new();
+                for pa in 0..n2 {
+                    for pb in 0..n2 {
+                        let (a, b) = (r(pa), r(pb));
+                        let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
+                        let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
+                        if tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
+                            brute.push(shaft_of(pair, pa, pb, n));
+                        }
+                    }
+                }
+                decided += (n2 * n2) as u64;
+                met += brute.len() as u64;
+                assert_eq!(found, brute, "case {case}, pair {pair}, n {n}, margin {margin}: {v:?}");
+            }
+        }
+        // The closed form must have decided most cases, and met shafts and missed others.
+        assert!(cases > 500, "{cases} cases decided in closed form");
+        assert!(met > decided / 5 && met < decided * 9 / 10, "{met} of {decided}");
     }
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the

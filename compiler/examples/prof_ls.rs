@@ -1,0 +1,82 @@
+//! Times one line-space bake of a row of seed 004's Table 1 (for profiling):
+//! `cargo run --release -p kiln-compiler --example prof_ls -- ROW VARIANT [RUNS]` (VARIANT:
+//! pnmt, cand or binary).
+
+use std::time::Instant;
+
+use kiln_compiler::bake::linespace::{self, SceneAttributes};
+use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
+use kiln_format::linespace::{PnmtLayout, Variants};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let row: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(4);
+    let variant = args.get(2).map(String::as_str).unwrap_or("pnmt");
+    let runs: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
+    let (object, res, n) = [
+        (0, 8, 4),
+        (0, 8, 5),
+        (TEAPOT, 8, 5),
+        (TEAPOT, 32, 5),
+        (BUNNY, 8, 5),
+        (BUNNY, 64, 5),
+        (DRAGON, 8, 5),
+        (DRAGON, 72, 5),
+    ][row - 1];
+    let variants = match variant {
+        "cand" => Variants::BINARY | Variants::CANDIDATES,
+        "binary" => Variants::BINARY,
+        _ => Variants::BINARY | Variants::PNMT,
+    };
+    let scene = cornell_with_object(object, 42);
+    let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);
+    let attrs = SceneAttributes {
+        vertices: &scene.vertices,
+        uvs: &scene.uvs,
+        triangles: &scene.triangles,
+        materials: &scene.triangle_materials,
+    };
+    let progress = kiln_compiler::progress::Progress::hidden();
+    let mut times = Vec::new();
+    for _ in 0..runs {
+        let mut voxels = geometry.voxels(res).clone();
+        // KILN_PROF_KEEP=walls|object: only the box's 12 triangles, or only the object's.
+        if let Ok(keep) = std::env::var("KILN_PROF_KEEP") {
+            let walls = keep == "walls";
+            let (mut offsets, mut tris) = (vec![0u32], Vec::new());
+            for w in voxels.offsets.windows(2) {
+                tris.extend(
+                    voxels.triangles[w[0] as usize..w[1] as usize].iter().filter(|&&t| (t < 12) == walls),
+                );
+                offsets.push(tris.len() as u32);
+            }
+            voxels.offsets = offsets;
+            voxels.triangles = tris;
+        }
+        let t = Instant::now();
+        let ls = linespace::bake(&attrs, voxels, 0.0, n, variants, PnmtLayout::CompactNoUv, None, &progress)
+            .expect("bake");
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+        let counts: Vec<u32> = ls.voxel_offsets.windows(2).map(|w| w[1] - w[0]).filter(|&c| c > 0).collect();
+        let mut sorted = counts.clone();
+        sorted.sort_unstable();
+        // A digest of the bits, records and lists, to compare bakes of two builds.
+        let mut digest = 0xcbf2_9ce4_8422_2325u64;
+        for w in ls.bits.iter().chain(&ls.pnmt).chain(&ls.candidates).chain(&ls.candidate_offsets) {
+            digest = (digest ^ *w as u64).wrapping_mul(0x100_0000_01b3);
+        }
+        println!(
+            "row {row} {variant}: {:.1} ms, digest {digest:016x}, tests {}, filled {}, cells {}, triangles a cell median {} mean {:.1} p90 {} max {}",
+            times.last().unwrap(),
+            ls.tests,
+            ls.header.filled,
+            counts.len(),
+            sorted[sorted.len() / 2],
+            counts.iter().sum::<u32>() as f64 / counts.len() as f64,
+            sorted[sorted.len() * 9 / 10],
+            sorted.last().unwrap()
+        );
+    }
+    times.sort_by(f64::total_cmp);
+    println!("median {:.1} ms", times[times.len() / 2]);
+}
