@@ -92,6 +92,7 @@ impl PnmtLayout {
     }
 
     /// The absent record.
+    #[inline]
     pub fn none(self) -> RecordWords {
         match self {
             Self::Full => bytemuck::cast(PnmtRecord::NONE),
@@ -101,6 +102,7 @@ impl PnmtLayout {
 
     /// The material of a record (`words` at least [`Self::words`] long), [`NO_RECORD`] for an
     /// absent one.
+    #[inline]
     pub fn material(self, w: &[u32]) -> u16 {
         match self {
             Self::Full => (w[1] >> 16) as u16,
@@ -112,6 +114,7 @@ impl PnmtLayout {
     }
 
     /// Whether a record holds a hit.
+    #[inline]
     pub fn is_some(self, w: &[u32]) -> bool {
         self.material(w) != NO_RECORD
     }
