@@ -60,7 +60,14 @@ impl Span {
         let m = [0, 1, 2].map(|i| normal.cross(v[(i + 1) % 3] - v[i]));
         let inside = |p: DVec3| (0..3).all(|i| m[i].dot(p - v[i]) >= 0.0);
         // The section is the convex hull of the plane's crossings of the box's 12 edges; the
-        // triangle (convex) holds it iff it holds them.
+        // triangle (convex) holds it iff it holds them. An edge is crossed where its corners lie
+        // on two sides, which is decided only with every corner clear of the plane by the slack
+        // (a crossing computed near a corner can round to beyond it and go unchecked).
+        let side = |p: DVec3| normal.dot(p) - offset;
+        let corner = |c: usize| DVec3::new([lo, hi][c & 1], [lo, hi][c >> 1 & 1], [lo, hi][c >> 2]);
+        if (0..8).any(|c| side(corner(c)).abs() <= slack) {
+            return None;
+        }
         let mut crossings = 0;
         for k in 0..3 {
             let (i, j) = ((k + 1) % 3, (k + 2) % 3);
@@ -68,22 +75,19 @@ impl Span {
                 let mut p = DVec3::ZERO;
                 p[i] = a;
                 p[j] = b;
-                if normal[k] == 0.0 {
-                    // Parallel to the edge: the plane must clearly miss it (an edge in the plane
-                    // would be a crossing everywhere along it).
-                    if (normal[i] * a + normal[j] * b - offset).abs() <= slack {
-                        return None;
-                    }
+                p[k] = lo;
+                let below = side(p) < 0.0;
+                p[k] = hi;
+                if below == (side(p) < 0.0) {
                     continue;
                 }
-                let x = (offset - normal[i] * a - normal[j] * b) / normal[k];
-                if (lo..=hi).contains(&x) {
-                    p[k] = x;
-                    if !inside(p) {
-                        return None;
-                    }
-                    crossings += 1;
+                // The corners' sides differ, so normal[k] is not zero, and the crossing lies
+                // strictly between them: rounding may only push it to the edge's ends.
+                p[k] = ((offset - normal[i] * a - normal[j] * b) / normal[k]).clamp(lo, hi);
+                if !inside(p) {
+                    return None;
                 }
+                crossings += 1;
             }
         }
         (crossings >= 3).then_some(Span { normal, offset, margin })
