@@ -16,30 +16,10 @@ use std::sync::atomic::Ordering::Relaxed;
 use std::time::Instant;
 
 use kiln_compiler::analyze::budget::Estimate;
-use kiln_compiler::bake::linespace::{self, SceneAttributes};
-use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
+use kiln_compiler::bake::linespace;
+use kiln_compiler::bench_scenes::{TABLE1, attributes, cornell_with_object};
 use kiln_compiler::ir::Scene;
 use kiln_format::linespace::{PnmtLayout, Variants};
-
-struct Row {
-    scene: u32,
-    object: usize,
-    res: u32,
-    n: u32,
-    thesis_voxel_ms: f64,
-    thesis_ls_ms: f64,
-}
-
-const ROWS: [Row; 8] = [
-    Row { scene: 4, object: 0, res: 8, n: 4, thesis_voxel_ms: 43.0, thesis_ls_ms: 154.0 },
-    Row { scene: 4, object: 0, res: 8, n: 5, thesis_voxel_ms: 43.0, thesis_ls_ms: 269.0 },
-    Row { scene: 5, object: TEAPOT, res: 8, n: 5, thesis_voxel_ms: 58.0, thesis_ls_ms: 644.0 },
-    Row { scene: 5, object: TEAPOT, res: 32, n: 5, thesis_voxel_ms: 47.0, thesis_ls_ms: 1795.0 },
-    Row { scene: 6, object: BUNNY, res: 8, n: 5, thesis_voxel_ms: 51.0, thesis_ls_ms: 3915.0 },
-    Row { scene: 6, object: BUNNY, res: 64, n: 5, thesis_voxel_ms: 71.0, thesis_ls_ms: 10081.0 },
-    Row { scene: 7, object: DRAGON, res: 8, n: 5, thesis_voxel_ms: 95.0, thesis_ls_ms: 94393.0 },
-    Row { scene: 7, object: DRAGON, res: 72, n: 5, thesis_voxel_ms: 88.0, thesis_ls_ms: 53675.0 },
-];
 
 /// The records the compiler stores for an untextured scene by default.
 const COMPACT: PnmtLayout = PnmtLayout::CompactNoUv;
@@ -56,15 +36,6 @@ fn mib(b: u64) -> f64 {
 /// Signed error of `estimate` against `actual`, percent.
 fn pct(estimate: u64, actual: u64) -> f64 {
     100.0 * (estimate as f64 / actual as f64 - 1.0)
-}
-
-fn attrs_of(scene: &Scene) -> SceneAttributes<'_> {
-    SceneAttributes {
-        vertices: &scene.vertices,
-        uvs: &scene.uvs,
-        triangles: &scene.triangles,
-        materials: &scene.triangle_materials,
-    }
 }
 
 /// The system allocator, counting the bytes held and their high-water mark, so that a bake's
@@ -146,7 +117,7 @@ fn bake(
     let voxels = geometry.voxels(res).clone();
     let voxel_ms = t.elapsed().as_secs_f64() * 1e3;
     let progress = kiln_compiler::progress::Progress::hidden();
-    let ls = linespace::bake(&attrs_of(scene), voxels, voxel_ms, n, variants, layout, None, &progress)
+    let ls = linespace::bake(&attributes(scene), voxels, voxel_ms, n, variants, layout, None, &progress)
         .expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
 }
@@ -226,7 +197,7 @@ fn main() {
         .skip(1)
         .find(|a| !a.starts_with('-'))
         .map(|s| s.split(',').filter_map(|x| x.parse::<usize>().ok()).map(|x| x - 1).collect())
-        .unwrap_or_else(|| (0..ROWS.len()).collect());
+        .unwrap_or_else(|| (0..TABLE1.len()).collect());
     let runs: usize = std::env::var("KILN_BENCH_RUNS").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
     println!(
         "line-space bake, {} threads, median of {runs} runs; thesis: GTX 1080, PNMT",
@@ -251,7 +222,7 @@ fn main() {
         "cand. MiB"
     );
     for &r in &rows {
-        let row = &ROWS[r];
+        let row = &TABLE1[r];
         let scene = cornell_with_object(row.object, 42);
         let tris = scene.triangles.len();
         let mut voxel = Vec::new();
@@ -335,7 +306,7 @@ fn main() {
             ls.tests,
             ls.header.filled,
             100.0 * ls.header.filled as f64 / (ls.header.slots as f64 * 15.0 * (row.n as f64).powi(4)),
-            100.0 * linespace::false_fill_rate(&attrs_of(&scene), &ls, 20_000),
+            100.0 * linespace::false_fill_rate(&attributes(&scene), &ls, 20_000),
             lc.header.entries,
             ls.pnmt_missing
         );

@@ -1,13 +1,13 @@
 //! Times one line-space bake of a row of seed 004's Table 1 (for profiling), and prints a digest
 //! of its bits, records and candidate lists (to compare two builds' bakes):
 //! `cargo run --release -p kiln-compiler --example prof_ls -- ROW VARIANT [RUNS]` (VARIANT:
-//! pnmt, cand or binary). `KILN_PROF_KEEP=walls` keeps only the Cornell box's 12 triangles in
+//! pnmt, cand or binary). `KILN_PROF_KEEP=walls` keeps only the Cornell box's triangles in
 //! the cells' lists, `object` only the object's.
 
 use std::time::Instant;
 
-use kiln_compiler::bake::linespace::{self, SceneAttributes};
-use kiln_compiler::bench_scenes::{BUNNY, DRAGON, TEAPOT, cornell_with_object};
+use kiln_compiler::bake::linespace;
+use kiln_compiler::bench_scenes::{BOX_TRIANGLES, TABLE1, attributes, cornell_with_object};
 use kiln_format::linespace::{PnmtLayout, Variants};
 
 fn main() {
@@ -15,40 +15,29 @@ fn main() {
     let row: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(4);
     let variant = args.get(2).map(String::as_str).unwrap_or("pnmt");
     let runs: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
-    let (object, res, n) = [
-        (0, 8, 4),
-        (0, 8, 5),
-        (TEAPOT, 8, 5),
-        (TEAPOT, 32, 5),
-        (BUNNY, 8, 5),
-        (BUNNY, 64, 5),
-        (DRAGON, 8, 5),
-        (DRAGON, 72, 5),
-    ][row - 1];
+    let row_config = TABLE1[row - 1];
+    let (res, n) = (row_config.res, row_config.n);
     let variants = match variant {
         "cand" => Variants::BINARY | Variants::CANDIDATES,
         "binary" => Variants::BINARY,
         _ => Variants::BINARY | Variants::PNMT,
     };
-    let scene = cornell_with_object(object, 42);
+    let scene = cornell_with_object(row_config.object, 42);
     let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);
-    let attrs = SceneAttributes {
-        vertices: &scene.vertices,
-        uvs: &scene.uvs,
-        triangles: &scene.triangles,
-        materials: &scene.triangle_materials,
-    };
+    let attrs = attributes(&scene);
     let progress = kiln_compiler::progress::Progress::hidden();
     let mut times = Vec::new();
     for _ in 0..runs {
         let mut voxels = geometry.voxels(res).clone();
-        // KILN_PROF_KEEP=walls|object: only the box's 12 triangles, or only the object's.
+        // KILN_PROF_KEEP=walls|object: only the box's triangles, or only the object's.
         if let Ok(keep) = std::env::var("KILN_PROF_KEEP") {
             let walls = keep == "walls";
             let (mut offsets, mut tris) = (vec![0u32], Vec::new());
             for w in voxels.offsets.windows(2) {
                 tris.extend(
-                    voxels.triangles[w[0] as usize..w[1] as usize].iter().filter(|&&t| (t < 12) == walls),
+                    voxels.triangles[w[0] as usize..w[1] as usize]
+                        .iter()
+                        .filter(|&&t| (t < BOX_TRIANGLES) == walls),
                 );
                 offsets.push(tris.len() as u32);
             }

@@ -7,6 +7,7 @@ use glam::Vec3;
 use kiln_format::manifest::{Light, LightKind};
 use kiln_format::sections::Vertex;
 
+use crate::bake::linespace::SceneAttributes;
 use crate::import::demo;
 use crate::ir::{Material, Scene};
 
@@ -16,6 +17,49 @@ pub const TEAPOT: usize = 15_704;
 pub const BUNNY: usize = 69_451;
 /// Stanford dragon.
 pub const DRAGON: usize = 871_306;
+
+/// The box's triangles in a scene with an object (walls and light quad), numbered before the
+/// object's.
+pub const BOX_TRIANGLES: u32 = 12;
+
+/// One configuration of seed 004's Table 1 and the thesis's times for it (GTX 1080).
+#[derive(Debug, Clone, Copy)]
+pub struct Table1Row {
+    /// The thesis's scene number.
+    pub scene: u32,
+    /// Triangles of the object in the box (0: scene 4's box with its blocks).
+    pub object: usize,
+    /// Voxel cells along the longest axis.
+    pub res: u32,
+    /// Shaft resolution N.
+    pub n: u32,
+    /// The thesis's voxelization time, ms.
+    pub thesis_voxel_ms: f64,
+    /// The thesis's (PNMT) line-space generation time, ms.
+    pub thesis_ls_ms: f64,
+}
+
+/// Seed 004's Table 1, row by row.
+pub const TABLE1: [Table1Row; 8] = [
+    Table1Row { scene: 4, object: 0, res: 8, n: 4, thesis_voxel_ms: 43.0, thesis_ls_ms: 154.0 },
+    Table1Row { scene: 4, object: 0, res: 8, n: 5, thesis_voxel_ms: 43.0, thesis_ls_ms: 269.0 },
+    Table1Row { scene: 5, object: TEAPOT, res: 8, n: 5, thesis_voxel_ms: 58.0, thesis_ls_ms: 644.0 },
+    Table1Row { scene: 5, object: TEAPOT, res: 32, n: 5, thesis_voxel_ms: 47.0, thesis_ls_ms: 1795.0 },
+    Table1Row { scene: 6, object: BUNNY, res: 8, n: 5, thesis_voxel_ms: 51.0, thesis_ls_ms: 3915.0 },
+    Table1Row { scene: 6, object: BUNNY, res: 64, n: 5, thesis_voxel_ms: 71.0, thesis_ls_ms: 10081.0 },
+    Table1Row { scene: 7, object: DRAGON, res: 8, n: 5, thesis_voxel_ms: 95.0, thesis_ls_ms: 94393.0 },
+    Table1Row { scene: 7, object: DRAGON, res: 72, n: 5, thesis_voxel_ms: 88.0, thesis_ls_ms: 53675.0 },
+];
+
+/// A benchmark scene's triangle attributes for the line space, in the scene's own order.
+pub fn attributes(scene: &Scene) -> SceneAttributes<'_> {
+    SceneAttributes {
+        vertices: &scene.vertices,
+        uvs: &scene.uvs,
+        triangles: &scene.triangles,
+        materials: &scene.triangle_materials,
+    }
+}
 
 /// The Cornell box of scene 4 (walls, two blocks, a light quad: 32 triangles), or with
 /// `object_triangles > 0` the 12-triangle box (walls and light quad) around a seeded object of

@@ -1123,31 +1123,39 @@ mod tests {
         margin: f64,
         what: &str,
     ) -> (u64, u64) {
-        let s = 1.0 / n as f64;
-        let r =
-            |p: u32| ((p / n) as f64 * s, (p / n + 1) as f64 * s, (p % n) as f64 * s, (p % n + 1) as f64 * s);
         let (mut decided, mut met) = (0, 0);
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let mut found = Vec::new();
             spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut |shaft, _, _| found.push(shaft));
-            let n2 = n * n;
-            let mut brute = Vec::new();
-            for pa in 0..n2 {
-                for pb in 0..n2 {
-                    let (a, b) = (r(pa), r(pb));
-                    let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
-                    let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
-                    if tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
-                        brute.push(shaft_of(pair, pa, pb, n));
-                    }
-                }
-            }
-            decided += (n2 * n2) as u64;
+            let brute = swept_shafts(tri, pair, n, margin);
+            decided += (n * n * n * n) as u64;
             met += brute.len() as u64;
             assert_eq!(found, brute, "{what}, pair {pair}, n {n}, margin {margin}");
         }
         (decided, met)
+    }
+
+    /// The shafts of face pair `pair` that the one-shaft sweep test finds `tri` meeting, tested
+    /// one by one (the reference of the search and of the closed form), ascending.
+    fn swept_shafts(tri: &Prepared, pair: u32, n: u32, margin: f64) -> Vec<u32> {
+        let (fa, fb) = pair_faces(pair);
+        let s = 1.0 / n as f64;
+        let r =
+            |p: u32| ((p / n) as f64 * s, (p / n + 1) as f64 * s, (p % n) as f64 * s, (p % n + 1) as f64 * s);
+        let n2 = n * n;
+        let mut found = Vec::new();
+        for pa in 0..n2 {
+            for pb in 0..n2 {
+                let (a, b) = (r(pa), r(pb));
+                let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
+                let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
+                if tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
+                    found.push(shaft_of(pair, pa, pb, n));
+                }
+            }
+        }
+        found
     }
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the
@@ -1176,33 +1184,13 @@ mod tests {
             let v = [0; 3].map(|_| centre + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size);
             let tri = Prepared::new(v);
             let poly = clip_to_box(v, DVec3::splat(-margin), DVec3::splat(1.0 + margin));
-            let s = 1.0 / n as f64;
             let n2 = n * n;
             for pair in 0..FACE_PAIRS {
                 let mut found = Vec::new();
                 let mut tests = 0;
                 search(&tri, &poly, pair, n, margin, &mut tests, &mut |shaft, _, _| found.push(shaft));
                 found.sort_unstable();
-                let (fa, fb) = pair_faces(pair);
-                let mut brute = Vec::new();
-                for pa in 0..n2 {
-                    for pb in 0..n2 {
-                        let r = |p: u32| {
-                            (
-                                (p / n) as f64 * s,
-                                (p / n + 1) as f64 * s,
-                                (p % n) as f64 * s,
-                                (p % n + 1) as f64 * s,
-                            )
-                        };
-                        let (a, b) = (r(pa), r(pb));
-                        let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
-                        let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
-                        if !poly.is_empty() && tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
-                            brute.push(pair * n2 * n2 + pa * n2 + pb);
-                        }
-                    }
-                }
+                let brute = if poly.is_empty() { Vec::new() } else { swept_shafts(&tri, pair, n, margin) };
                 tested += (n2 * n2) as u64;
                 found_total += brute.len() as u64;
                 assert_eq!(found, brute, "case {case}, pair {pair}, n {n}, margin {margin}: {v:?}");

@@ -34,6 +34,8 @@ pub struct Span {
     normal: DVec3,
     offset: f64,
     margin: f64,
+    /// [`SIDE_SLACK`] scaled by the normal's L1 norm: the least signed distance decided.
+    slack: f64,
 }
 
 /// The patches of one face by side of the plane: bit `u·n + v` for patch (u, v).
@@ -90,7 +92,7 @@ impl Span {
                 crossings += 1;
             }
         }
-        (crossings >= 3).then_some(Span { normal, offset, margin })
+        (crossings >= 3).then_some(Span { normal, offset, margin, slack })
     }
 
     /// The patches of `face` at `n` × `n` patches by side, or `None` if one lies too near the
@@ -99,8 +101,7 @@ impl Span {
         let s = 1.0 / n as f64;
         let j = face_axis(face);
         let (ua, va) = face_uv_axes(face);
-        let nl = self.normal;
-        let slack = SIDE_SLACK * nl.abs().element_sum();
+        let (nl, slack) = (self.normal, self.slack);
         // The widened box of patch (u, v): centre (face mod 2 on j, (index + 1/2)·s on ua and va),
         // half extents (m on j, s/2 + m on ua and va).
         let radius = nl[j].abs() * self.margin + (nl[ua].abs() + nl[va].abs()) * (0.5 * s + self.margin);
