@@ -9,7 +9,7 @@ use kiln_format::linespace::index::{
 };
 use kiln_format::linespace::{PnmtLayout, RecordWords, entry, words_per_slot};
 
-use super::geometry::{PairAxes, Prepared, clip_to_box_into, window_offset};
+use super::geometry::{PairAxes, PairMasks, Prepared, clip_to_box_into};
 use super::span::{Sides, Span, met_from};
 
 /// What one cell contributes to the line space.
@@ -66,224 +66,29 @@ fn outward(face: u32) -> DVec3 {
     n
 }
 
-/// The four corners of a face rectangle.
-fn corners(face: u32, u: (f64, f64), v: (f64, f64)) -> [DVec3; 4] {
-    let (ua, va) = face_uv_axes(face);
-    let mut base = DVec3::ZERO;
-    base[face_axis(face)] = (face % 2) as f64;
-    [(u.0, v.0), (u.1, v.0), (u.1, v.1), (u.0, v.1)].map(|(x, y)| {
-        let mut p = base;
-        p[ua] = x;
-        p[va] = y;
-        p
-    })
-}
-
-/// `x.floor()` without the libm call that baseline x86-64 makes of it (no SSE4.1 rounding; it
-/// was 3 % of a bake): below 2⁵² in magnitude truncation is exact and one step fixes negative
-/// fractions; beyond, every float is an integer (or infinite, or NaN) already.
-#[inline(always)]
-fn floor(x: f64) -> f64 {
-    if x.abs() < 4_503_599_627_370_496.0 {
-        let t = x as i64 as f64;
-        if t > x { t - 1.0 } else { t.copysign(x) }
-    } else {
-        x
-    }
-}
-
-/// Patch index range `[lo, hi)` along one face axis covering the interval `[a, b]` widened by
-/// `pad`.
-fn index_range(a: f64, b: f64, pad: f64, n: u32) -> (u32, u32) {
-    let nf = n as f64;
-    let lo = floor((a - pad) * nf).clamp(0.0, nf) as u32;
-    let hi = (floor((b + pad) * nf) + 1.0).clamp(0.0, nf) as u32;
-    (lo.min(n), hi.max(lo).min(n))
-}
-
-/// Patch ranges on face `to` that the widened shafts from the rectangle `from` (its four
-/// corners, on another face) can meet inside `poly` (the triangle clipped to the widened cell),
-/// or `None` for "any patch".
-///
-/// Let j be `to`'s axis and σ the sign of the way from `from` to `to` along j. The polygon is cut
-/// at σ·p_j = max σ·x_j + g (x over the corners, g = [`REACH_GAP`] of a patch):
-/// - **The part beyond the cut** has a central projection from every point x of `from` onto
-///   `to`'s plane; the projections of a convex set from a rectangle lie in the convex hull of
-///   the projections of its vertices from the rectangle's corners (each is projective with a
-///   positive denominator), so their bounding rectangle bounds what segments can reach. A point
-///   within the margin m of a segment x → y and beyond the cut projects from x to within
-///   m·(L + 1)/g ≤ 2m/g of y (L ≤ 1: the segment's extent along j), which pads the rectangle.
-/// - **The part behind the rectangle**, σ·p_j below every σ·x_j by more than m, lies on no
-///   widened segment (σ·(w_j − x_j) ≥ 0 along a segment).
-/// - **The part before the cut** can lie on a widened segment from x only near x: a segment point
-///   whose σ·(w_j − x_j) is below g + (the rectangle's extent along j) + m has moved at most that
-///   over L_min (the least corner-to-plane distance along j) in every coordinate. When the part's
-///   bounding box stays farther than that (plus m) from the rectangle's, it meets no shaft;
-///   otherwise every patch may be reached (`None`).
-fn reach(
-    from_face: u32,
-    from: &[DVec3; 4],
-    poly: &[DVec3],
-    to: u32,
-    n: u32,
-    margin: f64,
-) -> Option<[u32; 4]> {
-    let j = face_axis(to);
-    let bj = (to % 2) as f64;
-    let sigma = if to % 2 == 1 { 1.0 } else { -1.0 };
-    let (ua, va) = face_uv_axes(to);
-    let l_min = from.iter().map(|x| sigma * (bj - x[j])).fold(f64::INFINITY, f64::min);
-    if !(l_min > 0.0) {
-        return None;
-    }
-    let (xlo, xhi) = from
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(sigma * x[j]), hi.max(sigma * x[j])));
-    let gap = REACH_GAP / n as f64;
-    let cut = xhi + gap;
-    // The polygon in three bands along σ·j: behind the rectangle (below its least σ·x_j by more
-    // than the margin: no segment from it goes there), before the cut (kept as a bounding box)
-    // and beyond it (kept as vertices).
-    let planes = [xlo - margin, cut];
-    let band = |d: f64| (d >= planes[0]) as usize + (d >= planes[1]) as usize;
-    let (mut near_lo, mut near_hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-    let mut beyond = [DVec3::ZERO; 18];
-    let mut count = 0;
-    // For a pair of adjacent faces: the least of D_k(z) − (σ·z_j − min σ·x_j + m)/L_min − m over
-    // the band, D_k the distance from `from`'s plane (see below).
-    let k = face_axis(from_face);
-    let plane_k = (from_face % 2) as f64;
-    let mut slack = f64::INFINITY;
-    let mut add = |x: DVec3, b: usize, near_lo: &mut DVec3, near_hi: &mut DVec3| {
-        if b == 2 {
-            beyond[count] = x;
-            count += 1;
-        } else if b == 1 {
-            *near_lo = near_lo.min(x);
-            *near_hi = near_hi.max(x);
-            slack = slack.min((x[k] - plane_k).abs() - (sigma * x[j] - xlo + margin) / l_min - margin);
-        }
-    };
-    for (i, &p) in poly.iter().enumerate() {
-        // (Not `(i + 1) % len`: an integer division per edge.)
-        let q = if i + 1 < poly.len() { poly[i + 1] } else { poly[0] };
-        let (dp, dq) = (sigma * p[j], sigma * q[j]);
-        let (bp, bq) = (band(dp), band(dq));
-        add(p, bp, &mut near_lo, &mut near_hi);
-        for (k, &plane) in planes.iter().enumerate() {
-            // The edge crosses plane k (between bands k and k + 1).
-            if (bp <= k) != (bq <= k) {
-                let mut x = p + (q - p) * ((plane - dp) / (dq - dp));
-                x[j] = sigma * plane;
-                add(x, k, &mut near_lo, &mut near_hi);
-                add(x, k + 1, &mut near_lo, &mut near_hi);
-            }
-        }
-    }
-    // A band point z within m of a segment point w = x + t·(y − x) has σ·(w_j − x_j) = t·L ≥
-    // t·L_min and |w_k − x_k| ≤ t (k: `from`'s axis): so D_k(z) ≤ (σ·z_j − min σ·x_j + m)/L_min + m,
-    // linear in z, which the band (convex) breaks everywhere if it breaks it at every vertex.
-    if near_lo.x <= near_hi.x && !(k != j && slack > 0.0) {
-        let r = (gap + (xhi - xlo) + margin) / l_min + margin;
-        let (from_lo, from_hi) =
-            from.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
-        let apart = (near_lo - from_hi).max(from_lo - near_hi).max_element();
-        if !(apart > r) {
-            return None;
-        }
-    }
-    if count == 0 {
-        return Some([0, 0, 0, 0]);
-    }
-    let (mut umin, mut umax, mut vmin, mut vmax) =
-        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
-    for x in from {
-        let reach = bj - x[j];
-        for p in &beyond[..count] {
-            let y = *x + (*p - *x) * (reach / (p[j] - x[j]));
-            umin = umin.min(y[ua]);
-            umax = umax.max(y[ua]);
-            vmin = vmin.min(y[va]);
-            vmax = vmax.max(y[va]);
-        }
-    }
-    // The margin's image, with room for the rounding of the projections.
-    let pad = 2.0 * margin / gap * (1.0 + 1e-6) + 1e-9;
-    let (u0, u1) = index_range(umin, umax, pad, n);
-    let (v0, v1) = index_range(vmin, vmax, pad, n);
-    Some([u0, u1, v0, v1])
-}
-
-/// Patch ranges on face `to` that widened segments from the rectangle `from` (on `from_face`)
-/// through `poly` can end in, from monotonicity alone (where [`reach`] gives up): along a
-/// segment x → y every coordinate moves one way. So a point z within m of it has
-/// - on `from`'s axis k: |y_k − x_k| ≥ |z_k − x_k| − m (k is one of `to`'s axes when the faces
-///   are adjacent);
-/// - on an axis c of both faces: y_c ≥ z_c − m where every z_c ≥ max x_c + m, and
-///   y_c ≤ z_c + m where every z_c ≤ min x_c − m.
-fn reach_bound(from_face: u32, from: &[DVec3; 4], poly: &[DVec3], to: u32, n: u32, margin: f64) -> [u32; 4] {
-    let (k, plane_k) = (face_axis(from_face), (from_face % 2) as f64);
-    let (from_lo, from_hi) =
-        from.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
-    let (lo, hi) =
-        poly.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), z| (lo.min(*z), hi.max(*z)));
-    let (ua, va) = face_uv_axes(to);
-    let range = |c: usize| -> (u32, u32) {
-        let (mut a, mut b) = (0.0f64, 1.0f64);
-        if c == k {
-            let d = poly.iter().map(|z| (z[k] - plane_k).abs()).fold(f64::INFINITY, f64::min) - margin;
-            if plane_k == 0.0 {
-                a = d;
-            } else {
-                b = 1.0 - d;
-            }
-        } else if lo[c] >= from_hi[c] + margin {
-            a = lo[c] - margin;
-        } else if hi[c] <= from_lo[c] - margin {
-            b = hi[c] + margin;
-        }
-        index_range(a, b, 1e-9, n)
-    };
-    let ((u0, u1), (v0, v1)) = (range(ua), range(va));
-    [u0, u1, v0, v1]
-}
-
-/// Where [`reach`] cuts the polygon, in patches beyond the source rectangle's far side: a wider
-/// cut pads the projections less (2m/g) but leaves more of the polygon to the cruder bound.
-const REACH_GAP: f64 = 0.25;
-
-/// Calls `window(pa, q, axes)` for every patch `pa` of face a of pair `pair` from which the
-/// triangle `tri` (clipped to the widened cell: `poly`) may meet a shaft, with the patches `q` =
-/// [u0, u1) × [v0, v1) on face b that bound those shafts. The projections of the polygon from
-/// the patch's corners give `q` (see [`reach`]; all of face b where the projection is
-/// undefined); `axes.shafts_from` decides the shafts of `q` exactly.
-fn windows(
+/// Calls `patches(pa, among, axes, masks)` for every patch `pa` of face a of pair `pair` from
+/// which the triangle `tri` (clipped to the widened cell: `poly`) may meet a shaft, with the
+/// patches `among` of face b (bit u·n + v for patch (u, v)) that no single separation rejects
+/// ([`PairMasks::survivors`]); `axes.shafts_among` decides those shafts exactly.
+fn patch_sets(
     tri: &Prepared,
     poly: &[DVec3],
     pair: u32,
     n: u32,
     margin: f64,
-    window: &mut impl FnMut(u32, [u32; 4], &PairAxes),
+    patches: &mut impl FnMut(u32, u64, &PairAxes, &PairMasks),
 ) {
-    let (fa, fb) = pair_faces(pair);
     if poly.is_empty() {
         return;
     }
-    let s = 1.0 / n as f64;
+    let (fa, fb) = pair_faces(pair);
     let axes = tri.pair_axes(fa, fb, n, margin);
-    let prange = {
-        let whole = corners(fb, (0.0, 1.0), (0.0, 1.0));
-        reach(fb, &whole, poly, fa, n, margin).unwrap_or_else(|| reach_bound(fb, &whole, poly, fa, n, margin))
-    };
-    for au in prange[0]..prange[1] {
-        for av in prange[2]..prange[3] {
-            let (ua, va) = ((au as f64 * s, (au + 1) as f64 * s), (av as f64 * s, (av + 1) as f64 * s));
-            let from = corners(fa, ua, va);
-            let q = reach(fa, &from, poly, fb, n, margin)
-                .unwrap_or_else(|| reach_bound(fa, &from, poly, fb, n, margin));
-            if q[0] < q[1] && q[2] < q[3] {
-                window(au * n + av, q, &axes);
-            }
+    let masks = axes.masks(n);
+    let mut among = [0u64; MAX_PATCHES];
+    masks.survivors(&mut among);
+    for (pa, &set) in among.iter().enumerate().take((n * n) as usize) {
+        if set != 0 {
+            patches(pa as u32, set, &axes, &masks);
         }
     }
 }
@@ -307,25 +112,26 @@ fn search(
     tests: &mut u64,
     found: &mut impl FnMut(u32, u32, u32),
 ) {
-    windows(tri, poly, pair, n, margin, &mut |pa, q, axes| decide(axes, pair, pa, q, n, tests, found));
+    patch_sets(tri, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+        decide(axes, masks, pair, pa, among, n, tests, found)
+    });
 }
 
-/// Decides the shafts of pair `pair` from patch `pa` to the patches `rect` on face b by one
-/// many-shaft test (counted in `tests`), and calls `found(shaft, pa, pb)` for each the triangle
-/// meets.
+/// Decides the shafts of pair `pair` from patch `pa` to the patches `among` of face b exactly
+/// (counted in `tests`), and calls `found(shaft, pa, pb)` for each the triangle meets.
+#[allow(clippy::too_many_arguments)]
 fn decide(
     axes: &PairAxes,
+    masks: &PairMasks,
     pair: u32,
     pa: u32,
-    rect: [u32; 4],
+    among: u64,
     n: u32,
     tests: &mut u64,
     found: &mut impl FnMut(u32, u32, u32),
 ) {
-    *tests += ((rect[1] - rect[0]) * (rect[3] - rect[2])) as u64;
-    for k in set_bits(axes.shafts_from(pa / n, pa % n, rect)) {
-        let (du, dv) = window_offset(k, rect[3] - rect[2]);
-        let pb = (rect[0] + du) * n + rect[2] + dv;
+    *tests += among.count_ones() as u64;
+    for pb in set_bits(axes.shafts_among(pa, among, masks)) {
         found(shaft_of(pair, pa, pb, n), pa, pb);
     }
 }
@@ -641,38 +447,26 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
                 });
                 continue;
             }
-            windows(&prep, poly, pair, n, margin, &mut |pa, q, axes| {
-                // The rectangle of the window's shafts that need the exact test.
-                let mut sub = [u32::MAX, 0, u32::MAX, 0];
-                for u in q[0]..q[1] {
-                    for v in q[2]..q[3] {
-                        if state.needs_test(shaft_of(pair, pa, u * n + v, n), &filler) {
-                            sub = [sub[0].min(u), sub[1].max(u + 1), sub[2].min(v), sub[3].max(v + 1)];
-                        }
-                    }
+            patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+                // The shafts that need the exact test.
+                let mut need = 0u64;
+                for pb in set_bits(among) {
+                    need |= (state.needs_test(shaft_of(pair, pa, pb, n), &filler) as u64) << pb;
                 }
-                if sub[0] < sub[1] {
-                    decide(axes, pair, pa, sub, n, &mut out.tests, &mut |shaft, pa, pb| {
-                        state.fill(shaft, pa, pb, &filler)
-                    });
-                }
+                decide(axes, masks, pair, pa, need, n, &mut out.tests, &mut |shaft, pa, pb| {
+                    state.fill(shaft, pa, pb, &filler)
+                });
                 if !records_needed {
                     return;
                 }
                 // The rest are filled: only a better hit of a midpoint segment can change one,
                 // and counts if the triangle fills that shaft.
-                for u in q[0]..q[1] {
-                    for v in q[2]..q[3] {
-                        if (sub[0]..sub[1]).contains(&u) && (sub[2]..sub[3]).contains(&v) {
-                            continue;
-                        }
-                        let pb = u * n + v;
-                        let shaft = shaft_of(pair, pa, pb, n);
-                        if let Some(h) = state.better_hit(shaft, pa, pb, &filler) {
-                            out.tests += 1;
-                            if axes.shafts_from(pa / n, pa % n, [u, u + 1, v, v + 1]) != 0 {
-                                state.take_hit(shaft, h, t);
-                            }
+                for pb in set_bits(among & !need) {
+                    let shaft = shaft_of(pair, pa, pb, n);
+                    if let Some(h) = state.better_hit(shaft, pa, pb, &filler) {
+                        out.tests += 1;
+                        if axes.shafts_among(pa, 1 << pb, masks) != 0 {
+                            state.take_hit(shaft, h, t);
                         }
                     }
                 }
@@ -926,26 +720,6 @@ mod tests {
         fn material(&self, t: u32) -> u16 {
             (t % 3) as u16
         }
-    }
-
-    /// The quick floor against the standard library's at and beside integers, around 2⁵², on
-    /// signed zeros, infinities and NaN, and on a sweep of fractions of both signs.
-    #[test]
-    fn quick_floor_matches_floor() {
-        let big = 4_503_599_627_370_496.0f64;
-        let mut xs = vec![0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, big, -big, 2.0 * big, 1e300, -1e300];
-        for k in -70..70 {
-            let x = k as f64;
-            xs.extend([x, x.next_up(), x.next_down(), x + 0.5]);
-        }
-        for b in [big, -big] {
-            xs.extend([b.next_up(), b.next_down(), b.next_down().next_down()]);
-        }
-        xs.extend((0..100_000).map(|i| (i as f64 - 50_000.0) * 0.013_7));
-        for x in xs {
-            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "{x}");
-        }
-        assert!(floor(f64::NAN).is_nan());
     }
 
     /// A bake without candidates keeps only the union of the triangles' shafts and skips the
