@@ -75,6 +75,11 @@ impl PnmtLayout {
         }
     }
 
+    /// Whether records hold texture coordinates ([`Self::encode`] ignores them otherwise).
+    pub const fn stores_uv(self) -> bool {
+        !matches!(self, Self::CompactNoUv)
+    }
+
     /// Quantisation steps of a position across a cell.
     pub const fn position_steps(self) -> f64 {
         match self {

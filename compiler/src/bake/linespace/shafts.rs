@@ -188,6 +188,33 @@ struct Filler<'a> {
     kmax: f64,
 }
 
+impl<'a> Filler<'a> {
+    /// Triangle `triangle`, number `local` in its cell, clipped to the widened cell (`poly`), as
+    /// it fills the shafts of face pair `pair`.
+    fn new(triangle: u32, local: u32, seg: &'a SegmentTest, pair: u32, poly: &[DVec3], margin: f64) -> Self {
+        let (fa, fb) = pair_faces(pair);
+        let w = outward(fb) - outward(fa);
+        let key_lo = w.min(DVec3::ZERO).element_sum();
+        let (kmin, kmax) = if poly.is_empty() {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        } else {
+            poly.iter()
+                .map(|p| p.dot(w))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
+        };
+        Filler {
+            triangle,
+            local,
+            seg,
+            faces: (fa, fb),
+            qmin: quantise(kmin - 2.0 * margin, key_lo, false) as u8,
+            qmax: quantise(kmax + 2.0 * margin, key_lo, true) as u8,
+            kmin,
+            kmax,
+        }
+    }
+}
+
 /// What a cell's shafts hold while its triangles fill them: bits, candidate hits and the
 /// records' ends.
 struct Fills<'s> {
@@ -379,24 +406,19 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     }
     let lo_box = DVec3::splat(-margin);
     let hi_box = DVec3::splat(1.0 + margin);
-    // Midpoint segments: patch centres in world space, per face and patch.
-    let mut centres = [[Vec3::ZERO; MAX_PATCHES]; 6];
-    for (face, row) in centres.iter_mut().enumerate() {
-        let face = face as u32;
-        let (ua, va) = face_uv_axes(face);
-        for (patch, c) in row.iter_mut().enumerate().take((n * n) as usize) {
-            let patch = patch as u32;
-            let mut p = DVec3::ZERO;
-            p[face_axis(face)] = (face % 2) as f64;
-            p[ua] = ((patch / n) as f64 + 0.5) / n as f64;
-            p[va] = ((patch % n) as f64 + 0.5) / n as f64;
-            *c = (world_cell_min + p * cell).as_vec3();
-        }
-    }
+    let centres = patch_centres(n, world_cell_min, cell);
     // The clipped polygons of the cell's triangles (kept for the PNMT fallback), their buffers
     // reused from cell to cell.
     if polys.len() < tris.len() {
         polys.resize_with(tris.len(), Vec::new);
+    }
+    if let (&[t], None) = (tris, shade) {
+        let poly = &mut polys[0];
+        clip_to_box_into(local[t as usize].map(|p| p - cell_min), lo_box, hi_box, poly, clip_tmp);
+        let single =
+            Single { t, n, margin, candidates, pnmt, layout, world_cell_min, cell, centres: &centres };
+        single.bake(local[t as usize].map(|p| p - cell_min), poly, attrs, &mut out);
+        return out;
     }
     let mut state = Fills { bits: &mut out.bits, ends, hits, centres: &centres, candidates, records_needed };
     // Without candidates, only the union of the triangles' shafts and the records are kept:
@@ -415,25 +437,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         let sides = spanning_sides(v, margin, n);
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
-            let w = outward(fb) - outward(fa);
-            let key_lo = w.min(DVec3::ZERO).element_sum();
-            let (kmin, kmax) = if poly.is_empty() {
-                (f64::NEG_INFINITY, f64::INFINITY)
-            } else {
-                poly.iter()
-                    .map(|p| p.dot(w))
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
-            };
-            let filler = Filler {
-                triangle: t,
-                local: li as u32,
-                seg: &seg,
-                faces: (fa, fb),
-                qmin: quantise(kmin - 2.0 * margin, key_lo, false) as u8,
-                qmax: quantise(kmax + 2.0 * margin, key_lo, true) as u8,
-                kmin,
-                kmax,
-            };
+            let filler = Filler::new(t, li as u32, &seg, pair, poly, margin);
             if let Some(sides) = &sides {
                 // Every shaft is decided: the all-pairs bake's fills, which the union's equal.
                 spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut |shaft, pa, pb| {
@@ -525,45 +529,28 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
             let end = &ends[shaft];
             let pair = shaft as u32 / (n * n * n * n);
             let (fa, fb) = pair_faces(pair);
-            let w = outward(fb) - outward(fa);
             let record = |e: &End, side: usize, fallbacks: &mut Vec<RecordWords>| -> RecordWords {
                 if e.t.is_finite() {
-                    let [a, b, c] = attrs.corners(e.triangle);
-                    let p = (a * (1.0 - e.u - e.v) + b * e.u + c * e.v).as_dvec3();
-                    return layout.encode(
-                        p,
-                        attrs.normal(e.triangle, e.u, e.v),
-                        attrs.material(e.triangle),
-                        attrs.uv(e.triangle, e.u, e.v),
+                    return hit_record(
+                        attrs,
+                        layout,
+                        e.triangle,
+                        attrs.corners(e.triangle),
+                        e.u,
+                        e.v,
                         world_cell_min,
                         cell,
                     );
                 }
-                // The midpoint segment missed: the triangle reaching furthest towards this end,
-                // at its clipped vertex nearest that end. That depends on the triangle, the pair
-                // and the end alone, so it is made once per cell (a third of the records of
-                // seed 004's scenes are fallbacks).
+                // The midpoint segment missed: the triangle reaching furthest towards this end.
+                // That depends on the triangle, the pair and the end alone, so it is made once
+                // per cell (a third of the records of seed 004's scenes are fallbacks).
                 let Some(poly) = polys.get(e.local as usize) else { return layout.none() };
                 let slot = &mut fallbacks[(e.local * FACE_PAIRS + pair) as usize * 2 + side];
-                if *slot != UNMADE {
-                    return *slot;
+                if *slot == UNMADE {
+                    let t = tris[e.local as usize];
+                    *slot = fallback_record(attrs, layout, t, poly, pair, side, world_cell_min, cell);
                 }
-                let best = poly.iter().copied().min_by(|x, y| {
-                    let (kx, ky) = (x.dot(w), y.dot(w));
-                    if side == 0 { kx.total_cmp(&ky) } else { ky.total_cmp(&kx) }
-                });
-                let Some(q) = best else { return layout.none() };
-                let t = tris[e.local as usize];
-                let world = world_cell_min + q.clamp(DVec3::ZERO, DVec3::ONE) * cell;
-                let (u, v) = barycentric(attrs.corners(t), world.as_vec3());
-                *slot = layout.encode(
-                    world,
-                    attrs.normal(t, u, v),
-                    attrs.material(t),
-                    attrs.uv(t, u, v),
-                    world_cell_min,
-                    cell,
-                );
                 *slot
             };
             let front = record(&end[0], 0, fallbacks);
@@ -603,6 +590,139 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         }
     }
     out
+}
+
+/// Midpoint segments' ends: the patch centres of a cell (minimum corner `world_cell_min`, edge
+/// `cell`) in world space, per face and patch.
+fn patch_centres(n: u32, world_cell_min: DVec3, cell: f64) -> [[Vec3; MAX_PATCHES]; 6] {
+    let mut centres = [[Vec3::ZERO; MAX_PATCHES]; 6];
+    for (face, row) in centres.iter_mut().enumerate() {
+        let face = face as u32;
+        let (ua, va) = face_uv_axes(face);
+        for (patch, c) in row.iter_mut().enumerate().take((n * n) as usize) {
+            let patch = patch as u32;
+            let mut p = DVec3::ZERO;
+            p[face_axis(face)] = (face % 2) as f64;
+            p[ua] = ((patch / n) as f64 + 0.5) / n as f64;
+            p[va] = ((patch % n) as f64 + 0.5) / n as f64;
+            *c = (world_cell_min + p * cell).as_vec3();
+        }
+    }
+    centres
+}
+
+/// A cell of one triangle, baked without pre-illumination. Each shaft's front and back records
+/// are then the one hit of its midpoint segment, or the triangle's fallbacks for the pair; and
+/// the triangle finds its shafts in shaft order (pair, then front patch, then back patch). So
+/// the records, lists and bits are written as the shafts are found, without the per-shaft ends
+/// and buckets of [`bake_cell`] (which give the same bytes: seen in the bake's digests).
+struct Single<'c> {
+    t: u32,
+    n: u32,
+    margin: f64,
+    candidates: bool,
+    pnmt: bool,
+    layout: PnmtLayout,
+    world_cell_min: DVec3,
+    cell: f64,
+    centres: &'c [[Vec3; MAX_PATCHES]; 6],
+}
+
+impl Single<'_> {
+    /// Bakes the triangle with cell-local corners `v` (clipped to the widened cell: `poly`) into
+    /// `out`.
+    fn bake<A: HitAttributes + ?Sized>(
+        &self,
+        v: [DVec3; 3],
+        poly: &[DVec3],
+        attrs: &A,
+        out: &mut CellShafts,
+    ) {
+        let Single { t, n, margin, candidates, pnmt, layout, world_cell_min, cell, centres } = *self;
+        let prep = Prepared::new(v);
+        let seg = SegmentTest::new(if pnmt { attrs.corners(t) } else { [Vec3::ZERO; 3] });
+        let sides = spanning_sides(v, margin, n);
+        let mut tests = 0;
+        for pair in 0..FACE_PAIRS {
+            let (fa, fb) = pair_faces(pair);
+            let f = Filler::new(t, 0, &seg, pair, poly, margin);
+            let mut fallbacks = [None; 2];
+            let mut emit = |shaft: u32, pa: u32, pb: u32| {
+                out.bits[(shaft / 32) as usize] |= 1 << (shaft % 32);
+                if candidates {
+                    out.entries.push(entry::pack(0, f.qmin as u32, f.qmax as u32));
+                    out.list_ends.push(out.entries.len() as u32);
+                }
+                if !pnmt {
+                    return;
+                }
+                let (o, e) = (centres[fa as usize][pa as usize], centres[fb as usize][pb as usize]);
+                let records = match seg.hit(o, e) {
+                    Some(h) => [hit_record(attrs, layout, t, seg.c, h.u, h.v, world_cell_min, cell); 2],
+                    None => [0, 1].map(|side| {
+                        *fallbacks[side].get_or_insert_with(|| {
+                            fallback_record(attrs, layout, t, poly, pair, side, world_cell_min, cell)
+                        })
+                    }),
+                };
+                let words = layout.words();
+                out.pnmt.extend_from_slice(&records[0][..words]);
+                out.pnmt.extend_from_slice(&records[1][..words]);
+                out.pnmt_missing += records.iter().any(|r| !layout.is_some(r)) as u64;
+            };
+            match &sides {
+                Some(sides) => spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut emit),
+                None => search(&prep, poly, pair, n, margin, &mut tests, &mut emit),
+            }
+        }
+        out.tests += tests;
+    }
+}
+
+/// The record of the hit at barycentrics (`u`, `v`) of triangle `t`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn hit_record<A: HitAttributes + ?Sized>(
+    attrs: &A,
+    layout: PnmtLayout,
+    t: u32,
+    [a, b, c]: [Vec3; 3],
+    u: f32,
+    v: f32,
+    world_cell_min: DVec3,
+    cell: f64,
+) -> RecordWords {
+    let p = (a * (1.0 - u - v) + b * u + c * v).as_dvec3();
+    // (Interpolating texture coordinates the layout drops was a tenth of a wall cell's bake.)
+    let uv = if layout.stores_uv() { attrs.uv(t, u, v) } else { Vec2::ZERO };
+    layout.encode(p, attrs.normal(t, u, v), attrs.material(t), uv, world_cell_min, cell)
+}
+
+/// The record of a shaft of pair `pair` whose midpoint segment missed every triangle, towards
+/// its front (`side` 0) or back end: triangle `t` (clipped to the widened cell: `poly`), the
+/// one reaching furthest towards that end, at its clipped vertex nearest that end.
+#[allow(clippy::too_many_arguments)]
+fn fallback_record<A: HitAttributes + ?Sized>(
+    attrs: &A,
+    layout: PnmtLayout,
+    t: u32,
+    poly: &[DVec3],
+    pair: u32,
+    side: usize,
+    world_cell_min: DVec3,
+    cell: f64,
+) -> RecordWords {
+    let (fa, fb) = pair_faces(pair);
+    let w = outward(fb) - outward(fa);
+    let best = poly.iter().copied().min_by(|x, y| {
+        let (kx, ky) = (x.dot(w), y.dot(w));
+        if side == 0 { kx.total_cmp(&ky) } else { ky.total_cmp(&kx) }
+    });
+    let Some(q) = best else { return layout.none() };
+    let world = world_cell_min + q.clamp(DVec3::ZERO, DVec3::ONE) * cell;
+    let (u, v) = barycentric(attrs.corners(t), world.as_vec3());
+    let uv = if layout.stores_uv() { attrs.uv(t, u, v) } else { Vec2::ZERO };
+    layout.encode(world, attrs.normal(t, u, v), attrs.material(t), uv, world_cell_min, cell)
 }
 
 /// Radiance leaving a decoded record: (position, normal, direction to the viewer, material,
