@@ -256,7 +256,8 @@ impl Fills<'_> {
             self.ends[shaft as usize] = [NO_END; 2];
         }
         let (o, e) = self.segment(pa, pb, f);
-        if let Some(h) = f.seg.hit(o, e) {
+        let end = &self.ends[shaft as usize];
+        if let Some(h) = f.seg.hit_if(o, e, |t| !(t >= end[0].t) || !(t <= end[1].t)) {
             self.take_hit(shaft, h, f.triangle);
         }
         let end = &mut self.ends[shaft as usize];
@@ -302,9 +303,8 @@ impl Fills<'_> {
     #[inline(always)]
     fn better_hit(&self, shaft: u32, pa: u32, pb: u32, f: &Filler) -> Option<Intersection> {
         let (o, e) = self.segment(pa, pb, f);
-        let h = f.seg.hit(o, e)?;
         let end = &self.ends[shaft as usize];
-        (!(h.t >= end[0].t) || !(h.t <= end[1].t)).then_some(h)
+        f.seg.hit_if(o, e, |t| !(t >= end[0].t) || !(t <= end[1].t))
     }
 }
 
@@ -750,14 +750,23 @@ impl SegmentTest {
     }
 
     /// (t, u, v) where the segment o → e crosses the triangle.
+    #[inline(always)]
     fn hit(&self, o: Vec3, e: Vec3) -> Option<Intersection> {
+        self.hit_if(o, e, |_| true)
+    }
+
+    /// [`Self::hit`] where the crossing's segment parameter t passes `wanted` (checked before the
+    /// edge functions: in cells of many triangles most crossings lie between a segment's
+    /// nearest hits found already).
+    #[inline(always)]
+    fn hit_if(&self, o: Vec3, e: Vec3, wanted: impl Fn(f32) -> bool) -> Option<Intersection> {
         let d = e - o;
         let denom = self.n.dot(d);
         if denom == 0.0 || self.n2 == 0.0 {
             return None;
         }
         let t = self.n.dot(self.c[0] - o) / denom;
-        if !(0.0..=1.0).contains(&t) {
+        if !(0.0..=1.0).contains(&t) || !wanted(t) {
             return None;
         }
         let p = o + d * t;
