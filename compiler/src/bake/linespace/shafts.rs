@@ -219,6 +219,9 @@ impl<'a> Filler<'a> {
 /// records' ends.
 struct Fills<'s> {
     bits: &'s mut Vec<u32>,
+    /// Bit per shaft: its midpoint segment has a hit (its ends' `t` are finite). Kept only by
+    /// the union bake (empty otherwise).
+    hit_bits: &'s mut Vec<u32>,
     ends: &'s mut Vec<[End; 2]>,
     hits: &'s mut Vec<(u32, u8, u8, u16)>,
     centres: &'s [[Vec3; MAX_PATCHES]; 6],
@@ -227,11 +230,6 @@ struct Fills<'s> {
 }
 
 impl Fills<'_> {
-    #[inline(always)]
-    fn filled(&self, shaft: u32) -> bool {
-        self.bits[(shaft / 32) as usize] & (1 << (shaft % 32)) != 0
-    }
-
     /// The midpoint segment of the shaft from patch `pa` to `pb`, front patch centre to back.
     #[inline(always)]
     fn segment(&self, pa: u32, pb: u32, f: &Filler) -> (Vec3, Vec3) {
@@ -274,6 +272,9 @@ impl Fills<'_> {
     /// Takes the hit `h` of triangle `t` where it is nearer either end than the shaft's.
     #[inline(always)]
     fn take_hit(&mut self, shaft: u32, h: Intersection, t: u32) {
+        if let Some(w) = self.hit_bits.get_mut((shaft / 32) as usize) {
+            *w |= 1 << (shaft % 32);
+        }
         let end = &mut self.ends[shaft as usize];
         if !(h.t >= end[0].t) {
             end[0] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[0] };
@@ -283,19 +284,23 @@ impl Fills<'_> {
         }
     }
 
-    /// Whether filling `shaft` by `f` could change anything [`fill`](Self::fill) keeps other
-    /// than a segment hit: its bit (not yet filled), or, while its segment has no hit, the
-    /// fallback's key bounds.
+    /// The union bake's shafts among the filled ones `among` (bit pb for the shaft from patch
+    /// `pa` of pair `pair` to pb) that need the exact test: those not filled yet, and those
+    /// whose segment has no hit and whose fallback key bounds `f` would change (a filled shaft
+    /// with a hit can change only by a nearer hit, which the caller looks for).
     #[inline(always)]
-    fn needs_test(&self, shaft: u32, f: &Filler) -> bool {
-        if !self.filled(shaft) {
-            return true;
+    fn needing_test(&self, pair: u32, pa: u32, among: u64, n: u32, f: &Filler) -> u64 {
+        let first = shaft_of(pair, pa, 0, n) as usize;
+        let n2 = (n * n) as usize;
+        let filled = bit_range(self.bits, first, n2);
+        let mut need = among & !filled;
+        if self.records_needed {
+            for pb in set_bits(among & filled & !bit_range(self.hit_bits, first, n2)) {
+                let end = &self.ends[first + pb as usize];
+                need |= ((!(f.kmin >= end[0].key) || !(f.kmax <= end[1].key)) as u64) << pb;
+            }
         }
-        if !self.records_needed {
-            return false;
-        }
-        let end = &self.ends[shaft as usize];
-        end[0].t.is_nan() && (!(f.kmin >= end[0].key) || !(f.kmax <= end[1].key))
+        need
     }
 
     /// The hit of the filled `shaft`'s (from patch `pa` to `pb`) midpoint segment on `f`'s
@@ -306,6 +311,16 @@ impl Fills<'_> {
         let end = &self.ends[shaft as usize];
         f.seg.hit_if(o, e, |t| !(t >= end[0].t) || !(t <= end[1].t))
     }
+}
+
+/// Bits `start..start + len` (len ≤ 64) of `words`, as a mask from bit 0.
+#[inline(always)]
+fn bit_range(words: &[u32], start: usize, len: usize) -> u64 {
+    let (w, off) = (start / 32, start % 32);
+    let word = |k: usize| words.get(w + k).copied().unwrap_or(0) as u128;
+    let all = word(0) | word(1) << 32 | word(2) << 64;
+    let mask = if len == 64 { u64::MAX } else { (1u64 << len) - 1 };
+    (all >> off) as u64 & mask
 }
 
 /// Quantises a key in [lo, lo + 2] to 0..=255, rounding down (`up` false) or up.
@@ -349,6 +364,7 @@ pub struct Scratch {
     sorted: Vec<(u32, u8, u8, u16)>,
     counts: Vec<u32>,
     ends: Vec<[End; 2]>,
+    hit_bits: Vec<u32>,
     polys: Vec<Vec<DVec3>>,
     clip_tmp: Vec<DVec3>,
     /// The cell's fallback records by (triangle, pair, end), [`UNMADE`] until made.
@@ -396,7 +412,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
-    let Scratch { hits, sorted, counts, ends, polys, clip_tmp, fallbacks } = scratch;
+    let Scratch { hits, sorted, counts, ends, hit_bits, polys, clip_tmp, fallbacks } = scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
     // A shaft's ends are reset when it is first filled (resetting every shaft of every cell costs
@@ -420,13 +436,18 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         single.bake(local[t as usize].map(|p| p - cell_min), poly, attrs, &mut out);
         return out;
     }
-    let mut state = Fills { bits: &mut out.bits, ends, hits, centres: &centres, candidates, records_needed };
+    let union = !candidates && tris.len() >= UNION_MIN_TRIANGLES;
+    hit_bits.clear();
+    if union {
+        hit_bits.resize(out.bits.len(), 0);
+    }
+    let mut state =
+        Fills { bits: &mut out.bits, hit_bits, ends, hits, centres: &centres, candidates, records_needed };
     // Without candidates, only the union of the triangles' shafts and the records are kept:
     // a window whose shafts are all filled already, and whose records this triangle cannot
-    // change by filling them, needs no exact test (see `Fills::needs_test`). That pays where
+    // change by filling them, needs no exact test (see `Fills::needing_test`). That pays where
     // many triangles share the cell's shafts; in sparse cells its bookkeeping costs more than
     // the tests it saves.
-    let union = !candidates && tris.len() >= UNION_MIN_TRIANGLES;
     for (li, &t) in tris.iter().enumerate() {
         let v = local[t as usize].map(|p| p - cell_min);
         let prep = Prepared::new(v);
@@ -453,10 +474,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
             }
             patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
                 // The shafts that need the exact test.
-                let mut need = 0u64;
-                for pb in set_bits(among) {
-                    need |= (state.needs_test(shaft_of(pair, pa, pb, n), &filler) as u64) << pb;
-                }
+                let need = state.needing_test(pair, pa, among, n, &filler);
                 decide(axes, masks, pair, pa, need, n, &mut out.tests, &mut |shaft, pa, pb| {
                     state.fill(shaft, pa, pb, &filler)
                 });
