@@ -101,9 +101,9 @@ pub struct LineSpaceStats {
     pub candidate_entries: u64,
     /// Triangles of the fullest cell.
     pub max_cell_triangles: u32,
-    /// (Triangle, shaft) pairs tested exactly by separating axes: the shafts within each
-    /// triangle's projected reach (a triangle spanning its cell decides its shafts in closed form,
-    /// uncounted).
+    /// (Triangle, shaft) pairs left to the exact separating-axis decision: those no single
+    /// separation rejects at both ends (counted even where the sign masks alone decide them; a
+    /// triangle spanning its cell decides its shafts in closed form, uncounted).
     pub overlap_tests: u64,
     /// Filled shafts with a missing front or back PNMT record.
     pub pnmt_missing_records: u64,

@@ -80,7 +80,7 @@ impl Prepared {
     }
 
     /// The triangle's separations for the shafts of face pair (`fa`, `fb`) at resolution `n`,
-    /// ready for [`PairAxes::shafts_from`].
+    /// ready for [`PairAxes::masks`] and [`PairAxes::shafts_among`].
     pub fn pair_axes(&self, fa: u32, fb: u32, n: u32, margin: f64) -> PairAxes {
         let l = &self.lanes;
         let s = 1.0 / n as f64;
@@ -312,6 +312,10 @@ impl PairAxes {
     #[inline(always)]
     fn shafts_among_with(&self, pa: u32, among: u64, masks: &PairMasks, simd: bool) -> u64 {
         let lower = masks.at_a[pa as usize];
+        debug_assert!(
+            bits(lower as u64).all(|c| masks.at_b[c] & among == 0),
+            "shafts one separation rejects at both ends must be left out"
+        );
         if among == 0 || lower == 0 {
             return among;
         }

@@ -1,7 +1,7 @@
-//! Filling the shafts of one cell: for each triangle, face pair and patch on the first face, the
-//! patches on the second face that the triangle's projection can reach are tested together
-//! ([`PairAxes::shafts_from`], exact against the widened shaft); then the bits, the sorted
-//! candidate lists and the PNMT records.
+//! Filling the shafts of one cell: for each triangle and face pair, the signs of its
+//! separations at every patch of both faces ([`PairAxes::masks`]) drop the shafts one separation
+//! rejects at both ends, and the rest are decided exactly against the widened shaft
+//! ([`PairAxes::shafts_among`]); then the bits, the sorted candidate lists and the PNMT records.
 
 use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::{
@@ -29,7 +29,8 @@ pub struct CellShafts {
     pub pnmt_missing: u64,
     /// Front and back radiance (binary16 RGB, 0) of each filled shaft (empty without it).
     pub preillum: Vec<[u16; 8]>,
-    /// Overlap tests run (for the bake report).
+    /// (Triangle, shaft) pairs left to the exact decision (for the bake report; see
+    /// `LineSpaceStats::overlap_tests`).
     pub tests: u64,
 }
 
@@ -101,8 +102,8 @@ fn shaft_of(pair: u32, pa: u32, pb: u32, n: u32) -> u32 {
 }
 
 /// Calls `found(shaft, pa, pb)` for every shaft of face pair `pair` (from patch `pa` of face a to
-/// `pb` of face b) that the triangle `tri` (clipped to the widened cell: `poly`) meets: every
-/// [`windows`] window decided by one many-shaft test ([`PairAxes::shafts_from`]).
+/// `pb` of face b) that the triangle `tri` (clipped to the widened cell: `poly`) meets, in shaft
+/// order: the [`patch_sets`] of each source patch decided exactly.
 fn search(
     tri: &Prepared,
     poly: &[DVec3],
@@ -444,8 +445,8 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     let mut state =
         Fills { bits: &mut out.bits, hit_bits, ends, hits, centres: &centres, candidates, records_needed };
     // Without candidates, only the union of the triangles' shafts and the records are kept:
-    // a window whose shafts are all filled already, and whose records this triangle cannot
-    // change by filling them, needs no exact test (see `Fills::needing_test`). That pays where
+    // a shaft filled already, whose records this triangle cannot change by filling it, needs no
+    // exact test (see `Fills::needing_test`). That pays where
     // many triangles share the cell's shafts; in sparse cells its bookkeeping costs more than
     // the tests it saves.
     for (li, &t) in tris.iter().enumerate() {
@@ -872,8 +873,8 @@ mod tests {
     /// A bake without candidates keeps only the union of the triangles' shafts and skips the
     /// exact tests that cannot change it; its bits and PNMT records must be those of the bake
     /// that tests every triangle against every shaft it may reach (the candidate bake, which
-    /// keeps the records too). Cells of small triangles (where most windows are filled
-    /// already), large ones, a mix, and coincident copies (ties).
+    /// keeps the records too). Cells of small triangles (where most shafts a triangle meets are
+    /// filled already), large ones, a mix, and coincident copies (ties).
     #[test]
     fn union_bake_keeps_the_bits_and_records_of_the_all_pairs_bake() {
         let mut rnd = uniform(5);
@@ -924,6 +925,79 @@ mod tests {
         // The union bake must run fewer exact tests (about 70 % here), or it is not taking its
         // own path.
         assert!(skipped.1 * 5 < skipped.0 * 4, "{skipped:?}");
+    }
+
+    /// A cell of one triangle is written as its shafts are found (`Single`), without the
+    /// per-shaft ends and buckets; with pre-illumination the general path bakes it. Both must give
+    /// the same bits, candidate lists and PNMT records: triangles small and large (spanning the
+    /// cell: walls), inside, crossing faces and beyond the cell but within its margin, every
+    /// layout.
+    #[test]
+    fn one_triangle_cells_match_the_general_path() {
+        let mut rnd = uniform(41);
+        let (mut records, mut fallbacks) = (0usize, 0usize);
+        for case in 0..120u32 {
+            let n = 1 + case % 8;
+            let margin = [1e-5, 1e-3][(case % 2) as usize];
+            let layout =
+                [PnmtLayout::Full, PnmtLayout::Compact, PnmtLayout::CompactNoUv][(case % 3) as usize];
+            let tri = match case % 4 {
+                // A wall: a large triangle in a plane through the cell.
+                0 => {
+                    let x = rnd();
+                    [DVec3::new(x, -3.0, -3.0), DVec3::new(x + 0.01, 9.0, -3.0), DVec3::new(x, -3.0, 9.0)]
+                }
+                _ => {
+                    let size = [0.05, 0.4, 1.5][(case % 3) as usize];
+                    let c = DVec3::new(rnd(), rnd(), rnd()) * 1.2 - 0.1;
+                    [0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size)
+                }
+            };
+            let tris = vec![tri];
+            let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| p.as_vec3())).collect());
+            let shade: &Shade<'_> = &|_, _, _, _, _| Vec3::ONE;
+            let bake = |candidates: bool, shade: Option<&Shade<'_>>| {
+                bake_cell(
+                    &[0],
+                    &tris,
+                    DVec3::ZERO,
+                    DVec3::ZERO,
+                    1.0,
+                    n,
+                    margin,
+                    candidates,
+                    true,
+                    layout,
+                    &attrs,
+                    shade,
+                    &mut Scratch::default(),
+                )
+            };
+            for candidates in [false, true] {
+                let (single, general) = (bake(candidates, None), bake(candidates, Some(shade)));
+                assert_eq!(single.bits, general.bits, "case {case}");
+                assert_eq!(single.entries, general.entries, "case {case}");
+                assert_eq!(single.list_ends, general.list_ends, "case {case}");
+                assert_eq!(single.pnmt, general.pnmt, "case {case}");
+                assert_eq!(single.pnmt_missing, general.pnmt_missing, "case {case}");
+                assert_eq!(single.tests, general.tests, "case {case}");
+                assert!(
+                    single.preillum.is_empty()
+                        && general.preillum.len()
+                            == general
+                                .list_ends
+                                .len()
+                                .max(general.bits.iter().map(|w| w.count_ones() as usize).sum())
+                );
+                let words = layout.words();
+                for r in single.pnmt.chunks(2 * words) {
+                    records += 1;
+                    fallbacks += (r[..words] != r[words..]) as usize;
+                }
+            }
+        }
+        // Both kinds of record must occur: hits (front = back) and fallbacks.
+        assert!(records > 50_000 && fallbacks > 1000 && fallbacks < records / 2, "{records} {fallbacks}");
     }
 
     /// Triangles that may span the cell (large ones at every orientation; walls parallel to a
@@ -1080,8 +1154,7 @@ mod tests {
     }
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the
-    /// reach bounds must never leave out a shaft the triangle meets, and nothing else may be
-    /// found. Triangles of every size, crossing the cell's faces, lying just inside and just
+    /// sign masks must never drop a shaft the triangle meets, and nothing else may be found. Triangles of every size, crossing the cell's faces, lying just inside and just
     /// outside them, and tiny ones next to a face (where projections blow up).
     #[test]
     fn search_finds_exactly_the_shafts_the_sweep_test_finds() {
