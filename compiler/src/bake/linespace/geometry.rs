@@ -173,7 +173,13 @@ pub struct PairAxes {
 const AXES: usize = 13;
 
 /// Patches per face at the largest shaft resolution.
-const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
+pub const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
+
+/// The mask of the lowest `count` (≤ 64) bits: every patch of a face of `count` patches.
+#[inline(always)]
+pub fn low_bits(count: usize) -> u64 {
+    if count == 64 { u64::MAX } else { (1u64 << count) - 1 }
+}
 
 /// Patch coordinates (u, v) of patch p = u·n + v in f64, per n: `PATCH_UV[n][0][p]` is u,
 /// `PATCH_UV[n][1][p]` is v (zero beyond n²).
@@ -191,14 +197,20 @@ static PATCH_UV: std::sync::LazyLock<[[[f64; MAX_PATCHES]; 2]; MAX_SHAFT_RES as 
 
 /// The set bits of `mask`, lowest first.
 #[inline(always)]
-fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
+pub fn set_bits(mut mask: u64) -> impl Iterator<Item = u32> {
     std::iter::from_fn(move || {
         (mask != 0).then(|| {
-            let k = mask.trailing_zeros() as usize;
+            let k = mask.trailing_zeros();
             mask &= mask - 1;
             k
         })
     })
+}
+
+/// [`set_bits`] as indices.
+#[inline(always)]
+fn bits(mask: u64) -> impl Iterator<Item = usize> {
+    set_bits(mask).map(|k| k as usize)
 }
 
 /// Where one triangle's separations from the patches of a face pair are positive. A separation
@@ -223,7 +235,7 @@ impl PairMasks {
     /// ends (a superset of the shafts the triangle meets).
     pub fn survivors(&self, out: &mut [u64; MAX_PATCHES]) {
         let n2 = (self.n * self.n) as usize;
-        let all = if n2 == 64 { u64::MAX } else { (1u64 << n2) - 1 };
+        let all = low_bits(n2);
         for (pa, out) in out.iter_mut().enumerate().take(n2) {
             let mut rejected = 0u64;
             for c in bits((self.at_a[pa] & self.some_b) as u64) {
@@ -235,7 +247,7 @@ impl PairMasks {
 
     /// `some_b` and `free_b` from `at_b`.
     fn finish_b(&mut self, n2: usize) {
-        let all = if n2 == 64 { u64::MAX } else { (1u64 << n2) - 1 };
+        let all = low_bits(n2);
         let mut any = 0u64;
         for (c, &m) in self.at_b.iter().enumerate() {
             self.some_b |= ((m != 0) as u32) << c;
@@ -378,7 +390,7 @@ impl PairAxes {
 unsafe fn masks_avx2(p: &PairAxes, n: u32) -> PairMasks {
     use std::arch::x86_64::*;
     let n2 = (n * n) as usize;
-    let all = if n2 == 64 { u64::MAX } else { (1u64 << n2) - 1 };
+    let all = low_bits(n2);
     let [us, vs] = &PATCH_UV[n as usize];
     let zero = _mm256_setzero_pd();
     let gt = |x: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, zero);

@@ -5,11 +5,11 @@
 
 use glam::{DVec3, Vec2, Vec3};
 use kiln_format::linespace::index::{
-    FACE_PAIRS, MAX_SHAFT_RES, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel,
+    FACE_PAIRS, face_axis, face_uv_axes, pair_faces, shaft_parts, shafts_per_voxel,
 };
 use kiln_format::linespace::{PnmtLayout, RecordWords, entry, words_per_slot};
 
-use super::geometry::{PairAxes, PairMasks, Prepared, clip_to_box_into};
+use super::geometry::{MAX_PATCHES, PairAxes, PairMasks, Prepared, clip_to_box_into, low_bits, set_bits};
 use super::span::{Sides, Span, met_from};
 
 /// What one cell contributes to the line space.
@@ -153,24 +153,12 @@ fn spanning_sides(v: [DVec3; 3], margin: f64, n: u32) -> Option<[Sides; 6]> {
 /// separating-axis test: the bake's count of tests leaves them out).
 fn spanned(a: &Sides, b: &Sides, pair: u32, n: u32, found: &mut impl FnMut(u32, u32, u32)) {
     let n2 = n * n;
-    let all = if n2 == 64 { u64::MAX } else { (1u64 << n2) - 1 };
+    let all = low_bits(n2 as usize);
     for pa in 0..n2 {
         for pb in set_bits(met_from(1 << pa, a, b, all)) {
             found(shaft_of(pair, pa, pb, n), pa, pb);
         }
     }
-}
-
-/// The set bits of `mask`, lowest first.
-#[inline(always)]
-fn set_bits(mut mask: u64) -> impl Iterator<Item = u32> {
-    std::iter::from_fn(move || {
-        (mask != 0).then(|| {
-            let k = mask.trailing_zeros();
-            mask &= mask - 1;
-            k
-        })
-    })
 }
 
 /// A triangle of the cell as it fills the shafts of one face pair.
@@ -320,8 +308,7 @@ fn bit_range(words: &[u32], start: usize, len: usize) -> u64 {
     let (w, off) = (start / 32, start % 32);
     let word = |k: usize| words.get(w + k).copied().unwrap_or(0) as u128;
     let all = word(0) | word(1) << 32 | word(2) << 64;
-    let mask = if len == 64 { u64::MAX } else { (1u64 << len) - 1 };
-    (all >> off) as u64 & mask
+    (all >> off) as u64 & low_bits(len)
 }
 
 /// Quantises a key in [lo, lo + 2] to 0..=255, rounding down (`up` false) or up.
@@ -376,9 +363,6 @@ pub struct Scratch {
 /// is clamped below all ones, the compact ones leave the fourth word zero).
 const UNMADE: RecordWords = [u32::MAX; 4];
 
-/// Patches per face at the largest shaft resolution.
-const MAX_PATCHES: usize = (MAX_SHAFT_RES * MAX_SHAFT_RES) as usize;
-
 const NO_END: End = End { t: f32::NAN, triangle: u32::MAX, u: 0.0, v: 0.0, key: f64::NAN, local: u32::MAX };
 
 /// The least number of triangles in a cell for which a bake without candidates keeps only the
@@ -430,11 +414,11 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         polys.resize_with(tris.len(), Vec::new);
     }
     if let (&[t], None) = (tris, shade) {
-        let poly = &mut polys[0];
-        clip_to_box_into(local[t as usize].map(|p| p - cell_min), lo_box, hi_box, poly, clip_tmp);
+        let (v, poly) = (local[t as usize].map(|p| p - cell_min), &mut polys[0]);
+        clip_to_box_into(v, lo_box, hi_box, poly, clip_tmp);
         let single =
             Single { t, n, margin, candidates, pnmt, layout, world_cell_min, cell, centres: &centres };
-        single.bake(local[t as usize].map(|p| p - cell_min), poly, attrs, &mut out);
+        single.bake(v, poly, attrs, &mut out);
         return out;
     }
     let union = !candidates && tris.len() >= UNION_MIN_TRIANGLES;
@@ -870,6 +854,36 @@ mod tests {
         }
     }
 
+    /// Bakes every triangle of `tris` (grid-local corners, also their world corners) as the
+    /// list of the unit cell at the origin.
+    fn bake_unit_cell(
+        tris: &[[DVec3; 3]],
+        n: u32,
+        margin: f64,
+        candidates: bool,
+        pnmt: bool,
+        layout: PnmtLayout,
+        shade: Option<&Shade<'_>>,
+    ) -> CellShafts {
+        let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| p.as_vec3())).collect());
+        let ids: Vec<u32> = (0..tris.len() as u32).collect();
+        bake_cell(
+            &ids,
+            tris,
+            DVec3::ZERO,
+            DVec3::ZERO,
+            1.0,
+            n,
+            margin,
+            candidates,
+            pnmt,
+            layout,
+            &attrs,
+            shade,
+            &mut Scratch::default(),
+        )
+    }
+
     /// A bake without candidates keeps only the union of the triangles' shafts and skips the
     /// exact tests that cannot change it; its bits and PNMT records must be those of the bake
     /// that tests every triangle against every shaft it may reach (the candidate bake, which
@@ -894,24 +908,8 @@ mod tests {
                 let copy = tris[0];
                 tris.push(copy);
             }
-            let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| p.as_vec3())).collect());
-            let ids: Vec<u32> = (0..tris.len() as u32).collect();
             let bake = |candidates: bool, pnmt: bool| {
-                bake_cell(
-                    &ids,
-                    &tris,
-                    DVec3::ZERO,
-                    DVec3::ZERO,
-                    1.0,
-                    n,
-                    margin,
-                    candidates,
-                    pnmt,
-                    PnmtLayout::Full,
-                    &attrs,
-                    None,
-                    &mut Scratch::default(),
-                )
+                bake_unit_cell(&tris, n, margin, candidates, pnmt, PnmtLayout::Full, None)
             };
             let all = bake(true, true);
             let union = bake(false, true);
@@ -953,25 +951,9 @@ mod tests {
                     [0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size)
                 }
             };
-            let tris = vec![tri];
-            let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| p.as_vec3())).collect());
             let shade: &Shade<'_> = &|_, _, _, _, _| Vec3::ONE;
             let bake = |candidates: bool, shade: Option<&Shade<'_>>| {
-                bake_cell(
-                    &[0],
-                    &tris,
-                    DVec3::ZERO,
-                    DVec3::ZERO,
-                    1.0,
-                    n,
-                    margin,
-                    candidates,
-                    true,
-                    layout,
-                    &attrs,
-                    shade,
-                    &mut Scratch::default(),
-                )
+                bake_unit_cell(&[tri], n, margin, candidates, true, layout, shade)
             };
             for candidates in [false, true] {
                 let (single, general) = (bake(candidates, None), bake(candidates, Some(shade)));
@@ -981,14 +963,9 @@ mod tests {
                 assert_eq!(single.pnmt, general.pnmt, "case {case}");
                 assert_eq!(single.pnmt_missing, general.pnmt_missing, "case {case}");
                 assert_eq!(single.tests, general.tests, "case {case}");
-                assert!(
-                    single.preillum.is_empty()
-                        && general.preillum.len()
-                            == general
-                                .list_ends
-                                .len()
-                                .max(general.bits.iter().map(|w| w.count_ones() as usize).sum())
-                );
+                // (One radiance per filled shaft, on the general path only.)
+                let filled: usize = general.bits.iter().map(|w| w.count_ones() as usize).sum();
+                assert!(single.preillum.is_empty() && general.preillum.len() == filled);
                 let words = layout.words();
                 for r in single.pnmt.chunks(2 * words) {
                     records += 1;
