@@ -8,7 +8,9 @@
 //! the compact records' error against them, record by record.
 //!
 //! `cargo bench -p kiln-compiler --bench linespace [-- ROWS]` (ROWS: comma-separated row numbers,
-//! default all; KILN_BENCH_RUNS: runs per row, default 3).
+//! default all; KILN_BENCH_RUNS: runs per row, default 3). With `KILN_BENCH_GPU=1` the binary
+//! and PNMT bakes run on the GPU (`linespace::gpu`; the candidate bakes stay on the CPU), and
+//! each row's PNMT bits and records are compared with a CPU bake's, word for word.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::AtomicUsize;
@@ -105,7 +107,34 @@ fn bake_measured(
     (ls, ms, mib((PEAK.load(Relaxed) - before) as u64))
 }
 
+/// The GPU of `KILN_BENCH_GPU=1` (opened once, before the first row).
+static GPU: std::sync::OnceLock<Option<linespace::gpu::GpuBaker>> = std::sync::OnceLock::new();
+
+fn gpu() -> Option<&'static linespace::gpu::GpuBaker> {
+    GPU.get_or_init(|| {
+        std::env::var_os("KILN_BENCH_GPU").map(|_| {
+            let t = Instant::now();
+            let options = kiln_gpubake::Options { allow_cpu: true, validate: false };
+            let gpu = linespace::gpu::GpuBaker::new(&options).expect("KILN_BENCH_GPU: a Vulkan device");
+            println!("GPU bake on {} (opened in {:.0} ms)", gpu.device(), t.elapsed().as_secs_f64() * 1e3);
+            gpu
+        })
+    })
+    .as_ref()
+}
+
 fn bake(
+    scene: &Scene,
+    res: u32,
+    n: u32,
+    variants: u32,
+    layout: PnmtLayout,
+) -> (linespace::BakedLineSpace, f64) {
+    bake_on(gpu(), scene, res, n, variants, layout)
+}
+
+fn bake_on(
+    gpu: Option<&linespace::gpu::GpuBaker>,
     scene: &Scene,
     res: u32,
     n: u32,
@@ -117,7 +146,7 @@ fn bake(
     let voxels = geometry.voxels(res).clone();
     let voxel_ms = t.elapsed().as_secs_f64() * 1e3;
     let progress = kiln_compiler::progress::Progress::hidden();
-    let ls = linespace::bake(&attributes(scene), voxels, voxel_ms, n, variants, layout, None, &progress)
+    let ls = linespace::bake(gpu, &attributes(scene), voxels, voxel_ms, n, variants, layout, None, &progress)
         .expect("bake");
     (ls, t.elapsed().as_secs_f64() * 1e3)
 }
@@ -199,6 +228,7 @@ fn main() {
         .map(|s| s.split(',').filter_map(|x| x.parse::<usize>().ok()).map(|x| x - 1).collect())
         .unwrap_or_else(|| (0..TABLE1.len()).collect());
     let runs: usize = std::env::var("KILN_BENCH_RUNS").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
+    gpu();
     println!(
         "line-space bake, {} threads, median of {runs} runs; thesis: GTX 1080, PNMT",
         rayon::current_num_threads()
@@ -278,6 +308,19 @@ fn main() {
             full_ms - full.voxel_ms
         );
         drop(full);
+        if gpu().is_some() {
+            let (cpu, cpu_ms) =
+                bake_on(None, &scene, row.res, row.n, Variants::BINARY | Variants::PNMT, COMPACT);
+            let same = cpu.bits == ls.bits && cpu.ranks == ls.ranks && cpu.pnmt == ls.pnmt;
+            let differing = cpu.pnmt.iter().zip(&ls.pnmt).filter(|(a, b)| a != b).count();
+            println!(
+                "      GPU against CPU bake ({:.1} ms on the CPU): {} (bit words {} / {}, record words differing {differing})",
+                cpu_ms - cpu.voxel_ms,
+                if same { "the same bits, ranks and records" } else { "DIFFERENT" },
+                cpu.bits.len(),
+                ls.bits.len()
+            );
+        }
         let _ = row.thesis_voxel_ms;
         let t = Instant::now();
         let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);

@@ -2,7 +2,9 @@
 //! of its bits, records and candidate lists (to compare two builds' bakes):
 //! `cargo run --release -p kiln-compiler --example prof_ls -- ROW VARIANT [RUNS]` (VARIANT:
 //! pnmt, cand or binary). `KILN_PROF_KEEP=walls` keeps only the Cornell box's triangles in
-//! the cells' lists, `object` only the object's.
+//! the cells' lists, `object` only the object's. `KILN_PROF_GPU=1` bakes on the GPU (a CPU
+//! implementation such as lavapipe too, where there is no GPU), `validate` with Vulkan's
+//! validation layer.
 
 use std::time::Instant;
 
@@ -26,6 +28,12 @@ fn main() {
     let geometry = kiln_compiler::analyze::geometry::SceneGeometry::new(&scene);
     let attrs = attributes(&scene);
     let progress = kiln_compiler::progress::Progress::hidden();
+    let gpu = std::env::var("KILN_PROF_GPU").ok().map(|v| {
+        let options = kiln_gpubake::Options { allow_cpu: true, validate: v == "validate" };
+        let gpu = linespace::gpu::GpuBaker::new(&options).expect("a Vulkan device");
+        println!("device: {}", gpu.device());
+        gpu
+    });
     let mut times = Vec::new();
     for _ in 0..runs {
         let mut voxels = geometry.voxels(res).clone();
@@ -45,8 +53,18 @@ fn main() {
             voxels.triangles = tris;
         }
         let t = Instant::now();
-        let ls = linespace::bake(&attrs, voxels, 0.0, n, variants, PnmtLayout::CompactNoUv, None, &progress)
-            .expect("bake");
+        let ls = linespace::bake(
+            gpu.as_ref(),
+            &attrs,
+            voxels,
+            0.0,
+            n,
+            variants,
+            PnmtLayout::CompactNoUv,
+            None,
+            &progress,
+        )
+        .expect("bake");
         times.push(t.elapsed().as_secs_f64() * 1e3);
         let counts: Vec<u32> = ls.voxel_offsets.windows(2).map(|w| w[1] - w[0]).filter(|&c| c > 0).collect();
         let mut sorted = counts.clone();
@@ -67,6 +85,9 @@ fn main() {
             sorted[sorted.len() * 9 / 10],
             sorted.last().unwrap()
         );
+    }
+    if let Some(gpu) = &gpu {
+        println!("validation errors: {}", gpu.validation_errors());
     }
     times.sort_by(f64::total_cmp);
     println!("median {:.1} ms", times[times.len() / 2]);

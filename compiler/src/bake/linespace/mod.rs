@@ -3,6 +3,7 @@
 
 pub mod estimate;
 mod geometry;
+pub mod gpu;
 mod shafts;
 mod span;
 pub mod stages;
@@ -101,9 +102,11 @@ impl HitAttributes for SceneAttributes<'_> {
 
 /// Bakes the line space over `voxels` (the voxel grid in `attrs`' triangle order, which took
 /// `voxel_ms` to build) at shaft resolution `n` with `variants` (0: grid only), PNMT records
-/// in `layout`.
+/// in `layout`; on `gpu` where it is given and makes these variants ([`gpu::supports`]), else
+/// on the CPU.
 #[allow(clippy::too_many_arguments)]
 pub fn bake(
+    gpu: Option<&gpu::GpuBaker>,
     attrs: &SceneAttributes,
     voxels: voxelize::Voxels,
     voxel_ms: f64,
@@ -155,6 +158,31 @@ pub fn bake(
     header.slots = occupied.len() as u32;
     let margin_local = header.margin / header.cell;
     progress.count("line space: cells", occupied.len() as u64);
+    if let Some(gpu) = gpu.filter(|_| gpu::supports(variants, layout, attrs)) {
+        gpu::bake(
+            gpu,
+            attrs,
+            &header,
+            &local,
+            &voxel_offsets,
+            &voxel_triangles,
+            &occupied,
+            n,
+            margin_local,
+            layout,
+            pnmt,
+            progress,
+            &mut out,
+        )?;
+        header.filled =
+            out.ranks.last().map_or(0, |&r| r as u64) + out.bits.last().map_or(0, |w| w.count_ones() as u64);
+        out.header = header;
+        out.voxel_offsets = voxel_offsets;
+        out.voxel_triangles = voxel_triangles;
+        out.slots = slots;
+        out.total_ms = voxel_ms + start.elapsed().as_secs_f64() * 1e3;
+        return Ok(out);
+    }
     // Cells are baked a chunk at a time and each chunk's parts appended to the sections before
     // the next: holding every cell's parts until the end doubled the bake's peak memory at the
     // fine rows of seed 004's table (gigabytes of PNMT records).
@@ -333,7 +361,7 @@ fn append_par<'a, I: Sync, T: Copy + Send, P: ExactSizeIterator<Item = T>>(
     unsafe { out.set_len(out.len() + total) };
 }
 
-fn too_many() -> CliError {
+pub(super) fn too_many() -> CliError {
     CliError::input(
         "the line space has more than 2^32 filled shafts or candidate entries; lower --voxel-res or --shaft-res",
     )

@@ -184,13 +184,7 @@ impl<'a> Filler<'a> {
         let (fa, fb) = pair_faces(pair);
         let w = outward(fb) - outward(fa);
         let key_lo = w.min(DVec3::ZERO).element_sum();
-        let (kmin, kmax) = if poly.is_empty() {
-            (f64::NEG_INFINITY, f64::INFINITY)
-        } else {
-            poly.iter()
-                .map(|p| p.dot(w))
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
-        };
+        let (kmin, kmax) = key_bounds(pair, poly);
         Filler {
             triangle,
             local,
@@ -200,6 +194,48 @@ impl<'a> Filler<'a> {
             qmax: quantise(kmax + 2.0 * margin, key_lo, true) as u8,
             kmin,
             kmax,
+        }
+    }
+}
+
+/// The key bounds of a triangle clipped to the widened cell (`poly`) along face pair `pair`: the
+/// least and greatest key of its vertices (unbounded for an empty polygon), the PNMT fallback's
+/// measure of how far it reaches towards either end.
+fn key_bounds(pair: u32, poly: &[DVec3]) -> (f64, f64) {
+    let (fa, fb) = pair_faces(pair);
+    let w = outward(fb) - outward(fa);
+    if poly.is_empty() {
+        return (f64::NEG_INFINITY, f64::INFINITY);
+    }
+    poly.iter().map(|p| p.dot(w)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
+}
+
+/// What the GPU bake needs of triangle `t` (cell-relative corners `v`) in the cell of world
+/// minimum corner `world_cell_min` and edge `cell`, per face pair: its key bounds, appended to
+/// `keys` (the 15 minima, then the 15 maxima), and its fallback records towards the front and
+/// back ends, appended to `fallbacks` (`layout.words()` words each, pair by pair). `poly` and
+/// `tmp` are scratch buffers.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn triangle_pair_data<A: HitAttributes + ?Sized>(
+    attrs: &A,
+    layout: PnmtLayout,
+    t: u32,
+    v: [DVec3; 3],
+    margin: f64,
+    world_cell_min: DVec3,
+    cell: f64,
+    (poly, tmp): (&mut Vec<DVec3>, &mut Vec<DVec3>),
+    keys: &mut Vec<f64>,
+    fallbacks: &mut Vec<u32>,
+) {
+    clip_to_box_into(v, DVec3::splat(-margin), DVec3::splat(1.0 + margin), poly, tmp);
+    let bounds: Vec<(f64, f64)> = (0..FACE_PAIRS).map(|pair| key_bounds(pair, poly)).collect();
+    keys.extend(bounds.iter().map(|b| b.0));
+    keys.extend(bounds.iter().map(|b| b.1));
+    for pair in 0..FACE_PAIRS {
+        for side in 0..2 {
+            let r = fallback_record(attrs, layout, t, poly, pair, side, world_cell_min, cell);
+            fallbacks.extend_from_slice(&r[..layout.words()]);
         }
     }
 }

@@ -25,6 +25,7 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
         shading.radiance(p.as_vec3(), n, n, v, m as u32, uv)
     };
     let ls = super::bake(
+        None,
         &ctx.attributes(),
         voxels,
         voxel_ms,
