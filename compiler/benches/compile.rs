@@ -108,8 +108,15 @@ fn tiny(runs: usize) {
         strict: false,
         warning_levels: Vec::new(),
     };
-    let out_args =
-        OutputArgs { report: None, depfile: None, threads: None, quiet: true, cache: None, no_cache: true };
+    let out_args = OutputArgs {
+        report: None,
+        depfile: None,
+        threads: None,
+        line_space_device: Default::default(),
+        quiet: true,
+        cache: None,
+        no_cache: true,
+    };
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
     let (mut process, mut in_process, mut lut) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..runs {
@@ -168,8 +175,15 @@ fn pica(runs: usize) {
         strict: false,
         warning_levels: Vec::new(),
     };
-    let out_args =
-        OutputArgs { report: None, depfile: None, threads: None, quiet: true, cache: None, no_cache: true };
+    let out_args = OutputArgs {
+        report: None,
+        depfile: None,
+        threads: None,
+        line_space_device: Default::default(),
+        quiet: true,
+        cache: None,
+        no_cache: true,
+    };
     println!("pica_pica, {runs} runs, {} threads; medians (min..max) in ms", rayon::current_num_threads());
 
     // 1. Per-stage compile time.

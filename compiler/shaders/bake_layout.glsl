@@ -35,6 +35,11 @@ struct BakeCell {
     uint reserved; // offset 76
 }; // 80 bytes
 
+// PNMT: the full layout's code, absent records' materials.
+const uint BAKE_PNMT_FULL = 0u;
+const uint BAKE_NO_RECORD = 65535u;
+const uint BAKE_NO_RECORD_COMPACT = 4095u;
+
 // Per face: its axis, its (u, v) axes; per pair: its faces a and b.
 const uint BAKE_FACE_AXIS[6] = uint[6](0u, 0u, 1u, 1u, 2u, 2u);
 const uint BAKE_FACE_U[6] = uint[6](1u, 1u, 0u, 0u, 0u, 0u);

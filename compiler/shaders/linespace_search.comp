@@ -7,6 +7,7 @@
 // shafts.rs's Fills::fill fills it: its bit, the nearest hits of its midpoint segment from
 // either end, and the fallback triangles by key.
 #extension GL_GOOGLE_include_directive : require
+#define KILN_BAKE_TRI_BINDING 5
 #include "linespace_common.glsl"
 
 layout(local_size_x = 64) in;
@@ -19,7 +20,6 @@ layout(std430, set = 0, binding = 3) readonly buffer KeysB { double keys[]; };
 // Per global triangle: grid-local corners (9 doubles).
 layout(std430, set = 0, binding = 4) readonly buffer LocalB { double local_corners[]; };
 // Per global triangle: world corners (9 floats), vertex normals (9), material, padding.
-layout(std430, set = 0, binding = 5) readonly buffer TrisB { float tri_data[]; };
 layout(std430, set = 0, binding = 6) buffer EndsB { End ends[]; };
 layout(std430, set = 0, binding = 7) buffer BitsB { uint bits[]; };
 layout(std430, set = 0, binding = 8) buffer TestsB { uint tests[]; };

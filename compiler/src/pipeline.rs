@@ -231,6 +231,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         .build()
         .map_err(|e| CliError::io(format!("cannot start {threads} worker threads: {e}")))?;
     let cache = out.cache_dir().map(|d| Cache::open(&d)).transpose()?;
+    crate::bake::linespace::gpu::choose(out.line_space_device);
     let progress = Progress::new(!out.quiet);
     let inputs = hash_inputs(&loaded.scene.inputs)?;
     let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress, cache.as_ref())?))?;

@@ -737,7 +737,10 @@ pub fn bake_layout() -> String {
     declare::<BakeParams>(&mut s);
     declare::<BakeCell>(&mut s);
     s.push_str(&format!(
-        "// Per face: its axis, its (u, v) axes; per pair: its faces a and b.\nconst uint BAKE_FACE_AXIS[6] = uint[6]({});\nconst uint BAKE_FACE_U[6] = uint[6]({});\nconst uint BAKE_FACE_V[6] = uint[6]({});\nconst uint BAKE_PAIR_A[{FACE_PAIRS}] = uint[{FACE_PAIRS}]({});\nconst uint BAKE_PAIR_B[{FACE_PAIRS}] = uint[{FACE_PAIRS}]({});\n\n#endif\n",
+        "// PNMT: the full layout's code, absent records' materials.\nconst uint BAKE_PNMT_FULL = {}u;\nconst uint BAKE_NO_RECORD = {}u;\nconst uint BAKE_NO_RECORD_COMPACT = {}u;\n\n// Per face: its axis, its (u, v) axes; per pair: its faces a and b.\nconst uint BAKE_FACE_AXIS[6] = uint[6]({});\nconst uint BAKE_FACE_U[6] = uint[6]({});\nconst uint BAKE_FACE_V[6] = uint[6]({});\nconst uint BAKE_PAIR_A[{FACE_PAIRS}] = uint[{FACE_PAIRS}]({});\nconst uint BAKE_PAIR_B[{FACE_PAIRS}] = uint[{FACE_PAIRS}]({});\n\n#endif\n",
+        crate::linespace::PnmtLayout::Full.code(),
+        crate::linespace::NO_RECORD,
+        crate::linespace::NO_RECORD_COMPACT,
         faces(|f| face_axis(f) as u32),
         faces(|f| face_uv_axes(f).0 as u32),
         faces(|f| face_uv_axes(f).1 as u32),

@@ -354,6 +354,13 @@ impl Compute {
 
     /// Records commands with `record`, submits them and waits for them to finish.
     pub fn run(&self, record: impl FnOnce(&mut Commands) -> Result<()>) -> Result<()> {
+        self.submit(record)?.wait()
+    }
+
+    /// Records commands with `record` and submits them; [`Pending::wait`] waits for them. Work
+    /// submitted later runs after it (each dispatch, copy and fill begins with a full barrier,
+    /// whose scope reaches back over earlier submissions to the queue).
+    pub fn submit(&self, record: impl FnOnce(&mut Commands) -> Result<()>) -> Result<Pending<'_>> {
         let d = &self.device;
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.pool)
@@ -362,49 +369,85 @@ impl Compute {
         // SAFETY: valid pool.
         let cmd = unsafe { d.allocate_command_buffers(&info) }
             .map_err(|e| vk_err("allocating a command buffer", e))?[0];
+        let mut pending = Pending { compute: self, cmd, pools: Vec::new(), fence: vk::Fence::null() };
         let mut c = Commands { device: d, cmd, pools: Vec::new() };
-        let result = (|| {
-            // SAFETY: a fresh command buffer, recorded once.
-            unsafe {
-                d.begin_command_buffer(
-                    cmd,
-                    &vk::CommandBufferBeginInfo::default()
-                        .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-                )
-            }
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: a fresh command buffer, recorded once.
+        unsafe { d.begin_command_buffer(cmd, &begin) }
             .map_err(|e| vk_err("beginning a command buffer", e))?;
-            record(&mut c)?;
-            // SAFETY: recording began above.
-            unsafe { d.end_command_buffer(cmd) }.map_err(|e| vk_err("ending a command buffer", e))?;
-            // SAFETY: valid device.
-            let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
-                .map_err(|e| vk_err("creating a fence", e))?;
-            let cmds = [cmd];
-            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-            // SAFETY: the command buffer is complete; the fence is unsignalled.
-            let done = unsafe { d.queue_submit(self.queue, &submit, fence) }
-                .map_err(|e| vk_err("submitting GPU work", e))
-                .and_then(|()| {
-                    // SAFETY: the fence was submitted above.
-                    unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }
-                        .map_err(|e| vk_err("waiting for the GPU", e))
-                });
-            // SAFETY: the fence is signalled or was never submitted.
-            unsafe { d.destroy_fence(fence, None) };
-            done
-        })();
-        if result.is_err() {
-            // SAFETY: after a failure nothing may still run; wait to be sure before freeing.
-            let _ = unsafe { d.device_wait_idle() };
+        let recorded = record(&mut c);
+        pending.pools = std::mem::take(&mut c.pools);
+        recorded?;
+        // SAFETY: recording began above.
+        unsafe { d.end_command_buffer(cmd) }.map_err(|e| vk_err("ending a command buffer", e))?;
+        // SAFETY: valid device.
+        pending.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }
+            .map_err(|e| vk_err("creating a fence", e))?;
+        let cmds = [cmd];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        // SAFETY: the command buffer is complete; the fence is unsignalled.
+        if let Err(e) = unsafe { d.queue_submit(self.queue, &submit, pending.fence) } {
+            // SAFETY: never submitted: nothing waits on the fence.
+            unsafe { d.destroy_fence(pending.fence, None) };
+            pending.fence = vk::Fence::null();
+            return Err(vk_err("submitting GPU work", e));
         }
-        // SAFETY: the work finished (waited on), so its command buffer and descriptor pools are free.
-        unsafe {
-            d.free_command_buffers(self.pool, &[cmd]);
-            for p in c.pools.drain(..) {
-                d.destroy_descriptor_pool(p, None);
+        Ok(pending)
+    }
+}
+
+/// Submitted work ([`Compute::submit`]); dropping it waits too.
+pub struct Pending<'a> {
+    compute: &'a Compute,
+    cmd: vk::CommandBuffer,
+    pools: Vec<vk::DescriptorPool>,
+    fence: vk::Fence,
+}
+
+impl std::fmt::Debug for Pending<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pending").finish()
+    }
+}
+
+impl Pending<'_> {
+    /// Waits for the work to finish.
+    pub fn wait(mut self) -> Result<()> {
+        self.finish()
+    }
+
+    fn finish(&mut self) -> Result<()> {
+        let d = &self.compute.device;
+        let mut result = Ok(());
+        if self.fence != vk::Fence::null() {
+            // SAFETY: the fence was submitted with the work.
+            result = unsafe { d.wait_for_fences(&[self.fence], true, u64::MAX) }
+                .map_err(|e| vk_err("waiting for the GPU", e));
+            if result.is_err() {
+                // SAFETY: after a failure nothing may still run; wait to be sure before freeing.
+                let _ = unsafe { d.device_wait_idle() };
             }
+            // SAFETY: signalled (or the device is idle).
+            unsafe { d.destroy_fence(self.fence, None) };
+            self.fence = vk::Fence::null();
+        }
+        if self.cmd != vk::CommandBuffer::null() {
+            // SAFETY: the work finished, so its command buffer and descriptor pools are free.
+            unsafe {
+                d.free_command_buffers(self.compute.pool, &[self.cmd]);
+                for p in self.pools.drain(..) {
+                    d.destroy_descriptor_pool(p, None);
+                }
+            }
+            self.cmd = vk::CommandBuffer::null();
         }
         result
+    }
+}
+
+impl Drop for Pending<'_> {
+    fn drop(&mut self) {
+        let _ = self.finish();
     }
 }
 

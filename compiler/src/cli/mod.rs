@@ -235,6 +235,16 @@ pub struct OutputArgs {
     /// Worker threads [default: all cores]. The output is identical for every count.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub threads: Option<u16>,
+    /// Where the line space is baked. The output is identical for every device.
+    #[arg(
+        long,
+        value_enum,
+        default_value_t,
+        help = "Where the line space is baked: auto (a GPU through Vulkan compute where one opens and \
+the bake is large enough to gain from it, else the CPU), cpu, or gpu (an error without one). The output \
+is identical for every device; the GPU bakes the binary and PNMT variants, the CPU the rest"
+    )]
+    pub line_space_device: crate::bake::linespace::gpu::BakeDevice,
     /// Print nothing but errors and warnings.
     #[arg(long, short = 'q')]
     pub quiet: bool,

@@ -6,9 +6,12 @@
 //! separating-axis sweep in the CPU's double-precision arithmetic (sign masks, then the fraction
 //! test; `geometry.rs`), and fills the shafts met as `Fills::fill` does (bit, nearest midpoint
 //! hits from either end, fallback triangles by key); `linespace_records` encodes each filled
-//! shaft's two records at its rank. What depends on the clipped triangle alone (key bounds and
-//! fallback records per pair, a few per triangle and cell) is made here on the CPU, in parallel,
-//! with the CPU bake's own functions.
+//! shaft's two records at its rank. Before them `linespace_prepare` clips each of the batch's cell
+//! triangles to the widened cell and makes what depends on that alone: its key bounds and
+//! fallback records per pair.
+//!
+//! Batches are pipelined: while the GPU searches one, the CPU copies the records of the one
+//! before out of the mapped memory the GPU wrote them to.
 //!
 //! Not on the GPU: candidate lists and pre-illuminated radiance (the CPU bakes those), and
 //! records with texture coordinates where the scene has any (binary16 rounding is not
@@ -22,18 +25,22 @@ use kiln_gpubake::{Buffer, Compute, Kernel, Memory, Options};
 use rayon::prelude::*;
 
 use super::SceneAttributes;
-use super::shafts::{HitAttributes, triangle_pair_data};
+use super::shafts::HitAttributes;
 use crate::exit::{CliError, CliResult};
 use crate::progress::Progress;
 
+const PREPARE: &[u8] = include_bytes!("../../../shaders/spirv/linespace_prepare.comp.spv");
 const SEARCH: &[u8] = include_bytes!("../../../shaders/spirv/linespace_search.comp.spv");
 const RECORDS: &[u8] = include_bytes!("../../../shaders/spirv/linespace_records.comp.spv");
 
 /// Bytes of one shaft's two ends in the search's scratch (`End` in `linespace_common.glsl`).
 const END_BYTES: u64 = 64;
 
-/// The scratch of ends one batch may use: batches are cut to it.
-const BATCH_SCRATCH: u64 = 1 << 30;
+/// The scratch of ends one batch may use: batches are cut to it. Smaller batches pipeline
+/// better and need less pinned host memory for their records (whose allocation the driver
+/// charges by the byte); 256 MiB still holds hundreds of cells at N = 5, thousands of
+/// workgroups.
+const BATCH_SCRATCH: u64 = 1 << 28;
 
 /// Cell triangles one batch may hold (their key bounds and fallbacks are uploaded per batch).
 const BATCH_CELL_TRIANGLES: usize = 1 << 22;
@@ -42,6 +49,7 @@ const BATCH_CELL_TRIANGLES: usize = 1 << 22;
 #[derive(Debug)]
 pub struct GpuBaker {
     // Kernels before the device: fields drop in order.
+    prepare: Kernel,
     search: Kernel,
     records: Kernel,
     compute: Compute,
@@ -51,9 +59,10 @@ impl GpuBaker {
     /// Opens a GPU (or, with `options.allow_cpu`, a CPU implementation) and builds the kernels.
     pub fn new(options: &Options) -> Result<GpuBaker, String> {
         let compute = Compute::new(options).map_err(|e| e.0)?;
+        let prepare = compute.kernel(PREPARE, 7).map_err(|e| e.0)?;
         let search = compute.kernel(SEARCH, 9).map_err(|e| e.0)?;
         let records = compute.kernel(RECORDS, 7).map_err(|e| e.0)?;
-        Ok(GpuBaker { search, records, compute })
+        Ok(GpuBaker { prepare, search, records, compute })
     }
 
     /// The device's name.
@@ -64,6 +73,51 @@ impl GpuBaker {
     /// Validation errors so far (with `Options::validate`).
     pub fn validation_errors(&self) -> u32 {
         self.compute.validation_errors()
+    }
+}
+
+/// Where `kiln compile` bakes the line space (`--line-space-device`). The file is the same
+/// either way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum BakeDevice {
+    /// The GPU where one opens and the bake is large enough to gain from it (see [`AUTO_MIN_WORK`]),
+    /// else the CPU.
+    #[default]
+    Auto,
+    /// The CPU.
+    Cpu,
+    /// The GPU; an error if none opens.
+    Gpu,
+}
+
+/// The least work (Σ over occupied cells of triangles × shafts) for which `auto` opens a GPU:
+/// below it the CPU bake takes tens of milliseconds, about what opening a GPU costs (Table 1's
+/// rows 1 and 2, 2.5 M and 6.2 M, bake faster on the H200 machine's 16 CPU threads than on its
+/// GPU; row 3, 194 M, twice as fast on the GPU).
+pub const AUTO_MIN_WORK: u64 = 50_000_000;
+
+static CHOICE: std::sync::Mutex<BakeDevice> = std::sync::Mutex::new(BakeDevice::Auto);
+static OPENED: std::sync::OnceLock<Result<std::sync::Mutex<GpuBaker>, String>> = std::sync::OnceLock::new();
+
+/// Sets where later bakes of this process run.
+pub fn choose(device: BakeDevice) {
+    *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) = device;
+}
+
+/// The GPU a bake of `work` (Σ triangles × shafts over the occupied cells) runs on under the
+/// current choice, opened once per process; `None`: the CPU.
+pub fn for_bake(work: u64) -> CliResult<Option<std::sync::MutexGuard<'static, GpuBaker>>> {
+    let choice = *CHOICE.lock().unwrap_or_else(|e| e.into_inner());
+    if choice == BakeDevice::Cpu || (choice == BakeDevice::Auto && work < AUTO_MIN_WORK) {
+        return Ok(None);
+    }
+    let opened = OPENED.get_or_init(|| GpuBaker::new(&Options::default()).map(std::sync::Mutex::new));
+    match (opened, choice) {
+        (Ok(gpu), _) => Ok(Some(gpu.lock().unwrap_or_else(|e| e.into_inner()))),
+        (Err(e), BakeDevice::Gpu) => Err(CliError::input(format!(
+            "--line-space-device gpu: no GPU for the line-space bake ({e}); use auto or cpu"
+        ))),
+        (Err(_), _) => Ok(None),
     }
 }
 
@@ -79,26 +133,29 @@ fn gpu_err(e: kiln_gpubake::Error) -> CliError {
     ))
 }
 
-/// A device buffer and the mapped buffer it is filled from or read back into.
-struct Staged {
-    device: Buffer,
-    host: Buffer,
-}
-
-/// Uploads `data` into a new device buffer (through a staging buffer, copied by `run`'s
-/// caller via the returned pair).
-fn staged<T: bytemuck::Pod>(compute: &Compute, data: &[T]) -> kiln_gpubake::Result<Staged> {
+/// Uploads `data` into a new device buffer through a mapped one: the pair, for a copy command.
+fn staged<T: bytemuck::Pod>(compute: &Compute, data: &[T]) -> kiln_gpubake::Result<(Buffer, Buffer)> {
     let bytes = std::mem::size_of_val(data) as u64;
     let device = compute.buffer(bytes, Memory::Device)?;
     let mut host = compute.buffer(bytes, Memory::Upload)?;
     host.write(data)?;
-    Ok(Staged { device, host })
+    Ok((host, device))
 }
 
-/// Bakes the binary (and, if `variants` has it, PNMT) line space of the `occupied` cells into
-/// `bits`, `ranks` and `pnmt` (appended in cell order, as the CPU bake lays them out); returns
-/// the (triangle, shaft) pairs the separations left to decide and the filled shafts lacking a
-/// record.
+/// A batch's buffers the CPU fills or reads: two sets, so that one batch's records are copied
+/// out while the GPU works on the next.
+struct HostSide {
+    cells: Buffer,
+    cell_tris: Buffer,
+    bits: Buffer,
+    tests: Buffer,
+    records: Buffer,
+}
+
+/// Bakes the binary (and, if `pnmt`, PNMT) line space of the `occupied` cells into `out`'s
+/// `bits`, `ranks` and `pnmt` (appended in cell order, as the CPU bake lays them out), with the
+/// (triangle, shaft) pairs the separations left to decide in `tests` and the filled shafts
+/// lacking a record in `pnmt_missing`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bake(
     gpu: &GpuBaker,
@@ -141,7 +198,8 @@ pub(super) fn bake(
     let corners: Vec<f64> = local.iter().flat_map(|t| t.iter().flat_map(|p| p.to_array())).collect();
     let max_material = u32::from(layout.max_material());
     let tri_data: Vec<f32> = (0..attrs.triangles.len() as u32)
-        .flat_map(|t| {
+        .into_par_iter()
+        .flat_map_iter(|t| {
             let c = attrs.corners(t);
             let nrm = attrs.triangles[t as usize].map(|i| attrs.vertices[i as usize].normal);
             let m = u32::from(attrs.material(t)).min(max_material);
@@ -154,78 +212,164 @@ pub(super) fn bake(
             d
         })
         .collect();
+    // Batches: cells up to the scratch's and the triangle lists' budgets, every buffer a kernel
+    // binds within the device's storage-buffer range.
+    let limit = BATCH_SCRATCH.min(compute.max_buffer());
+    let max_cells = (limit / (shafts as u64 * END_BYTES)).max(1) as usize;
+    let per_cell_triangle = 30 * 8u64.max(4 * words as u64);
+    let max_tris = BATCH_CELL_TRIANGLES.min((limit / per_cell_triangle) as usize);
+    let cell_len = |c: usize| (voxel_offsets[c + 1] - voxel_offsets[c]) as usize;
+    let mut batches = Vec::new();
+    let mut start = 0;
+    while start < occupied.len() {
+        let (mut end, mut tris) = (start, 0);
+        while end < occupied.len() && end - start < max_cells {
+            let len = cell_len(occupied[end]);
+            if end > start && tris + len > max_tris {
+                break;
+            }
+            tris += len;
+            end += 1;
+        }
+        batches.push((start..end, tris));
+        start = end;
+    }
+    let most_cells = batches.iter().map(|b| b.0.len()).max().unwrap_or(0) as u64;
+    let most_tris = batches.iter().map(|b| b.1).max().unwrap_or(0) as u64;
+    let record_limit = (most_cells * shafts as u64 * 2 * words as u64 * 4).min(limit);
+    // KILN_GPU_TIMING=1: where the time goes, per phase, on stderr.
+    let timing = std::env::var_os("KILN_GPU_TIMING").is_some();
+    let mut phases = [0f64; 7];
+    let mut clock = std::time::Instant::now();
+    let mut lap = |phase: usize| {
+        if timing {
+            phases[phase] += clock.elapsed().as_secs_f64() * 1e3;
+            clock = std::time::Instant::now();
+        }
+    };
+    let mut rank = 0u64;
+    out.bits.reserve_exact(occupied.len() * wps);
+    out.ranks.reserve_exact(occupied.len() * wps);
     let mut run = || -> kiln_gpubake::Result<()> {
-        let params_buf = staged(compute, std::slice::from_ref(&params))?;
-        let corners_buf = staged(compute, &corners)?;
-        let tris_buf = staged(compute, &tri_data)?;
+        let (params_host, params_dev) = staged(compute, std::slice::from_ref(&params))?;
+        let (corners_host, corners_dev) = staged(compute, &corners)?;
+        let (tris_host, tris_dev) = staged(compute, &tri_data)?;
         compute.run(|c| {
-            for b in [&params_buf, &corners_buf, &tris_buf] {
-                c.copy(&b.host, &b.device, b.host.size());
+            for (h, d) in
+                [(&params_host, &params_dev), (&corners_host, &corners_dev), (&tris_host, &tris_dev)]
+            {
+                c.copy(h, d, h.size());
             }
             Ok(())
         })?;
-        // Every buffer a kernel binds must stay within the device's storage-buffer range.
-        let limit = BATCH_SCRATCH.min(compute.max_buffer());
-        let max_cells = (limit / (shafts as u64 * END_BYTES)).max(1) as usize;
-        let per_cell_triangle = 30 * 8u64.max(4 * words as u64);
-        let max_tris = BATCH_CELL_TRIANGLES.min((limit / per_cell_triangle) as usize);
-        let mut rank =
-            out.ranks.last().map_or(0, |&r| r as u64) + out.bits.last().map_or(0, |w| w.count_ones() as u64);
-        let mut start = 0;
-        while start < occupied.len() {
-            // Cells up to the scratch's and the triangle lists' budgets.
-            let mut end = start;
-            let mut tris = 0usize;
-            while end < occupied.len() && end - start < max_cells {
-                let c = occupied[end];
-                let len = (voxel_offsets[c + 1] - voxel_offsets[c]) as usize;
-                if end > start && tris + len > max_tris {
-                    break;
-                }
-                tris += len;
-                end += 1;
+        drop((params_host, corners_host, tris_host));
+        lap(4);
+        let cells_dev = compute.buffer(most_cells * size_of::<BakeCell>() as u64, Memory::Device)?;
+        let cell_tris_dev = compute.buffer(most_tris * 4, Memory::Device)?;
+        let keys = compute.buffer(most_tris * 30 * 8, Memory::Device)?;
+        let fallbacks =
+            compute.buffer(if pnmt { most_tris * 30 * words as u64 * 4 } else { 4 }, Memory::Device)?;
+        let ends = compute.buffer(most_cells * shafts as u64 * END_BYTES, Memory::Device)?;
+        let bits_dev = compute.buffer(most_cells * wps as u64 * 4, Memory::Device)?;
+        let tests_dev = compute.buffer(most_cells * 15 * 4, Memory::Device)?;
+        // Records are written to GPU memory and copied to the host by a copy command: the
+        // kernel writing them to host memory itself was slower by an order of magnitude.
+        let mut records_dev = compute.buffer(if pnmt { record_limit } else { 4 }, Memory::Device)?;
+        let mut host: Vec<HostSide> = (0..2.min(batches.len()))
+            .map(|_| {
+                Ok(HostSide {
+                    cells: compute.buffer(most_cells * size_of::<BakeCell>() as u64, Memory::Upload)?,
+                    cell_tris: compute.buffer(most_tris * 4, Memory::Upload)?,
+                    bits: compute.buffer(most_cells * wps as u64 * 4, Memory::Readback)?,
+                    tests: compute.buffer(most_cells * 15 * 4, Memory::Readback)?,
+                    records: compute.buffer(if pnmt { record_limit } else { 4 }, Memory::Readback)?,
+                })
+            })
+            .collect::<kiln_gpubake::Result<_>>()?;
+        lap(0);
+        // The batch whose records are on their way: (its host side, records bytes, cells done).
+        let mut in_flight: Option<(kiln_gpubake::Pending, usize, u64, usize)> = None;
+        let mut cells_done = 0;
+        for (i, (range, tris)) in batches.iter().enumerate() {
+            let batch = &occupied[range.clone()];
+            let side = i % 2;
+            let first_tri = voxel_offsets[batch[0]] as usize;
+            let mut cells = Vec::with_capacity(batch.len());
+            for &c in batch {
+                let cc = header.cell_coords(c);
+                let w = header.cell_min(cc);
+                cells.push(BakeCell {
+                    gx: cc[0] as f64,
+                    gy: cc[1] as f64,
+                    gz: cc[2] as f64,
+                    wx: w.x,
+                    wy: w.y,
+                    wz: w.z,
+                    cell: header.cell,
+                    inv_cell: 1.0 / header.cell,
+                    tri_first: voxel_offsets[c] - first_tri as u32,
+                    tri_count: cell_len(c) as u32,
+                    ..Default::default()
+                });
             }
-            let batch = &occupied[start..end];
-            let prepared =
-                prepare(attrs, header, local, voxel_offsets, voxel_triangles, batch, margin, layout, pnmt);
-            let Prepared { mut cells, cell_tris, keys, fallbacks } = prepared;
-            let cells_buf = staged(compute, &cells)?;
-            let cell_tris_buf = staged(compute, &cell_tris)?;
-            let keys_buf = staged(compute, &keys)?;
-            let ends = compute.buffer(batch.len() as u64 * shafts as u64 * END_BYTES, Memory::Device)?;
-            let bits_bytes = (batch.len() * wps * 4) as u64;
-            let bits = compute.buffer(bits_bytes, Memory::Device)?;
-            let bits_back = compute.buffer(bits_bytes, Memory::Readback)?;
-            let tests_bytes = batch.len() as u64 * 15 * 4;
-            let tests = compute.buffer(tests_bytes, Memory::Device)?;
-            let tests_back = compute.buffer(tests_bytes, Memory::Readback)?;
-            compute.run(|c| {
-                for b in [&cells_buf, &cell_tris_buf, &keys_buf] {
-                    c.copy(&b.host, &b.device, b.host.size());
-                }
-                c.zero(&bits, bits.size());
+            let h = &mut host[side];
+            h.cells.write(&cells)?;
+            // The occupied cells are in order, so their lists are one run of the voxel lists.
+            h.cell_tris.write(&voxel_triangles[first_tri..first_tri + tris])?;
+            let cells_bytes = std::mem::size_of_val(cells.as_slice()) as u64;
+            let (bits_bytes, tests_bytes) = ((batch.len() * wps * 4) as u64, batch.len() as u64 * 15 * 4);
+            let groups = batch.len() as u32;
+            let h = &host[side];
+            let search = compute.submit(|c| {
+                c.copy(&h.cells, &cells_dev, cells_bytes);
+                c.copy(&h.cell_tris, &cell_tris_dev, *tris as u64 * 4);
+                c.zero(&bits_dev, bits_bytes);
+                c.dispatch(
+                    &gpu.prepare,
+                    &[&params_dev, &cells_dev, &cell_tris_dev, &corners_dev, &tris_dev, &keys, &fallbacks],
+                    [groups, 1, 1],
+                )?;
                 c.dispatch(
                     &gpu.search,
                     &[
-                        &params_buf.device,
-                        &cells_buf.device,
-                        &cell_tris_buf.device,
-                        &keys_buf.device,
-                        &corners_buf.device,
-                        &tris_buf.device,
+                        &params_dev,
+                        &cells_dev,
+                        &cell_tris_dev,
+                        &keys,
+                        &corners_dev,
+                        &tris_dev,
                         &ends,
-                        &bits,
-                        &tests,
+                        &bits_dev,
+                        &tests_dev,
                     ],
-                    [batch.len() as u32, 15, 1],
+                    [groups, 15, 1],
                 )?;
-                c.copy(&bits, &bits_back, bits_bytes);
-                c.copy(&tests, &tests_back, tests_bytes);
+                c.copy(&bits_dev, &h.bits, bits_bytes);
+                c.copy(&tests_dev, &h.tests, tests_bytes);
                 c.to_host();
                 Ok(())
             })?;
-            let batch_bits: &[u32] = bytemuck::cast_slice(&bits_back.bytes()[..bits_bytes as usize]);
-            out.tests += bytemuck::cast_slice::<u8, u32>(&tests_back.bytes()[..tests_bytes as usize])
+            // Timing: the search alone (no overlap with the records before).
+            let search = if timing {
+                lap(2);
+                search.wait()?;
+                lap(5);
+                compute.submit(|_| Ok(()))?
+            } else {
+                search
+            };
+            // While the GPU searches, the records of the batch before go out.
+            if let Some((pending, prev, bytes, done)) = in_flight.take() {
+                pending.wait()?;
+                lap(1);
+                copy_out(&host[prev].records, bytes, words, layout, done as f64 / occupied.len() as f64, out);
+                lap(3);
+            }
+            search.wait()?;
+            lap(1);
+            let h = &mut host[side];
+            let batch_bits: Vec<u32> = bytemuck::cast_slice(&h.bits.bytes()[..bits_bytes as usize]).to_vec();
+            out.tests += bytemuck::cast_slice::<u8, u32>(&h.tests.bytes()[..tests_bytes as usize])
                 .iter()
                 .map(|&t| t as u64)
                 .sum::<u64>();
@@ -242,124 +386,81 @@ pub(super) fn bake(
                     filled += w.count_ones() as u64;
                 }
             }
-            out.bits.extend_from_slice(batch_bits);
+            out.bits.extend_from_slice(&batch_bits);
+            cells_done += batch.len();
             if pnmt && filled > 0 {
-                let fallbacks_buf = staged(compute, &fallbacks)?;
-                let mut cells_again = compute.buffer(cells_buf.host.size(), Memory::Upload)?;
-                cells_again.write(&cells)?;
                 let record_bytes = filled * 2 * words as u64 * 4;
-                let records = compute.buffer(record_bytes, Memory::Device)?;
-                let records_back = compute.buffer(record_bytes, Memory::Readback)?;
-                compute.run(|c| {
-                    c.copy(&cells_again, &cells_buf.device, cells_again.size());
-                    c.copy(&fallbacks_buf.host, &fallbacks_buf.device, fallbacks_buf.host.size());
+                if record_bytes > h.records.size() {
+                    h.records = compute.buffer(record_bytes, Memory::Readback)?;
+                }
+                if record_bytes > records_dev.size() {
+                    records_dev = compute.buffer(record_bytes, Memory::Device)?;
+                }
+                h.cells.write(&cells)?;
+                let h = &host[side];
+                let records = compute.submit(|c| {
+                    c.copy(&h.cells, &cells_dev, cells_bytes);
                     c.dispatch(
                         &gpu.records,
-                        &[
-                            &params_buf.device,
-                            &cells_buf.device,
-                            &fallbacks_buf.device,
-                            &tris_buf.device,
-                            &ends,
-                            &bits,
-                            &records,
-                        ],
-                        [batch.len() as u32, 1, 1],
+                        &[&params_dev, &cells_dev, &fallbacks, &tris_dev, &ends, &bits_dev, &records_dev],
+                        [groups, 1, 1],
                     )?;
-                    c.copy(&records, &records_back, record_bytes);
+                    c.copy(&records_dev, &h.records, record_bytes);
                     c.to_host();
                     Ok(())
                 })?;
-                let recs: &[u32] = bytemuck::cast_slice(&records_back.bytes()[..record_bytes as usize]);
-                out.pnmt.extend_from_slice(recs);
-                out.pnmt_missing += recs
-                    .par_chunks_exact(2 * words as usize)
-                    .filter(|r| !layout.is_some(&r[..]) || !layout.is_some(&r[words as usize..]))
-                    .count() as u64;
+                let records = if timing {
+                    lap(2);
+                    records.wait()?;
+                    lap(6);
+                    compute.submit(|_| Ok(()))?
+                } else {
+                    records
+                };
+                in_flight = Some((records, side, record_bytes, cells_done));
             }
+            lap(2);
             progress.inc(batch.len() as u64);
-            start = end;
+        }
+        if let Some((pending, prev, bytes, done)) = in_flight.take() {
+            pending.wait()?;
+            lap(1);
+            copy_out(&host[prev].records, bytes, words, layout, done as f64 / occupied.len() as f64, out);
+            lap(3);
         }
         Ok(())
     };
-    run().map_err(gpu_err)
-}
-
-/// One batch's cells, their triangle lists, and per cell triangle the key bounds and fallback
-/// records (`triangle_pair_data`).
-struct Prepared {
-    cells: Vec<BakeCell>,
-    cell_tris: Vec<u32>,
-    keys: Vec<f64>,
-    fallbacks: Vec<u32>,
-}
-
-#[allow(clippy::too_many_arguments)]
-fn prepare(
-    attrs: &SceneAttributes,
-    header: &GridHeader,
-    local: &[[DVec3; 3]],
-    voxel_offsets: &[u32],
-    voxel_triangles: &[u32],
-    batch: &[usize],
-    margin: f64,
-    layout: PnmtLayout,
-    pnmt: bool,
-) -> Prepared {
-    let parts: Vec<(Vec<f64>, Vec<u32>)> = batch
-        .par_iter()
-        .map_init(
-            || (Vec::new(), Vec::new()),
-            |scratch, &c| {
-                let cc = header.cell_coords(c);
-                let grid_min = DVec3::new(cc[0] as f64, cc[1] as f64, cc[2] as f64);
-                let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
-                let mut keys = Vec::with_capacity(tris.len() * 30);
-                let mut fallbacks = Vec::new();
-                for &t in tris {
-                    let v = local[t as usize].map(|p| p - grid_min);
-                    triangle_pair_data(
-                        attrs,
-                        layout,
-                        t,
-                        v,
-                        margin,
-                        header.cell_min(cc),
-                        header.cell,
-                        (&mut scratch.0, &mut scratch.1),
-                        &mut keys,
-                        &mut fallbacks,
-                    );
-                }
-                if !pnmt {
-                    fallbacks.clear();
-                }
-                (keys, fallbacks)
-            },
-        )
-        .collect();
-    let mut cells = Vec::with_capacity(batch.len());
-    let mut cell_tris = Vec::new();
-    for &c in batch {
-        let cc = header.cell_coords(c);
-        let w = header.cell_min(cc);
-        let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
-        cells.push(BakeCell {
-            gx: cc[0] as f64,
-            gy: cc[1] as f64,
-            gz: cc[2] as f64,
-            wx: w.x,
-            wy: w.y,
-            wz: w.z,
-            cell: header.cell,
-            inv_cell: 1.0 / header.cell,
-            tri_first: cell_tris.len() as u32,
-            tri_count: tris.len() as u32,
-            ..Default::default()
-        });
-        cell_tris.extend_from_slice(tris);
+    let result = run().map_err(gpu_err);
+    if timing {
+        eprintln!(
+            "GPU bake, ms: buffers {:.1}, uploads {:.1}, search {:.1}, records {:.1}, other waits {:.1}, CPU between kernels {:.1}, copying records out {:.1}",
+            phases[0], phases[4], phases[5], phases[6], phases[1], phases[2], phases[3]
+        );
     }
-    let keys = parts.iter().flat_map(|p| p.0.iter().copied()).collect();
-    let fallbacks = parts.iter().flat_map(|p| p.1.iter().copied()).collect();
-    Prepared { cells, cell_tris, keys, fallbacks }
+    result
+}
+
+/// Appends the first `bytes` of `records` (a batch's records, `words` a record) to `out.pnmt`,
+/// in parallel, counting the filled shafts lacking a record; `done` is the fraction of the cells
+/// baked once these are appended (the vector's growth is extrapolated from it).
+fn copy_out(
+    records: &Buffer,
+    bytes: u64,
+    words: u32,
+    layout: PnmtLayout,
+    done: f64,
+    out: &mut super::BakedLineSpace,
+) {
+    let recs: &[u32] = bytemuck::cast_slice(&records.bytes()[..bytes as usize]);
+    let shaft = 2 * words as usize;
+    let pieces: Vec<&[u32]> = recs.chunks(shaft << 14).collect();
+    super::append_par(&mut out.pnmt, &pieces, |p| p.iter().copied(), done);
+    out.pnmt_missing += pieces
+        .par_iter()
+        .map(|p| {
+            p.chunks_exact(shaft)
+                .filter(|r| !layout.is_some(&r[..]) || !layout.is_some(&r[words as usize..]))
+                .count() as u64
+        })
+        .sum::<u64>();
 }

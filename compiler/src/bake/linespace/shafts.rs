@@ -210,36 +210,6 @@ fn key_bounds(pair: u32, poly: &[DVec3]) -> (f64, f64) {
     poly.iter().map(|p| p.dot(w)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), k| (a.min(k), b.max(k)))
 }
 
-/// What the GPU bake needs of triangle `t` (cell-relative corners `v`) in the cell of world
-/// minimum corner `world_cell_min` and edge `cell`, per face pair: its key bounds, appended to
-/// `keys` (the 15 minima, then the 15 maxima), and its fallback records towards the front and
-/// back ends, appended to `fallbacks` (`layout.words()` words each, pair by pair). `poly` and
-/// `tmp` are scratch buffers.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn triangle_pair_data<A: HitAttributes + ?Sized>(
-    attrs: &A,
-    layout: PnmtLayout,
-    t: u32,
-    v: [DVec3; 3],
-    margin: f64,
-    world_cell_min: DVec3,
-    cell: f64,
-    (poly, tmp): (&mut Vec<DVec3>, &mut Vec<DVec3>),
-    keys: &mut Vec<f64>,
-    fallbacks: &mut Vec<u32>,
-) {
-    clip_to_box_into(v, DVec3::splat(-margin), DVec3::splat(1.0 + margin), poly, tmp);
-    let bounds: Vec<(f64, f64)> = (0..FACE_PAIRS).map(|pair| key_bounds(pair, poly)).collect();
-    keys.extend(bounds.iter().map(|b| b.0));
-    keys.extend(bounds.iter().map(|b| b.1));
-    for pair in 0..FACE_PAIRS {
-        for side in 0..2 {
-            let r = fallback_record(attrs, layout, t, poly, pair, side, world_cell_min, cell);
-            fallbacks.extend_from_slice(&r[..layout.words()]);
-        }
-    }
-}
-
 /// What a cell's shafts hold while its triangles fill them: bits, candidate hits and the
 /// records' ends.
 struct Fills<'s> {

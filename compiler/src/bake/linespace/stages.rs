@@ -24,8 +24,12 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
     let shade = |p: glam::DVec3, n: glam::Vec3, v: glam::Vec3, m: u16, uv: glam::Vec2| {
         shading.radiance(p.as_vec3(), n, n, v, m as u32, uv)
     };
+    // Σ triangles × shafts: the work that decides whether a GPU is worth opening.
+    let shafts = kiln_format::linespace::index::shafts_per_voxel(ctx.plan.shaft_res.max(1)) as u64;
+    let work = if ctx.plan.shaft_variants == 0 { 0 } else { voxels.triangles.len() as u64 * shafts };
+    let gpu = super::gpu::for_bake(work)?;
     let ls = super::bake(
-        None,
+        gpu.as_deref(),
         &ctx.attributes(),
         voxels,
         voxel_ms,
