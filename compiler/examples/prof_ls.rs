@@ -31,6 +31,7 @@ fn main() {
     let gpu = std::env::var("KILN_PROF_GPU").ok().map(|v| {
         let options = kiln_gpubake::Options { allow_cpu: true, validate: v == "validate" };
         let gpu = linespace::gpu::GpuBaker::new(&options).expect("a Vulkan device");
+        gpu.warm(n, PnmtLayout::CompactNoUv).expect("GPU buffers");
         println!("device: {}", gpu.device());
         gpu
     });

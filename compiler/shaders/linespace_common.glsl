@@ -25,8 +25,11 @@ struct End {
     float v;
     double key;
     uint local_tri;
-    uint pad;
 };
+
+// What the search leaves of an end for the records (3 words): the hit triangle, or the fallback
+// as FALLBACK | its cell-local number; then the hit's barycentrics u and v (their bits).
+const uint FALLBACK = 0x80000000u;
 
 const uint NONE = 0xffffffffu;
 

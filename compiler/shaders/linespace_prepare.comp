@@ -1,8 +1,9 @@
 #version 460
 // The line-space bake's per-triangle data on the GPU: one workgroup per cell, a thread per cell
-// triangle. Each triangle is clipped to the widened cell (geometry.rs: clip_to_box_into); per
-// face pair its key bounds (shafts.rs: key_bounds) and, for PNMT, its fallback records towards
-// either end (shafts.rs: fallback_record) are written for the search and records kernels.
+// triangle. Each triangle's separating axes (geometry.rs: Prepared::new) and their separations
+// from every face (Prepared::pair_axes) are written for the search; then it is clipped to the widened cell (geometry.rs: clip_to_box_into) and per face
+// pair its key bounds (shafts.rs: key_bounds) and, for PNMT, its fallback records towards either
+// end (shafts.rs: fallback_record) are written for the search and records kernels.
 #extension GL_GOOGLE_include_directive : require
 #define KILN_BAKE_TRI_BINDING 4
 #include "linespace_common.glsl"
@@ -17,6 +18,29 @@ layout(std430, set = 0, binding = 3) readonly buffer LocalB { double local_corne
 layout(std430, set = 0, binding = 5) writeonly buffer KeysB { double keys[]; };
 // Per cell triangle, pair and end: the fallback record.
 layout(std430, set = 0, binding = 6) writeonly buffer FallbacksB { uint fallbacks[]; };
+// Per cell triangle, face and separating axis: its separations from the face's patch (0, 0) on
+// side 0 and side 1, and their steps per patch along u and v (Prepared::pair_axes).
+layout(std430, set = 0, binding = 7) writeonly buffer FaceSepsB { double face_seps[]; };
+
+// Axis `i` of the triangle with cell-relative corners v (Prepared::new's order: X, Y, Z, the
+// normal, then X, Y, Z crossed with each edge).
+dvec3 axis_of(uint i, dvec3 v0, dvec3 v1, dvec3 v2) {
+    precise dvec3 e0 = v1 - v0;
+    precise dvec3 e1 = v2 - v1;
+    precise dvec3 e2 = v0 - v2;
+    if (i < 3u) {
+        dvec3 l = dvec3(0.0);
+        l[i] = 1.0;
+        return l;
+    }
+    if (i == 3u) {
+        return dcross_glam(e0, e1);
+    }
+    uint b = (i - 4u) / 3u, k = (i - 4u) % 3u;
+    dvec3 unit = dvec3(0.0);
+    unit[b] = 1.0;
+    return dcross_glam(unit, k == 0u ? e0 : (k == 1u ? e1 : e2));
+}
 
 // A triangle clipped to a box has at most 3 + 6 vertices.
 const uint MAX_POLY = 9u;
@@ -73,6 +97,32 @@ void main() {
             uint b = 9u * t + 3u * k;
             precise dvec3 v = dvec3(local_corners[b], local_corners[b + 1u], local_corners[b + 2u]) - cmin;
             poly[k] = v;
+        }
+        // The separating axes (Prepared::new) and their separations from each face's patches
+        // (Prepared::pair_axes, per face).
+        for (uint i = 0u; i < 13u; ++i) {
+            dvec3 l = axis_of(i, poly[0], poly[1], poly[2]);
+            precise double l1 = abs(l.x) + abs(l.y) + abs(l.z);
+            precise double p0 = ddot_glam(l, poly[0]);
+            precise double p1 = ddot_glam(l, poly[1]);
+            precise double p2 = ddot_glam(l, poly[2]);
+            double t0 = min(min(p0, p1), p2);
+            double t1 = max(max(p0, p1), p2);
+            for (uint face = 0u; face < 6u; ++face) {
+                uint j = BAKE_FACE_AXIS[face], ua = BAKE_FACE_U[face], va = BAKE_FACE_V[face];
+                double plane = double(face % 2u);
+                precise double k = l[j] * plane + (l[ua] + l[va]) * P.half_s;
+                precise double r = (abs(l[ua]) + abs(l[va])) * P.half_s + P.margin * l1;
+                precise double s0 = k - r - t1;
+                precise double s1 = t0 - k - r;
+                precise double du = l[ua] * P.s;
+                precise double dv = l[va] * P.s;
+                uint b = ((ct * 6u + face) * 13u + i) * 4u;
+                face_seps[b] = s0;
+                face_seps[b + 1u] = s1;
+                face_seps[b + 2u] = du;
+                face_seps[b + 3u] = dv;
+            }
         }
         // Sutherland–Hodgman against the widened cell, as clip_to_box_into.
         for (uint axis = 0u; axis < 3u; ++axis) {

@@ -14,7 +14,8 @@ layout(std430, set = 0, binding = 0) readonly buffer ParamsB { BakeParams P; };
 layout(std430, set = 0, binding = 1) readonly buffer CellsB { BakeCell cells[]; };
 // Per cell triangle, pair and end: the fallback record (P.words words).
 layout(std430, set = 0, binding = 2) readonly buffer FallbacksB { uint fallbacks[]; };
-layout(std430, set = 0, binding = 4) readonly buffer EndsB { End ends[]; };
+// Per shaft: its front and back ends, 3 words each (see FALLBACK).
+layout(std430, set = 0, binding = 4) readonly buffer EndsB { uint ends[]; };
 layout(std430, set = 0, binding = 5) readonly buffer BitsB { uint bits[]; };
 layout(std430, set = 0, binding = 6) writeonly buffer RecordsB { uint records[]; };
 
@@ -47,12 +48,13 @@ void main() {
         uint pair = s / P.n4;
         uint out_at = (c.record_base + rank) * 2u * P.words;
         for (uint side = 0u; side < 2u; ++side) {
-            End e = ends[ci * P.shafts * 2u + 2u * s + side];
+            uint e = (ci * P.shafts + s) * 6u + 3u * side;
+            uint code = ends[e];
             uvec4 r;
-            if (e.hit != NONE) {
-                r = hit_record(e.hit, e.u, e.v, c, P.layout_code);
+            if ((code & FALLBACK) == 0u) {
+                r = hit_record(code, uintBitsToFloat(ends[e + 1u]), uintBitsToFloat(ends[e + 2u]), c, P.layout_code);
             } else {
-                uint f = (((c.tri_first + e.local_tri) * 15u + pair) * 2u + side) * P.words;
+                uint f = (((c.tri_first + (code & ~FALLBACK)) * 15u + pair) * 2u + side) * P.words;
                 r = uvec4(fallbacks[f], fallbacks[f + 1u], P.words > 2u ? fallbacks[f + 2u] : 0u,
                           P.words > 3u ? fallbacks[f + 3u] : 0u);
             }

@@ -232,6 +232,13 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         .map_err(|e| CliError::io(format!("cannot start {threads} worker threads: {e}")))?;
     let cache = out.cache_dir().map(|d| Cache::open(&d)).transpose()?;
     crate::bake::linespace::gpu::choose(out.line_space_device);
+    // A line space large enough for the GPU: open it while the earlier stages run.
+    let plan = &loaded.plan;
+    if plan.shaft_variants != 0 && plan.shaft_res > 0 {
+        let shafts = kiln_format::linespace::index::shafts_per_voxel(plan.shaft_res) as u64;
+        let work = loaded.geometry.voxels(plan.voxel_res).triangles.len() as u64 * shafts;
+        crate::bake::linespace::gpu::open_early(work, plan.shaft_res, plan.pnmt_layout);
+    }
     let progress = Progress::new(!out.quiet);
     let inputs = hash_inputs(&loaded.scene.inputs)?;
     let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress, cache.as_ref())?))?;

@@ -286,7 +286,9 @@ impl Compute {
             }
         };
         match mapped {
-            Ok(mapped) => Ok(Buffer { buffer, memory: mem, size, mapped, device: self.device.clone() }),
+            Ok(mapped) => {
+                Ok(Buffer { buffer, memory: mem, kind: memory, size, mapped, device: self.device.clone() })
+            }
             Err(e) => {
                 destroy();
                 // SAFETY: the memory is no longer bound to a live buffer.
@@ -531,6 +533,7 @@ pub enum Memory {
 pub struct Buffer {
     buffer: vk::Buffer,
     memory: vk::DeviceMemory,
+    kind: Memory,
     size: u64,
     mapped: Option<*mut u8>,
     device: ash::Device,
@@ -552,6 +555,11 @@ impl Buffer {
     /// Size, bytes.
     pub fn size(&self) -> u64 {
         self.size
+    }
+
+    /// Where it lives.
+    pub fn memory(&self) -> Memory {
+        self.kind
     }
 
     /// The mapped bytes of an [`Memory::Upload`] or [`Memory::Readback`] buffer.

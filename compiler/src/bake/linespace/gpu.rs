@@ -33,14 +33,23 @@ const PREPARE: &[u8] = include_bytes!("../../../shaders/spirv/linespace_prepare.
 const SEARCH: &[u8] = include_bytes!("../../../shaders/spirv/linespace_search.comp.spv");
 const RECORDS: &[u8] = include_bytes!("../../../shaders/spirv/linespace_records.comp.spv");
 
-/// Bytes of one shaft's two ends in the search's scratch (`End` in `linespace_common.glsl`).
-const END_BYTES: u64 = 64;
+/// The most bytes of buffers a [`GpuBaker`] keeps between bakes.
+const POOL_BYTES: u64 = 2 << 30;
 
-/// The scratch of ends one batch may use: batches are cut to it. Smaller batches pipeline
-/// better and need less pinned host memory for their records (whose allocation the driver
-/// charges by the byte); 256 MiB still holds hundreds of cells at N = 5, thousands of
-/// workgroups.
+/// Threads of a search workgroup (`linespace_search.comp`'s local size).
+const SEARCH_GROUP: u32 = 128;
+
+/// Bytes of one shaft's two ends as the search leaves them for the records (3 words an end).
+const END_BYTES: u64 = 24;
+
+/// The scratch of ends one batch may use: batches are cut to it (1,193 cells at N = 5). Smaller
+/// batches need less pinned host memory for their records, whose allocation the driver charges
+/// by the byte (0.5 ms a MiB on the H200 machine), but each costs submissions and a partly
+/// idle GPU: at 32 MiB the teapot's 32³ bake took 1.1×, the 72³ dragon's 1.4× as long.
 const BATCH_SCRATCH: u64 = 1 << 28;
+
+/// Bytes of one cell triangle's separations from the faces (6 faces × 13 axes × 4 doubles).
+const FACE_SEP_BYTES: u64 = 6 * 13 * 4 * 8;
 
 /// Cell triangles one batch may hold (their key bounds and fallbacks are uploaded per batch).
 const BATCH_CELL_TRIANGLES: usize = 1 << 22;
@@ -48,6 +57,12 @@ const BATCH_CELL_TRIANGLES: usize = 1 << 22;
 /// A GPU ready to bake line spaces.
 #[derive(Debug)]
 pub struct GpuBaker {
+    /// The thread freeing buffers the pool does not keep.
+    releasing: std::sync::Mutex<Option<std::thread::JoinHandle<()>>>,
+    /// Buffers of earlier bakes (or of [`GpuBaker::warm`]), reused by later ones: allocating
+    /// GPU and pinned host memory costs the driver about 0.5 ms a MiB on the H200 machine, as
+    /// much as the bake of the teapot's 32³ line space itself.
+    pool: std::sync::Mutex<Vec<Buffer>>,
     // Kernels before the device: fields drop in order.
     prepare: Kernel,
     search: Kernel,
@@ -59,10 +74,17 @@ impl GpuBaker {
     /// Opens a GPU (or, with `options.allow_cpu`, a CPU implementation) and builds the kernels.
     pub fn new(options: &Options) -> Result<GpuBaker, String> {
         let compute = Compute::new(options).map_err(|e| e.0)?;
-        let prepare = compute.kernel(PREPARE, 7).map_err(|e| e.0)?;
+        let prepare = compute.kernel(PREPARE, 8).map_err(|e| e.0)?;
         let search = compute.kernel(SEARCH, 9).map_err(|e| e.0)?;
         let records = compute.kernel(RECORDS, 7).map_err(|e| e.0)?;
-        Ok(GpuBaker { prepare, search, records, compute })
+        Ok(GpuBaker {
+            releasing: std::sync::Mutex::new(None),
+            pool: std::sync::Mutex::new(Vec::new()),
+            prepare,
+            search,
+            records,
+            compute,
+        })
     }
 
     /// The device's name.
@@ -72,7 +94,87 @@ impl GpuBaker {
 
     /// Validation errors so far (with `Options::validate`).
     pub fn validation_errors(&self) -> u32 {
+        self.wait_released();
         self.compute.validation_errors()
+    }
+
+    /// Allocates what a bake at shaft resolution `n` of up to [`BATCH_SCRATCH`] of ends a
+    /// batch and half its shafts filled needs, into the pool, so that the first bake finds
+    /// its largest buffers made (a process that will bake can do this while it does other
+    /// work; the bench does it when it opens the GPU, and says how long that took).
+    pub fn warm(&self, n: u32, layout: PnmtLayout) -> Result<(), String> {
+        let shafts = shafts_per_voxel(n.clamp(1, 8)) as u64;
+        let cells = (BATCH_SCRATCH.min(self.compute.max_buffer()) / (shafts * END_BYTES)).max(1);
+        let records = cells * shafts * 2 * layout.words() as u64 * 4 * 3 / 5;
+        let made = [
+            (cells * shafts * END_BYTES, Memory::Device),
+            (records, Memory::Device),
+            (records, Memory::Readback),
+            (records, Memory::Readback),
+        ]
+        .into_iter()
+        .map(|(size, memory)| self.compute.buffer(size, memory))
+        .collect::<kiln_gpubake::Result<Vec<_>>>()
+        .map_err(|e| e.0)?;
+        self.pool.lock().unwrap_or_else(|e| e.into_inner()).extend(made);
+        Ok(())
+    }
+
+    /// A buffer of at least `size` bytes in `memory`: the smallest such from the pool, or a new
+    /// one.
+    fn take(&self, size: u64, memory: Memory) -> kiln_gpubake::Result<Buffer> {
+        let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
+        let best = pool
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.memory() == memory && b.size() >= size)
+            .min_by_key(|(_, b)| b.size())
+            .map(|(i, _)| i);
+        match best {
+            Some(i) => Ok(pool.swap_remove(i)),
+            None => {
+                drop(pool);
+                self.compute.buffer(size, memory)
+            }
+        }
+    }
+
+    /// Keeps `buffers` for later bakes, up to [`POOL_BYTES`] (the largest first); frees the rest
+    /// on another thread.
+    fn keep(&self, buffers: Vec<Buffer>) {
+        let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
+        pool.extend(buffers);
+        pool.sort_by_key(|b| std::cmp::Reverse(b.size()));
+        let mut total = 0;
+        let keep = pool.iter().take_while(|b| {
+            total += b.size();
+            total <= POOL_BYTES
+        });
+        let kept = keep.count();
+        let extra = pool.split_off(kept);
+        drop(pool);
+        self.release(extra);
+    }
+
+    /// Frees `buffers` on another thread (the previous batch of them first).
+    fn release(&self, buffers: Vec<Buffer>) {
+        self.wait_released();
+        let handle = std::thread::spawn(move || drop(buffers));
+        *self.releasing.lock().unwrap_or_else(|e| e.into_inner()) = Some(handle);
+    }
+
+    /// Waits until the buffers handed to [`Self::release`] are freed.
+    fn wait_released(&self) {
+        if let Some(h) = self.releasing.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            let _ = h.join();
+        }
+    }
+}
+
+impl Drop for GpuBaker {
+    fn drop(&mut self) {
+        // The buffers must go before the device they were made on.
+        self.wait_released();
     }
 }
 
@@ -104,20 +206,54 @@ pub fn choose(device: BakeDevice) {
     *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) = device;
 }
 
-/// The GPU a bake of `work` (Σ triangles × shafts over the occupied cells) runs on under the
-/// current choice, opened once per process; `None`: the CPU.
-pub fn for_bake(work: u64) -> CliResult<Option<std::sync::MutexGuard<'static, GpuBaker>>> {
-    let choice = *CHOICE.lock().unwrap_or_else(|e| e.into_inner());
-    if choice == BakeDevice::Cpu || (choice == BakeDevice::Auto && work < AUTO_MIN_WORK) {
+/// The process's GPU, opened (and warmed for shaft resolution `n`) on first use.
+fn opened(n: u32, layout: PnmtLayout) -> &'static Result<std::sync::Mutex<GpuBaker>, String> {
+    OPENED.get_or_init(|| {
+        let gpu = GpuBaker::new(&Options::default())?;
+        // A bake without the warm buffers allocates its own.
+        let _ = gpu.warm(n, layout);
+        Ok(std::sync::Mutex::new(gpu))
+    })
+}
+
+/// Whether a bake of `work` runs on a GPU under the current choice (if one opens).
+fn wants_gpu(work: u64) -> bool {
+    match *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) {
+        BakeDevice::Cpu => false,
+        BakeDevice::Gpu => true,
+        BakeDevice::Auto => work >= AUTO_MIN_WORK,
+    }
+}
+
+/// Opens the GPU on another thread if a bake of about `work` at resolution `n` will want it,
+/// so that opening it (half a second on the H200 machine) overlaps the stages before the line
+/// space.
+pub fn open_early(work: u64, n: u32, layout: PnmtLayout) {
+    if wants_gpu(work) && OPENED.get().is_none() {
+        std::thread::spawn(move || {
+            opened(n, layout);
+        });
+    }
+}
+
+/// The GPU a bake of `work` (Σ triangles × shafts over the occupied cells) at resolution `n`
+/// runs on under the current choice, opened once per process; `None`: the CPU.
+pub fn for_bake(
+    work: u64,
+    n: u32,
+    layout: PnmtLayout,
+) -> CliResult<Option<std::sync::MutexGuard<'static, GpuBaker>>> {
+    if !wants_gpu(work) {
         return Ok(None);
     }
-    let opened = OPENED.get_or_init(|| GpuBaker::new(&Options::default()).map(std::sync::Mutex::new));
-    match (opened, choice) {
-        (Ok(gpu), _) => Ok(Some(gpu.lock().unwrap_or_else(|e| e.into_inner()))),
-        (Err(e), BakeDevice::Gpu) => Err(CliError::input(format!(
-            "--line-space-device gpu: no GPU for the line-space bake ({e}); use auto or cpu"
-        ))),
-        (Err(_), _) => Ok(None),
+    match opened(n, layout) {
+        Ok(gpu) => Ok(Some(gpu.lock().unwrap_or_else(|e| e.into_inner()))),
+        Err(e) if *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) == BakeDevice::Gpu => {
+            Err(CliError::input(format!(
+                "--line-space-device gpu: no GPU for the line-space bake ({e}); use auto or cpu"
+            )))
+        }
+        Err(_) => Ok(None),
     }
 }
 
@@ -215,8 +351,10 @@ pub(super) fn bake(
     // Batches: cells up to the scratch's and the triangle lists' budgets, every buffer a kernel
     // binds within the device's storage-buffer range.
     let limit = BATCH_SCRATCH.min(compute.max_buffer());
-    let max_cells = (limit / (shafts as u64 * END_BYTES)).max(1) as usize;
-    let per_cell_triangle = 30 * 8u64.max(4 * words as u64);
+    // (A batch's cells are the search's second dispatch dimension: at most 65,535.)
+    let max_cells = (limit / (shafts as u64 * END_BYTES)).clamp(1, 65_535) as usize;
+    // The largest per-triangle buffer: the separations from the faces.
+    let per_cell_triangle = FACE_SEP_BYTES.max(30 * 8u64.max(4 * words as u64));
     let max_tris = BATCH_CELL_TRIANGLES.min((limit / per_cell_triangle) as usize);
     let cell_len = |c: usize| (voxel_offsets[c + 1] - voxel_offsets[c]) as usize;
     let mut batches = Vec::new();
@@ -236,10 +374,10 @@ pub(super) fn bake(
     }
     let most_cells = batches.iter().map(|b| b.0.len()).max().unwrap_or(0) as u64;
     let most_tris = batches.iter().map(|b| b.1).max().unwrap_or(0) as u64;
-    let record_limit = (most_cells * shafts as u64 * 2 * words as u64 * 4).min(limit);
+    let record_limit = most_cells * shafts as u64 * 2 * words as u64 * 4;
     // KILN_GPU_TIMING=1: where the time goes, per phase, on stderr.
     let timing = std::env::var_os("KILN_GPU_TIMING").is_some();
-    let mut phases = [0f64; 7];
+    let mut phases = [0f64; 9];
     let mut clock = std::time::Instant::now();
     let mut lap = |phase: usize| {
         if timing {
@@ -264,25 +402,25 @@ pub(super) fn bake(
         })?;
         drop((params_host, corners_host, tris_host));
         lap(4);
-        let cells_dev = compute.buffer(most_cells * size_of::<BakeCell>() as u64, Memory::Device)?;
-        let cell_tris_dev = compute.buffer(most_tris * 4, Memory::Device)?;
-        let keys = compute.buffer(most_tris * 30 * 8, Memory::Device)?;
-        let fallbacks =
-            compute.buffer(if pnmt { most_tris * 30 * words as u64 * 4 } else { 4 }, Memory::Device)?;
-        let ends = compute.buffer(most_cells * shafts as u64 * END_BYTES, Memory::Device)?;
-        let bits_dev = compute.buffer(most_cells * wps as u64 * 4, Memory::Device)?;
-        let tests_dev = compute.buffer(most_cells * 15 * 4, Memory::Device)?;
+        let cells_dev = gpu.take(most_cells * size_of::<BakeCell>() as u64, Memory::Device)?;
+        let cell_tris_dev = gpu.take(most_tris * 4, Memory::Device)?;
+        let keys = gpu.take(most_tris * 30 * 8, Memory::Device)?;
+        let face_seps = gpu.take(most_tris * FACE_SEP_BYTES, Memory::Device)?;
+        let fallbacks = gpu.take(if pnmt { most_tris * 30 * words as u64 * 4 } else { 4 }, Memory::Device)?;
+        let ends = gpu.take(most_cells * shafts as u64 * END_BYTES, Memory::Device)?;
+        let bits_dev = gpu.take(most_cells * wps as u64 * 4, Memory::Device)?;
+        let tests_dev = gpu.take(most_cells * 4, Memory::Device)?;
         // Records are written to GPU memory and copied to the host by a copy command: the
         // kernel writing them to host memory itself was slower by an order of magnitude.
-        let mut records_dev = compute.buffer(if pnmt { record_limit } else { 4 }, Memory::Device)?;
+        let mut records_dev = gpu.take(4, Memory::Device)?;
         let mut host: Vec<HostSide> = (0..2.min(batches.len()))
             .map(|_| {
                 Ok(HostSide {
-                    cells: compute.buffer(most_cells * size_of::<BakeCell>() as u64, Memory::Upload)?,
-                    cell_tris: compute.buffer(most_tris * 4, Memory::Upload)?,
-                    bits: compute.buffer(most_cells * wps as u64 * 4, Memory::Readback)?,
-                    tests: compute.buffer(most_cells * 15 * 4, Memory::Readback)?,
-                    records: compute.buffer(if pnmt { record_limit } else { 4 }, Memory::Readback)?,
+                    cells: gpu.take(most_cells * size_of::<BakeCell>() as u64, Memory::Upload)?,
+                    cell_tris: gpu.take(most_tris * 4, Memory::Upload)?,
+                    bits: gpu.take(most_cells * wps as u64 * 4, Memory::Readback)?,
+                    tests: gpu.take(most_cells * 4, Memory::Readback)?,
+                    records: gpu.take(4, Memory::Readback)?,
                 })
             })
             .collect::<kiln_gpubake::Result<_>>()?;
@@ -290,6 +428,7 @@ pub(super) fn bake(
         // The batch whose records are on their way: (its host side, records bytes, cells done).
         let mut in_flight: Option<(kiln_gpubake::Pending, usize, u64, usize)> = None;
         let mut cells_done = 0;
+        let mut retired = Vec::new();
         for (i, (range, tris)) in batches.iter().enumerate() {
             let batch = &occupied[range.clone()];
             let side = i % 2;
@@ -317,18 +456,38 @@ pub(super) fn bake(
             // The occupied cells are in order, so their lists are one run of the voxel lists.
             h.cell_tris.write(&voxel_triangles[first_tri..first_tri + tris])?;
             let cells_bytes = std::mem::size_of_val(cells.as_slice()) as u64;
-            let (bits_bytes, tests_bytes) = ((batch.len() * wps * 4) as u64, batch.len() as u64 * 15 * 4);
+            let (bits_bytes, tests_bytes) = ((batch.len() * wps * 4) as u64, batch.len() as u64 * 4);
             let groups = batch.len() as u32;
             let h = &host[side];
-            let search = compute.submit(|c| {
+            let prepare = |c: &mut kiln_gpubake::Commands| {
                 c.copy(&h.cells, &cells_dev, cells_bytes);
                 c.copy(&h.cell_tris, &cell_tris_dev, *tris as u64 * 4);
-                c.zero(&bits_dev, bits_bytes);
+                c.zero(&tests_dev, tests_bytes);
                 c.dispatch(
                     &gpu.prepare,
-                    &[&params_dev, &cells_dev, &cell_tris_dev, &corners_dev, &tris_dev, &keys, &fallbacks],
+                    &[
+                        &params_dev,
+                        &cells_dev,
+                        &cell_tris_dev,
+                        &corners_dev,
+                        &tris_dev,
+                        &keys,
+                        &fallbacks,
+                        &face_seps,
+                    ],
                     [groups, 1, 1],
-                )?;
+                )
+            };
+            if timing {
+                // Timing: the preparation alone.
+                lap(2);
+                compute.run(prepare)?;
+                lap(4);
+            }
+            let search = compute.submit(|c| {
+                if !timing {
+                    prepare(c)?;
+                }
                 c.dispatch(
                     &gpu.search,
                     &[
@@ -336,13 +495,13 @@ pub(super) fn bake(
                         &cells_dev,
                         &cell_tris_dev,
                         &keys,
-                        &corners_dev,
                         &tris_dev,
+                        &face_seps,
                         &ends,
                         &bits_dev,
                         &tests_dev,
                     ],
-                    [groups, 15, 1],
+                    [shafts.div_ceil(SEARCH_GROUP), groups, 1],
                 )?;
                 c.copy(&bits_dev, &h.bits, bits_bytes);
                 c.copy(&tests_dev, &h.tests, tests_bytes);
@@ -368,34 +527,49 @@ pub(super) fn bake(
             search.wait()?;
             lap(1);
             let h = &mut host[side];
-            let batch_bits: Vec<u32> = bytemuck::cast_slice(&h.bits.bytes()[..bits_bytes as usize]).to_vec();
+            let batch_bits: &[u32] = bytemuck::cast_slice(&h.bits.bytes()[..bits_bytes as usize]);
             out.tests += bytemuck::cast_slice::<u8, u32>(&h.tests.bytes()[..tests_bytes as usize])
                 .iter()
                 .map(|&t| t as u64)
                 .sum::<u64>();
-            // Ranks, and each cell's first record in the batch.
-            let mut filled = 0u64;
-            for (cell, words) in cells.iter_mut().zip(batch_bits.chunks_exact(wps)) {
-                cell.record_base = filled as u32;
-                for &w in words {
-                    out.ranks.push(
-                        u32::try_from(rank)
-                            .map_err(|_| kiln_gpubake::Error(super::too_many().to_string()))?,
-                    );
-                    rank += w.count_ones() as u64;
-                    filled += w.count_ones() as u64;
-                }
+            // Ranks, and each cell's first record in the batch (the counts checked against u32
+            // once, for the whole batch).
+            let batch_filled: u64 = batch_bits.iter().map(|w| w.count_ones() as u64).sum();
+            if rank + batch_filled > u32::MAX as u64 {
+                return Err(kiln_gpubake::Error(super::too_many().to_string()));
             }
-            out.bits.extend_from_slice(&batch_bits);
+            let mut filled = 0u32;
+            let base = rank as u32;
+            for (cell, words) in cells.iter_mut().zip(batch_bits.chunks_exact(wps)) {
+                cell.record_base = filled;
+                out.ranks.extend(words.iter().map(|w| {
+                    let r = base + filled;
+                    filled += w.count_ones();
+                    r
+                }));
+            }
+            rank += batch_filled;
+            let filled = filled as u64;
+            out.bits.extend_from_slice(batch_bits);
             cells_done += batch.len();
+            lap(8);
             if pnmt && filled > 0 {
                 let record_bytes = filled * 2 * words as u64 * 4;
+                // Sized to the records found with room for the batches to come (the fine rows of
+                // seed 004's table fill half their shafts), not to the most a batch can hold:
+                // the driver charges pinned memory by the byte. Outgrown buffers are freed with
+                // the rest, at the end.
+                let room = (record_bytes + record_bytes / 4)
+                    .max(record_limit * 3 / 5)
+                    .min(record_limit)
+                    .max(record_bytes);
                 if record_bytes > h.records.size() {
-                    h.records = compute.buffer(record_bytes, Memory::Readback)?;
+                    retired.push(std::mem::replace(&mut h.records, gpu.take(room, Memory::Readback)?));
                 }
                 if record_bytes > records_dev.size() {
-                    records_dev = compute.buffer(record_bytes, Memory::Device)?;
+                    retired.push(std::mem::replace(&mut records_dev, gpu.take(room, Memory::Device)?));
                 }
+                lap(7);
                 h.cells.write(&cells)?;
                 let h = &host[side];
                 let records = compute.submit(|c| {
@@ -428,13 +602,42 @@ pub(super) fn bake(
             copy_out(&host[prev].records, bytes, words, layout, done as f64 / occupied.len() as f64, out);
             lap(3);
         }
+        // Kept for the next bake (freeing hundreds of MiB of GPU and pinned memory, what the
+        // pool does not keep, takes the driver milliseconds: on another thread).
+        let mut done: Vec<Buffer> = vec![
+            params_dev,
+            corners_dev,
+            tris_dev,
+            cells_dev,
+            cell_tris_dev,
+            keys,
+            face_seps,
+            fallbacks,
+            ends,
+            bits_dev,
+            tests_dev,
+            records_dev,
+        ];
+        for h in host {
+            done.extend([h.cells, h.cell_tris, h.bits, h.tests, h.records]);
+        }
+        done.extend(retired);
+        gpu.keep(done);
         Ok(())
     };
     let result = run().map_err(gpu_err);
     if timing {
         eprintln!(
-            "GPU bake, ms: buffers {:.1}, uploads {:.1}, search {:.1}, records {:.1}, other waits {:.1}, CPU between kernels {:.1}, copying records out {:.1}",
-            phases[0], phases[4], phases[5], phases[6], phases[1], phases[2], phases[3]
+            "GPU bake, ms: buffers {:.1}, uploads and preparation {:.1}, search {:.1}, records {:.1}, other waits {:.1}, CPU between kernels {:.1} (ranks {:.1}, record buffers {:.1}), copying records out {:.1}",
+            phases[0],
+            phases[4],
+            phases[5],
+            phases[6],
+            phases[1],
+            phases[2] + phases[7] + phases[8],
+            phases[8],
+            phases[7],
+            phases[3]
         );
     }
     result

@@ -48,6 +48,8 @@ pub struct BakedLineSpace {
     pub tests: u64,
     /// Filled shafts whose PNMT sample rays all missed (no record).
     pub pnmt_missing: u64,
+    /// The GPU that baked the shafts (`None`: the CPU).
+    pub device: Option<String>,
     /// Wall time of voxelization, ms.
     pub voxel_ms: f64,
     /// Wall time of the whole bake, ms.
@@ -174,6 +176,7 @@ pub fn bake(
             progress,
             &mut out,
         )?;
+        out.device = Some(gpu.device().to_string());
         header.filled =
             out.ranks.last().map_or(0, |&r| r as u64) + out.bits.last().map_or(0, |w| w.count_ones() as u64);
         out.header = header;

@@ -27,7 +27,7 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
     // Σ triangles × shafts: the work that decides whether a GPU is worth opening.
     let shafts = kiln_format::linespace::index::shafts_per_voxel(ctx.plan.shaft_res.max(1)) as u64;
     let work = if ctx.plan.shaft_variants == 0 { 0 } else { voxels.triangles.len() as u64 * shafts };
-    let gpu = super::gpu::for_bake(work)?;
+    let gpu = super::gpu::for_bake(work, ctx.plan.shaft_res, ctx.plan.pnmt_layout)?;
     let ls = super::bake(
         gpu.as_deref(),
         &ctx.attributes(),
