@@ -108,15 +108,7 @@ fn tiny(runs: usize) {
         strict: false,
         warning_levels: Vec::new(),
     };
-    let out_args = OutputArgs {
-        report: None,
-        depfile: None,
-        threads: None,
-        line_space_device: Default::default(),
-        quiet: true,
-        cache: None,
-        no_cache: true,
-    };
+    let out_args = quiet_output();
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
     let (mut process, mut in_process, mut lut) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..runs {
@@ -175,15 +167,7 @@ fn pica(runs: usize) {
         strict: false,
         warning_levels: Vec::new(),
     };
-    let out_args = OutputArgs {
-        report: None,
-        depfile: None,
-        threads: None,
-        line_space_device: Default::default(),
-        quiet: true,
-        cache: None,
-        no_cache: true,
-    };
+    let out_args = quiet_output();
     println!("pica_pica, {runs} runs, {} threads; medians (min..max) in ms", rayon::current_num_threads());
 
     // 1. Per-stage compile time.
@@ -273,4 +257,17 @@ fn pica(runs: usize) {
     println!("  speed-up, checksums verified           {:>8.1}x  (target >= 20)", c / median(open_geo));
     println!("  speed-up, no checksums                 {:>8.1}x", c / median(open_lazy));
     println!("  speed-up, every checksum               {:>8.1}x", c / median(open_all));
+}
+
+/// Output options of a quiet compile without report, depfile or stage cache.
+fn quiet_output() -> OutputArgs {
+    OutputArgs {
+        report: None,
+        depfile: None,
+        threads: None,
+        line_space_device: Default::default(),
+        quiet: true,
+        cache: None,
+        no_cache: true,
+    }
 }

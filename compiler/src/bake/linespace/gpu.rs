@@ -376,15 +376,8 @@ pub(super) fn bake(
     let most_tris = batches.iter().map(|b| b.1).max().unwrap_or(0) as u64;
     let record_limit = most_cells * shafts as u64 * 2 * words as u64 * 4;
     // KILN_GPU_TIMING=1: where the time goes, per phase, on stderr.
-    let timing = std::env::var_os("KILN_GPU_TIMING").is_some();
-    let mut phases = [0f64; 9];
-    let mut clock = std::time::Instant::now();
-    let mut lap = |phase: usize| {
-        if timing {
-            phases[phase] += clock.elapsed().as_secs_f64() * 1e3;
-            clock = std::time::Instant::now();
-        }
-    };
+    let mut laps = Laps::new(std::env::var_os("KILN_GPU_TIMING").is_some());
+    let timing = laps.on;
     let mut rank = 0u64;
     out.bits.reserve_exact(occupied.len() * wps);
     out.ranks.reserve_exact(occupied.len() * wps);
@@ -401,7 +394,7 @@ pub(super) fn bake(
             Ok(())
         })?;
         drop((params_host, corners_host, tris_host));
-        lap(4);
+        laps.lap(4);
         let cells_dev = gpu.take(most_cells * size_of::<BakeCell>() as u64, Memory::Device)?;
         let cell_tris_dev = gpu.take(most_tris * 4, Memory::Device)?;
         let keys = gpu.take(most_tris * 30 * 8, Memory::Device)?;
@@ -424,7 +417,7 @@ pub(super) fn bake(
                 })
             })
             .collect::<kiln_gpubake::Result<_>>()?;
-        lap(0);
+        laps.lap(0);
         // The batch whose records are on their way: (its host side, records bytes, cells done).
         let mut in_flight: Option<(kiln_gpubake::Pending, usize, u64, usize)> = None;
         let mut cells_done = 0;
@@ -480,9 +473,9 @@ pub(super) fn bake(
             };
             if timing {
                 // Timing: the preparation alone.
-                lap(2);
+                laps.lap(2);
                 compute.run(prepare)?;
-                lap(4);
+                laps.lap(4);
             }
             let search = compute.submit(|c| {
                 if !timing {
@@ -509,23 +502,16 @@ pub(super) fn bake(
                 Ok(())
             })?;
             // Timing: the search alone (no overlap with the records before).
-            let search = if timing {
-                lap(2);
-                search.wait()?;
-                lap(5);
-                compute.submit(|_| Ok(()))?
-            } else {
-                search
-            };
+            let search = laps.alone(compute, search, 5)?;
             // While the GPU searches, the records of the batch before go out.
             if let Some((pending, prev, bytes, done)) = in_flight.take() {
                 pending.wait()?;
-                lap(1);
+                laps.lap(1);
                 copy_out(&host[prev].records, bytes, words, layout, done as f64 / occupied.len() as f64, out);
-                lap(3);
+                laps.lap(3);
             }
             search.wait()?;
-            lap(1);
+            laps.lap(1);
             let h = &mut host[side];
             let batch_bits: &[u32] = bytemuck::cast_slice(&h.bits.bytes()[..bits_bytes as usize]);
             out.tests += bytemuck::cast_slice::<u8, u32>(&h.tests.bytes()[..tests_bytes as usize])
@@ -552,7 +538,7 @@ pub(super) fn bake(
             let filled = filled as u64;
             out.bits.extend_from_slice(batch_bits);
             cells_done += batch.len();
-            lap(8);
+            laps.lap(8);
             if pnmt && filled > 0 {
                 let record_bytes = filled * 2 * words as u64 * 4;
                 // Sized to the records found with room for the batches to come (the fine rows of
@@ -569,7 +555,7 @@ pub(super) fn bake(
                 if record_bytes > records_dev.size() {
                     retired.push(std::mem::replace(&mut records_dev, gpu.take(room, Memory::Device)?));
                 }
-                lap(7);
+                laps.lap(7);
                 h.cells.write(&cells)?;
                 let h = &host[side];
                 let records = compute.submit(|c| {
@@ -583,24 +569,17 @@ pub(super) fn bake(
                     c.to_host();
                     Ok(())
                 })?;
-                let records = if timing {
-                    lap(2);
-                    records.wait()?;
-                    lap(6);
-                    compute.submit(|_| Ok(()))?
-                } else {
-                    records
-                };
+                let records = laps.alone(compute, records, 6)?;
                 in_flight = Some((records, side, record_bytes, cells_done));
             }
-            lap(2);
+            laps.lap(2);
             progress.inc(batch.len() as u64);
         }
         if let Some((pending, prev, bytes, done)) = in_flight.take() {
             pending.wait()?;
-            lap(1);
+            laps.lap(1);
             copy_out(&host[prev].records, bytes, words, layout, done as f64 / occupied.len() as f64, out);
-            lap(3);
+            laps.lap(3);
         }
         // Kept for the next bake (freeing hundreds of MiB of GPU and pinned memory, what the
         // pool does not keep, takes the driver milliseconds: on another thread).
@@ -626,7 +605,8 @@ pub(super) fn bake(
         Ok(())
     };
     let result = run().map_err(gpu_err);
-    if timing {
+    if laps.on {
+        let phases = laps.phases;
         eprintln!(
             "GPU bake, ms: buffers {:.1}, uploads and preparation {:.1}, search {:.1}, records {:.1}, other waits {:.1}, CPU between kernels {:.1} (ranks {:.1}, record buffers {:.1}), copying records out {:.1}",
             phases[0],
@@ -641,6 +621,44 @@ pub(super) fn bake(
         );
     }
     result
+}
+
+/// Wall time per phase of a bake, when on (`KILN_GPU_TIMING`).
+struct Laps {
+    on: bool,
+    phases: [f64; 9],
+    clock: std::time::Instant,
+}
+
+impl Laps {
+    fn new(on: bool) -> Laps {
+        Laps { on, phases: [0.0; 9], clock: std::time::Instant::now() }
+    }
+
+    /// Adds the time since the last lap to `phase`.
+    fn lap(&mut self, phase: usize) {
+        if self.on {
+            self.phases[phase] += self.clock.elapsed().as_secs_f64() * 1e3;
+            self.clock = std::time::Instant::now();
+        }
+    }
+
+    /// When on, waits for `work` and counts it as `phase` alone (no overlap with what follows):
+    /// returns work already done.
+    fn alone<'a>(
+        &mut self,
+        compute: &'a Compute,
+        work: kiln_gpubake::Pending<'a>,
+        phase: usize,
+    ) -> kiln_gpubake::Result<kiln_gpubake::Pending<'a>> {
+        if !self.on {
+            return Ok(work);
+        }
+        self.lap(2);
+        work.wait()?;
+        self.lap(phase);
+        compute.submit(|_| Ok(()))
+    }
 }
 
 /// Appends the first `bytes` of `records` (a batch's records, `words` a record) to `out.pnmt`,
