@@ -64,7 +64,7 @@ precise double ddot_glam(dvec3 a, dvec3 b) {
 }
 
 #ifdef KILN_BAKE_TRI_BINDING
-// Per global triangle: world corners (9 floats), vertex normals (9), material (its bits), padding.
+// Per global triangle: world corners (9 floats), vertex normals (9), material (a whole float), padding.
 layout(std430, set = 0, binding = KILN_BAKE_TRI_BINDING) readonly buffer TrisB { float tri_data[]; };
 
 vec3 tri_vec(uint t, uint k) {
@@ -154,7 +154,7 @@ uvec4 encode(dvec3 position, vec3 normal, uint material, BakeCell c, uint layout
 uvec4 hit_record(uint t, float u, float v, BakeCell c, uint layout_code) {
     precise float w = 1.0 - u - v;
     precise vec3 p = tri_vec(t, 0u) * w + tri_vec(t, 1u) * u + tri_vec(t, 2u) * v;
-    uint material = floatBitsToUint(tri_data[20u * t + 18u]);
+    uint material = uint(tri_data[20u * t + 18u]);
     return encode(dvec3(p), shading_normal(t, u, v), material, c, layout_code);
 }
 

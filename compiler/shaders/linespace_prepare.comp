@@ -199,7 +199,7 @@ void main() {
                     dvec3 qc = min(max(q, dvec3(0.0)), dvec3(1.0));
                     precise dvec3 world = dvec3(c.wx, c.wy, c.wz) + qc * c.cell;
                     vec2 uv = barycentric(t, vec3(world));
-                    uint material = floatBitsToUint(tri_data[20u * t + 18u]);
+                    uint material = uint(tri_data[20u * t + 18u]);
                     r = encode(world, shading_normal(t, uv.x, uv.y), material, c, P.layout_code);
                 }
                 uint f = ((ct * 15u + pair) * 2u + side) * P.words;

@@ -24,7 +24,8 @@ layout(std430, set = 0, binding = 5) readonly buffer FaceSepsB { double face_sep
 // Per shaft: its front and back ends, 3 words each (see FALLBACK).
 layout(std430, set = 0, binding = 6) writeonly buffer EndsB { uint ends[]; };
 layout(std430, set = 0, binding = 7) writeonly buffer BitsB { uint bits[]; };
-layout(std430, set = 0, binding = 8) buffer TestsB { uint tests[]; };
+// Per (cell, workgroup): the (triangle, shaft) pairs the sign masks left to decide.
+layout(std430, set = 0, binding = 8) writeonly buffer TestsB { uint tests[]; };
 
 // The workgroup's 128 shafts: four whole bit words of the cell.
 shared uint sh_bits[4];
@@ -82,6 +83,11 @@ void main() {
     uint tested = 0u;
     for (uint li = 0u; live && li < c.tri_count; ++li) {
         uint ct = c.tri_first + li;
+        // A triangle clipped away entirely (key minimum −∞, see linespace_prepare.comp) meets
+        // nothing: the CPU bake skips it (shafts.rs: patch_sets).
+        if (keys[ct * 30u] == -1.0 / 0.0) {
+            continue;
+        }
         // The sign masks at both ends; a separation positive at both rejects the shaft.
         uint lower = 0u, upper = 0u;
         bool rejected = false;
@@ -211,7 +217,7 @@ void main() {
     if (tid < 4u && w < wps) {
         bits[ci * wps + w] = sh_bits[tid];
     }
-    if (tid == 0u && sh_tests != 0u) {
-        atomicAdd(tests[ci], sh_tests);
+    if (tid == 0u) {
+        tests[ci * gl_NumWorkGroups.x + gl_WorkGroupID.x] = sh_tests;
     }
 }

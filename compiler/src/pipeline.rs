@@ -234,14 +234,25 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
     crate::bake::linespace::gpu::choose(out.line_space_device);
     // A line space large enough for the GPU: open it while the earlier stages run.
     let plan = &loaded.plan;
-    if plan.shaft_variants != 0 && plan.shaft_res > 0 {
+    let attrs = crate::bake::linespace::SceneAttributes {
+        vertices: &loaded.scene.vertices,
+        uvs: &loaded.scene.uvs,
+        triangles: &loaded.scene.triangles,
+        materials: &loaded.scene.triangle_materials,
+    };
+    if plan.shaft_variants != 0
+        && plan.shaft_res > 0
+        && crate::bake::linespace::gpu::supports(plan.shaft_variants, plan.pnmt_layout, &attrs)
+    {
         let shafts = kiln_format::linespace::index::shafts_per_voxel(plan.shaft_res) as u64;
         let work = loaded.geometry.voxels(plan.voxel_res).triangles.len() as u64 * shafts;
         crate::bake::linespace::gpu::open_early(work, plan.shaft_res, plan.pnmt_layout);
     }
     let progress = Progress::new(!out.quiet);
     let inputs = hash_inputs(&loaded.scene.inputs)?;
-    let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress, cache.as_ref())?))?;
+    let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress, cache.as_ref())?));
+    crate::bake::linespace::gpu::finish();
+    let baked = baked?;
     progress.stage("write");
     let t_write = Instant::now();
     let bytes = bake::write(&baked, output).map_err(|e| CliError::io(e.to_string()))?;

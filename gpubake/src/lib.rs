@@ -39,19 +39,46 @@ pub struct Options {
     pub validate: bool,
 }
 
+/// The instance and device, destroyed when the last of the [`Compute`], [`Buffer`]s and
+/// [`Kernel`]s made on them goes.
+struct Owner {
+    instance: ash::Instance,
+    device: ash::Device,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// The validation error counter the messenger writes (boxed: its address is the messenger's
+    /// user data).
+    _errors: std::sync::Arc<AtomicU32>,
+}
+
+impl Drop for Owner {
+    fn drop(&mut self) {
+        // SAFETY: nothing made on the device is left (every holder of an `Arc<Owner>` is gone,
+        // and `Compute`'s drop waited for the device to go idle).
+        unsafe {
+            self.device.destroy_device(None);
+            if let Some((u, m)) = &self.debug {
+                u.destroy_debug_utils_messenger(*m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
 /// A Vulkan device with one compute queue.
 pub struct Compute {
     _entry: ash::Entry,
-    instance: ash::Instance,
+    owner: std::sync::Arc<Owner>,
     device: ash::Device,
+    /// Held while the queue or the command pool is used (Vulkan leaves their synchronisation to
+    /// the caller).
+    lock: std::sync::Mutex<()>,
     queue: vk::Queue,
     pool: vk::CommandPool,
     memory: vk::PhysicalDeviceMemoryProperties,
     name: String,
     cpu: bool,
     max_buffer: u64,
-    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-    errors: Box<AtomicU32>,
+    errors: std::sync::Arc<AtomicU32>,
 }
 
 impl std::fmt::Debug for Compute {
@@ -123,7 +150,7 @@ impl Compute {
             vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error("no Vulkan driver found".into()),
             e => vk_err("creating the Vulkan instance", e),
         })?;
-        let errors = Box::new(AtomicU32::new(0));
+        let errors = std::sync::Arc::new(AtomicU32::new(0));
         let debug = if options.validate {
             let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
@@ -133,7 +160,7 @@ impl Compute {
                         | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION,
                 )
                 .pfn_user_callback(Some(debug_callback))
-                .user_data(&*errors as *const AtomicU32 as *mut c_void);
+                .user_data(std::sync::Arc::as_ptr(&errors) as *mut c_void);
             // SAFETY: `info` is valid; the counter outlives the messenger.
             match unsafe { utils.create_debug_utils_messenger(&info, None) } {
                 Ok(m) => Some((utils, m)),
@@ -193,17 +220,19 @@ impl Compute {
         };
         // SAFETY: plain query.
         let memory = unsafe { instance.get_physical_device_memory_properties(physical) };
+        let owner =
+            std::sync::Arc::new(Owner { instance, device: device.clone(), debug, _errors: errors.clone() });
         Ok(Compute {
             _entry: entry,
-            instance,
+            owner,
             device,
+            lock: std::sync::Mutex::new(()),
             queue,
             pool,
             memory,
             name,
             cpu,
             max_buffer,
-            debug,
             errors,
         })
     }
@@ -286,9 +315,15 @@ impl Compute {
             }
         };
         match mapped {
-            Ok(mapped) => {
-                Ok(Buffer { buffer, memory: mem, kind: memory, size, mapped, device: self.device.clone() })
-            }
+            Ok(mapped) => Ok(Buffer {
+                buffer,
+                memory: mem,
+                kind: memory,
+                size,
+                mapped,
+                device: self.device.clone(),
+                _owner: self.owner.clone(),
+            }),
             Err(e) => {
                 destroy();
                 // SAFETY: the memory is no longer bound to a live buffer.
@@ -317,6 +352,7 @@ impl Compute {
                 .map_err(|e| vk_err("creating a shader module", e))?;
         let mut k = Kernel {
             device: d.clone(),
+            _owner: self.owner.clone(),
             module,
             set_layout: vk::DescriptorSetLayout::null(),
             layout: vk::PipelineLayout::null(),
@@ -356,14 +392,21 @@ impl Compute {
 
     /// Records commands with `record`, submits them and waits for them to finish.
     pub fn run(&self, record: impl FnOnce(&mut Commands) -> Result<()>) -> Result<()> {
-        self.submit(record)?.wait()
+        // SAFETY: the work is waited for before the buffers `record` borrowed can go.
+        unsafe { self.submit(record) }?.wait()
     }
 
     /// Records commands with `record` and submits them; [`Pending::wait`] waits for them. Work
     /// submitted later runs after it (each dispatch, copy and fill begins with a full barrier,
     /// whose scope reaches back over earlier submissions to the queue).
-    pub fn submit(&self, record: impl FnOnce(&mut Commands) -> Result<()>) -> Result<Pending<'_>> {
+    ///
+    /// # Safety
+    ///
+    /// Every buffer and kernel the commands use must outlive the returned [`Pending`] (be neither
+    /// dropped nor read through [`Buffer::bytes`] before it is waited for or dropped).
+    pub unsafe fn submit(&self, record: impl FnOnce(&mut Commands) -> Result<()>) -> Result<Pending<'_>> {
         let d = &self.device;
+        let _guard = self.lock.lock().unwrap_or_else(|e| e.into_inner());
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(self.pool)
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -372,7 +415,7 @@ impl Compute {
         let cmd = unsafe { d.allocate_command_buffers(&info) }
             .map_err(|e| vk_err("allocating a command buffer", e))?[0];
         let mut pending = Pending { compute: self, cmd, pools: Vec::new(), fence: vk::Fence::null() };
-        let mut c = Commands { device: d, cmd, pools: Vec::new() };
+        let mut c = Commands { device: d, max_range: self.max_buffer, cmd, pools: Vec::new() };
         let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         // SAFETY: a fresh command buffer, recorded once.
         unsafe { d.begin_command_buffer(cmd, &begin) }
@@ -434,6 +477,7 @@ impl Pending<'_> {
             self.fence = vk::Fence::null();
         }
         if self.cmd != vk::CommandBuffer::null() {
+            let _guard = self.compute.lock.lock().unwrap_or_else(|e| e.into_inner());
             // SAFETY: the work finished, so its command buffer and descriptor pools are free.
             unsafe {
                 d.free_command_buffers(self.compute.pool, &[self.cmd]);
@@ -455,16 +499,11 @@ impl Drop for Pending<'_> {
 
 impl Drop for Compute {
     fn drop(&mut self) {
-        // SAFETY: buffers and kernels hold clones of the device handle and must be dropped first
-        // (they borrow nothing, so the caller's order decides; `run` leaves nothing in flight).
+        // SAFETY: no `Pending` is left (each borrows the `Compute`), so no command buffer of the
+        // pool is in use; the device itself goes with the last `Arc<Owner>`.
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.pool, None);
-            self.device.destroy_device(None);
-            if let Some((u, m)) = &self.debug {
-                u.destroy_debug_utils_messenger(*m, None);
-            }
-            self.instance.destroy_instance(None);
         }
     }
 }
@@ -487,6 +526,14 @@ fn pick(instance: &ash::Instance, allow_cpu: bool) -> Result<(vk::PhysicalDevice
         };
         let name = p.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
         let cpu = p.device_type == vk::PhysicalDeviceType::CPU;
+        if p.api_version < vk::API_VERSION_1_2 {
+            rejected.push(format!(
+                "{name} (Vulkan {}.{}, needs 1.2)",
+                vk::api_version_major(p.api_version),
+                vk::api_version_minor(p.api_version)
+            ));
+            continue;
+        }
         if cpu && !allow_cpu {
             rejected.push(format!("{name} (a CPU implementation)"));
             continue;
@@ -537,6 +584,7 @@ pub struct Buffer {
     size: u64,
     mapped: Option<*mut u8>,
     device: ash::Device,
+    _owner: std::sync::Arc<Owner>,
 }
 
 // SAFETY: the mapping is plain host memory owned by this buffer; access goes through `&self` /
@@ -566,7 +614,8 @@ impl Buffer {
     pub fn bytes(&self) -> &[u8] {
         match self.mapped {
             // SAFETY: the mapping covers `size` bytes and lives as long as the buffer; the GPU
-            // writes it only inside `Compute::run`, which has returned.
+            // writes it only in work that `Compute::submit`'s contract has the caller wait for
+            // before reading (`Compute::run` waits itself).
             Some(p) => unsafe { std::slice::from_raw_parts(p, self.size as usize) },
             None => &[],
         }
@@ -609,6 +658,7 @@ impl Drop for Buffer {
 /// A compute pipeline and its layout.
 pub struct Kernel {
     device: ash::Device,
+    _owner: std::sync::Arc<Owner>,
     module: vk::ShaderModule,
     set_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
@@ -637,6 +687,7 @@ impl Drop for Kernel {
 /// Commands being recorded by [`Compute::run`].
 pub struct Commands<'a> {
     device: &'a ash::Device,
+    max_range: u64,
     cmd: vk::CommandBuffer,
     pools: Vec<vk::DescriptorPool>,
 }
@@ -672,9 +723,15 @@ impl Commands<'_> {
         // SAFETY: the pool has room for this one set.
         let set = unsafe { d.allocate_descriptor_sets(&alloc) }
             .map_err(|e| vk_err("allocating a descriptor set", e))?[0];
+        // Bound up to the storage-buffer range: a pooled buffer may be larger than its use.
         let infos: Vec<[vk::DescriptorBufferInfo; 1]> = buffers
             .iter()
-            .map(|b| [vk::DescriptorBufferInfo::default().buffer(b.buffer).offset(0).range(vk::WHOLE_SIZE)])
+            .map(|b| {
+                [vk::DescriptorBufferInfo::default()
+                    .buffer(b.buffer)
+                    .offset(0)
+                    .range(b.size.min(self.max_range))]
+            })
             .collect();
         let writes: Vec<_> = infos
             .iter()

@@ -120,14 +120,16 @@ impl GpuBaker {
         Ok(())
     }
 
-    /// A buffer of at least `size` bytes in `memory`: the smallest such from the pool, or a new
-    /// one.
+    /// A buffer of at least `size` bytes in `memory`: the smallest such from the pool if it is
+    /// at most twice as large (or 2 MiB), else a new one.
     fn take(&self, size: u64, memory: Memory) -> kiln_gpubake::Result<Buffer> {
         let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
         let best = pool
             .iter()
             .enumerate()
-            .filter(|(_, b)| b.memory() == memory && b.size() >= size)
+            // Not a buffer much larger than asked: a small request would take a large one that a
+            // later request of its size then has to allocate anew.
+            .filter(|(_, b)| b.memory() == memory && b.size() >= size && b.size() <= size.max(1 << 20) * 2)
             .min_by_key(|(_, b)| b.size())
             .map(|(i, _)| i);
         match best {
@@ -164,7 +166,7 @@ impl GpuBaker {
     }
 
     /// Waits until the buffers handed to [`Self::release`] are freed.
-    fn wait_released(&self) {
+    pub fn wait_released(&self) {
         if let Some(h) = self.releasing.lock().unwrap_or_else(|e| e.into_inner()).take() {
             let _ = h.join();
         }
@@ -216,6 +218,12 @@ fn opened(n: u32, layout: PnmtLayout) -> &'static Result<std::sync::Mutex<GpuBak
     })
 }
 
+/// Whether the current choice is `gpu` (a failure of the GPU bake is then an error, not a
+/// fallback to the CPU).
+pub fn required() -> bool {
+    *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) == BakeDevice::Gpu
+}
+
 /// Whether a bake of `work` runs on a GPU under the current choice (if one opens).
 fn wants_gpu(work: u64) -> bool {
     match *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) {
@@ -230,9 +238,24 @@ fn wants_gpu(work: u64) -> bool {
 /// space.
 pub fn open_early(work: u64, n: u32, layout: PnmtLayout) {
     if wants_gpu(work) && OPENED.get().is_none() {
-        std::thread::spawn(move || {
+        let handle = std::thread::spawn(move || {
             opened(n, layout);
         });
+        *OPENING.lock().unwrap_or_else(|e| e.into_inner()) = Some(handle);
+    }
+}
+
+/// The thread [`open_early`] started.
+static OPENING: std::sync::Mutex<Option<std::thread::JoinHandle<()>>> = std::sync::Mutex::new(None);
+
+/// Waits for the threads of the GPU bake (opening the GPU, freeing buffers) to finish, so that
+/// none is inside the driver when the process exits.
+pub fn finish() {
+    if let Some(h) = OPENING.lock().unwrap_or_else(|e| e.into_inner()).take() {
+        let _ = h.join();
+    }
+    if let Some(Ok(gpu)) = OPENED.get() {
+        gpu.lock().unwrap_or_else(|e| e.into_inner()).wait_released();
     }
 }
 
@@ -257,7 +280,8 @@ pub fn for_bake(
     }
 }
 
-/// Whether the GPU bake makes these variants (binary, PNMT) in this layout for this scene.
+/// Whether the GPU bake makes these variants (binary, PNMT) in this layout for this scene (no
+/// candidates or pre-illumination; texture coordinates only where the scene has none).
 pub fn supports(variants: u32, layout: PnmtLayout, attrs: &SceneAttributes) -> bool {
     variants & (Variants::CANDIDATES | Variants::PREILLUM) == 0
         && (!layout.stores_uv() || attrs.uvs.is_empty())
@@ -330,7 +354,7 @@ pub(super) fn bake(
         ..Default::default()
     };
     // Every triangle's grid-local corners (doubles) and world corners, vertex normals and
-    // material (floats; the material as its bits), in the scene's order.
+    // material (floats), in the scene's order.
     let corners: Vec<f64> = local.iter().flat_map(|t| t.iter().flat_map(|p| p.to_array())).collect();
     let max_material = u32::from(layout.max_material());
     let tri_data: Vec<f32> = (0..attrs.triangles.len() as u32)
@@ -344,7 +368,8 @@ pub(super) fn bake(
                 d[3 * k..3 * k + 3].copy_from_slice(&c[k].to_array());
                 d[9 + 3 * k..12 + 3 * k].copy_from_slice(&nrm[k]);
             }
-            d[18] = f32::from_bits(m);
+            // Materials are below 2^16: exact as floats.
+            d[18] = m as f32;
             d
         })
         .collect();
@@ -374,7 +399,25 @@ pub(super) fn bake(
     }
     let most_cells = batches.iter().map(|b| b.0.len()).max().unwrap_or(0) as u64;
     let most_tris = batches.iter().map(|b| b.1).max().unwrap_or(0) as u64;
-    let record_limit = most_cells * shafts as u64 * 2 * words as u64 * 4;
+    let record_limit = (most_cells * shafts as u64 * 2 * words as u64 * 4).min(compute.max_buffer());
+    let search_groups = shafts.div_ceil(SEARCH_GROUP);
+    // Every buffer a kernel binds within the device's storage-buffer range, every index within
+    // 32 bits (a cell of millions of triangles, a scene of tens of millions, can exceed them).
+    let max = compute.max_buffer();
+    let sizes = [
+        ("the scene's corners", corners.len() as u64 * 8),
+        ("the scene's triangle data", tri_data.len() as u64 * 4),
+        ("a batch's separations", most_tris * FACE_SEP_BYTES),
+        ("a batch's fallback records", most_tris * 30 * words as u64 * 4),
+        ("a batch's ends", most_cells * shafts as u64 * END_BYTES),
+    ];
+    if let Some((what, bytes)) = sizes.iter().find(|(_, b)| *b > max) {
+        return Err(CliError::input(format!(
+            "the GPU line-space bake cannot hold {what} ({} MiB, the device binds at most {} MiB); bake on the CPU (--line-space-device cpu) or raise --voxel-res",
+            bytes >> 20,
+            max >> 20
+        )));
+    }
     // KILN_GPU_TIMING=1: where the time goes, per phase, on stderr.
     let mut laps = Laps::new(std::env::var_os("KILN_GPU_TIMING").is_some());
     let timing = laps.on;
@@ -402,7 +445,7 @@ pub(super) fn bake(
         let fallbacks = gpu.take(if pnmt { most_tris * 30 * words as u64 * 4 } else { 4 }, Memory::Device)?;
         let ends = gpu.take(most_cells * shafts as u64 * END_BYTES, Memory::Device)?;
         let bits_dev = gpu.take(most_cells * wps as u64 * 4, Memory::Device)?;
-        let tests_dev = gpu.take(most_cells * 4, Memory::Device)?;
+        let tests_dev = gpu.take(most_cells * search_groups as u64 * 4, Memory::Device)?;
         // Records are written to GPU memory and copied to the host by a copy command: the
         // kernel writing them to host memory itself was slower by an order of magnitude.
         let mut records_dev = gpu.take(4, Memory::Device)?;
@@ -412,7 +455,7 @@ pub(super) fn bake(
                     cells: gpu.take(most_cells * size_of::<BakeCell>() as u64, Memory::Upload)?,
                     cell_tris: gpu.take(most_tris * 4, Memory::Upload)?,
                     bits: gpu.take(most_cells * wps as u64 * 4, Memory::Readback)?,
-                    tests: gpu.take(most_cells * 4, Memory::Readback)?,
+                    tests: gpu.take(most_cells * search_groups as u64 * 4, Memory::Readback)?,
                     records: gpu.take(4, Memory::Readback)?,
                 })
             })
@@ -449,7 +492,8 @@ pub(super) fn bake(
             // The occupied cells are in order, so their lists are one run of the voxel lists.
             h.cell_tris.write(&voxel_triangles[first_tri..first_tri + tris])?;
             let cells_bytes = std::mem::size_of_val(cells.as_slice()) as u64;
-            let (bits_bytes, tests_bytes) = ((batch.len() * wps * 4) as u64, batch.len() as u64 * 4);
+            let (bits_bytes, tests_bytes) =
+                ((batch.len() * wps * 4) as u64, batch.len() as u64 * search_groups as u64 * 4);
             let groups = batch.len() as u32;
             let h = &host[side];
             let prepare = |c: &mut kiln_gpubake::Commands| {
@@ -477,30 +521,35 @@ pub(super) fn bake(
                 compute.run(prepare)?;
                 laps.lap(4);
             }
-            let search = compute.submit(|c| {
-                if !timing {
-                    prepare(c)?;
-                }
-                c.dispatch(
-                    &gpu.search,
-                    &[
-                        &params_dev,
-                        &cells_dev,
-                        &cell_tris_dev,
-                        &keys,
-                        &tris_dev,
-                        &face_seps,
-                        &ends,
-                        &bits_dev,
-                        &tests_dev,
-                    ],
-                    [shafts.div_ceil(SEARCH_GROUP), groups, 1],
-                )?;
-                c.copy(&bits_dev, &h.bits, bits_bytes);
-                c.copy(&tests_dev, &h.tests, tests_bytes);
-                c.to_host();
-                Ok(())
-            })?;
+            // SAFETY: every buffer the commands use is declared before `search` and `in_flight`
+            // (so outlives them, error paths included) and is neither read nor replaced before
+            // `search` is waited for.
+            let search = unsafe {
+                compute.submit(|c| {
+                    if !timing {
+                        prepare(c)?;
+                    }
+                    c.dispatch(
+                        &gpu.search,
+                        &[
+                            &params_dev,
+                            &cells_dev,
+                            &cell_tris_dev,
+                            &keys,
+                            &tris_dev,
+                            &face_seps,
+                            &ends,
+                            &bits_dev,
+                            &tests_dev,
+                        ],
+                        [search_groups, groups, 1],
+                    )?;
+                    c.copy(&bits_dev, &h.bits, bits_bytes);
+                    c.copy(&tests_dev, &h.tests, tests_bytes);
+                    c.to_host();
+                    Ok(())
+                })?
+            };
             // Timing: the search alone (no overlap with the records before).
             let search = laps.alone(compute, search, 5)?;
             // While the GPU searches, the records of the batch before go out.
@@ -549,6 +598,13 @@ pub(super) fn bake(
                     .max(record_limit * 3 / 5)
                     .min(record_limit)
                     .max(record_bytes);
+                if record_bytes > max {
+                    return Err(kiln_gpubake::Error(format!(
+                        "a batch's records ({} MiB) exceed what the device binds ({} MiB)",
+                        record_bytes >> 20,
+                        max >> 20
+                    )));
+                }
                 if record_bytes > h.records.size() {
                     retired.push(std::mem::replace(&mut h.records, gpu.take(room, Memory::Readback)?));
                 }
@@ -558,17 +614,21 @@ pub(super) fn bake(
                 laps.lap(7);
                 h.cells.write(&cells)?;
                 let h = &host[side];
-                let records = compute.submit(|c| {
-                    c.copy(&h.cells, &cells_dev, cells_bytes);
-                    c.dispatch(
-                        &gpu.records,
-                        &[&params_dev, &cells_dev, &fallbacks, &tris_dev, &ends, &bits_dev, &records_dev],
-                        [groups, 1, 1],
-                    )?;
-                    c.copy(&records_dev, &h.records, record_bytes);
-                    c.to_host();
-                    Ok(())
-                })?;
+                // SAFETY: as for the search; the records buffers are replaced only after the
+                // batch before has been waited for (`in_flight`), and read only after this one.
+                let records = unsafe {
+                    compute.submit(|c| {
+                        c.copy(&h.cells, &cells_dev, cells_bytes);
+                        c.dispatch(
+                            &gpu.records,
+                            &[&params_dev, &cells_dev, &fallbacks, &tris_dev, &ends, &bits_dev, &records_dev],
+                            [groups, 1, 1],
+                        )?;
+                        c.copy(&records_dev, &h.records, record_bytes);
+                        c.to_host();
+                        Ok(())
+                    })?
+                };
                 let records = laps.alone(compute, records, 6)?;
                 in_flight = Some((records, side, record_bytes, cells_done));
             }
@@ -657,7 +717,8 @@ impl Laps {
         self.lap(2);
         work.wait()?;
         self.lap(phase);
-        compute.submit(|_| Ok(()))
+        // SAFETY: no commands, no buffers.
+        unsafe { compute.submit(|_| Ok(())) }
     }
 }
 

@@ -24,21 +24,42 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
     let shade = |p: glam::DVec3, n: glam::Vec3, v: glam::Vec3, m: u16, uv: glam::Vec2| {
         shading.radiance(p.as_vec3(), n, n, v, m as u32, uv)
     };
-    // Σ triangles × shafts: the work that decides whether a GPU is worth opening.
-    let shafts = kiln_format::linespace::index::shafts_per_voxel(ctx.plan.shaft_res.max(1)) as u64;
-    let work = if ctx.plan.shaft_variants == 0 { 0 } else { voxels.triangles.len() as u64 * shafts };
-    let gpu = super::gpu::for_bake(work, ctx.plan.shaft_res, ctx.plan.pnmt_layout)?;
-    let ls = super::bake(
-        gpu.as_deref(),
-        &ctx.attributes(),
-        voxels,
-        voxel_ms,
-        ctx.plan.shaft_res,
-        ctx.plan.shaft_variants,
-        ctx.plan.pnmt_layout,
-        Some(&shade),
-        ctx.progress,
-    )?;
+    let attrs = ctx.attributes();
+    let plan = ctx.plan;
+    // Σ triangles × shafts: the work that decides whether a GPU is worth opening, for variants
+    // the GPU bakes.
+    let on_gpu =
+        plan.shaft_variants != 0 && super::gpu::supports(plan.shaft_variants, plan.pnmt_layout, &attrs);
+    let shafts = kiln_format::linespace::index::shafts_per_voxel(plan.shaft_res.max(1)) as u64;
+    let gpu = if on_gpu {
+        super::gpu::for_bake(voxels.triangles.len() as u64 * shafts, plan.shaft_res, plan.pnmt_layout)?
+    } else {
+        None
+    };
+    let bake = |gpu: Option<&super::gpu::GpuBaker>, voxels| {
+        super::bake(
+            gpu,
+            &attrs,
+            voxels,
+            voxel_ms,
+            plan.shaft_res,
+            plan.shaft_variants,
+            plan.pnmt_layout,
+            Some(&shade),
+            ctx.progress,
+        )
+    };
+    let on_gpu = gpu.is_some();
+    let first = bake(gpu.as_deref(), voxels);
+    drop(gpu);
+    let ls = match first {
+        // `auto` falls back to the CPU (the same bytes) where the GPU fails.
+        Err(e) if on_gpu && !super::gpu::required() => {
+            eprintln!("warning: {e}; baking the line space on the CPU");
+            bake(None, ctx.geometry.voxels(plan.voxel_res).reordered(&ctx.bvh.order))?
+        }
+        r => r?,
+    };
     let mut out = Sections::default();
     out.push(GRID, 0, bytemuck::bytes_of(&ls.header).to_vec());
     out.push(VOXEL_OFFSETS, 0, bytemuck::cast_slice(&ls.voxel_offsets).to_vec());
