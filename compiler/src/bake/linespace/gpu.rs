@@ -100,8 +100,9 @@ impl GpuBaker {
 
     /// Allocates what a bake at shaft resolution `n` of up to [`BATCH_SCRATCH`] of ends a
     /// batch and half its shafts filled needs, into the pool, so that the first bake finds
-    /// its largest buffers made (a process that will bake can do this while it does other
-    /// work; the bench does it when it opens the GPU, and says how long that took).
+    /// its largest buffers made, and runs the kernels once (a process that will bake can do this
+    /// while it does other work; the bench does it when it opens the GPU, and says how long that
+    /// took).
     pub fn warm(&self, n: u32, layout: PnmtLayout) -> Result<(), String> {
         let shafts = shafts_per_voxel(n.clamp(1, 8)) as u64;
         let cells = (BATCH_SCRATCH.min(self.compute.max_buffer()) / (shafts * END_BYTES)).max(1);
@@ -117,7 +118,51 @@ impl GpuBaker {
         .collect::<kiln_gpubake::Result<Vec<_>>>()
         .map_err(|e| e.0)?;
         self.pool.lock().unwrap_or_else(|e| e.into_inner()).extend(made);
-        Ok(())
+        self.run_empty(n, layout).map_err(|e| e.0)
+    }
+
+    /// Runs the three kernels once over a cell without triangles, so that whatever the driver
+    /// does on a pipeline's first use happens now rather than in the first bake.
+    fn run_empty(&self, n: u32, layout: PnmtLayout) -> kiln_gpubake::Result<()> {
+        let n = n.clamp(1, 8);
+        let shafts = shafts_per_voxel(n);
+        let groups = shafts.div_ceil(SEARCH_GROUP);
+        let c = &self.compute;
+        let upload = |bytes: &[u8]| -> kiln_gpubake::Result<Buffer> {
+            let mut b = c.buffer(bytes.len() as u64, Memory::Upload)?;
+            b.write(bytes)?;
+            Ok(b)
+        };
+        let params = BakeParams {
+            n,
+            n2: n * n,
+            n4: n * n * n * n,
+            shafts,
+            layout_code: layout.code(),
+            words: layout.words() as u32,
+            records: 1,
+            ..Default::default()
+        };
+        let cell = BakeCell { cell: 1.0, inv_cell: 1.0, ..Default::default() };
+        let params = upload(bytemuck::bytes_of(&params))?;
+        let cells = upload(bytemuck::bytes_of(&cell))?;
+        let empty = c.buffer(4, Memory::Device)?;
+        let ends = c.buffer(shafts as u64 * END_BYTES, Memory::Device)?;
+        let bits = c.buffer(words_per_slot(n) as u64 * 4, Memory::Device)?;
+        let tests = c.buffer(groups as u64 * 4, Memory::Device)?;
+        c.run(|r| {
+            r.dispatch(
+                &self.prepare,
+                &[&params, &cells, &empty, &empty, &empty, &empty, &empty, &empty],
+                [1, 1, 1],
+            )?;
+            r.dispatch(
+                &self.search,
+                &[&params, &cells, &empty, &empty, &empty, &empty, &ends, &bits, &tests],
+                [groups, 1, 1],
+            )?;
+            r.dispatch(&self.records, &[&params, &cells, &empty, &empty, &ends, &bits, &empty], [1, 1, 1])
+        })
     }
 
     /// A buffer of at least `size` bytes in `memory`: the smallest such from the pool if it is
