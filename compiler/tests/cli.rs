@@ -263,3 +263,37 @@ fn demo_is_deterministic_across_thread_counts() {
     let b = std::fs::read(dir.path().join("b.kiln")).unwrap();
     assert!(a == b, "demo output differs between 1 and 2 threads");
 }
+
+/// `--line-space-device`: the report says where the shafts were baked; `auto` keeps a demo's
+/// small bake on the CPU (under `linespace::gpu::AUTO_MIN_WORK`); `gpu` without a GPU (CI's
+/// machine: lavapipe is a CPU implementation, which only tests take) is an input error naming
+/// the option, and with one the shafts are baked there and the file is the CPU's, byte for byte.
+#[test]
+fn line_space_device_is_reported_and_gpu_without_one_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = ["demo", "-q", "--shaft-variants", "binary,pnmt"];
+    let with = |out: &str, device: &str| {
+        let mut a = args.to_vec();
+        a.extend(["-o", out, "--report"]);
+        a.push(if out == "cpu.kiln" { "cpu.json" } else { "other.json" });
+        a.extend(["--line-space-device", device]);
+        kiln(dir.path(), &a)
+    };
+    with("cpu.kiln", "auto").expect(0);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("cpu.json")).unwrap()).unwrap();
+    assert_eq!(report["line_space"]["device"], "cpu");
+    let gpu = with("gpu.kiln", "gpu");
+    if gpu.code == 0 {
+        let other: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("other.json")).unwrap()).unwrap();
+        assert_ne!(other["line_space"]["device"], "cpu");
+        assert_eq!(
+            std::fs::read(dir.path().join("gpu.kiln")).unwrap(),
+            std::fs::read(dir.path().join("cpu.kiln")).unwrap()
+        );
+    } else {
+        gpu.expect(3).says("--line-space-device gpu: no GPU");
+    }
+    kiln(dir.path(), &["demo", "-q", "--line-space-device", "tpu"]).expect(2);
+}

@@ -117,6 +117,9 @@ pub struct LineSpaceStats {
     pub bytes_pnmt: u64,
     /// How the PNMT records are stored: `full`, `compact` or `compact-no-uv` (null without PNMT).
     pub pnmt_records: Option<&'static str>,
+    /// Where the shafts were baked (`--line-space-device`): the GPU's name, or `cpu`; null when
+    /// the stage came from the cache. The bytes are the same either way.
+    pub device: Option<String>,
 }
 
 /// Hash of the inputs: the contents of every file read, in reading order, or the scene data
@@ -442,9 +445,11 @@ fn grid_and_line_space(ctx: &BakeContext, key: &ContentHash) -> CliResult<GridAn
     let line_space = linespace::stages::line_space(&baked);
     let counts = [baked.tests, baked.pnmt_missing];
     let (grid_ms, line_space_ms) = (baked.voxel_ms, baked.total_ms - baked.voxel_ms);
+    let device = baked.device.clone().unwrap_or_else(|| "cpu".into());
     drop(baked);
-    let stats = LineSpaceStats::of_sections(&grid, &line_space, counts[0], counts[1])
+    let mut stats = LineSpaceStats::of_sections(&grid, &line_space, counts[0], counts[1])
         .ok_or_else(|| crate::exit::CliError::input("the voxel-grid stage made no grid header"))?;
+    stats.device = Some(device);
     if let Some(cache) = ctx.cache {
         let mut sections = grid.entry_sections();
         sections.extend(line_space.entry_sections());
@@ -601,6 +606,7 @@ impl LineSpaceStats {
             pnmt_records: (header.variants & kiln_format::linespace::Variants::PNMT != 0)
                 .then(|| header.pnmt_records().map(|l| l.name()))
                 .flatten(),
+            device: None,
         })
     }
 }

@@ -316,11 +316,11 @@ pub fn for_bake(
     }
     match opened(n, layout) {
         Ok(gpu) => Ok(Some(gpu.lock().unwrap_or_else(|e| e.into_inner()))),
-        Err(e) if *CHOICE.lock().unwrap_or_else(|e| e.into_inner()) == BakeDevice::Gpu => {
-            Err(CliError::input(format!(
-                "--line-space-device gpu: no GPU for the line-space bake ({e}); use auto or cpu"
-            )))
-        }
+        // The machine lacks what was asked for: unsupported (exit 3), as an unsupported input is.
+        Err(e) if required() => Err(CliError::new(
+            crate::exit::Exit::Unsupported,
+            format!("--line-space-device gpu: no GPU for the line-space bake ({e}); use auto or cpu"),
+        )),
         Err(_) => Ok(None),
     }
 }
