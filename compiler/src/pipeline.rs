@@ -234,18 +234,14 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
     crate::bake::linespace::gpu::choose(out.line_space_device);
     // A line space large enough for the GPU: open it while the earlier stages run.
     let plan = &loaded.plan;
-    let attrs = crate::bake::linespace::SceneAttributes {
-        vertices: &loaded.scene.vertices,
-        uvs: &loaded.scene.uvs,
-        triangles: &loaded.scene.triangles,
-        materials: &loaded.scene.triangle_materials,
-    };
-    if plan.shaft_variants != 0
-        && plan.shaft_res > 0
-        && crate::bake::linespace::gpu::supports(plan.shaft_variants, plan.pnmt_layout, &attrs)
-    {
-        let shafts = kiln_format::linespace::index::shafts_per_voxel(plan.shaft_res) as u64;
-        let work = loaded.geometry.voxels(plan.voxel_res).triangles.len() as u64 * shafts;
+    let work = crate::bake::linespace::gpu::planned_work(
+        plan.shaft_variants,
+        plan.pnmt_layout,
+        !loaded.scene.uvs.is_empty(),
+        plan.shaft_res,
+        || loaded.geometry.voxels(plan.voxel_res).triangles.len(),
+    );
+    if let Some(work) = work {
         crate::bake::linespace::gpu::open_early(work, plan.shaft_res, plan.pnmt_layout);
     }
     let progress = Progress::new(!out.quiet);

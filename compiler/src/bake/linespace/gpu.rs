@@ -1,14 +1,14 @@
 //! The line-space bake on a GPU, through Vulkan compute (`kiln-gpubake`): the binary and PNMT
 //! variants, the same bytes as the CPU bake (`shafts.rs`).
 //!
-//! Two kernels per batch of cells (`compiler/shaders/`): `linespace_search` takes a workgroup
-//! per (cell, face pair) through the cell's triangles in list order, decides every shaft with the
-//! separating-axis sweep in the CPU's double-precision arithmetic (sign masks, then the fraction
-//! test; `geometry.rs`), and fills the shafts met as `Fills::fill` does (bit, nearest midpoint
-//! hits from either end, fallback triangles by key); `linespace_records` encodes each filled
-//! shaft's two records at its rank. Before them `linespace_prepare` clips each of the batch's cell
-//! triangles to the widened cell and makes what depends on that alone: its key bounds and
-//! fallback records per pair.
+//! Three kernels per batch of cells (`compiler/shaders/`): `linespace_prepare` takes a thread
+//! per cell triangle and makes what depends on it alone: its separations from each face, and,
+//! clipped to the widened cell, its key bounds and fallback records per pair;
+//! `linespace_search` takes a thread per (cell, shaft) through the cell's triangles in list
+//! order, decides the shaft with the separating-axis sweep in the CPU's double-precision
+//! arithmetic (sign masks, then the fraction test; `geometry.rs`), and fills it as `Fills::fill`
+//! does (bit, nearest midpoint hits from either end, fallback triangles by key);
+//! `linespace_records` encodes each filled shaft's two records at its rank.
 //!
 //! Batches are pipelined: while the GPU searches one, the CPU copies the records of the one
 //! before out of the mapped memory the GPU wrote them to.
@@ -51,7 +51,8 @@ const BATCH_SCRATCH: u64 = 1 << 28;
 /// Bytes of one cell triangle's separations from the faces (6 faces × 13 axes × 4 doubles).
 const FACE_SEP_BYTES: u64 = 6 * 13 * 4 * 8;
 
-/// Cell triangles one batch may hold (their key bounds and fallbacks are uploaded per batch).
+/// Cell triangles one batch may hold (each has its separations, key bounds and fallbacks in GPU
+/// memory for the batch).
 const BATCH_CELL_TRIANGLES: usize = 1 << 22;
 
 /// A GPU ready to bake line spaces.
@@ -133,16 +134,7 @@ impl GpuBaker {
             b.write(bytes)?;
             Ok(b)
         };
-        let params = BakeParams {
-            n,
-            n2: n * n,
-            n4: n * n * n * n,
-            shafts,
-            layout_code: layout.code(),
-            words: layout.words() as u32,
-            records: 1,
-            ..Default::default()
-        };
+        let params = bake_params(n, layout, true, 0.0);
         let cell = BakeCell { cell: 1.0, inv_cell: 1.0, ..Default::default() };
         let params = upload(bytemuck::bytes_of(&params))?;
         let cells = upload(bytemuck::bytes_of(&cell))?;
@@ -325,17 +317,53 @@ pub fn for_bake(
     }
 }
 
-/// Whether the GPU bake makes these variants (binary, PNMT) in this layout for this scene (no
-/// candidates or pre-illumination; texture coordinates only where the scene has none).
-pub fn supports(variants: u32, layout: PnmtLayout, attrs: &SceneAttributes) -> bool {
-    variants & (Variants::CANDIDATES | Variants::PREILLUM) == 0
-        && (!layout.stores_uv() || attrs.uvs.is_empty())
+/// Whether the GPU bake makes these variants (binary, PNMT) in this layout for a scene with
+/// (`has_uvs`) or without texture coordinates (no candidates or pre-illumination; records with
+/// texture coordinates only where the scene has none).
+pub fn supports(variants: u32, layout: PnmtLayout, has_uvs: bool) -> bool {
+    variants & (Variants::CANDIDATES | Variants::PREILLUM) == 0 && (!layout.stores_uv() || !has_uvs)
+}
+
+/// The work of a line-space bake the GPU makes, Σ over the occupied cells of triangles × shafts
+/// (`cell_triangles()` entries in the voxel grid's lists at resolution `n`), the measure of
+/// whether opening a GPU pays; `None` where the GPU makes none of `variants` ([`supports`]).
+pub fn planned_work(
+    variants: u32,
+    layout: PnmtLayout,
+    has_uvs: bool,
+    n: u32,
+    cell_triangles: impl FnOnce() -> usize,
+) -> Option<u64> {
+    (variants != 0 && n > 0 && supports(variants, layout, has_uvs))
+        .then(|| cell_triangles() as u64 * shafts_per_voxel(n) as u64)
 }
 
 fn gpu_err(e: kiln_gpubake::Error) -> CliError {
     CliError::input(format!(
         "the GPU line-space bake failed: {e} (bake on the CPU with --line-space-device cpu)"
     ))
+}
+
+/// The kernels' settings for shaft resolution `n`, records in `layout` (tracked if `records`),
+/// the grid margin `margin` in cells.
+fn bake_params(n: u32, layout: PnmtLayout, records: bool, margin: f64) -> BakeParams {
+    let s = 1.0 / n as f64;
+    let centre: Vec<f64> = (0..8).map(|i| if i < n { (i as f64 + 0.5) / n as f64 } else { 0.0 }).collect();
+    BakeParams {
+        n,
+        n2: n * n,
+        n4: n * n * n * n,
+        shafts: shafts_per_voxel(n),
+        layout_code: layout.code(),
+        words: layout.words() as u32,
+        records: records as u32,
+        s,
+        half_s: 0.5 * s,
+        margin,
+        centre_lo: [centre[0], centre[1], centre[2], centre[3]],
+        centre_hi: [centre[4], centre[5], centre[6], centre[7]],
+        ..Default::default()
+    }
 }
 
 /// Uploads `data` into a new device buffer through a mapped one: the pair, for a copy command.
@@ -381,23 +409,7 @@ pub(super) fn bake(
     let shafts = shafts_per_voxel(n);
     let wps = words_per_slot(n);
     let words = layout.words() as u32;
-    let s = 1.0 / n as f64;
-    let centre: Vec<f64> = (0..8).map(|i| if i < n { (i as f64 + 0.5) / n as f64 } else { 0.0 }).collect();
-    let params = BakeParams {
-        n,
-        n2: n * n,
-        n4: n * n * n * n,
-        shafts,
-        layout_code: layout.code(),
-        words,
-        records: pnmt as u32,
-        s,
-        half_s: 0.5 * s,
-        margin,
-        centre_lo: [centre[0], centre[1], centre[2], centre[3]],
-        centre_hi: [centre[4], centre[5], centre[6], centre[7]],
-        ..Default::default()
-    };
+    let params = bake_params(n, layout, pnmt, margin);
     // Every triangle's grid-local corners (doubles) and world corners, vertex normals and
     // material (floats), in the scene's order.
     let corners: Vec<f64> = local.iter().flat_map(|t| t.iter().flat_map(|p| p.to_array())).collect();
@@ -446,15 +458,24 @@ pub(super) fn bake(
     let most_tris = batches.iter().map(|b| b.1).max().unwrap_or(0) as u64;
     let record_limit = (most_cells * shafts as u64 * 2 * words as u64 * 4).min(compute.max_buffer());
     let search_groups = shafts.div_ceil(SEARCH_GROUP);
+    // The per-batch buffers' sizes (the largest batch's).
+    let cells_size = most_cells * size_of::<BakeCell>() as u64;
+    let cell_tris_size = most_tris * 4;
+    let keys_size = most_tris * 30 * 8;
+    let face_seps_size = most_tris * FACE_SEP_BYTES;
+    let fallbacks_size = if pnmt { most_tris * 30 * words as u64 * 4 } else { 4 };
+    let ends_size = most_cells * shafts as u64 * END_BYTES;
+    let bits_size = most_cells * wps as u64 * 4;
+    let tests_size = most_cells * search_groups as u64 * 4;
     // Every buffer a kernel binds within the device's storage-buffer range, every index within
     // 32 bits (a cell of millions of triangles, a scene of tens of millions, can exceed them).
     let max = compute.max_buffer();
     let sizes = [
         ("the scene's corners", corners.len() as u64 * 8),
         ("the scene's triangle data", tri_data.len() as u64 * 4),
-        ("a batch's separations", most_tris * FACE_SEP_BYTES),
-        ("a batch's fallback records", most_tris * 30 * words as u64 * 4),
-        ("a batch's ends", most_cells * shafts as u64 * END_BYTES),
+        ("a batch's separations", face_seps_size),
+        ("a batch's fallback records", fallbacks_size),
+        ("a batch's ends", ends_size),
     ];
     if let Some((what, bytes)) = sizes.iter().find(|(_, b)| *b > max) {
         return Err(CliError::input(format!(
@@ -483,24 +504,24 @@ pub(super) fn bake(
         })?;
         drop((params_host, corners_host, tris_host));
         laps.lap(4);
-        let cells_dev = gpu.take(most_cells * size_of::<BakeCell>() as u64, Memory::Device)?;
-        let cell_tris_dev = gpu.take(most_tris * 4, Memory::Device)?;
-        let keys = gpu.take(most_tris * 30 * 8, Memory::Device)?;
-        let face_seps = gpu.take(most_tris * FACE_SEP_BYTES, Memory::Device)?;
-        let fallbacks = gpu.take(if pnmt { most_tris * 30 * words as u64 * 4 } else { 4 }, Memory::Device)?;
-        let ends = gpu.take(most_cells * shafts as u64 * END_BYTES, Memory::Device)?;
-        let bits_dev = gpu.take(most_cells * wps as u64 * 4, Memory::Device)?;
-        let tests_dev = gpu.take(most_cells * search_groups as u64 * 4, Memory::Device)?;
+        let cells_dev = gpu.take(cells_size, Memory::Device)?;
+        let cell_tris_dev = gpu.take(cell_tris_size, Memory::Device)?;
+        let keys = gpu.take(keys_size, Memory::Device)?;
+        let face_seps = gpu.take(face_seps_size, Memory::Device)?;
+        let fallbacks = gpu.take(fallbacks_size, Memory::Device)?;
+        let ends = gpu.take(ends_size, Memory::Device)?;
+        let bits_dev = gpu.take(bits_size, Memory::Device)?;
+        let tests_dev = gpu.take(tests_size, Memory::Device)?;
         // Records are written to GPU memory and copied to the host by a copy command: the
         // kernel writing them to host memory itself was slower by an order of magnitude.
         let mut records_dev = gpu.take(4, Memory::Device)?;
         let mut host: Vec<HostSide> = (0..2.min(batches.len()))
             .map(|_| {
                 Ok(HostSide {
-                    cells: gpu.take(most_cells * size_of::<BakeCell>() as u64, Memory::Upload)?,
-                    cell_tris: gpu.take(most_tris * 4, Memory::Upload)?,
-                    bits: gpu.take(most_cells * wps as u64 * 4, Memory::Readback)?,
-                    tests: gpu.take(most_cells * search_groups as u64 * 4, Memory::Readback)?,
+                    cells: gpu.take(cells_size, Memory::Upload)?,
+                    cell_tris: gpu.take(cell_tris_size, Memory::Upload)?,
+                    bits: gpu.take(bits_size, Memory::Readback)?,
+                    tests: gpu.take(tests_size, Memory::Readback)?,
                     records: gpu.take(4, Memory::Readback)?,
                 })
             })
@@ -612,24 +633,19 @@ pub(super) fn bake(
                 .iter()
                 .map(|&t| t as u64)
                 .sum::<u64>();
-            // Ranks, and each cell's first record in the batch (the counts checked against u32
-            // once, for the whole batch).
+            // Ranks, and each cell's first record in the batch (the batch's records are addressed
+            // in 32 bits on the GPU: checked for the whole batch first).
             let batch_filled: u64 = batch_bits.iter().map(|w| w.count_ones() as u64).sum();
             if rank + batch_filled > u32::MAX as u64 {
                 return Err(kiln_gpubake::Error(super::too_many().to_string()));
             }
-            let mut filled = 0u32;
-            let base = rank as u32;
+            let first = rank;
             for (cell, words) in cells.iter_mut().zip(batch_bits.chunks_exact(wps)) {
-                cell.record_base = filled;
-                out.ranks.extend(words.iter().map(|w| {
-                    let r = base + filled;
-                    filled += w.count_ones();
-                    r
-                }));
+                cell.record_base = (rank - first) as u32;
+                rank = super::push_ranks(&mut out.ranks, words, rank)
+                    .map_err(|e| kiln_gpubake::Error(e.to_string()))?;
             }
-            rank += batch_filled;
-            let filled = filled as u64;
+            let filled = rank - first;
             out.bits.extend_from_slice(batch_bits);
             cells_done += batch.len();
             laps.lap(8);

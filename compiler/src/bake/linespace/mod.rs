@@ -160,7 +160,7 @@ pub fn bake(
     header.slots = occupied.len() as u32;
     let margin_local = header.margin / header.cell;
     progress.count("line space: cells", occupied.len() as u64);
-    if let Some(gpu) = gpu.filter(|_| gpu::supports(variants, layout, attrs)) {
+    if let Some(gpu) = gpu.filter(|_| gpu::supports(variants, layout, !attrs.uvs.is_empty())) {
         gpu::bake(
             gpu,
             attrs,
@@ -177,15 +177,54 @@ pub fn bake(
             &mut out,
         )?;
         out.device = Some(gpu.device().to_string());
-        header.filled =
-            out.ranks.last().map_or(0, |&r| r as u64) + out.bits.last().map_or(0, |w| w.count_ones() as u64);
-        out.header = header;
-        out.voxel_offsets = voxel_offsets;
-        out.voxel_triangles = voxel_triangles;
-        out.slots = slots;
-        out.total_ms = voxel_ms + start.elapsed().as_secs_f64() * 1e3;
-        return Ok(out);
+    } else {
+        bake_on_cpu(
+            attrs,
+            &header,
+            &local,
+            &voxel_offsets,
+            &voxel_triangles,
+            &occupied,
+            n,
+            margin_local,
+            (candidates, pnmt, layout),
+            shade,
+            progress,
+            &mut out,
+        )?;
     }
+    header.filled =
+        out.ranks.last().map_or(0, |&r| r as u64) + out.bits.last().map_or(0, |w| w.count_ones() as u64);
+    out.candidates.shrink_to_fit();
+    out.candidate_offsets.shrink_to_fit();
+    out.pnmt.shrink_to_fit();
+    out.preillum.shrink_to_fit();
+    header.entries = out.candidates.len() as u64;
+    out.header = header;
+    out.voxel_offsets = voxel_offsets;
+    out.voxel_triangles = voxel_triangles;
+    out.slots = slots;
+    out.total_ms = voxel_ms + start.elapsed().as_secs_f64() * 1e3;
+    Ok(out)
+}
+
+/// The CPU bake of the `occupied` cells into `out` (see [`bake`]), with candidates, PNMT
+/// records in `layout` and pre-illumination (`shade`) as asked.
+#[allow(clippy::too_many_arguments)]
+fn bake_on_cpu(
+    attrs: &SceneAttributes,
+    header: &GridHeader,
+    local: &[[DVec3; 3]],
+    voxel_offsets: &[u32],
+    voxel_triangles: &[u32],
+    occupied: &[usize],
+    n: u32,
+    margin_local: f64,
+    (candidates, pnmt, layout): (bool, bool, PnmtLayout),
+    shade: Option<&Shade<'_>>,
+    progress: &Progress,
+    out: &mut BakedLineSpace,
+) -> CliResult<()> {
     // Cells are baked a chunk at a time and each chunk's parts appended to the sections before
     // the next: holding every cell's parts until the end doubled the bake's peak memory at the
     // fine rows of seed 004's table (gigabytes of PNMT records).
@@ -202,7 +241,7 @@ pub fn bake(
                 let tris = &voxel_triangles[voxel_offsets[c] as usize..voxel_offsets[c + 1] as usize];
                 let r = shafts::bake_cell(
                     tris,
-                    &local,
+                    local,
                     cell_min,
                     header.cell_min(cc),
                     header.cell,
@@ -221,10 +260,7 @@ pub fn bake(
             .collect();
         for cell in &per_cell {
             out.tests += cell.tests;
-            for &w in &cell.bits {
-                out.ranks.push(u32::try_from(rank).map_err(|_| too_many())?);
-                rank += w.count_ones() as u64;
-            }
+            rank = push_ranks(&mut out.ranks, &cell.bits, rank)?;
             out.bits.extend_from_slice(&cell.bits);
         }
         if candidates {
@@ -250,18 +286,17 @@ pub fn bake(
             append_par(&mut out.preillum, &per_cell, |c| c.preillum.iter().copied(), done);
         }
     }
-    header.filled = rank;
-    out.candidates.shrink_to_fit();
-    out.candidate_offsets.shrink_to_fit();
-    out.pnmt.shrink_to_fit();
-    out.preillum.shrink_to_fit();
-    header.entries = out.candidates.len() as u64;
-    out.header = header;
-    out.voxel_offsets = voxel_offsets;
-    out.voxel_triangles = voxel_triangles;
-    out.slots = slots;
-    out.total_ms = voxel_ms + start.elapsed().as_secs_f64() * 1e3;
-    Ok(out)
+    Ok(())
+}
+
+/// Appends to `ranks` the filled shafts before each of `words`, `rank` before the first;
+/// returns the filled shafts after the last.
+pub(super) fn push_ranks(ranks: &mut Vec<u32>, words: &[u32], mut rank: u64) -> CliResult<u64> {
+    for &w in words {
+        ranks.push(u32::try_from(rank).map_err(|_| too_many())?);
+        rank += w.count_ones() as u64;
+    }
+    Ok(rank)
 }
 
 /// Fraction of filled shafts that no triangle meets by the one-shaft sweep test (0 while every

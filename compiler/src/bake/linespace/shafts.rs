@@ -1137,8 +1137,9 @@ mod tests {
     }
 
     /// The search against every shaft of the pair tested one by one with the sweep test: the
-    /// sign masks must never drop a shaft the triangle meets, and nothing else may be found. Triangles of every size, crossing the cell's faces, lying just inside and just
-    /// outside them, and tiny ones next to a face (where projections blow up).
+    /// sign masks must never drop a shaft the triangle meets, and nothing else may be found.
+    /// Triangles of every size, crossing the cell's faces, lying just inside and just outside
+    /// them, and tiny ones next to a face (where projections blow up).
     #[test]
     fn search_finds_exactly_the_shafts_the_sweep_test_finds() {
         let mut rnd = uniform(11);

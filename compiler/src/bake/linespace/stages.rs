@@ -26,15 +26,14 @@ pub fn voxel_grid(ctx: &BakeContext) -> CliResult<(Sections, BakedLineSpace)> {
     };
     let attrs = ctx.attributes();
     let plan = ctx.plan;
-    // Σ triangles × shafts: the work that decides whether a GPU is worth opening, for variants
-    // the GPU bakes.
-    let on_gpu =
-        plan.shaft_variants != 0 && super::gpu::supports(plan.shaft_variants, plan.pnmt_layout, &attrs);
-    let shafts = kiln_format::linespace::index::shafts_per_voxel(plan.shaft_res.max(1)) as u64;
-    let gpu = if on_gpu {
-        super::gpu::for_bake(voxels.triangles.len() as u64 * shafts, plan.shaft_res, plan.pnmt_layout)?
-    } else {
-        None
+    let has_uvs = !attrs.uvs.is_empty();
+    let work =
+        super::gpu::planned_work(plan.shaft_variants, plan.pnmt_layout, has_uvs, plan.shaft_res, || {
+            voxels.triangles.len()
+        });
+    let gpu = match work {
+        Some(work) => super::gpu::for_bake(work, plan.shaft_res, plan.pnmt_layout)?,
+        None => None,
     };
     let bake = |gpu: Option<&super::gpu::GpuBaker>, voxels| {
         super::bake(
