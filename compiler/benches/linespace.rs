@@ -183,7 +183,7 @@ fn memory(ls: &linespace::BakedLineSpace, full: &linespace::BakedLineSpace, lc: 
             let piece = &b[i * PIECE..((i + 1) * PIECE).min(b.len())];
             raw += piece.len();
             framed +=
-                kiln_format::codec::compress_zstd(piece).map_or(piece.len(), |f| f.len().min(piece.len()));
+                kiln_format::codec::compress_zstd(piece, 1).map_or(piece.len(), |f| f.len().min(piece.len()));
         }
         (b.len() as f64 * framed as f64 / raw.max(1) as f64) as usize
     };

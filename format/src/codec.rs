@@ -73,13 +73,21 @@ impl Aligned {
 /// Compresses `bytes` as one zstd frame: level [`ZSTD_LEVEL`], the decoded size in the frame
 /// header, zstd's own content checksum (XXH64 of the decoded bytes, which the decoder verifies:
 /// a second check on the decoded content beside the table's checksum of the stored bytes), no
-/// dictionary id. Single-threaded: the library is built without its multithreaded compressor.
-pub fn compress_zstd(bytes: &[u8]) -> std::io::Result<Vec<u8>> {
+/// dictionary id; on `workers` threads (at least one).
+///
+/// Always zstd's multithreaded compressor: it cuts a large section into jobs of a size set by
+/// the level and compresses them in parallel, and its frames are the same for any number of
+/// workers from one up (unlike the single-threaded compressor's, which differ from them), so
+/// the bytes depend on the section's bytes only, not on the machine
+/// (`tests/codec.rs::frames_do_not_depend_on_the_worker_count`). Sections of at most 512 KiB
+/// zstd compresses on the calling thread whatever the count.
+pub fn compress_zstd(bytes: &[u8], workers: u32) -> std::io::Result<Vec<u8>> {
     use zstd::zstd_safe::CParameter;
     let mut c = zstd::bulk::Compressor::new(ZSTD_LEVEL)?;
     c.set_parameter(CParameter::ContentSizeFlag(true))?;
     c.set_parameter(CParameter::ChecksumFlag(true))?;
     c.set_parameter(CParameter::DictIdFlag(false))?;
+    c.set_parameter(CParameter::NbWorkers(workers.max(1)))?;
     c.compress(bytes)
 }
 

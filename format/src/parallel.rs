@@ -3,12 +3,17 @@
 
 use std::sync::Mutex;
 
+/// The machine's hardware threads (1 if unknown).
+pub(crate) fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// Runs `f` on every item, on as many threads as the machine has (at most one per item), each
 /// thread taking the next item in order until none is left; returns the results in item order.
 /// A panic in `f` reaches the caller.
 pub(crate) fn on_all_cores<T: Send, R: Send>(items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
     let count = items.len();
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(count);
+    let threads = cores().min(count);
     let queue = Mutex::new(items.into_iter().enumerate());
     let results = Mutex::new(Vec::with_capacity(count));
     std::thread::scope(|scope| {

@@ -435,3 +435,37 @@ fn decoding_sections_in_parallel_gives_each_section_and_reports_damage() {
     let err = bf.decode_sections(&all).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::Checksum { .. }), "{err}");
 }
+
+/// The writer's frames are a function of the section's bytes alone: zstd's multithreaded
+/// compressor gives the same frame for one worker and for several (and asking for none still
+/// gets that compressor, not the single-threaded one, whose frames differ), and the frame
+/// decodes, by the zstd library directly, to the bytes. 40 MiB of records with some structure:
+/// more than two of the compressor's jobs at the writer's level.
+#[test]
+fn frames_do_not_depend_on_the_worker_count() {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let bytes: Vec<u8> = (0..10 << 20)
+        .flat_map(|i: u32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let word = if state.is_multiple_of(4) { state as u32 & 0x3ff_03ff } else { i / 64 };
+            word.to_le_bytes()
+        })
+        .collect();
+    let one = kiln_format::codec::compress_zstd(&bytes, 1).unwrap();
+    assert!(one.len() < bytes.len() / 2, "the records compress ({} of {} bytes)", one.len(), bytes.len());
+    for workers in [0, 2, 5] {
+        let frame = kiln_format::codec::compress_zstd(&bytes, workers).unwrap();
+        assert!(
+            frame == one,
+            "{workers} workers made another frame ({} bytes, one worker {})",
+            frame.len(),
+            one.len()
+        );
+    }
+    let mut single = zstd::bulk::Compressor::new(kiln_format::codec::ZSTD_LEVEL).unwrap();
+    single.set_parameter(zstd::zstd_safe::CParameter::ChecksumFlag(true)).unwrap();
+    assert!(single.compress(&bytes).unwrap() != one, "the single-threaded compressor's frame is another");
+    assert!(zstd::bulk::decompress(&one, bytes.len()).unwrap() == bytes, "the frame decodes to the bytes");
+}
