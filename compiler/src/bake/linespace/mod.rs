@@ -4,6 +4,7 @@
 pub mod estimate;
 mod geometry;
 pub mod gpu;
+mod segment;
 mod shafts;
 mod span;
 pub mod stages;

@@ -10,6 +10,7 @@ use kiln_format::linespace::index::{
 use kiln_format::linespace::{PnmtLayout, RecordWords, entry, words_per_slot};
 
 use super::geometry::{MAX_PATCHES, PairAxes, PairMasks, Prepared, clip_to_box_into, low_bits, set_bits};
+use super::segment::{FaceCentres, Intersection, LaneHits, SegmentTest};
 use super::span::{Sides, Span, met_from};
 
 /// What one cell contributes to the line space.
@@ -32,6 +33,9 @@ pub struct CellShafts {
     /// (Triangle, shaft) pairs left to the exact decision (for the bake report; see
     /// `LineSpaceStats::overlap_tests`).
     pub tests: u64,
+    /// Shafts the records-first bake baked again alone (a tentative end's triangle missed the
+    /// shaft; see [`RecordsFirst`]).
+    pub rebaked: u64,
 }
 
 /// Scene data the PNMT records need, per global triangle number.
@@ -363,6 +367,8 @@ pub struct Scratch {
     clip_tmp: Vec<DVec3>,
     /// The cell's fallback records by (triangle, pair, end), [`UNMADE`] until made.
     fallbacks: Vec<RecordWords>,
+    /// The records-first bake's per-triangle data and bookkeeping ([`RecordsFirst`]).
+    first: FirstScratch,
 }
 
 /// A fallback record not made yet: no layout's encoder makes it (the full record's material
@@ -403,7 +409,8 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
-    let Scratch { hits, sorted, counts, ends, hit_bits, polys, clip_tmp, fallbacks } = scratch;
+    let Scratch { hits, sorted, counts, ends, hit_bits, polys, clip_tmp, fallbacks, first: first_scratch } =
+        scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
     // A shaft's ends are reset when it is first filled (resetting every shaft of every cell costs
@@ -427,13 +434,69 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         single.bake(v, poly, attrs, &mut out);
         return out;
     }
+    if records_needed && !candidates {
+        let first = RecordsFirst { tris, n, margin, centres: &centres };
+        first.bake(local, cell_min, attrs, polys, clip_tmp, hit_bits, ends, first_scratch, &mut out);
+    } else {
+        bake_all_pairs(
+            tris,
+            local,
+            cell_min,
+            n,
+            margin,
+            (candidates, records_needed),
+            attrs,
+            &centres,
+            (hits, ends, hit_bits, polys, clip_tmp),
+            &mut out,
+        );
+    }
+    finish_cell(
+        tris,
+        n,
+        (candidates, pnmt, layout),
+        world_cell_min,
+        cell,
+        attrs,
+        shade,
+        &centres,
+        (hits, sorted, counts, ends, polys, fallbacks),
+        &mut out,
+    );
+    out
+}
+
+/// The bake of a cell with candidates, or without records (see [`bake_cell`]): every triangle,
+/// in list order, fills the shafts it meets; without candidates, in a cell of
+/// [`UNION_MIN_TRIANGLES`] or more, only the union of the shafts is kept (a filled shaft is not
+/// tested again).
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn bake_all_pairs<A: HitAttributes + ?Sized>(
+    tris: &[u32],
+    local: &[[DVec3; 3]],
+    cell_min: DVec3,
+    n: u32,
+    margin: f64,
+    (candidates, records_needed): (bool, bool),
+    attrs: &A,
+    centres: &[[Vec3; MAX_PATCHES]; 6],
+    (hits, ends, hit_bits, polys, clip_tmp): (
+        &mut Vec<(u32, u8, u8, u16)>,
+        &mut Vec<[End; 2]>,
+        &mut Vec<u32>,
+        &mut [Vec<DVec3>],
+        &mut Vec<DVec3>,
+    ),
+    out: &mut CellShafts,
+) {
+    let lo_box = DVec3::splat(-margin);
+    let hi_box = DVec3::splat(1.0 + margin);
     let union = !candidates && tris.len() >= UNION_MIN_TRIANGLES;
     hit_bits.clear();
     if union {
         hit_bits.resize(out.bits.len(), 0);
     }
-    let mut state =
-        Fills { bits: &mut out.bits, hit_bits, ends, hits, centres: &centres, candidates, records_needed };
+    let mut state = Fills { bits: &mut out.bits, hit_bits, ends, hits, centres, candidates, records_needed };
     // Without candidates, only the union of the triangles' shafts and the records are kept:
     // a shaft filled already, whose records this triangle cannot change by filling it, needs no
     // exact test (see `Fills::needing_test`). That pays where
@@ -486,6 +549,361 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
             });
         }
     }
+}
+
+/// The bake of a cell without candidates whose records are needed, in two passes over its
+/// triangles. The records are the first and last hits of each shaft's midpoint segment among
+/// the triangles that meet the shaft (exactly; the earliest triangle of the list on ties), and
+/// the bits the union of those shafts. So:
+///
+/// 1. **Segments.** Each triangle's midpoint segments are tested against every shaft its sign
+///    masks leave ([`PairMasks::survivors`]: a superset of the shafts it meets), the nearest hits
+///    kept as the shafts' tentative ends, without the exact test.
+/// 2. **Exact tests.** Each tentative end's triangle is tested against its shaft; the shafts
+///    without a hit are tested as the union bake tests them (a filled one only where its
+///    fallback key bounds could change).
+///
+/// A tentative end whose triangle meets the shaft is the end the bake that tests every pair
+/// finds: the hits it ranges over are a subset of the tentative's, holding it. A shaft whose
+/// tentative end fails its test (a segment crossing a triangle just outside the widened shaft,
+/// where the single-precision segment test and the exact test disagree) is baked again alone,
+/// every triangle in list order ([`Fills::fill`]). In a cell of tens of triangles most filled
+/// shafts have a hit, and a hit shaft is now tested exactly once or twice, not once per triangle
+/// reaching it (seven times on average in the teapot's 32³ object cells).
+struct RecordsFirst<'c> {
+    tris: &'c [u32],
+    n: u32,
+    margin: f64,
+    centres: &'c [[Vec3; MAX_PATCHES]; 6],
+}
+
+/// [`RecordsFirst`]'s buffers, reused from cell to cell.
+#[derive(Debug, Default)]
+struct FirstScratch {
+    /// Per triangle of the cell: prepared, and spanning's sides.
+    prepared: Vec<(Prepared, Option<[Sides; 6]>)>,
+    /// Shafts whose ends were reset in this cell.
+    seen: Vec<u32>,
+    /// Shafts whose tentative front (0) and back (1) ends were confirmed.
+    confirmed: [Vec<u32>; 2],
+    /// The hit shafts to confirm, by triangle (`starts` into `shafts`).
+    starts: Vec<u32>,
+    shafts: Vec<u32>,
+    /// The first pass's t of each shaft's front and back hit (NaN: none yet), by shaft.
+    ts: [Vec<f32>; 2],
+}
+
+impl RecordsFirst<'_> {
+    #[allow(clippy::too_many_arguments)]
+    fn bake<A: HitAttributes + ?Sized>(
+        &self,
+        local: &[[DVec3; 3]],
+        cell_min: DVec3,
+        attrs: &A,
+        polys: &mut [Vec<DVec3>],
+        clip_tmp: &mut Vec<DVec3>,
+        hit_bits: &mut Vec<u32>,
+        ends: &mut Vec<[End; 2]>,
+        scratch: &mut FirstScratch,
+        out: &mut CellShafts,
+    ) {
+        let RecordsFirst { tris, n, margin, centres } = *self;
+        let words = out.bits.len();
+        let FirstScratch { prepared, seen, confirmed, starts, shafts, ts } = scratch;
+        let [c0, c1] = confirmed;
+        for v in [&mut *hit_bits, &mut *seen, c0, c1] {
+            v.clear();
+            v.resize(words, 0);
+        }
+        prepared.clear();
+        let (lo_box, hi_box) = (DVec3::splat(-margin), DVec3::splat(1.0 + margin));
+        // 1. Segments.
+        let faces = centres.map(|face| FaceCentres::new(&face));
+        let [front, back] = ts;
+        for t in [&mut *front, &mut *back] {
+            t.clear();
+            // (Padded: `hits_among` reads whole groups of eight.)
+            t.resize(out.bits.len() * 32 + MAX_PATCHES, f32::NAN);
+        }
+        let mut lane = LaneHits::default();
+        let n2 = (n * n) as usize;
+        for (li, &t) in tris.iter().enumerate() {
+            let v = local[t as usize].map(|p| p - cell_min);
+            let prep = Prepared::new(v);
+            clip_to_box_into(v, lo_box, hi_box, &mut polys[li], clip_tmp);
+            let poly = &polys[li];
+            let seg = SegmentTest::new(attrs.corners(t));
+            let sides = spanning_sides(v, margin, n);
+            for pair in 0..FACE_PAIRS {
+                let (fa, fb) = pair_faces(pair);
+                let mut from_patch = |pa: u32, among: u64| {
+                    let first = shaft_of(pair, pa, 0, n) as usize;
+                    let o = centres[fa as usize][pa as usize];
+                    let (f, b) = (&front[first..], &back[first..]);
+                    let hits = seg.hits_among(o, &faces[fb as usize], among, f, b, &mut lane);
+                    for pb in set_bits(hits) {
+                        let shaft = first + pb as usize;
+                        let (w, bit) = (shaft / 32, 1u32 << (shaft % 32));
+                        let end = &mut ends[shaft];
+                        if seen[w] & bit == 0 {
+                            seen[w] |= bit;
+                            *end = [NO_END; 2];
+                        }
+                        hit_bits[w] |= bit;
+                        let h = seg.lane(&lane, pb);
+                        let tentative =
+                            End { t: h.t, triangle: t, u: h.u, v: h.v, key: f64::NAN, local: li as u32 };
+                        if !(h.t >= end[0].t) {
+                            end[0] = tentative;
+                            front[shaft] = h.t;
+                        }
+                        if !(h.t <= end[1].t) {
+                            end[1] = tentative;
+                            back[shaft] = h.t;
+                        }
+                    }
+                };
+                match &sides {
+                    Some(sides) => {
+                        let all = low_bits(n2);
+                        for pa in 0..n2 as u32 {
+                            let among = met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all);
+                            if among != 0 {
+                                from_patch(pa, among);
+                            }
+                        }
+                    }
+                    None => {
+                        patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, _, _| from_patch(pa, among))
+                    }
+                }
+            }
+            prepared.push((prep, sides));
+        }
+        // The hit shafts by the triangles of their tentative ends (a counting sort: each
+        // triangle's shafts in shaft order).
+        starts.clear();
+        starts.resize(tris.len() + 1, 0);
+        let ends_ro: &[[End; 2]] = ends;
+        let tentative = |w: usize, word: u32| {
+            set_bits(word.into()).map(move |b| {
+                let shaft = w * 32 + b as usize;
+                (shaft, ends_ro[shaft][0].local, ends_ro[shaft][1].local)
+            })
+        };
+        for (w, &word) in hit_bits.iter().enumerate() {
+            for (_, front, back) in tentative(w, word) {
+                starts[front as usize + 1] += 1;
+                starts[back as usize + 1] += (back != front) as u32;
+            }
+        }
+        for i in 0..tris.len() {
+            starts[i + 1] += starts[i];
+        }
+        shafts.clear();
+        shafts.resize(starts[tris.len()] as usize, 0);
+        let mut next = starts.clone();
+        for (w, &word) in hit_bits.iter().enumerate() {
+            for (shaft, front, back) in tentative(w, word) {
+                shafts[next[front as usize] as usize] = shaft as u32;
+                next[front as usize] += 1;
+                if back != front {
+                    shafts[next[back as usize] as usize] = shaft as u32;
+                    next[back as usize] += 1;
+                }
+            }
+        }
+        // 2. Exact tests.
+        let n4 = (n2 * n2) as u32;
+        let seg = SegmentTest::new([Vec3::ZERO; 3]);
+        for (li, &t) in tris.iter().enumerate() {
+            let (prep, sides) = &prepared[li];
+            let poly = &polys[li];
+            let mut mine = &shafts[starts[li] as usize..starts[li + 1] as usize];
+            for pair in 0..FACE_PAIRS {
+                let (fa, fb) = pair_faces(pair);
+                let filler = Filler::new(t, li as u32, &seg, pair, poly, margin);
+                // This triangle's tentative ends in this pair, by front patch.
+                let mut confirm = [0u64; MAX_PATCHES];
+                let split = mine.partition_point(|&s| s < (pair + 1) * n4);
+                for &shaft in &mine[..split] {
+                    let rest = shaft - pair * n4;
+                    confirm[rest as usize / n2] |= 1 << (rest as usize % n2);
+                }
+                mine = &mine[split..];
+                let mut exact = Exact {
+                    bits: &mut out.bits,
+                    seen,
+                    hit_bits,
+                    ends,
+                    confirmed,
+                    li: li as u32,
+                    kmin: filler.kmin,
+                    kmax: filler.kmax,
+                };
+                if let Some(sides) = sides {
+                    spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut |shaft, _, _| {
+                        exact.met(shaft)
+                    });
+                    continue;
+                }
+                let tests = &mut out.tests;
+                patch_sets(prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+                    let first = shaft_of(pair, pa, 0, n) as usize;
+                    let need = exact.needing_test(first, n2, among) | (confirm[pa as usize] & among);
+                    decide(axes, masks, pair, pa, need, n, tests, &mut |shaft, _, _| exact.met(shaft));
+                });
+            }
+        }
+        // A hit shaft is filled where both its tentative ends were confirmed, else baked alone.
+        for w in 0..words {
+            let word = hit_bits[w];
+            let sure = word & confirmed[0][w] & confirmed[1][w];
+            out.bits[w] |= sure;
+            for b in set_bits((word & !sure).into()) {
+                let shaft = (w * 32) as u32 + b;
+                out.rebaked += 1;
+                self.bake_alone(shaft, attrs, prepared, polys, hit_bits, ends, out);
+            }
+        }
+    }
+
+    /// Bakes `shaft` alone: every triangle of the cell in list order fills it if it meets it.
+    #[allow(clippy::too_many_arguments)]
+    fn bake_alone<A: HitAttributes + ?Sized>(
+        &self,
+        shaft: u32,
+        attrs: &A,
+        prepared: &[(Prepared, Option<[Sides; 6]>)],
+        polys: &[Vec<DVec3>],
+        hit_bits: &mut Vec<u32>,
+        ends: &mut Vec<[End; 2]>,
+        out: &mut CellShafts,
+    ) {
+        let RecordsFirst { tris, n, margin, centres } = *self;
+        let (w, bit) = ((shaft / 32) as usize, 1u32 << (shaft % 32));
+        out.bits[w] &= !bit;
+        hit_bits[w] &= !bit;
+        let pair = shaft / (n * n * n * n);
+        let (fa, pa, fb, pb) = shaft_parts(shaft, n);
+        let mut state = Fills {
+            bits: &mut out.bits,
+            hit_bits,
+            ends,
+            hits: &mut Vec::new(),
+            centres,
+            candidates: false,
+            records_needed: true,
+        };
+        for (li, &t) in tris.iter().enumerate() {
+            let ((prep, sides), poly) = (&prepared[li], &polys[li]);
+            let meets = match sides {
+                Some(sides) => {
+                    let all = low_bits((n * n) as usize);
+                    met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all) >> pb & 1 == 1
+                }
+                None if poly.is_empty() => false,
+                None => {
+                    let axes = prep.pair_axes(fa, fb, n, margin);
+                    let masks = axes.masks(n);
+                    let mut among = [0u64; MAX_PATCHES];
+                    masks.survivors(&mut among);
+                    let test = among[pa as usize] & 1 << pb;
+                    out.tests += (test != 0) as u64;
+                    axes.shafts_among(pa, test, &masks) != 0
+                }
+            };
+            if meets {
+                let seg = SegmentTest::new(attrs.corners(t));
+                state.fill(shaft, pa, pb, &Filler::new(t, li as u32, &seg, pair, poly, margin));
+            }
+        }
+    }
+}
+
+/// One triangle's exact tests in the second pass of [`RecordsFirst`].
+struct Exact<'a> {
+    bits: &'a mut [u32],
+    /// Shafts whose ends were reset in this cell.
+    seen: &'a mut [u32],
+    hit_bits: &'a [u32],
+    ends: &'a mut [[End; 2]],
+    confirmed: &'a mut [Vec<u32>; 2],
+    /// The triangle's place in the cell's list, and its key bounds in the pair.
+    li: u32,
+    kmin: f64,
+    kmax: f64,
+}
+
+impl Exact<'_> {
+    /// The triangle meets `shaft`: a shaft with a hit has the ends it is the tentative triangle
+    /// of confirmed; one without is filled, its fallback key bounds taken where they are beyond
+    /// the shaft's (strictly: the earliest triangle of the list on ties).
+    #[inline(always)]
+    fn met(&mut self, shaft: u32) {
+        let (w, bit) = ((shaft / 32) as usize, 1u32 << (shaft % 32));
+        let end = &mut self.ends[shaft as usize];
+        if self.hit_bits[w] & bit != 0 {
+            for (k, c) in self.confirmed.iter_mut().enumerate() {
+                c[w] |= ((end[k].local == self.li) as u32) << (shaft % 32);
+            }
+            return;
+        }
+        self.bits[w] |= bit;
+        if self.seen[w] & bit == 0 {
+            self.seen[w] |= bit;
+            *end = [NO_END; 2];
+        }
+        if !(self.kmin >= end[0].key) {
+            end[0].key = self.kmin;
+            end[0].local = self.li;
+        }
+        if !(self.kmax <= end[1].key) {
+            end[1].key = self.kmax;
+            end[1].local = self.li;
+        }
+    }
+
+    /// Of the shafts `among` (bit pb for shaft `first` + pb, `n2` of them), those without a hit
+    /// that need the exact test: those not filled yet, and those whose key bounds this triangle
+    /// would change.
+    #[inline(always)]
+    fn needing_test(&self, first: usize, n2: usize, among: u64) -> u64 {
+        let no_hit = among & !bit_range(self.hit_bits, first, n2);
+        let filled = bit_range(self.bits, first, n2);
+        let mut need = no_hit & !filled;
+        for pb in set_bits(no_hit & filled) {
+            let end = &self.ends[first + pb as usize];
+            need |= ((!(self.kmin >= end[0].key) || !(self.kmax <= end[1].key)) as u64) << pb;
+        }
+        need
+    }
+}
+
+/// The end of a cell's bake: the candidate lists from the (shaft, keys, triangle) hits, the
+/// records and radiance of the filled shafts from their ends.
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn finish_cell<A: HitAttributes + ?Sized>(
+    tris: &[u32],
+    n: u32,
+    (candidates, pnmt, layout): (bool, bool, PnmtLayout),
+    world_cell_min: DVec3,
+    cell: f64,
+    attrs: &A,
+    shade: Option<&Shade<'_>>,
+    centres: &[[Vec3; MAX_PATCHES]; 6],
+    (hits, sorted, counts, ends, polys, fallbacks): (
+        &mut Vec<(u32, u8, u8, u16)>,
+        &mut Vec<(u32, u8, u8, u16)>,
+        &mut Vec<u32>,
+        &mut Vec<[End; 2]>,
+        &mut [Vec<DVec3>],
+        &mut Vec<RecordWords>,
+    ),
+    out: &mut CellShafts,
+) {
+    let records_needed = pnmt || shade.is_some();
+    let shafts = shafts_per_voxel(n) as usize;
     if candidates {
         // Bucket by shaft (stable: triangle order), then order each bucket by key.
         counts.clear();
@@ -598,7 +1016,6 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
             }
         }
     }
-    out
 }
 
 /// Midpoint segments' ends: the patch centres of a cell (minimum corner `world_cell_min`, edge
@@ -738,63 +1155,6 @@ fn fallback_record<A: HitAttributes + ?Sized>(
 /// texture coordinates) → linear RGB.
 pub type Shade<'a> = dyn Fn(DVec3, Vec3, Vec3, u16, glam::Vec2) -> Vec3 + Sync + 'a;
 
-/// A segment–triangle test for midpoint segments (PNMT records need the nearest hit, not a
-/// watertight one): plane crossing, then three edge functions.
-#[derive(Debug, Clone, Copy)]
-struct SegmentTest {
-    c: [Vec3; 3],
-    n: Vec3,
-    n2: f32,
-    /// n × (each edge), corner to next corner: an edge function n · (edge × (p − corner)) is
-    /// (n × edge) · (p − corner), one dot product per edge and hit instead of a cross product
-    /// and a dot.
-    m: [Vec3; 3],
-}
-
-impl SegmentTest {
-    fn new(c: [Vec3; 3]) -> SegmentTest {
-        let n = (c[1] - c[0]).cross(c[2] - c[0]);
-        let m = [n.cross(c[1] - c[0]), n.cross(c[2] - c[1]), n.cross(c[0] - c[2])];
-        SegmentTest { c, n, n2: n.length_squared(), m }
-    }
-
-    /// (t, u, v) where the segment o → e crosses the triangle.
-    #[inline(always)]
-    fn hit(&self, o: Vec3, e: Vec3) -> Option<Intersection> {
-        self.hit_if(o, e, |_| true)
-    }
-
-    /// [`Self::hit`] where the crossing's segment parameter t passes `wanted` (checked before the
-    /// edge functions: in cells of many triangles most crossings lie between a segment's
-    /// nearest hits found already).
-    #[inline(always)]
-    fn hit_if(&self, o: Vec3, e: Vec3, wanted: impl Fn(f32) -> bool) -> Option<Intersection> {
-        let d = e - o;
-        let denom = self.n.dot(d);
-        if denom == 0.0 || self.n2 == 0.0 {
-            return None;
-        }
-        let t = self.n.dot(self.c[0] - o) / denom;
-        if !(0.0..=1.0).contains(&t) || !wanted(t) {
-            return None;
-        }
-        let p = o + d * t;
-        let [a, b, c] = self.c;
-        let w0 = self.m[0].dot(p - a);
-        let w1 = self.m[1].dot(p - b);
-        let w2 = self.m[2].dot(p - c);
-        (w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0).then(|| Intersection { t, u: w2 / self.n2, v: w0 / self.n2 })
-    }
-}
-
-/// Where a midpoint segment crosses a triangle.
-#[derive(Debug, Clone, Copy)]
-struct Intersection {
-    t: f32,
-    u: f32,
-    v: f32,
-}
-
 /// Barycentric weights (of corners 1 and 2) of the point of the triangle's plane nearest `p`.
 fn barycentric(c: [Vec3; 3], p: Vec3) -> (f32, f32) {
     let (e1, e2, d) = (c[1] - c[0], c[2] - c[0], p - c[0]);
@@ -929,6 +1289,81 @@ mod tests {
         // The union bake must run fewer exact tests (about 70 % here), or it is not taking its
         // own path.
         assert!(skipped.1 * 5 < skipped.0 * 4, "{skipped:?}");
+    }
+
+    /// The records-first bake (every cell without candidates whose records are needed) must
+    /// give the bits and PNMT records of the bake that tests every triangle against every shaft
+    /// it may reach (the candidate bake, which keeps the records too): cells of 2 to 100
+    /// triangles, small and large, ties (coincident copies), one scratch for all the cells (the
+    /// ends it keeps between cells), and cells far from the world's origin, where the segments'
+    /// single-precision hits and the exact tests disagree and shafts are baked again alone.
+    #[test]
+    fn records_first_bake_keeps_the_bits_and_records_of_the_all_pairs_bake() {
+        let mut rnd = uniform(17);
+        let mut scratch = Scratch::default();
+        let (mut rebaked, mut tests) = (0u64, (0u64, 0u64));
+        for case in 0..90u32 {
+            let n = 1 + case % 8;
+            let margin = [1e-5, 1e-3][(case % 2) as usize];
+            let count = 2 + (case as usize * 13) % 99;
+            let size = [0.05, 0.3, 1.5][(case / 2 % 3) as usize];
+            // Every third cell 2^21 cells from the origin: its world corners and segment ends in
+            // single precision are a quarter of a cell apart, so the segments' hits and the exact
+            // tests disagree often (a tentative end's triangle then misses its shaft).
+            let far = case % 3 == 0;
+            let world_min = DVec3::splat(if far { 2_097_152.0 } else { 0.0 });
+            let mut tris: Vec<[DVec3; 3]> = (0..count)
+                .map(|_| {
+                    let c = DVec3::new(rnd(), rnd(), rnd()) * 1.2 - 0.1;
+                    [0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size)
+                })
+                .collect();
+            if case % 4 == 0 {
+                let copy = tris[count / 2];
+                tris.insert(0, copy);
+            }
+            let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| (p + world_min).as_vec3())).collect());
+            let ids: Vec<u32> = (0..tris.len() as u32).collect();
+            let layout = [PnmtLayout::Full, PnmtLayout::CompactNoUv][(case / 3 % 2) as usize];
+            let bake = |candidates: bool, scratch: &mut Scratch| {
+                bake_cell(
+                    &ids,
+                    &tris,
+                    DVec3::ZERO,
+                    world_min,
+                    1.0,
+                    n,
+                    margin,
+                    candidates,
+                    true,
+                    layout,
+                    &attrs,
+                    None,
+                    scratch,
+                )
+            };
+            let all = bake(true, &mut Scratch::default());
+            let first = bake(false, &mut scratch);
+            let differ = |a: &[u32], b: &[u32]| a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert!(
+                first.bits == all.bits,
+                "case {case}: {} bit words differ",
+                differ(&first.bits, &all.bits)
+            );
+            assert!(
+                first.pnmt == all.pnmt,
+                "case {case}: {} record words differ",
+                differ(&first.pnmt, &all.pnmt)
+            );
+            assert_eq!(first.pnmt_missing, all.pnmt_missing, "case {case}");
+            rebaked += first.rebaked;
+            tests.0 += all.tests;
+            tests.1 += first.tests;
+        }
+        // Far from the origin some tentative ends must miss their shafts, or that path is
+        // untested; and the bake must test fewer pairs exactly, or it is not taking its path.
+        assert!(rebaked > 100, "{rebaked} shafts baked again alone");
+        assert!(tests.1 * 2 < tests.0, "{tests:?}");
     }
 
     /// A cell of one triangle is written as its shafts are found (`Single`), without the

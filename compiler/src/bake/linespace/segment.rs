@@ -1,0 +1,229 @@
+//! Midpoint segments against a triangle: the PNMT records' hits (single precision, the nearest
+//! hit, not a watertight one), one segment at a time or all the segments from one patch to the
+//! patches of a face at once (AVX2, the same arithmetic).
+
+use glam::Vec3;
+
+use super::geometry::{MAX_PATCHES, set_bits};
+
+/// A segment–triangle test for midpoint segments (PNMT records need the nearest hit, not a
+/// watertight one): plane crossing, then three edge functions.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct SegmentTest {
+    pub(super) c: [Vec3; 3],
+    n: Vec3,
+    n2: f32,
+    /// n × (each edge), corner to next corner: an edge function n · (edge × (p − corner)) is
+    /// (n × edge) · (p − corner), one dot product per edge and hit instead of a cross product
+    /// and a dot.
+    m: [Vec3; 3],
+}
+
+impl SegmentTest {
+    pub(super) fn new(c: [Vec3; 3]) -> SegmentTest {
+        let n = (c[1] - c[0]).cross(c[2] - c[0]);
+        let m = [n.cross(c[1] - c[0]), n.cross(c[2] - c[1]), n.cross(c[0] - c[2])];
+        SegmentTest { c, n, n2: n.length_squared(), m }
+    }
+
+    /// (t, u, v) where the segment o → e crosses the triangle.
+    #[inline(always)]
+    pub(super) fn hit(&self, o: Vec3, e: Vec3) -> Option<Intersection> {
+        self.hit_if(o, e, |_| true)
+    }
+
+    /// [`Self::hit`] where the crossing's segment parameter t passes `wanted` (checked before the
+    /// edge functions: in cells of many triangles most crossings lie between a segment's
+    /// nearest hits found already).
+    #[inline(always)]
+    pub(super) fn hit_if(&self, o: Vec3, e: Vec3, wanted: impl Fn(f32) -> bool) -> Option<Intersection> {
+        let (t, w0, w2) = self.crossing(o, e, wanted)?;
+        Some(Intersection { t, u: w2 / self.n2, v: w0 / self.n2 })
+    }
+
+    /// [`Self::hit_if`]'s t and the edge functions that make its barycentrics (v·n², u·n²).
+    #[inline(always)]
+    fn crossing(&self, o: Vec3, e: Vec3, wanted: impl Fn(f32) -> bool) -> Option<(f32, f32, f32)> {
+        let d = e - o;
+        let denom = self.n.dot(d);
+        if denom == 0.0 || self.n2 == 0.0 {
+            return None;
+        }
+        let t = self.n.dot(self.c[0] - o) / denom;
+        if !(0.0..=1.0).contains(&t) || !wanted(t) {
+            return None;
+        }
+        let p = o + d * t;
+        let [a, b, c] = self.c;
+        let w0 = self.m[0].dot(p - a);
+        let w1 = self.m[1].dot(p - b);
+        let w2 = self.m[2].dot(p - c);
+        (w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0).then_some((t, w0, w2))
+    }
+}
+
+/// Where a midpoint segment crosses a triangle.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Intersection {
+    pub(super) t: f32,
+    pub(super) u: f32,
+    pub(super) v: f32,
+}
+
+/// The patch centres of one face, by coordinate (padded with zeros to [`MAX_PATCHES`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FaceCentres {
+    x: [f32; MAX_PATCHES],
+    y: [f32; MAX_PATCHES],
+    z: [f32; MAX_PATCHES],
+}
+
+impl FaceCentres {
+    pub(super) fn new(centres: &[Vec3; MAX_PATCHES]) -> FaceCentres {
+        FaceCentres { x: centres.map(|c| c.x), y: centres.map(|c| c.y), z: centres.map(|c| c.z) }
+    }
+
+    fn at(&self, p: usize) -> Vec3 {
+        Vec3::new(self.x[p], self.y[p], self.z[p])
+    }
+}
+
+/// Per patch of the far face, what [`SegmentTest::hits_among`] found: the crossing's t and the
+/// edge functions that make its barycentrics.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LaneHits {
+    t: [f32; MAX_PATCHES],
+    w0: [f32; MAX_PATCHES],
+    w2: [f32; MAX_PATCHES],
+}
+
+impl Default for LaneHits {
+    fn default() -> Self {
+        LaneHits { t: [0.0; MAX_PATCHES], w0: [0.0; MAX_PATCHES], w2: [0.0; MAX_PATCHES] }
+    }
+}
+
+impl SegmentTest {
+    /// The segments from `o` to the patches `among` (bit p for patch p) of the face `to` that
+    /// cross the triangle at a t with `!(t >= front[p]) || !(t <= back[p])` (nearer either end
+    /// than the segment's hits so far; NaN: none yet), as a mask of the same bits; each one's
+    /// crossing is then [`Self::lane`]. The same hits, bit for bit, as [`Self::hit_if`] segment by
+    /// segment. `front` and `back` hold at least the highest patch of `among` rounded up to a
+    /// multiple of 8.
+    pub(super) fn hits_among(
+        &self,
+        o: Vec3,
+        to: &FaceCentres,
+        among: u64,
+        front: &[f32],
+        back: &[f32],
+        out: &mut LaneHits,
+    ) -> u64 {
+        if among == 0 || self.n2 == 0.0 {
+            return 0;
+        }
+        let lanes = (64 - among.leading_zeros() as usize).next_multiple_of(8);
+        assert!(front.len() >= lanes && back.len() >= lanes, "the ends' t cover the lanes");
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2; the lanes are within `front`, `back` (asserted) and the
+            // MAX_PATCHES arrays (a multiple of 8).
+            return unsafe { self.hits_avx2(o, to, among, lanes, front, back, out) };
+        }
+        let mut hits = 0;
+        for p in set_bits(among) {
+            let p = p as usize;
+            let wanted = |t: f32| !(t >= front[p]) || !(t <= back[p]);
+            if let Some((t, w0, w2)) = self.crossing(o, to.at(p), wanted) {
+                hits |= 1 << p;
+                (out.t[p], out.w0[p], out.w2[p]) = (t, w0, w2);
+            }
+        }
+        hits
+    }
+
+    /// The crossing [`Self::hits_among`] found towards patch `p`.
+    #[inline(always)]
+    pub(super) fn lane(&self, hits: &LaneHits, p: u32) -> Intersection {
+        let p = p as usize;
+        Intersection { t: hits.t[p], u: hits.w2[p] / self.n2, v: hits.w0[p] / self.n2 }
+    }
+
+    /// [`Self::hits_among`] in AVX2, eight segments at a time, with [`Self::hit_if`]'s operations
+    /// in its order (no fused multiply-adds).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn hits_avx2(
+        &self,
+        o: Vec3,
+        to: &FaceCentres,
+        among: u64,
+        lanes: usize,
+        front: &[f32],
+        back: &[f32],
+        out: &mut LaneHits,
+    ) -> u64 {
+        use std::arch::x86_64::*;
+        let s = _mm256_set1_ps;
+        let dot = |a: Vec3, x: __m256, y: __m256, z: __m256| {
+            _mm256_add_ps(
+                _mm256_add_ps(_mm256_mul_ps(s(a.x), x), _mm256_mul_ps(s(a.y), y)),
+                _mm256_mul_ps(s(a.z), z),
+            )
+        };
+        // The same for every segment from o: n · (c0 − o).
+        let num = s(self.n.dot(self.c[0] - o));
+        let (zero, one) = (_mm256_setzero_ps(), s(1.0));
+        let mut hits = 0u64;
+        for g in (0..lanes).step_by(8) {
+            let group = (among >> g) as u32 & 0xff;
+            if group == 0 {
+                continue;
+            }
+            // SAFETY (loads, stores): g + 8 <= lanes <= MAX_PATCHES and <= front, back's
+            // lengths (the caller's contract).
+            let ld = |a: &[f32]| unsafe { _mm256_loadu_ps(a.as_ptr().add(g)) };
+            let dx = _mm256_sub_ps(ld(&to.x), s(o.x));
+            let dy = _mm256_sub_ps(ld(&to.y), s(o.y));
+            let dz = _mm256_sub_ps(ld(&to.z), s(o.z));
+            let denom = dot(self.n, dx, dy, dz);
+            let t = _mm256_div_ps(num, denom);
+            let crossing = _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_NEQ_UQ>(denom, zero),
+                _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(t, zero), _mm256_cmp_ps::<_CMP_LE_OQ>(t, one)),
+            );
+            let wanted = _mm256_or_ps(
+                _mm256_cmp_ps::<_CMP_NGE_UQ>(t, ld(front)),
+                _mm256_cmp_ps::<_CMP_NLE_UQ>(t, ld(back)),
+            );
+            let live = _mm256_movemask_ps(_mm256_and_ps(crossing, wanted)) as u32 & group;
+            if live == 0 {
+                continue;
+            }
+            let px = _mm256_add_ps(s(o.x), _mm256_mul_ps(dx, t));
+            let py = _mm256_add_ps(s(o.y), _mm256_mul_ps(dy, t));
+            let pz = _mm256_add_ps(s(o.z), _mm256_mul_ps(dz, t));
+            let edge = |m: Vec3, c: Vec3| {
+                dot(m, _mm256_sub_ps(px, s(c.x)), _mm256_sub_ps(py, s(c.y)), _mm256_sub_ps(pz, s(c.z)))
+            };
+            let [a, b, c] = self.c;
+            let (w0, w1, w2) = (edge(self.m[0], a), edge(self.m[1], b), edge(self.m[2], c));
+            let inside = _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(w0, zero),
+                _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(w1, zero), _mm256_cmp_ps::<_CMP_GE_OQ>(w2, zero)),
+            );
+            let found = _mm256_movemask_ps(inside) as u32 & live;
+            if found != 0 {
+                // SAFETY: as the loads.
+                unsafe {
+                    _mm256_storeu_ps(out.t.as_mut_ptr().add(g), t);
+                    _mm256_storeu_ps(out.w0.as_mut_ptr().add(g), w0);
+                    _mm256_storeu_ps(out.w2.as_mut_ptr().add(g), w2);
+                }
+                hits |= (found as u64) << g;
+            }
+        }
+        hits
+    }
+}
