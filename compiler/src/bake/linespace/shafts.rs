@@ -591,7 +591,13 @@ struct FirstScratch {
     shafts: Vec<u32>,
     /// The first pass's t of each shaft's front and back hit (NaN: none yet), by shaft.
     ts: [Vec<f32>; 2],
+    /// The first pass's survivors by (triangle, pair, front patch).
+    amongs: Vec<u64>,
 }
+
+/// The most survivor masks [`RecordsFirst`] keeps from its first pass for its second (8 MiB; a
+/// cell of more triangles makes them again).
+const CACHED_SURVIVORS: usize = 1 << 20;
 
 impl RecordsFirst<'_> {
     #[allow(clippy::too_many_arguments)]
@@ -609,7 +615,7 @@ impl RecordsFirst<'_> {
     ) {
         let RecordsFirst { tris, n, margin, centres } = *self;
         let words = out.bits.len();
-        let FirstScratch { prepared, seen, confirmed, starts, shafts, ts } = scratch;
+        let FirstScratch { prepared, seen, confirmed, starts, shafts, ts, amongs } = scratch;
         let [c0, c1] = confirmed;
         for v in [&mut *hit_bits, &mut *seen, c0, c1] {
             v.clear();
@@ -627,6 +633,11 @@ impl RecordsFirst<'_> {
         }
         let mut lane = LaneHits::default();
         let n2 = (n * n) as usize;
+        // Each (triangle, pair)'s survivors, by front patch, for the second pass (where they
+        // fit in CACHED_SURVIVORS).
+        let cached = tris.len() * FACE_PAIRS as usize * n2 <= CACHED_SURVIVORS;
+        amongs.clear();
+        amongs.resize(if cached { tris.len() * FACE_PAIRS as usize * n2 } else { 0 }, 0);
         for (li, &t) in tris.iter().enumerate() {
             let v = local[t as usize].map(|p| p - cell_min);
             let prep = Prepared::new(v);
@@ -674,7 +685,14 @@ impl RecordsFirst<'_> {
                         }
                     }
                     None => {
-                        patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, _, _| from_patch(pa, among))
+                        let at = if cached { (li * FACE_PAIRS as usize + pair as usize) * n2 } else { 0 };
+                        let keep = &mut amongs[at..];
+                        patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, _, _| {
+                            if cached {
+                                keep[pa as usize] = among;
+                            }
+                            from_patch(pa, among)
+                        })
                     }
                 }
             }
@@ -748,11 +766,35 @@ impl RecordsFirst<'_> {
                     continue;
                 }
                 let tests = &mut out.tests;
-                patch_sets(prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
-                    let first = shaft_of(pair, pa, 0, n) as usize;
-                    let need = exact.needing_test(first, n2, among) | (confirm[pa as usize] & among);
-                    decide(axes, masks, pair, pa, need, n, tests, &mut |shaft, _, _| exact.met(shaft));
-                });
+                if !cached {
+                    patch_sets(prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+                        let first = shaft_of(pair, pa, 0, n) as usize;
+                        let need = exact.needing_test(first, n2, among) | (confirm[pa as usize] & among);
+                        decide(axes, masks, pair, pa, need, n, tests, &mut |shaft, _, _| exact.met(shaft));
+                    });
+                    continue;
+                }
+                // The first pass's survivors: the separations are made again only for a pair
+                // with shafts to test (a fifth of the teapot's 8³ object cells' bake went to
+                // making them again for every pair).
+                let among = &amongs[(li * FACE_PAIRS as usize + pair as usize) * n2..][..n2];
+                let mut need = [0u64; MAX_PATCHES];
+                let mut any = 0;
+                for (pa, (&among, need)) in among.iter().zip(&mut need).enumerate() {
+                    if among != 0 {
+                        let first = shaft_of(pair, pa as u32, 0, n) as usize;
+                        *need = exact.needing_test(first, n2, among) | (confirm[pa] & among);
+                        any |= *need;
+                    }
+                }
+                if any != 0 {
+                    let axes = prep.pair_axes(fa, fb, n, margin);
+                    let masks = axes.masks(n);
+                    for (pa, &need) in need.iter().enumerate().take(n2) {
+                        let met = &mut |shaft, _, _| exact.met(shaft);
+                        decide(&axes, &masks, pair, pa as u32, need, n, tests, met);
+                    }
+                }
             }
         }
         // A hit shaft is filled where both its tentative ends were confirmed, else baked alone.
