@@ -26,13 +26,8 @@ impl SegmentTest {
         SegmentTest { c, n, n2: n.length_squared(), m }
     }
 
-    /// (t, u, v) where the segment o → e crosses the triangle.
-    #[inline(always)]
-    pub(super) fn hit(&self, o: Vec3, e: Vec3) -> Option<Intersection> {
-        self.hit_if(o, e, |_| true)
-    }
-
-    /// [`Self::hit`] where the crossing's segment parameter t passes `wanted` (checked before the
+    /// (t, u, v) where the segment o → e crosses the triangle, if the crossing's segment
+    /// parameter t passes `wanted` (checked before the
     /// edge functions: in cells of many triangles most crossings lie between a segment's
     /// nearest hits found already).
     #[inline(always)]
@@ -79,6 +74,10 @@ pub(super) struct FaceCentres {
 }
 
 impl FaceCentres {
+    /// A face of centres at the origin (a placeholder where no segment is tested).
+    pub(super) const ZERO: FaceCentres =
+        FaceCentres { x: [0.0; MAX_PATCHES], y: [0.0; MAX_PATCHES], z: [0.0; MAX_PATCHES] };
+
     pub(super) fn new(centres: &[Vec3; MAX_PATCHES]) -> FaceCentres {
         FaceCentres { x: centres.map(|c| c.x), y: centres.map(|c| c.y), z: centres.map(|c| c.z) }
     }

@@ -1111,36 +1111,62 @@ impl Single<'_> {
         let seg = SegmentTest::new(if pnmt { attrs.corners(t) } else { [Vec3::ZERO; 3] });
         let sides = spanning_sides(v, margin, n);
         let mut tests = 0;
+        // The segments from a patch to the shafts it fills are tested eight at a time.
+        let faces = if pnmt { centres.map(|face| FaceCentres::new(&face)) } else { [FaceCentres::ZERO; 6] };
+        let (mut lane, none) = (LaneHits::default(), [f32::NAN; MAX_PATCHES]);
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let f = Filler::new(t, 0, &seg, pair, poly, margin);
             let mut fallbacks = [None; 2];
-            let mut emit = |shaft: u32, pa: u32, pb: u32| {
-                out.bits[(shaft / 32) as usize] |= 1 << (shaft % 32);
-                if candidates {
-                    out.entries.push(entry::pack(0, f.qmin as u32, f.qmax as u32));
-                    out.list_ends.push(out.entries.len() as u32);
+            // The shafts from patch pa to the patches `met` of face b.
+            let mut emit = |pa: u32, met: u64| {
+                for pb in set_bits(met) {
+                    let shaft = shaft_of(pair, pa, pb, n);
+                    out.bits[(shaft / 32) as usize] |= 1 << (shaft % 32);
+                    if candidates {
+                        out.entries.push(entry::pack(0, f.qmin as u32, f.qmax as u32));
+                        out.list_ends.push(out.entries.len() as u32);
+                    }
                 }
                 if !pnmt {
                     return;
                 }
-                let (o, e) = (centres[fa as usize][pa as usize], centres[fb as usize][pb as usize]);
-                let records = match seg.hit(o, e) {
-                    Some(h) => [hit_record(attrs, layout, t, seg.c, h.u, h.v, world_cell_min, cell); 2],
-                    None => [0, 1].map(|side| {
-                        *fallbacks[side].get_or_insert_with(|| {
-                            fallback_record(attrs, layout, t, poly, pair, side, world_cell_min, cell)
+                let o = centres[fa as usize][pa as usize];
+                let hits = seg.hits_among(o, &faces[fb as usize], met, &none, &none, &mut lane);
+                for pb in set_bits(met) {
+                    let records = if hits >> pb & 1 == 1 {
+                        let h = seg.lane(&lane, pb);
+                        [hit_record(attrs, layout, t, seg.c, h.u, h.v, world_cell_min, cell); 2]
+                    } else {
+                        [0, 1].map(|side| {
+                            *fallbacks[side].get_or_insert_with(|| {
+                                fallback_record(attrs, layout, t, poly, pair, side, world_cell_min, cell)
+                            })
                         })
-                    }),
-                };
-                let words = layout.words();
-                out.pnmt.extend_from_slice(&records[0][..words]);
-                out.pnmt.extend_from_slice(&records[1][..words]);
-                out.pnmt_missing += records.iter().any(|r| !layout.is_some(r)) as u64;
+                    };
+                    let words = layout.words();
+                    out.pnmt.extend_from_slice(&records[0][..words]);
+                    out.pnmt.extend_from_slice(&records[1][..words]);
+                    out.pnmt_missing += records.iter().any(|r| !layout.is_some(r)) as u64;
+                }
             };
             match &sides {
-                Some(sides) => spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut emit),
-                None => search(&prep, poly, pair, n, margin, &mut tests, &mut emit),
+                Some(sides) => {
+                    let all = low_bits((n * n) as usize);
+                    for pa in 0..n * n {
+                        let met = met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all);
+                        if met != 0 {
+                            emit(pa, met);
+                        }
+                    }
+                }
+                None => patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+                    tests += among.count_ones() as u64;
+                    let met = axes.shafts_among(pa, among, masks);
+                    if met != 0 {
+                        emit(pa, met);
+                    }
+                }),
             }
         }
         out.tests += tests;
