@@ -118,13 +118,33 @@ impl SegmentTest {
         back: &[f32],
         out: &mut LaneHits,
     ) -> u64 {
+        #[cfg(target_arch = "x86_64")]
+        let simd = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let simd = false;
+        self.hits_among_with(o, to, among, front, back, out, simd)
+    }
+
+    /// [`Self::hits_among`], in AVX2 if `simd` (the caller has checked that the CPU has it).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn hits_among_with(
+        &self,
+        o: Vec3,
+        to: &FaceCentres,
+        among: u64,
+        front: &[f32],
+        back: &[f32],
+        out: &mut LaneHits,
+        simd: bool,
+    ) -> u64 {
         if among == 0 || self.n2 == 0.0 {
             return 0;
         }
         let lanes = (64 - among.leading_zeros() as usize).next_multiple_of(8);
         assert!(front.len() >= lanes && back.len() >= lanes, "the ends' t cover the lanes");
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if simd {
             // SAFETY: the CPU has AVX2; the lanes are within `front`, `back` (asserted) and the
             // MAX_PATCHES arrays (a multiple of 8).
             return unsafe { self.hits_avx2(o, to, among, lanes, front, back, out) };
@@ -224,5 +244,61 @@ impl SegmentTest {
             }
         }
         hits
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bake::linespace::geometry::tests::uniform;
+
+    /// The AVX2 segment tests give the portable ones' hits, t and barycentrics bit for bit:
+    /// random triangles (some degenerate, some in a face's plane, so that segments start or end
+    /// on them: t = 0 or 1), random fronts and backs (some NaN: none yet), every lane count.
+    #[test]
+    fn avx2_segments_match_the_portable_ones() {
+        #[cfg(target_arch = "x86_64")]
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let mut rnd = uniform(7);
+        let mut centres = [Vec3::ZERO; MAX_PATCHES];
+        let (mut hits, mut lanes) = (0u32, 0u32);
+        for case in 0..6000u32 {
+            let n = 1 + case as usize % 8;
+            // Face x = 1's patch centres, from patch (0.5, 0.5) of face x = 0.
+            for (p, c) in centres.iter_mut().enumerate().take(n * n) {
+                *c = Vec3::new(1.0, ((p / n) as f32 + 0.5) / n as f32, ((p % n) as f32 + 0.5) / n as f32);
+            }
+            let to = FaceCentres::new(&centres);
+            let o = Vec3::new(0.0, rnd() as f32, rnd() as f32);
+            let mut corner = || Vec3::new(rnd() as f32 * 1.4 - 0.2, rnd() as f32, rnd() as f32);
+            let mut c = [corner(), corner(), corner()];
+            match case % 5 {
+                0 => c[2] = c[0] + (c[1] - c[0]) * 0.5,
+                1 => c.iter_mut().for_each(|p| p.x = 1.0),
+                2 => c.iter_mut().for_each(|p| p.x = 0.0),
+                _ => {}
+            }
+            let seg = SegmentTest::new(c);
+            let ends = |rnd: &mut dyn FnMut() -> f64| -> Vec<f32> {
+                (0..MAX_PATCHES).map(|_| if rnd() < 0.3 { f32::NAN } else { rnd() as f32 }).collect()
+            };
+            let (front, back) = (ends(&mut rnd), ends(&mut rnd));
+            let among = (rnd() * u64::MAX as f64) as u64 & crate::bake::linespace::geometry::low_bits(n * n);
+            let (mut a, mut b) = (LaneHits::default(), LaneHits::default());
+            let simd = seg.hits_among_with(o, &to, among, &front, &back, &mut a, true);
+            let portable = seg.hits_among_with(o, &to, among, &front, &back, &mut b, false);
+            assert_eq!(simd, portable, "case {case}");
+            for p in set_bits(simd) {
+                let (x, y) = (seg.lane(&a, p), seg.lane(&b, p));
+                let bits = |h: Intersection| [h.t.to_bits(), h.u.to_bits(), h.v.to_bits()];
+                assert_eq!(bits(x), bits(y), "case {case} patch {p}");
+                hits += 1;
+                lanes += (x.t == 0.0 || x.t == 1.0) as u32;
+            }
+        }
+        // Enough hits, some at a segment's ends, or the comparison says little.
+        assert!(hits > 3000 && lanes > 100, "{hits} hits, {lanes} at an end");
     }
 }
