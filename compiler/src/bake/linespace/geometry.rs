@@ -118,6 +118,38 @@ impl Prepared {
     }
 }
 
+/// One triangle's separations from the patches of each of the six faces at one resolution,
+/// with their sign masks ([`Prepared::face_tables`]). A face pair's ([`Self::pair`]) are two of
+/// them: each separation depends on its face alone, so a triangle's six faces serve its 15
+/// pairs (made for every pair, the same numbers were a sixth of an object cell's bake).
+#[derive(Debug, Clone)]
+pub struct FaceTables {
+    /// Face f's separations on both sides of the pair (f, f).
+    axes: [PairAxes; 6],
+    masks: [PairMasks; 6],
+}
+
+impl Prepared {
+    /// [`FaceTables`] at resolution `n` with the grid margin `margin`.
+    pub fn face_tables(&self, n: u32, margin: f64) -> FaceTables {
+        let axes: [PairAxes; 6] = std::array::from_fn(|f| self.pair_axes(f as u32, f as u32, n, margin));
+        let masks = std::array::from_fn(|f| axes[f].masks(n));
+        FaceTables { axes, masks }
+    }
+}
+
+impl FaceTables {
+    /// The separations and sign masks of face pair (`fa`, `fb`): those [`Prepared::pair_axes`]
+    /// and [`PairAxes::masks`] make, bit for bit.
+    pub fn pair(&self, fa: u32, fb: u32) -> (PairAxes, PairMasks) {
+        let (a, b) = (&self.axes[fa as usize], &self.axes[fb as usize]);
+        let axes = PairAxes { a: a.a, a_du: a.a_du, a_dv: a.a_dv, b: b.b, b_du: b.b_du, b_dv: b.b_dv };
+        let (ma, mb) = (&self.masks[fa as usize], &self.masks[fb as usize]);
+        let masks = PairMasks { n: ma.n, at_a: ma.at_a, at_b: mb.at_b, some_b: mb.some_b, free_b: mb.free_b };
+        (axes, masks)
+    }
+}
+
 /// The sweep test. On each axis, the separation of the box B(s) from the triangle (box minimum
 /// minus triangle maximum, and triangle minimum minus box maximum) is affine in s; its values at
 /// s = 0 (patch P) and s = 1 (patch Q) are computed for all lanes at once. A separation positive at

@@ -9,7 +9,9 @@ use kiln_format::linespace::index::{
 };
 use kiln_format::linespace::{PnmtLayout, RecordWords, entry, words_per_slot};
 
-use super::geometry::{MAX_PATCHES, PairAxes, PairMasks, Prepared, clip_to_box_into, low_bits, set_bits};
+use super::geometry::{
+    FaceTables, MAX_PATCHES, PairAxes, PairMasks, Prepared, clip_to_box_into, low_bits, set_bits,
+};
 use super::segment::{FaceCentres, Intersection, LaneHits, SegmentTest};
 use super::span::{Sides, Span, met_from};
 
@@ -76,19 +78,17 @@ fn outward(face: u32) -> DVec3 {
 /// patches `among` of face b (bit u·n + v for patch (u, v)) that no single separation rejects
 /// ([`PairMasks::survivors`]); `axes.shafts_among` decides those shafts exactly.
 fn patch_sets(
-    tri: &Prepared,
+    tables: &FaceTables,
     poly: &[DVec3],
     pair: u32,
     n: u32,
-    margin: f64,
     patches: &mut impl FnMut(u32, u64, &PairAxes, &PairMasks),
 ) {
     if poly.is_empty() {
         return;
     }
     let (fa, fb) = pair_faces(pair);
-    let axes = tri.pair_axes(fa, fb, n, margin);
-    let masks = axes.masks(n);
+    let (axes, masks) = tables.pair(fa, fb);
     let mut among = [0u64; MAX_PATCHES];
     masks.survivors(&mut among);
     for (pa, &set) in among.iter().enumerate().take((n * n) as usize) {
@@ -109,15 +109,14 @@ fn shaft_of(pair: u32, pa: u32, pb: u32, n: u32) -> u32 {
 /// `pb` of face b) that the triangle `tri` (clipped to the widened cell: `poly`) meets, in shaft
 /// order: the [`patch_sets`] of each source patch decided exactly.
 fn search(
-    tri: &Prepared,
+    tables: &FaceTables,
     poly: &[DVec3],
     pair: u32,
     n: u32,
-    margin: f64,
     tests: &mut u64,
     found: &mut impl FnMut(u32, u32, u32),
 ) {
-    patch_sets(tri, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+    patch_sets(tables, poly, pair, n, &mut |pa, among, axes, masks| {
         decide(axes, masks, pair, pa, among, n, tests, found)
     });
 }
@@ -510,23 +509,25 @@ fn bake_all_pairs<A: HitAttributes + ?Sized>(
         let seg = SegmentTest::new(if records_needed { attrs.corners(t) } else { [Vec3::ZERO; 3] });
         // A triangle spanning the cell meets what its plane meets (see `span`).
         let sides = spanning_sides(v, margin, n);
+        let tables = if sides.is_none() { Some(prep.face_tables(n, margin)) } else { None };
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let filler = Filler::new(t, li as u32, &seg, pair, poly, margin);
-            if let Some(sides) = &sides {
+            let (Some(tables), None) = (&tables, &sides) else {
+                let sides = sides.as_ref().expect("a spanning triangle, or its separations");
                 // Every shaft is decided: the all-pairs bake's fills, which the union's equal.
                 spanned(&sides[fa as usize], &sides[fb as usize], pair, n, &mut |shaft, pa, pb| {
                     state.fill(shaft, pa, pb, &filler)
                 });
                 continue;
-            }
+            };
             if !union {
-                search(&prep, poly, pair, n, margin, &mut out.tests, &mut |shaft, pa, pb| {
+                search(tables, poly, pair, n, &mut out.tests, &mut |shaft, pa, pb| {
                     state.fill(shaft, pa, pb, &filler)
                 });
                 continue;
             }
-            patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+            patch_sets(tables, poly, pair, n, &mut |pa, among, axes, masks| {
                 // The shafts that need the exact test.
                 let need = state.needing_test(pair, pa, among, n, &filler);
                 decide(axes, masks, pair, pa, need, n, &mut out.tests, &mut |shaft, pa, pb| {
@@ -645,6 +646,7 @@ impl RecordsFirst<'_> {
             let poly = &polys[li];
             let seg = SegmentTest::new(attrs.corners(t));
             let sides = spanning_sides(v, margin, n);
+            let tables = if sides.is_none() { Some(prep.face_tables(n, margin)) } else { None };
             for pair in 0..FACE_PAIRS {
                 let (fa, fb) = pair_faces(pair);
                 let mut from_patch = |pa: u32, among: u64| {
@@ -687,7 +689,8 @@ impl RecordsFirst<'_> {
                     None => {
                         let at = if cached { (li * FACE_PAIRS as usize + pair as usize) * n2 } else { 0 };
                         let keep = &mut amongs[at..];
-                        patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, _, _| {
+                        let tables = tables.as_ref().expect("the separations of a triangle not spanning");
+                        patch_sets(tables, poly, pair, n, &mut |pa, among, _, _| {
                             if cached {
                                 keep[pa as usize] = among;
                             }
@@ -738,6 +741,8 @@ impl RecordsFirst<'_> {
             let (prep, sides) = &prepared[li];
             let poly = &polys[li];
             let mut mine = &shafts[starts[li] as usize..starts[li + 1] as usize];
+            // Made again where a pair has shafts to test.
+            let mut tables = None;
             for pair in 0..FACE_PAIRS {
                 let (fa, fb) = pair_faces(pair);
                 let filler = Filler::new(t, li as u32, &seg, pair, poly, margin);
@@ -767,7 +772,8 @@ impl RecordsFirst<'_> {
                 }
                 let tests = &mut out.tests;
                 if !cached {
-                    patch_sets(prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
+                    let tables = tables.get_or_insert_with(|| prep.face_tables(n, margin));
+                    patch_sets(tables, poly, pair, n, &mut |pa, among, axes, masks| {
                         let first = shaft_of(pair, pa, 0, n) as usize;
                         let need = exact.needing_test(first, n2, among) | (confirm[pa as usize] & among);
                         decide(axes, masks, pair, pa, need, n, tests, &mut |shaft, _, _| exact.met(shaft));
@@ -788,8 +794,8 @@ impl RecordsFirst<'_> {
                     }
                 }
                 if any != 0 {
-                    let axes = prep.pair_axes(fa, fb, n, margin);
-                    let masks = axes.masks(n);
+                    let (axes, masks) =
+                        tables.get_or_insert_with(|| prep.face_tables(n, margin)).pair(fa, fb);
                     for (pa, &need) in need.iter().enumerate().take(n2) {
                         let met = &mut |shaft, _, _| exact.met(shaft);
                         decide(&axes, &masks, pair, pa as u32, need, n, tests, met);
@@ -1110,6 +1116,7 @@ impl Single<'_> {
         let prep = Prepared::new(v);
         let seg = SegmentTest::new(if pnmt { attrs.corners(t) } else { [Vec3::ZERO; 3] });
         let sides = spanning_sides(v, margin, n);
+        let tables = if sides.is_none() { Some(prep.face_tables(n, margin)) } else { None };
         let mut tests = 0;
         // The segments from a patch to the shafts it fills are tested eight at a time.
         let faces = if pnmt { centres.map(|face| FaceCentres::new(&face)) } else { [FaceCentres::ZERO; 6] };
@@ -1160,13 +1167,19 @@ impl Single<'_> {
                         }
                     }
                 }
-                None => patch_sets(&prep, poly, pair, n, margin, &mut |pa, among, axes, masks| {
-                    tests += among.count_ones() as u64;
-                    let met = axes.shafts_among(pa, among, masks);
-                    if met != 0 {
-                        emit(pa, met);
-                    }
-                }),
+                None => patch_sets(
+                    tables.as_ref().expect("not spanning"),
+                    poly,
+                    pair,
+                    n,
+                    &mut |pa, among, axes, masks| {
+                        tests += among.count_ones() as u64;
+                        let met = axes.shafts_among(pa, among, masks);
+                        if met != 0 {
+                            emit(pa, met);
+                        }
+                    },
+                ),
             }
         }
         out.tests += tests;
@@ -1666,10 +1679,11 @@ mod tests {
             let tri = Prepared::new(v);
             let poly = clip_to_box(v, DVec3::splat(-margin), DVec3::splat(1.0 + margin));
             let n2 = n * n;
+            let tables = tri.face_tables(n, margin);
             for pair in 0..FACE_PAIRS {
                 let mut found = Vec::new();
                 let mut tests = 0;
-                search(&tri, &poly, pair, n, margin, &mut tests, &mut |shaft, _, _| found.push(shaft));
+                search(&tables, &poly, pair, n, &mut tests, &mut |shaft, _, _| found.push(shaft));
                 found.sort_unstable();
                 let brute = if poly.is_empty() { Vec::new() } else { swept_shafts(&tri, pair, n, margin) };
                 tested += (n2 * n2) as u64;
