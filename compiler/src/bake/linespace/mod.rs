@@ -101,6 +101,9 @@ impl HitAttributes for SceneAttributes<'_> {
     fn material(&self, t: u32) -> u16 {
         self.materials[t as usize].min(u16::MAX as u32 - 1) as u16
     }
+    fn corner_normals(&self, t: u32) -> Option<[Vec3; 3]> {
+        Some(self.triangles[t as usize].map(|i| Vec3::from(self.vertices[i as usize].normal)))
+    }
 }
 
 /// Bakes the line space over `voxels` (the voxel grid in `attrs`' triangle order, which took

@@ -51,6 +51,12 @@ pub trait HitAttributes: Sync {
     fn uv(&self, t: u32, u: f32, v: f32) -> Vec2;
     /// Material.
     fn material(&self, t: u32) -> u16;
+    /// The shading normals at the corners where [`Self::normal`] interpolates them (`a·(1 − u −
+    /// v) + b·u + c·v` in that order wherever that is finite and non-zero), so that a bake can
+    /// interpolate them itself, eight hits at a time; `None` where it does not.
+    fn corner_normals(&self, _t: u32) -> Option<[Vec3; 3]> {
+        None
+    }
 }
 
 /// A face rectangle as a (degenerate) box in cell-local coordinates: (centre, half extents).
@@ -1121,6 +1127,18 @@ impl Single<'_> {
         // The segments from a patch to the shafts it fills are tested eight at a time.
         let faces = if pnmt { centres.map(|face| FaceCentres::new(&face)) } else { [FaceCentres::ZERO; 6] };
         let (mut lane, none) = (LaneHits::default(), [f32::NAN; MAX_PATCHES]);
+        // And their records encoded eight at a time where the layout and the scene allow.
+        let batch = (pnmt && layout == PnmtLayout::CompactNoUv)
+            .then(|| attrs.corner_normals(t))
+            .flatten()
+            .map(|normals| Batch {
+                corners: seg.c,
+                normals,
+                material: attrs.material(t),
+                world_cell_min,
+                cell,
+            });
+        let mut batched = [[0u32; 2]; MAX_PATCHES];
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let f = Filler::new(t, 0, &seg, pair, poly, margin);
@@ -1140,8 +1158,12 @@ impl Single<'_> {
                 }
                 let o = centres[fa as usize][pa as usize];
                 let hits = seg.hits_among(o, &faces[fb as usize], met, &none, &none, &mut lane);
+                let done = batch.as_ref().map_or(0, |b| b.records(&seg, &lane, hits, &mut batched));
                 for pb in set_bits(met) {
-                    let records = if hits >> pb & 1 == 1 {
+                    let records = if done >> pb & 1 == 1 {
+                        let [w0, w1] = batched[pb as usize];
+                        [[w0, w1, 0, 0]; 2]
+                    } else if hits >> pb & 1 == 1 {
                         let h = seg.lane(&lane, pb);
                         [hit_record(attrs, layout, t, seg.c, h.u, h.v, world_cell_min, cell); 2]
                     } else {
@@ -1183,6 +1205,68 @@ impl Single<'_> {
             }
         }
         out.tests += tests;
+    }
+}
+
+/// A triangle's hit records in the compact layout without uv, eight at a time
+/// ([`PnmtLayout::encode_compact_x8`]): what [`hit_record`] makes, bit for bit.
+struct Batch {
+    corners: [Vec3; 3],
+    /// Shading normals at the corners ([`HitAttributes::corner_normals`]).
+    normals: [Vec3; 3],
+    material: u16,
+    world_cell_min: DVec3,
+    cell: f64,
+}
+
+impl Batch {
+    /// Encodes the records of the `hits` (bit p: the crossing `lane` holds for patch p) into
+    /// `out` by patch; returns those encoded (the rest, with normals the encoder leaves out, and
+    /// all of them where the CPU lacks AVX2, need [`hit_record`]).
+    fn records(
+        &self,
+        seg: &SegmentTest,
+        lane: &LaneHits,
+        hits: u64,
+        out: &mut [[u32; 2]; MAX_PATCHES],
+    ) -> u64 {
+        let ([a, b, c], [na, nb, nc]) = (self.corners, self.normals);
+        let mut done = 0u64;
+        let mut rest = hits;
+        while rest != 0 {
+            let mut patches = [0u32; 8];
+            let mut count = 0;
+            while rest != 0 && count < 8 {
+                patches[count] = rest.trailing_zeros();
+                rest &= rest - 1;
+                count += 1;
+            }
+            let (mut p, mut n) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
+            for k in 0..8 {
+                // (Lanes past the last repeat it.)
+                let h = seg.lane(lane, patches[k.min(count - 1)]);
+                let (u, v) = (h.u, h.v);
+                // hit_record's position and SceneAttributes::normal's interpolation.
+                let position = a * (1.0 - u - v) + b * u + c * v;
+                let normal = na * (1.0 - u - v) + nb * u + nc * v;
+                for axis in 0..3 {
+                    p[axis][k] = position[axis];
+                    n[axis][k] = normal[axis];
+                }
+            }
+            let Some((words, taken)) =
+                PnmtLayout::encode_compact_x8(&p, &n, self.material, self.world_cell_min, self.cell)
+            else {
+                return done;
+            };
+            for k in 0..count {
+                if taken >> k & 1 == 1 {
+                    out[patches[k] as usize] = words[k];
+                    done |= 1 << patches[k];
+                }
+            }
+        }
+        done
     }
 }
 
@@ -1289,15 +1373,23 @@ mod tests {
         fn corners(&self, t: u32) -> [Vec3; 3] {
             self.0[t as usize]
         }
-        fn normal(&self, t: u32, _: f32, _: f32) -> Vec3 {
-            let [a, b, c] = self.0[t as usize];
-            (b - a).cross(c - a)
+        fn normal(&self, t: u32, u: f32, v: f32) -> Vec3 {
+            let [a, b, c] = self.corner_normals(t).unwrap();
+            let n = a * (1.0 - u - v) + b * u + c * v;
+            if n.is_finite() && n != Vec3::ZERO { n } else { Vec3::Z }
         }
         fn uv(&self, _: u32, u: f32, v: f32) -> Vec2 {
             Vec2::new(u, v)
         }
         fn material(&self, t: u32) -> u16 {
             (t % 3) as u16
+        }
+        /// The geometric normal bent a little differently at each corner.
+        fn corner_normals(&self, t: u32) -> Option<[Vec3; 3]> {
+            let [a, b, c] = self.0[t as usize];
+            let g = (b - a).cross(c - a);
+            let bend = g.length() * 0.3;
+            Some([g + Vec3::X * bend, g - Vec3::Y * bend, g + Vec3::Z * bend])
         }
     }
 
