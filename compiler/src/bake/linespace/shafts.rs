@@ -96,7 +96,7 @@ fn patch_sets(
     let (fa, fb) = pair_faces(pair);
     let (axes, masks) = tables.pair(fa, fb);
     let mut among = [0u64; MAX_PATCHES];
-    masks.survivors(&mut among);
+    tables.survivors(fa, &masks, &mut among);
     for (pa, &set) in among.iter().enumerate().take((n * n) as usize) {
         if set != 0 {
             patches(pa as u32, set, &axes, &masks);
