@@ -65,6 +65,30 @@ pub(super) struct Intersection {
     pub(super) v: f32,
 }
 
+/// The vector instructions a kernel uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Simd {
+    None,
+    Avx2,
+    Avx512,
+}
+
+impl Simd {
+    /// The widest this CPU has.
+    fn detect() -> Simd {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return Simd::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return Simd::Avx2;
+            }
+        }
+        Simd::None
+    }
+}
+
 /// The patch centres of one face, by coordinate (padded with zeros to [`MAX_PATCHES`]).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct FaceCentres {
@@ -108,7 +132,7 @@ impl SegmentTest {
     /// than the segment's hits so far; NaN: none yet), as a mask of the same bits; each one's
     /// crossing is then [`Self::lane`]. The same hits, bit for bit, as [`Self::hit_if`] segment by
     /// segment. `front` and `back` hold at least the highest patch of `among` rounded up to a
-    /// multiple of 8.
+    /// multiple of 16.
     pub(super) fn hits_among(
         &self,
         o: Vec3,
@@ -118,14 +142,11 @@ impl SegmentTest {
         back: &[f32],
         out: &mut LaneHits,
     ) -> u64 {
-        #[cfg(target_arch = "x86_64")]
-        let simd = std::arch::is_x86_feature_detected!("avx2");
-        #[cfg(not(target_arch = "x86_64"))]
-        let simd = false;
-        self.hits_among_with(o, to, among, front, back, out, simd)
+        self.hits_among_with(o, to, among, front, back, out, Simd::detect())
     }
 
-    /// [`Self::hits_among`], in AVX2 if `simd` (the caller has checked that the CPU has it).
+    /// [`Self::hits_among`] with the instructions `simd` (the caller has checked that the CPU
+    /// has them).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn hits_among_with(
@@ -136,18 +157,22 @@ impl SegmentTest {
         front: &[f32],
         back: &[f32],
         out: &mut LaneHits,
-        simd: bool,
+        simd: Simd,
     ) -> u64 {
         if among == 0 || self.n2 == 0.0 {
             return 0;
         }
-        let lanes = (64 - among.leading_zeros() as usize).next_multiple_of(8);
+        let width = if simd == Simd::Avx512 { 16 } else { 8 };
+        let lanes = (64 - among.leading_zeros() as usize).next_multiple_of(width);
         assert!(front.len() >= lanes && back.len() >= lanes, "the ends' t cover the lanes");
         #[cfg(target_arch = "x86_64")]
-        if simd {
-            // SAFETY: the CPU has AVX2; the lanes are within `front`, `back` (asserted) and the
-            // MAX_PATCHES arrays (a multiple of 8).
-            return unsafe { self.hits_avx2(o, to, among, lanes, front, back, out) };
+        match simd {
+            // SAFETY: the CPU has AVX-512F; the lanes are within `front`, `back` (asserted) and
+            // the MAX_PATCHES arrays (a multiple of 16).
+            Simd::Avx512 => return unsafe { self.hits_avx512(o, to, among, lanes, front, back, out) },
+            // SAFETY: as above, with AVX2 and 8.
+            Simd::Avx2 => return unsafe { self.hits_avx2(o, to, among, lanes, front, back, out) },
+            Simd::None => {}
         }
         let mut hits = 0;
         for p in set_bits(among) {
@@ -166,6 +191,79 @@ impl SegmentTest {
     pub(super) fn lane(&self, hits: &LaneHits, p: u32) -> Intersection {
         let p = p as usize;
         Intersection { t: hits.t[p], u: hits.w2[p] / self.n2, v: hits.w0[p] / self.n2 }
+    }
+
+    /// [`Self::hits_among`] in AVX-512, sixteen segments at a time, with [`Self::hit_if`]'s
+    /// operations in its order (no fused multiply-adds).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn hits_avx512(
+        &self,
+        o: Vec3,
+        to: &FaceCentres,
+        among: u64,
+        lanes: usize,
+        front: &[f32],
+        back: &[f32],
+        out: &mut LaneHits,
+    ) -> u64 {
+        use std::arch::x86_64::*;
+        let s = _mm512_set1_ps;
+        let dot = |a: Vec3, x: __m512, y: __m512, z: __m512| {
+            _mm512_add_ps(
+                _mm512_add_ps(_mm512_mul_ps(s(a.x), x), _mm512_mul_ps(s(a.y), y)),
+                _mm512_mul_ps(s(a.z), z),
+            )
+        };
+        let num = s(self.n.dot(self.c[0] - o));
+        let (zero, one) = (_mm512_setzero_ps(), s(1.0));
+        let mut hits = 0u64;
+        for g in (0..lanes).step_by(16) {
+            let group = (among >> g) as u16;
+            if group == 0 {
+                continue;
+            }
+            // SAFETY (loads, stores): g + 16 <= lanes <= MAX_PATCHES and <= front, back's
+            // lengths (the caller's contract).
+            let ld = |a: &[f32]| unsafe { _mm512_loadu_ps(a.as_ptr().add(g)) };
+            let dx = _mm512_sub_ps(ld(&to.x), s(o.x));
+            let dy = _mm512_sub_ps(ld(&to.y), s(o.y));
+            let dz = _mm512_sub_ps(ld(&to.z), s(o.z));
+            let denom = dot(self.n, dx, dy, dz);
+            let t = _mm512_div_ps(num, denom);
+            let crossing = _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(denom, zero)
+                & _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, zero)
+                & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, one);
+            let wanted = _mm512_cmp_ps_mask::<_CMP_NGE_UQ>(t, ld(front))
+                | _mm512_cmp_ps_mask::<_CMP_NLE_UQ>(t, ld(back));
+            let live = crossing & wanted & group;
+            if live == 0 {
+                continue;
+            }
+            let px = _mm512_add_ps(s(o.x), _mm512_mul_ps(dx, t));
+            let py = _mm512_add_ps(s(o.y), _mm512_mul_ps(dy, t));
+            let pz = _mm512_add_ps(s(o.z), _mm512_mul_ps(dz, t));
+            let edge = |m: Vec3, c: Vec3| {
+                dot(m, _mm512_sub_ps(px, s(c.x)), _mm512_sub_ps(py, s(c.y)), _mm512_sub_ps(pz, s(c.z)))
+            };
+            let [a, b, c] = self.c;
+            let (w0, w1, w2) = (edge(self.m[0], a), edge(self.m[1], b), edge(self.m[2], c));
+            let found = live
+                & _mm512_cmp_ps_mask::<_CMP_GE_OQ>(w0, zero)
+                & _mm512_cmp_ps_mask::<_CMP_GE_OQ>(w1, zero)
+                & _mm512_cmp_ps_mask::<_CMP_GE_OQ>(w2, zero);
+            if found != 0 {
+                // SAFETY: as the loads.
+                unsafe {
+                    _mm512_storeu_ps(out.t.as_mut_ptr().add(g), t);
+                    _mm512_storeu_ps(out.w0.as_mut_ptr().add(g), w0);
+                    _mm512_storeu_ps(out.w2.as_mut_ptr().add(g), w2);
+                }
+                hits |= (found as u64) << g;
+            }
+        }
+        hits
     }
 
     /// [`Self::hits_among`] in AVX2, eight segments at a time, with [`Self::hit_if`]'s operations
@@ -252,15 +350,17 @@ mod tests {
     use super::*;
     use crate::bake::linespace::geometry::tests::uniform;
 
-    /// The AVX2 segment tests give the portable ones' hits, t and barycentrics bit for bit:
+    /// The AVX2 and AVX-512 segment tests give the portable ones' hits, t and barycentrics bit for bit:
     /// random triangles (some degenerate, some in a face's plane, so that segments start or end
     /// on them: t = 0 or 1), random fronts and backs (some NaN: none yet), every lane count.
     #[test]
-    fn avx2_segments_match_the_portable_ones() {
-        #[cfg(target_arch = "x86_64")]
-        if !std::arch::is_x86_feature_detected!("avx2") {
-            return;
-        }
+    fn vector_segments_match_the_portable_ones() {
+        let widest = Simd::detect();
+        let kinds: &[Simd] = match widest {
+            Simd::Avx512 => &[Simd::Avx2, Simd::Avx512],
+            Simd::Avx2 => &[Simd::Avx2],
+            Simd::None => return,
+        };
         let mut rnd = uniform(7);
         let mut centres = [Vec3::ZERO; MAX_PATCHES];
         let (mut hits, mut lanes) = (0u32, 0u32);
@@ -286,16 +386,19 @@ mod tests {
             };
             let (front, back) = (ends(&mut rnd), ends(&mut rnd));
             let among = (rnd() * u64::MAX as f64) as u64 & crate::bake::linespace::geometry::low_bits(n * n);
-            let (mut a, mut b) = (LaneHits::default(), LaneHits::default());
-            let simd = seg.hits_among_with(o, &to, among, &front, &back, &mut a, true);
-            let portable = seg.hits_among_with(o, &to, among, &front, &back, &mut b, false);
-            assert_eq!(simd, portable, "case {case}");
-            for p in set_bits(simd) {
-                let (x, y) = (seg.lane(&a, p), seg.lane(&b, p));
-                let bits = |h: Intersection| [h.t.to_bits(), h.u.to_bits(), h.v.to_bits()];
-                assert_eq!(bits(x), bits(y), "case {case} patch {p}");
-                hits += 1;
-                lanes += (x.t == 0.0 || x.t == 1.0) as u32;
+            let mut b = LaneHits::default();
+            let portable = seg.hits_among_with(o, &to, among, &front, &back, &mut b, Simd::None);
+            for &kind in kinds {
+                let mut a = LaneHits::default();
+                let simd = seg.hits_among_with(o, &to, among, &front, &back, &mut a, kind);
+                assert_eq!(simd, portable, "case {case} {kind:?}");
+                for p in set_bits(simd) {
+                    let (x, y) = (seg.lane(&a, p), seg.lane(&b, p));
+                    let bits = |h: Intersection| [h.t.to_bits(), h.u.to_bits(), h.v.to_bits()];
+                    assert_eq!(bits(x), bits(y), "case {case} patch {p} {kind:?}");
+                    hits += 1;
+                    lanes += (x.t == 0.0 || x.t == 1.0) as u32;
+                }
             }
         }
         // Enough hits, some at a segment's ends, or the comparison says little.
