@@ -1139,6 +1139,21 @@ impl Single<'_> {
                 cell,
             });
         let mut batched = [[0u32; 2]; MAX_PATCHES];
+        // A spanning triangle's shafts are counted first, so that its records are written
+        // without growing their vector (copying and faulting in pages was a twentieth of a wall
+        // cell's bake).
+        if let (Some(sides), true) = (&sides, pnmt) {
+            let all = low_bits((n * n) as usize);
+            let mut count = 0;
+            for pair in 0..FACE_PAIRS {
+                let (fa, fb) = pair_faces(pair);
+                for pa in 0..n * n {
+                    count += met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all).count_ones()
+                        as usize;
+                }
+            }
+            out.pnmt.reserve_exact(count * 2 * layout.words());
+        }
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
             let f = Filler::new(t, 0, &seg, pair, poly, margin);
