@@ -374,6 +374,9 @@ pub struct Scratch {
     fallbacks: Vec<RecordWords>,
     /// The records-first bake's per-triangle data and bookkeeping ([`RecordsFirst`]).
     first: FirstScratch,
+    /// A cell's hits (triangle, u, v) in the order their records are written, and the records.
+    hit_list: Vec<(u32, f32, f32)>,
+    encoded: Vec<RecordWords>,
 }
 
 /// A fallback record not made yet: no layout's encoder makes it (the full record's material
@@ -414,8 +417,19 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
     let records_needed = pnmt || shade.is_some();
     let shafts = shafts_per_voxel(n) as usize;
     let mut out = CellShafts { bits: vec![0; words_per_slot(n)], ..Default::default() };
-    let Scratch { hits, sorted, counts, ends, hit_bits, polys, clip_tmp, fallbacks, first: first_scratch } =
-        scratch;
+    let Scratch {
+        hits,
+        sorted,
+        counts,
+        ends,
+        hit_bits,
+        polys,
+        clip_tmp,
+        fallbacks,
+        first: first_scratch,
+        hit_list,
+        encoded,
+    } = scratch;
     // (shaft, key min, key max, local triangle)
     hits.clear();
     // A shaft's ends are reset when it is first filled (resetting every shaft of every cell costs
@@ -466,6 +480,7 @@ pub fn bake_cell<A: HitAttributes + ?Sized>(
         shade,
         &centres,
         (hits, sorted, counts, ends, polys, fallbacks),
+        (hit_list, encoded),
         &mut out,
     );
     out
@@ -954,6 +969,7 @@ fn finish_cell<A: HitAttributes + ?Sized>(
         &mut [Vec<DVec3>],
         &mut Vec<RecordWords>,
     ),
+    (hit_list, encoded): (&mut Vec<(u32, f32, f32)>, &mut Vec<RecordWords>),
     out: &mut CellShafts,
 ) {
     let records_needed = pnmt || shade.is_some();
@@ -1001,17 +1017,38 @@ fn finish_cell<A: HitAttributes + ?Sized>(
         }
         fallbacks.clear();
         fallbacks.resize(tris.len() * 2 * FACE_PAIRS as usize, UNMADE);
-        let filled = out
-            .bits
-            .iter()
-            .enumerate()
-            .flat_map(|(w, &word)| set_bits(word.into()).map(move |b| w * 32 + b as usize));
-        for shaft in filled {
+        let filled = || {
+            out.bits
+                .iter()
+                .enumerate()
+                .flat_map(|(w, &word)| set_bits(word.into()).map(move |b| w * 32 + b as usize))
+        };
+        // The hit records of the compact layout without uv made first, eight at a time, in the
+        // order they are written.
+        encoded.clear();
+        if pnmt && shade.is_none() && layout == PnmtLayout::CompactNoUv {
+            hit_list.clear();
+            for shaft in filled() {
+                let end = &ends[shaft];
+                if end[0].t.is_finite() {
+                    hit_list.push((end[0].triangle, end[0].u, end[0].v));
+                    if !end[1].same_hit(&end[0]) {
+                        hit_list.push((end[1].triangle, end[1].u, end[1].v));
+                    }
+                }
+            }
+            encode_hits(attrs, hit_list, world_cell_min, cell, encoded);
+        }
+        let mut next_hit = encoded.iter();
+        for shaft in filled() {
             let end = &ends[shaft];
             let pair = shaft as u32 / (n * n * n * n);
             let (fa, fb) = pair_faces(pair);
-            let record = |e: &End, side: usize, fallbacks: &mut Vec<RecordWords>| -> RecordWords {
+            let mut record = |e: &End, side: usize, fallbacks: &mut Vec<RecordWords>| -> RecordWords {
                 if e.t.is_finite() {
+                    if let Some(&words) = next_hit.next() {
+                        return words;
+                    }
                     return hit_record(
                         attrs,
                         layout,
@@ -1260,14 +1297,7 @@ impl Batch {
             for k in 0..8 {
                 // (Lanes past the last repeat it.)
                 let h = seg.lane(lane, patches[k.min(count - 1)]);
-                let (u, v) = (h.u, h.v);
-                // hit_record's position and SceneAttributes::normal's interpolation.
-                let position = a * (1.0 - u - v) + b * u + c * v;
-                let normal = na * (1.0 - u - v) + nb * u + nc * v;
-                for axis in 0..3 {
-                    p[axis][k] = position[axis];
-                    n[axis][k] = normal[axis];
-                }
+                set_lane(&mut p, &mut n, k, [a, b, c], [na, nb, nc], h.u, h.v);
             }
             let Some((words, taken)) =
                 PnmtLayout::encode_compact_x8(&p, &n, self.material, self.world_cell_min, self.cell)
@@ -1282,6 +1312,64 @@ impl Batch {
             }
         }
         done
+    }
+}
+
+/// Lane `k` of [`PnmtLayout::encode_compact_x8`]'s input: the hit at barycentrics (`u`, `v`) of
+/// the triangle with `corners` and shading `normals` at them, interpolated as [`hit_record`]
+/// and `SceneAttributes::normal` do.
+#[inline(always)]
+fn set_lane(
+    p: &mut [[f32; 8]; 3],
+    n: &mut [[f32; 8]; 3],
+    k: usize,
+    [a, b, c]: [Vec3; 3],
+    [na, nb, nc]: [Vec3; 3],
+    u: f32,
+    v: f32,
+) {
+    let position = a * (1.0 - u - v) + b * u + c * v;
+    let normal = na * (1.0 - u - v) + nb * u + nc * v;
+    for axis in 0..3 {
+        p[axis][k] = position[axis];
+        n[axis][k] = normal[axis];
+    }
+}
+
+/// The records of `hits` ((triangle, u, v) each) in the compact layout without uv, eight at a
+/// time where the scene gives corner normals ([`HitAttributes::corner_normals`]) and the CPU
+/// AVX2, appended to `out`: what [`hit_record`] makes, bit for bit.
+fn encode_hits<A: HitAttributes + ?Sized>(
+    attrs: &A,
+    hits: &[(u32, f32, f32)],
+    world_cell_min: DVec3,
+    cell: f64,
+    out: &mut Vec<RecordWords>,
+) {
+    let layout = PnmtLayout::CompactNoUv;
+    let max = layout.max_material();
+    for chunk in hits.chunks(8) {
+        let (mut p, mut n) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
+        let mut ready = chunk.len() == 8;
+        for (k, &(t, u, v)) in chunk.iter().enumerate() {
+            let Some(normals) = attrs.corner_normals(t) else {
+                ready = false;
+                break;
+            };
+            set_lane(&mut p, &mut n, k, attrs.corners(t), normals, u, v);
+        }
+        // (The materials are or-ed in below, lane by lane.)
+        let encoded =
+            if ready { PnmtLayout::encode_compact_x8(&p, &n, 0, world_cell_min, cell) } else { None };
+        for (k, &(t, u, v)) in chunk.iter().enumerate() {
+            out.push(match encoded {
+                Some((words, taken)) if taken >> k & 1 == 1 => {
+                    let m = attrs.material(t).min(max) as u32;
+                    [words[k][0] | (m >> 10) << 30, words[k][1] | (m & 0x3ff) << 22, 0, 0]
+                }
+                _ => hit_record(attrs, layout, t, attrs.corners(t), u, v, world_cell_min, cell),
+            });
+        }
     }
 }
 
@@ -1513,7 +1601,8 @@ mod tests {
             let attrs = ListAttributes(tris.iter().map(|t| t.map(|p| (p + world_min).as_vec3())).collect());
             let ids: Vec<u32> = (0..tris.len() as u32).collect();
             let layout = [PnmtLayout::Full, PnmtLayout::CompactNoUv][(case / 3 % 2) as usize];
-            let bake = |candidates: bool, scratch: &mut Scratch| {
+            let shade: &Shade<'_> = &|_, _, _, _, _| Vec3::ONE;
+            let bake = |candidates: bool, shade: Option<&Shade<'_>>, scratch: &mut Scratch| {
                 bake_cell(
                     &ids,
                     &tris,
@@ -1526,12 +1615,15 @@ mod tests {
                     true,
                     layout,
                     &attrs,
-                    None,
+                    shade,
                     scratch,
                 )
             };
-            let all = bake(true, &mut Scratch::default());
-            let first = bake(false, &mut scratch);
+            let all = bake(true, None, &mut Scratch::default());
+            let first = bake(false, None, &mut scratch);
+            // With pre-illumination the records are encoded one at a time, not eight at a time.
+            let shaded = bake(false, Some(shade), &mut Scratch::default());
+            assert!(first.pnmt == shaded.pnmt, "case {case}: the records encoded eight at a time differ");
             let differ = |a: &[u32], b: &[u32]| a.iter().zip(b).filter(|(x, y)| x != y).count();
             assert!(
                 first.bits == all.bits,
