@@ -250,7 +250,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
     let written = baked.and_then(|baked| {
         progress.stage("write");
         let t_write = Instant::now();
-        let bytes = bake::write(&baked, output).map_err(|e| CliError::io(e.to_string()))?;
+        let bytes = bake::write(&baked, output, threads).map_err(|e| CliError::io(e.to_string()))?;
         Ok((baked, bytes, t_write.elapsed().as_secs_f64() * 1e3))
     });
     // After the write: a GPU opened early for a line space that then came from the stage cache

@@ -12,8 +12,17 @@ pub(crate) fn cores() -> usize {
 /// thread taking the next item in order until none is left; returns the results in item order.
 /// A panic in `f` reaches the caller.
 pub(crate) fn on_all_cores<T: Send, R: Send>(items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+    on_threads(cores(), items, f)
+}
+
+/// [`on_all_cores`] on at most `threads` threads.
+pub(crate) fn on_threads<T: Send, R: Send>(
+    threads: usize,
+    items: Vec<T>,
+    f: impl Fn(T) -> R + Sync,
+) -> Vec<R> {
     let count = items.len();
-    let threads = cores().min(count);
+    let threads = threads.clamp(1, count.max(1));
     let queue = Mutex::new(items.into_iter().enumerate());
     let results = Mutex::new(Vec::with_capacity(count));
     std::thread::scope(|scope| {

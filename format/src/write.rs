@@ -117,6 +117,8 @@ impl Compression {
 pub struct FileWriter<'a> {
     pending: Vec<Pending<'a>>,
     compression: Compression,
+    /// Threads that compress (`None`: one per core).
+    threads: Option<usize>,
 }
 
 impl std::fmt::Debug for FileWriter<'_> {
@@ -129,6 +131,13 @@ impl<'a> FileWriter<'a> {
     /// An empty writer.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Compresses on at most `threads` threads (at least one; one per core unless called). The
+    /// bytes are the same for every count.
+    pub fn threads(&mut self, threads: usize) -> &mut Self {
+        self.threads = Some(threads.max(1));
+        self
     }
 
     /// Chooses which sections are compressed (none unless called).
@@ -244,7 +253,7 @@ impl<'a> FileWriter<'a> {
         Ok((header, entries))
     }
 
-    /// Compresses the sections the policy selects, on as many threads as the machine has: the
+    /// Compresses the sections the policy selects, on the writer's threads: the
     /// small ones side by side, a thread each, then each large one on all the threads (zstd's
     /// jobs; one section of PNMT records can be most of a file, and one thread took 14 s over
     /// 2.7 GB). The bytes do not depend on the thread count ([`crate::codec::compress_zstd`]).
@@ -264,10 +273,10 @@ impl<'a> FileWriter<'a> {
             }
             Ok(())
         };
-        let results = crate::parallel::on_all_cores(small, |p| compress(p, 1));
+        let threads = self.threads.unwrap_or_else(crate::parallel::cores);
+        let results = crate::parallel::on_threads(threads, small, |p| compress(p, 1));
         results.into_iter().collect::<Result<(), WriteError>>()?;
-        let cores = crate::parallel::cores() as u32;
-        large.into_iter().try_for_each(|p| compress(p, cores))
+        large.into_iter().try_for_each(|p| compress(p, threads as u32))
     }
 
     /// Writes the file to `out`; returns its length.

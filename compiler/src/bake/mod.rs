@@ -611,9 +611,9 @@ impl LineSpaceStats {
     }
 }
 
-fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::WriteError> {
+fn writer(baked: &Baked, threads: usize) -> Result<kiln_format::FileWriter<'_>, kiln_format::WriteError> {
     let mut w = kiln_format::FileWriter::new();
-    w.compression(baked.codec.compression());
+    w.compression(baked.codec.compression()).threads(threads);
     w.manifest(&baked.manifest, baked.manifest_hash)?;
     // Full PNMT records (or none) are what version 1 of VGRD and LSPN hold, byte for byte: written
     // at version 1, such a file stays readable by format 1.2 readers. Compact ones need version 2.
@@ -633,12 +633,12 @@ fn writer(baked: &Baked) -> Result<kiln_format::FileWriter<'_>, kiln_format::Wri
     Ok(w)
 }
 
-/// Writes the baked file atomically; returns its size.
-pub fn write(baked: &Baked, path: &std::path::Path) -> Result<u64, kiln_format::WriteError> {
-    writer(baked)?.write_atomic(path)
+/// Writes the baked file atomically, compressing on `threads` threads; returns its size.
+pub fn write(baked: &Baked, path: &std::path::Path, threads: usize) -> Result<u64, kiln_format::WriteError> {
+    writer(baked, threads)?.write_atomic(path)
 }
 
-/// The baked file in memory.
+/// The baked file in memory, compressed on the current rayon pool's thread count.
 pub fn to_bytes(baked: &Baked) -> Result<Vec<u8>, kiln_format::WriteError> {
-    writer(baked)?.to_bytes()
+    writer(baked, rayon::current_num_threads())?.to_bytes()
 }

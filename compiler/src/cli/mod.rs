@@ -232,7 +232,8 @@ pub struct OutputArgs {
     /// Write a make/ninja depfile listing every file read.
     #[arg(long, value_name = "DEPS.d")]
     pub depfile: Option<PathBuf>,
-    /// Worker threads [default: all cores]. The output is identical for every count.
+    /// Worker threads for the bakes and the compression [default: all cores]. The output is
+    /// identical for every count.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub threads: Option<u16>,
     /// Where the line space is baked. The output is identical for every device.
