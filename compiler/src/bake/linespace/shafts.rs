@@ -385,11 +385,12 @@ const UNMADE: RecordWords = [u32::MAX; 4];
 
 const NO_END: End = End { t: f32::NAN, triangle: u32::MAX, u: 0.0, v: 0.0, key: f64::NAN, local: u32::MAX };
 
-/// The least number of triangles in a cell for which a bake without candidates keeps only the
-/// union. Measured on seed 004's table (GPU machine's CPUs) with the union in every cell: it
-/// took 0.79× the all-pairs time on the dragon at 8³ (16 threads) and 0.85× on the bunny at 8³
-/// (2 threads): hundreds to thousands of triangles a cell; but 1.06–1.18× at 32³–72³, a few to
-/// tens a cell.
+/// The least number of triangles in a cell for which a bake without candidates or records (binary
+/// alone; with records, [`RecordsFirst`] bakes every cell of several triangles) keeps only the
+/// union. Measured on seed 004's table (GPU machine's CPUs, PNMT, before records first) with the
+/// union in every cell: it took 0.79× the all-pairs time on the dragon at 8³ (16 threads) and
+/// 0.85× on the bunny at 8³ (2 threads): hundreds to thousands of triangles a cell; but
+/// 1.06–1.18× at 32³–72³, a few to tens a cell.
 const UNION_MIN_TRIANGLES: usize = 64;
 
 /// Bakes one cell. `tris` are the cell's global triangle numbers, `local` their grid-local
