@@ -259,18 +259,10 @@ impl Fills<'_> {
         }
         let (o, e) = self.segment(pa, pb, f);
         let end = &self.ends[shaft as usize];
-        if let Some(h) = f.seg.hit_if(o, e, |t| !(t >= end[0].t) || !(t <= end[1].t)) {
+        if let Some(h) = f.seg.hit_if(o, e, |t| nearer(end, t).contains(&true)) {
             self.take_hit(shaft, h, f.triangle);
         }
-        let end = &mut self.ends[shaft as usize];
-        if !(f.kmin >= end[0].key) {
-            end[0].key = f.kmin;
-            end[0].local = f.local;
-        }
-        if !(f.kmax <= end[1].key) {
-            end[1].key = f.kmax;
-            end[1].local = f.local;
-        }
+        take_keys(&mut self.ends[shaft as usize], f.kmin, f.kmax, f.local);
     }
 
     /// Takes the hit `h` of triangle `t` where it is nearer either end than the shaft's.
@@ -280,10 +272,11 @@ impl Fills<'_> {
             *w |= 1 << (shaft % 32);
         }
         let end = &mut self.ends[shaft as usize];
-        if !(h.t >= end[0].t) {
+        let [front, back] = nearer(end, h.t);
+        if front {
             end[0] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[0] };
         }
-        if !(h.t <= end[1].t) {
+        if back {
             end[1] = End { t: h.t, triangle: t, u: h.u, v: h.v, ..end[1] };
         }
     }
@@ -295,16 +288,8 @@ impl Fills<'_> {
     #[inline(always)]
     fn needing_test(&self, pair: u32, pa: u32, among: u64, n: u32, f: &Filler) -> u64 {
         let first = shaft_of(pair, pa, 0, n) as usize;
-        let n2 = (n * n) as usize;
-        let filled = bit_range(self.bits, first, n2);
-        let mut need = among & !filled;
-        if self.records_needed {
-            for pb in set_bits(among & filled & !bit_range(self.hit_bits, first, n2)) {
-                let end = &self.ends[first + pb as usize];
-                need |= ((!(f.kmin >= end[0].key) || !(f.kmax <= end[1].key)) as u64) << pb;
-            }
-        }
-        need
+        let keys = self.records_needed.then_some((f.kmin, f.kmax));
+        needing_test(self.bits, self.hit_bits, self.ends, first, (n * n) as usize, among, keys)
     }
 
     /// The hit of the filled `shaft`'s (from patch `pa` to `pb`) midpoint segment on `f`'s
@@ -313,7 +298,7 @@ impl Fills<'_> {
     fn better_hit(&self, shaft: u32, pa: u32, pb: u32, f: &Filler) -> Option<Intersection> {
         let (o, e) = self.segment(pa, pb, f);
         let end = &self.ends[shaft as usize];
-        f.seg.hit_if(o, e, |t| !(t >= end[0].t) || !(t <= end[1].t))
+        f.seg.hit_if(o, e, |t| nearer(end, t).contains(&true))
     }
 }
 
@@ -357,6 +342,35 @@ impl End {
             && self.u.to_bits() == other.u.to_bits()
             && self.v.to_bits() == other.v.to_bits()
     }
+}
+
+/// Which of a shaft's ends (front, back) a segment hit at `t` is nearer than: strictly (the
+/// earliest triangle of the list keeps a tie), and any hit is nearer than none (NaN).
+#[inline(always)]
+fn nearer(end: &[End; 2], t: f32) -> [bool; 2] {
+    [!(t >= end[0].t), !(t <= end[1].t)]
+}
+
+/// Takes the fallback key bounds (`kmin`, `kmax`) of the cell's triangle `local` where they reach
+/// beyond the shaft's ([`keys_beyond`]).
+#[inline(always)]
+fn take_keys(end: &mut [End; 2], kmin: f64, kmax: f64, local: u32) {
+    let [lo, hi] = keys_beyond(end, kmin, kmax);
+    if lo {
+        end[0].key = kmin;
+        end[0].local = local;
+    }
+    if hi {
+        end[1].key = kmax;
+        end[1].local = local;
+    }
+}
+
+/// Whether the key bounds (`kmin`, `kmax`) reach beyond the shaft's fallback bounds, towards its
+/// front and its back: strictly, and any bound beyond none (NaN).
+#[inline(always)]
+fn keys_beyond(end: &[End; 2], kmin: f64, kmax: f64) -> [bool; 2] {
+    [!(kmin >= end[0].key), !(kmax <= end[1].key)]
 }
 
 /// Buffers reused across the cells one worker thread bakes (allocating them per cell costs
@@ -688,11 +702,12 @@ impl RecordsFirst<'_> {
                         let h = seg.lane(&lane, pb);
                         let tentative =
                             End { t: h.t, triangle: t, u: h.u, v: h.v, key: f64::NAN, local: li as u32 };
-                        if !(h.t >= end[0].t) {
+                        let [nearer_front, nearer_back] = nearer(end, h.t);
+                        if nearer_front {
                             end[0] = tentative;
                             front[shaft] = h.t;
                         }
-                        if !(h.t <= end[1].t) {
+                        if nearer_back {
                             end[1] = tentative;
                             back[shaft] = h.t;
                         }
@@ -924,14 +939,7 @@ impl Exact<'_> {
             self.seen[w] |= bit;
             *end = [NO_END; 2];
         }
-        if !(self.kmin >= end[0].key) {
-            end[0].key = self.kmin;
-            end[0].local = self.li;
-        }
-        if !(self.kmax <= end[1].key) {
-            end[1].key = self.kmax;
-            end[1].local = self.li;
-        }
+        take_keys(end, self.kmin, self.kmax, self.li);
     }
 
     /// Of the shafts `among` (bit pb for shaft `first` + pb, `n2` of them), those without a hit
@@ -940,14 +948,33 @@ impl Exact<'_> {
     #[inline(always)]
     fn needing_test(&self, first: usize, n2: usize, among: u64) -> u64 {
         let no_hit = among & !bit_range(self.hit_bits, first, n2);
-        let filled = bit_range(self.bits, first, n2);
-        let mut need = no_hit & !filled;
-        for pb in set_bits(no_hit & filled) {
-            let end = &self.ends[first + pb as usize];
-            need |= ((!(self.kmin >= end[0].key) || !(self.kmax <= end[1].key)) as u64) << pb;
-        }
-        need
+        needing_test(self.bits, self.hit_bits, self.ends, first, n2, no_hit, Some((self.kmin, self.kmax)))
     }
+}
+
+/// Of the shafts `among` (bit pb for shaft `first` + pb, `n2` of them; `bits` filled,
+/// `hit_bits` with a segment hit), those a triangle's exact test may change: those not filled
+/// yet, and, with its key bounds `keys`, those filled without a hit whose fallback bounds it
+/// reaches beyond.
+#[inline(always)]
+fn needing_test(
+    bits: &[u32],
+    hit_bits: &[u32],
+    ends: &[[End; 2]],
+    first: usize,
+    n2: usize,
+    among: u64,
+    keys: Option<(f64, f64)>,
+) -> u64 {
+    let filled = bit_range(bits, first, n2);
+    let mut need = among & !filled;
+    if let Some((kmin, kmax)) = keys {
+        for pb in set_bits(among & filled & !bit_range(hit_bits, first, n2)) {
+            let end = &ends[first + pb as usize];
+            need |= (keys_beyond(end, kmin, kmax).contains(&true) as u64) << pb;
+        }
+    }
+    need
 }
 
 /// The end of a cell's bake: the candidate lists from the (shaft, keys, triangle) hits, the
@@ -1177,20 +1204,22 @@ impl Single<'_> {
                 cell,
             });
         let mut batched = [[0u32; 2]; MAX_PATCHES];
-        // A spanning triangle's shafts are counted first, so that its records are written
-        // without growing their vector (copying and faulting in pages was a twentieth of a wall
-        // cell's bake).
-        if let (Some(sides), true) = (&sides, pnmt) {
+        // A spanning triangle's shafts, by pair and front patch, found first and counted, so that
+        // its records are written without growing their vector (copying and faulting in pages
+        // was a twentieth of a wall cell's bake).
+        let mut met_sets = [[0u64; MAX_PATCHES]; FACE_PAIRS as usize];
+        if let Some(sides) = &sides {
             let all = low_bits((n * n) as usize);
-            let mut count = 0;
-            for pair in 0..FACE_PAIRS {
-                let (fa, fb) = pair_faces(pair);
-                for pa in 0..n * n {
-                    count += met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all).count_ones()
-                        as usize;
+            for (pair, sets) in met_sets.iter_mut().enumerate() {
+                let (fa, fb) = pair_faces(pair as u32);
+                for (pa, set) in sets.iter_mut().enumerate().take((n * n) as usize) {
+                    *set = met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all);
                 }
             }
-            out.pnmt.reserve_exact(count * 2 * layout.words());
+            if pnmt {
+                let count: u32 = met_sets.iter().flatten().map(|s| s.count_ones()).sum();
+                out.pnmt.reserve_exact(count as usize * 2 * layout.words());
+            }
         }
         for pair in 0..FACE_PAIRS {
             let (fa, fb) = pair_faces(pair);
@@ -1233,12 +1262,10 @@ impl Single<'_> {
                 }
             };
             match &sides {
-                Some(sides) => {
-                    let all = low_bits((n * n) as usize);
-                    for pa in 0..n * n {
-                        let met = met_from(1 << pa, &sides[fa as usize], &sides[fb as usize], all);
+                Some(_) => {
+                    for (pa, &met) in met_sets[pair as usize].iter().enumerate() {
                         if met != 0 {
-                            emit(pa, met);
+                            emit(pa as u32, met);
                         }
                     }
                 }
