@@ -17,14 +17,12 @@
 //! records with texture coordinates where the scene has any (binary16 rounding is not
 //! reproduced); [`supports`] says which.
 
-use glam::DVec3;
 use kiln_format::gpu::{BakeCell, BakeParams};
 use kiln_format::linespace::index::shafts_per_voxel;
-use kiln_format::linespace::{GridHeader, PnmtLayout, Variants, words_per_slot};
+use kiln_format::linespace::{PnmtLayout, Variants, words_per_slot};
 use kiln_gpubake::{Buffer, Compute, Kernel, Memory, Options};
 use rayon::prelude::*;
 
-use super::SceneAttributes;
 use super::shafts::HitAttributes;
 use crate::exit::{CliError, CliResult};
 use crate::progress::Progress;
@@ -385,26 +383,19 @@ struct HostSide {
     records: Buffer,
 }
 
-/// Bakes the binary (and, if `pnmt`, PNMT) line space of the `occupied` cells into `out`'s
+/// Bakes the binary (and, if `pnmt`, PNMT) line space of the occupied `cells` into `out`'s
 /// `bits`, `ranks` and `pnmt` (appended in cell order, as the CPU bake lays them out), with the
 /// (triangle, shaft) pairs the separations left to decide in `tests` and the filled shafts
 /// lacking a record in `pnmt_missing`.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn bake(
     gpu: &GpuBaker,
-    attrs: &SceneAttributes,
-    header: &GridHeader,
-    local: &[[DVec3; 3]],
-    voxel_offsets: &[u32],
-    voxel_triangles: &[u32],
-    occupied: &[usize],
-    n: u32,
-    margin: f64,
+    cells: &super::Cells,
     layout: PnmtLayout,
     pnmt: bool,
     progress: &Progress,
     out: &mut super::BakedLineSpace,
 ) -> CliResult<()> {
+    let super::Cells { attrs, header, local, voxel_offsets, voxel_triangles, occupied, n, margin } = *cells;
     let compute = &gpu.compute;
     let shafts = shafts_per_voxel(n);
     let wps = words_per_slot(n);

@@ -164,38 +164,21 @@ pub fn bake(
     header.slots = occupied.len() as u32;
     let margin_local = header.margin / header.cell;
     progress.count("line space: cells", occupied.len() as u64);
+    let cells = Cells {
+        attrs,
+        header: &header,
+        local: &local,
+        voxel_offsets: &voxel_offsets,
+        voxel_triangles: &voxel_triangles,
+        occupied: &occupied,
+        n,
+        margin: margin_local,
+    };
     if let Some(gpu) = gpu.filter(|_| gpu::supports(variants, layout, !attrs.uvs.is_empty())) {
-        gpu::bake(
-            gpu,
-            attrs,
-            &header,
-            &local,
-            &voxel_offsets,
-            &voxel_triangles,
-            &occupied,
-            n,
-            margin_local,
-            layout,
-            pnmt,
-            progress,
-            &mut out,
-        )?;
+        gpu::bake(gpu, &cells, layout, pnmt, progress, &mut out)?;
         out.device = Some(gpu.device().to_string());
     } else {
-        bake_on_cpu(
-            attrs,
-            &header,
-            &local,
-            &voxel_offsets,
-            &voxel_triangles,
-            &occupied,
-            n,
-            margin_local,
-            (candidates, pnmt, layout),
-            shade,
-            progress,
-            &mut out,
-        )?;
+        bake_on_cpu(&cells, (candidates, pnmt, layout), shade, progress, &mut out)?;
     }
     header.filled =
         out.ranks.last().map_or(0, |&r| r as u64) + out.bits.last().map_or(0, |w| w.count_ones() as u64);
@@ -212,23 +195,34 @@ pub fn bake(
     Ok(out)
 }
 
-/// The CPU bake of the `occupied` cells into `out` (see [`bake`]), with candidates, PNMT
+/// What a device bakes: the occupied cells of a voxel grid at shaft resolution `n`.
+pub(super) struct Cells<'a> {
+    /// The scene, triangles in the grid's order.
+    pub attrs: &'a SceneAttributes<'a>,
+    pub header: &'a GridHeader,
+    /// Every triangle's grid-local corners.
+    pub local: &'a [[DVec3; 3]],
+    /// The cells' triangle lists.
+    pub voxel_offsets: &'a [u32],
+    pub voxel_triangles: &'a [u32],
+    /// The cells with triangles, in slot order.
+    pub occupied: &'a [usize],
+    pub n: u32,
+    /// The grid margin, in cells.
+    pub margin: f64,
+}
+
+/// The CPU bake of the occupied `cells` into `out` (see [`bake`]), with candidates, PNMT
 /// records in `layout` and pre-illumination (`shade`) as asked.
-#[allow(clippy::too_many_arguments)]
 fn bake_on_cpu(
-    attrs: &SceneAttributes,
-    header: &GridHeader,
-    local: &[[DVec3; 3]],
-    voxel_offsets: &[u32],
-    voxel_triangles: &[u32],
-    occupied: &[usize],
-    n: u32,
-    margin_local: f64,
+    cells: &Cells,
     (candidates, pnmt, layout): (bool, bool, PnmtLayout),
     shade: Option<&Shade<'_>>,
     progress: &Progress,
     out: &mut BakedLineSpace,
 ) -> CliResult<()> {
+    let Cells { attrs, header, local, voxel_offsets, voxel_triangles, occupied, n, margin: margin_local } =
+        *cells;
     // Cells are baked a chunk at a time and each chunk's parts appended to the sections before
     // the next: holding every cell's parts until the end doubled the bake's peak memory at the
     // fine rows of seed 004's table (gigabytes of PNMT records).
