@@ -168,7 +168,7 @@ impl PnmtLayout {
     }
 
     /// Eight hits' records in the compact layout without uv at once (AVX2): lane k's two words
-    /// are those of `CompactNoUv.encode(positions[·][k] as f64, normals[·][k], material, _,
+    /// are those of `CompactNoUv.encode(positions[·][k] as f64, normals[·][k], materials[k], _,
     /// cell_min, cell)`, bit for bit, for each lane set in the returned mask: the lanes whose
     /// normal is finite and non-zero with a finite octahedral map (the rest need [`Self::encode`]).
     /// `None` where the CPU lacks AVX2. The bakes' walls write tens of millions of records, and
@@ -176,17 +176,17 @@ impl PnmtLayout {
     pub fn encode_compact_x8(
         positions: &[[f32; 8]; 3],
         normals: &[[f32; 8]; 3],
-        material: u16,
+        materials: &[u16; 8],
         cell_min: DVec3,
         cell: f64,
     ) -> Option<([[u32; 2]; 8], u8)> {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
-            let m = material.min(Self::CompactNoUv.max_material()) as u32;
+            let m = materials.map(|m| m.min(Self::CompactNoUv.max_material()) as u32);
             // SAFETY: the CPU has AVX2.
-            return Some(unsafe { compact_x8(positions, normals, m, cell_min, cell) });
+            return Some(unsafe { compact_x8(positions, normals, &m, cell_min, cell) });
         }
-        let _ = (positions, normals, material, cell_min, cell);
+        let _ = (positions, normals, materials, cell_min, cell);
         None
     }
 
@@ -289,7 +289,7 @@ fn round_unsigned(x: f64) -> u32 {
 unsafe fn compact_x8(
     positions: &[[f32; 8]; 3],
     normals: &[[f32; 8]; 3],
-    m: u32,
+    m: &[u32; 8],
     cell_min: DVec3,
     cell: f64,
 ) -> ([[u32; 2]; 8], u8) {
@@ -341,13 +341,15 @@ unsafe fn compact_x8(
         _mm256_add_epi32(_mm256_add_epi32(_mm256_sub_epi32(i, up), down), _mm256_set1_epi32(1023))
     };
     let (sx, sy) = (round(fx), round(fy));
+    // SAFETY: `m` holds eight u32.
+    let m = unsafe { _mm256_loadu_si256(m.as_ptr().cast()) };
     let w0 = _mm256_or_si256(
         _mm256_or_si256(q[0], _mm256_slli_epi32::<10>(q[1])),
-        _mm256_or_si256(_mm256_slli_epi32::<20>(q[2]), _mm256_set1_epi32(((m >> 10) << 30) as i32)),
+        _mm256_or_si256(_mm256_slli_epi32::<20>(q[2]), _mm256_slli_epi32::<30>(_mm256_srli_epi32::<10>(m))),
     );
     let w1 = _mm256_or_si256(
         _mm256_or_si256(sx, _mm256_slli_epi32::<11>(sy)),
-        _mm256_set1_epi32(((m & 0x3ff) << 22) as i32),
+        _mm256_slli_epi32::<22>(_mm256_and_si256(m, _mm256_set1_epi32(0x3ff))),
     );
     let (mut a, mut b) = ([0u32; 8], [0u32; 8]);
     // SAFETY: each array holds eight u32.
@@ -420,7 +422,8 @@ mod tests {
     /// quantisations, normals of every octant, tiny and huge, zero, infinite and NaN.
     #[test]
     fn eight_lane_compact_records_match_encode() {
-        let Some(_) = PnmtLayout::encode_compact_x8(&[[0.0; 8]; 3], &[[0.0; 8]; 3], 0, DVec3::ZERO, 1.0)
+        let Some(_) =
+            PnmtLayout::encode_compact_x8(&[[0.0; 8]; 3], &[[0.0; 8]; 3], &[0; 8], DVec3::ZERO, 1.0)
         else {
             return;
         };
@@ -464,13 +467,14 @@ mod tests {
                     _ => {}
                 }
             }
-            let material = (case % 5000) as u16;
-            let (words, mask) = PnmtLayout::encode_compact_x8(&p, &n, material, cell_min, cell).unwrap();
+            // Materials differing lane by lane, some beyond the layout's largest.
+            let materials: [u16; 8] = std::array::from_fn(|k| ((case * 7 + k as u32 * 977) % 5000) as u16);
+            let (words, mask) = PnmtLayout::encode_compact_x8(&p, &n, &materials, cell_min, cell).unwrap();
             for k in 0..8 {
                 let pos = DVec3::new(p[0][k] as f64, p[1][k] as f64, p[2][k] as f64);
                 let normal = Vec3::new(n[0][k], n[1][k], n[2][k]);
                 let expected =
-                    PnmtLayout::CompactNoUv.encode(pos, normal, material, Vec2::ZERO, cell_min, cell);
+                    PnmtLayout::CompactNoUv.encode(pos, normal, materials[k], Vec2::ZERO, cell_min, cell);
                 let ordinary = normal.is_finite() && normal != Vec3::ZERO;
                 lanes += 1;
                 if mask >> k & 1 == 1 {

@@ -1321,15 +1321,11 @@ impl Batch {
                 rest &= rest - 1;
                 count += 1;
             }
-            let (mut p, mut n) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
-            for k in 0..8 {
-                // (Lanes past the last repeat it.)
-                let h = seg.lane(lane, patches[k.min(count - 1)]);
-                set_lane(&mut p, &mut n, k, [a, b, c], [na, nb, nc], h.u, h.v);
-            }
-            let Some((words, taken)) =
-                PnmtLayout::encode_compact_x8(&p, &n, self.material, self.world_cell_min, self.cell)
-            else {
+            let hit = |k: usize| {
+                let h = seg.lane(lane, patches[k]);
+                Some(([a, b, c], [na, nb, nc], self.material, h.u, h.v))
+            };
+            let Some((words, taken)) = encode_eight(count, hit, self.world_cell_min, self.cell) else {
                 return done;
             };
             for k in 0..count {
@@ -1343,25 +1339,33 @@ impl Batch {
     }
 }
 
-/// Lane `k` of [`PnmtLayout::encode_compact_x8`]'s input: the hit at barycentrics (`u`, `v`) of
-/// the triangle with `corners` and shading `normals` at them, interpolated as [`hit_record`]
-/// and `SceneAttributes::normal` do.
-#[inline(always)]
-fn set_lane(
-    p: &mut [[f32; 8]; 3],
-    n: &mut [[f32; 8]; 3],
-    k: usize,
-    [a, b, c]: [Vec3; 3],
-    [na, nb, nc]: [Vec3; 3],
-    u: f32,
-    v: f32,
-) {
-    let position = a * (1.0 - u - v) + b * u + c * v;
-    let normal = na * (1.0 - u - v) + nb * u + nc * v;
-    for axis in 0..3 {
-        p[axis][k] = position[axis];
-        n[axis][k] = normal[axis];
+/// The records of up to eight hits (`count` ≥ 1) in the compact layout without uv
+/// ([`PnmtLayout::encode_compact_x8`]), hit k given by `hit(k)`: the corners of its triangle, the
+/// shading normals at them, its material and its barycentrics (u, v), or `None` where the scene
+/// has no corner normals. Positions and normals are interpolated as [`hit_record`] and
+/// `SceneAttributes::normal` do; the words are [`hit_record`]'s, bit for bit, for every hit the
+/// returned mask takes (`None`: none taken).
+#[allow(clippy::type_complexity)]
+fn encode_eight(
+    count: usize,
+    hit: impl Fn(usize) -> Option<([Vec3; 3], [Vec3; 3], u16, f32, f32)>,
+    world_cell_min: DVec3,
+    cell: f64,
+) -> Option<([[u32; 2]; 8], u8)> {
+    let (mut p, mut n, mut m) = ([[0f32; 8]; 3], [[0f32; 8]; 3], [0u16; 8]);
+    for k in 0..8 {
+        // (Lanes past the last repeat it.)
+        let ([a, b, c], [na, nb, nc], material, u, v) = hit(k.min(count - 1))?;
+        let position = a * (1.0 - u - v) + b * u + c * v;
+        let normal = na * (1.0 - u - v) + nb * u + nc * v;
+        for axis in 0..3 {
+            p[axis][k] = position[axis];
+            n[axis][k] = normal[axis];
+        }
+        m[k] = material;
     }
+    let (words, taken) = PnmtLayout::encode_compact_x8(&p, &n, &m, world_cell_min, cell)?;
+    Some((words, taken & low_bits(count) as u8))
 }
 
 /// The records of `hits` ((triangle, u, v) each) in the compact layout without uv, eight at a
@@ -1374,28 +1378,25 @@ fn encode_hits<A: HitAttributes + ?Sized>(
     cell: f64,
     out: &mut Vec<RecordWords>,
 ) {
-    let layout = PnmtLayout::CompactNoUv;
-    let max = layout.max_material();
     for chunk in hits.chunks(8) {
-        let (mut p, mut n) = ([[0f32; 8]; 3], [[0f32; 8]; 3]);
-        let mut ready = chunk.len() == 8;
-        for (k, &(t, u, v)) in chunk.iter().enumerate() {
-            let Some(normals) = attrs.corner_normals(t) else {
-                ready = false;
-                break;
-            };
-            set_lane(&mut p, &mut n, k, attrs.corners(t), normals, u, v);
-        }
-        // (The materials are or-ed in below, lane by lane.)
-        let encoded =
-            if ready { PnmtLayout::encode_compact_x8(&p, &n, 0, world_cell_min, cell) } else { None };
+        let hit = |k: usize| {
+            let (t, u, v) = chunk[k];
+            Some((attrs.corners(t), attrs.corner_normals(t)?, attrs.material(t), u, v))
+        };
+        let encoded = encode_eight(chunk.len(), hit, world_cell_min, cell);
         for (k, &(t, u, v)) in chunk.iter().enumerate() {
             out.push(match encoded {
-                Some((words, taken)) if taken >> k & 1 == 1 => {
-                    let m = attrs.material(t).min(max) as u32;
-                    [words[k][0] | (m >> 10) << 30, words[k][1] | (m & 0x3ff) << 22, 0, 0]
-                }
-                _ => hit_record(attrs, layout, t, attrs.corners(t), u, v, world_cell_min, cell),
+                Some((words, taken)) if taken >> k & 1 == 1 => [words[k][0], words[k][1], 0, 0],
+                _ => hit_record(
+                    attrs,
+                    PnmtLayout::CompactNoUv,
+                    t,
+                    attrs.corners(t),
+                    u,
+                    v,
+                    world_cell_min,
+                    cell,
+                ),
             });
         }
     }
