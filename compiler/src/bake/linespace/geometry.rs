@@ -14,6 +14,8 @@
 use glam::DVec3;
 use kiln_format::linespace::index::{MAX_SHAFT_RES, face_axis, face_uv_axes};
 
+use super::simd::Simd;
+
 /// A triangle prepared for overlap tests: its 13 separating axes and its projection on each.
 #[derive(Debug, Clone)]
 pub struct Prepared {
@@ -382,17 +384,12 @@ impl PairAxes {
     /// at the b end only, from above (s ≤ −a/(b − a)). Without bounds of both kinds the interval
     /// is not empty; with them the roots are compared as fractions, without dividing.
     pub fn shafts_among(&self, pa: u32, among: u64, masks: &PairMasks) -> u64 {
-        #[cfg(target_arch = "x86_64")]
-        let simd = std::arch::is_x86_feature_detected!("avx2");
-        #[cfg(not(target_arch = "x86_64"))]
-        let simd = false;
-        self.shafts_among_with(pa, among, masks, simd)
+        self.shafts_among_with(pa, among, masks, Simd::detect())
     }
 
-    /// [`PairAxes::shafts_among`], with the AVX2 per-shaft test if `simd` (the caller has
-    /// checked that the CPU has AVX2) or the portable one.
+    /// [`PairAxes::shafts_among`] with the per-shaft test of `simd` (which the CPU must have).
     #[inline(always)]
-    fn shafts_among_with(&self, pa: u32, among: u64, masks: &PairMasks, simd: bool) -> u64 {
+    fn shafts_among_with(&self, pa: u32, among: u64, masks: &PairMasks, simd: Simd) -> u64 {
         let lower = masks.at_a[pa as usize];
         debug_assert!(
             bits(lower as u64).all(|c| masks.at_b[c] & among == 0),
@@ -413,25 +410,25 @@ impl PairAxes {
         let n = masks.n;
         let [us, vs] = &PATCH_UV[n as usize];
         let sa = self.a_end(us[pa as usize], vs[pa as usize]);
-        // The patches to test, in order.
-        let mut list = [0u8; MAX_PATCHES];
+        // The patches to test, in order, and their coordinates (the last repeated to a multiple
+        // of eight: the vector kernels' padding).
+        let (mut list, mut bu, mut bv) = ([0u8; MAX_PATCHES], [0.0f64; MAX_PATCHES], [0.0f64; MAX_PATCHES]);
         let mut count = 0;
         for pb in bits(test) {
-            list[count] = pb as u8;
+            (list[count], bu[count], bv[count]) = (pb as u8, us[pb], vs[pb]);
             count += 1;
         }
-        let at = |k: usize| (us[list[k] as usize], vs[list[k] as usize]);
-        #[cfg(target_arch = "x86_64")]
-        let met = if simd {
-            // SAFETY: the caller has checked that the CPU supports AVX2.
-            unsafe { groups_avx2(self, &sa, lower, upper, count, at) }
-        } else {
-            groups(self, &sa, lower, upper, count, at)
-        };
-        #[cfg(not(target_arch = "x86_64"))]
-        let met = {
-            let _ = simd;
-            groups(self, &sa, lower, upper, count, at)
+        for k in count..count.next_multiple_of(8) {
+            (bu[k], bv[k]) = (bu[count - 1], bv[count - 1]);
+        }
+        let met = match simd {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller has checked that the CPU has AVX-512F.
+            Simd::Avx512 => unsafe { groups_avx512(self, &sa, lower, upper, count, &bu, &bv) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the caller has checked that the CPU has AVX2.
+            Simd::Avx2 => unsafe { groups_avx2(self, &sa, lower, upper, count, &bu, &bv) },
+            _ => groups(self, &sa, lower, upper, count, &bu, &bv),
         };
         let mut out = among & !test;
         for (k, &pb) in list.iter().enumerate().take(count) {
@@ -500,19 +497,21 @@ unsafe fn masks_avx2(p: &PairAxes, n: u32) -> PairMasks {
 
 /// The per-shaft part of [`PairAxes::shafts_among`]: the pairs `lower` bound s from below, the
 /// pairs `upper` from above (`sa`: their a ends), shaft `k` < `count` ends at the b patch
-/// `at(k)`; bit k of the result is set where that shaft meets the triangle. Plain arithmetic
-/// (no fused multiply-adds), so that [`groups_avx2`] gives the same bits.
+/// (`us[k]`, `vs[k]`); bit k of the result is set where that shaft meets the triangle. Plain
+/// arithmetic (no fused multiply-adds), so that [`groups_avx2`] and [`groups_avx512`] give the
+/// same bits.
 fn groups(
     p: &PairAxes,
     sa: &[f64; 2 * LANES],
     lower: u32,
     upper: u32,
     count: usize,
-    at: impl Fn(usize) -> (f64, f64),
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
 ) -> u64 {
     let mut mask = 0u64;
     for k in 0..count {
-        let (bu, bv) = at(k);
+        let (bu, bv) = (us[k], vs[k]);
         // Roots as fractions num/den (den > 0): the interval [lo, hi] of s the shaft leaves.
         let (mut lo_n, mut lo_d, mut hi_n, mut hi_d) = (0.0f64, 1.0f64, 1.0f64, 1.0f64);
         for c in bits(lower as u64) {
@@ -549,19 +548,20 @@ unsafe fn groups_avx2(
     lower: u32,
     upper: u32,
     count: usize,
-    at: impl Fn(usize) -> (f64, f64),
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
 ) -> u64 {
     let mut mask = 0u64;
     let groups = count.div_ceil(4);
     let mut g = 0;
     while g + 1 < groups {
         // SAFETY: the caller's CPU has AVX2.
-        mask |= unsafe { group_avx2::<2>(p, sa, lower, upper, g, count, &at) } << (4 * g);
+        mask |= unsafe { group_avx2::<2>(p, sa, lower, upper, g, us, vs) } << (4 * g);
         g += 2;
     }
     if g < groups {
         // SAFETY: as above.
-        mask |= unsafe { group_avx2::<1>(p, sa, lower, upper, g, count, &at) } << (4 * g);
+        mask |= unsafe { group_avx2::<1>(p, sa, lower, upper, g, us, vs) } << (4 * g);
     }
     mask
 }
@@ -578,22 +578,19 @@ unsafe fn group_avx2<const G: usize>(
     lower: u32,
     upper: u32,
     first: usize,
-    count: usize,
-    at: &impl Fn(usize) -> (f64, f64),
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
 ) -> u64 {
     use std::arch::x86_64::*;
     let s = |x: f64| _mm256_set1_pd(x);
     let (zero, one) = (_mm256_setzero_pd(), s(1.0));
     let gt = |x: __m256d, y: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, y);
-    let mut bu = [zero; G];
-    let mut bv = [zero; G];
-    for k in 0..G {
-        // The padding repeats the last shaft.
-        let at = |q: usize| at((4 * (first + k) + q).min(count - 1));
-        let [(a0, c0), (a1, c1), (a2, c2), (a3, c3)] = [at(0), at(1), at(2), at(3)];
-        bu[k] = _mm256_set_pd(a3, a2, a1, a0);
-        bv[k] = _mm256_set_pd(c3, c2, c1, c0);
-    }
+    // SAFETY (loads): 4·(first + G) <= MAX_PATCHES: the caller's groups are within the count,
+    // padded to a multiple of eight.
+    let bu: [__m256d; G] =
+        std::array::from_fn(|k| unsafe { _mm256_loadu_pd(us.as_ptr().add(4 * (first + k))) });
+    let bv: [__m256d; G] =
+        std::array::from_fn(|k| unsafe { _mm256_loadu_pd(vs.as_ptr().add(4 * (first + k))) });
     let (mut lo_n, mut lo_d, mut hi_n, mut hi_d) = ([zero; G], [one; G], [one; G], [one; G]);
     let (mut lower, mut upper) = (lower, upper);
     while lower | upper != 0 {
@@ -634,6 +631,101 @@ unsafe fn group_avx2<const G: usize>(
         let ok =
             _mm256_cmp_pd::<_CMP_LE_OQ>(_mm256_mul_pd(lo_n[k], hi_d[k]), _mm256_mul_pd(hi_n[k], lo_d[k]));
         mask |= (_mm256_movemask_pd(ok) as u64) << (4 * k);
+    }
+    mask
+}
+
+/// [`groups`] in AVX-512, eight shafts at a time, with the same arithmetic operation for
+/// operation (the same bits); up to four groups of eight side by side, their bounds'
+/// compare-and-select chains interleaved (see [`group_avx2`]).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn groups_avx512(
+    p: &PairAxes,
+    sa: &[f64; 2 * LANES],
+    lower: u32,
+    upper: u32,
+    count: usize,
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
+) -> u64 {
+    let mut mask = 0u64;
+    let groups = count.div_ceil(8);
+    let mut g = 0;
+    while g < groups {
+        // SAFETY: the caller's CPU has AVX-512F; the groups are within the padded count.
+        let (met, taken) = unsafe {
+            match groups - g {
+                1 => (group_avx512::<1>(p, sa, lower, upper, g, us, vs), 1),
+                2 => (group_avx512::<2>(p, sa, lower, upper, g, us, vs), 2),
+                3 => (group_avx512::<3>(p, sa, lower, upper, g, us, vs), 3),
+                _ => (group_avx512::<4>(p, sa, lower, upper, g, us, vs), 4),
+            }
+        };
+        mask |= met << (8 * g);
+        g += taken;
+    }
+    mask
+}
+
+/// `G` groups of eight shafts of [`groups_avx512`] from group `first` on.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+unsafe fn group_avx512<const G: usize>(
+    p: &PairAxes,
+    sa: &[f64; 2 * LANES],
+    lower: u32,
+    upper: u32,
+    first: usize,
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
+) -> u64 {
+    use std::arch::x86_64::*;
+    let s = |x: f64| _mm512_set1_pd(x);
+    let (zero, one) = (_mm512_setzero_pd(), s(1.0));
+    let (mul, add, sub) = (_mm512_mul_pd, _mm512_add_pd, _mm512_sub_pd);
+    // SAFETY (loads): 8·(first + G) <= MAX_PATCHES, as in `group_avx2`.
+    let bu: [__m512d; G] =
+        std::array::from_fn(|k| unsafe { _mm512_loadu_pd(us.as_ptr().add(8 * (first + k))) });
+    let bv: [__m512d; G] =
+        std::array::from_fn(|k| unsafe { _mm512_loadu_pd(vs.as_ptr().add(8 * (first + k))) });
+    let (mut lo_n, mut lo_d, mut hi_n, mut hi_d) = ([zero; G], [one; G], [one; G], [one; G]);
+    let (mut lower, mut upper) = (lower, upper);
+    while lower | upper != 0 {
+        if lower != 0 {
+            let c = lower.trailing_zeros() as usize;
+            lower &= lower - 1;
+            let (a, (base, du, dv)) = (sa[c], p.b_end(c));
+            let (num, base, du, dv) = (s(a), s(base), s(du), s(dv));
+            for k in 0..G {
+                let b = add(base, add(mul(bu[k], du), mul(bv[k], dv)));
+                let den = sub(num, b);
+                let later = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(mul(num, lo_d[k]), mul(lo_n[k], den));
+                lo_n[k] = _mm512_mask_mov_pd(lo_n[k], later, num);
+                lo_d[k] = _mm512_mask_mov_pd(lo_d[k], later, den);
+            }
+        }
+        if upper != 0 {
+            let c = upper.trailing_zeros() as usize;
+            upper &= upper - 1;
+            let (a, (base, du, dv)) = (sa[c], p.b_end(c));
+            let (va, num, base, du, dv) = (s(a), s(-a), s(base), s(du), s(dv));
+            for k in 0..G {
+                let b = add(base, add(mul(bu[k], du), mul(bv[k], dv)));
+                let den = sub(b, va);
+                let positive = _mm512_cmp_pd_mask::<_CMP_GT_OQ>(b, zero);
+                let earlier =
+                    _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(positive, mul(num, hi_d[k]), mul(hi_n[k], den));
+                hi_n[k] = _mm512_mask_mov_pd(hi_n[k], earlier, num);
+                hi_d[k] = _mm512_mask_mov_pd(hi_d[k], earlier, den);
+            }
+        }
+    }
+    let mut mask = 0u64;
+    for k in 0..G {
+        let ok = _mm512_cmp_pd_mask::<_CMP_LE_OQ>(mul(lo_n[k], hi_d[k]), mul(hi_n[k], lo_d[k]));
+        mask |= (ok as u64) << (8 * k);
     }
     mask
 }
@@ -824,11 +916,11 @@ pub(crate) mod tests {
         assert!(met > 10_000 && missed > 10_000, "{met} met, {missed} missed");
     }
 
-    /// The AVX2 masks and per-shaft test and the portable ones give the same bits (a compile on
-    /// a CPU without AVX2 writes the same bytes).
+    /// The AVX2 masks and the AVX2 and AVX-512 per-shaft tests give the portable ones' bits (a
+    /// compile on a CPU without them writes the same bytes).
     #[cfg(target_arch = "x86_64")]
     #[test]
-    fn avx2_shaft_lanes_match_the_portable_ones() {
+    fn vector_shaft_lanes_match_the_portable_ones() {
         if !std::arch::is_x86_feature_detected!("avx2") {
             return;
         }
@@ -848,9 +940,11 @@ pub(crate) mod tests {
             let mut among = [0u64; MAX_PATCHES];
             masks.survivors(&mut among);
             for pa in 0..n * n {
-                let portable = axes.shafts_among_with(pa, among[pa as usize], &masks, false);
-                let simd = axes.shafts_among_with(pa, among[pa as usize], &masks, true);
-                assert_eq!(portable, simd, "case {case} patch {pa}");
+                let portable = axes.shafts_among_with(pa, among[pa as usize], &masks, Simd::None);
+                for &kind in Simd::available() {
+                    let simd = axes.shafts_among_with(pa, among[pa as usize], &masks, kind);
+                    assert_eq!(portable, simd, "case {case} patch {pa} {kind:?}");
+                }
                 met += portable.count_ones() as u64;
                 open += among[pa as usize].count_ones() as u64;
             }

@@ -6,6 +6,7 @@ mod geometry;
 pub mod gpu;
 mod segment;
 mod shafts;
+mod simd;
 mod span;
 pub mod stages;
 pub mod voxelize;

@@ -5,6 +5,7 @@
 use glam::Vec3;
 
 use super::geometry::{MAX_PATCHES, set_bits};
+use super::simd::Simd;
 
 /// A segment–triangle test for midpoint segments (PNMT records need the nearest hit, not a
 /// watertight one): plane crossing, then three edge functions.
@@ -63,30 +64,6 @@ pub(super) struct Intersection {
     pub(super) t: f32,
     pub(super) u: f32,
     pub(super) v: f32,
-}
-
-/// The vector instructions a kernel uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Simd {
-    None,
-    Avx2,
-    Avx512,
-}
-
-impl Simd {
-    /// The widest this CPU has.
-    fn detect() -> Simd {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                return Simd::Avx512;
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                return Simd::Avx2;
-            }
-        }
-        Simd::None
-    }
 }
 
 /// The patch centres of one face, by coordinate (padded with zeros to [`MAX_PATCHES`]).
