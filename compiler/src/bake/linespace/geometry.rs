@@ -410,31 +410,28 @@ impl PairAxes {
         let n = masks.n;
         let [us, vs] = &PATCH_UV[n as usize];
         let sa = self.a_end(us[pa as usize], vs[pa as usize]);
-        // The patches to test, in order, and their coordinates (the last repeated to a multiple
-        // of eight: the vector kernels' padding).
-        let (mut list, mut bu, mut bv) = ([0u8; MAX_PATCHES], [0.0f64; MAX_PATCHES], [0.0f64; MAX_PATCHES]);
-        let mut count = 0;
-        for pb in bits(test) {
-            (list[count], bu[count], bv[count]) = (pb as u8, us[pb], vs[pb]);
-            count += 1;
-        }
-        for k in count..count.next_multiple_of(8) {
-            (bu[k], bv[k]) = (bu[count - 1], bv[count - 1]);
-        }
+        // The tested patches' coordinates, in patch order (the lanes past `count` up to a
+        // multiple of eight: finite padding, the vector kernels' results there dropped).
+        let (mut bu, mut bv) = ([0.0f64; PADDED], [0.0f64; PADDED]);
         let met = match simd {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller has checked that the CPU has AVX-512F.
-            Simd::Avx512 => unsafe { groups_avx512(self, &sa, lower, upper, count, &bu, &bv) },
+            // SAFETY: the caller has checked that the CPU has AVX-512F and BMI2.
+            Simd::Avx512 => unsafe {
+                let count = compress_avx512(test, us, vs, &mut bu, &mut bv);
+                deposit_bmi2(groups_avx512(self, &sa, lower, upper, count, &bu, &bv), test)
+            },
             #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller has checked that the CPU has AVX2.
-            Simd::Avx2 => unsafe { groups_avx2(self, &sa, lower, upper, count, &bu, &bv) },
-            _ => groups(self, &sa, lower, upper, count, &bu, &bv),
+            Simd::Avx2 => unsafe {
+                let count = compress(test, us, vs, &mut bu, &mut bv);
+                deposit(groups_avx2(self, &sa, lower, upper, count, &bu, &bv), test)
+            },
+            _ => {
+                let count = compress(test, us, vs, &mut bu, &mut bv);
+                deposit(groups(self, &sa, lower, upper, count, &bu, &bv), test)
+            }
         };
-        let mut out = among & !test;
-        for (k, &pb) in list.iter().enumerate().take(count) {
-            out |= (met >> k & 1) << pb;
-        }
-        out
+        among & !test | met
     }
 
     /// The b end's separation of pair `c` as base + u·du + v·dv (negating du and dv gives the
@@ -448,6 +445,73 @@ impl PairAxes {
             (self.b[1][i], -self.b_du[i], -self.b_dv[i])
         }
     }
+}
+
+/// Lanes of the tested patches' coordinates: every patch, and a vector's worth of padding.
+const PADDED: usize = MAX_PATCHES + 8;
+
+/// Writes the coordinates (`us`, `vs`) of the patches in `set` to the first lanes of `bu`, `bv`,
+/// in patch order; returns their count.
+#[inline(always)]
+fn compress(
+    set: u64,
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
+    bu: &mut [f64; PADDED],
+    bv: &mut [f64; PADDED],
+) -> usize {
+    let mut count = 0;
+    for p in bits(set) {
+        (bu[count], bv[count]) = (us[p], vs[p]);
+        count += 1;
+    }
+    count
+}
+
+/// [`compress`] in AVX-512, eight patches at a time (a compressed vector written at the count
+/// so far: the lanes past the count get zeros).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn compress_avx512(
+    set: u64,
+    us: &[f64; MAX_PATCHES],
+    vs: &[f64; MAX_PATCHES],
+    bu: &mut [f64; PADDED],
+    bv: &mut [f64; PADDED],
+) -> usize {
+    use std::arch::x86_64::*;
+    let mut count = 0;
+    for g in 0..(64 - set.leading_zeros() as usize).div_ceil(8) {
+        let m = (set >> (8 * g)) as u8;
+        // SAFETY: 8·g + 8 <= MAX_PATCHES, the tables' length; count <= 8·g, so count + 8 <=
+        // PADDED.
+        unsafe {
+            let (u, v) = (_mm512_loadu_pd(us.as_ptr().add(8 * g)), _mm512_loadu_pd(vs.as_ptr().add(8 * g)));
+            _mm512_storeu_pd(bu.as_mut_ptr().add(count), _mm512_maskz_compress_pd(m, u));
+            _mm512_storeu_pd(bv.as_mut_ptr().add(count), _mm512_maskz_compress_pd(m, v));
+        }
+        count += m.count_ones() as usize;
+    }
+    count
+}
+
+/// The bits of `value`, lowest first, placed at the set bits of `mask`, lowest first (bit k of
+/// a kernel's result, for the k-th tested patch, at that patch's bit).
+#[inline(always)]
+fn deposit(mut value: u64, mask: u64) -> u64 {
+    let mut out = 0;
+    for p in set_bits(mask) {
+        out |= (value & 1) << p;
+        value >>= 1;
+    }
+    out
+}
+
+/// [`deposit`] in one BMI2 instruction.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "bmi2")]
+unsafe fn deposit_bmi2(value: u64, mask: u64) -> u64 {
+    std::arch::x86_64::_pdep_u64(value, mask)
 }
 
 /// [`PairAxes::masks`] in AVX2, with the same arithmetic: face a four pairs at a time per
@@ -506,8 +570,8 @@ fn groups(
     lower: u32,
     upper: u32,
     count: usize,
-    us: &[f64; MAX_PATCHES],
-    vs: &[f64; MAX_PATCHES],
+    us: &[f64; PADDED],
+    vs: &[f64; PADDED],
 ) -> u64 {
     let mut mask = 0u64;
     for k in 0..count {
@@ -548,8 +612,8 @@ unsafe fn groups_avx2(
     lower: u32,
     upper: u32,
     count: usize,
-    us: &[f64; MAX_PATCHES],
-    vs: &[f64; MAX_PATCHES],
+    us: &[f64; PADDED],
+    vs: &[f64; PADDED],
 ) -> u64 {
     let mut mask = 0u64;
     let groups = count.div_ceil(4);
@@ -578,8 +642,8 @@ unsafe fn group_avx2<const G: usize>(
     lower: u32,
     upper: u32,
     first: usize,
-    us: &[f64; MAX_PATCHES],
-    vs: &[f64; MAX_PATCHES],
+    us: &[f64; PADDED],
+    vs: &[f64; PADDED],
 ) -> u64 {
     use std::arch::x86_64::*;
     let s = |x: f64| _mm256_set1_pd(x);
@@ -646,8 +710,8 @@ unsafe fn groups_avx512(
     lower: u32,
     upper: u32,
     count: usize,
-    us: &[f64; MAX_PATCHES],
-    vs: &[f64; MAX_PATCHES],
+    us: &[f64; PADDED],
+    vs: &[f64; PADDED],
 ) -> u64 {
     let mut mask = 0u64;
     let groups = count.div_ceil(8);
@@ -678,8 +742,8 @@ unsafe fn group_avx512<const G: usize>(
     lower: u32,
     upper: u32,
     first: usize,
-    us: &[f64; MAX_PATCHES],
-    vs: &[f64; MAX_PATCHES],
+    us: &[f64; PADDED],
+    vs: &[f64; PADDED],
 ) -> u64 {
     use std::arch::x86_64::*;
     let s = |x: f64| _mm512_set1_pd(x);

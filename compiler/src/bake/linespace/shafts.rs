@@ -302,6 +302,14 @@ impl Fills<'_> {
     }
 }
 
+/// A candidate hit's place in its shaft's list, as one number: by quantised key minimum, then
+/// maximum, then the triangle's place in the cell's list (sorting numbers, not tuples, was a
+/// tenth of a candidate bake).
+#[inline(always)]
+fn sort_key(qmin: u8, qmax: u8, local: u16) -> u32 {
+    (qmin as u32) << 24 | (qmax as u32) << 16 | local as u32
+}
+
 /// Bits `start..start + len` (len ≤ 64) of `words`, as a mask from bit 0.
 #[inline(always)]
 fn bit_range(words: &[u32], start: usize, len: usize) -> u64 {
@@ -378,7 +386,8 @@ fn keys_beyond(end: &[End; 2], kmin: f64, kmax: f64) -> [bool; 2] {
 #[derive(Debug, Default)]
 pub struct Scratch {
     hits: Vec<(u32, u8, u8, u16)>,
-    sorted: Vec<(u32, u8, u8, u16)>,
+    /// The candidate hits bucketed by shaft, each as its sort key ([`sort_key`]).
+    sorted: Vec<u32>,
     counts: Vec<u32>,
     ends: Vec<[End; 2]>,
     hit_bits: Vec<u32>,
@@ -991,7 +1000,7 @@ fn finish_cell<A: HitAttributes + ?Sized>(
     centres: &[[Vec3; MAX_PATCHES]; 6],
     (hits, sorted, counts, ends, polys, fallbacks): (
         &mut Vec<(u32, u8, u8, u16)>,
-        &mut Vec<(u32, u8, u8, u16)>,
+        &mut Vec<u32>,
         &mut Vec<u32>,
         &mut Vec<[End; 2]>,
         &mut [Vec<DVec3>],
@@ -1013,10 +1022,10 @@ fn finish_cell<A: HitAttributes + ?Sized>(
             counts[i + 1] += counts[i];
         }
         sorted.clear();
-        sorted.resize(hits.len(), (0, 0, 0, 0));
+        sorted.resize(hits.len(), 0);
         for h in hits.iter() {
             let slot = &mut counts[h.0 as usize];
-            sorted[*slot as usize] = *h;
+            sorted[*slot as usize] = sort_key(h.1, h.2, h.3);
             *slot += 1;
         }
         // counts[s] now ends bucket s; bucket s starts where bucket s − 1 ended.
@@ -1026,11 +1035,12 @@ fn finish_cell<A: HitAttributes + ?Sized>(
             if group.is_empty() {
                 continue;
             }
-            group.sort_unstable_by_key(|h| (h.1, h.2, h.3));
+            group.sort_unstable();
             let mut running = 0u32;
-            out.entries.extend(group.iter().map(|&(_, kmin, kmax, li)| {
-                running = running.max(kmax as u32);
-                entry::pack(li as u32, kmin as u32, running)
+            out.entries.extend(group.iter().map(|&key| {
+                let (kmin, kmax, li) = (key >> 24, key >> 16 & 0xff, key & 0xffff);
+                running = running.max(kmax);
+                entry::pack(li, kmin, running)
             }));
             out.list_ends.push(out.entries.len() as u32);
         }

@@ -7,6 +7,7 @@
 pub(super) enum Simd {
     None,
     Avx2,
+    /// AVX-512F with BMI2 (which every CPU with AVX-512 has).
     Avx512,
 }
 
@@ -15,7 +16,7 @@ impl Simd {
     pub(super) fn detect() -> Simd {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx512f") {
+            if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("bmi2") {
                 return Simd::Avx512;
             }
             if std::arch::is_x86_feature_detected!("avx2") {
