@@ -653,11 +653,19 @@ struct FirstScratch {
     ts: [Vec<f32>; 2],
     /// The first pass's survivors by (triangle, pair, front patch).
     amongs: Vec<u64>,
+    /// The first pass's face tables by triangle (`None` for a spanning one), where the cell
+    /// has at most [`CACHED_TABLES`] triangles.
+    tables: Vec<Option<FaceTables>>,
 }
 
 /// The most survivor masks [`RecordsFirst`] keeps from its first pass for its second (8 MiB; a
 /// cell of more triangles makes them again).
 const CACHED_SURVIVORS: usize = 1 << 20;
+
+/// The most triangles whose face tables [`RecordsFirst`] keeps from its first pass for its
+/// second (8 KiB each: 8 MiB; a cell of more triangles makes them again where a pair has shafts
+/// to test). Made again, they were a twelfth of the teapot's 32³ object cells' bake.
+const CACHED_TABLES: usize = 1024;
 
 impl RecordsFirst<'_> {
     #[allow(clippy::too_many_arguments)]
@@ -675,7 +683,7 @@ impl RecordsFirst<'_> {
     ) {
         let RecordsFirst { tris, n, margin, centres } = *self;
         let words = out.bits.len();
-        let FirstScratch { prepared, seen, confirmed, starts, shafts, ts, amongs } = scratch;
+        let FirstScratch { prepared, seen, confirmed, starts, shafts, ts, amongs, tables: kept } = scratch;
         let [c0, c1] = confirmed;
         for v in [&mut *hit_bits, &mut *seen, c0, c1] {
             v.clear();
@@ -698,6 +706,8 @@ impl RecordsFirst<'_> {
         let cached = tris.len() * FACE_PAIRS as usize * n2 <= CACHED_SURVIVORS;
         amongs.clear();
         amongs.resize(if cached { tris.len() * FACE_PAIRS as usize * n2 } else { 0 }, 0);
+        kept.clear();
+        let keep_tables = tris.len() <= CACHED_TABLES;
         for (li, &t) in tris.iter().enumerate() {
             let v = local[t as usize].map(|p| p - cell_min);
             let prep = Prepared::new(v);
@@ -760,6 +770,9 @@ impl RecordsFirst<'_> {
                 }
             }
             prepared.push((prep, sides));
+            if keep_tables {
+                kept.push(tables);
+            }
         }
         // The hit shafts by the triangles of their tentative ends (a counting sort: each
         // triangle's shafts in shaft order).
@@ -801,8 +814,9 @@ impl RecordsFirst<'_> {
             let (prep, sides) = &prepared[li];
             let poly = &polys[li];
             let mut mine = &shafts[starts[li] as usize..starts[li + 1] as usize];
-            // Made again where a pair has shafts to test.
-            let mut tables = None;
+            // The first pass's, or made again where a pair has shafts to test.
+            let kept = kept.get(li).and_then(Option::as_ref);
+            let mut made = None;
             for pair in 0..FACE_PAIRS {
                 let (fa, fb) = pair_faces(pair);
                 let filler = Filler::new(t, li as u32, &seg, pair, poly, margin);
@@ -832,7 +846,8 @@ impl RecordsFirst<'_> {
                 }
                 let tests = &mut out.tests;
                 if !cached {
-                    let tables = tables.get_or_insert_with(|| prep.face_tables(n, margin));
+                    let tables =
+                        kept.unwrap_or_else(|| made.get_or_insert_with(|| prep.face_tables(n, margin)));
                     patch_sets(tables, poly, pair, n, &mut |pa, among, axes, masks| {
                         let first = shaft_of(pair, pa, 0, n) as usize;
                         let need = exact.needing_test(first, n2, among) | (confirm[pa as usize] & among);
@@ -854,8 +869,9 @@ impl RecordsFirst<'_> {
                     }
                 }
                 if any != 0 {
-                    let (axes, masks) =
-                        tables.get_or_insert_with(|| prep.face_tables(n, margin)).pair(fa, fb);
+                    let tables =
+                        kept.unwrap_or_else(|| made.get_or_insert_with(|| prep.face_tables(n, margin)));
+                    let (axes, masks) = tables.pair(fa, fb);
                     for (pa, &need) in need.iter().enumerate().take(n2) {
                         let met = &mut |shaft, _, _| exact.met(shaft);
                         decide(&axes, &masks, pair, pa as u32, need, n, tests, met);
