@@ -400,6 +400,11 @@ impl PairAxes {
         }
         // Shafts ending at a patch whose box meets the triangle have no upper bound.
         let test = among & !masks.free_b;
+        #[cfg(target_arch = "x86_64")]
+        if simd == Simd::Avx512 {
+            // SAFETY: the caller has checked that the CPU has AVX-512F and BMI2.
+            return unsafe { self.shafts_among_avx512(pa, among, lower, test, masks) };
+        }
         let mut upper = 0u32;
         for c in bits((masks.some_b & !lower) as u64) {
             upper |= ((masks.at_b[c] & test != 0) as u32) << c;
@@ -413,25 +418,69 @@ impl PairAxes {
         // The tested patches' coordinates, in patch order (the lanes past `count` up to a
         // multiple of eight: finite padding, the vector kernels' results there dropped).
         let (mut bu, mut bv) = ([0.0f64; PADDED], [0.0f64; PADDED]);
+        let count = compress(test, us, vs, &mut bu, &mut bv);
         let met = match simd {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: the caller has checked that the CPU has AVX-512F and BMI2.
-            Simd::Avx512 => unsafe {
-                let count = compress_avx512(test, us, vs, &mut bu, &mut bv);
-                deposit_bmi2(groups_avx512(self, &sa, lower, upper, count, &bu, &bv), test)
-            },
-            #[cfg(target_arch = "x86_64")]
             // SAFETY: the caller has checked that the CPU has AVX2.
-            Simd::Avx2 => unsafe {
-                let count = compress(test, us, vs, &mut bu, &mut bv);
-                deposit(groups_avx2(self, &sa, lower, upper, count, &bu, &bv), test)
-            },
-            _ => {
-                let count = compress(test, us, vs, &mut bu, &mut bv);
-                deposit(groups(self, &sa, lower, upper, count, &bu, &bv), test)
-            }
+            Simd::Avx2 => unsafe { groups_avx2(self, &sa, lower, upper, count, &bu, &bv) },
+            _ => groups(self, &sa, lower, upper, count, &bu, &bv),
         };
-        among & !test | met
+        among & !test | deposit(met, test)
+    }
+
+    /// The rest of [`PairAxes::shafts_among`] after its first shortcut (the pairs `lower`
+    /// positive at the a end; the shafts to `test`), in AVX-512 throughout: the pairs bounding
+    /// from above found eight at a time, the a end's separations sixteen at a time, the tested
+    /// patches' coordinates compressed eight at a time (into buffers left unfilled beyond them,
+    /// whose zeroing was a twentieth of a candidate bake) and the results deposited with BMI2.
+    /// The same bits as the portable code.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,bmi2")]
+    unsafe fn shafts_among_avx512(
+        &self,
+        pa: u32,
+        among: u64,
+        lower: u32,
+        test: u64,
+        masks: &PairMasks,
+    ) -> u64 {
+        use std::arch::x86_64::*;
+        use std::mem::MaybeUninit;
+        let t = _mm512_set1_epi64(test as i64);
+        let mut upper = 0u32;
+        for g in 0..4 {
+            // SAFETY: 8·g + 8 <= 2·LANES, `at_b`'s length.
+            let at_b = unsafe { _mm512_loadu_si512(masks.at_b.as_ptr().add(8 * g).cast()) };
+            upper |= (_mm512_test_epi64_mask(at_b, t) as u32) << (8 * g);
+        }
+        upper &= masks.some_b & !lower;
+        if upper == 0 {
+            return among;
+        }
+        let [us, vs] = &PATCH_UV[masks.n as usize];
+        // `a_end`'s arithmetic, every lane (the padding's never read: no pair there is
+        // positive).
+        let mut sa = [0.0f64; 2 * LANES];
+        let (u, v) = (_mm512_set1_pd(us[pa as usize]), _mm512_set1_pd(vs[pa as usize]));
+        for h in (0..LANES).step_by(8) {
+            // SAFETY: h + 8 <= LANES, the arrays' length; LANES + h + 8 <= 2·LANES, `sa`'s.
+            unsafe {
+                let ld = |x: &[f64; LANES]| _mm512_loadu_pd(x.as_ptr().add(h));
+                let ta = _mm512_add_pd(_mm512_mul_pd(u, ld(&self.a_du)), _mm512_mul_pd(v, ld(&self.a_dv)));
+                _mm512_storeu_pd(sa.as_mut_ptr().add(h), _mm512_add_pd(ld(&self.a[0]), ta));
+                _mm512_storeu_pd(sa.as_mut_ptr().add(LANES + h), _mm512_sub_pd(ld(&self.a[1]), ta));
+            }
+        }
+        let (mut bu, mut bv) =
+            (MaybeUninit::<[f64; PADDED]>::uninit(), MaybeUninit::<[f64; PADDED]>::uninit());
+        let (bu, bv) = (bu.as_mut_ptr().cast::<f64>(), bv.as_mut_ptr().cast::<f64>());
+        // SAFETY: the buffers hold PADDED lanes; the kernel reads the first count rounded up
+        // to eight, which `compress_avx512` writes.
+        let met = unsafe {
+            let count = compress_avx512(test, us, vs, bu, bv);
+            groups_avx512(self, &sa, lower, upper, count, bu, bv)
+        };
+        among & !test | _pdep_u64(met, test)
     }
 
     /// The b end's separation of pair `c` as base + u·du + v·dv (negating du and dv gives the
@@ -469,28 +518,34 @@ fn compress(
 }
 
 /// [`compress`] in AVX-512, eight patches at a time (a compressed vector written at the count
-/// so far: the lanes past the count get zeros).
+/// so far), into buffers of [`PADDED`] lanes; the lanes from the count to the next multiple of
+/// eight are zeroed, so that every lane a kernel reads is written.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn compress_avx512(
     set: u64,
     us: &[f64; MAX_PATCHES],
     vs: &[f64; MAX_PATCHES],
-    bu: &mut [f64; PADDED],
-    bv: &mut [f64; PADDED],
+    bu: *mut f64,
+    bv: *mut f64,
 ) -> usize {
     use std::arch::x86_64::*;
     let mut count = 0;
     for g in 0..(64 - set.leading_zeros() as usize).div_ceil(8) {
         let m = (set >> (8 * g)) as u8;
         // SAFETY: 8·g + 8 <= MAX_PATCHES, the tables' length; count <= 8·g, so count + 8 <=
-        // PADDED.
+        // PADDED, the buffers' (the caller's promise).
         unsafe {
             let (u, v) = (_mm512_loadu_pd(us.as_ptr().add(8 * g)), _mm512_loadu_pd(vs.as_ptr().add(8 * g)));
-            _mm512_storeu_pd(bu.as_mut_ptr().add(count), _mm512_maskz_compress_pd(m, u));
-            _mm512_storeu_pd(bv.as_mut_ptr().add(count), _mm512_maskz_compress_pd(m, v));
+            _mm512_storeu_pd(bu.add(count), _mm512_maskz_compress_pd(m, u));
+            _mm512_storeu_pd(bv.add(count), _mm512_maskz_compress_pd(m, v));
         }
         count += m.count_ones() as usize;
+    }
+    // SAFETY: count <= MAX_PATCHES, so count + 8 <= PADDED.
+    unsafe {
+        _mm512_storeu_pd(bu.add(count), _mm512_setzero_pd());
+        _mm512_storeu_pd(bv.add(count), _mm512_setzero_pd());
     }
     count
 }
@@ -505,13 +560,6 @@ fn deposit(mut value: u64, mask: u64) -> u64 {
         value >>= 1;
     }
     out
-}
-
-/// [`deposit`] in one BMI2 instruction.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "bmi2")]
-unsafe fn deposit_bmi2(value: u64, mask: u64) -> u64 {
-    std::arch::x86_64::_pdep_u64(value, mask)
 }
 
 /// [`PairAxes::masks`] in AVX2, with the same arithmetic: face a four pairs at a time per
@@ -710,8 +758,8 @@ unsafe fn groups_avx512(
     lower: u32,
     upper: u32,
     count: usize,
-    us: &[f64; PADDED],
-    vs: &[f64; PADDED],
+    us: *const f64,
+    vs: *const f64,
 ) -> u64 {
     let mut mask = 0u64;
     let groups = count.div_ceil(8);
@@ -742,18 +790,16 @@ unsafe fn group_avx512<const G: usize>(
     lower: u32,
     upper: u32,
     first: usize,
-    us: &[f64; PADDED],
-    vs: &[f64; PADDED],
+    us: *const f64,
+    vs: *const f64,
 ) -> u64 {
     use std::arch::x86_64::*;
     let s = |x: f64| _mm512_set1_pd(x);
     let (zero, one) = (_mm512_setzero_pd(), s(1.0));
     let (mul, add, sub) = (_mm512_mul_pd, _mm512_add_pd, _mm512_sub_pd);
-    // SAFETY (loads): 8·(first + G) <= MAX_PATCHES, as in `group_avx2`.
-    let bu: [__m512d; G] =
-        std::array::from_fn(|k| unsafe { _mm512_loadu_pd(us.as_ptr().add(8 * (first + k))) });
-    let bv: [__m512d; G] =
-        std::array::from_fn(|k| unsafe { _mm512_loadu_pd(vs.as_ptr().add(8 * (first + k))) });
+    // SAFETY (loads): the groups lie within the lanes the caller wrote.
+    let bu: [__m512d; G] = std::array::from_fn(|k| unsafe { _mm512_loadu_pd(us.add(8 * (first + k))) });
+    let bv: [__m512d; G] = std::array::from_fn(|k| unsafe { _mm512_loadu_pd(vs.add(8 * (first + k))) });
     let (mut lo_n, mut lo_d, mut hi_n, mut hi_d) = ([zero; G], [one; G], [one; G], [one; G]);
     let (mut lower, mut upper) = (lower, upper);
     while lower | upper != 0 {
