@@ -1108,10 +1108,14 @@ fn finish_cell<A: HitAttributes + ?Sized>(
             encode_hits(attrs, hit_list, world_cell_min, cell, encoded);
         }
         let mut next_hit = encoded.iter();
+        // The pair of the shafts, advanced as they come (in order), not divided out of each.
+        let n4 = (n * n * n * n) as usize;
+        let (mut pair, mut pair_end) = (0u32, n4);
         for shaft in filled() {
+            while shaft >= pair_end {
+                (pair, pair_end) = (pair + 1, pair_end + n4);
+            }
             let end = &ends[shaft];
-            let pair = shaft as u32 / (n * n * n * n);
-            let (fa, fb) = pair_faces(pair);
             let mut record = |e: &End, side: usize, fallbacks: &mut Vec<RecordWords>| -> RecordWords {
                 if e.t.is_finite() {
                     if let Some(&words) = next_hit.next() {
@@ -1149,7 +1153,7 @@ fn finish_cell<A: HitAttributes + ?Sized>(
             };
             let pair_records = [front, back];
             if let Some(shade) = shade {
-                let (_, pa, _, pb) = shaft_parts(shaft as u32, n);
+                let (fa, pa, fb, pb) = shaft_parts(shaft as u32, n);
                 let mut rgb = [0u16; 8];
                 for (k, r) in pair_records.iter().enumerate() {
                     let Some(hit) = layout.decode(r, world_cell_min, cell) else { continue };
