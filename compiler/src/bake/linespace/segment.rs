@@ -170,6 +170,12 @@ impl SegmentTest {
         Intersection { t: hits.t[p], u: hits.w2[p] / self.n2, v: hits.w0[p] / self.n2 }
     }
 
+    /// The crossings of the patches `p` as [`Self::lane`]'s numerators and denominator:
+    /// (u numerators, v numerators, denominator), u = w2 / n2 and v = w0 / n2 in each lane.
+    pub(super) fn lanes_x8(&self, hits: &LaneHits, p: &[u32; 8]) -> ([f32; 8], [f32; 8], f32) {
+        (p.map(|p| hits.w2[p as usize]), p.map(|p| hits.w0[p as usize]), self.n2)
+    }
+
     /// [`Self::hits_among`] in AVX-512, sixteen segments at a time, with [`Self::hit_if`]'s
     /// operations in its order (no fused multiply-adds).
     #[cfg(target_arch = "x86_64")]
