@@ -650,6 +650,15 @@ fn groups(
     mask
 }
 
+/// Takes the lowest pair off `set`; returns its a end (`sa`) and its b end as
+/// [`PairAxes::b_end`] gives it (the vector kernels' bound steps).
+#[inline(always)]
+fn pop_pair(set: &mut u32, sa: &[f64; 2 * LANES], p: &PairAxes) -> (f64, (f64, f64, f64)) {
+    let c = set.trailing_zeros() as usize;
+    *set &= *set - 1;
+    (sa[c], p.b_end(c))
+}
+
 /// [`groups`] in AVX2 intrinsics, four shafts at a time, with the same arithmetic operation
 /// for operation (the same bits).
 #[cfg(target_arch = "x86_64")]
@@ -707,9 +716,7 @@ unsafe fn group_avx2<const G: usize>(
     let (mut lower, mut upper) = (lower, upper);
     while lower | upper != 0 {
         if lower != 0 {
-            let c = lower.trailing_zeros() as usize;
-            lower &= lower - 1;
-            let (a, (base, du, dv)) = (sa[c], p.b_end(c));
+            let (a, (base, du, dv)) = pop_pair(&mut lower, sa, p);
             let (num, base, du, dv) = (s(a), s(base), s(du), s(dv));
             for k in 0..G {
                 let b =
@@ -721,9 +728,7 @@ unsafe fn group_avx2<const G: usize>(
             }
         }
         if upper != 0 {
-            let c = upper.trailing_zeros() as usize;
-            upper &= upper - 1;
-            let (a, (base, du, dv)) = (sa[c], p.b_end(c));
+            let (a, (base, du, dv)) = pop_pair(&mut upper, sa, p);
             let (va, num, base, du, dv) = (s(a), s(-a), s(base), s(du), s(dv));
             for k in 0..G {
                 let b =
@@ -804,9 +809,7 @@ unsafe fn group_avx512<const G: usize>(
     let (mut lower, mut upper) = (lower, upper);
     while lower | upper != 0 {
         if lower != 0 {
-            let c = lower.trailing_zeros() as usize;
-            lower &= lower - 1;
-            let (a, (base, du, dv)) = (sa[c], p.b_end(c));
+            let (a, (base, du, dv)) = pop_pair(&mut lower, sa, p);
             let (num, base, du, dv) = (s(a), s(base), s(du), s(dv));
             for k in 0..G {
                 let b = add(base, add(mul(bu[k], du), mul(bv[k], dv)));
@@ -817,9 +820,7 @@ unsafe fn group_avx512<const G: usize>(
             }
         }
         if upper != 0 {
-            let c = upper.trailing_zeros() as usize;
-            upper &= upper - 1;
-            let (a, (base, du, dv)) = (sa[c], p.b_end(c));
+            let (a, (base, du, dv)) = pop_pair(&mut upper, sa, p);
             let (va, num, base, du, dv) = (s(a), s(-a), s(base), s(du), s(dv));
             for k in 0..G {
                 let b = add(base, add(mul(bu[k], du), mul(bv[k], dv)));
