@@ -706,8 +706,8 @@ unsafe fn group_avx2<const G: usize>(
     let s = |x: f64| _mm256_set1_pd(x);
     let (zero, one) = (_mm256_setzero_pd(), s(1.0));
     let gt = |x: __m256d, y: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, y);
-    // SAFETY (loads): 4·(first + G) <= MAX_PATCHES: the caller's groups are within the count,
-    // padded to a multiple of eight.
+    // SAFETY (loads): 4·(first + G) <= 4·ceil(count / 4) <= MAX_PATCHES < PADDED, the arrays'
+    // length (the caller's groups cover the count, the lanes past it zeros).
     let bu: [__m256d; G] =
         std::array::from_fn(|k| unsafe { _mm256_loadu_pd(us.as_ptr().add(4 * (first + k))) });
     let bv: [__m256d; G] =
