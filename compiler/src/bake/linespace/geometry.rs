@@ -81,42 +81,37 @@ impl Prepared {
         sweep(&self.lanes, c0, c1, h0, h1, margin)
     }
 
-    /// The triangle's separations for the shafts of face pair (`fa`, `fb`) at resolution `n`,
-    /// ready for [`PairAxes::masks`] and [`PairAxes::shafts_among`].
-    pub fn pair_axes(&self, fa: u32, fb: u32, n: u32, margin: f64) -> PairAxes {
+    /// The triangle's separations from the patches of face `face` at resolution `n`, as either
+    /// end of a shaft: [`PairAxes`] of two of them are the separations for the shafts of a face
+    /// pair, ready for [`PairAxes::masks`] and [`PairAxes::shafts_among`].
+    pub fn face_axes(&self, face: u32, n: u32, margin: f64) -> FaceAxes {
+        let mut f = FaceAxes { sep: [[0.0; LANES]; 2], du: [0.0; LANES], dv: [0.0; LANES] };
+        self.face_axes_into(face, n, margin, &mut f);
+        f
+    }
+
+    /// [`Self::face_axes`] into `f`.
+    fn face_axes_into(&self, face: u32, n: u32, margin: f64, f: &mut FaceAxes) {
         let l = &self.lanes;
         let s = 1.0 / n as f64;
         let half = 0.5 * s;
-        let mut p = PairAxes {
-            a: [[0.0; LANES]; 2],
-            a_du: [0.0; LANES],
-            a_dv: [0.0; LANES],
-            b: [[0.0; LANES]; 2],
-            b_du: [0.0; LANES],
-            b_dv: [0.0; LANES],
-        };
         // A patch of face f at indices (u, v) is the box with centre (f mod 2) on f's axis and
         // (index + 1/2)·s on the other two, half extent s/2 on those. So on every axis the
         // centre's projection is affine in (u, v) and the box's radius is one number.
-        for (face, sep, du, dv) in
-            [(fa, &mut p.a, &mut p.a_du, &mut p.a_dv), (fb, &mut p.b, &mut p.b_du, &mut p.b_dv)]
-        {
-            let (j, plane) = (face_axis(face), (face % 2) as f64);
-            let (ua, va) = face_uv_axes(face);
-            for i in 0..LANES {
-                let lv = [l.l[0][i], l.l[1][i], l.l[2][i]];
-                let av = [l.a[0][i], l.a[1][i], l.a[2][i]];
-                let k = lv[j] * plane + (lv[ua] + lv[va]) * half;
-                let r = (av[ua] + av[va]) * half + margin * l.l1[i];
-                // Positive: separated. Box minimum minus triangle maximum is k − r − t1 plus
-                // (u·du + v·dv); triangle minimum minus box maximum is t0 − k − r minus it.
-                sep[0][i] = k - r - l.t1[i];
-                sep[1][i] = l.t0[i] - k - r;
-                du[i] = lv[ua] * s;
-                dv[i] = lv[va] * s;
-            }
+        let (j, plane) = (face_axis(face), (face % 2) as f64);
+        let (ua, va) = face_uv_axes(face);
+        for i in 0..LANES {
+            let lv = [l.l[0][i], l.l[1][i], l.l[2][i]];
+            let av = [l.a[0][i], l.a[1][i], l.a[2][i]];
+            let k = lv[j] * plane + (lv[ua] + lv[va]) * half;
+            let r = (av[ua] + av[va]) * half + margin * l.l1[i];
+            // Positive: separated. Box minimum minus triangle maximum is k − r − t1 plus
+            // (u·du + v·dv); triangle minimum minus box maximum is t0 − k − r minus it.
+            f.sep[0][i] = k - r - l.t1[i];
+            f.sep[1][i] = l.t0[i] - k - r;
+            f.du[i] = lv[ua] * s;
+            f.dv[i] = lv[va] * s;
         }
-        p
     }
 }
 
@@ -124,31 +119,52 @@ impl Prepared {
 /// with their sign masks ([`Prepared::face_tables`]). A face pair's ([`Self::pair`]) are two of
 /// them: each separation depends on its face alone, so a triangle's six faces serve its 15
 /// pairs (made for every pair, the same numbers were a sixth of an object cell's bake).
+///
+/// A pair's separations and masks are views of two faces' ([`Self::pair`]): copied into one
+/// value per pair (1.3 KB), they were a twentieth of the teapot's 32³ object cells' bake.
 #[derive(Debug, Clone)]
 pub struct FaceTables {
-    /// Face f's separations on both sides of the pair (f, f).
-    axes: [PairAxes; 6],
-    masks: [PairMasks; 6],
+    /// Face f's separations, as either end of a shaft.
+    axes: [FaceAxes; 6],
+    /// The sign masks of the pair (f, f).
+    masks: [MaskTable; 6],
+}
+
+impl Default for FaceTables {
+    fn default() -> Self {
+        let axes = FaceAxes { sep: [[0.0; LANES]; 2], du: [0.0; LANES], dv: [0.0; LANES] };
+        let masks = MaskTable { n: 0, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
+        FaceTables {
+            axes: std::array::from_fn(|_| axes.clone()),
+            masks: std::array::from_fn(|_| masks.clone()),
+        }
+    }
 }
 
 impl Prepared {
     /// [`FaceTables`] at resolution `n` with the grid margin `margin`.
     pub fn face_tables(&self, n: u32, margin: f64) -> FaceTables {
-        let axes: [PairAxes; 6] = std::array::from_fn(|f| self.pair_axes(f as u32, f as u32, n, margin));
-        let masks = std::array::from_fn(|f| axes[f].masks(n));
-        FaceTables { axes, masks }
+        let mut t = FaceTables::default();
+        self.face_tables_into(n, margin, &mut t);
+        t
+    }
+
+    /// [`Self::face_tables`] into `t` (made in place: a cell's kept tables are not moved).
+    pub fn face_tables_into(&self, n: u32, margin: f64, t: &mut FaceTables) {
+        for f in 0..6 {
+            self.face_axes_into(f as u32, n, margin, &mut t.axes[f]);
+            let axes = &t.axes[f];
+            t.masks[f] = PairAxes { a: axes, b: axes }.masks(n);
+        }
     }
 }
 
 impl FaceTables {
-    /// The separations and sign masks of face pair (`fa`, `fb`): those [`Prepared::pair_axes`]
-    /// and [`PairAxes::masks`] make, bit for bit.
-    pub fn pair(&self, fa: u32, fb: u32) -> (PairAxes, PairMasks) {
-        let (a, b) = (&self.axes[fa as usize], &self.axes[fb as usize]);
-        let axes = PairAxes { a: a.a, a_du: a.a_du, a_dv: a.a_dv, b: b.b, b_du: b.b_du, b_dv: b.b_dv };
-        let (ma, mb) = (&self.masks[fa as usize], &self.masks[fb as usize]);
-        let masks = PairMasks { n: ma.n, at_a: ma.at_a, at_b: mb.at_b, some_b: mb.some_b, free_b: mb.free_b };
-        (axes, masks)
+    /// The separations and sign masks of face pair (`fa`, `fb`): those of
+    /// [`Prepared::face_axes`] and [`PairAxes::masks`], as views of the two faces' tables.
+    pub fn pair(&self, fa: u32, fb: u32) -> (PairAxes<'_>, PairMasks<'_>) {
+        let axes = PairAxes { a: &self.axes[fa as usize], b: &self.axes[fb as usize] };
+        (axes, MaskTable::pair(&self.masks[fa as usize], &self.masks[fb as usize]))
     }
 
     /// [`PairMasks::survivors`] of the pair (`fa`, `fb`) (`masks`, from [`Self::pair`]), the
@@ -170,7 +186,7 @@ impl FaceTables {
 /// positive.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn survivors_avx512(columns: &[u64; 2 * LANES], m: &PairMasks, out: &mut [u64; MAX_PATCHES]) {
+unsafe fn survivors_avx512(columns: &[u64; 2 * LANES], m: &PairMasks<'_>, out: &mut [u64; MAX_PATCHES]) {
     use std::arch::x86_64::*;
     let n2 = (m.n * m.n) as usize;
     let groups = n2.div_ceil(8);
@@ -228,17 +244,21 @@ fn sweep(l: &Lanes, c0: DVec3, c1: DVec3, h0: DVec3, h1: DVec3, margin: f64) -> 
     lo <= hi
 }
 
-/// One triangle's separations from the patches of two faces (see [`Prepared::pair_axes`]): on
-/// each of the 16 lanes (13 axes and padding) and for each of the two sides, `a[side] ±
-/// (u·a_du + v·a_dv)` for the patch (u, v) of face a (+ for side 0), the same with `b` for face b.
+/// One triangle's separations from the patches of two faces, a view of each face's
+/// ([`Prepared::face_axes`]): face a's as the a end of the shafts, face b's as the b end.
+#[derive(Debug, Clone, Copy)]
+pub struct PairAxes<'f> {
+    pub a: &'f FaceAxes,
+    pub b: &'f FaceAxes,
+}
+
+/// One triangle's separations from the patches of one face ([`Prepared::face_axes`]): on each
+/// lane and side, `sep[side] ± (u·du + v·dv)` for the patch (u, v) (+ for side 0).
 #[derive(Debug, Clone)]
-pub struct PairAxes {
-    a: [[f64; LANES]; 2],
-    a_du: [f64; LANES],
-    a_dv: [f64; LANES],
-    b: [[f64; LANES]; 2],
-    b_du: [f64; LANES],
-    b_dv: [f64; LANES],
+pub struct FaceAxes {
+    sep: [[f64; LANES]; 2],
+    du: [f64; LANES],
+    dv: [f64; LANES],
 }
 
 /// The lanes holding real axes (the rest are padding, never separating).
@@ -289,32 +309,38 @@ fn bits(mask: u64) -> impl Iterator<Item = usize> {
 /// is named by the bit `side·16 + lane` ("pair" below), a patch (u, v) by the bit u·n + v. A shaft
 /// whose two ends are both separated by one pair misses the triangle
 /// ([`PairMasks::survivors`]); the rest need [`PairAxes::shafts_among`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct PairMasks {
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairMasks<'m> {
     n: u32,
     /// Per patch of face a (the a end of its shafts): the pairs positive there.
-    at_a: [u32; MAX_PATCHES],
+    at_a: &'m [u32; MAX_PATCHES],
     /// Per pair: the patches of face b (the b end) where it is positive.
-    at_b: [u64; 2 * LANES],
+    at_b: &'m [u64; 2 * LANES],
     /// The pairs positive at some patch of face b.
     some_b: u32,
     /// The patches of face b where none is: the triangle meets their boxes.
     free_b: u64,
 }
 
-impl PairMasks {
-    /// For every patch of face a, the patches of face b that no single pair separates at both
-    /// ends (a superset of the shafts the triangle meets).
-    pub fn survivors(&self, out: &mut [u64; MAX_PATCHES]) {
-        let n2 = (self.n * self.n) as usize;
-        let all = low_bits(n2);
-        for (pa, out) in out.iter_mut().enumerate().take(n2) {
-            let mut rejected = 0u64;
-            for c in bits((self.at_a[pa] & self.some_b) as u64) {
-                rejected |= self.at_b[c];
-            }
-            *out = all & !rejected;
-        }
+/// The sign masks [`PairAxes::masks`] makes, held: [`PairMasks`] are views of one or two.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MaskTable {
+    n: u32,
+    at_a: [u32; MAX_PATCHES],
+    at_b: [u64; 2 * LANES],
+    some_b: u32,
+    free_b: u64,
+}
+
+impl MaskTable {
+    /// The masks of the pair whose a end's are `a`'s and b end's `b`'s.
+    pub fn pair<'m>(a: &'m MaskTable, b: &'m MaskTable) -> PairMasks<'m> {
+        PairMasks { n: a.n, at_a: &a.at_a, at_b: &b.at_b, some_b: b.some_b, free_b: b.free_b }
+    }
+
+    /// The masks as a view.
+    pub fn view(&self) -> PairMasks<'_> {
+        MaskTable::pair(self, self)
     }
 
     /// `some_b` and `free_b` from `at_b`.
@@ -329,10 +355,26 @@ impl PairMasks {
     }
 }
 
-impl PairAxes {
+impl PairMasks<'_> {
+    /// For every patch of face a, the patches of face b that no single pair separates at both
+    /// ends (a superset of the shafts the triangle meets).
+    pub fn survivors(&self, out: &mut [u64; MAX_PATCHES]) {
+        let n2 = (self.n * self.n) as usize;
+        let all = low_bits(n2);
+        for (pa, out) in out.iter_mut().enumerate().take(n2) {
+            let mut rejected = 0u64;
+            for c in bits((self.at_a[pa] & self.some_b) as u64) {
+                rejected |= self.at_b[c];
+            }
+            *out = all & !rejected;
+        }
+    }
+}
+
+impl PairAxes<'_> {
     /// The sign masks of every separation at every patch of both faces (resolution `n`), with
     /// the arithmetic of [`PairAxes::shafts_among`] (the same signs, bit for bit).
-    pub fn masks(&self, n: u32) -> PairMasks {
+    pub fn masks(&self, n: u32) -> MaskTable {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports the features the function is compiled for.
@@ -342,10 +384,10 @@ impl PairAxes {
     }
 
     /// [`PairAxes::masks`] without SIMD intrinsics.
-    fn masks_portable(&self, n: u32) -> PairMasks {
+    fn masks_portable(&self, n: u32) -> MaskTable {
         let n2 = (n * n) as usize;
         let [us, vs] = &PATCH_UV[n as usize];
-        let mut m = PairMasks { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
+        let mut m = MaskTable { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
         for p in 0..n2 {
             let sa = self.a_end(us[p], vs[p]);
             for (c, &x) in sa.iter().enumerate() {
@@ -354,9 +396,9 @@ impl PairAxes {
         }
         for i in 0..AXES {
             for p in 0..n2 {
-                let t = us[p] * self.b_du[i] + vs[p] * self.b_dv[i];
-                m.at_b[i] |= ((self.b[0][i] + t > 0.0) as u64) << p;
-                m.at_b[LANES + i] |= ((self.b[1][i] - t > 0.0) as u64) << p;
+                let t = us[p] * self.b.du[i] + vs[p] * self.b.dv[i];
+                m.at_b[i] |= ((self.b.sep[0][i] + t > 0.0) as u64) << p;
+                m.at_b[LANES + i] |= ((self.b.sep[1][i] - t > 0.0) as u64) << p;
             }
         }
         m.finish_b(n2);
@@ -368,9 +410,9 @@ impl PairAxes {
     fn a_end(&self, u: f64, v: f64) -> [f64; 2 * LANES] {
         let mut sa = [0.0f64; 2 * LANES];
         for i in 0..AXES {
-            let ta = u * self.a_du[i] + v * self.a_dv[i];
-            sa[i] = self.a[0][i] + ta;
-            sa[LANES + i] = self.a[1][i] - ta;
+            let ta = u * self.a.du[i] + v * self.a.dv[i];
+            sa[i] = self.a.sep[0][i] + ta;
+            sa[LANES + i] = self.a.sep[1][i] - ta;
         }
         sa
     }
@@ -466,9 +508,9 @@ impl PairAxes {
             // SAFETY: h + 8 <= LANES, the arrays' length; LANES + h + 8 <= 2·LANES, `sa`'s.
             unsafe {
                 let ld = |x: &[f64; LANES]| _mm512_loadu_pd(x.as_ptr().add(h));
-                let ta = _mm512_add_pd(_mm512_mul_pd(u, ld(&self.a_du)), _mm512_mul_pd(v, ld(&self.a_dv)));
-                _mm512_storeu_pd(sa.as_mut_ptr().add(h), _mm512_add_pd(ld(&self.a[0]), ta));
-                _mm512_storeu_pd(sa.as_mut_ptr().add(LANES + h), _mm512_sub_pd(ld(&self.a[1]), ta));
+                let ta = _mm512_add_pd(_mm512_mul_pd(u, ld(&self.a.du)), _mm512_mul_pd(v, ld(&self.a.dv)));
+                _mm512_storeu_pd(sa.as_mut_ptr().add(h), _mm512_add_pd(ld(&self.a.sep[0]), ta));
+                _mm512_storeu_pd(sa.as_mut_ptr().add(LANES + h), _mm512_sub_pd(ld(&self.a.sep[1]), ta));
             }
         }
         let (mut bu, mut bv) =
@@ -489,9 +531,9 @@ impl PairAxes {
     fn b_end(&self, c: usize) -> (f64, f64, f64) {
         let (side, i) = (c / LANES, c % LANES);
         if side == 0 {
-            (self.b[0][i], self.b_du[i], self.b_dv[i])
+            (self.b.sep[0][i], self.b.du[i], self.b.dv[i])
         } else {
-            (self.b[1][i], -self.b_du[i], -self.b_dv[i])
+            (self.b.sep[1][i], -self.b.du[i], -self.b.dv[i])
         }
     }
 }
@@ -566,30 +608,30 @@ fn deposit(mut value: u64, mask: u64) -> u64 {
 /// patch, face b four patches at a time per pair.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn masks_avx2(p: &PairAxes, n: u32) -> PairMasks {
+unsafe fn masks_avx2(p: &PairAxes<'_>, n: u32) -> MaskTable {
     use std::arch::x86_64::*;
     let n2 = (n * n) as usize;
     let all = low_bits(n2);
     let [us, vs] = &PATCH_UV[n as usize];
     let zero = _mm256_setzero_pd();
     let gt = |x: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, zero);
-    let mut m = PairMasks { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
+    let mut m = MaskTable { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
     // SAFETY (loads): g + 4 <= LANES, the arrays' length.
     let ld = |x: &[f64; LANES], g: usize| unsafe { _mm256_loadu_pd(x.as_ptr().add(g)) };
     for (pa, at) in m.at_a.iter_mut().enumerate().take(n2) {
         let (u, v) = (_mm256_set1_pd(us[pa]), _mm256_set1_pd(vs[pa]));
         let mut bits = 0u32;
         for g in (0..LANES).step_by(4) {
-            let ta = _mm256_add_pd(_mm256_mul_pd(u, ld(&p.a_du, g)), _mm256_mul_pd(v, ld(&p.a_dv, g)));
-            let side0 = _mm256_movemask_pd(gt(_mm256_add_pd(ld(&p.a[0], g), ta))) as u32;
-            let side1 = _mm256_movemask_pd(gt(_mm256_sub_pd(ld(&p.a[1], g), ta))) as u32;
+            let ta = _mm256_add_pd(_mm256_mul_pd(u, ld(&p.a.du, g)), _mm256_mul_pd(v, ld(&p.a.dv, g)));
+            let side0 = _mm256_movemask_pd(gt(_mm256_add_pd(ld(&p.a.sep[0], g), ta))) as u32;
+            let side1 = _mm256_movemask_pd(gt(_mm256_sub_pd(ld(&p.a.sep[1], g), ta))) as u32;
             bits |= side0 << g | side1 << (LANES + g);
         }
         *at = bits;
     }
     for i in 0..AXES {
-        let (b0, b1) = (_mm256_set1_pd(p.b[0][i]), _mm256_set1_pd(p.b[1][i]));
-        let (du, dv) = (_mm256_set1_pd(p.b_du[i]), _mm256_set1_pd(p.b_dv[i]));
+        let (b0, b1) = (_mm256_set1_pd(p.b.sep[0][i]), _mm256_set1_pd(p.b.sep[1][i]));
+        let (du, dv) = (_mm256_set1_pd(p.b.du[i]), _mm256_set1_pd(p.b.dv[i]));
         let (mut m0, mut m1) = (0u64, 0u64);
         for g in (0..n2).step_by(4) {
             // SAFETY: g + 4 <= MAX_PATCHES, the tables' length (patches beyond n² are masked
@@ -1044,10 +1086,13 @@ pub(crate) mod tests {
             let tri = Prepared::new([0; 3].map(|_| c + (DVec3::new(rnd(), rnd(), rnd()) - 0.5) * size));
             let pair = case % 15;
             let (fa, fb) = kiln_format::linespace::index::pair_faces(pair);
-            let axes = tri.pair_axes(fa, fb, n, [0.0, 1e-5, 1e-2][(case % 5 % 3) as usize]);
-            let masks = axes.masks_portable(n);
+            let margin = [0.0, 1e-5, 1e-2][(case % 5 % 3) as usize];
+            let (a, b) = (tri.face_axes(fa, n, margin), tri.face_axes(fb, n, margin));
+            let axes = PairAxes { a: &a, b: &b };
+            let table = axes.masks_portable(n);
             // SAFETY: AVX2 was detected above.
-            assert_eq!(masks, unsafe { masks_avx2(&axes, n) }, "case {case}");
+            assert_eq!(table, unsafe { masks_avx2(&axes, n) }, "case {case}");
+            let masks = table.view();
             let mut among = [0u64; MAX_PATCHES];
             masks.survivors(&mut among);
             for pa in 0..n * n {
@@ -1081,11 +1126,13 @@ pub(crate) mod tests {
             for pair in 0..FACE_PAIRS {
                 let (fa, fb) = pair_faces(pair);
                 let (axes, masks) = tables.pair(fa, fb);
-                let own_axes = tri.pair_axes(fa, fb, n, margin);
-                let own = own_axes.masks(n);
+                let (a, b) = (tri.face_axes(fa, n, margin), tri.face_axes(fb, n, margin));
+                let own_axes = PairAxes { a: &a, b: &b };
+                let own_table = own_axes.masks(n);
+                let own = own_table.view();
                 assert_eq!(masks, own, "case {case} pair {pair}");
-                let bits = |x: &[[f64; LANES]; 2]| x.map(|l| l.map(f64::to_bits));
-                assert_eq!((bits(&axes.a), bits(&axes.b)), (bits(&own_axes.a), bits(&own_axes.b)));
+                let bits = |x: &FaceAxes| [x.sep[0], x.sep[1], x.du, x.dv].map(|l| l.map(f64::to_bits));
+                assert_eq!((bits(axes.a), bits(axes.b)), (bits(own_axes.a), bits(own_axes.b)));
                 let (mut fast, mut slow) = ([0u64; MAX_PATCHES], [7u64; MAX_PATCHES]);
                 tables.survivors(fa, &masks, &mut fast);
                 own.survivors(&mut slow);
@@ -1127,8 +1174,10 @@ pub(crate) mod tests {
                     (c, h)
                 };
                 let (ca, ha) = face_box(fa, au, av);
-                let axes = tri.pair_axes(fa, fb, n, margin);
-                let masks = axes.masks(n);
+                let (a, b) = (tri.face_axes(fa, n, margin), tri.face_axes(fb, n, margin));
+                let axes = PairAxes { a: &a, b: &b };
+                let table = axes.masks(n);
+                let masks = table.view();
                 let mut among = [0u64; MAX_PATCHES];
                 masks.survivors(&mut among);
                 let pa = au * n + av;

@@ -654,9 +654,10 @@ struct FirstScratch {
     ts: [Vec<f32>; 2],
     /// The first pass's survivors by (triangle, pair, front patch).
     amongs: Vec<u64>,
-    /// The first pass's face tables by triangle (`None` for a spanning one), where the cell
-    /// has at most [`CACHED_TABLES`] triangles.
-    tables: Vec<Option<FaceTables>>,
+    /// The first pass's face tables by triangle (a spanning one's unused), where the cell has
+    /// at most [`CACHED_TABLES`] triangles; else the first is each triangle's in turn. Made in
+    /// place and kept from cell to cell (moving them was a fortieth of an object cell's bake).
+    tables: Vec<FaceTables>,
 }
 
 /// The most survivor masks [`RecordsFirst`] keeps from its first pass for its second (8 MiB; a
@@ -707,7 +708,6 @@ impl RecordsFirst<'_> {
         let cached = tris.len() * FACE_PAIRS as usize * n2 <= CACHED_SURVIVORS;
         amongs.clear();
         amongs.resize(if cached { tris.len() * FACE_PAIRS as usize * n2 } else { 0 }, 0);
-        kept.clear();
         let keep_tables = tris.len() <= CACHED_TABLES;
         for (li, &t) in tris.iter().enumerate() {
             let v = local[t as usize].map(|p| p - cell_min);
@@ -716,7 +716,16 @@ impl RecordsFirst<'_> {
             let poly = &polys[li];
             let seg = SegmentTest::new(attrs.corners(t));
             let sides = spanning_sides(v, margin, n);
-            let tables = if sides.is_none() { Some(prep.face_tables(n, margin)) } else { None };
+            let slot = if keep_tables { li } else { 0 };
+            if kept.len() <= slot {
+                kept.push(FaceTables::default());
+            }
+            let tables = if sides.is_none() {
+                prep.face_tables_into(n, margin, &mut kept[slot]);
+                Some(&kept[slot])
+            } else {
+                None
+            };
             for pair in 0..FACE_PAIRS {
                 let (fa, fb) = pair_faces(pair);
                 let mut from_patch = |pa: u32, among: u64| {
@@ -760,7 +769,7 @@ impl RecordsFirst<'_> {
                     None => {
                         let at = if cached { (li * FACE_PAIRS as usize + pair as usize) * n2 } else { 0 };
                         let keep = &mut amongs[at..];
-                        let tables = tables.as_ref().expect("the separations of a triangle not spanning");
+                        let tables = tables.expect("the separations of a triangle not spanning");
                         patch_sets(tables, poly, pair, n, &mut |pa, among, _, _| {
                             if cached {
                                 keep[pa as usize] = among;
@@ -771,9 +780,6 @@ impl RecordsFirst<'_> {
                 }
             }
             prepared.push((prep, sides));
-            if keep_tables {
-                kept.push(tables);
-            }
         }
         // The hit shafts by the triangles of their tentative ends (a counting sort: each
         // triangle's shafts in shaft order).
@@ -816,7 +822,7 @@ impl RecordsFirst<'_> {
             let poly = &polys[li];
             let mut mine = &shafts[starts[li] as usize..starts[li + 1] as usize];
             // The first pass's, or made again where a pair has shafts to test.
-            let kept = kept.get(li).and_then(Option::as_ref);
+            let kept = (keep_tables && sides.is_none()).then(|| &kept[li]);
             let mut made = None;
             for pair in 0..FACE_PAIRS {
                 let (fa, fb) = pair_faces(pair);
@@ -929,8 +935,10 @@ impl RecordsFirst<'_> {
                 }
                 None if poly.is_empty() => false,
                 None => {
-                    let axes = prep.pair_axes(fa, fb, n, margin);
-                    let masks = axes.masks(n);
+                    let (a, b) = (prep.face_axes(fa, n, margin), prep.face_axes(fb, n, margin));
+                    let axes = PairAxes { a: &a, b: &b };
+                    let table = axes.masks(n);
+                    let masks = table.view();
                     let mut among = [0u64; MAX_PATCHES];
                     masks.survivors(&mut among);
                     let test = among[pa as usize] & 1 << pb;
