@@ -85,7 +85,7 @@ impl Prepared {
     /// end of a shaft: [`PairAxes`] of two of them are the separations for the shafts of a face
     /// pair, ready for [`PairAxes::masks`] and [`PairAxes::shafts_among`].
     pub fn face_axes(&self, face: u32, n: u32, margin: f64) -> FaceAxes {
-        let mut f = FaceAxes { sep: [[0.0; LANES]; 2], du: [0.0; LANES], dv: [0.0; LANES] };
+        let mut f = FaceAxes::default();
         self.face_axes_into(face, n, margin, &mut f);
         f
     }
@@ -111,6 +111,8 @@ impl Prepared {
             f.sep[1][i] = l.t0[i] - k - r;
             f.du[i] = lv[ua] * s;
             f.dv[i] = lv[va] * s;
+            (f.signed_du[i], f.signed_du[LANES + i]) = (f.du[i], -f.du[i]);
+            (f.signed_dv[i], f.signed_dv[LANES + i]) = (f.dv[i], -f.dv[i]);
         }
     }
 }
@@ -132,7 +134,7 @@ pub struct FaceTables {
 
 impl Default for FaceTables {
     fn default() -> Self {
-        let axes = FaceAxes { sep: [[0.0; LANES]; 2], du: [0.0; LANES], dv: [0.0; LANES] };
+        let axes = FaceAxes::default();
         let masks = MaskTable { n: 0, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
         FaceTables {
             axes: std::array::from_fn(|_| axes.clone()),
@@ -259,6 +261,23 @@ pub struct FaceAxes {
     sep: [[f64; LANES]; 2],
     du: [f64; LANES],
     dv: [f64; LANES],
+    /// `du` and `dv` by pair (side·16 + lane): negated for side 1 (the b end's step takes its
+    /// pair's without branching on the side; a branch there mispredicted at every change of
+    /// side in a chain of bounds).
+    signed_du: [f64; 2 * LANES],
+    signed_dv: [f64; 2 * LANES],
+}
+
+impl Default for FaceAxes {
+    fn default() -> Self {
+        FaceAxes {
+            sep: [[0.0; LANES]; 2],
+            du: [0.0; LANES],
+            dv: [0.0; LANES],
+            signed_du: [0.0; 2 * LANES],
+            signed_dv: [0.0; 2 * LANES],
+        }
+    }
 }
 
 /// The lanes holding real axes (the rest are padding, never separating).
@@ -529,12 +548,7 @@ impl PairAxes<'_> {
     /// same bits as subtracting for side 1).
     #[inline(always)]
     fn b_end(&self, c: usize) -> (f64, f64, f64) {
-        let (side, i) = (c / LANES, c % LANES);
-        if side == 0 {
-            (self.b.sep[0][i], self.b.du[i], self.b.dv[i])
-        } else {
-            (self.b.sep[1][i], -self.b.du[i], -self.b.dv[i])
-        }
+        (self.b.sep[c / LANES][c % LANES], self.b.signed_du[c], self.b.signed_dv[c])
     }
 }
 
