@@ -412,9 +412,10 @@ pub struct Scratch {
     fallbacks: Vec<RecordWords>,
     /// The records-first bake's per-triangle data and bookkeeping ([`RecordsFirst`]).
     first: FirstScratch,
-    /// A cell's hits (triangle, u, v) in the order their records are written, and the records.
+    /// A cell's hits (triangle, u, v) in the order their records are written, and the records
+    /// (the compact layout without uv: two words).
     hit_list: Vec<(u32, f32, f32)>,
-    encoded: Vec<RecordWords>,
+    encoded: Vec<[u32; 2]>,
 }
 
 /// A fallback record not made yet: no layout's encoder makes it (the full record's material
@@ -1081,7 +1082,7 @@ fn finish_cell<A: HitAttributes + ?Sized>(
         &mut [Vec<DVec3>],
         &mut Vec<RecordWords>,
     ),
-    (hit_list, encoded): (&mut Vec<(u32, f32, f32)>, &mut Vec<RecordWords>),
+    (hit_list, encoded): (&mut Vec<(u32, f32, f32)>, &mut Vec<[u32; 2]>),
     out: &mut CellShafts,
 ) {
     let records_needed = pnmt || shade.is_some();
@@ -1163,8 +1164,8 @@ fn finish_cell<A: HitAttributes + ?Sized>(
             let end = &ends[shaft];
             let mut record = |e: &End, side: usize, fallbacks: &mut Vec<RecordWords>| -> RecordWords {
                 if e.t.is_finite() {
-                    if let Some(&words) = next_hit.next() {
-                        return words;
+                    if let Some(&[w0, w1]) = next_hit.next() {
+                        return [w0, w1, 0, 0];
                     }
                     return hit_record(
                         attrs,
@@ -1557,15 +1558,17 @@ fn encode_eight(
     Some((words, taken & low_bits(count) as u8))
 }
 
-/// The records of `hits` ((triangle, u, v) each) in the compact layout without uv, eight at a
-/// time where the scene gives corner normals ([`HitAttributes::corner_normals`]) and the CPU
-/// AVX2, appended to `out`: what [`hit_record`] makes, bit for bit.
+/// The records of `hits` ((triangle, u, v) each) in the compact layout without uv (its two
+/// words), eight at a time where the scene gives corner normals
+/// ([`HitAttributes::corner_normals`]) and the CPU AVX2, appended to `out`: what [`hit_record`]
+/// makes, bit for bit. Eight taken are appended as one copy (pushed one at a time as four-word
+/// records, each went through the stack: a thirtieth of the teapot's 32³ bake).
 fn encode_hits<A: HitAttributes + ?Sized>(
     attrs: &A,
     hits: &[(u32, f32, f32)],
     world_cell_min: DVec3,
     cell: f64,
-    out: &mut Vec<RecordWords>,
+    out: &mut Vec<[u32; 2]>,
 ) {
     for chunk in hits.chunks(8) {
         let hit = |k: usize| {
@@ -1573,19 +1576,28 @@ fn encode_hits<A: HitAttributes + ?Sized>(
             Some((attrs.corners(t), attrs.corner_normals(t)?, attrs.material(t), u, v))
         };
         let encoded = encode_eight(chunk.len(), hit, world_cell_min, cell);
+        if let Some((words, taken)) = encoded
+            && taken == low_bits(chunk.len()) as u8
+        {
+            out.extend_from_slice(&words[..chunk.len()]);
+            continue;
+        }
         for (k, &(t, u, v)) in chunk.iter().enumerate() {
             out.push(match encoded {
-                Some((words, taken)) if taken >> k & 1 == 1 => [words[k][0], words[k][1], 0, 0],
-                _ => hit_record(
-                    attrs,
-                    PnmtLayout::CompactNoUv,
-                    t,
-                    attrs.corners(t),
-                    u,
-                    v,
-                    world_cell_min,
-                    cell,
-                ),
+                Some((words, taken)) if taken >> k & 1 == 1 => words[k],
+                _ => {
+                    let [w0, w1, ..] = hit_record(
+                        attrs,
+                        PnmtLayout::CompactNoUv,
+                        t,
+                        attrs.corners(t),
+                        u,
+                        v,
+                        world_cell_min,
+                        cell,
+                    );
+                    [w0, w1]
+                }
             });
         }
     }
