@@ -123,7 +123,7 @@ impl Prepared {
 /// pairs (made for every pair, the same numbers were a sixth of an object cell's bake).
 ///
 /// A pair's separations and masks are views of two faces' ([`Self::pair`]): copied into one
-/// value per pair (1.3 KB), they were a twentieth of the teapot's 32³ object cells' bake.
+/// value per pair (1.5 KB), they were a twentieth of the teapot's 32³ object cells' bake.
 #[derive(Debug, Clone)]
 pub struct FaceTables {
     /// Face f's separations, as either end of a shaft.
@@ -1147,6 +1147,8 @@ pub(crate) mod tests {
                 assert_eq!(masks, own, "case {case} pair {pair}");
                 let bits = |x: &FaceAxes| [x.sep[0], x.sep[1], x.du, x.dv].map(|l| l.map(f64::to_bits));
                 assert_eq!((bits(axes.a), bits(axes.b)), (bits(own_axes.a), bits(own_axes.b)));
+                let signed = |x: &FaceAxes| [x.signed_du, x.signed_dv].map(|l| l.map(f64::to_bits));
+                assert_eq!(signed(axes.b), signed(own_axes.b), "case {case} pair {pair}");
                 let (mut fast, mut slow) = ([0u64; MAX_PATCHES], [7u64; MAX_PATCHES]);
                 tables.survivors(fa, &masks, &mut fast);
                 own.survivors(&mut slow);

@@ -621,17 +621,18 @@ fn bake_all_pairs<A: HitAttributes + ?Sized>(
 /// 1. **Segments.** Each triangle's midpoint segments are tested against every shaft its sign
 ///    masks leave ([`PairMasks::survivors`]: a superset of the shafts it meets), the nearest hits
 ///    kept as the shafts' tentative ends, without the exact test.
-/// 2. **Exact tests.** Each tentative end's triangle is tested against its shaft; the shafts
-///    without a hit are tested as the union bake tests them (a filled one only where its
-///    fallback key bounds could change).
+/// 2. **Exact tests.** Each tentative end's triangle is tested against its shaft, unless the
+///    end's hit already witnesses that it meets it ([`witnessed`]); the shafts without a hit are
+///    tested as the union bake tests them (a filled one only where its fallback key bounds could
+///    change).
 ///
 /// A tentative end whose triangle meets the shaft is the end the bake that tests every pair
 /// finds: the hits it ranges over are a subset of the tentative's, holding it. A shaft whose
 /// tentative end fails its test (a segment crossing a triangle just outside the widened shaft,
 /// where the single-precision segment test and the exact test disagree) is baked again alone,
 /// every triangle in list order ([`Fills::fill`]). In a cell of tens of triangles most filled
-/// shafts have a hit, and a hit shaft is now tested exactly once or twice, not once per triangle
-/// reaching it (seven times on average in the teapot's 32³ object cells).
+/// shafts have a hit, and a hit shaft is now tested exactly at most twice (mostly not at all), not
+/// once per triangle reaching it (seven times on average in the teapot's 32³ object cells).
 struct RecordsFirst<'c> {
     tris: &'c [u32],
     n: u32,
@@ -666,7 +667,7 @@ struct FirstScratch {
 const CACHED_SURVIVORS: usize = 1 << 20;
 
 /// The most triangles whose face tables [`RecordsFirst`] keeps from its first pass for its
-/// second (8 KiB each: 8 MiB; a cell of more triangles makes them again where a pair has shafts
+/// second (about 9 KiB each: 9 MiB; a cell of more triangles makes them again where a pair has shafts
 /// to test). Made again, they were a twelfth of the teapot's 32³ object cells' bake.
 const CACHED_TABLES: usize = 1024;
 
@@ -1270,7 +1271,7 @@ fn local_patch_centres(n: u32) -> [[DVec3; MAX_PATCHES]; 6] {
 /// patches of adjacent faces B(t) itself does: its half extents are t/(2n), (1 − t)/(2n) and
 /// 1/(2n). Between opposite faces (B flat along their axis, the segment crossing it at unit
 /// speed and at most one cell across it), a point δ (|δ| ≤ r ≤ 1/(4n) on every axis) from the
-/// segment's point at t lies in B(t + δ_axis), t + δ_axis within [0, 1] and the point off its
+/// segment's point at t lies in B(t ± δ_axis), t ± δ_axis within [0, 1] and the point off its
 /// centre by at most 2r ≤ 1/(2n) across. So the triangle meets the shaft with a clearance of
 /// r/2 cells, which the exact test's double-precision rounding (about 10⁻¹³ cells) cannot undo:
 /// its answer is known. The single-precision hit is only the witness's source: a wrong one (a
