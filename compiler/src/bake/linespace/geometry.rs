@@ -109,10 +109,8 @@ impl Prepared {
             // (u·du + v·dv); triangle minimum minus box maximum is t0 − k − r minus it.
             f.sep[0][i] = k - r - l.t1[i];
             f.sep[1][i] = l.t0[i] - k - r;
-            f.du[i] = lv[ua] * s;
-            f.dv[i] = lv[va] * s;
-            (f.signed_du[i], f.signed_du[LANES + i]) = (f.du[i], -f.du[i]);
-            (f.signed_dv[i], f.signed_dv[LANES + i]) = (f.dv[i], -f.dv[i]);
+            (f.du[i], f.dv[i]) = (lv[ua] * s, lv[va] * s);
+            (f.du[LANES + i], f.dv[LANES + i]) = (-f.du[i], -f.dv[i]);
         }
     }
 }
@@ -135,7 +133,7 @@ pub struct FaceTables {
 impl Default for FaceTables {
     fn default() -> Self {
         let axes = FaceAxes::default();
-        let masks = MaskTable { n: 0, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
+        let masks = MaskTable::empty(0);
         FaceTables {
             axes: std::array::from_fn(|_| axes.clone()),
             masks: std::array::from_fn(|_| masks.clone()),
@@ -259,24 +257,16 @@ pub struct PairAxes<'f> {
 #[derive(Debug, Clone)]
 pub struct FaceAxes {
     sep: [[f64; LANES]; 2],
-    du: [f64; LANES],
-    dv: [f64; LANES],
-    /// `du` and `dv` by pair (side·16 + lane): negated for side 1 (the b end's step takes its
+    /// By pair (side·16 + lane): side 0's, then side 1's negated (the b end's step takes its
     /// pair's without branching on the side; a branch there mispredicted at every change of
-    /// side in a chain of bounds).
-    signed_du: [f64; 2 * LANES],
-    signed_dv: [f64; 2 * LANES],
+    /// side in a chain of bounds). The a end's sums use side 0's.
+    du: [f64; 2 * LANES],
+    dv: [f64; 2 * LANES],
 }
 
 impl Default for FaceAxes {
     fn default() -> Self {
-        FaceAxes {
-            sep: [[0.0; LANES]; 2],
-            du: [0.0; LANES],
-            dv: [0.0; LANES],
-            signed_du: [0.0; 2 * LANES],
-            signed_dv: [0.0; 2 * LANES],
-        }
+        FaceAxes { sep: [[0.0; LANES]; 2], du: [0.0; 2 * LANES], dv: [0.0; 2 * LANES] }
     }
 }
 
@@ -352,6 +342,11 @@ pub struct MaskTable {
 }
 
 impl MaskTable {
+    /// No separation positive anywhere, at resolution `n` (filled by [`PairAxes::masks`]).
+    fn empty(n: u32) -> MaskTable {
+        MaskTable { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 }
+    }
+
     /// The masks of the pair whose a end's are `a`'s and b end's `b`'s.
     pub fn pair<'m>(a: &'m MaskTable, b: &'m MaskTable) -> PairMasks<'m> {
         PairMasks { n: a.n, at_a: &a.at_a, at_b: &b.at_b, some_b: b.some_b, free_b: b.free_b }
@@ -406,7 +401,7 @@ impl PairAxes<'_> {
     fn masks_portable(&self, n: u32) -> MaskTable {
         let n2 = (n * n) as usize;
         let [us, vs] = &PATCH_UV[n as usize];
-        let mut m = MaskTable { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
+        let mut m = MaskTable::empty(n);
         for p in 0..n2 {
             let sa = self.a_end(us[p], vs[p]);
             for (c, &x) in sa.iter().enumerate() {
@@ -524,9 +519,9 @@ impl PairAxes<'_> {
         let mut sa = [0.0f64; 2 * LANES];
         let (u, v) = (_mm512_set1_pd(us[pa as usize]), _mm512_set1_pd(vs[pa as usize]));
         for h in (0..LANES).step_by(8) {
-            // SAFETY: h + 8 <= LANES, the arrays' length; LANES + h + 8 <= 2·LANES, `sa`'s.
+            // SAFETY: h + 8 <= LANES, no longer than the arrays read; LANES + h + 8 <= 2·LANES, `sa`'s.
             unsafe {
-                let ld = |x: &[f64; LANES]| _mm512_loadu_pd(x.as_ptr().add(h));
+                let ld = |x: &[f64]| _mm512_loadu_pd(x.as_ptr().add(h));
                 let ta = _mm512_add_pd(_mm512_mul_pd(u, ld(&self.a.du)), _mm512_mul_pd(v, ld(&self.a.dv)));
                 _mm512_storeu_pd(sa.as_mut_ptr().add(h), _mm512_add_pd(ld(&self.a.sep[0]), ta));
                 _mm512_storeu_pd(sa.as_mut_ptr().add(LANES + h), _mm512_sub_pd(ld(&self.a.sep[1]), ta));
@@ -548,7 +543,7 @@ impl PairAxes<'_> {
     /// same bits as subtracting for side 1).
     #[inline(always)]
     fn b_end(&self, c: usize) -> (f64, f64, f64) {
-        (self.b.sep[c / LANES][c % LANES], self.b.signed_du[c], self.b.signed_dv[c])
+        (self.b.sep[c / LANES][c % LANES], self.b.du[c], self.b.dv[c])
     }
 }
 
@@ -629,9 +624,9 @@ unsafe fn masks_avx2(p: &PairAxes<'_>, n: u32) -> MaskTable {
     let [us, vs] = &PATCH_UV[n as usize];
     let zero = _mm256_setzero_pd();
     let gt = |x: __m256d| _mm256_cmp_pd::<_CMP_GT_OQ>(x, zero);
-    let mut m = MaskTable { n, at_a: [0; MAX_PATCHES], at_b: [0; 2 * LANES], some_b: 0, free_b: 0 };
-    // SAFETY (loads): g + 4 <= LANES, the arrays' length.
-    let ld = |x: &[f64; LANES], g: usize| unsafe { _mm256_loadu_pd(x.as_ptr().add(g)) };
+    let mut m = MaskTable::empty(n);
+    // SAFETY (loads): g + 4 <= LANES, no longer than the arrays read.
+    let ld = |x: &[f64], g: usize| unsafe { _mm256_loadu_pd(x.as_ptr().add(g)) };
     for (pa, at) in m.at_a.iter_mut().enumerate().take(n2) {
         let (u, v) = (_mm256_set1_pd(us[pa]), _mm256_set1_pd(vs[pa]));
         let mut bits = 0u32;
@@ -1145,10 +1140,10 @@ pub(crate) mod tests {
                 let own_table = own_axes.masks(n);
                 let own = own_table.view();
                 assert_eq!(masks, own, "case {case} pair {pair}");
-                let bits = |x: &FaceAxes| [x.sep[0], x.sep[1], x.du, x.dv].map(|l| l.map(f64::to_bits));
+                let bits = |x: &FaceAxes| {
+                    (x.sep.map(|l| l.map(f64::to_bits)), [x.du, x.dv].map(|l| l.map(f64::to_bits)))
+                };
                 assert_eq!((bits(axes.a), bits(axes.b)), (bits(own_axes.a), bits(own_axes.b)));
-                let signed = |x: &FaceAxes| [x.signed_du, x.signed_dv].map(|l| l.map(f64::to_bits));
-                assert_eq!(signed(axes.b), signed(own_axes.b), "case {case} pair {pair}");
                 let (mut fast, mut slow) = ([0u64; MAX_PATCHES], [7u64; MAX_PATCHES]);
                 tables.survivors(fa, &masks, &mut fast);
                 own.survivors(&mut slow);

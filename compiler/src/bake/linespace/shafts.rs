@@ -784,20 +784,18 @@ impl RecordsFirst<'_> {
             prepared.push((prep, sides));
         }
         // A tentative end's triangle whose hit witnesses that it meets the shaft
-        // ([`witnessed`]: nine in ten of the teapot's 32³ object cells') is confirmed without
+        // ([`witnessed`]: nearly every one in the teapot's 32³ object cells) is confirmed without
         // the exact test; the rest are left to it.
         let [c0, c1] = confirmed;
         let centres_local = local_patch_centres(n);
         let corners = |li: u32| local[tris[li as usize] as usize].map(|p| p - cell_min);
-        let n4 = (n2 * n2) as u32;
         for (w, &word) in hit_bits.iter().enumerate() {
             let mut sure = [0u32; 2];
             for b in set_bits(word.into()) {
                 let shaft = (w * 32) as u32 + b;
-                let (pair, rest) = (shaft / n4, shaft % n4);
-                let (fa, fb) = pair_faces(pair);
-                let a = centres_local[fa as usize][(rest / n2 as u32) as usize];
-                let z = centres_local[fb as usize][(rest % n2 as u32) as usize];
+                let (fa, pa, fb, pb) = shaft_parts(shaft, n);
+                let (a, z) =
+                    (centres_local[fa as usize][pa as usize], centres_local[fb as usize][pb as usize]);
                 let [front, back] = &ends[shaft as usize];
                 let vf = corners(front.local);
                 let by_front = witnessed(&vf, front, a, z, n);
@@ -829,7 +827,8 @@ impl RecordsFirst<'_> {
                 let [f, k] = &ends_ro[shaft];
                 // (Front and back: a triangle confirmed at one end is at the other.)
                 let open = |e: &End, c: &[u32]| (c[w] >> b & 1 == 0).then_some(e.local);
-                (shaft, open(f, c0), open(k, c1).filter(|&l| Some(l) != open(f, c0)))
+                let front = open(f, c0);
+                (shaft, front, open(k, c1).filter(|&l| Some(l) != front))
             })
         };
         for (w, &word) in hit_bits.iter().enumerate() {
@@ -854,6 +853,7 @@ impl RecordsFirst<'_> {
             }
         }
         // 2. Exact tests.
+        let n4 = (n2 * n2) as u32;
         let seg = SegmentTest::new([Vec3::ZERO; 3]);
         for (li, &t) in tris.iter().enumerate() {
             let (prep, sides) = &prepared[li];
@@ -2065,20 +2065,22 @@ mod tests {
         (decided, met)
     }
 
+    /// The box (centre, half extents) of patch `p` of face `face`, `n` patches a side.
+    fn patch_box(face: u32, p: u32, n: u32) -> (DVec3, DVec3) {
+        let s = 1.0 / n as f64;
+        let (u, v) = ((p / n) as f64 * s, (p % n) as f64 * s);
+        face_box(face, (u, u + s), (v, v + s))
+    }
+
     /// The shafts of face pair `pair` that the one-shaft sweep test finds `tri` meeting, tested
     /// one by one (the reference of the search and of the closed form), ascending.
     fn swept_shafts(tri: &Prepared, pair: u32, n: u32, margin: f64) -> Vec<u32> {
         let (fa, fb) = pair_faces(pair);
-        let s = 1.0 / n as f64;
-        let r =
-            |p: u32| ((p / n) as f64 * s, (p / n + 1) as f64 * s, (p % n) as f64 * s, (p % n + 1) as f64 * s);
         let n2 = n * n;
         let mut found = Vec::new();
         for pa in 0..n2 {
             for pb in 0..n2 {
-                let (a, b) = (r(pa), r(pb));
-                let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
-                let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
+                let ((ca, ha), (cb, hb)) = (patch_box(fa, pa, n), patch_box(fb, pb, n));
                 if tri.overlaps_sweep(ca, cb - ca, ha, hb - ha, margin) {
                     found.push(shaft_of(pair, pa, pb, n));
                 }
@@ -2100,13 +2102,7 @@ mod tests {
             let pair = case / 8 % FACE_PAIRS;
             let (fa, fb) = pair_faces(pair);
             let (pa, pb) = ((rnd() * (n * n) as f64) as u32, (rnd() * (n * n) as f64) as u32);
-            let s = 1.0 / n as f64;
-            let r = |p: u32| {
-                ((p / n) as f64 * s, (p / n + 1) as f64 * s, (p % n) as f64 * s, (p % n + 1) as f64 * s)
-            };
-            let (a, b) = (r(pa), r(pb));
-            let (ca, ha) = face_box(fa, (a.0, a.1), (a.2, a.3));
-            let (cb, hb) = face_box(fb, (b.0, b.1), (b.2, b.3));
+            let ((ca, ha), (cb, hb)) = (patch_box(fa, pa, n), patch_box(fb, pb, n));
             // t from the ends (down to 1e-7) to the middle, from either end.
             let t = 0.5 * 10f64.powf(-7.0 * rnd() * rnd());
             let t = if case % 2 == 0 { t } else { 1.0 - t };
