@@ -10,7 +10,7 @@
 use kiln_player::gpu::{Gpu, GpuOptions};
 use kiln_player::render::passes::direct::DirectPass;
 use kiln_player::render::passes::kernel::Kernel;
-use kiln_player::render::{Techniques, spirv, technique_flags};
+use kiln_player::render::{Techniques, spirv};
 
 fn main() {
     let mut paths: Vec<String> = std::env::args().skip(1).collect();
@@ -19,7 +19,7 @@ fn main() {
         paths.remove(0);
     }
     let constants: Vec<u32> = if default {
-        DirectPass::constants(technique_flags(&Techniques::default()), false, false).to_vec()
+        DirectPass::constants(Techniques::default().flags(), false, false).to_vec()
     } else {
         Vec::new()
     };

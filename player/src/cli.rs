@@ -4,14 +4,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::builder::{PossibleValue, PossibleValuesParser};
-use clap::{Parser, ValueEnum};
+use clap::{Arg, ArgAction, ArgMatches, Command, CommandFactory, FromArgMatches, Parser};
 
 use crate::bench;
 use crate::camera::{CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
-use crate::render::technique::{Effect, KnobValue, Techniques, catalogue, techniques_of};
+use crate::render::techniques::{Effect, Knob, KnobRange, KnobValue, Techniques, catalogue, techniques_of};
 use crate::render::{Purpose, RenderSettings};
 use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions};
@@ -33,7 +33,13 @@ x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14) of the ACES filmic curve, per channel
 
 Exit codes: 0 success, 1 invalid or damaged .kiln file, 2 usage error, 3 unsupported (no Vulkan
 loader, no suitable device, missing feature), 4 I/O error, 5 GPU failure or validation errors
-(with --validate).";
+(with --validate).
+
+Shell completions and a man page: kiln-play completions SHELL, kiln-play man.";
+
+const SHORT_AFTER_HELP: &str = "\
+Each effect's flag picks its technique; the techniques' knobs (--ao-samples, --gi-bounces, ...),
+every option and examples: kiln-play --help.";
 
 /// Image size `WxH`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,109 +64,17 @@ impl std::str::FromStr for Size {
     }
 }
 
-/// The values `--EFFECT` takes: the catalogue's techniques of that effect, with their help.
-fn techniques(effect: Effect) -> PossibleValuesParser {
-    PossibleValuesParser::new(techniques_of(effect).map(|t| PossibleValue::new(t.name).help(t.help)))
-}
-
-/// `--reflection-res`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ReflectionResArg {
-    /// One ray per pixel.
-    Full,
-    /// One ray per 2 × 2 pixels, upsampled with edge-aware weights.
-    Half,
-}
-
-/// `--gi-structure` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum GiStructureArg {
-    /// The shaft's PNMT record.
-    Pnmt,
-    /// The shaft's candidate list.
-    Candidates,
-    /// The record's pre-illuminated radiance.
-    Preillum,
-}
-
-/// `--ls-shadow-test` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LsShadowTestArg {
-    /// Exact tests in the cells holding the ray's ends.
-    Ends,
-    /// Exact tests wherever the shaft is filled.
-    Filled,
-}
-
-/// `--ao-res` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum AoResArg {
-    /// One sample set per pixel.
-    Full,
-    /// One per 2 × 2 pixels.
-    Half,
-}
-
-/// `--media-res` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum MediaResArg {
-    /// The screen's resolution.
-    Full,
-    /// Half on each axis.
-    Half,
-    /// A quarter on each axis.
-    Quarter,
-}
-
-/// `--ssgi-mip` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SsgiMipArg {
-    /// One of each 2 × 2 block's texels, on a rotated grid (the seed's "fast").
-    Nearest,
-    /// The texel agreeing best with its neighbourhood (the seed's "precise").
-    Voting,
-}
-
-/// `--ssgi-rotation` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum SsgiRotationArg {
-    /// A random angle per texel (the seed's).
-    Pixel,
-    /// One per 8 × 8 texels (coherent reads).
-    Tile,
-}
-
-/// `--ssgi-falloff` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OffOnArg {
-    /// Off.
-    Off,
-    /// On.
-    On,
-}
-
-/// `--media-phase` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum MediaPhaseArg {
-    /// Henyey–Greenstein with the medium's g.
-    Medium,
-    /// Rayleigh.
-    Rayleigh,
-}
-
-/// `--taa-weights` (order as the catalogue's choices).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum TaaWeightsArg {
-    /// c / (1 + luma) (Karis's, the seed's).
-    Luma,
-    /// The radiance itself.
-    Linear,
-}
-
 /// kiln-play renders .kiln files with Vulkan 1.3: in a window, headless to PNG or EXR, or as a
 /// benchmark.
 #[derive(Debug, Parser)]
-#[command(name = "kiln-play", version, about, after_help = AFTER_HELP, args_override_self = true)]
+#[command(
+    name = "kiln-play",
+    version,
+    about,
+    after_help = SHORT_AFTER_HELP,
+    after_long_help = AFTER_HELP,
+    args_override_self = true
+)]
 pub struct Args {
     /// The .kiln file to play (`kiln compile` or `kiln demo` make one).
     pub file: Option<PathBuf>,
@@ -178,27 +92,27 @@ pub struct Args {
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
     /// Measure per-pass GPU times and the load breakdown (headless).
-    #[arg(long, conflicts_with = "output")]
+    #[arg(long, conflicts_with = "output", help_heading = "Measuring")]
     pub bench: bool,
     /// Measure the compute traversal's throughput (Mrays/s) on primary, shadow and diffuse
     /// rays at --size from the file's camera, each set traced --frames times (default 20).
-    #[arg(long, conflicts_with_all = ["bench", "reference", "output"])]
+    #[arg(long, conflicts_with_all = ["bench", "reference", "output"], help_heading = "Measuring")]
     pub bench_rays: bool,
     /// With --bench or --bench-rays: print JSON instead of a table.
-    #[arg(long)]
+    #[arg(long, help_heading = "Measuring")]
     pub json: bool,
     /// With --bench: frames rendered before measuring.
-    #[arg(long, value_name = "N", default_value_t = 10)]
+    #[arg(long, value_name = "N", default_value_t = 10, help_heading = "Measuring", hide_short_help = true)]
     pub warmup: u32,
     /// Enable the Khronos validation layer; errors make the exit code 5.
-    #[arg(long)]
+    #[arg(long, help_heading = "Device and loading", hide_short_help = true)]
     pub validate: bool,
     /// Use the first device whose name contains NAME (see --list-devices); default: a discrete
     /// GPU, else any, lavapipe last.
-    #[arg(long, value_name = "NAME")]
+    #[arg(long, value_name = "NAME", help_heading = "Device and loading")]
     pub device: Option<String>,
     /// List the Vulkan devices and exit.
-    #[arg(long)]
+    #[arg(long, help_heading = "Device and loading")]
     pub list_devices: bool,
     /// Camera override: position, target and optionally the vertical field of view in degrees.
     #[arg(long, value_name = "PX,PY,PZ,TX,TY,TZ[,VFOV]", allow_hyphen_values = true)]
@@ -206,181 +120,19 @@ pub struct Args {
     /// With -o, --headless or --bench: move the camera through the poses of FILE over the
     /// frames (one `px,py,pz,tx,ty,tz[,vfov]` per line, `#` comments; frame i at i/(N−1) of
     /// the way, linear between poses): a fly-through, for timing and error with a moving camera.
-    #[arg(long, value_name = "FILE", conflicts_with = "camera")]
+    #[arg(long, value_name = "FILE", conflicts_with = "camera", hide_short_help = true)]
     pub camera_path: Option<PathBuf>,
     /// Exposure in stops (radiance × 2^EV before tone mapping; PNG and window only).
     #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
-    /// How the G-buffer is made.
-    #[arg(long, value_parser = techniques(Effect::GBuffer), default_value = "raster")]
-    pub gbuffer: String,
-    /// Shadows technique.
-    #[arg(long, value_parser = techniques(Effect::Shadows), default_value = "shadowmap")]
-    pub shadows: String,
-    /// Ambient occlusion technique.
-    #[arg(long, value_parser = techniques(Effect::Ao), default_value = "none")]
-    pub ao: String,
-    /// With --ao rt, sao or gtao: the AO radius in scene units (rt: the ray length; sao, gtao:
-    /// the samples' world radius; default: --ao-reach times the scene's diagonal).
-    #[arg(long, value_name = "R")]
-    pub ao_radius: Option<f32>,
-    /// With --ao rt, sao or gtao: the AO radius as a fraction of the scene's bounding-box
-    /// diagonal, when no --ao-radius is given (default: rt 0.1, ≥ 10 making every hit occlude
-    /// fully, the sky's true visibility; sao and gtao 0.05, about the seed's 1.8 m in Sponza).
-    #[arg(long, value_name = "FRACTION")]
-    pub ao_reach: Option<f32>,
-    /// With --ao sao: samples per AO pixel on the spiral, 1 to 64 (default 16, the seed's N).
-    #[arg(long, value_name = "N")]
-    pub ao_samples: Option<u32>,
-    /// With --ao sao: turns of the sample spiral, τ (default 7).
-    #[arg(long, value_name = "TURNS")]
-    pub ao_turns: Option<f32>,
-    /// With --ao sao: resolution of the samples (default half, the seed's; the depth-aware blur
-    /// upsamples).
-    #[arg(long, value_enum, value_name = "RES")]
-    pub ao_res: Option<AoResArg>,
-    /// With --ao gtao: screen directions (slices) per pixel, 1 to 32 (default 3, XeGTAO's High).
-    #[arg(long, value_name = "N")]
-    pub ao_slices: Option<u32>,
-    /// With --ao gtao: samples along each side of a slice, 1 to 64 (default 3, XeGTAO's High).
-    #[arg(long, value_name = "N")]
-    pub ao_steps: Option<u32>,
-    /// Reflections technique.
-    #[arg(long, value_parser = techniques(Effect::Reflections), default_value = "none")]
-    pub reflections: String,
-    /// With --reflections rt: resolution of the traced reflections.
-    #[arg(long, value_enum, default_value = "full")]
-    pub reflection_res: ReflectionResArg,
-    /// With --reflections rt: surfaces rougher than this keep the split-sum ambient.
-    #[arg(long, value_name = "ROUGHNESS", default_value_t = 1.0)]
-    pub reflection_max_roughness: f32,
-    /// With --reflections ssr: most iterations of the hierarchical march per pixel, 1 to 1024
-    /// (default 48: each skips a cell of empty space a level up or refines a potential hit a
-    /// level down; 48 crosses a 1080p screen with room to refine, fewer lose distant hits).
-    #[arg(long, value_name = "N")]
-    pub ssr_steps: Option<u32>,
-    /// With --reflections ssr: surfaces rougher than this keep the split-sum ambient, 0 to 1
-    /// (default 0.6: beyond it the reflection cone covers much of the screen, where one ray says
-    /// little; faded over the last fifth below it).
-    #[arg(long, value_name = "ROUGHNESS")]
-    pub ssr_max_roughness: Option<f32>,
-    /// With --shadows rt: sphere radius of point and spot lights in scene units (0: hard
-    /// shadows, as the file's punctual lights imply).
-    #[arg(long, value_name = "R", default_value_t = 0.0)]
-    pub light_radius: f32,
-    /// With --shadows rt: angular diameter of directional lights in degrees (the sun: 0.53).
-    #[arg(long, value_name = "DEGREES", default_value_t = 0.0)]
-    pub sun_angle: f32,
-    /// With --shadows linespace: how a filled shaft is decided. ends: exact triangle tests in the
-    /// cells holding the ray's ends, a filled shaft elsewhere occludes (conservative, cheapest);
-    /// filled: exact tests wherever the shaft is filled (exact).
-    #[arg(long, value_enum, default_value = "ends")]
-    pub ls_shadow_test: LsShadowTestArg,
-    /// Do not average the ray-traced passes over frames (every frame shows one sample): the
-    /// same as --aa none.
-    #[arg(long, conflicts_with = "aa")]
-    pub no_accumulate: bool,
-    /// What happens to samples across frames. accumulate: the ray-traced passes keep a running
-    /// mean while the camera is still (a move restarts it); reproject: the mean follows the
-    /// camera (reprojected, restarted only where a point was hidden); taa: that and temporal
-    /// anti-aliasing (a sub-pixel jitter per frame, a reprojected, neighbourhood-clipped
-    /// history); none: every frame its own.
-    #[arg(long, value_parser = techniques(Effect::Aa), default_value = "accumulate")]
-    pub aa: String,
-    /// With --aa reproject: the longest history of the ray-traced passes while the camera
-    /// moves, 1 to 1024 (default 32; a still camera's running mean is unbounded).
-    #[arg(long, value_name = "N")]
-    pub history_frames: Option<u32>,
-    /// With --aa taa: the longest history in frames, 1 to 1024 (default 16): a new frame weighs
-    /// at least 1/N; longer converges further on a still camera, smears more on a moving one.
-    #[arg(long, value_name = "N")]
-    pub taa_frames: Option<u32>,
-    /// With --aa taa: how frames are blended (default luma: c / (1 + luma), the seed's,
-    /// damping fireflies; linear: the radiance itself, converging to the supersampled image).
-    #[arg(long, value_enum, value_name = "WEIGHTS")]
-    pub taa_weights: Option<TaaWeightsArg>,
-    /// Global illumination technique.
-    #[arg(long, value_parser = techniques(Effect::Gi), default_value = "none")]
-    pub gi: String,
-    /// With --gi rt or linespace: bounces of indirect light after the visible surface, 1 to 8 (1: the sky,
-    /// emissive surfaces and the light the first surface hit receives directly).
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub gi_bounces: u32,
-    /// With --gi linespace: what answers the bounce rays. pnmt: the shaft's stored hit, no
-    /// triangle test (approximate); candidates: the shaft's triangle list (exact); preillum: the
-    /// stored hit's baked radiance (one bounce, no shading).
-    #[arg(long, value_enum, default_value = "pnmt")]
-    pub gi_structure: GiStructureArg,
-    /// With --gi ssgi: spiral samples per pixel on each level, 1 to 1024 (default 128, the
-    /// seed's).
-    #[arg(long, value_name = "N")]
-    pub ssgi_samples: Option<u32>,
-    /// With --gi ssgi: the finest level gathered (default half, the seed's ~540p at 1080p),
-    /// upsampled to the screen with depth and normal weights.
-    #[arg(long, value_enum, value_name = "RES")]
-    pub ssgi_res: Option<MediaResArg>,
-    /// With --gi ssgi: sample radius in pixels of each level, 4 to 256 (default 40, the seed's).
-    #[arg(long, value_name = "PIXELS")]
-    pub ssgi_radius: Option<u32>,
-    /// With --gi ssgi: how the depth and normal pyramids are reduced (default voting, the
-    /// seed's precise MIP mapping).
-    #[arg(long, value_enum, value_name = "REDUCTION")]
-    pub ssgi_mip: Option<SsgiMipArg>,
-    /// With --gi ssgi: the seed's distance fall-off (1/r² → 1/r^2.5 beyond one scene unit) in
-    /// place of visibility (default off).
-    #[arg(long, value_enum, value_name = "ON")]
-    pub ssgi_falloff: Option<OffOnArg>,
-    /// With --gi ssgi: the most frames its running mean averages while the camera is still,
-    /// 1 to 4096 (default 16).
-    #[arg(long, value_name = "N")]
-    pub ssgi_frames: Option<u32>,
-    /// With --gi ssgi: how the sample spirals turn: pixel (a random angle per texel, the seed's)
-    /// or tile (one per 8 × 8 texels, the default: coherent reads, 15 % faster on an H100, one
-    /// frame's noise 14 % higher and correlated within a tile until frames average it).
-    #[arg(long, value_enum, value_name = "HOW")]
-    pub ssgi_rotation: Option<SsgiRotationArg>,
-    /// Participating media technique.
-    #[arg(long, value_parser = techniques(Effect::Media), default_value = "none")]
-    pub media: String,
-    /// With --media march: steps along the view ray through each medium, 1 to 1024.
-    #[arg(long, value_name = "N", default_value_t = 32)]
-    pub media_steps: u32,
-    /// With --media mitchell or toth: samples per pixel, 1 to 1024 (default 60): mitchell's
-    /// towards the light, toth's along the view ray (over an interleaving block).
-    #[arg(long, value_name = "N")]
-    pub media_samples: Option<u32>,
-    /// With --media mitchell or sousa: resolution of the occlusion image or depth map and the
-    /// first blurs, as a fraction of the screen's (default quarter).
-    #[arg(long, value_enum, value_name = "RES")]
-    pub media_res: Option<MediaResArg>,
-    /// With --media mitchell: the shafts' gain where every sample sees the emitter (default
-    /// 1.921, the seed's exposure 0.01921 × its 100 samples).
-    #[arg(long, value_name = "GAIN")]
-    pub media_exposure: Option<f32>,
-    /// With --media sousa: samples per pass, TAPS (3 passes, steps 1/TAPS, 1/TAPS², 1/TAPS³ of
-    /// the screen), 1 to 64 (default 6).
-    #[arg(long, value_name = "N")]
-    pub media_taps: Option<u32>,
-    /// With --media sousa: the factor on each pass's sum at 6 taps (default 0.19, the seed's;
-    /// scaled by 6/TAPS for other tap counts, so that taps refine rather than brighten).
-    #[arg(long, value_name = "F")]
-    pub media_brightness: Option<f32>,
-    /// With --media toth: side of the interleaving block in pixels, 1 to 8 (default 4;
-    /// block² must not exceed --media-samples).
-    #[arg(long, value_name = "N")]
-    pub media_block: Option<u32>,
-    /// With --media toth: the phase function (default medium: Henyey–Greenstein with the
-    /// medium's g, as the reference renders).
-    #[arg(long, value_enum, value_name = "PHASE")]
-    pub media_phase: Option<MediaPhaseArg>,
     /// Render the unbiased reference path tracer instead (headless, needs -o OUT.exr).
-    #[arg(long, conflicts_with_all = ["bench", "bench_rays"])]
+    #[arg(long, conflicts_with_all = ["bench", "bench_rays"], help_heading = "Measuring")]
     pub reference: bool,
     /// With --reference: samples per pixel.
-    #[arg(long, value_name = "N", default_value_t = 256)]
+    #[arg(long, value_name = "N", default_value_t = 256, help_heading = "Measuring")]
     pub spp: u32,
     /// Do not read or write the pipeline cache (~/.cache/kiln/pipelines.bin).
-    #[arg(long)]
+    #[arg(long, help_heading = "Device and loading", hide_short_help = true)]
     pub no_pipeline_cache: bool,
     /// Wait for every pipeline before the first frame. By default, with ray-traced techniques
     /// (--shadows, --ao, --reflections or --gi rt or linespace), the first frames show a
@@ -391,7 +143,7 @@ pub struct Args {
     /// says what was shown instead and for how long. Only the window shows fallback frames:
     /// headless output and every --bench frame come from the chosen techniques (--bench
     /// times the fallback's first frame and the chosen techniques' separately).
-    #[arg(long)]
+    #[arg(long, help_heading = "Device and loading", hide_short_help = true)]
     pub no_progressive_pipelines: bool,
     /// Upload every texture level before the first frame. By default textures stream: the
     /// first frame samples only each texture's levels from the first at most 256 texels on a
@@ -400,80 +152,29 @@ pub struct Args {
     /// resident. Only the window shows coarse frames: headless output and every --bench frame
     /// come from the refined textures (--bench times the first frame and the refinement
     /// separately).
-    #[arg(long)]
+    #[arg(long, help_heading = "Device and loading", hide_short_help = true)]
     pub no_texture_streaming: bool,
+    /// The techniques and knobs the command line chooses (flags made from the catalogue by
+    /// [`command`]).
+    #[arg(skip)]
+    pub choices: TechniqueFlags,
 }
 
 impl Args {
-    /// The value the command line gives a knob (flags named as the catalogue's knobs).
-    fn knob(&self, name: &str) -> Option<KnobValue> {
-        match name {
-            "light-radius" => Some(KnobValue::Number(self.light_radius)),
-            "sun-angle" => Some(KnobValue::Number(self.sun_angle)),
-            "ls-shadow-test" => Some(KnobValue::Choice(self.ls_shadow_test as usize)),
-            "ao-radius" => self.ao_radius.map(KnobValue::Number),
-            "ao-reach" => self.ao_reach.map(KnobValue::Number),
-            "ao-samples" => self.ao_samples.map(|n| KnobValue::Number(n as f32)),
-            "ao-turns" => self.ao_turns.map(KnobValue::Number),
-            "ao-res" => self.ao_res.map(|r| KnobValue::Choice(r as usize)),
-            "ao-slices" => self.ao_slices.map(|n| KnobValue::Number(n as f32)),
-            "ao-steps" => self.ao_steps.map(|n| KnobValue::Number(n as f32)),
-            "reflection-res" => Some(KnobValue::Choice(self.reflection_res as usize)),
-            "reflection-max-roughness" => Some(KnobValue::Number(self.reflection_max_roughness)),
-            "ssr-steps" => self.ssr_steps.map(|n| KnobValue::Number(n as f32)),
-            "ssr-max-roughness" => self.ssr_max_roughness.map(KnobValue::Number),
-            "gi-bounces" => Some(KnobValue::Number(self.gi_bounces as f32)),
-            "gi-structure" => Some(KnobValue::Choice(self.gi_structure as usize)),
-            "ssgi-samples" => self.ssgi_samples.map(|n| KnobValue::Number(n as f32)),
-            "ssgi-res" => self.ssgi_res.map(|r| KnobValue::Choice(r as usize)),
-            "ssgi-radius" => self.ssgi_radius.map(|n| KnobValue::Number(n as f32)),
-            "ssgi-mip" => self.ssgi_mip.map(|m| KnobValue::Choice(m as usize)),
-            "ssgi-falloff" => self.ssgi_falloff.map(|f| KnobValue::Choice(f as usize)),
-            "ssgi-frames" => self.ssgi_frames.map(|n| KnobValue::Number(n as f32)),
-            "ssgi-rotation" => self.ssgi_rotation.map(|r| KnobValue::Choice(r as usize)),
-            "media-steps" => Some(KnobValue::Number(self.media_steps as f32)),
-            "media-samples" => self.media_samples.map(|n| KnobValue::Number(n as f32)),
-            "media-res" => self.media_res.map(|r| KnobValue::Choice(r as usize)),
-            "media-exposure" => self.media_exposure.map(KnobValue::Number),
-            "media-taps" => self.media_taps.map(|n| KnobValue::Number(n as f32)),
-            "media-brightness" => self.media_brightness.map(KnobValue::Number),
-            "media-block" => self.media_block.map(|n| KnobValue::Number(n as f32)),
-            "media-phase" => self.media_phase.map(|p| KnobValue::Choice(p as usize)),
-            "taa-frames" => self.taa_frames.map(|n| KnobValue::Number(n as f32)),
-            "history-frames" => self.history_frames.map(|n| KnobValue::Number(n as f32)),
-            "taa-weights" => self.taa_weights.map(|w| KnobValue::Choice(w as usize)),
-            _ => None,
-        }
-    }
-
     /// The techniques the flags choose, each with the knobs the command line sets.
     fn techniques(&self) -> PlayResult<Techniques> {
         let usage = |e: String| PlayError::new(Exit::Usage, e);
-        // Every knob flag is checked, whether or not its technique was chosen.
-        for info in catalogue() {
-            for k in info.knobs {
-                if let Some(v) = self.knob(k.name) {
-                    k.check(v).map_err(|e| usage(format!("--{e}")))?;
-                }
-            }
-        }
         let mut t = Techniques::default();
-        let none = String::from("none");
-        let chosen = [
-            (Effect::GBuffer, &self.gbuffer),
-            (Effect::Shadows, &self.shadows),
-            (Effect::Ao, &self.ao),
-            (Effect::Reflections, &self.reflections),
-            (Effect::Gi, &self.gi),
-            (Effect::Media, &self.media),
-            (Effect::Aa, if self.no_accumulate { &none } else { &self.aa }),
-        ];
-        for (effect, name) in chosen {
+        for effect in Effect::ALL {
+            let none = effect == Effect::Aa && self.choices.no_accumulate;
+            let name = if none { "none" } else { self.choices.technique(effect) };
             let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
-                .find(|i| i.name == name.as_str())
-                .map(|i| i.knobs.iter().filter_map(|k| self.knob(k.name).map(|v| (k.name, v))).collect())
+                .find(|i| i.name == name)
+                .map(|i| {
+                    i.knobs.iter().filter_map(|k| self.choices.knob(k.name).map(|v| (k.name, v))).collect()
+                })
                 .unwrap_or_default();
-            t.set(effect, name, &knobs).map_err(usage)?;
+            t.set(effect, name, &knobs).map_err(|e| usage(format!("--{effect} {name}: {e}")))?;
         }
         Ok(t)
     }
@@ -482,7 +183,7 @@ impl Args {
         if !self.exposure.is_finite() {
             return Err(PlayError::new(Exit::Usage, "--exposure must be finite"));
         }
-        if self.ao_radius == Some(0.0) {
+        if self.choices.knob("ao-radius") == Some(KnobValue::Number(0.0)) {
             return Err(PlayError::new(Exit::Usage, "--ao-radius must be greater than 0"));
         }
         let techniques = self.techniques()?;
@@ -518,6 +219,210 @@ impl Args {
                 TextureUpload::CoarseFirst
             },
         })
+    }
+}
+
+/// What the catalogue's flags say: each effect's technique and the knob values given.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TechniqueFlags {
+    /// (effect, technique name), every effect (its default when not given).
+    chosen: Vec<(Effect, String)>,
+    /// (knob, value) of every knob flag given.
+    knobs: Vec<(&'static str, KnobValue)>,
+    /// `--no-accumulate`.
+    no_accumulate: bool,
+}
+
+impl TechniqueFlags {
+    /// The technique chosen for `effect` (its catalogue default when the flag is absent).
+    fn technique(&self, effect: Effect) -> &str {
+        self.chosen.iter().find(|(e, _)| *e == effect).map_or_else(|| default_technique(effect), |(_, n)| n)
+    }
+
+    /// The value the command line gives the knob `name`.
+    fn knob(&self, name: &str) -> Option<KnobValue> {
+        self.knobs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
+    }
+
+    fn from_matches(m: &ArgMatches) -> TechniqueFlags {
+        let chosen = Effect::ALL
+            .into_iter()
+            .filter_map(|e| m.get_one::<String>(e.name()).map(|n| (e, n.clone())))
+            .collect();
+        let knobs = knob_flags()
+            .into_iter()
+            .filter_map(|k| m.get_one::<KnobValue>(k.name).map(|v| (k.name, *v)))
+            .collect();
+        TechniqueFlags { chosen, knobs, no_accumulate: m.get_flag("no_accumulate") }
+    }
+}
+
+/// The technique `Techniques::default()` uses for `effect`.
+fn default_technique(effect: Effect) -> &'static str {
+    Techniques::default().name_of(effect)
+}
+
+/// Every knob of the catalogue once (knobs shared by several techniques, e.g. `--ao-radius`,
+/// have one flag), in catalogue order.
+fn knob_flags() -> Vec<&'static Knob> {
+    let mut seen: Vec<&'static Knob> = Vec::new();
+    for info in catalogue() {
+        for k in info.knobs {
+            if !seen.iter().any(|s| s.name == k.name) {
+                seen.push(k);
+            }
+        }
+    }
+    seen
+}
+
+/// The `--help` text of the knob flag `knob` of `effect`: which techniques read it, what it
+/// does, its range and each technique's default.
+fn knob_help(effect: Effect, knob: &Knob) -> String {
+    let users: Vec<(&str, &Knob)> = techniques_of(effect)
+        .filter_map(|t| t.knobs.iter().find(|k| k.name == knob.name).map(|k| (t.name, k)))
+        .collect();
+    let names: Vec<&str> = users.iter().map(|(n, _)| *n).collect();
+    let range = match knob.range {
+        KnobRange::Number { min, max, whole, .. } => {
+            let max = if max.is_infinite() { "∞".to_string() } else { max.to_string() };
+            format!("{}{min} to {max}", if whole { "a whole number, " } else { "" })
+        }
+        KnobRange::Choice(options) => options.join(", "),
+    };
+    let defaults: Vec<String> = if users.iter().all(|(_, k)| k.default == knob.default) {
+        vec![knob.default_text()]
+    } else {
+        users.iter().map(|(n, k)| format!("{n} {}", k.default_text())).collect()
+    };
+    let names = match names.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => names.join(""),
+    };
+    format!("With --{effect} {names}: {} ({range}) [default: {}]", knob.help, defaults.join(", "))
+}
+
+/// A knob flag's parser: the text as the knob's value, checked against its range (whichever
+/// technique is chosen: a bad value is an error even where no technique reads it).
+fn knob_parser(
+    knob: &'static Knob,
+) -> impl Fn(&str) -> Result<KnobValue, String> + Clone + Send + Sync + 'static {
+    move |s: &str| {
+        let v = knob.parse(s)?;
+        knob.check(v)?;
+        Ok(v)
+    }
+}
+
+/// `kiln-play`'s command line: the fixed flags of [`Args`] and, under a heading per effect,
+/// each effect's technique flag and its techniques' knob flags, made from the catalogue
+/// ([`crate::render::techniques::catalogue`]); `completions` and `man` write the shell
+/// completions and the man page.
+pub fn command() -> Command {
+    let mut cmd = Args::command();
+    for effect in Effect::ALL {
+        let heading = effect.title();
+        let values = techniques_of(effect).map(|t| PossibleValue::new(t.name).help(t.help));
+        cmd = cmd.arg(
+            Arg::new(effect.name())
+                .long(effect.name())
+                .value_name("TECHNIQUE")
+                .value_parser(PossibleValuesParser::new(values))
+                .help(format!("{} technique [default: {}]", heading, default_technique(effect)))
+                .help_heading(heading),
+        );
+        if effect == Effect::Aa {
+            cmd = cmd.arg(
+                Arg::new("no_accumulate")
+                    .long("no-accumulate")
+                    .action(ArgAction::SetTrue)
+                    .conflicts_with("aa")
+                    .help("Do not average the ray-traced passes over frames (every frame shows one sample): the same as --aa none")
+                    .help_heading(heading)
+                    .hide_short_help(true),
+            );
+        }
+        // A knob shared across effects would sit under the first one's heading.
+        let own: Vec<&'static Knob> = knob_flags()
+            .into_iter()
+            .filter(|k| techniques_of(effect).any(|t| t.knobs.iter().any(|tk| tk.name == k.name)))
+            .filter(|k| {
+                !Effect::ALL[..Effect::ALL.iter().position(|e| *e == effect).unwrap_or(0)]
+                    .iter()
+                    .any(|e| techniques_of(*e).any(|t| t.knobs.iter().any(|tk| tk.name == k.name)))
+            })
+            .collect();
+        for knob in own {
+            let value_name = match knob.range {
+                KnobRange::Number { whole: true, .. } => "N".to_string(),
+                KnobRange::Number { .. } => "X".to_string(),
+                KnobRange::Choice(_) => "CHOICE".to_string(),
+            };
+            let mut arg = Arg::new(knob.name)
+                .long(knob.name)
+                .value_name(value_name)
+                .allow_negative_numbers(true)
+                .value_parser(clap::builder::ValueParser::new(knob_parser(knob)))
+                .help(knob_help(effect, knob))
+                .help_heading(heading)
+                .hide_short_help(true);
+            if let KnobRange::Choice(options) = knob.range {
+                arg = arg.hide_possible_values(true).value_name(options.join("|"));
+            }
+            cmd = cmd.arg(arg);
+        }
+    }
+    let shell = Arg::new("shell")
+        .required(true)
+        .value_parser(clap::value_parser!(clap_complete::Shell))
+        .help("bash, elvish, fish, powershell or zsh");
+    cmd.subcommand(Command::new("completions").about("Write shell completions to stdout").arg(shell))
+        .subcommand(Command::new("man").about("Write the man page (roff) to stdout"))
+        .args_conflicts_with_subcommands(true)
+}
+
+/// What the command line asks for: a session, or completions or the man page.
+#[derive(Debug)]
+pub enum Invocation {
+    /// Play, render or measure a file.
+    Play(Box<Args>),
+    /// Shell completions for a shell.
+    Completions(clap_complete::Shell),
+    /// The man page.
+    Man,
+}
+
+/// Parses a command line (the program's name first), exiting with clap's message and exit code
+/// 2 on a usage error (0 for --help and --version).
+pub fn parse_from<I, T>(args: I) -> Result<Invocation, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let matches = command().try_get_matches_from(args)?;
+    match matches.subcommand() {
+        Some(("completions", m)) => {
+            Ok(Invocation::Completions(*m.get_one::<clap_complete::Shell>("shell").expect("required")))
+        }
+        Some(("man", _)) => Ok(Invocation::Man),
+        _ => {
+            let mut args = Args::from_arg_matches(&matches)?;
+            args.choices = TechniqueFlags::from_matches(&matches);
+            Ok(Invocation::Play(Box::new(args)))
+        }
+    }
+}
+
+/// Writes what `invocation` asks for beyond a session (completions, the man page) to `out`.
+pub fn write_generated(invocation: &Invocation, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+    let mut cmd = command();
+    match invocation {
+        Invocation::Completions(shell) => {
+            clap_complete::generate(*shell, &mut cmd, "kiln-play", out);
+            Ok(())
+        }
+        Invocation::Man => clap_mangen::Man::new(cmd).render(out),
+        Invocation::Play(_) => Ok(()),
     }
 }
 
@@ -638,15 +543,38 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::techniques::ao::{self, Radius};
+    use crate::render::techniques::{aa, gi, reflections, shadows};
     use crate::render::{Aa, Ao, GBuffer, Gi, ReflectionRes, Reflections, ScreenFraction, Shadows};
 
     fn parse(args: &[&str]) -> Result<Args, clap::Error> {
-        Args::try_parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))
+        match parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))? {
+            Invocation::Play(a) => Ok(*a),
+            other => panic!("{args:?} is not a session: {other:?}"),
+        }
     }
 
     fn techniques(args: &[&str]) -> Techniques {
         parse(args).unwrap().techniques().unwrap()
     }
+
+    /// The message of a refused command line, whether clap or the techniques refuse it; usage
+    /// errors either way.
+    fn refusal(args: &[&str]) -> String {
+        match parse(args) {
+            Err(e) => {
+                assert_eq!(e.exit_code(), 2, "{args:?}: {e}");
+                e.to_string()
+            }
+            Ok(a) => {
+                let e = a.techniques().expect_err("refused");
+                assert_eq!(e.exit, Exit::Usage);
+                e.message
+            }
+        }
+    }
+
+    const AO_RT: Ao = Ao::Rt(ao::rt::Rt { radius: Radius { radius: None, reach: 0.1 } });
 
     #[test]
     fn flags_set_technique_values_with_their_knobs() {
@@ -676,30 +604,39 @@ mod tests {
             "2",
             "--no-accumulate",
         ]);
-        assert_eq!(t.gbuffer, GBuffer::Visibility);
-        assert_eq!(t.shadows, Shadows::Rt { light_radius: 1.0, sun_degrees: 0.53 });
-        assert_eq!(t.ao, Ao::Rt { radius: Some(0.5), reach: 0.1 });
-        assert_eq!(t.reflections, Reflections::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 });
-        assert_eq!(t.gi, Gi::Rt { bounces: 2 });
-        assert_eq!(t.aa, Aa::None);
-        let e = parse(&["f.kiln", "--gi", "rt", "--gi-bounces", "9"]).unwrap().techniques().unwrap_err();
-        assert!(e.to_string().contains("gi-bounces"), "{e}");
+        assert_eq!(
+            t.gbuffer,
+            GBuffer::Visibility(crate::render::techniques::gbuffer::visibility::Visibility)
+        );
+        assert_eq!(t.shadows, Shadows::Rt(shadows::rt::Rt { light_radius: 1.0, sun_degrees: 0.53 }));
+        assert_eq!(t.ao, Ao::Rt(ao::rt::Rt { radius: Radius { radius: Some(0.5), reach: 0.1 } }));
+        assert_eq!(
+            t.reflections,
+            Reflections::Rt(reflections::rt::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 })
+        );
+        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2 }));
+        assert_eq!(t.aa, Aa::Off(aa::none::Off));
+        let e = refusal(&["f.kiln", "--gi", "rt", "--gi-bounces", "9"]);
+        assert!(e.contains("gi-bounces"), "{e}");
         let d = techniques(&["f.kiln"]);
         assert_eq!(d, Techniques::default());
-        assert_eq!(d.shadows, Shadows::ShadowMap);
+        assert_eq!(d.name_of(Effect::Shadows), "shadowmap");
     }
 
     #[test]
     fn aa_flags_choose_taa_with_its_knobs() {
         let t = techniques(&["f.kiln", "--aa", "taa", "--taa-frames", "8", "--taa-weights", "luma"]);
-        assert_eq!(t.aa, Aa::Taa { frames: 8, luma_weights: true });
-        assert_eq!(techniques(&["f.kiln", "--aa", "taa"]).aa, Aa::Taa { frames: 16, luma_weights: false });
-        assert_eq!(techniques(&["f.kiln", "--aa", "none"]).aa, Aa::None);
+        assert_eq!(t.aa, Aa::Taa(aa::taa::Taa { frames: 8, luma_weights: true }));
+        assert_eq!(
+            techniques(&["f.kiln", "--aa", "taa"]).aa,
+            Aa::Taa(aa::taa::Taa { frames: 16, luma_weights: false })
+        );
+        assert_eq!(techniques(&["f.kiln", "--aa", "none"]).aa, Aa::Off(aa::none::Off));
         let t = techniques(&["f.kiln", "--aa", "reproject", "--history-frames", "8"]);
-        assert_eq!(t.aa, Aa::Reproject { frames: 8 });
+        assert_eq!(t.aa, Aa::Reproject(aa::reproject::Reproject { frames: 8 }));
         assert_eq!(t.aa.reprojected(), Some(8));
-        let e = parse(&["f.kiln", "--aa", "taa", "--taa-frames", "0"]).unwrap().techniques().unwrap_err();
-        assert!(e.message.contains("--taa-frames"), "{}", e.message);
+        let e = refusal(&["f.kiln", "--aa", "taa", "--taa-frames", "0"]);
+        assert!(e.contains("--taa-frames"), "{e}");
         let e = parse(&["f.kiln", "--aa", "taa", "--no-accumulate"]).unwrap_err().to_string();
         assert!(e.contains("--no-accumulate") && e.contains("--aa"), "{e}");
     }
@@ -708,7 +645,7 @@ mod tests {
     fn ssr_flags_set_its_knobs_with_their_defaults() {
         assert_eq!(
             techniques(&["f.kiln", "--reflections", "ssr"]).reflections,
-            Reflections::Ssr { steps: 48, max_roughness: 0.6 }
+            Reflections::Ssr(reflections::ssr::Ssr { steps: 48, max_roughness: 0.6 })
         );
         let t = techniques(&[
             "f.kiln",
@@ -719,30 +656,35 @@ mod tests {
             "--ssr-max-roughness",
             "0.3",
         ]);
-        assert_eq!(t.reflections, Reflections::Ssr { steps: 96, max_roughness: 0.3 });
-        for bad in [&["--ssr-steps", "0"][..], &["--ssr-max-roughness", "1.5"]] {
+        assert_eq!(t.reflections, Reflections::Ssr(reflections::ssr::Ssr { steps: 96, max_roughness: 0.3 }));
+        for bad in [&["--ssr-steps", "0"][..], &["--ssr-max-roughness", "1.5"], &["--ssr-steps", "1.5"]] {
             let args: Vec<&str> =
                 ["f.kiln", "--reflections", "ssr"].into_iter().chain(bad.iter().copied()).collect();
-            let e = parse(&args).unwrap().techniques().unwrap_err();
-            assert_eq!(e.exit, Exit::Usage);
-            assert!(e.message.contains(bad[0]), "{bad:?}: {}", e.message);
+            let e = refusal(&args);
+            assert!(e.contains(bad[0]), "{bad:?}: {e}");
         }
     }
 
     #[test]
     fn the_last_flag_wins() {
-        assert_eq!(techniques(&["f.kiln", "--shadows", "rt", "--shadows", "none"]).shadows, Shadows::None);
+        assert_eq!(
+            techniques(&["f.kiln", "--shadows", "rt", "--shadows", "none"]).name_of(Effect::Shadows),
+            "none"
+        );
         let t = techniques(&["f.kiln", "--ao", "rt", "--ao-radius", "2", "--ao-radius", "3"]);
-        assert_eq!(t.ao, Ao::Rt { radius: Some(3.0), reach: 0.1 });
+        assert_eq!(t.ao, Ao::Rt(ao::rt::Rt { radius: Radius { radius: Some(3.0), reach: 0.1 } }));
     }
 
     #[test]
     fn screen_space_ao_flags_set_their_knobs_with_the_techniques_defaults() {
         let sao = techniques(&["f.kiln", "--ao", "sao"]);
-        assert_eq!(
-            sao.ao,
-            Ao::Sao { radius: None, reach: 0.05, samples: 16, turns: 7.0, resolution: ScreenFraction::Half }
-        );
+        let sao_default = ao::sao::Sao {
+            radius: Radius { radius: None, reach: 0.05 },
+            samples: 16,
+            turns: 7.0,
+            resolution: ScreenFraction::Half,
+        };
+        assert_eq!(sao.ao, Ao::Sao(sao_default));
         let t = techniques(&[
             "f.kiln",
             "--ao",
@@ -758,18 +700,17 @@ mod tests {
         ]);
         assert_eq!(
             t.ao,
-            Ao::Sao {
-                radius: Some(1.8),
-                reach: 0.05,
+            Ao::Sao(ao::sao::Sao {
+                radius: Radius { radius: Some(1.8), reach: 0.05 },
                 samples: 8,
                 turns: 5.0,
                 resolution: ScreenFraction::Full
-            }
+            })
         );
-        assert_eq!(
-            techniques(&["f.kiln", "--ao", "gtao"]).ao,
-            Ao::Gtao { radius: None, reach: 0.05, slices: 3, steps: 3 }
-        );
+        let gtao = |reach, slices, steps| {
+            Ao::Gtao(ao::gtao::Gtao { radius: Radius { radius: None, reach }, slices, steps })
+        };
+        assert_eq!(techniques(&["f.kiln", "--ao", "gtao"]).ao, gtao(0.05, 3, 3));
         let t = techniques(&[
             "f.kiln",
             "--ao",
@@ -781,9 +722,9 @@ mod tests {
             "--ao-reach",
             "0.2",
         ]);
-        assert_eq!(t.ao, Ao::Gtao { radius: None, reach: 0.2, slices: 9, steps: 4 });
+        assert_eq!(t.ao, gtao(0.2, 9, 4));
         // --ao-reach keeps each technique's own default when not given.
-        assert_eq!(techniques(&["f.kiln", "--ao", "rt"]).ao, Ao::Rt { radius: None, reach: 0.1 });
+        assert_eq!(techniques(&["f.kiln", "--ao", "rt"]).ao, AO_RT);
         // Out of range, fractional or unknown values name the flag.
         for bad in [
             &["--ao", "sao", "--ao-samples", "0"][..],
@@ -794,10 +735,9 @@ mod tests {
             &["--ao", "sao", "--ao-reach", "0"],
         ] {
             let args: Vec<&str> = std::iter::once("f.kiln").chain(bad.iter().copied()).collect();
-            let e = parse(&args).unwrap().techniques().unwrap_err();
-            assert_eq!(e.exit, Exit::Usage);
+            let e = refusal(&args);
             let flag = bad[2].split('=').next().unwrap();
-            assert!(e.message.contains(flag), "{bad:?}: {}", e.message);
+            assert!(e.contains(flag), "{bad:?}: {e}");
         }
         let e = parse(&["f.kiln", "--ao", "sao", "--ao-res", "quarter"]).unwrap_err().to_string();
         assert!(e.contains("full") && e.contains("half"), "{e}");
@@ -817,10 +757,124 @@ mod tests {
 
     #[test]
     fn bad_values_are_usage_errors_naming_the_flag() {
-        let e = parse(&["f.kiln", "--light-radius=-1"]).unwrap().techniques().unwrap_err();
-        assert_eq!(e.exit, Exit::Usage);
-        assert!(e.message.contains("--light-radius"), "{}", e.message);
+        // A knob is checked whether or not its technique is chosen.
+        let e = refusal(&["f.kiln", "--light-radius=-1"]);
+        assert!(e.contains("--light-radius"), "{e}");
         let e = parse(&["f.kiln", "--shadows", "raytraced"]).unwrap_err().to_string();
         assert!(e.contains("shadowmap") && e.contains("rt"), "{e}");
+    }
+
+    /// The long help states each knob's default as the catalogue has it (the flags used to
+    /// repeat the defaults by hand and disagreed: `--taa-weights` said luma, the catalogue
+    /// linear), and each effect's default technique.
+    #[test]
+    fn help_states_the_catalogues_defaults() {
+        let help = command().render_long_help().to_string();
+        // Undo clap's wrapping: one flag's text per block (a flag's line is indented less than
+        // its description's).
+        let mut blocks: Vec<String> = Vec::new();
+        for line in help.lines() {
+            let indent = line.len() - line.trim_start().len();
+            if line.trim_start().starts_with('-') && indent < 8 {
+                blocks.push(line.trim().to_string());
+            } else if let Some(b) = blocks.last_mut() {
+                b.push(' ');
+                b.push_str(line.trim());
+            }
+        }
+        let flat = blocks.join(" ");
+        for info in catalogue() {
+            for k in info.knobs {
+                let start = format!("--{} <", k.name);
+                let block = blocks
+                    .iter()
+                    .find(|b| b.starts_with(&start))
+                    .unwrap_or_else(|| panic!("--{} missing", k.name));
+                let default = k.default_text();
+                assert!(
+                    block.contains(&format!("[default: {default}]"))
+                        || block.contains(&format!("{} {default}", info.name)),
+                    "--{} of {} {}: default {default} not in: {block}",
+                    k.name,
+                    info.effect,
+                    info.name
+                );
+            }
+        }
+        assert!(flat.contains("--taa-weights <luma|linear>"), "{flat}");
+        for e in Effect::ALL {
+            assert!(help.contains(e.title()), "heading {e}");
+            let default = Techniques::default().name_of(e);
+            assert!(flat.contains(&format!("technique [default: {default}]")), "{e}");
+        }
+        // The short help names the effects and leaves the knobs to --help.
+        let short = command().render_help().to_string();
+        assert!(short.contains("--ao <TECHNIQUE>") && !short.contains("--ao-samples <N>"), "{short}");
+        assert!(short.contains("kiln-play --help"), "{short}");
+    }
+
+    /// Completions and the man page name every flag the catalogue makes.
+    #[test]
+    fn completions_and_man_page_cover_the_catalogue() {
+        let mut bash = Vec::new();
+        write_generated(&Invocation::Completions(clap_complete::Shell::Bash), &mut bash).unwrap();
+        let mut man = Vec::new();
+        write_generated(&Invocation::Man, &mut man).unwrap();
+        let (bash, man) = (String::from_utf8(bash).unwrap(), String::from_utf8(man).unwrap());
+        for info in catalogue() {
+            for k in info.knobs {
+                assert!(bash.contains(&format!("--{}", k.name)), "bash: --{}", k.name);
+                // roff escapes '-' as '\-'.
+                assert!(man.contains(&format!("\\-\\-{}", k.name.replace('-', "\\-"))), "man: --{}", k.name);
+            }
+        }
+        assert!(matches!(parse_from(["kiln-play", "completions", "zsh"]), Ok(Invocation::Completions(_))));
+        assert!(matches!(parse_from(["kiln-play", "man"]), Ok(Invocation::Man)));
+        assert!(parse_from(["kiln-play", "completions", "cmd.exe"]).is_err());
+    }
+
+    /// Every `kiln-play` line in the README and the docs parses and chooses valid techniques
+    /// (a flag renamed or dropped breaks a documented command line).
+    #[test]
+    fn documented_command_lines_parse() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut files = vec![root.join("README.md")];
+        if let Ok(dir) = std::fs::read_dir(root.join("docs")) {
+            files.extend(
+                dir.filter_map(|e| e.ok())
+                    .map(|e| e.path())
+                    .filter(|p| p.extension().is_some_and(|x| x == "md")),
+            );
+        }
+        let mut checked = 0;
+        for file in files {
+            let text = std::fs::read_to_string(&file).unwrap();
+            // Join continued lines, then take each command from `kiln-play` to a comment, a
+            // pipe or the end of its code span.
+            let text = text.replace("\\\n", " ");
+            for line in text.lines() {
+                let Some(at) = line.find("kiln-play ") else { continue };
+                let rest = &line[at + "kiln-play ".len()..];
+                let end = rest.find(['#', '`', '|', ';', '&', '>', ')']).unwrap_or(rest.len());
+                let words: Vec<&str> = rest[..end].split_whitespace().collect();
+                // Prose ("kiln-play renders ...") and placeholders ("kiln-play FILE [OPTIONS]").
+                let runs = words.iter().any(|w| w.ends_with(".kiln"));
+                if !runs || line.contains("...") || rest[..end].contains('[') {
+                    continue;
+                }
+                let mut args = vec!["kiln-play"];
+                args.extend(words.iter().copied());
+                let parsed = parse_from(args.iter().copied());
+                match parsed {
+                    Ok(Invocation::Play(a)) => {
+                        a.techniques().unwrap_or_else(|e| panic!("{}: {line}: {e}", file.display()));
+                    }
+                    Ok(_) => {}
+                    Err(e) => panic!("{}: `{}` is refused: {e}", file.display(), args.join(" ")),
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked >= 10, "only {checked} documented command lines found");
     }
 }

@@ -3,13 +3,24 @@
 use std::process::ExitCode;
 use std::time::Instant;
 
-use clap::Parser;
-use kiln_player::cli::{Args, run};
+use kiln_player::cli::{Invocation, parse_from, run, write_generated};
 
 fn main() -> ExitCode {
     let start = Instant::now();
-    let args = Args::parse();
-    match run(args, start) {
+    let invocation = match parse_from(std::env::args_os()) {
+        Ok(i) => i,
+        Err(e) => e.exit(),
+    };
+    let Invocation::Play(args) = invocation else {
+        return match write_generated(&invocation, &mut std::io::stdout().lock()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: could not write to stdout: {e}");
+                ExitCode::from(4)
+            }
+        };
+    };
+    match run(*args, start) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");

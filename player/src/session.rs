@@ -476,32 +476,7 @@ impl Session {
                 ));
             }
         }
-        if render.techniques.shadows == crate::render::Shadows::ShadowMap
-            && scene.manifest.shadow_maps.is_empty()
-            && !scene.manifest.lights.is_empty()
-        {
-            warnings.push("--shadows shadowmap: the file has no shadow maps (compiled with shadows skipped); lights are unshadowed".into());
-        }
-        let media = render.techniques.media;
-        if media != crate::render::Media::None {
-            let flag = format!("--media {}", render.techniques.name_of(crate::render::Effect::Media));
-            let casters = scene.manifest.lights.iter().any(|l| l.casts_shadows);
-            if scene.manifest.media.is_empty() {
-                warnings.push(format!("{flag}: the file has no participating medium (add a [[medium]] to the sidecar and recompile); it adds nothing"));
-            } else if matches!(media, crate::render::Media::March { .. })
-                && scene.manifest.media_visibility.is_none()
-                && casters
-            {
-                warnings.push(format!(
-                    "{flag}: the file has no light-visibility volume; shafts of light are unshadowed"
-                ));
-            } else if matches!(media, crate::render::Media::Toth { .. })
-                && scene.manifest.shadow_maps.is_empty()
-                && casters
-            {
-                warnings.push(format!("{flag}: the file has no shadow maps; shafts of light are unshadowed"));
-            }
-        }
+        warnings.extend(render.techniques.warnings(&scene.manifest));
         Ok(Session {
             camera,
             times,

@@ -6,6 +6,7 @@
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{Bounds, LightKind, Medium, Sky};
+use kiln_player::render::techniques;
 use kiln_player::render::{Media, Phase, ScreenFraction};
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
@@ -75,7 +76,11 @@ fn mitchells_blur_matches_its_definition() {
     let bytes = sky_over_wall(to_sun);
     let dir = tempfile::tempdir().unwrap();
     let (samples, exposure) = (60u32, 1.921f32);
-    let media = Media::Mitchell { samples, resolution: ScreenFraction::Full, exposure };
+    let media = Media::Mitchell(techniques::media::mitchell::Mitchell {
+        samples,
+        resolution: ScreenFraction::Full,
+        exposure,
+    });
     let (rgb, _) = render(dir.path(), "mitchell", &bytes, |f| Options::new(f, W, H).media(media));
     let cam = camera();
     let (_, v_light) = cam.project_direction(to_sun.as_dvec3()).expect("the sun is in front");
@@ -129,7 +134,11 @@ fn sousas_shafts_come_from_the_far_sky() {
     let rows = (W * (H / 2 - 2)) as f64;
     let mut bottoms = Vec::new();
     for taps in [6, 3] {
-        let media = Media::Sousa { taps, resolution: ScreenFraction::Full, brightness: 0.19 };
+        let media = Media::Sousa(techniques::media::sousa::Sousa {
+            taps,
+            resolution: ScreenFraction::Full,
+            brightness: 0.19,
+        });
         let (rgb, _) = render(dir.path(), "sousa", &bytes, |f| Options::new(f, W, H).media(media));
         let (mut top, mut bottom) = (0.0f64, 0.0f64);
         for y in 0..H {
@@ -178,13 +187,24 @@ fn image_space_god_rays_miss_a_light_behind_the_camera() {
     let (none, _) = render(dir.path(), "none", &bytes, |f| Options::new(f, W, H));
     assert!(none.iter().all(|&v| v == 0.0), "black wall, black sky");
     for media in [
-        Media::Mitchell { samples: 60, resolution: ScreenFraction::Quarter, exposure: 1.921 },
-        Media::Sousa { taps: 6, resolution: ScreenFraction::Quarter, brightness: 0.19 },
+        Media::Mitchell(techniques::media::mitchell::Mitchell {
+            samples: 60,
+            resolution: ScreenFraction::Quarter,
+            exposure: 1.921,
+        }),
+        Media::Sousa(techniques::media::sousa::Sousa {
+            taps: 6,
+            resolution: ScreenFraction::Quarter,
+            brightness: 0.19,
+        }),
     ] {
         let (rgb, _) = render(dir.path(), "image space", &bytes, |f| Options::new(f, W, H).media(media));
         assert!(rgb.iter().all(|&v| v == 0.0), "{media:?} shows light from behind the camera");
     }
-    for media in [Media::March { steps: 16 }, Media::Toth { samples: 16, block: 2, phase: Phase::Medium }] {
+    for media in [
+        Media::March(techniques::media::march::March { steps: 16 }),
+        Media::Toth(techniques::media::toth::Toth { samples: 16, block: 2, phase: Phase::Medium }),
+    ] {
         let (rgb, _) = render(dir.path(), "world space", &bytes, |f| Options::new(f, W, H).media(media));
         let m = mean(&rgb);
         eprintln!("{media:?}: mean {m:?}");
@@ -217,7 +237,11 @@ fn mitchells_blur_of_a_point_lights_sphere_matches_its_definition() {
     let bytes = compile(scene, kiln_compiler::settings::Settings { media_volume_res: 4, ..fast_settings() });
     let dir = tempfile::tempdir().unwrap();
     let (samples, exposure) = (60u32, 1.921f32);
-    let media = Media::Mitchell { samples, resolution: ScreenFraction::Full, exposure };
+    let media = Media::Mitchell(techniques::media::mitchell::Mitchell {
+        samples,
+        resolution: ScreenFraction::Full,
+        exposure,
+    });
     let (rgb, _) = render(dir.path(), "mitchell point", &bytes, |f| Options::new(f, W, H).media(media));
     let cam = camera();
     let radius = 0.02 * (30.0f64 * 30.0 + 30.0 * 30.0).sqrt();

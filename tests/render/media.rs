@@ -7,6 +7,7 @@ use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{Bounds, LightKind, Medium, OrthographicCamera, Sky};
 use kiln_player::reference::{DEFAULT_SEED, Sampling, render_with};
+use kiln_player::render::techniques;
 use kiln_player::render::{Media, Phase};
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
@@ -260,8 +261,8 @@ fn the_marches_show_the_volumetric_shadow_of_an_occluder() {
     let dir = tempfile::tempdir().unwrap();
     // The ray march reads the light's visibility from the baked volume, toth from the shadow map
     // (shadows on the surfaces off: the pass binds the maps itself).
-    let toth = Media::Toth { samples: 64, block: 4, phase: Phase::Medium };
-    for media in [Media::March { steps: 32 }, toth] {
+    let toth = Media::Toth(techniques::media::toth::Toth { samples: 64, block: 4, phase: Phase::Medium });
+    for media in [Media::March(techniques::media::march::March { steps: 32 }), toth] {
         let (rgb, _) =
             render(dir.path(), "roof", &bytes, |f| Options::new(f, W, H).unshadowed().media(media));
         // toth's blur window is moved inside the image at its border: there it averages
@@ -382,7 +383,7 @@ fn the_shadow_map_march_matches_single_scattering_in_a_lit_slab() {
         {
             // 60 samples over 16 pixels: some pixels take 4, some 3, and every sample must still
             // count once.
-            let media = Media::Toth { samples: 60, block: 4, phase };
+            let media = Media::Toth(techniques::media::toth::Toth { samples: 60, block: 4, phase });
             let (rgb, _) = render(dir.path(), &format!("toth {phase:?}"), &bytes, |f| {
                 Options::new(f, W, H).media(media)
             });
@@ -451,7 +452,7 @@ fn the_marches_match_single_scattering_from_a_point_light() {
             .sum::<f64>()
     };
     let dir = tempfile::tempdir().unwrap();
-    let toth = Media::Toth { samples: 60, block: 1, phase: Phase::Medium };
+    let toth = Media::Toth(techniques::media::toth::Toth { samples: 60, block: 1, phase: Phase::Medium });
     let (rgb, _) = render(dir.path(), "toth point", &bytes, |f| Options::new(f, W, H).media(toth));
     let mut want_mean = [0.0f64; 3];
     for py in 0..H {
@@ -468,7 +469,7 @@ fn the_marches_match_single_scattering_from_a_point_light() {
         }
     }
     let (rgb, _) = render(dir.path(), "march point", &bytes, |f| {
-        Options::new(f, W, H).media(Media::March { steps: 64 })
+        Options::new(f, W, H).media(Media::March(techniques::media::march::March { steps: 64 }))
     });
     let got = mean(&rgb);
     for c in 0..3 {

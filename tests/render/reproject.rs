@@ -10,6 +10,7 @@ use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::Sky;
 use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::render::Aa;
+use kiln_player::render::techniques;
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
 use crate::harness::{H, Pinhole, W, fast_settings, render_frames, square, srgb8};
@@ -54,14 +55,15 @@ fn reprojected_ao_follows_a_moving_camera_and_restarts_where_disoccluded() {
     let last: CameraOverride = pose(0.6).parse().unwrap();
     let ao = move |aa: Aa| move |f: &Path| Options::new(f, W, H).unshadowed().rt_ao(Some(RADIUS)).aa(aa);
     // The converged still image at the last pose.
-    let (still, _) =
-        render_frames(dir.path(), "still", &bytes, 64, move |f| ao(Aa::Accumulate)(f).camera(last));
+    let (still, _) = render_frames(dir.path(), "still", &bytes, 64, move |f| {
+        ao(Aa::Accumulate(techniques::aa::accumulate::Accumulate))(f).camera(last)
+    });
     let moving = |name: &str, aa: Aa| {
         let path = path.clone();
         render_frames(dir.path(), name, &bytes, frames, move |f| ao(aa)(f).camera_path(path.clone())).0
     };
-    let carried = moving("reproject", Aa::Reproject { frames: 32 });
-    let restarted = moving("restart", Aa::Accumulate);
+    let carried = moving("reproject", Aa::Reproject(techniques::aa::reproject::Reproject { frames: 32 }));
+    let restarted = moving("restart", Aa::Accumulate(techniques::aa::accumulate::Accumulate));
 
     // Classify the last frame's pixels by geometry computed here: the floor the last 7 frames'
     // eyes saw (it has 6 frames of history at least), the floor the plate hid from the previous

@@ -9,6 +9,7 @@ use std::path::Path;
 
 use glam::{DVec3, Vec3};
 use kiln_format::manifest::Sky;
+use kiln_player::render::techniques;
 use kiln_player::render::{Ao, ScreenFraction};
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
@@ -69,7 +70,12 @@ fn scene(with_wall: bool) -> Vec<u8> {
 }
 
 fn sao(resolution: ScreenFraction) -> Ao {
-    Ao::Sao { radius: Some(RADIUS as f32), reach: 0.05, samples: 16, turns: 7.0, resolution }
+    Ao::Sao(techniques::ao::sao::Sao {
+        radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
+        samples: 16,
+        turns: 7.0,
+        resolution,
+    })
 }
 
 /// (mean, largest |got − expected|) over the pixels `pick` keeps, with their count.
@@ -102,7 +108,15 @@ fn screen_space_ao_of_a_flat_floor_is_one() {
     for (name, ao, tolerance) in [
         ("sao-full", sao(ScreenFraction::Full), 1e-3),
         ("sao-half", sao(ScreenFraction::Half), 1e-3),
-        ("gtao", Ao::Gtao { radius: Some(RADIUS as f32), reach: 0.05, slices: 3, steps: 3 }, 0.03),
+        (
+            "gtao",
+            Ao::Gtao(techniques::ao::gtao::Gtao {
+                radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
+                slices: 3,
+                steps: 3,
+            }),
+            0.03,
+        ),
     ] {
         let img = ao_image(dir.path(), name, &bytes, ao);
         let (mean, worst, n) = compare(&img, floor);
@@ -228,7 +242,12 @@ fn sao_of_an_inside_corner_matches_its_estimator_integrated_here() {
         ("sao-corner-half", RADIUS, ScreenFraction::Half, 0.04, 0.15),
         ("sao-corner-r4", 4.0, ScreenFraction::Full, 0.02, 0.05),
     ] {
-        let ao = Ao::Sao { radius: Some(radius as f32), reach: 0.05, samples: 16, turns: 7.0, resolution };
+        let ao = Ao::Sao(techniques::ao::sao::Sao {
+            radius: techniques::ao::Radius { radius: Some(radius as f32), reach: 0.05 },
+            samples: 16,
+            turns: 7.0,
+            resolution,
+        });
         let expected = |x, y, _| sao_expected(&cam, x, y, radius, 64);
         check_corner(
             dir.path(),
@@ -253,7 +272,11 @@ fn gtao_of_an_inside_corner_matches_the_closed_form_visibility() {
     for (name, slices, steps, tolerance, worst_allowed) in
         [("gtao-corner-8x24", 8, 24, 0.02, 0.05), ("gtao-corner-3x3", 3, 3, 0.05, 0.15)]
     {
-        let ao = Ao::Gtao { radius: Some(RADIUS as f32), reach: 0.05, slices, steps };
+        let ao = Ao::Gtao(techniques::ao::gtao::Gtao {
+            radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
+            slices,
+            steps,
+        });
         let expected = |_, _, p: DVec3| wall_visibility(p.z, RADIUS);
         check_corner(dir.path(), &bytes, name, ao, "the closed form", expected, tolerance, worst_allowed);
     }
@@ -287,7 +310,15 @@ fn screen_space_ao_does_not_bleed_across_depth_edges() {
     for (name, ao, tolerance) in [
         ("sao-plate", sao(ScreenFraction::Full), 1e-3),
         ("sao-plate-half", sao(ScreenFraction::Half), 1e-3),
-        ("gtao-plate", Ao::Gtao { radius: Some(RADIUS as f32), reach: 0.05, slices: 3, steps: 3 }, 0.03),
+        (
+            "gtao-plate",
+            Ao::Gtao(techniques::ao::gtao::Gtao {
+                radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
+                slices: 3,
+                steps: 3,
+            }),
+            0.03,
+        ),
     ] {
         let img = ao_image(dir.path(), name, &bytes, ao);
         let (mean, worst, n) = compare(&img, top);

@@ -15,6 +15,7 @@ use std::f64::consts::PI;
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{LightKind, Sky};
+use kiln_player::render::techniques;
 use kiln_player::render::{Gi, ScreenFraction};
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
@@ -95,7 +96,7 @@ fn floor_point(cam: &Pinhole, x: u32, y: u32) -> Option<DVec3> {
 }
 
 fn ssgi(tiled: bool) -> Gi {
-    Gi::Ssgi {
+    Gi::Ssgi(techniques::gi::ssgi::Ssgi {
         samples: 128,
         resolution: ScreenFraction::Half,
         radius: 40,
@@ -103,7 +104,7 @@ fn ssgi(tiled: bool) -> Gi {
         falloff: false,
         frames: 16,
         tiled,
-    }
+    })
 }
 
 /// Per-channel radiance with SSGI (spirals turned per texel or per tile) minus without, for
@@ -113,7 +114,13 @@ fn gathered(name: &str, cam: &Pinhole, tiled: bool) -> Vec<f64> {
     let bytes = scene(cam);
     let opts = |gi: Gi| move |f: &std::path::Path| Options::new(f, W, H).unshadowed().gi(gi);
     let (with, _) = render_frames(dir.path(), name, &bytes, FRAMES, opts(ssgi(tiled)));
-    let (without, _) = render_frames(dir.path(), &format!("{name}-off"), &bytes, 1, opts(Gi::None));
+    let (without, _) = render_frames(
+        dir.path(),
+        &format!("{name}-off"),
+        &bytes,
+        1,
+        opts(Gi::Off(techniques::gi::none::Off)),
+    );
     with.iter().zip(&without).map(|(&a, &b)| a as f64 - b as f64).collect()
 }
 

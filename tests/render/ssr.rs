@@ -9,6 +9,7 @@ use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::Sky;
 use kiln_player::render::Reflections;
+use kiln_player::render::techniques;
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
 use crate::harness::{H, Pinhole, W, fast_settings, metal, render, render_frames, square};
@@ -29,7 +30,8 @@ const Y1: f64 = 4.0;
 const EMITTED: f64 = 4.0;
 const SKY: f64 = 0.25;
 /// The SSR technique under test: a mirror is well within its roughness limit.
-const SSR: Reflections = Reflections::Ssr { steps: 48, max_roughness: 0.6 };
+const SSR: Reflections =
+    Reflections::Ssr(techniques::reflections::ssr::Ssr { steps: 48, max_roughness: 0.6 });
 
 fn camera() -> Pinhole {
     Pinhole::new(EYE, TARGET, [0.0, 1.0, 0.0], VFOV, W, H)

@@ -9,6 +9,7 @@ use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::Sky;
 use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::render::Aa;
+use kiln_player::render::techniques;
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
 use crate::harness::{H, Pinhole, W, fast_settings, render, render_frames, square, srgb8};
@@ -103,7 +104,7 @@ fn edge_flip(reference: &[f32], test: &[f32]) -> f64 {
 /// The supersampled reference through `camera` (`None`: the file's).
 fn supersampled(dir: &Path, bytes: &[u8], camera: Option<CameraOverride>) -> Vec<f32> {
     let (big, _) = render(dir, "ssaa", bytes, |f| {
-        let o = Options::new(f, W * SS, H * SS).unshadowed().aa(Aa::None);
+        let o = Options::new(f, W * SS, H * SS).unshadowed().aa(Aa::Off(techniques::aa::none::Off));
         match camera {
             Some(c) => o.camera(c),
             None => o,
@@ -122,7 +123,7 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
     let bytes = strips_scene(&cam);
     let reference = supersampled(dir.path(), &bytes, None);
     let opts = |aa: Aa| move |f: &Path| Options::new(f, W, H).unshadowed().aa(aa);
-    let (aliased, _) = render(dir.path(), "none", &bytes, opts(Aa::None));
+    let (aliased, _) = render(dir.path(), "none", &bytes, opts(Aa::Off(techniques::aa::none::Off)));
     // A running mean over two cycles of the 16 jitter positions, blended linearly: the box
     // filter's integral by 16 Halton points, as the reference is by a 4 × 4 grid.
     let (mean, _) = render_frames(
@@ -130,7 +131,7 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
         "taa-mean",
         &bytes,
         32,
-        opts(Aa::Taa { frames: 1024, luma_weights: false }),
+        opts(Aa::Taa(techniques::aa::taa::Taa { frames: 1024, luma_weights: false })),
     );
     // The defaults: 16 frames of history, luma weights.
     let (default, _) = render_frames(
@@ -138,7 +139,7 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
         "taa-default",
         &bytes,
         32,
-        opts(Aa::Taa { frames: 16, luma_weights: false }),
+        opts(Aa::Taa(techniques::aa::taa::Taa { frames: 16, luma_weights: false })),
     );
     let (f_none, f_mean, f_default) =
         (edge_flip(&reference, &aliased), edge_flip(&reference, &mean), edge_flip(&reference, &default));
@@ -180,9 +181,10 @@ fn taa_on_a_moving_camera_leaves_no_ghost_behind_disoccluded_edges() {
         "taa-moving",
         &bytes,
         frames,
-        moving(Aa::Taa { frames: 16, luma_weights: false }),
+        moving(Aa::Taa(techniques::aa::taa::Taa { frames: 16, luma_weights: false })),
     );
-    let (single, _) = render_frames(dir.path(), "none-moving", &bytes, frames, moving(Aa::None));
+    let (single, _) =
+        render_frames(dir.path(), "none-moving", &bytes, frames, moving(Aa::Off(techniques::aa::none::Off)));
     // Floor pixels far from every strip in the reference: their 5 × 5 neighbourhood is floor
     // throughout (so this frame's jittered neighbourhood holds no strip either).
     let floor = floor_radiance();

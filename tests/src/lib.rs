@@ -9,9 +9,10 @@ use kiln_compiler::settings::Settings;
 use kiln_format::sections::Vertex;
 use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::gpu::GpuOptions;
+use kiln_player::render::techniques::{ao as ao_techniques, gbuffer, gi, media, reflections, shadows};
 use kiln_player::render::{
-    Aa, Ao, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose, ReflectionRes,
-    Reflections as ReflectionsTechnique, Shadows,
+    Aa, Ao, Effect, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose,
+    ReflectionRes, Reflections as ReflectionsTechnique, Shadows,
 };
 use kiln_player::scene::TextureUpload;
 use kiln_player::session::{PipelineStart, SessionOptions};
@@ -106,8 +107,8 @@ impl Options {
     /// No shadow maps (`--shadows none`; with a ray-traced pass, only what that pass gives).
     pub fn unshadowed(mut self) -> Options {
         let t = &mut self.0.render.techniques;
-        if t.shadows == Shadows::ShadowMap {
-            t.shadows = Shadows::None;
+        if t.name_of(Effect::Shadows) == "shadowmap" {
+            t.shadows = Shadows::Off(shadows::none::Off);
         }
         self
     }
@@ -121,8 +122,8 @@ impl Options {
     /// Makes the G-buffer the given way.
     pub fn gbuffer(mut self, gbuffer: GBuffer) -> Options {
         self.0.render.techniques.gbuffer = match gbuffer {
-            GBuffer::Raster => GBufferTechnique::Raster,
-            GBuffer::Visibility => GBufferTechnique::Visibility,
+            GBuffer::Raster => GBufferTechnique::Raster(gbuffer::raster::Raster),
+            GBuffer::Visibility => GBufferTechnique::Visibility(gbuffer::visibility::Visibility),
         };
         self
     }
@@ -130,7 +131,7 @@ impl Options {
     /// Ray-traced shadows instead of shadow maps, point and spot lights spheres of
     /// `light_radius`, directional lights `sun_degrees` wide (0 and 0: hard shadows).
     pub fn rt_shadows(mut self, light_radius: f32, sun_degrees: f32) -> Options {
-        self.0.render.techniques.shadows = Shadows::Rt { light_radius, sun_degrees };
+        self.0.render.techniques.shadows = Shadows::Rt(shadows::rt::Rt { light_radius, sun_degrees });
         self
     }
 
@@ -138,13 +139,15 @@ impl Options {
     /// shafts (`exact`) or near the rays' ends only.
     pub fn line_space_shadows(mut self, exact: bool) -> Options {
         let test = if exact { LsShadowTest::Filled } else { LsShadowTest::Ends };
-        self.0.render.techniques.shadows = Shadows::LineSpace { light_radius: 0.0, sun_degrees: 0.0, test };
+        self.0.render.techniques.shadows =
+            Shadows::LineSpace(shadows::linespace::LineSpace { light_radius: 0.0, sun_degrees: 0.0, test });
         self
     }
 
     /// Ray-traced ambient occlusion, rays of length `radius` (`None`: the player's default).
     pub fn rt_ao(mut self, radius: Option<f32>) -> Options {
-        self.0.render.techniques.ao = Ao::Rt { radius, reach: 0.1 };
+        self.0.render.techniques.ao =
+            Ao::Rt(ao_techniques::rt::Rt { radius: ao_techniques::Radius { radius, reach: 0.1 } });
         self
     }
 
@@ -161,7 +164,7 @@ impl Options {
             Reflections::Half => ReflectionRes::Half,
         };
         self.0.render.techniques.reflections =
-            ReflectionsTechnique::Rt { resolution: res, max_roughness: 1.0 };
+            ReflectionsTechnique::Rt(reflections::rt::Rt { resolution: res, max_roughness: 1.0 });
         self
     }
 
@@ -173,14 +176,14 @@ impl Options {
 
     /// Path-traced diffuse GI counting `bounces` scattering events after the visible surface.
     pub fn rt_gi(mut self, bounces: u32) -> Options {
-        self.0.render.techniques.gi = Gi::Rt { bounces };
+        self.0.render.techniques.gi = Gi::Rt(gi::rt::Rt { bounces });
         self
     }
 
     /// Path-traced GI through the line space with `bounces` bounces, bounce rays through
     /// `structure`.
     pub fn line_space_gi(mut self, bounces: u32, structure: GiStructure) -> Options {
-        self.0.render.techniques.gi = Gi::LineSpace { bounces, structure };
+        self.0.render.techniques.gi = Gi::LineSpace(gi::linespace::LineSpace { bounces, structure });
         self
     }
 
@@ -192,7 +195,7 @@ impl Options {
 
     /// Participating media by ray marching (`--media march`) with `steps` steps per medium.
     pub fn media_march(mut self, steps: u32) -> Options {
-        self.0.render.techniques.media = Media::March { steps };
+        self.0.render.techniques.media = Media::March(media::march::March { steps });
         self
     }
 

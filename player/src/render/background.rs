@@ -12,7 +12,7 @@ use std::thread::JoinHandle;
 use std::time::Instant;
 
 use super::frame::{Frame, SceneLights};
-use super::technique::Techniques;
+use super::techniques::Techniques;
 use super::texels::TexelDecode;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::Gpu;

@@ -1,40 +1,16 @@
-//! Wires the passes of a run: which passes the chosen techniques need, in frame order, and the
-//! images they make and bind.
+//! Wires the passes of a run: each effect's technique adds its passes at their [`Stage`]
+//! ([`FrameBuild`]), the shared prerequisites (depth and lit pyramids) are made once for all
+//! their readers, and the passes run in stage order; the images they make and bind.
 //!
-//! Frame order: G-buffer (raster, or visibility raster + resolve) → ray-traced shadows, the
-//! depth pyramid (for screen-space AO or GI), AO (ray-traced, SAO or GTAO), reflections
-//! (ray-traced, or the Hi-Z pyramid and SSR, which reads the previous frame's radiance before the
-//! direct pass overwrites it), GI (ray-traced, or the lit pyramid and screen-space GI) (each when
-//! chosen) → the
-//! ray-traced passes' reprojected accumulation (with `--aa reproject` or `taa`) → direct light
-//! and composition → participating media (march, mitchell, sousa or toth, when chosen) →
-//! temporal anti-aliasing (when chosen) → tone mapping.
+//! Frame order: [`Stage`]'s.
 
 use super::graph::{FrameImages, TargetDecl};
 use super::passes::Pass;
-use super::passes::depth_pyramid::{self, DepthPyramidPass, Reduction};
+use super::passes::depth_pyramid::{DepthPyramidPass, Reduction};
 use super::passes::direct::DirectPass;
-use super::passes::gbuffer::GBufferPass;
-use super::passes::hiz::HizPass;
 use super::passes::lit_pyramid::LitPyramidPass;
-use super::passes::media::MediaMarchPass;
-use super::passes::mitchell::MitchellPass;
-use super::passes::resolve::ResolvePass;
-use super::passes::rt_ao::RtAoPass;
-use super::passes::rt_gi::RtGiPass;
-use super::passes::rt_history::RtHistoryPass;
-use super::passes::rt_reflections::RtReflectionsPass;
-use super::passes::rt_shadows::RtShadowsPass;
-use super::passes::sousa::SousaPass;
-use super::passes::ssgi::SsgiPass;
-use super::passes::ssr::SsrPass;
-use super::passes::taa::TaaPass;
 use super::passes::tonemap::TonemapPass;
-use super::passes::toth::TothPass;
-use super::passes::visibility::VisibilityPass;
-use super::passes::{gtao, sao};
-use super::spirv;
-use super::technique::{Aa, Ao, GBuffer, Gi, GiStructure, Media, Reflections, Techniques};
+use super::techniques::{Effect, Techniques};
 use super::texels::TexelDecode;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Gpu, ImageDesc};
@@ -75,6 +51,89 @@ impl SceneLights {
     }
 }
 
+/// Where a pass runs in the frame: stages run in this order, the passes of one stage in the
+/// order they were added (effects add theirs in [`Effect::ALL`] order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Stage {
+    /// The G-buffer.
+    GBuffer,
+    /// Ray-traced shadows.
+    Shadows,
+    /// The depth pyramid (screen-space AO and GI), made once for every reader.
+    DepthPyramid,
+    /// Ambient occlusion.
+    Ao,
+    /// The lit pyramid (the previous frame's radiance: screen-space reflections and GI), made
+    /// once, before either reads it and before the direct pass overwrites the radiance.
+    LitPyramid,
+    /// Reflections.
+    Reflections,
+    /// Global illumination.
+    Gi,
+    /// The ray-traced passes' reprojected accumulation.
+    Accumulate,
+    /// Direct light and composition.
+    Direct,
+    /// Participating media.
+    Media,
+    /// Temporal anti-aliasing's resolve.
+    Resolve,
+    /// Tone mapping.
+    Tonemap,
+}
+
+/// What the depth pyramid's readers ask of it; the frame makes one that serves them all.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct PyramidRequest {
+    reduction: Reduction,
+    normals: bool,
+    top: u32,
+}
+
+/// The passes of a frame being gathered from its techniques ([`crate::render::techniques::Technique::passes`]).
+pub struct FrameBuild<'a> {
+    /// The device the passes are built on.
+    pub gpu: &'a Gpu,
+    /// Every effect's technique.
+    pub techniques: &'a Techniques,
+    /// The scene's lights.
+    pub lights: SceneLights,
+    /// How passes that read the texel buffer decode it.
+    pub decode: TexelDecode,
+    makers: Vec<(Stage, Maker<'a>)>,
+    depth_pyramid: Option<PyramidRequest>,
+    lit_pyramid: bool,
+}
+
+impl std::fmt::Debug for FrameBuild<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FrameBuild").field("passes", &self.makers.len()).finish()
+    }
+}
+
+impl<'a> FrameBuild<'a> {
+    /// Adds a pass at `stage`, made by `make` (on a thread of its own).
+    pub fn add<P: Pass + 'static>(&mut self, stage: Stage, make: impl FnOnce() -> PlayResult<P> + Send + 'a) {
+        self.makers.push((stage, Box::new(move || Ok(Box::new(make()?) as Box<dyn Pass>))));
+    }
+
+    /// Asks for the depth pyramid up to level `top`, reduced as `reduction` says (voting wins
+    /// over nearest), with normals when `normals`.
+    pub fn depth_pyramid(&mut self, reduction: Reduction, normals: bool, top: u32) {
+        let r = self.depth_pyramid.get_or_insert(PyramidRequest { reduction, normals, top });
+        if reduction == Reduction::Voting {
+            r.reduction = Reduction::Voting;
+        }
+        r.normals |= normals;
+        r.top = r.top.max(top);
+    }
+
+    /// Asks for the lit pyramid.
+    pub fn lit_pyramid(&mut self) {
+        self.lit_pyramid = true;
+    }
+}
+
 /// Builds the passes `techniques` need, in frame order, for a scene of `lights` whose texel
 /// buffer is decoded as `decode` says.
 fn passes(
@@ -83,98 +142,36 @@ fn passes(
     scene_lights: SceneLights,
     decode: TexelDecode,
 ) -> PlayResult<Vec<(Box<dyn Pass>, f64)>> {
-    let lights = scene_lights.count;
+    let mut frame = FrameBuild {
+        gpu,
+        techniques,
+        lights: scene_lights,
+        decode,
+        makers: Vec::new(),
+        depth_pyramid: None,
+        lit_pyramid: false,
+    };
+    for effect in Effect::ALL {
+        techniques.get(effect).passes(&mut frame);
+    }
+    if let Some(PyramidRequest { reduction, normals, top }) = frame.depth_pyramid {
+        frame.add(Stage::DepthPyramid, move || DepthPyramidPass::new(gpu, reduction, normals, top));
+    }
+    if frame.lit_pyramid {
+        frame.add(Stage::LitPyramid, move || LitPyramidPass::new(gpu));
+    }
+    frame.add(Stage::Direct, move || DirectPass::new(gpu, techniques, scene_lights.rect));
+    frame.add(Stage::Tonemap, move || TonemapPass::new(gpu));
+    let mut makers = frame.makers;
+    // Stable: a stage's passes keep the order they were added in.
+    makers.sort_by_key(|(stage, _)| *stage);
     // Each pass builds its pipelines on a thread of its own: a driver compiles a call's
     // pipelines one after another, and on a cold cache the default frame's took 350 ms in a row
     // on the H100.
-    let mut makers: Vec<Maker<'_>> = Vec::new();
-    {
-        match techniques.gbuffer {
-            GBuffer::Raster => makers.push(maker(move || GBufferPass::new(gpu))),
-            GBuffer::Visibility => {
-                makers.push(maker(move || VisibilityPass::new(gpu)));
-                makers.push(maker(move || ResolvePass::new(gpu, decode)));
-            }
-        }
-        if techniques.shadows.traced().is_some() {
-            makers.push(maker(move || RtShadowsPass::new(gpu, techniques.shadows, lights, decode)));
-        }
-        // The depth pyramid, for screen-space AO and GI (GI's with normals, reduced as it says).
-        let screen_ao = matches!(techniques.ao, Ao::Sao { .. } | Ao::Gtao { .. });
-        // Levels: GI gathers up to the top; SAO's samples read up to level 5; GTAO reads level 0.
-        let ao_top = if matches!(techniques.ao, Ao::Sao { .. }) { sao::TOP_LEVEL } else { 0 };
-        if let Gi::Ssgi { voting, .. } = techniques.gi {
-            let reduction = if voting { Reduction::Voting } else { Reduction::Nearest };
-            makers.push(maker(move || DepthPyramidPass::new(gpu, reduction, true, depth_pyramid::TOP)));
-        } else if screen_ao {
-            makers.push(maker(move || DepthPyramidPass::new(gpu, Reduction::Nearest, false, ao_top)));
-        }
-        match techniques.ao {
-            Ao::None => {}
-            Ao::Rt { .. } => makers.push(maker(move || RtAoPass::new(gpu, decode))),
-            Ao::Sao { .. } | Ao::Gtao { .. } => {
-                let ao = techniques.ao;
-                makers.push(maker(move || {
-                    if let Ao::Sao { .. } = ao { sao::pass(gpu, ao) } else { gtao::pass(gpu, ao) }
-                }));
-            }
-        }
-        // The lit pyramid (the previous frame's radiance), for screen-space reflections and GI:
-        // made once, before either reads it.
-        if matches!(techniques.reflections, Reflections::Ssr { .. })
-            || matches!(techniques.gi, Gi::Ssgi { .. })
-        {
-            makers.push(maker(move || LitPyramidPass::new(gpu)));
-        }
-        match techniques.reflections {
-            Reflections::None => {}
-            Reflections::Rt { resolution, .. } => {
-                makers.push(maker(move || RtReflectionsPass::new(gpu, resolution, lights, decode)))
-            }
-            Reflections::Ssr { .. } => {
-                makers.push(maker(move || HizPass::new(gpu)));
-                makers.push(maker(move || SsrPass::new(gpu, techniques.reflections)));
-            }
-        }
-        match techniques.gi {
-            Gi::Rt { .. } => makers.push(maker(move || RtGiPass::new(gpu, spirv::RT_GI, decode))),
-            Gi::LineSpace { structure, .. } => {
-                let code = match structure {
-                    GiStructure::Pnmt => spirv::RT_GI_LINESPACE_PNMT,
-                    GiStructure::Candidates => spirv::RT_GI_LINESPACE_CANDIDATES,
-                    GiStructure::Preillum => spirv::RT_GI_LINESPACE_PREILLUM,
-                };
-                makers.push(maker(move || RtGiPass::with_line_space(gpu, code, decode)));
-            }
-            Gi::Ssgi { .. } => makers.push(maker(move || SsgiPass::new(gpu, techniques.gi))),
-            Gi::None => {}
-        }
-        if let Some(frames) = techniques.reprojected_rays() {
-            makers.push(maker(move || RtHistoryPass::new(gpu, techniques, lights, frames)));
-        }
-        makers.push(maker(move || DirectPass::new(gpu, techniques, scene_lights.rect)));
-        match techniques.media {
-            Media::None => {}
-            Media::March { steps } => makers.push(maker(move || MediaMarchPass::new(gpu, steps))),
-            Media::Mitchell { samples, resolution, exposure } => {
-                makers.push(maker(move || MitchellPass::new(gpu, samples, resolution, exposure)))
-            }
-            Media::Sousa { taps, resolution, brightness } => {
-                makers.push(maker(move || SousaPass::new(gpu, taps, resolution, brightness)))
-            }
-            Media::Toth { samples, block, phase } => {
-                makers.push(maker(move || TothPass::new(gpu, samples, block, phase)))
-            }
-        }
-        if let Aa::Taa { frames, luma_weights } = techniques.aa {
-            makers.push(maker(move || TaaPass::new(gpu, frames, luma_weights)));
-        }
-        makers.push(maker(move || TonemapPass::new(gpu)));
-    }
     let results: Vec<PlayResult<(Box<dyn Pass>, f64)>> = std::thread::scope(|s| {
         let threads: Vec<_> = makers
             .into_iter()
-            .map(|m| {
+            .map(|(_, m)| {
                 s.spawn(move || {
                     let t = std::time::Instant::now();
                     m().map(|p| (p, t.elapsed().as_secs_f64() * 1e3))
@@ -207,10 +204,6 @@ fn passes(
 
 /// A pass to make: its constructor, run on a thread of its own by [`passes`].
 type Maker<'a> = Box<dyn FnOnce() -> PlayResult<Box<dyn Pass>> + Send + 'a>;
-
-fn maker<'a, P: Pass + 'static>(make: impl FnOnce() -> PlayResult<P> + Send + 'a) -> Maker<'a> {
-    Box::new(move || Ok(Box::new(make()?) as Box<dyn Pass>))
-}
 
 fn make_images(gpu: &Gpu, passes: &[Box<dyn Pass>], width: u32, height: u32) -> PlayResult<FrameImages> {
     let made: Vec<(TargetDecl, ImageDesc)> = passes.iter().flat_map(|p| p.targets(width, height)).collect();

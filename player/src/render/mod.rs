@@ -1,10 +1,11 @@
-//! The frame: one file per pass under [`passes`], techniques as values ([`technique`]), the
+//! The frame: one file per pass under [`passes`], one module per technique under
+//! [`techniques`], the
 //! passes of a run wired by [`frame`] with barriers derived from their declared reads and writes
 //! ([`graph`]). Pipelines are built without the scene (so they compile while it uploads);
 //! [`Renderer::new`] then binds the scene.
 //!
 //! The ray-traced passes take one sample per pixel per frame and average frames while the
-//! camera is still (a running mean, [`technique::Aa::Accumulate`]); any change of the view or
+//! camera is still (a running mean, `--aa accumulate`); any change of the view or
 //! projection restarts the average (no reprojection: a moving camera sees the one-sample image).
 
 pub mod background;
@@ -14,7 +15,7 @@ pub mod graph;
 pub mod lights;
 pub mod passes;
 pub mod spirv;
-pub mod technique;
+pub mod techniques;
 pub mod texels;
 
 use crate::gpu::vk;
@@ -29,9 +30,12 @@ pub use dummies::Dummies;
 use frame::Frame;
 use graph::{Access, FrameImages};
 use passes::{FrameCtx, Shared};
-pub use technique::{
-    Aa, Ao, Effect, GBuffer, Gi, GiStructure, LsShadowTest, Media, Needs, Phase, ReflectionRes, Reflections,
-    ScreenFraction, Shadows, Techniques,
+pub use techniques::gi::linespace::GiStructure;
+pub use techniques::media::toth::Phase;
+pub use techniques::reflections::rt::ReflectionRes;
+pub use techniques::shadows::linespace::LsShadowTest;
+pub use techniques::{
+    Aa, Ao, Effect, GBuffer, Gi, Media, Needs, Reflections, ScreenFraction, Shadows, Techniques,
 };
 pub use texels::TexelDecode;
 
@@ -61,35 +65,6 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// What else the session serves.
     pub purpose: Purpose,
-}
-
-/// The frame flags (`FrameFlags`) that `t` sets: all but `SHADOW_MAPS`, which also depends on
-/// the file. The direct pass is specialised for these ([`passes::direct::DirectPass::new`]).
-pub fn technique_flags(t: &Techniques) -> u32 {
-    let mut flags = 0;
-    if t.shadows.traced().is_some() {
-        flags |= FrameFlags::RT_SHADOWS;
-    }
-    // The direct pass multiplies the sky's ambient by the AO image, whichever technique makes it
-    // (the flag's name predates the screen-space ones).
-    if t.ao != Ao::None {
-        flags |= FrameFlags::RT_AO;
-    }
-    if t.gi.bounces().is_some() {
-        flags |= FrameFlags::RT_GI;
-    }
-    if let Gi::Ssgi { .. } = t.gi {
-        flags |= FrameFlags::SCREEN_GI;
-    }
-    match t.reflections {
-        Reflections::Rt { resolution: ReflectionRes::Full, .. } => flags |= FrameFlags::RT_REFLECTIONS,
-        Reflections::Rt { resolution: ReflectionRes::Half, .. } => {
-            flags |= FrameFlags::RT_REFLECTIONS | FrameFlags::REFLECTIONS_HALF
-        }
-        Reflections::Ssr { .. } => flags |= FrameFlags::SCREEN_REFLECTIONS,
-        Reflections::None => {}
-    }
-    flags
 }
 
 impl RenderSettings {
@@ -165,52 +140,32 @@ impl Renderer {
         settings: RenderSettings,
     ) -> PlayResult<Renderer> {
         let t = settings.techniques;
-        // The shadow maps are bound for surfaces (`--shadows shadowmap`) or for the media march
-        // through them (`--media toth`); the flag below says whether surfaces use them.
-        let surface_maps = t.shadows == Shadows::ShadowMap;
-        let media_maps = matches!(t.media, Media::Toth { .. });
-        let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, surface_maps || media_maps);
-        let rt_shadows = t.shadows.traced().is_some();
+        // The shadow maps are bound for whatever reads them (`--shadows shadowmap`, the media
+        // march through them, `--media toth`); the flag below says whether surfaces use them.
+        let surface_maps = t.shadow_mapped_surfaces();
+        let mut plan = lights::plan(&scene.manifest, &scene.shadow_maps, t.needs().shadow_maps);
+        let rt_shadows = t.shadows.technique().ray_traced();
         if rt_shadows && plan.lights_used as usize > MAX_RT_SHADOW_LIGHTS {
             plan.warnings.push(format!(
                 "{} light(s) are drawn without ray-traced shadows: at most {MAX_RT_SHADOW_LIGHTS} have them",
                 plan.lights_used as usize - MAX_RT_SHADOW_LIGHTS
             ));
         }
-        let (light_radius, sun_degrees) = t.shadows.traced().unwrap_or((0.0, 0.0));
+        let rays = t.rays(&techniques::RayScene {
+            diagonal: scene.diagonal(),
+            lights_used: plan.lights_used as usize,
+        });
         for l in &mut plan.lights {
             l.radius = match l.kind {
-                LightKinds::POINT | LightKinds::SPOT => light_radius.max(0.0),
-                LightKinds::DIRECTIONAL => (sun_degrees.max(0.0) * 0.5).to_radians(),
+                LightKinds::POINT | LightKinds::SPOT => rays.light_radius.max(0.0),
+                LightKinds::DIRECTIONAL => (rays.sun_degrees.max(0.0) * 0.5).to_radians(),
                 _ => 0.0,
             };
         }
-        let diagonal = scene.diagonal();
-        let lights_used = plan.lights_used as usize;
-        let (reflection_step, reflection_lights, max_roughness) = match t.reflections {
-            Reflections::Rt { resolution, max_roughness } => (
-                passes::rt_reflections::step(resolution),
-                passes::rt_reflections::lights(lights_used),
-                max_roughness,
-            ),
-            Reflections::None | Reflections::Ssr { .. } => (1, 0, 1.0),
-        };
-        let shadow_layers = if rt_shadows { passes::rt_shadows::layers(lights_used) } else { 0 };
-        let rt_constants = RtConstants {
-            ao_radius: t.ao.world_radius(diagonal).max(1e-6),
-            max_roughness,
-            shadow_lights: shadow_layers.min(plan.lights_used),
-            reflection_step,
-            reflection_lights,
-            gi_bounces: match t.gi {
-                Gi::Rt { bounces } | Gi::LineSpace { bounces, .. } => bounces,
-                Gi::None | Gi::Ssgi { .. } => 0,
-            },
-            emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count),
-            ..Default::default()
-        };
+        let rt_constants =
+            RtConstants { emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count), ..rays.rt };
         let mut flags = if plan.shadows_bound && surface_maps { FrameFlags::SHADOW_MAPS } else { 0 };
-        flags |= technique_flags(&t);
+        flags |= t.flags();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let mut frame = frame;
         let buffers = (|| {
@@ -263,11 +218,7 @@ impl Renderer {
             flags,
             lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
             sky: scene.manifest.sky.radiance,
-            media_dimming: if t.media.dims_surfaces() {
-                scene.media.as_ref().map_or(0, |m| m.count)
-            } else {
-                0
-            },
+            media_dimming: if t.dims_surfaces() { scene.media.as_ref().map_or(0, |m| m.count) } else { 0 },
             settings,
             timestamps,
             frame_count: 0,

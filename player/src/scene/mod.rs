@@ -758,9 +758,9 @@ impl GpuScene {
                 } else if kind == sections::BRDF_LUT {
                     "no pass reads the BRDF table".into()
                 } else if kind == sections::MEDIA_VISIBILITY {
-                    "no media technique reads it (--media march does; toth reads the shadow maps)".into()
+                    no_reader(|n| n.media_volumes)
                 } else if kind == sections::SHADOW_MAP {
-                    "no pass reads shadow maps (neither --shadows shadowmap nor --media toth)".into()
+                    no_reader(|n| n.shadow_maps)
                 } else {
                     "no enabled pass reads it".into()
                 };
@@ -1020,6 +1020,12 @@ pub fn sampled_desc(
         uploaded: true,
         components: vk::ComponentMapping::default(),
     }
+}
+
+/// Why a section that only some techniques read is not uploaded: none of them is chosen, named
+/// from the catalogue (`--shadows shadowmap or --media toth reads it`).
+fn no_reader(reads: impl Fn(&crate::render::Needs) -> bool) -> String {
+    format!("no chosen technique reads it ({} would)", crate::render::techniques::readers(reads).join(" or "))
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use crate::cli::Size;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::GpuOptions;
 use crate::gpu::default_cache_path;
-use crate::render::technique::{KnobRole, catalogue};
+use crate::render::techniques::{KnobRole, catalogue};
 
 use super::measure::Timing;
 use super::plan::{Request, Target, preset_help};

@@ -5,8 +5,8 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use crate::render::technique::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
-use crate::render::{Aa, Effect, Needs, Shadows, Techniques};
+use crate::render::techniques::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
+use crate::render::{Effect, Needs, Techniques};
 use crate::scene::linespace::variants_needed;
 use kiln_format::linespace::Variants;
 
@@ -231,14 +231,14 @@ type Preset = (&'static str, &'static str, fn(&mut Techniques));
 /// The frame presets, each with both G-buffers.
 const PRESETS: [Preset; 7] = [
     ("baked", "shadow maps, no AO, split-sum reflections", |t| {
-        t.shadows = Shadows::ShadowMap;
+        set(t, Effect::Shadows, "shadowmap");
     }),
     ("baked-ssr", "as baked with screen-space reflections (--reflections ssr)", |t| {
-        t.shadows = Shadows::ShadowMap;
+        set(t, Effect::Shadows, "shadowmap");
         set(t, Effect::Reflections, "ssr");
     }),
     ("baked-taa", "as baked with temporal anti-aliasing (--aa taa)", |t| {
-        t.shadows = Shadows::ShadowMap;
+        set(t, Effect::Shadows, "shadowmap");
         set(t, Effect::Aa, "taa");
     }),
     ("rt", "ray-traced shadows, AO and full-resolution reflections (seed 001)", |t| {
@@ -277,11 +277,10 @@ fn set(t: &mut Techniques, effect: Effect, name: &str) {
 /// The techniques effect charts hold fixed: raster G-buffer, shadow maps where the file has
 /// them (else none), every other effect off, accumulation on.
 pub fn fixed(offers: &Offers) -> Techniques {
-    Techniques {
-        shadows: if offers.shadow_maps { Shadows::ShadowMap } else { Shadows::None },
-        aa: Aa::Accumulate,
-        ..Techniques::default()
-    }
+    let mut t = Techniques::default();
+    set(&mut t, Effect::Shadows, if offers.shadow_maps { "shadowmap" } else { "none" });
+    set(&mut t, Effect::Aa, "accumulate");
+    t
 }
 
 /// Every combination of a technique's quality knobs (scene knobs stay at their defaults).
@@ -350,7 +349,8 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                         continue;
                     }
                     for gbuffer in techniques_of(Effect::GBuffer) {
-                        let mut t = Techniques { aa: Aa::Accumulate, ..Techniques::default() };
+                        let mut t = Techniques::default();
+                        set(&mut t, Effect::Aa, "accumulate");
                         set(&mut t, Effect::GBuffer, gbuffer.name);
                         apply(&mut t);
                         if let Some(reason) = offers.lacks(&t) {
@@ -425,7 +425,7 @@ mod tests {
         let r = plan(&request(vec![Target::Effect(Effect::Reflections)], &["reflections:rt"]), &ALL_OFFERED);
         // resolution (2 options) × max roughness (2 sweep values)
         assert_eq!(r.configs.len(), 4);
-        assert!(r.configs.iter().all(|c| c.techniques.shadows == Shadows::ShadowMap));
+        assert!(r.configs.iter().all(|c| c.techniques.name_of(Effect::Shadows) == "shadowmap"));
         let ao = plan(&request(vec![Target::Effect(Effect::Ao)], &[]), &ALL_OFFERED);
         // none, rt at each reach (the absolute radius has one sweep value: not varied), sao's
         // samples × resolutions and gtao's slices × steps (their reach held at 0.05)
@@ -449,7 +449,7 @@ mod tests {
         assert!(
             p.configs
                 .iter()
-                .all(|c| !c.techniques.ray_traced() && c.techniques.shadows != Shadows::ShadowMap)
+                .all(|c| !c.techniques.ray_traced() && c.techniques.name_of(Effect::Shadows) != "shadowmap")
         );
         assert!(
             p.skipped.iter().any(|s| s.effect == "ao" && s.technique == "rt" && s.reason.contains("BVH"))

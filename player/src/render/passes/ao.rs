@@ -1,6 +1,6 @@
 //! The ambient-occlusion image the direct-light pass multiplies the sky's ambient by (when
 //! `FrameFlags::RT_AO` is set), made by whichever AO technique runs: the ray-traced pass
-//! ([`super::rt_ao`], a running mean) or a screen-space one ([`super::sao`], [`super::gtao`]),
+//! ([`super::rt_ao`], a running mean) or a screen-space one (`--ao sao`, `--ao gtao`),
 //! and the screen-space techniques' pass, [`ScreenAoPass`]: its estimator, then a bilateral blur with depth
 //! weights that also upsamples a half-resolution result (`shaders/ao/blur.comp`).
 
@@ -13,7 +13,7 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::technique::Ao;
+use crate::render::techniques::ao::Radius;
 
 /// Ambient openness in [0, 1] per screen pixel (1: nothing occludes).
 pub const AO: TargetDecl = TargetDecl {
@@ -60,14 +60,14 @@ fn bind_estimator(kernel: &mut Kernel, gpu: &Gpu, shared: &Shared) -> PlayResult
     )
 }
 
-/// A screen-space AO pass ([`super::sao`], [`super::gtao`]): its estimator kernel, then the
+/// A screen-space AO pass (`--ao sao`, `--ao gtao`): its estimator kernel, then the
 /// blur.
 #[derive(Debug)]
 pub struct ScreenAoPass {
     estimator: Kernel,
     blur: Kernel,
     constants: ScreenAoConstants,
-    technique: Ao,
+    radius: Radius,
 }
 
 impl ScreenAoPass {
@@ -77,7 +77,7 @@ impl ScreenAoPass {
         gpu: &Gpu,
         spirv: &[u8],
         constants: ScreenAoConstants,
-        technique: Ao,
+        radius: Radius,
     ) -> PlayResult<ScreenAoPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<ScreenAoConstants>() as u32;
@@ -97,7 +97,7 @@ impl ScreenAoPass {
             ],
             push,
         )?;
-        Ok(ScreenAoPass { estimator, blur, constants, technique })
+        Ok(ScreenAoPass { estimator, blur, constants, radius })
     }
 }
 
@@ -115,7 +115,7 @@ impl Pass for ScreenAoPass {
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
-        self.constants.radius = self.technique.world_radius(shared.scene.diagonal()).max(1e-6);
+        self.constants.radius = self.radius.world(shared.scene.diagonal()).max(1e-6);
         bind_estimator(&mut self.estimator, gpu, shared)?;
         let img = |t: &TargetDecl| shared.images.get(t).view;
         self.blur.write(

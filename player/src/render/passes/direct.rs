@@ -13,7 +13,7 @@ use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::{MAX_SHADOW_MAPS, Techniques, spirv, technique_flags};
+use crate::render::{MAX_SHADOW_MAPS, Techniques, spirv};
 use kiln_format::gpu::FrameFlags;
 
 /// Linear scene radiance (what `-o x.exr` writes).
@@ -64,8 +64,7 @@ impl DirectPass {
     /// inputs they never provide is left out, which halved the driver's cold compile of this
     /// pass on the H100 (docs/benchmarks/codec-default).
     pub fn new(gpu: &Gpu, techniques: &Techniques, rect_lights: bool) -> PlayResult<DirectPass> {
-        let constants =
-            Self::constants(technique_flags(techniques), techniques.media.dims_surfaces(), rect_lights);
+        let constants = Self::constants(techniques.flags(), techniques.dims_surfaces(), rect_lights);
         Ok(DirectPass(Kernel::specialized(gpu, &Self::bindings(), spirv::DIRECT, 0, &constants)?))
     }
 
@@ -187,7 +186,7 @@ mod tests {
         assert_eq!(DirectPass::constants(0, false, false), [0; 8]);
         assert_eq!(DirectPass::constants(FrameFlags::SCREEN_GI, false, true), [0, 0, 0, 0, 1, 0, 0, 1]);
         assert_eq!(DirectPass::constants(FrameFlags::RT_GI, true, false), [0, 0, 0, 0, 1, 0, 1, 0]);
-        let defaults = technique_flags(&Techniques::default());
+        let defaults = Techniques::default().flags();
         assert_eq!(DirectPass::constants(defaults, false, false), [0; 8], "default flags {defaults:#x}");
     }
 }

@@ -15,7 +15,7 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::technique::ScreenFraction;
+use crate::render::techniques::ScreenFraction;
 
 /// The seed's density (Fig. 3.6): the march covers 1/1.4 of the way to the light.
 pub const DENSITY: f32 = 1.4;

@@ -11,7 +11,7 @@ pub mod ao;
 pub mod depth_pyramid;
 pub mod direct;
 pub mod gbuffer;
-pub mod gtao;
+
 pub mod hiz;
 pub mod hybrid;
 pub mod kernel;
@@ -26,7 +26,7 @@ pub mod rt_gi;
 pub mod rt_history;
 pub mod rt_reflections;
 pub mod rt_shadows;
-pub mod sao;
+
 pub mod sousa;
 pub mod ssgi;
 pub mod ssr;

@@ -19,9 +19,10 @@ use super::kernel::Kernel;
 use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
+use crate::render::Techniques;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::technique::{Ao, Reflections, Techniques};
+use crate::render::techniques::{ao as ao_techniques, reflections};
 
 const SAMPLED_STORAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
     vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::SAMPLED.as_raw(),
@@ -127,7 +128,7 @@ impl RtHistoryPass {
                 layers: rt_shadows::layers(lights),
             });
         }
-        if let Ao::Rt { .. } = techniques.ao {
+        if let crate::render::Ao::Rt(ao_techniques::rt::Rt { .. }) = techniques.ao {
             let t = ao::AO;
             targets.push(Accumulated {
                 target: t,
@@ -137,7 +138,8 @@ impl RtHistoryPass {
                 layers: 1,
             });
         }
-        if let Reflections::Rt { resolution, .. } = techniques.reflections {
+        if let crate::render::Reflections::Rt(reflections::rt::Rt { resolution, .. }) = techniques.reflections
+        {
             let t = rt_reflections::REFLECTIONS;
             targets.push(Accumulated {
                 target: t,

@@ -11,7 +11,7 @@ use crate::error::PlayResult;
 use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
 use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::technique::ReflectionRes;
+use crate::render::techniques::reflections::rt::ReflectionRes;
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
 
 const fn rgba32(name: &'static str, array: bool) -> TargetDecl {

@@ -9,10 +9,9 @@ use super::hybrid::{self, HybridKernel};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Gpu, ImageDesc, Use};
+use crate::render::MAX_RT_SHADOW_LIGHTS;
 use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::technique::{LsShadowTest, Shadows};
-use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
 
 /// Shadow visibility, one layer per light.
 pub const SHADOWS: TargetDecl = TargetDecl {
@@ -35,22 +34,20 @@ pub struct RtShadowsPass {
 }
 
 impl RtShadowsPass {
-    /// Builds the pipeline of `technique` (its rays through the BVH or the line space) for a
-    /// scene of `lights` lights, decoding the texel buffer as `decode` says.
+    /// Builds the pipeline of the shader `code` (its rays through the BVH, or through the line
+    /// space when `line_space`) for a scene of `lights` lights, decoding the texel buffer as
+    /// `decode` says.
     pub fn new(
         gpu: &Gpu,
-        technique: Shadows,
+        code: &[u8],
+        line_space: bool,
         lights: usize,
         decode: TexelDecode,
     ) -> PlayResult<RtShadowsPass> {
-        let kernel = match technique {
-            Shadows::LineSpace { test: LsShadowTest::Ends, .. } => {
-                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE, decode)?
-            }
-            Shadows::LineSpace { test: LsShadowTest::Filled, .. } => {
-                HybridKernel::with_line_space(gpu, spirv::RT_SHADOWS_LINESPACE_EXACT, decode)?
-            }
-            _ => HybridKernel::new(gpu, spirv::RT_SHADOWS, decode)?,
+        let kernel = if line_space {
+            HybridKernel::with_line_space(gpu, code, decode)?
+        } else {
+            HybridKernel::new(gpu, code, decode)?
         };
         Ok(RtShadowsPass { kernel, layers: layers(lights) })
     }

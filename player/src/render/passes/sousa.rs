@@ -16,7 +16,7 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::technique::ScreenFraction;
+use crate::render::techniques::ScreenFraction;
 
 const fn small_target(name: &'static str) -> TargetDecl {
     TargetDecl {

@@ -24,7 +24,7 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::technique::Gi;
+use crate::render::techniques::gi::ssgi::Ssgi;
 
 /// Each level's gathered irradiance (plus everything coarser), in the pyramids' layout.
 pub const GI_LEVELS: TargetDecl = TargetDecl {
@@ -66,11 +66,9 @@ pub struct SsgiPass {
 }
 
 impl SsgiPass {
-    /// Builds the pipelines of `technique` (a [`Gi::Ssgi`]).
-    pub fn new(gpu: &Gpu, technique: Gi) -> PlayResult<SsgiPass> {
-        let Gi::Ssgi { samples, resolution, radius, falloff, frames, tiled, .. } = technique else {
-            unreachable!("the frame builds the SSGI pass for --gi ssgi only")
-        };
+    /// Builds the pipelines of `technique`.
+    pub fn new(gpu: &Gpu, technique: &Ssgi) -> PlayResult<SsgiPass> {
+        let Ssgi { samples, resolution, radius, falloff, frames, tiled, .. } = *technique;
         use BindingKind::*;
         let push = std::mem::size_of::<ScreenGiConstants>() as u32;
         let bindings = [

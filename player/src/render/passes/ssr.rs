@@ -24,7 +24,6 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::technique::Reflections;
 
 /// How far a ray may pass behind the surface the depth buffer holds and still count as meeting
 /// it, as a fraction of that surface's camera depth. The march finds a hit where the ray reaches a
@@ -46,11 +45,9 @@ pub struct SsrPass {
 }
 
 impl SsrPass {
-    /// Builds the pipeline for `technique` (a [`Reflections::Ssr`]).
-    pub fn new(gpu: &Gpu, technique: Reflections) -> PlayResult<SsrPass> {
-        let Reflections::Ssr { steps, max_roughness } = technique else {
-            unreachable!("the frame builds the SSR pass for --reflections ssr only")
-        };
+    /// Builds the pipeline: at most `steps` iterations of the march per pixel, surfaces rougher
+    /// than `max_roughness` left to the split-sum ambient.
+    pub fn new(gpu: &Gpu, steps: u32, max_roughness: f32) -> PlayResult<SsrPass> {
         use BindingKind::*;
         let bindings = [
             Binding::one(Uniform),

@@ -15,7 +15,7 @@ use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::technique::Phase;
+use crate::render::techniques::media::toth::Phase;
 use crate::render::{MAX_SHADOW_MAPS, spirv};
 
 /// The light scattered towards the camera per pixel, before the blur.

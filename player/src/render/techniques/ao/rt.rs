@@ -1,0 +1,49 @@
+//! `--ao rt`: one cosine-weighted ray per pixel per frame through the BVH; a hit at t weighs
+//! (t/R)² (`passes/rt_ao.rs`, `shaders/rt/ao.comp`).
+
+use kiln_format::gpu::FrameFlags;
+
+use super::{AO_RADIUS, Radius, ao_reach};
+use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_ao::RtAoPass;
+use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+
+/// Ray-traced ambient occlusion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rt {
+    /// The ray length R.
+    pub radius: Radius,
+}
+
+impl Registered for Rt {
+    const NAME: &'static str = "rt";
+    const HELP: &'static str =
+        "ray-traced: one cosine-weighted ray per pixel per frame within --ao-radius (or --ao-reach)";
+    const KNOBS: &'static [Knob] = &[AO_RADIUS, ao_reach(0.1, &[0.03, 0.1, 0.3, 100.0])];
+    const STOCHASTIC: bool = true;
+
+    fn new(k: &Knobs) -> Result<Rt, String> {
+        Ok(Rt { radius: Radius::of(k) })
+    }
+}
+
+impl Technique for Rt {
+    fn ray_traced(&self) -> bool {
+        true
+    }
+
+    fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
+        let (gpu, decode) = (frame.gpu, frame.decode);
+        frame.add(Stage::Ao, move || RtAoPass::new(gpu, decode));
+    }
+
+    fn flags(&self) -> u32 {
+        // The direct pass multiplies the sky's ambient by the AO image, whichever technique
+        // makes it (the flag's name predates the screen-space ones).
+        FrameFlags::RT_AO
+    }
+
+    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
+        inputs.rt.ao_radius = self.radius.world(scene.diagonal).max(1e-6);
+    }
+}

@@ -1,0 +1,35 @@
+//! `--gbuffer visibility`: a visibility buffer (the triangle under each pixel) rasterised, the
+//! materials evaluated in compute: far cheaper where raster throughput is small next to compute
+//! (datacenter GPUs).
+
+use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::resolve::ResolvePass;
+use crate::render::passes::visibility::VisibilityPass;
+use crate::render::techniques::{Knobs, Needs, Registered, Technique};
+
+/// A visibility buffer rasterised, the materials resolved in compute.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Visibility;
+
+impl Registered for Visibility {
+    const NAME: &'static str = "visibility";
+    const HELP: &'static str = "rasterise a visibility buffer (triangle per pixel), evaluate materials in compute: \
+                                faster on GPUs with little raster hardware (e.g. NVIDIA H100/H200)";
+
+    fn new(_: &Knobs) -> Result<Visibility, String> {
+        Ok(Visibility)
+    }
+}
+
+impl Technique for Visibility {
+    fn needs(&self) -> Needs {
+        // The resolve reads the materials, triangles and texels as storage buffers.
+        Needs { scene_buffers: true, ..Needs::NONE }
+    }
+
+    fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
+        let (gpu, decode) = (frame.gpu, frame.decode);
+        frame.add(Stage::GBuffer, move || VisibilityPass::new(gpu));
+        frame.add(Stage::GBuffer, move || ResolvePass::new(gpu, decode));
+    }
+}

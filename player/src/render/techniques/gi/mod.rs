@@ -1,0 +1,34 @@
+//! Indirect diffuse light: what replaces the sky's diffuse ambient.
+
+use super::knobs::{Knob, count};
+use super::techniques;
+
+techniques! {
+    /// Indirect diffuse light.
+    Gi for Gi, default none::Off;
+    none => Off,
+    rt => Rt,
+    linespace => LineSpace,
+    ssgi => Ssgi,
+}
+
+/// Bounces of the path-traced GI techniques.
+pub const GI_BOUNCES: Knob = count(
+    "gi-bounces",
+    "bounces of indirect light after the visible surface (1: the sky, emissive surfaces and \
+     the light the first surface hit receives directly; each more adds one bounce)",
+    1.0,
+    8.0,
+    1.0,
+    &[1.0, 2.0],
+);
+
+impl Gi {
+    /// The bounce count of a path-traced technique.
+    pub fn bounces(&self) -> Option<u32> {
+        match *self {
+            Gi::Rt(rt::Rt { bounces }) | Gi::LineSpace(linespace::LineSpace { bounces, .. }) => Some(bounces),
+            Gi::Off(_) | Gi::Ssgi(_) => None,
+        }
+    }
+}

@@ -1,0 +1,51 @@
+//! `--gi rt`: path traced from the G-buffer through the CWBVH: one cosine-weighted path per
+//! pixel per frame, next-event estimation at its hits (`passes/rt_gi.rs`, `shaders/rt/gi.glsl`).
+
+use kiln_format::gpu::FrameFlags;
+
+use super::GI_BOUNCES;
+use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_gi::RtGiPass;
+use crate::render::spirv;
+use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+
+/// Path-traced diffuse GI through the BVH.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Rt {
+    /// Scattering events after the primary surface whose light counts (1: the sky, and what
+    /// the first surface hit emits and receives directly), 1..=8.
+    pub bounces: u32,
+}
+
+impl Registered for Rt {
+    const NAME: &'static str = "rt";
+    const HELP: &'static str = "path-traced diffuse GI from the G-buffer through the BVH: one cosine-weighted path per \
+                                pixel per frame, next-event estimation to lights and emissive surfaces at its hits, \
+                                averaged while the camera is still; replaces the sky's diffuse ambient and its AO \
+                                (see --gi-bounces)";
+    const KNOBS: &'static [Knob] = &[GI_BOUNCES];
+    const STOCHASTIC: bool = true;
+
+    fn new(k: &Knobs) -> Result<Rt, String> {
+        Ok(Rt { bounces: k.whole("gi-bounces")? })
+    }
+}
+
+impl Technique for Rt {
+    fn ray_traced(&self) -> bool {
+        true
+    }
+
+    fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
+        let (gpu, decode) = (frame.gpu, frame.decode);
+        frame.add(Stage::Gi, move || RtGiPass::new(gpu, spirv::RT_GI, decode));
+    }
+
+    fn flags(&self) -> u32 {
+        FrameFlags::RT_GI
+    }
+
+    fn rays(&self, _: &RayScene, inputs: &mut RayInputs) {
+        inputs.rt.gi_bounces = self.bounces;
+    }
+}

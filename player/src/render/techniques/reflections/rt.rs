@@ -1,0 +1,81 @@
+//! `--reflections rt`: one GGX visible-normal sample per pixel (or per 2 × 2) per frame through
+//! the BVH, shaded at the hit (`passes/rt_reflections.rs`, `shaders/rt/reflections.comp`).
+
+use kiln_format::gpu::FrameFlags;
+
+use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_reflections::{self, RtReflectionsPass};
+use crate::render::techniques::knobs::{UNBOUNDED, choice, number};
+use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+
+/// Ray-traced glossy reflections.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rt {
+    /// Full or half resolution.
+    pub resolution: ReflectionRes,
+    /// Surfaces rougher than this keep the split-sum ambient.
+    pub max_roughness: f32,
+}
+
+/// Resolution of the ray-traced reflections.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReflectionRes {
+    /// One ray per pixel.
+    Full,
+    /// One ray per 2 × 2 pixels, upsampled with normal- and plane-aware weights.
+    Half,
+}
+
+impl Registered for Rt {
+    const NAME: &'static str = "rt";
+    const HELP: &'static str = "ray-traced glossy reflections (GGX visible-normal samples, one per pixel per frame \
+                                at --reflection-res)";
+    const KNOBS: &'static [Knob] = &[
+        choice(
+            "reflection-res",
+            "full: one ray per pixel; half: one per 2 × 2 pixels, upsampled with edge-aware weights",
+            &["full", "half"],
+            0,
+        ),
+        number(
+            "reflection-max-roughness",
+            "surfaces rougher than this keep the split-sum ambient",
+            0.0,
+            UNBOUNDED,
+            1.0,
+            &[0.4, 1.0],
+        ),
+    ];
+    const STOCHASTIC: bool = true;
+
+    fn new(k: &Knobs) -> Result<Rt, String> {
+        Ok(Rt {
+            resolution: if k.choice("reflection-res") == "half" { ReflectionRes::Half } else { ReflectionRes::Full },
+            max_roughness: k.number("reflection-max-roughness"),
+        })
+    }
+}
+
+impl Technique for Rt {
+    fn ray_traced(&self) -> bool {
+        true
+    }
+
+    fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
+        let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
+        frame.add(Stage::Reflections, move || RtReflectionsPass::new(gpu, self.resolution, lights, decode));
+    }
+
+    fn flags(&self) -> u32 {
+        match self.resolution {
+            ReflectionRes::Full => FrameFlags::RT_REFLECTIONS,
+            ReflectionRes::Half => FrameFlags::RT_REFLECTIONS | FrameFlags::REFLECTIONS_HALF,
+        }
+    }
+
+    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
+        inputs.rt.reflection_step = rt_reflections::step(self.resolution);
+        inputs.rt.reflection_lights = rt_reflections::lights(scene.lights_used);
+        inputs.rt.max_roughness = self.max_roughness;
+    }
+}
