@@ -2,7 +2,7 @@
 //! under the content hash of what the stage reads, so that a compile whose inputs changed only in
 //! part re-bakes only the stages that read the changed part.
 //!
-//! The layout is a plain content-addressed directory (README, "Stage cache"):
+//! The layout is a plain content-addressed directory (docs/compiler.md, "Stage cache"):
 //!
 //! ```text
 //! DIR/CACHEDIR.TAG           marks the directory as a cache for backup tools
@@ -124,7 +124,7 @@ impl Cache {
         if !tag.exists() {
             let _ = std::fs::write(
                 &tag,
-                "Signature: 8a477f597d28d172789f06886806bc55\n# This is a kiln stage cache (kiln compile --cache); see kiln's README, \"Stage cache\".\n",
+                "Signature: 8a477f597d28d172789f06886806bc55\n# This is a kiln stage cache (kiln compile --cache); see kiln's docs/compiler.md, \"Stage cache\".\n",
             );
         }
         Ok(Cache { dir: dir.to_path_buf() })

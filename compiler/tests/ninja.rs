@@ -1,4 +1,4 @@
-//! `kiln compile` as a build action under ninja (the README's "Build systems" rule, run as
+//! `kiln compile` as a build action under ninja (docs/compiler.md's "Build systems" rule, run as
 //! written): the depfile names every input the compile read (OBJ, MTL, texture, sidecar), so
 //! ninja rebuilds when any of them changes and only then, and a clean rebuild gives the same
 //! bytes. Needs `ninja` (Debian `ninja-build`); without it the test says so and passes, unless
@@ -49,7 +49,7 @@ fn ninja_rebuilds_exactly_when_an_input_the_depfile_names_changes() {
     std::fs::write(d.join("paint.png"), png([200, 40, 40])).unwrap();
     std::fs::write(d.join("scene.toml"), "[sky]\nradiance = [0.5, 0.5, 0.5]\n").unwrap();
     std::fs::write(d.join("unrelated.txt"), "not an input").unwrap();
-    // The rule of the README's "Build systems" section.
+    // The rule of docs/compiler.md's "Build systems" section.
     let rule = format!(
         "rule kiln\n  command = {} compile $in --config scene.toml -o $out --depfile $out.d -q --shaft-variants none\n  depfile = $out.d\n  deps = gcc\n  description = kiln $in\n\nbuild scene.kiln: kiln scene.obj\n",
         env!("CARGO_BIN_EXE_kiln")

@@ -157,7 +157,7 @@ fn section_bytes(dir: &std::path::Path, file: &std::path::Path, kinds: &[&str]) 
 #[test]
 fn pica_pica() {
     // The defaults: binary and PNMT within the default budget, twice the geometry's bytes, at
-    // least 8 MiB (README, "Voxel grid and line space"); summed here from the written sections.
+    // least 8 MiB (docs/linespace.md, "Voxel grid and line space"); summed from the written sections.
     let Some((dir, file)) = check_scene("pica_pica", 76_274, 6, &[]) else { return };
     let geometry = section_bytes(dir.path(), &file, &["VERT", "UVS0", "COL0", "TRIS", "TMAT"]);
     let budget = (2 * geometry).div_ceil(1 << 20).clamp(8, 384) << 20;

@@ -190,10 +190,10 @@ impl Plan {
         // binary variant's any-hit query ran 1.34x the BVH's any hit (5.0 vs 3.7 Mrays/s, one
         // thread, `cargo bench --bench queries`), and its line space is small (under 8 MiB at
         // auto resolution), so no triangle minimum would save anything worth a missing variant.
-        // On the GPU (README, "The line space on the GPU") the queries are no faster than the
-        // player's CWBVH where their answer is usable; the technique that pays there is GI from
-        // pre-illuminated records, which needs `--shaft-variants …,preillum` (its bake shades
-        // every record: 90 s for the bunny-count box on 16 cores, too slow for a default).
+        // On the GPU (docs/linespace.md, "The line space on the GPU") the queries are no faster
+        // than the player's CWBVH where their answer is usable; the technique that pays there is
+        // GI from pre-illuminated records, which needs `--shaft-variants …,preillum` (its bake
+        // shades every record: 90 s for the bunny-count box on 16 cores, too slow for a default).
         let lit = !scene.lights.is_empty()
             || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
             || scene.sky.radiance.iter().any(|&r| r > 0.0);

@@ -12,7 +12,7 @@
 //! model after model, are the file's triangles in file order. Where the totals disagree, normals
 //! are flat and a warning says so.
 //!
-//! MTL → PBR rule (documented in the README):
+//! MTL → PBR rule (documented in docs/compiler.md, "OBJ/MTL"):
 //! - `d` (or `1 - Tr`) is the alpha. Roughness is `Pr`, or from the Phong exponent `Ns` as
 //!   `(2 / (Ns + 2))^(1/4)` (Walter et al.'s Beckmann–Phong correspondence α = √(2/(Ns+2)), with
 //!   perceptual roughness √α); without either 1, or 0 for a mirror (`illum` 3 or 5).
@@ -236,7 +236,7 @@ fn max3(c: [f32; 3]) -> f32 {
     c[0].max(c[1]).max(c[2])
 }
 
-/// The MTL → PBR rule (module documentation and README). Warnings where the mapping drops
+/// The MTL → PBR rule (module documentation and docs/compiler.md). Warnings where the mapping drops
 /// information go to `warnings`.
 fn convert_material(
     m: &tobj::Material,

@@ -62,7 +62,7 @@ pub struct DirectPass(Kernel);
 impl DirectPass {
     /// Builds the pipeline, specialised for `techniques` (and rect lights or none): the code for
     /// inputs they never provide is left out, which halved the driver's cold compile of this
-    /// pass on the H100 (docs/benchmarks/codec-default).
+    /// pass on the H100 (docs/benchmarks/codec/auto-default).
     pub fn new(gpu: &Gpu, techniques: &Techniques, rect_lights: bool) -> PlayResult<DirectPass> {
         let constants = Self::constants(techniques.flags(), techniques.dims_surfaces(), rect_lights);
         Ok(DirectPass(Kernel::specialized(gpu, &Self::bindings(), spirv::DIRECT, 0, &constants)?))
