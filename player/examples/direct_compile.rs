@@ -34,7 +34,7 @@ fn main() {
     });
     for path in &paths {
         let code = if path == "-" {
-            spirv::DIRECT.to_vec()
+            std::fs::read(spirv::shader_dir().join("lighting/direct.comp.spv")).expect("the committed SPIR-V")
         } else {
             std::fs::read(path).unwrap_or_else(|e| {
                 eprintln!("{path}: {e}");

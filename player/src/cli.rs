@@ -544,8 +544,9 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 mod tests {
     use super::*;
     use crate::render::techniques::ao::{self, Radius};
+    use crate::render::techniques::reflections::rt::ReflectionRes;
     use crate::render::techniques::{aa, gi, reflections, shadows};
-    use crate::render::{Aa, Ao, GBuffer, Gi, ReflectionRes, Reflections, ScreenFraction, Shadows};
+    use crate::render::{Aa, Ao, GBuffer, Gi, Reflections, ScreenFraction, Shadows};
 
     fn parse(args: &[&str]) -> Result<Args, clap::Error> {
         match parse_from(std::iter::once("kiln-play").chain(args.iter().copied()))? {

@@ -82,9 +82,9 @@ impl RtPipelinePeer {
     ) -> PlayResult<(AccelerationStructures, RayTracingPipeline, f64)> {
         let mut structures = AccelerationStructures::new(gpu, corners)?;
         let shaders = RayTracingShaders {
-            raygen: spirv::PEER_RGEN,
-            miss: spirv::PEER_RMISS,
-            closest_hit: spirv::PEER_RCHIT,
+            raygen: spirv::shader!("peer/trace.rgen"),
+            miss: spirv::shader!("peer/trace.rmiss"),
+            closest_hit: spirv::shader!("peer/trace.rchit"),
         };
         let push_bytes = std::mem::size_of::<Push>() as u32;
         let made = Self::build(gpu, &structures, pool, timestamps)

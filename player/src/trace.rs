@@ -105,7 +105,10 @@ impl RayQuery {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<RayQuery> {
         let storage = Binding::one(BindingKind::Storage);
-        Ok(RayQuery { kernel: TraceKernel::new(gpu, &[storage; 4], spirv::TRACE_RAYS)?, warmup: 0 })
+        Ok(RayQuery {
+            kernel: TraceKernel::new(gpu, &[storage; 4], spirv::shader!("trace/rays.comp"))?,
+            warmup: 0,
+        })
     }
 
     /// Traces `rays` through `bvh`; returns one hit per ray and the GPU milliseconds of the

@@ -71,7 +71,10 @@ impl LineSpaceQuery {
     pub fn new(gpu: &Gpu) -> PlayResult<LineSpaceQuery> {
         let mut bindings = vec![Binding::one(BindingKind::Storage); 5];
         bindings.extend(LineSpaceBuffers::bindings());
-        Ok(LineSpaceQuery { kernel: TraceKernel::new(gpu, &bindings, spirv::TRACE_LINESPACE)?, warmup: 0 })
+        Ok(LineSpaceQuery {
+            kernel: TraceKernel::new(gpu, &bindings, spirv::shader!("trace/linespace.comp"))?,
+            warmup: 0,
+        })
     }
 
     /// Traces `rays` with `query`; `normals` (one per ray, or empty for none) are the geometric

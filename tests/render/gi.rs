@@ -11,8 +11,8 @@ use kiln_compiler::settings::{Settings, VoxelRes};
 use kiln_format::linespace::Variants;
 use kiln_format::manifest::{LightKind, Sky};
 use kiln_player::reference::{Sampling, render_with};
-use kiln_player::render::GiStructure;
 use kiln_player::render::Readable;
+use kiln_player::render::techniques::gi::linespace::GiStructure;
 use kiln_player::session::Session;
 use kiln_tests::{Options, compile, scene_of, vulkan};
 

@@ -7,7 +7,8 @@ use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{Bounds, LightKind, Medium, Sky};
 use kiln_player::render::techniques;
-use kiln_player::render::{Media, Phase, ScreenFraction};
+use kiln_player::render::techniques::media::toth::Phase;
+use kiln_player::render::{Media, ScreenFraction};
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
 use crate::harness::{Pinhole, fast_settings, light, render};

@@ -7,8 +7,9 @@ use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{Bounds, LightKind, Medium, OrthographicCamera, Sky};
 use kiln_player::reference::{DEFAULT_SEED, Sampling, render_with};
+use kiln_player::render::Media;
 use kiln_player::render::techniques;
-use kiln_player::render::{Media, Phase};
+use kiln_player::render::techniques::media::toth::Phase;
 use kiln_tests::{Options, compile, scene_of, vulkan};
 
 use crate::harness::{Pinhole, fast_settings, light, render, square};

@@ -9,10 +9,13 @@ use kiln_compiler::settings::Settings;
 use kiln_format::sections::Vertex;
 use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::gpu::GpuOptions;
+use kiln_player::render::techniques::gi::linespace::GiStructure;
+use kiln_player::render::techniques::reflections::rt::ReflectionRes;
+use kiln_player::render::techniques::shadows::linespace::LsShadowTest;
 use kiln_player::render::techniques::{ao as ao_techniques, gbuffer, gi, media, reflections, shadows};
 use kiln_player::render::{
-    Aa, Ao, Effect, GBuffer as GBufferTechnique, Gi, GiStructure, LsShadowTest, Media, Purpose,
-    ReflectionRes, Reflections as ReflectionsTechnique, Shadows,
+    Aa, Ao, Effect, GBuffer as GBufferTechnique, Gi, Media, Purpose, Reflections as ReflectionsTechnique,
+    Shadows,
 };
 use kiln_player::scene::TextureUpload;
 use kiln_player::session::{PipelineStart, SessionOptions};

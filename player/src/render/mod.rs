@@ -30,10 +30,6 @@ pub use dummies::Dummies;
 use frame::Frame;
 use graph::{Access, FrameImages};
 use passes::{FrameCtx, Shared};
-pub use techniques::gi::linespace::GiStructure;
-pub use techniques::media::toth::Phase;
-pub use techniques::reflections::rt::ReflectionRes;
-pub use techniques::shadows::linespace::LsShadowTest;
 pub use techniques::{
     Aa, Ao, Effect, GBuffer, Gi, Media, Needs, Reflections, ScreenFraction, Shadows, Techniques,
 };

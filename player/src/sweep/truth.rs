@@ -19,7 +19,7 @@ use xxhash_rust::xxh3::Xxh3;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::image_out::read_exr;
 use crate::reference::{DEFAULT_SEED, MAX_PATH, Sampling, read_spp, render_with, write_exr};
-use crate::render::spirv::PATHTRACE;
+use crate::render::spirv;
 use crate::session::SessionOptions;
 
 use super::results::{Figures, ReferenceInfo};
@@ -40,7 +40,7 @@ pub struct Reference {
 /// The cache key of a reference: hex of a 128-bit hash.
 pub fn key(content_hash: &str, camera: &str, width: u32, height: u32, spp: u32, bounces: u32) -> String {
     let mut h = Xxh3::new();
-    for part in [content_hash.as_bytes(), camera.as_bytes(), PATHTRACE] {
+    for part in [content_hash.as_bytes(), camera.as_bytes(), spirv::shader!("reference/pathtrace.comp")] {
         h.update(&(part.len() as u64).to_le_bytes());
         h.update(part);
     }

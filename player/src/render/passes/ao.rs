@@ -13,7 +13,23 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::techniques::ao::Radius;
+
+/// An AO technique's radius (the ray length, the screen-space samples' world radius): in scene units, or as a fraction of the scene's diagonal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Radius {
+    /// In scene units; `None`: `reach` times the scene's bounding-box diagonal.
+    pub radius: Option<f32>,
+    /// As a fraction of the scene's bounding-box diagonal (when `radius` is `None`); for rays,
+    /// values ≥ 10 make every hit occlude fully: the sky's visibility.
+    pub reach: f32,
+}
+
+impl Radius {
+    /// In scene units, for a scene of bounding-box diagonal `diagonal`.
+    pub fn world(&self, diagonal: f32) -> f32 {
+        self.radius.unwrap_or(self.reach * diagonal)
+    }
+}
 
 /// Ambient openness in [0, 1] per screen pixel (1: nothing occludes).
 pub const AO: TargetDecl = TargetDecl {
@@ -92,7 +108,7 @@ impl ScreenAoPass {
                         Binding::one(StorageImage),
                         Binding::one(StorageImage),
                     ],
-                    spirv::AO_BLUR,
+                    spirv::shader!("ao/blur.comp"),
                 ),
             ],
             push,

@@ -120,15 +120,15 @@ impl DepthPyramidPass {
                         Binding::one(Sampled),
                         Binding::one(StorageImage),
                     ],
-                    spirv::PYRAMID_LINEAR,
+                    spirv::shader!("pyramid/linear.comp"),
                 ),
                 (
                     &[Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)],
-                    spirv::PYRAMID_REDUCE,
+                    spirv::shader!("pyramid/reduce.comp"),
                 ),
                 (
                     &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)],
-                    spirv::PYRAMID_SINGLE,
+                    spirv::shader!("pyramid/single.comp"),
                 ),
             ],
             push,

@@ -65,7 +65,13 @@ impl DirectPass {
     /// pass on the H100 (docs/benchmarks/codec/auto-default).
     pub fn new(gpu: &Gpu, techniques: &Techniques, rect_lights: bool) -> PlayResult<DirectPass> {
         let constants = Self::constants(techniques.flags(), techniques.dims_surfaces(), rect_lights);
-        Ok(DirectPass(Kernel::specialized(gpu, &Self::bindings(), spirv::DIRECT, 0, &constants)?))
+        Ok(DirectPass(Kernel::specialized(
+            gpu,
+            &Self::bindings(),
+            spirv::shader!("lighting/direct.comp"),
+            0,
+            &constants,
+        )?))
     }
 
     /// Specialization constants by id (`direct.comp`): 0 is unused (the texel decoders' id), then

@@ -63,7 +63,14 @@ impl GBufferPass {
     pub fn new(gpu: &Gpu) -> PlayResult<GBufferPass> {
         let mut draws = SceneDraws::new(gpu)?;
         let formats = COLORS.map(|c| c.format);
-        match draws.pipeline(gpu, spirv::GBUFFER_VERT, spirv::GBUFFER_FRAG, &formats, DEPTH.format, false) {
+        match draws.pipeline(
+            gpu,
+            spirv::shader!("gbuffer/gbuffer.vert"),
+            spirv::shader!("gbuffer/gbuffer.frag"),
+            &formats,
+            DEPTH.format,
+            false,
+        ) {
             Ok(pipeline) => Ok(GBufferPass { draws, pipeline }),
             Err(e) => {
                 draws.destroy(gpu);

@@ -65,9 +65,9 @@ impl HizPass {
             [
                 (
                     &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)],
-                    spirv::HIZ_COPY,
+                    spirv::shader!("hiz/copy.comp"),
                 ),
-                (&[Binding::one(Uniform), Binding::one(StorageImage)], spirv::HIZ_REDUCE),
+                (&[Binding::one(Uniform), Binding::one(StorageImage)], spirv::shader!("hiz/reduce.comp")),
             ],
             push,
         )?;

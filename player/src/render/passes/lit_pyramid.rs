@@ -52,9 +52,9 @@ impl LitPyramidPass {
                         Binding::one(StorageImage),
                         Binding::one(StorageImage),
                     ],
-                    spirv::LIT_REPROJECT,
+                    spirv::shader!("lit/reproject.comp"),
                 ),
-                (&[Binding::one(Uniform), Binding::one(StorageImage)], spirv::LIT_REDUCE),
+                (&[Binding::one(Uniform), Binding::one(StorageImage)], spirv::shader!("lit/reduce.comp")),
             ],
             push,
         )?;

@@ -39,8 +39,12 @@ impl MediaMarchPass {
             Binding::one(Sampled),
             Binding::one(StorageImage),
         ];
-        let kernel =
-            Kernel::new(gpu, &bindings, spirv::MEDIA_MARCH, std::mem::size_of::<MarchConstants>() as u32)?;
+        let kernel = Kernel::new(
+            gpu,
+            &bindings,
+            spirv::shader!("media/march.comp"),
+            std::mem::size_of::<MarchConstants>() as u32,
+        )?;
         let constants = MarchConstants { steps, ..Default::default() };
         Ok(MediaMarchPass { kernel, constants, active: false })
     }

@@ -67,7 +67,7 @@ impl MitchellPass {
                         Binding::one(Sampled),
                         Binding::one(StorageImage),
                     ],
-                    spirv::MITCHELL_OCCLUSION,
+                    spirv::shader!("mitchell/occlusion.comp"),
                 ),
                 (
                     &[
@@ -77,7 +77,7 @@ impl MitchellPass {
                         Binding::one(Sampled),
                         Binding::one(StorageImage),
                     ],
-                    spirv::MITCHELL_BLUR,
+                    spirv::shader!("mitchell/blur.comp"),
                 ),
             ],
             push,

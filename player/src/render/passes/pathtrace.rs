@@ -39,7 +39,7 @@ impl PathTracePass {
         Ok(PathTracePass(Kernel::reading_texels(
             gpu,
             &bindings,
-            spirv::PATHTRACE,
+            spirv::shader!("reference/pathtrace.comp"),
             std::mem::size_of::<u32>() as u32,
             decode,
         )?))

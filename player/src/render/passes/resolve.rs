@@ -27,7 +27,13 @@ impl ResolvePass {
         bindings.extend([Binding::one(Storage); 7]);
         bindings.extend([Binding::one(StorageImage); 5]);
         bindings.push(Binding::one(Sampled));
-        Ok(ResolvePass(Kernel::reading_texels(gpu, &bindings, spirv::RESOLVE, 0, decode)?))
+        Ok(ResolvePass(Kernel::reading_texels(
+            gpu,
+            &bindings,
+            spirv::shader!("gbuffer/resolve.comp"),
+            0,
+            decode,
+        )?))
     }
 }
 

@@ -18,7 +18,7 @@ pub struct RtAoPass(HybridKernel);
 impl RtAoPass {
     /// Builds the pipeline, decoding the texel buffer as `decode` says.
     pub fn new(gpu: &Gpu, decode: TexelDecode) -> PlayResult<RtAoPass> {
-        Ok(RtAoPass(HybridKernel::new(gpu, spirv::RT_AO, decode)?))
+        Ok(RtAoPass(HybridKernel::new(gpu, spirv::shader!("rt/ao.comp"), decode)?))
     }
 }
 

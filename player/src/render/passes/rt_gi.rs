@@ -5,7 +5,7 @@
 //!
 //! The estimator is independent of the ray structure: a kernel defines its hooks (closest hit,
 //! shadow rays) and includes it. [`RtGiPass::new`] takes that kernel's SPIR-V; `--gi rt` gives
-//! it [`crate::render::spirv::RT_GI`], whose hooks trace the CWBVH.
+//! it [`crate::render::spirv::shader!("rt/gi.comp")`], whose hooks trace the CWBVH.
 
 use crate::gpu::vk;
 
@@ -30,7 +30,7 @@ pub struct RtGiPass(HybridKernel);
 
 impl RtGiPass {
     /// Builds the pipeline of a GI kernel: `spirv` includes `shaders/rt/gi.glsl` with the hooks
-    /// of its ray structure (e.g. [`crate::render::spirv::RT_GI`]).
+    /// of its ray structure (e.g. [`crate::render::spirv::shader!("rt/gi.comp")`]).
     /// The texel buffer is decoded as `decode` says.
     pub fn new(gpu: &Gpu, spirv: &[u8], decode: TexelDecode) -> PlayResult<RtGiPass> {
         Ok(RtGiPass(HybridKernel::new(gpu, spirv, decode)?))

@@ -16,13 +16,11 @@
 
 use super::gbuffer::DEPTH;
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
-use crate::render::Techniques;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::techniques::{ao as ao_techniques, reflections};
 
 const SAMPLED_STORAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
     vk::ImageUsageFlags::STORAGE.as_raw() | vk::ImageUsageFlags::SAMPLED.as_raw(),
@@ -43,21 +41,40 @@ const DEPTHS: [TargetDecl; 2] =
 
 /// Which blend kernel a target takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
+pub enum Kind {
+    /// A layered one-channel target (a layer per light).
     Layers,
+    /// A one-channel target.
     One,
+    /// A four-channel target.
     Four,
 }
 
-/// One accumulated target and its two histories.
+/// One accumulated target and its two histories: what a ray-traced technique hands this pass
+/// (`Technique::accumulated`).
 #[derive(Debug, Clone, Copy)]
-struct Accumulated {
+pub struct Accumulated {
     target: TargetDecl,
     histories: [TargetDecl; 2],
     kind: Kind,
     /// Screen pixels per texel along each axis.
     step: u32,
     layers: u32,
+}
+
+impl Accumulated {
+    /// `target`, blended by the kernel of `kind`, with histories named `histories`, one texel
+    /// per `step` × `step` pixels, `layers` layers.
+    pub fn new(
+        target: TargetDecl,
+        histories: [&'static str; 2],
+        kind: Kind,
+        step: u32,
+        layers: u32,
+    ) -> Accumulated {
+        let history = |name| TargetDecl { name, usage: SAMPLED_STORAGE, ..target };
+        Accumulated { target, histories: histories.map(history), kind, step, layers }
+    }
 }
 
 /// Push constants of the blend kernels.
@@ -81,9 +98,9 @@ pub struct RtHistoryPass {
 }
 
 impl RtHistoryPass {
-    /// The pass for the ray-traced targets `techniques` make (shadows of `lights` lights),
-    /// histories capped at `cap` frames while the camera moves.
-    pub fn new(gpu: &Gpu, techniques: &Techniques, lights: usize, cap: u32) -> PlayResult<RtHistoryPass> {
+    /// The pass for the ray-traced `targets`, in the order given, histories capped at `cap`
+    /// frames while the camera moves.
+    pub fn new(gpu: &Gpu, targets: Vec<Accumulated>, cap: u32) -> PlayResult<RtHistoryPass> {
         use BindingKind::*;
         let blend: &[Binding] = &[
             Binding::one(Uniform),
@@ -104,61 +121,13 @@ impl RtHistoryPass {
         let [motion, layers, one, four] = Kernel::several(
             gpu,
             [
-                (motion_bindings, spirv::HISTORY_MOTION),
-                (blend, spirv::HISTORY_BLEND_LAYERS),
-                (blend, spirv::HISTORY_BLEND_R),
-                (blend, spirv::HISTORY_BLEND_RGBA),
+                (motion_bindings, spirv::shader!("history/motion.comp")),
+                (blend, spirv::shader!("history/blend_layers.comp")),
+                (blend, spirv::shader!("history/blend_r.comp")),
+                (blend, spirv::shader!("history/blend_rgba.comp")),
             ],
             push,
         )?;
-        let mut targets = Vec::new();
-        let history = |t: TargetDecl, a: &'static str, b: &'static str| {
-            [
-                TargetDecl { name: a, usage: SAMPLED_STORAGE, ..t },
-                TargetDecl { name: b, usage: SAMPLED_STORAGE, ..t },
-            ]
-        };
-        if techniques.shadows.traced().is_some() {
-            let t = rt_shadows::SHADOWS;
-            targets.push(Accumulated {
-                target: t,
-                histories: history(t, "rt shadows history a", "rt shadows history b"),
-                kind: Kind::Layers,
-                step: 1,
-                layers: rt_shadows::layers(lights),
-            });
-        }
-        if let crate::render::Ao::Rt(ao_techniques::rt::Rt { .. }) = techniques.ao {
-            let t = ao::AO;
-            targets.push(Accumulated {
-                target: t,
-                histories: history(t, "rt ao history a", "rt ao history b"),
-                kind: Kind::One,
-                step: 1,
-                layers: 1,
-            });
-        }
-        if let crate::render::Reflections::Rt(reflections::rt::Rt { resolution, .. }) = techniques.reflections
-        {
-            let t = rt_reflections::REFLECTIONS;
-            targets.push(Accumulated {
-                target: t,
-                histories: history(t, "rt reflections history a", "rt reflections history b"),
-                kind: Kind::Four,
-                step: rt_reflections::step(resolution),
-                layers: 1,
-            });
-        }
-        if techniques.gi.bounces().is_some() {
-            let t = rt_gi::GI;
-            targets.push(Accumulated {
-                target: t,
-                histories: history(t, "rt gi history a", "rt gi history b"),
-                kind: Kind::Four,
-                step: 1,
-                layers: 1,
-            });
-        }
         Ok(RtHistoryPass { motion, blends: [layers, one, four], targets, cap: cap.max(1) as f32, turn: 0 })
     }
 

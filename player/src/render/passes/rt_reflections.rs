@@ -11,7 +11,6 @@ use crate::error::PlayResult;
 use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
 use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::techniques::reflections::rt::ReflectionRes;
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
 
 const fn rgba32(name: &'static str, array: bool) -> TargetDecl {
@@ -29,14 +28,6 @@ pub const LIGHT_TERMS: TargetDecl = rgba32("reflection light terms", true);
 /// The pass's targets in binding order (`shaders/rt/hybrid.glsl`, bindings 18–21).
 pub const TARGETS: [TargetDecl; 4] = [REFLECTIONS, PARTIAL, ORIGINS, LIGHT_TERMS];
 
-/// Pixels per reflection sample along each axis.
-pub fn step(resolution: ReflectionRes) -> u32 {
-    match resolution {
-        ReflectionRes::Full => 1,
-        ReflectionRes::Half => 2,
-    }
-}
-
 /// Lights whose reflection-hit shadow rays are traced.
 pub fn lights(lights: usize) -> u32 {
     lights.min(MAX_RT_SHADOW_LIGHTS) as u32
@@ -53,30 +44,20 @@ pub struct RtReflectionsPass {
 }
 
 impl RtReflectionsPass {
-    /// Builds the pipelines for `resolution` and a scene of `lights` lights, decoding the
+    /// Builds the pipelines for one sample per `step` × `step` pixels and a scene of `lights`
+    /// lights, decoding the
     /// texel buffer as `decode` says.
-    pub fn new(
-        gpu: &Gpu,
-        resolution: ReflectionRes,
-        lights: usize,
-        decode: TexelDecode,
-    ) -> PlayResult<RtReflectionsPass> {
+    pub fn new(gpu: &Gpu, step: u32, lights: usize, decode: TexelDecode) -> PlayResult<RtReflectionsPass> {
         let mut set = HybridSet::new(gpu, false, decode)?;
-        let trace = match set.pipeline(gpu, spirv::RT_REFLECTIONS) {
+        let trace = match set.pipeline(gpu, spirv::shader!("rt/reflections.comp")) {
             Ok(p) => p,
             Err(e) => {
                 set.destroy(gpu);
                 return Err(e);
             }
         };
-        match set.pipeline(gpu, spirv::RT_REFLECTION_SHADOWS) {
-            Ok(shadows) => Ok(RtReflectionsPass {
-                set,
-                trace,
-                shadows,
-                step: step(resolution),
-                lights: self::lights(lights),
-            }),
+        match set.pipeline(gpu, spirv::shader!("rt/reflection_shadows.comp")) {
+            Ok(shadows) => Ok(RtReflectionsPass { set, trace, shadows, step, lights: self::lights(lights) }),
             Err(e) => {
                 let mut t = trace;
                 t.destroy(gpu);

@@ -64,9 +64,12 @@ fn kernels(gpu: &Gpu, push: u32) -> PlayResult<[Kernel; 3]> {
     Kernel::several(
         gpu,
         [
-            (&[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)], spirv::SOUSA_DEPTH),
-            (&blur_bindings, spirv::SOUSA_BLUR),
-            (&blur_bindings, spirv::SOUSA_COMPOSITE),
+            (
+                &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage)],
+                spirv::shader!("sousa/depth.comp"),
+            ),
+            (&blur_bindings, spirv::shader!("sousa/blur.comp")),
+            (&blur_bindings, spirv::shader!("sousa/composite.comp")),
         ],
         push,
     )

@@ -24,7 +24,7 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
-use crate::render::techniques::gi::ssgi::Ssgi;
+use crate::render::techniques::ScreenFraction;
 
 /// Each level's gathered irradiance (plus everything coarser), in the pyramids' layout.
 pub const GI_LEVELS: TargetDecl = TargetDecl {
@@ -66,9 +66,18 @@ pub struct SsgiPass {
 }
 
 impl SsgiPass {
-    /// Builds the pipelines of `technique`.
-    pub fn new(gpu: &Gpu, technique: &Ssgi) -> PlayResult<SsgiPass> {
-        let Ssgi { samples, resolution, radius, falloff, frames, tiled, .. } = *technique;
+    /// Builds the pipelines: `samples` spiral samples per pixel on each level of radius
+    /// `radius` pixels, the finest level at `resolution`, the seed's fall-off when `falloff`,
+    /// a running mean of at most `frames`, one spiral rotation per 8 × 8 texels when `tiled`.
+    pub fn new(
+        gpu: &Gpu,
+        samples: u32,
+        resolution: ScreenFraction,
+        radius: u32,
+        falloff: bool,
+        frames: u32,
+        tiled: bool,
+    ) -> PlayResult<SsgiPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<ScreenGiConstants>() as u32;
         let bindings = [
@@ -84,9 +93,9 @@ impl SsgiPass {
         let [pack, gather, resolve] = Kernel::several(
             gpu,
             [
-                (&bindings, spirv::SSGI_PACK),
-                (&bindings, spirv::SSGI_GATHER),
-                (&resolve_bindings, spirv::SSGI_RESOLVE),
+                (&bindings, spirv::shader!("ssgi/pack.comp")),
+                (&bindings, spirv::shader!("ssgi/gather.comp")),
+                (&resolve_bindings, spirv::shader!("ssgi/resolve.comp")),
             ],
             push,
         )?;

@@ -59,7 +59,7 @@ impl SsrPass {
             Binding::one(StorageImage),
         ];
         let push = std::mem::size_of::<SsrConstants>() as u32;
-        let kernel = Kernel::new(gpu, &bindings, spirv::SSR_TRACE, push)?;
+        let kernel = Kernel::new(gpu, &bindings, spirv::shader!("ssr/trace.comp"), push)?;
         let constants =
             SsrConstants { steps: steps.max(1), max_roughness, thickness: THICKNESS, top: TOP, level: 0 };
         Ok(SsrPass { kernel, constants })

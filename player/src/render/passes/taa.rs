@@ -65,7 +65,10 @@ impl TaaPass {
         let output_bindings = [Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)];
         let [kernel, output] = Kernel::several(
             gpu,
-            [(&bindings, spirv::TAA_RESOLVE), (&output_bindings, spirv::TAA_OUTPUT)],
+            [
+                (&bindings, spirv::shader!("taa/resolve.comp")),
+                (&output_bindings, spirv::shader!("taa/output.comp")),
+            ],
             std::mem::size_of::<Push>() as u32,
         )?;
         Ok(TaaPass { kernel, output, push, turn: 0 })

@@ -30,7 +30,7 @@ impl TonemapPass {
     pub fn new(gpu: &Gpu) -> PlayResult<TonemapPass> {
         use BindingKind::*;
         let bindings = [Binding::one(Uniform), Binding::one(StorageImage), Binding::one(StorageImage)];
-        Ok(TonemapPass(Kernel::new(gpu, &bindings, spirv::TONEMAP, 0)?))
+        Ok(TonemapPass(Kernel::new(gpu, &bindings, spirv::shader!("post/tonemap.comp"), 0)?))
     }
 }
 

@@ -6,7 +6,7 @@
 //! (`shaders/toth/blur.comp`). World space: it holds with the light off screen or behind the
 //! camera.
 
-use kiln_format::gpu::{Phases, TothConstants};
+use kiln_format::gpu::TothConstants;
 
 use super::direct::RADIANCE;
 use super::gbuffer::DEPTH;
@@ -15,7 +15,6 @@ use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
-use crate::render::techniques::media::toth::Phase;
 use crate::render::{MAX_SHADOW_MAPS, spirv};
 
 /// The light scattered towards the camera per pixel, before the blur.
@@ -40,8 +39,8 @@ pub struct TothPass {
 
 impl TothPass {
     /// Builds the pipelines: `samples` along each view ray, interleaved over `block` × `block`
-    /// pixels, with `phase`.
-    pub fn new(gpu: &Gpu, samples: u32, block: u32, phase: Phase) -> PlayResult<TothPass> {
+    /// pixels, with the phase function `phase` (`Phases`).
+    pub fn new(gpu: &Gpu, samples: u32, block: u32, phase: u32) -> PlayResult<TothPass> {
         use BindingKind::*;
         let push = std::mem::size_of::<TothConstants>() as u32;
         let maps = Binding { kind: Sampled, count: MAX_SHADOW_MAPS as u32 };
@@ -59,7 +58,7 @@ impl TothPass {
                         Binding::one(Sampled),
                         Binding::one(StorageImage),
                     ],
-                    spirv::TOTH_MARCH,
+                    spirv::shader!("toth/march.comp"),
                 ),
                 (
                     &[
@@ -69,20 +68,12 @@ impl TothPass {
                         Binding::one(Sampled),
                         Binding::one(StorageImage),
                     ],
-                    spirv::TOTH_BLUR,
+                    spirv::shader!("toth/blur.comp"),
                 ),
             ],
             push,
         )?;
-        let constants = TothConstants {
-            samples: samples.max(1),
-            block: block.max(1),
-            phase: match phase {
-                Phase::Medium => Phases::HENYEY_GREENSTEIN,
-                Phase::Rayleigh => Phases::RAYLEIGH,
-            },
-            media: 0,
-        };
+        let constants = TothConstants { samples: samples.max(1), block: block.max(1), phase, media: 0 };
         Ok(TothPass { march, blur, constants, active: false })
     }
 }

@@ -28,16 +28,16 @@ impl VisibilityPass {
         let mut draws = SceneDraws::new(gpu)?;
         let colors = [TRIANGLE.format];
         let build = |fragment: &[u8], cull: bool| {
-            draws.pipeline(gpu, spirv::GBUFFER_VERT, fragment, &colors, DEPTH.format, cull)
+            draws.pipeline(gpu, spirv::shader!("gbuffer/gbuffer.vert"), fragment, &colors, DEPTH.format, cull)
         };
-        let opaque = match build(spirv::VISIBILITY_OPAQUE_FRAG, true) {
+        let opaque = match build(spirv::shader!("gbuffer/visibility_opaque.frag"), true) {
             Ok(p) => p,
             Err(e) => {
                 draws.destroy(gpu);
                 return Err(e);
             }
         };
-        match build(spirv::VISIBILITY_FRAG, false) {
+        match build(spirv::shader!("gbuffer/visibility.frag"), false) {
             Ok(raster) => Ok(VisibilityPass { draws, opaque, raster }),
             Err(e) => {
                 let mut o = opaque;

@@ -35,6 +35,7 @@ pub use reflections::Reflections;
 pub use shadows::Shadows;
 
 use super::frame::FrameBuild;
+use super::passes::rt_history::Accumulated;
 
 /// What a technique does beyond its passes, each with the answer of a technique that does
 /// nothing. Implemented by every technique module; reached through its effect's enum
@@ -69,6 +70,12 @@ pub trait Technique: fmt::Debug + Send + Sync {
 
     /// Sets its part of the ray-traced passes' constants and the lights' sizes.
     fn rays(&self, _scene: &RayScene, _inputs: &mut RayInputs) {}
+
+    /// The target it makes that the reprojected accumulation carries across frames, for a
+    /// scene of `lights` lights (the ray-traced techniques' one sample per pixel per frame).
+    fn accumulated(&self, _lights: usize) -> Option<Accumulated> {
+        None
+    }
 
     /// Whether it dims the light reaching surfaces, and the surfaces seen, through the media.
     fn dims_surfaces(&self) -> bool {
@@ -376,7 +383,8 @@ impl Techniques {
         }
     }
 
-    fn each(&self) -> impl Iterator<Item = &dyn Technique> {
+    /// Every effect's technique, in frame order.
+    pub fn each(&self) -> impl Iterator<Item = &dyn Technique> {
         Effect::ALL.into_iter().map(|e| self.get(e))
     }
 

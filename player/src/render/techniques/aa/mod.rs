@@ -39,7 +39,9 @@ impl Aa {
 /// capped at `frames` while the camera moves.
 fn reproject_rays(frame: &mut FrameBuild<'_>, frames: u32) {
     if frame.techniques.ray_traced() {
-        let (gpu, techniques, lights) = (frame.gpu, frame.techniques, frame.lights.count);
-        frame.add(Stage::Accumulate, move || RtHistoryPass::new(gpu, techniques, lights, frames));
+        let lights = frame.lights.count;
+        let targets = frame.techniques.each().filter_map(|t| t.accumulated(lights)).collect();
+        let gpu = frame.gpu;
+        frame.add(Stage::Accumulate, move || RtHistoryPass::new(gpu, targets, frames));
     }
 }

@@ -57,7 +57,7 @@ impl Technique for Gtao {
                 step: 1,
                 ..Default::default()
             };
-            ScreenAoPass::new(gpu, spirv::GTAO, constants, self.radius)
+            ScreenAoPass::new(gpu, spirv::shader!("gtao/gtao.comp"), constants, self.radius)
         });
     }
 

@@ -2,6 +2,7 @@
 
 use super::knobs::{Knob, UNBOUNDED, number};
 use super::techniques;
+pub use crate::render::passes::ao::Radius;
 
 techniques! {
     /// Ambient occlusion.
@@ -37,25 +38,10 @@ pub const fn ao_reach(default: f32, sweep: &'static [f32]) -> Knob {
     )
 }
 
-/// An AO technique's radius: in scene units, or as a fraction of the scene's diagonal.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Radius {
-    /// In scene units; `None`: `reach` times the scene's bounding-box diagonal.
-    pub radius: Option<f32>,
-    /// As a fraction of the scene's bounding-box diagonal (when `radius` is `None`); for rays,
-    /// values ≥ 10 make every hit occlude fully: the sky's visibility.
-    pub reach: f32,
-}
-
 impl Radius {
     /// The radius of the knobs `ao-radius` (0: none) and `ao-reach`.
     pub fn of(k: &super::Knobs) -> Radius {
         let r = k.number("ao-radius");
         Radius { radius: (r > 0.0).then_some(r), reach: k.number("ao-reach") }
-    }
-
-    /// In scene units, for a scene of bounding-box diagonal `diagonal`.
-    pub fn world(&self, diagonal: f32) -> f32 {
-        self.radius.unwrap_or(self.reach * diagonal)
     }
 }

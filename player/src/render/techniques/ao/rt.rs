@@ -5,7 +5,9 @@ use kiln_format::gpu::FrameFlags;
 
 use super::{AO_RADIUS, Radius, ao_reach};
 use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::ao;
 use crate::render::passes::rt_ao::RtAoPass;
+use crate::render::passes::rt_history::{Accumulated, Kind};
 use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
 
 /// Ray-traced ambient occlusion.
@@ -41,6 +43,11 @@ impl Technique for Rt {
         // The direct pass multiplies the sky's ambient by the AO image, whichever technique
         // makes it (the flag's name predates the screen-space ones).
         FrameFlags::RT_AO
+    }
+
+    fn accumulated(&self, _: usize) -> Option<Accumulated> {
+        let histories = ["rt ao history a", "rt ao history b"];
+        Some(Accumulated::new(ao::AO, histories, Kind::One, 1, 1))
     }
 
     fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {

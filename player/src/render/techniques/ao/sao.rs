@@ -79,7 +79,7 @@ impl Technique for Sao {
                 step: self.resolution.divisor(),
                 ..Default::default()
             };
-            ScreenAoPass::new(gpu, spirv::SAO, constants, self.radius)
+            ScreenAoPass::new(gpu, spirv::shader!("sao/sao.comp"), constants, self.radius)
         });
     }
 

@@ -7,6 +7,7 @@ use kiln_format::gpu::FrameFlags;
 
 use super::GI_BOUNCES;
 use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_gi::RtGiPass;
 use crate::render::spirv;
 use crate::render::techniques::knobs::choice;
@@ -78,15 +79,19 @@ impl Technique for LineSpace {
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, decode) = (frame.gpu, frame.decode);
         let code = match self.structure {
-            GiStructure::Pnmt => spirv::RT_GI_LINESPACE_PNMT,
-            GiStructure::Candidates => spirv::RT_GI_LINESPACE_CANDIDATES,
-            GiStructure::Preillum => spirv::RT_GI_LINESPACE_PREILLUM,
+            GiStructure::Pnmt => spirv::shader!("rt/gi_linespace_pnmt.comp"),
+            GiStructure::Candidates => spirv::shader!("rt/gi_linespace_candidates.comp"),
+            GiStructure::Preillum => spirv::shader!("rt/gi_linespace_preillum.comp"),
         };
         frame.add(Stage::Gi, move || RtGiPass::with_line_space(gpu, code, decode));
     }
 
     fn flags(&self) -> u32 {
         FrameFlags::RT_GI
+    }
+
+    fn accumulated(&self, _: usize) -> Option<Accumulated> {
+        super::accumulated()
     }
 
     fn rays(&self, _: &RayScene, inputs: &mut RayInputs) {

@@ -2,6 +2,8 @@
 
 use super::knobs::{Knob, count};
 use super::techniques;
+use crate::render::passes::rt_gi;
+use crate::render::passes::rt_history::{Accumulated, Kind};
 
 techniques! {
     /// Indirect diffuse light.
@@ -22,6 +24,12 @@ pub const GI_BOUNCES: Knob = count(
     1.0,
     &[1.0, 2.0],
 );
+
+/// The GI image the reprojected accumulation carries (every path-traced technique's).
+fn accumulated() -> Option<Accumulated> {
+    let histories = ["rt gi history a", "rt gi history b"];
+    Some(Accumulated::new(rt_gi::GI, histories, Kind::Four, 1, 1))
+}
 
 impl Gi {
     /// The bounce count of a path-traced technique.

@@ -5,6 +5,7 @@ use kiln_format::gpu::FrameFlags;
 
 use super::GI_BOUNCES;
 use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_gi::RtGiPass;
 use crate::render::spirv;
 use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
@@ -38,11 +39,15 @@ impl Technique for Rt {
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, decode) = (frame.gpu, frame.decode);
-        frame.add(Stage::Gi, move || RtGiPass::new(gpu, spirv::RT_GI, decode));
+        frame.add(Stage::Gi, move || RtGiPass::new(gpu, spirv::shader!("rt/gi.comp"), decode));
     }
 
     fn flags(&self) -> u32 {
         FrameFlags::RT_GI
+    }
+
+    fn accumulated(&self, _: usize) -> Option<Accumulated> {
+        super::accumulated()
     }
 
     fn rays(&self, _: &RayScene, inputs: &mut RayInputs) {

@@ -116,7 +116,8 @@ impl Technique for Ssgi {
         frame.depth_pyramid(reduction, true, depth_pyramid::TOP);
         frame.lit_pyramid();
         let gpu = frame.gpu;
-        frame.add(Stage::Gi, move || SsgiPass::new(gpu, self));
+        let Ssgi { samples, resolution, radius, falloff, frames, tiled, .. } = *self;
+        frame.add(Stage::Gi, move || SsgiPass::new(gpu, samples, resolution, radius, falloff, frames, tiled));
     }
 
     fn flags(&self) -> u32 {

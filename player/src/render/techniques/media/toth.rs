@@ -2,6 +2,8 @@
 //! errata fixed), interleaved over block × block pixels and blurred back together
 //! (`passes/toth.rs`, `shaders/toth/`).
 
+use kiln_format::gpu::Phases;
+
 use super::{MEDIA_SAMPLES, casters, no_medium};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::toth::TothPass;
@@ -78,7 +80,11 @@ impl Technique for Toth {
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let gpu = frame.gpu;
-        frame.add(Stage::Media, move || TothPass::new(gpu, self.samples, self.block, self.phase));
+        let phase = match self.phase {
+            Phase::Medium => Phases::HENYEY_GREENSTEIN,
+            Phase::Rayleigh => Phases::RAYLEIGH,
+        };
+        frame.add(Stage::Media, move || TothPass::new(gpu, self.samples, self.block, phase));
     }
 
     fn dims_surfaces(&self) -> bool {

@@ -4,6 +4,7 @@
 use kiln_format::gpu::FrameFlags;
 
 use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_history::{Accumulated, Kind};
 use crate::render::passes::rt_reflections::{self, RtReflectionsPass};
 use crate::render::techniques::knobs::{UNBOUNDED, choice, number};
 use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
@@ -24,6 +25,16 @@ pub enum ReflectionRes {
     Full,
     /// One ray per 2 × 2 pixels, upsampled with normal- and plane-aware weights.
     Half,
+}
+
+impl ReflectionRes {
+    /// Pixels per reflection sample along each axis.
+    pub fn step(self) -> u32 {
+        match self {
+            ReflectionRes::Full => 1,
+            ReflectionRes::Half => 2,
+        }
+    }
 }
 
 impl Registered for Rt {
@@ -63,7 +74,7 @@ impl Technique for Rt {
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
-        frame.add(Stage::Reflections, move || RtReflectionsPass::new(gpu, self.resolution, lights, decode));
+        frame.add(Stage::Reflections, move || RtReflectionsPass::new(gpu, self.resolution.step(), lights, decode));
     }
 
     fn flags(&self) -> u32 {
@@ -73,8 +84,14 @@ impl Technique for Rt {
         }
     }
 
+    fn accumulated(&self, _: usize) -> Option<Accumulated> {
+        let histories = ["rt reflections history a", "rt reflections history b"];
+        let step = self.resolution.step();
+        Some(Accumulated::new(rt_reflections::REFLECTIONS, histories, Kind::Four, step, 1))
+    }
+
     fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
-        inputs.rt.reflection_step = rt_reflections::step(self.resolution);
+        inputs.rt.reflection_step = self.resolution.step();
         inputs.rt.reflection_lights = rt_reflections::lights(scene.lights_used);
         inputs.rt.max_roughness = self.max_roughness;
     }

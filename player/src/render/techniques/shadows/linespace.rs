@@ -5,6 +5,7 @@ use kiln_format::gpu::FrameFlags;
 
 use super::{LIGHT_RADIUS, SUN_ANGLE, traced_fallback, traced_rays};
 use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_shadows::RtShadowsPass;
 use crate::render::spirv;
 use crate::render::techniques::knobs::choice;
@@ -76,14 +77,18 @@ impl Technique for LineSpace {
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
         let code = match self.test {
-            LsShadowTest::Ends => spirv::RT_SHADOWS_LINESPACE,
-            LsShadowTest::Filled => spirv::RT_SHADOWS_LINESPACE_EXACT,
+            LsShadowTest::Ends => spirv::shader!("rt/shadows_linespace.comp"),
+            LsShadowTest::Filled => spirv::shader!("rt/shadows_linespace_exact.comp"),
         };
         frame.add(Stage::Shadows, move || RtShadowsPass::new(gpu, code, true, lights, decode));
     }
 
     fn flags(&self) -> u32 {
         FrameFlags::RT_SHADOWS
+    }
+
+    fn accumulated(&self, lights: usize) -> Option<Accumulated> {
+        super::accumulated(lights)
     }
 
     fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {

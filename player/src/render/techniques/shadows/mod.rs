@@ -2,6 +2,7 @@
 
 use super::knobs::{Knob, UNBOUNDED, number, scene};
 use super::{RayInputs, RayScene, techniques};
+use crate::render::passes::rt_history::{Accumulated, Kind};
 use crate::render::passes::rt_shadows;
 
 techniques! {
@@ -38,6 +39,12 @@ fn traced_rays(light_radius: f32, sun_degrees: f32, scene: &RayScene, inputs: &m
     inputs.light_radius = light_radius;
     inputs.sun_degrees = sun_degrees;
     inputs.rt.shadow_lights = rt_shadows::layers(scene.lights_used).min(scene.lights_used as u32);
+}
+
+/// The shadow layers the reprojected accumulation carries, one per light.
+fn accumulated(lights: usize) -> Option<Accumulated> {
+    let histories = ["rt shadows history a", "rt shadows history b"];
+    Some(Accumulated::new(rt_shadows::SHADOWS, histories, Kind::Layers, 1, rt_shadows::layers(lights)))
 }
 
 /// What a traced technique falls back to: the file's shadow maps, else none.

@@ -5,6 +5,7 @@ use kiln_format::gpu::FrameFlags;
 
 use super::{LIGHT_RADIUS, SUN_ANGLE, traced_fallback, traced_rays};
 use crate::render::frame::{FrameBuild, Stage};
+use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_shadows::RtShadowsPass;
 use crate::render::spirv;
 use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
@@ -41,11 +42,15 @@ impl Technique for Rt {
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
-        frame.add(Stage::Shadows, move || RtShadowsPass::new(gpu, spirv::RT_SHADOWS, false, lights, decode));
+        frame.add(Stage::Shadows, move || RtShadowsPass::new(gpu, spirv::shader!("rt/shadows.comp"), false, lights, decode));
     }
 
     fn flags(&self) -> u32 {
         FrameFlags::RT_SHADOWS
+    }
+
+    fn accumulated(&self, lights: usize) -> Option<Accumulated> {
+        super::accumulated(lights)
     }
 
     fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
