@@ -31,7 +31,8 @@ use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
 use kiln_format::manifest::{Bounds, LightKind, Medium};
 use kiln_format::sections::{MaterialFlags, NO_TEXTURE, Vertex};
-use kiln_tests::{Options, compile, skip, vulkan};
+use kiln_test_support::{gpu_test, mitsuba_python, read_npy, require, workspace, write_npy};
+use kiln_tests::{Options, compile};
 
 /// Image size: small, as kiln samples about 0.06 M paths/s on lavapipe with two cores.
 const W: u32 = 64;
@@ -46,49 +47,6 @@ const KILN_SPP_FOG: u32 = 1024;
 const MITSUBA_SPP: u32 = 8192;
 /// The bound on mean HDR-FLIP of kiln's image against Mitsuba's.
 const MAX_MEAN_FLIP: f64 = 0.05;
-
-const INSTALL: &str = "run .ci/run or python3 -m venv .venv-mitsuba && \
-                       .venv-mitsuba/bin/pip install mitsuba flip-evaluator numpy";
-
-/// The Python that has Mitsuba and FLIP, if any.
-fn mitsuba_python() -> Option<PathBuf> {
-    let (python, origin) = match std::env::var_os("KILN_MITSUBA_PYTHON") {
-        Some(p) => (PathBuf::from(p), "KILN_MITSUBA_PYTHON"),
-        None => (workspace().join(".venv-mitsuba/bin/python"), ".venv-mitsuba"),
-    };
-    if !python.exists() {
-        skip(
-            "KILN_REQUIRE_MITSUBA",
-            format!("Mitsuba not installed ({origin} missing: {}; {INSTALL})", python.display()),
-        );
-        return None;
-    }
-    let probe = Command::new(&python)
-        .args(["-c", "import mitsuba, flip_evaluator, numpy; mitsuba.set_variant('scalar_rgb')"])
-        .output();
-    match probe {
-        Ok(o) if o.status.success() => Some(python),
-        Ok(o) => {
-            let why = String::from_utf8_lossy(&o.stderr).trim().lines().last().unwrap_or("").to_string();
-            skip(
-                "KILN_REQUIRE_MITSUBA",
-                format!(
-                    "{} cannot import mitsuba (scalar_rgb), flip_evaluator and numpy: {why}; {INSTALL}",
-                    python.display()
-                ),
-            );
-            None
-        }
-        Err(e) => {
-            skip("KILN_REQUIRE_MITSUBA", format!("cannot run {}: {e}", python.display()));
-            None
-        }
-    }
-}
-
-fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// The renderers take turns, so that each has the machine's cores and its time is its own.
 static MACHINE: Mutex<()> = Mutex::new(());
@@ -183,23 +141,6 @@ fn scene_json(s: &Scene) -> String {
     )
 }
 
-/// Writes linear RGB (row 0 at the top) as a NumPy float32 array of shape (height, width, 3).
-fn write_npy(path: &Path, w: u32, h: u32, rgb: &[f32]) {
-    assert_eq!(rgb.len(), (w * h * 3) as usize);
-    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({h}, {w}, 3), }}");
-    while (10 + header.len() + 1) % 64 != 0 {
-        header.push(' ');
-    }
-    header.push('\n');
-    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
-    bytes.extend((header.len() as u16).to_le_bytes());
-    bytes.extend(header.as_bytes());
-    for v in rgb {
-        bytes.extend(v.to_le_bytes());
-    }
-    std::fs::write(path, bytes).unwrap();
-}
-
 /// Runs `render.py` with `args`; returns its last line of output, parsed.
 fn python(python: &Path, args: &[&str]) -> serde_json::Value {
     let script = workspace().join("tests/mitsuba/render.py");
@@ -238,13 +179,8 @@ fn assert_red_left(name: &str, rgb: &[f32]) {
 
 /// Renders `scene` with both (kiln at `kiln_spp`), compares, and asserts the bound on mean FLIP.
 fn check(case: &str, scene: Scene, kiln_spp: u32) {
-    if !vulkan() {
-        return;
-    }
-    let Some(py) = mitsuba_python() else {
-        return;
-    };
-    let tmp = tempfile::tempdir().unwrap();
+    let tmp = gpu_test!();
+    let py = require!(mitsuba_python());
     let dir = match std::env::var_os("KILN_MITSUBA_OUT") {
         Some(d) => {
             let d = PathBuf::from(d);
@@ -302,19 +238,9 @@ fn check(case: &str, scene: Scene, kiln_spp: u32) {
         n["rel_mse"].as_f64().unwrap(),
     );
     assert_red_left(&format!("{case} (kiln)"), &rgb);
-    let mitsuba = read_npy(&mitsuba_path);
+    let mitsuba = read_npy(&mitsuba_path, W, H);
     assert_red_left(&format!("{case} (mitsuba)"), &mitsuba);
     assert!(flip <= MAX_MEAN_FLIP, "{case}: mean FLIP {flip:.4} > {MAX_MEAN_FLIP} (relMSE {rel_mse:.5})");
-}
-
-/// Reads the float32 (height, width, 3) array `render.py` wrote.
-fn read_npy(path: &Path) -> Vec<f32> {
-    let bytes = std::fs::read(path).unwrap();
-    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
-    let len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = String::from_utf8_lossy(&bytes[10..10 + len]);
-    assert!(header.contains("'<f4'") && header.contains(&format!("({H}, {W}, 3)")), "{header}");
-    bytes[10 + len..].chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect()
 }
 
 #[test]

@@ -16,8 +16,9 @@ use kiln_format::query::{BvhQuery, IndexedTriangles, Ray, intersect_triangle};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::session::Session;
 use kiln_player::trace::{GpuRay, NO_HIT, RayQuery};
+use kiln_test_support::{require, vulkan};
 use kiln_tests::shapes::{height_grid, soup, sphere, transformed};
-use kiln_tests::{Options, compile, scene_of, shared_scenes, vulkan};
+use kiln_tests::{Options, compile, scene_of, shared_scenes};
 
 fn open(dir: &std::path::Path, bytes: &[u8]) -> Session {
     let file = dir.join("scene.kiln");
@@ -105,9 +106,7 @@ fn check_shape(tris: &[[Vec3; 3]], n: u64, seed: u64, what: &str) {
 
 #[test]
 fn gpu_traversal_equals_the_cpu_query_on_adversarial_shapes() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let mut rng = Rng::new(3);
     check_shape(&soup(&mut rng, 3000, 0.1), 6000, 1, "soup");
     let grid = height_grid(16, 0.2, &mut rng);
@@ -131,9 +130,7 @@ fn gpu_traversal_equals_the_cpu_query_on_adversarial_shapes() {
 
 #[test]
 fn gpu_traversal_is_watertight_on_a_closed_sphere() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let tris = sphere(48, 24);
     let bytes = compile(scene_of(&tris), geometry_only());
     let centre = Vec3::new(1e-3, -2e-3, 3e-3);
@@ -154,9 +151,7 @@ fn gpu_traversal_is_watertight_on_a_closed_sphere() {
 
 #[test]
 fn gpu_traversal_equals_the_cpu_query_on_the_shared_scenes() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let Some(scenes) = shared_scenes() else {
         return;
     };

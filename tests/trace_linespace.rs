@@ -28,8 +28,9 @@ use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::session::Session;
 use kiln_player::trace::{GpuHit, GpuRay, NO_HIT};
 use kiln_player::trace_linespace::{LineSpaceQuery, LsQuery};
+use kiln_test_support::{require, vulkan};
 use kiln_tests::shapes::{height_grid, soup, transformed};
-use kiln_tests::{Options, compile, scene_of, shared_scenes, vulkan};
+use kiln_tests::{Options, compile, scene_of, shared_scenes};
 
 fn settings(res: u32, n: u32) -> Settings {
     Settings {
@@ -251,9 +252,7 @@ fn textured(mut scene: kiln_compiler::ir::Scene) -> kiln_compiler::ir::Scene {
 
 #[test]
 fn gpu_line_space_equals_the_cpu_queries_on_shapes() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let mut rng = Rng::new(11);
     let soup = textured(scene_of(&soup(&mut rng, 1500, 0.15)));
     check(&compile(soup, settings(8, 4)), 3000, 1, "textured soup", PnmtLayout::Compact);
@@ -272,9 +271,7 @@ fn gpu_line_space_equals_the_cpu_queries_on_shapes() {
 
 #[test]
 fn gpu_line_space_equals_the_cpu_queries_on_the_cornell_box() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let Some(scenes) = shared_scenes() else {
         return;
     };

@@ -8,6 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use kiln_test_support::{glslc, require};
+
 fn shaders() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")
 }
@@ -35,14 +37,7 @@ fn committed_bake_spirv_is_compiled_from_the_glsl() {
         spirv, expected,
         "shaders/spirv/ must hold exactly one .spv per kernel: run compiler/shaders/build.sh"
     );
-    if Command::new("glslc").arg("--version").output().is_err() {
-        assert!(
-            std::env::var_os("KILN_REQUIRE_GLSLC").is_none(),
-            "glslc missing but KILN_REQUIRE_GLSLC is set"
-        );
-        eprintln!("skipped: no glslc (Debian: glslc)");
-        return;
-    }
+    require!(glslc());
     let out = std::env::temp_dir().join(format!("kiln-bake-spirv-{}", std::process::id()));
     std::fs::create_dir_all(&out).unwrap();
     for k in &kernels {

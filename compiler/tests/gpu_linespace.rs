@@ -13,9 +13,10 @@ use kiln_compiler::ir::Scene;
 use kiln_compiler::progress::Progress;
 use kiln_format::linespace::{PnmtLayout, Variants};
 use kiln_format::sections::Vertex;
+use kiln_test_support::{Need, require};
 
 fn open() -> Option<GpuBaker> {
-    let required = std::env::var_os("KILN_REQUIRE_VULKAN").is_some();
+    let required = Need::Vulkan.required();
     let validate = GpuBaker::new(&kiln_gpubake::Options { allow_cpu: true, validate: true });
     let gpu = match validate {
         Ok(g) => Ok(g),
@@ -25,14 +26,7 @@ fn open() -> Option<GpuBaker> {
         }
         Err(e) => Err(e),
     };
-    match gpu {
-        Ok(g) => Some(g),
-        Err(e) => {
-            assert!(!required, "no Vulkan device for the GPU bake but KILN_REQUIRE_VULKAN is set: {e}");
-            eprintln!("skipped: no Vulkan device with 64-bit floats ({e})");
-            None
-        }
-    }
+    Need::Vulkan.check(gpu.map_err(|e| format!("no Vulkan device with 64-bit floats for the GPU bake ({e})")))
 }
 
 fn bake(
@@ -86,7 +80,7 @@ fn same(what: &str, cpu: &BakedLineSpace, gpu: &BakedLineSpace) {
 
 #[test]
 fn gpu_bake_matches_the_cpu_bake() {
-    let Some(gpu) = open() else { return };
+    let gpu = require!(open());
     let pnmt = Variants::BINARY | Variants::PNMT;
     // (scene, grid resolution, N, variants, layout): walls alone at the largest N; cells of a
     // few to hundreds of triangles; every N; binary alone; both layouts.

@@ -8,6 +8,8 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
+use kiln_test_support::require;
+
 /// Runs ninja in `dir`; returns its stdout.
 fn ninja(dir: &Path) -> String {
     let o = Command::new("ninja").arg("-C").arg(dir).output().expect("ninja runs");
@@ -33,14 +35,7 @@ fn png(rgb: [u8; 3]) -> Vec<u8> {
 
 #[test]
 fn ninja_rebuilds_exactly_when_an_input_the_depfile_names_changes() {
-    if Command::new("ninja").arg("--version").output().is_err() {
-        assert!(
-            std::env::var_os("KILN_REQUIRE_NINJA").is_none(),
-            "ninja is missing but KILN_REQUIRE_NINJA is set"
-        );
-        eprintln!("skipping: ninja is not installed (Debian: ninja-build)");
-        return;
-    }
+    require!(kiln_test_support::ninja());
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let obj = "mtllib scene.mtl\nusemtl painted\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";

@@ -13,76 +13,17 @@
 //! `KILN_MITSUBA_PYTHON` names. Without either the test says why and passes, unless
 //! `KILN_REQUIRE_MITSUBA` is set (as `.ci/run` does), when it fails.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 
 use kiln_metrics::{RgbImage, hdr_flip, ldr_flip};
+use kiln_test_support::{flip_python, require, workspace, write_npy};
 
 /// Largest allowed difference of the mean FLIP from flip_evaluator's. kiln-bench needs 1e-3;
 /// the port agrees to about 1e-6 (both work in f32 with the same filters and order of
 /// summation), and 1e-3 let real bugs through: a blue-yellow CSF amplitude of 30 instead of 34.1
 /// moved the means by at most 5e-4, zero padding at the left border by at most 1.4e-3.
 const TOLERANCE: f64 = 1e-5;
-
-const INSTALL: &str = "run .ci/run or python3 -m venv .venv-mitsuba && \
-                       .venv-mitsuba/bin/pip install mitsuba flip-evaluator numpy";
-
-/// Says why the test cannot run; fails if `require` is set (the convention of kiln-tests).
-fn skip(require: &str, why: String) {
-    assert!(std::env::var_os(require).is_none(), "{why}, but {require} is set");
-    eprintln!("skipping: {why}");
-}
-
-fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// The Python that has flip_evaluator, if any.
-fn flip_python() -> Option<PathBuf> {
-    let (python, origin) = match std::env::var_os("KILN_MITSUBA_PYTHON") {
-        Some(p) => (PathBuf::from(p), "KILN_MITSUBA_PYTHON"),
-        None => (workspace().join(".venv-mitsuba/bin/python"), ".venv-mitsuba"),
-    };
-    if !python.exists() {
-        skip(
-            "KILN_REQUIRE_MITSUBA",
-            format!("flip_evaluator not installed ({origin} missing: {}; {INSTALL})", python.display()),
-        );
-        return None;
-    }
-    match Command::new(&python).args(["-c", "import flip_evaluator, numpy"]).output() {
-        Ok(o) if o.status.success() => Some(python),
-        Ok(o) => {
-            let why = String::from_utf8_lossy(&o.stderr).trim().lines().last().unwrap_or("").to_string();
-            skip(
-                "KILN_REQUIRE_MITSUBA",
-                format!("{} cannot import flip_evaluator and numpy: {why}; {INSTALL}", python.display()),
-            );
-            None
-        }
-        Err(e) => {
-            skip("KILN_REQUIRE_MITSUBA", format!("cannot run {}: {e}", python.display()));
-            None
-        }
-    }
-}
-
-/// Writes linear RGB (row 0 at the top) as a NumPy float32 array of shape (height, width, 3).
-fn write_npy(path: &Path, w: u32, h: u32, rgb: &[f32]) {
-    assert_eq!(rgb.len(), (w * h * 3) as usize);
-    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({h}, {w}, 3), }}");
-    while (10 + header.len() + 1) % 64 != 0 {
-        header.push(' ');
-    }
-    header.push('\n');
-    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
-    bytes.extend((header.len() as u16).to_le_bytes());
-    bytes.extend(header.as_bytes());
-    for v in rgb {
-        bytes.extend(v.to_le_bytes());
-    }
-    std::fs::write(path, bytes).unwrap();
-}
 
 /// xorshift64: deterministic noise in [0, 1).
 struct Rng(u64);
@@ -214,7 +155,7 @@ fn pairs() -> Vec<Pair> {
 
 #[test]
 fn mean_flip_agrees_with_flip_evaluator() {
-    let Some(python) = flip_python() else { return };
+    let python = require!(flip_python());
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("kiln-metrics-flip");
     std::fs::create_dir_all(&dir).unwrap();
     let pairs = pairs();

@@ -24,32 +24,8 @@ use std::sync::OnceLock;
 use serde_json::Value;
 
 mod common;
-use common::{kiln, vulkan};
-
-fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-/// The Python with flip-evaluator and numpy (`.venv-mitsuba`, which `.ci/run` makes).
-fn flip_python() -> Option<PathBuf> {
-    let python = std::env::var_os("KILN_MITSUBA_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| workspace().join(".venv-mitsuba/bin/python"));
-    let ok = Command::new(&python)
-        .args(["-c", "import flip_evaluator, numpy"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        assert!(
-            std::env::var_os("KILN_REQUIRE_MITSUBA").is_none(),
-            "{} cannot import flip_evaluator and numpy, but KILN_REQUIRE_MITSUBA is set",
-            python.display()
-        );
-        eprintln!("skipping the FLIP recomputation: no flip-evaluator (run .ci/run)");
-        return None;
-    }
-    Some(python)
-}
+use common::kiln;
+use kiln_test_support::{chromium, flip_python, gpu_test, mse, read_exr, require, screenshot, vulkan};
 
 /// A temporary folder with the demo scene compiled into it.
 fn demo() -> &'static (tempfile::TempDir, PathBuf) {
@@ -173,9 +149,7 @@ fn f(v: &Value) -> f64 {
 
 #[test]
 fn every_effect_with_choices_has_a_front_and_wrong_techniques_lie_off_it() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let (out, r) = sweep();
     for effect in ["shadows", "frame"] {
         let ps = points(r, effect);
@@ -217,9 +191,7 @@ fn every_effect_with_choices_has_a_front_and_wrong_techniques_lie_off_it() {
 
 #[test]
 fn rt_ao_converges_with_frames_accumulated_to_the_noise_floor() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let (_, r) = sky_sweep();
     assert!(points(r, "ao").len() > 4, "every reach is swept");
     // Reach 100 diagonals: every hit occludes fully, the sky's visibility.
@@ -254,15 +226,9 @@ fn rt_ao_converges_with_frames_accumulated_to_the_noise_floor() {
     }
 }
 
-fn read_exr(path: &Path) -> Vec<f32> {
-    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).into_rgb32f().into_raw()
-}
-
 #[test]
 fn reported_errors_are_recomputed_from_the_kept_images() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let mut pairs = Vec::new();
     for (out, r) in [sweep(), sky_sweep()] {
         pairs.extend(recompute(out.path(), r));
@@ -271,14 +237,13 @@ fn reported_errors_are_recomputed_from_the_kept_images() {
         for reference in r["references"].as_array().unwrap() {
             let key = reference["key"].as_str().unwrap();
             let [a, b] = ["a", "b"].map(|h| out.path().join("reference").join(format!("{key}-{h}.exr")));
-            let (x, y) = (read_exr(&a), read_exr(&b));
-            let mse = x.iter().zip(&y).map(|(p, q)| ((p - q) as f64).powi(2)).sum::<f64>() / x.len() as f64;
+            let mse = mse(&read_exr(&a), &read_exr(&b));
             let reported = f(&reference["noise_floor"]["rmse"]);
             assert!((mse.sqrt() / 2.0 - reported).abs() <= 1e-6 * reported, "{key}: floor {reported}");
             pairs.push((a, b, f(&reference["noise_floor"]["flip"])));
         }
     }
-    let Some(python) = flip_python() else { return };
+    let python = require!(flip_python());
     // flip-evaluator, one process per reference image.
     let mut by_reference: std::collections::BTreeMap<&PathBuf, Vec<&(PathBuf, PathBuf, f64)>> =
         Default::default();
@@ -338,8 +303,7 @@ fn recompute(out: &Path, r: &Value) -> Vec<(PathBuf, PathBuf, f64)> {
         let path = images.join(format!("{name}.exr"));
         let test = read_exr(&path);
         assert_eq!(test.len(), reference.len());
-        let mse = test.iter().zip(&reference).map(|(t, r)| ((t - r) as f64).powi(2)).sum::<f64>()
-            / test.len() as f64;
+        let mse = mse(&test, &reference);
         let rel = test
             .iter()
             .zip(&reference)
@@ -374,9 +338,7 @@ fn split_csv(line: &str) -> Vec<String> {
 
 #[test]
 fn csv_says_what_json_says() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let (out, r) = sweep();
     let csv = std::fs::read_to_string(out.path().join("results.csv")).unwrap();
     let mut lines = csv.lines();
@@ -437,10 +399,7 @@ fn bad_requests_are_refused_before_any_work() {
 
 #[test]
 fn the_reference_is_cached_by_file_camera_size_and_samples() {
-    if !vulkan() {
-        return;
-    }
-    let out = tempfile::tempdir().unwrap();
+    let out = gpu_test!();
     let file = sky_scene().1.to_str().unwrap().to_string();
     let run = |spp: &str| {
         let o = bench(&[
@@ -477,62 +436,26 @@ fn the_reference_is_cached_by_file_camera_size_and_samples() {
     assert_eq!(other["spp"], 32);
 }
 
-/// Chromium's binary, if one is installed.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser", "google-chrome"]
-        .iter()
-        .flat_map(|name| std::env::split_paths(&path).map(move |d| d.join(name)))
-        .find(|p| p.is_file())
-}
-
-/// A 1200 × 1600 screenshot of `html` by headless Chromium, decoded.
-fn screenshot(chromium: &Path, html: &Path) -> image::RgbImage {
-    let shot = html.with_file_name("shot.png");
-    let _ = std::fs::remove_file(&shot);
-    let profile = html.with_file_name("profile");
-    let o = Command::new(chromium)
-        .args(["--headless", "--disable-gpu", "--no-sandbox", "--disable-dev-shm-usage", "--hide-scrollbars"])
-        .args(["--no-first-run", "--window-size=1200,1600"])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("file://{}", html.display()))
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "chromium: {}", String::from_utf8_lossy(&o.stderr));
-    image::open(&shot).expect("chromium wrote the screenshot").to_rgb8()
-}
-
 #[test]
 fn the_page_of_a_sweep_shows_its_charts_in_a_browser() {
-    if !vulkan() {
-        return;
-    }
-    let Some(chromium) = chromium() else {
-        assert!(
-            std::env::var_os("KILN_REQUIRE_CHROMIUM").is_none(),
-            "no chromium, but KILN_REQUIRE_CHROMIUM is set"
-        );
-        eprintln!("skipping: chromium is not installed");
-        return;
-    };
+    let page = gpu_test!();
+    let chromium = require!(chromium());
     // A copy of the sweep's page and charts, screenshotted with its SVG charts and without them:
     // the charts' part of the page must differ (they really load and draw).
     let (out, _) = sweep();
-    let page = tempfile::tempdir().unwrap();
     for entry in std::fs::read_dir(out.path()).unwrap() {
         let path = entry.unwrap().path();
         if matches!(path.extension().and_then(|e| e.to_str()), Some("html" | "svg" | "png")) {
             std::fs::copy(&path, page.path().join(path.file_name().unwrap())).unwrap();
         }
     }
-    let html = page.path().join("index.html");
-    let with = screenshot(&chromium, &html);
+    let (html, profile) = (page.path().join("index.html"), page.path().join("profile"));
+    let with = screenshot(&chromium, &html, &profile);
     assert_eq!(with.dimensions(), (1200, 1600));
     for chart in ["shadows.svg", "frame.svg"] {
         std::fs::remove_file(page.path().join(chart)).unwrap();
     }
-    let without = screenshot(&chromium, &html);
+    let without = screenshot(&chromium, &html, &profile);
     let differing = with.pixels().zip(without.pixels()).filter(|(a, b)| a != b).count();
     assert!(differing > 50_000, "only {differing} pixels differ with the charts removed");
     // The charts draw dark lines and text on white: plenty of non-white pixels where they are.

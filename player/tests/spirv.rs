@@ -8,6 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use kiln_test_support::{glslc, require};
+
 fn shaders() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders")
 }
@@ -50,15 +52,7 @@ fn sources() -> Vec<String> {
 
 #[test]
 fn embedded_spirv_is_built_from_the_committed_sources() {
-    let version = Command::new("glslc").arg("--version").output();
-    if version.as_ref().map_or(true, |o| !o.status.success()) {
-        assert!(
-            std::env::var_os("KILN_REQUIRE_GLSLC").is_none(),
-            "glslc is not installed but KILN_REQUIRE_GLSLC is set"
-        );
-        eprintln!("skipping: glslc is not installed (Debian: glslc)");
-        return;
-    }
+    require!(glslc());
     let dir = tempfile::tempdir().unwrap();
     for source in sources() {
         let embedded = &std::fs::read(shaders().join(format!("{source}.spv")))

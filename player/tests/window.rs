@@ -6,20 +6,14 @@
 
 use std::process::Command;
 
+use kiln_test_support::{gpu_test, require, xvfb_run};
+
 mod common;
 
 #[test]
 fn window_presents_frames_and_exits_cleanly_under_xvfb() {
-    let required = std::env::var_os("KILN_REQUIRE_VULKAN").is_some();
-    if Command::new("xvfb-run").arg("--help").output().is_err() {
-        assert!(!required, "xvfb-run is not installed but KILN_REQUIRE_VULKAN is set");
-        eprintln!("skipping: xvfb-run is not installed (Debian: xvfb xauth)");
-        return;
-    }
-    if !common::vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    require!(xvfb_run());
+    let dir = gpu_test!();
     let file = dir.path().join("demo.kiln");
     common::kiln(&["demo", "-q", "--shaft-variants", "none", "-o", file.to_str().unwrap()]);
     // The default frame, and the hybrid one (every ray-traced pass, the visibility buffer).

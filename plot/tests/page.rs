@@ -2,11 +2,8 @@
 //! screenshot; without Chromium the test says so and passes, unless `KILN_REQUIRE_CHROMIUM` is
 //! set, as `.ci/run` sets it).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::{Duration, Instant};
-
 use kiln_plot::{Chart, ChartPoint, Page, Section, Table, index_html, png, svg};
+use kiln_test_support::{chromium, require, screenshot};
 
 const HOSTILE: &str = "<script>alert('x')</script> & \"quoted\" <b>";
 
@@ -56,63 +53,9 @@ fn text_is_escaped() {
     assert!(!h.contains("http"), "nothing from the network: {h}");
 }
 
-/// Chromium's binary, if one is installed.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    ["chromium", "chromium-browser", "google-chrome"]
-        .iter()
-        .flat_map(|name| std::env::split_paths(&path).map(move |d| d.join(name)))
-        .find(|p| p.is_file())
-}
-
-/// A screenshot of `html` at 1200x1600, decoded.
-fn screenshot(chromium: &Path, html: &Path, profile: &Path) -> image::RgbImage {
-    let shot = html.with_file_name("shot.png");
-    let _ = std::fs::remove_file(&shot);
-    let mut child = Command::new(chromium)
-        .args([
-            "--headless",
-            "--disable-gpu",
-            "--no-sandbox",
-            "--disable-dev-shm-usage",
-            "--hide-scrollbars",
-            "--no-first-run",
-            "--window-size=1200,1600",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg(format!("--screenshot={}", shot.display()))
-        .arg(format!("file://{}", html.display()))
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("chromium starts");
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let out = child.wait_with_output().unwrap();
-            assert!(status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
-            break;
-        }
-        if start.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("chromium took over 2 minutes");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    eprintln!("chromium screenshot: {:.1} s", start.elapsed().as_secs_f64());
-    image::open(&shot).expect("chromium wrote the screenshot").to_rgb8()
-}
-
 #[test]
 fn browser_shows_the_charts() {
-    let Some(chromium) = chromium() else {
-        assert!(
-            std::env::var_os("KILN_REQUIRE_CHROMIUM").is_none(),
-            "chromium is not installed, but KILN_REQUIRE_CHROMIUM is set"
-        );
-        eprintln!("skipping: chromium is not installed");
-        return;
-    };
+    let chromium = require!(chromium());
     let dir = tempfile::tempdir().unwrap();
     let chart = Chart {
         title: "shadows: browser test".into(),

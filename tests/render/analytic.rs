@@ -4,7 +4,8 @@
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{LightKind, Sky};
-use kiln_tests::{GBuffer, Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{GBuffer, Options, compile, scene_of};
 
 use crate::harness::{
     ALBEDO, H, Pinhole, TOLERANCE, W, albedo, compare_plane, fast_settings, light, render, square, srgb8,
@@ -12,10 +13,7 @@ use crate::harness::{
 
 #[test]
 fn point_light_on_a_diffuse_plane_matches_albedo_over_pi_times_i_cos_over_d2() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
     let mut scene = scene_of(&square(0.0, 10.0));
     scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
@@ -49,10 +47,7 @@ fn point_light_on_a_diffuse_plane_matches_albedo_over_pi_times_i_cos_over_d2() {
 
 #[test]
 fn directional_light_on_a_diffuse_plane_is_albedo_over_pi_times_e_cos() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let cam = Pinhole::new([3.0, 6.0, 5.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
     let mut scene = scene_of(&square(0.0, 10.0));
     scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
@@ -78,16 +73,13 @@ fn directional_light_on_a_diffuse_plane_is_albedo_over_pi_times_e_cos() {
 
 #[test]
 fn an_orthographic_camera_sees_the_lit_square_where_its_parallel_rays_meet_it() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // Straight down onto a 6 × 6 square lit by a directional light, through an orthographic
     // camera 4 units high (half extents): pixel (px, py) looks at x = ndc.x · 4 · aspect,
     // z = −ndc.y · 4 (right = +x, up = −z). Inside the square: albedo/π · E cos; outside: the
     // black sky. Both G-buffers and the reference path tracer. The square's vertex colours fall
     // linearly along x, so that a surface point found off the pixel's parallel ray (the
     // visibility resolve's barycentrics) shows the wrong shade.
-    let dir = tempfile::tempdir().unwrap();
     let shade = |x: f64| 0.6 + 0.3 * x / 3.0;
     let ymag = 4.0f64;
     let aspect = W as f64 / H as f64;

@@ -7,7 +7,8 @@ use std::time::Instant;
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{LightKind, Sky};
-use kiln_tests::{GBuffer, Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{GBuffer, Options, compile, scene_of};
 
 use crate::harness::{
     H, Pinhole, TOLERANCE, W, compare_plane, fast_settings, floor_pixels, light, render, square,
@@ -36,10 +37,7 @@ fn coloured_floor() -> kiln_compiler::ir::Scene {
 
 #[test]
 fn vertex_colours_multiply_the_base_colour_in_both_g_buffers() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let cam = Pinhole::new([0.0, 8.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 60.0, W, H);
     let mut scene = coloured_floor();
     let lp = [1.0f32, 3.0, -0.5];
@@ -72,13 +70,10 @@ fn vertex_colours_multiply_the_base_colour_in_both_g_buffers() {
 
 #[test]
 fn the_reference_path_tracer_reads_vertex_colours() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A white furnace: a Lambertian floor under a sky of radiance 1 sees only the sky, so it
     // reflects exactly its albedo, here the vertex colour (cosine-weighted sampling has zero
     // variance there).
-    let dir = tempfile::tempdir().unwrap();
     let cam = Pinhole::new([0.0, 6.0, 9.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 60.0, W, H);
     let mut scene = coloured_floor();
     scene.sky = Sky { radiance: [1.0; 3] };

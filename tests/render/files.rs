@@ -8,16 +8,14 @@ use kiln_compiler::import::demo::{cornell_box, lambert_material};
 use kiln_format::manifest::Sky;
 use kiln_player::error::Exit;
 use kiln_player::headless;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{fast_settings, render, square};
 
 #[test]
 fn damaged_files_fail_cleanly_and_minimal_files_render() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let good = compile(cornell_box(), fast_settings());
     let file = kiln_format::read::KilnFile::from_bytes(&good, Default::default()).unwrap();
     let vert = file.find(kiln_format::sections::VERTICES, 0).unwrap().entry;

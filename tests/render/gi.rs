@@ -14,7 +14,8 @@ use kiln_player::reference::{Sampling, render_with};
 use kiln_player::render::Readable;
 use kiln_player::render::techniques::gi::linespace::GiStructure;
 use kiln_player::session::Session;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::{gpu_test, require, vulkan};
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{Pinhole, fast_settings, light, square, srgb8};
 
@@ -88,16 +89,13 @@ fn mean_and_noise(two: &[Vec<f32>; 2], rect: (u32, u32, u32, u32)) -> (f64, f64)
 
 #[test]
 fn gi_plus_direct_light_converges_to_the_reference_of_one_more_bounce_under_a_lit_ceiling() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A diffuse floor under a diffuse ceiling (2 × 2 units at height 1) lit by a point light
     // between them, an emissive panel just below the ceiling and a dim sky around it. The direct
     // pass lights the floor from the point light; GI with one bounce adds the panel (which only
     // GI sees: the direct pass samples no emissive triangles), the sky where the ceiling does not
     // hide it, and the light of the point light and the panel that the ceiling reflects. That is
     // exactly what the reference counts with two scattering events.
-    let dir = tempfile::tempdir().unwrap();
     let file = lit_ceiling(dir.path(), fast_settings());
     let none = two_estimates(&Options::new(&file, W, H).unshadowed(), 1);
     // One bounce against two scattering events, and (through the MIS-weighted continuation) two
@@ -146,9 +144,7 @@ fn lit_ceiling(dir: &Path, settings: Settings) -> PathBuf {
 
 #[test]
 fn gi_through_the_line_space_converges_to_the_reference_with_candidates_and_near_it_with_pnmt() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     // The same estimator as --gi rt: with the candidate lists every bounce hit is exact, and the
     // shadow rays through the binary line space are exact within two cells of their ends, which
     // covers every feeler under the 1-unit ceiling at both resolutions below. So the result
@@ -175,14 +171,11 @@ fn gi_through_the_line_space_converges_to_the_reference_with_candidates_and_near
 
 #[test]
 fn gi_brings_the_sky_that_a_wall_reflects_onto_the_floor() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A floor beside a tall bright wall under a sky, no light: the floor sees the sky directly
     // and through the wall, which sees it over half its hemisphere. The sky is no emitter of the
     // next-event table, so at GI's last hit only an escaping ray brings it; without that the
     // wall's share (about a sixth of the floor's radiance here) is missing.
-    let dir = tempfile::tempdir().unwrap();
     let cam = Pinhole::new([-0.8, 1.2, 0.0], [0.2, 0.0, 0.0], [0.0, 1.0, 0.0], 70.0, W, H);
     let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
     // The wall x = 0.5, 4 high, facing −x.

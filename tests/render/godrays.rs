@@ -9,7 +9,8 @@ use kiln_format::manifest::{Bounds, LightKind, Medium, Sky};
 use kiln_player::render::techniques;
 use kiln_player::render::techniques::media::toth::Phase;
 use kiln_player::render::{Media, ScreenFraction};
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{Pinhole, fast_settings, light, render};
 use crate::media::{H, W, henyey_greenstein, mean};
@@ -70,12 +71,9 @@ fn shaft_radiance(d: DVec3, to_sun: DVec3) -> [f64; 3] {
 /// light mirrored vertically, and the scale.
 #[test]
 fn mitchells_blur_matches_its_definition() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let to_sun = Vec3::from_array(TO_SUN);
     let bytes = sky_over_wall(to_sun);
-    let dir = tempfile::tempdir().unwrap();
     let (samples, exposure) = (60u32, 1.921f32);
     let media = Media::Mitchell(techniques::media::mitchell::Mitchell {
         samples,
@@ -124,12 +122,9 @@ fn mitchells_blur_matches_its_definition() {
 /// without, 3 taps would be 8 times darker).
 #[test]
 fn sousas_shafts_come_from_the_far_sky() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let to_sun = Vec3::from_array(TO_SUN);
     let bytes = sky_over_wall(to_sun);
-    let dir = tempfile::tempdir().unwrap();
     let cam = camera();
     let bound = (6.0f64 * 0.19).powi(3);
     let rows = (W * (H / 2 - 2)) as f64;
@@ -179,12 +174,9 @@ fn sousas_shafts_come_from_the_far_sky() {
 /// failure, asserted rather than hidden.
 #[test]
 fn image_space_god_rays_miss_a_light_behind_the_camera() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let behind = Vec3::new(0.0, 0.2, 1.0);
     let bytes = sky_over_wall(behind);
-    let dir = tempfile::tempdir().unwrap();
     let (none, _) = render(dir.path(), "none", &bytes, |f| Options::new(f, W, H));
     assert!(none.iter().all(|&v| v == 0.0), "black wall, black sky");
     for media in [
@@ -221,9 +213,7 @@ fn image_space_god_rays_miss_a_light_behind_the_camera() {
 /// irradiance at the camera, I/d², × albedo × HG: within 1.5 % of the full-exposure value.
 #[test]
 fn mitchells_blur_of_a_point_lights_sphere_matches_its_definition() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let lamp = DVec3::new(0.0, 1.6, 4.0);
     let intensity = 3.0f64;
     let p = |x: f32, y: f32| Vec3::new(x, y, -20.0);
@@ -236,7 +226,6 @@ fn mitchells_blur_of_a_point_lights_sphere_matches_its_definition() {
     scene.media.push(FOG);
     scene.cameras.push(camera().file_camera());
     let bytes = compile(scene, kiln_compiler::settings::Settings { media_volume_res: 4, ..fast_settings() });
-    let dir = tempfile::tempdir().unwrap();
     let (samples, exposure) = (60u32, 1.921f32);
     let media = Media::Mitchell(techniques::media::mitchell::Mitchell {
         samples,

@@ -10,7 +10,8 @@ use kiln_player::reference::{DEFAULT_SEED, Sampling, render_with};
 use kiln_player::render::Media;
 use kiln_player::render::techniques;
 use kiln_player::render::techniques::media::toth::Phase;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::{gpu_test, require, vulkan};
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{Pinhole, fast_settings, light, render, square};
 
@@ -140,9 +141,7 @@ fn rayleigh(cos_theta: f64) -> f64 {
 
 #[test]
 fn single_scattering_in_a_lit_slab_matches_the_closed_form() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     // The haze, and an isotropic medium.
     let travel = Vec3::from_array(TRAVEL);
     for (sigma_a, sigma_s, g) in [(HAZE.sigma_a, HAZE.sigma_s, HAZE.g), ([0.0; 3], [0.5; 3], 0.0)] {
@@ -173,12 +172,9 @@ fn single_scattering_in_a_lit_slab_matches_the_closed_form() {
 /// pixel within a step's variation of it (the 4 × 4 interleaved step offsets).
 #[test]
 fn the_ray_march_matches_single_scattering_in_a_lit_slab() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let travel = Vec3::from_array(TRAVEL);
     let Haze { sigma_a, sigma_s, g, depth, irradiance } = HAZE;
-    let dir = tempfile::tempdir().unwrap();
     let bytes = slab_file(sigma_a, sigma_s, g, depth, travel, irradiance);
     let want: Vec<f64> = (0..3)
         .map(|c| {
@@ -234,9 +230,7 @@ fn the_ray_march_matches_single_scattering_in_a_lit_slab() {
 /// light. Both `march` (the baked visibility volume) and `toth` (the shadow map).
 #[test]
 fn the_marches_show_the_volumetric_shadow_of_an_occluder() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let (sigma_a, sigma_s, g, irradiance) = ([0.05f32, 0.1, 0.02], [0.2f32, 0.3, 0.5], 0.3f32, 2.0f32);
     let mut tris = square(-0.5, 12.0).to_vec();
     // The roof: x in [−12, 0], facing down, above the slab.
@@ -259,7 +253,6 @@ fn the_marches_show_the_volumetric_shadow_of_an_occluder() {
     let aspect = W as f32 / H as f32;
     scene.orthographic.push(OrthographicCamera { camera: 0, xmag: ymag * aspect, ymag });
     let bytes = compile(scene, kiln_compiler::settings::Settings { media_volume_res: 64, ..fast_settings() });
-    let dir = tempfile::tempdir().unwrap();
     // The ray march reads the light's visibility from the baked volume, toth from the shadow map
     // (shadows on the surfaces off: the pass binds the maps itself).
     let toth = Media::Toth(techniques::media::toth::Toth { samples: 64, block: 4, phase: Phase::Medium });
@@ -323,15 +316,12 @@ fn roof_shadow(
 /// adds: albedo/π · E μ e^{−σt·D(1 + 1/μ)} + the closed form above, per channel.
 #[test]
 fn the_ray_march_dims_the_light_that_reaches_surfaces_through_the_medium() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let travel = Vec3::from_array(TRAVEL);
     let Haze { sigma_a, sigma_s, g, depth, irradiance } = HAZE;
     // An albedo the G-buffer's 8-bit sRGB target holds exactly.
     let albedo = crate::harness::srgb8(188);
     let bytes = slab_over(sigma_a, sigma_s, g, depth, travel, irradiance, albedo);
-    let dir = tempfile::tempdir().unwrap();
     let (rgb, _) =
         render(dir.path(), "floor", &bytes, |f| Options::new(f, W, H).unshadowed().media_march(64));
     let got = mean(&rgb);
@@ -369,11 +359,8 @@ fn the_ray_march_dims_the_light_that_reaches_surfaces_through_the_medium() {
 /// Δs factor.
 #[test]
 fn the_shadow_map_march_matches_single_scattering_in_a_lit_slab() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let Haze { sigma_a, sigma_s, g, depth, irradiance } = HAZE;
-    let dir = tempfile::tempdir().unwrap();
     // Two scattering angles (cos θ −0.6 and −0.96), so that a phase function with the right
     // value at one angle but the wrong shape fails too.
     for travel in [Vec3::from_array(TRAVEL), Vec3::new(0.28, -0.96, 0.0)] {
@@ -420,9 +407,7 @@ fn the_shadow_map_march_matches_single_scattering_in_a_lit_slab() {
 /// source at a jittered point of each step) in the image's mean.
 #[test]
 fn the_marches_match_single_scattering_from_a_point_light() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let Haze { sigma_a, sigma_s, g, depth, .. } = HAZE;
     let (lamp, intensity) = (DVec3::new(0.3, depth as f64 + 1.5, 0.2), 20.0f64);
     let lamp_light = light(LightKind::Point, lamp.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity as f32);
@@ -452,7 +437,6 @@ fn the_marches_match_single_scattering_from_a_point_light() {
             })
             .sum::<f64>()
     };
-    let dir = tempfile::tempdir().unwrap();
     let toth = Media::Toth(techniques::media::toth::Toth { samples: 60, block: 1, phase: Phase::Medium });
     let (rgb, _) = render(dir.path(), "toth point", &bytes, |f| Options::new(f, W, H).media(toth));
     let mut want_mean = [0.0f64; 3];

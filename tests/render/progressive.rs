@@ -9,7 +9,8 @@ use std::time::{Duration, Instant};
 use kiln_compiler::import::demo::cornell_box;
 use kiln_player::bench;
 use kiln_player::session::Session;
-use kiln_tests::{Options, compile, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile};
 
 use crate::harness::{WrittenExr, fast_settings, traced, written_exr};
 
@@ -22,10 +23,7 @@ fn demo(dir: &std::path::Path) -> std::path::PathBuf {
 
 #[test]
 fn headless_output_behind_a_fallback_is_bit_identical_to_waiting_for_every_pipeline() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = demo(dir.path());
     let (w, h, frames) = (64, 48, 3);
     // GI too: its bounces shade hits with the materials and triangles that upload after the
@@ -69,10 +67,7 @@ fn headless_output_behind_a_fallback_is_bit_identical_to_waiting_for_every_pipel
 
 #[test]
 fn bench_reports_the_first_frame_the_chosen_techniques_and_residency_separately_and_measures_only_them() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = demo(dir.path());
     let report =
         bench::run(&traced(Options::new(&file, 48, 32)).progressive().build(), 1, 2, Instant::now()).unwrap();
@@ -131,10 +126,7 @@ fn bench_reports_the_first_frame_the_chosen_techniques_and_residency_separately_
 
 #[test]
 fn a_session_switches_from_the_fallback_by_itself_at_the_current_size() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = demo(dir.path());
     let mut session =
         Session::open(&traced(Options::new(&file, 64, 48)).progressive().build(), Instant::now()).unwrap();
@@ -164,10 +156,7 @@ fn a_session_switches_from_the_fallback_by_itself_at_the_current_size() {
 
 #[test]
 fn closing_a_session_while_its_pipelines_compile_leaks_nothing() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = demo(dir.path());
     let o = traced(Options::new(&file, 64, 48)).rt_gi(1).progressive().build();
     let session = Session::open(&o, Instant::now()).unwrap();

@@ -7,7 +7,8 @@ use std::time::Instant;
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::{cornell_box, lambert_material};
 use kiln_format::manifest::Sky;
-use kiln_tests::{Options, Reflections, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, Reflections, compile, scene_of};
 
 use crate::harness::{
     H, Pinhole, W, fast_settings, floor_pixels, metal, pixel_xy, ratio_stats, render, render_frames, square,
@@ -16,14 +17,11 @@ use crate::harness::{
 
 #[test]
 fn ray_traced_ao_under_a_ceiling_matches_the_analytic_openness_and_converges() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A floor under a ceiling at height h, sky radiance S, AO radius R > h. With cosine-weighted
     // rays u = cos²θ is uniform; a ray hits the ceiling at t = h / cosθ, contributing (t/R)²
     // when t < R and 1 otherwise, so the openness is k (1 + ln(1/k)) with k = (h/R)², and a
     // diffuse floor shows albedo · S · openness.
-    let dir = tempfile::tempdir().unwrap();
     let (h, r, sky) = (1.0f64, 2.0f64, 2.0f32);
     // An albedo the sRGB G-buffer stores exactly.
     let albedo = srgb8(188);
@@ -62,14 +60,11 @@ fn ray_traced_ao_under_a_ceiling_matches_the_analytic_openness_and_converges() {
 
 #[test]
 fn ray_traced_reflections_of_a_mirror_floor_show_the_sky_and_an_emitter_at_the_fresnel_weight() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A smooth metal floor (F0 = base) under an emissive panel covering x in [−1, 1] at height
     // 2, facing down, in a sky of radiance S. A pixel's mirror ray sees the panel (radiance E)
     // or the sky; it shows F · L with Schlick's F at the view angle (α = 10⁻³: G2/G1 = 1 and
     // the lobe is a mirror to within a pixel). The split-sum fallback cannot see the panel.
-    let dir = tempfile::tempdir().unwrap();
     let (sky, emitted, base) = (1.0f32, 4.0f32, 0.8f32);
     let cam = Pinhole::new([0.0, 1.0, 6.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 60.0, W, H);
     let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();
@@ -153,10 +148,7 @@ fn ray_traced_reflections_of_a_mirror_floor_show_the_sky_and_an_emitter_at_the_f
 
 #[test]
 fn accumulation_restarts_when_the_camera_moves_or_the_size_changes() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = dir.path().join("demo.kiln");
     std::fs::write(&file, compile(cornell_box(), fast_settings())).unwrap();
     let all = Options::new(&file, 64, 48).rt_shadows(0.05, 0.0).rt_ao(None).rt_reflections(Reflections::Half);

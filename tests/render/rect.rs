@@ -12,7 +12,8 @@ use std::time::Instant;
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{LightKind, Sky};
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{
     ALBEDO, H, Pinhole, TOLERANCE, W, albedo, compare_plane, fast_settings, floor_pixels, light, pixel_xy,
@@ -123,10 +124,7 @@ fn camera() -> Pinhole {
 
 #[test]
 fn rect_light_on_a_diffuse_plane_matches_the_polygon_irradiance_in_the_direct_pass() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let cam = camera();
     let rect = Rect::new();
     let bytes = scene_bytes(&cam, &[]);
@@ -186,14 +184,11 @@ fn visible_fraction(rect: &Rect, p: DVec3, grow: f64) -> f64 {
 
 #[test]
 fn rect_light_ray_traced_shadows_give_the_umbra_lit_floor_and_penumbra_the_geometry_implies() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // Per pixel and frame one ray to a uniform point on the light decides the light's
     // visibility; the frames average to the visible fraction of its area, which scales the
     // direct pass's unshadowed radiance. Fully lit floor: the closed form; umbra: black;
     // penumbra: the closed form times the fraction computed here (on average over pixels).
-    let dir = tempfile::tempdir().unwrap();
     let cam = camera();
     let rect = Rect::new();
     let (ox, oz, oy, half) = OCCLUDER;
@@ -250,13 +245,10 @@ fn rect_light_ray_traced_shadows_give_the_umbra_lit_floor_and_penumbra_the_geome
 
 #[test]
 fn rect_light_reference_path_tracer_matches_the_polygon_irradiance() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // Light sampling and BRDF sampling (which sees the rect light when it crosses it) under
     // MIS: unbiased, so the mean ratio to the closed form is 1 up to noise, in each third of
     // the floor by brightness. The albedo reaches the path tracer as stored (no sRGB target).
-    let dir = tempfile::tempdir().unwrap();
     let cam = camera();
     let rect = Rect::new();
     let file = dir.path().join("rect-reference.kiln");
@@ -280,14 +272,11 @@ fn rect_light_reference_path_tracer_matches_the_polygon_irradiance() {
 
 #[test]
 fn the_camera_sees_the_rect_light_itself_in_the_frame_and_the_reference() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // From below the light's emitting side shows its radiance, exactly, in the frame (the direct
     // pass intersects each pixel's ray with the rectangle) and in the path tracer (camera rays
     // count it with weight 1); from above (`camera()`) only its dark back would be seen, which is
     // what the other tests here rely on.
-    let dir = tempfile::tempdir().unwrap();
     let rect = Rect::new();
     let cam = Pinhole::new([0.5, 0.3, 1.5], [0.5, 2.0, -0.3], [0.0, 1.0, 0.0], 70.0, W, H);
     let bytes = scene_bytes(&cam, &[]);

@@ -5,22 +5,20 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use kiln_format::manifest::Sky;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, floor_pixels, metal, ratio_stats};
 
 #[test]
 fn reference_path_tracer_reflects_a_uniform_sky_off_rough_metal_with_the_ggx_albedo() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A white-furnace check of the reference path tracer's GGX: a metal floor with F0 = 1 in a
     // sky of radiance 1 reflects exactly the directional albedo E(n·v, roughness) of
     // single-scattering GGX with height-correlated Smith (a half-space sees only the sky, so one
     // bounce is the whole answer). E comes from the compiler's independent quadrature of the
     // same BRDF (`brdf_lut::integrate`, checked against Gauss–Legendre at 1e-3), so the sampling
     // (visible normals), the evaluation and their MIS weights must agree for the mean to match.
-    let dir = tempfile::tempdir().unwrap();
     let roughness = [0.2f32, 0.5, 1.0];
     let cam = Pinhole::new([0.0, 6.0, 9.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 60.0, W, H);
     let strip = |x0: f32, x1: f32| {
@@ -67,9 +65,7 @@ fn reference_path_tracer_reflects_a_uniform_sky_off_rough_metal_with_the_ggx_alb
 
 #[test]
 fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // Inside a closed box whose walls all emit Le and reflect diffusely with albedo ρ, every
     // point receives the same radiance, so the light after at most N scattering events is
     // Le (1 + ρ + … + ρ^N) everywhere, and Le / (1 − ρ) without a limit. The bounce limit that
@@ -96,7 +92,6 @@ fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
     scene.sky = Sky { radiance: [0.0; 3] };
     let cam = Pinhole::new([0.0, 0.2, 0.5], [0.3, 0.0, -1.0], [0.0, 1.0, 0.0], 70.0, W, H);
     scene.cameras.push(cam.file_camera());
-    let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("glowing-box.kiln");
     std::fs::write(&file, compile(scene, fast_settings())).unwrap();
     let o = Options::new(&file, W, H).reference().build();

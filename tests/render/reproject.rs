@@ -11,7 +11,8 @@ use kiln_format::manifest::Sky;
 use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::render::Aa;
 use kiln_player::render::techniques;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, render_frames, square, srgb8};
 
@@ -23,10 +24,7 @@ const RADIUS: f32 = 2.0;
 
 #[test]
 fn reprojected_ao_follows_a_moving_camera_and_restarts_where_disoccluded() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     // A floor under a ceiling (as the AO test's) with a plate floating between them; the
     // camera just under the ceiling looks straight down and slides sideways, so that the plate
     // (2.25 times nearer) sweeps over the floor and uncovers a strip of it every frame.

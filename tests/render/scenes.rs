@@ -8,16 +8,14 @@ use kiln_compiler::import::demo::cornell_box;
 use kiln_compiler::settings::Settings;
 use kiln_player::camera::CameraOverride;
 use kiln_player::headless;
-use kiln_tests::{GBuffer, Options, Reflections, compile, shared_scenes, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{GBuffer, Options, Reflections, compile, shared_scenes};
 
 use crate::harness::{fast_settings, render, render_frames};
 
 #[test]
 fn demo_scene_renders_clean_in_png_and_exr_with_a_camera_override() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let bytes = compile(cornell_box(), fast_settings());
     let (rgb, result) = render(dir.path(), "demo", &bytes, |f| Options::new(f, 64, 48));
     assert!(rgb.iter().any(|&v| v > 0.0), "the demo frame is black");
@@ -36,9 +34,7 @@ fn demo_scene_renders_clean_in_png_and_exr_with_a_camera_override() {
 
 #[test]
 fn pica_pica_renders_clean_with_three_lights_and_its_shadow_maps() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     let Some(scenes) = shared_scenes() else {
         return;
     };
@@ -50,7 +46,6 @@ fn pica_pica_renders_clean_with_three_lights_and_its_shadow_maps() {
         .apply(&mut scene, "pica_pica.toml")
         .unwrap();
     let bytes = compile(scene, Settings { shaft_variants: Some(0), shadow_res: 256, ..Default::default() });
-    let dir = tempfile::tempdir().unwrap();
     let (rgb, result) = render(dir.path(), "pica", &bytes, |f| Options::new(f, 160, 90));
     let s = &result.session;
     assert_eq!(s.scene.manifest.lights.len(), 3);

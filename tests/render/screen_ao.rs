@@ -11,7 +11,8 @@ use glam::{DVec3, Vec3};
 use kiln_format::manifest::Sky;
 use kiln_player::render::techniques;
 use kiln_player::render::{Ao, ScreenFraction};
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, pixel_xy, render, square};
 
@@ -94,14 +95,11 @@ fn compare(ao: &[f64], pick: impl Fn(u32, u32) -> Option<f64>) -> (f64, f64, usi
 
 #[test]
 fn screen_space_ao_of_a_flat_floor_is_one() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // Every sample lies in the centre's tangent plane: SAO's v·n = 0 < β, GTAO's horizons are
     // the tangent plane on both sides. SAO is exactly 1 (up to the depth reconstruction);
     // GTAO's mean over its slices of |n_p|·â is 1 only as the slices' integral over φ, which
     // the per-pixel rotations and the blur approximate with 16 rotations × 3 slices.
-    let dir = tempfile::tempdir().unwrap();
     let bytes = scene(false);
     let cam = camera();
     let floor = |x: u32, y: u32| surface(&cam, x, y, false).map(|_| 1.0);
@@ -225,16 +223,13 @@ fn check_corner(
 
 #[test]
 fn sao_of_an_inside_corner_matches_its_estimator_integrated_here() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // The player's per-pixel rotations (16, one per pixel of a 4 × 4 block) and its blur
     // approximate the mean over φ that `sao_expected` integrates; the blur also mixes
     // neighbours a few pixels apart in d. Radius 4 projects to 60 to 120 pixels: most samples
     // read pyramid levels 1 to 2 (m = ⌊log₂(r'α/16)⌋), whose nearest depths rebuilt at the
     // sample's pixel lie off the surface by up to a few pixels' worth of depth; the estimator
     // here reads the exact surface.
-    let dir = tempfile::tempdir().unwrap();
     let bytes = scene(true);
     let cam = camera();
     for (name, radius, resolution, tolerance, worst_allowed) in [
@@ -264,10 +259,7 @@ fn sao_of_an_inside_corner_matches_its_estimator_integrated_here() {
 
 #[test]
 fn gtao_of_an_inside_corner_matches_the_closed_form_visibility() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let bytes = scene(true);
     for (name, slices, steps, tolerance, worst_allowed) in
         [("gtao-corner-8x24", 8, 24, 0.02, 0.05), ("gtao-corner-3x3", 3, 3, 0.05, 0.15)]
@@ -284,15 +276,12 @@ fn gtao_of_an_inside_corner_matches_the_closed_form_visibility() {
 
 #[test]
 fn screen_space_ao_does_not_bleed_across_depth_edges() {
-    if !vulkan() {
-        return;
-    }
+    let dir = gpu_test!();
     // A plate at height 0.5 over the floor, its top facing up: every sample beside it lands on
     // the floor below its tangent plane, so its top is unoccluded up to its edges (as the flat
     // floor), while the floor seen under it, just past its near edge on the screen, is strongly
     // occluded and some 40 % farther from the camera. A blur that mixed them would darken the
     // top's edge pixels.
-    let dir = tempfile::tempdir().unwrap();
     let (y0, x0, z0, z1) = (0.5f32, 0.7f32, 0.6f32, 1.6f32);
     let p = |x: f32, z: f32| Vec3::new(x, y0, z);
     let mut tris: Vec<[Vec3; 3]> = square(0.0, 20.0).to_vec();

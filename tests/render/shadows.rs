@@ -8,7 +8,8 @@ use kiln_compiler::import::demo::lambert_material;
 use kiln_compiler::settings::{Settings, VoxelRes};
 use kiln_format::linespace::Variants;
 use kiln_format::manifest::LightKind;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::{gpu_test, require, vulkan};
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{
     ALBEDO, H, Pinhole, TOLERANCE, W, albedo, compare_plane, fast_settings, floor_pixels, light, pixel_xy,
@@ -17,18 +18,14 @@ use crate::harness::{
 
 #[test]
 fn an_occluder_casts_the_shadow_its_geometry_implies() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     // Shadow maps: PCF blurs the edge over a few texels.
     occluder_case("occluder", [0.15; 2], fast_settings(), |f| Options::new(f, W, H));
 }
 
 #[test]
 fn ray_traced_hard_shadows_are_exact_up_to_the_pixel_at_the_umbra_edge() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     // A point light of radius 0: one ray per pixel decides exactly, so only pixels whose
     // footprint straddles the edge (about 0.06 units here) are left out.
     occluder_case("occluder-rt", [0.04; 2], fast_settings(), |f| Options::new(f, W, H).rt_shadows(0.0, 0.0));
@@ -47,9 +44,7 @@ fn line_space_settings() -> Settings {
 
 #[test]
 fn line_space_shadow_feelers_exact_in_filled_shafts_equal_ray_traced_shadows() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     occluder_case("occluder-ls-filled", [0.04; 2], line_space_settings(), |f| {
         Options::new(f, W, H).line_space_shadows(true)
     });
@@ -57,9 +52,7 @@ fn line_space_shadow_feelers_exact_in_filled_shafts_equal_ray_traced_shadows() {
 
 #[test]
 fn line_space_shadow_feelers_darken_the_umbra_and_only_what_the_shafts_cover() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     // Conservative between the ends: the umbra is exact and black; the lit floor may be darkened
     // only within the shafts around the occluder, which at 6 cells and N = 4 reach at most one
     // floor cell (10 / 6 units) beyond the umbra's edge.
@@ -70,10 +63,7 @@ fn line_space_shadow_feelers_darken_the_umbra_and_only_what_the_shafts_cover() {
 
 #[test]
 fn line_space_shadows_refuse_a_file_without_line_space() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let bytes = compile(scene_of(&square(0.0, 1.0)), fast_settings());
     let file = dir.path().join("plain.kiln");
     std::fs::write(&file, bytes).unwrap();

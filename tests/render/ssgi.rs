@@ -17,7 +17,8 @@ use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::{LightKind, Sky};
 use kiln_player::render::techniques;
 use kiln_player::render::{Gi, ScreenFraction};
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::{require, vulkan};
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, light, pixel_xy, render_frames, square, srgb8};
 
@@ -126,9 +127,7 @@ fn gathered(name: &str, cam: &Pinhole, tiled: bool) -> Vec<f64> {
 
 #[test]
 fn ssgi_bleeds_a_red_wall_onto_the_floor_as_the_closed_form_says() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     let cam = facing();
     for tiled in [false, true] {
         bleed(&cam, tiled);
@@ -183,9 +182,7 @@ fn bleed(cam: &Pinhole, tiled: bool) {
 
 #[test]
 fn ssgi_gives_nothing_from_a_wall_off_screen() {
-    if !vulkan() {
-        return;
-    }
+    require!(vulkan());
     // The documented limitation: the gather sees only what the screen shows. The floor before
     // the wall would receive the wall's red (the closed form below), but the camera looks down
     // at the sunlit floor alone, and coplanar floor points light each other with cos θ = 0.

@@ -10,7 +10,8 @@ use kiln_compiler::import::demo::lambert_material;
 use kiln_format::manifest::Sky;
 use kiln_player::render::Reflections;
 use kiln_player::render::techniques;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, metal, render, render_frames, square};
 
@@ -100,10 +101,7 @@ fn settled(cam: &Pinhole, x: i64, y: i64) -> bool {
 
 #[test]
 fn ssr_of_a_mirror_floor_shows_an_on_screen_emitter_at_the_mirrored_pixels_and_the_split_sum_elsewhere() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let bytes = scene();
     let cam = camera();
     // SSR shows the previous frame's radiance: the first frame has none, the second shows the

@@ -16,7 +16,8 @@ use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::bench;
 use kiln_player::render::Readable;
 use kiln_player::session::Session;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, WrittenExr, fast_settings, light, square, traced, written_exr};
 
@@ -117,10 +118,7 @@ fn radiance(session: &mut Session) -> Vec<f32> {
 
 #[test]
 fn headless_output_with_streamed_textures_is_bit_identical_to_a_whole_load() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     for (format, name) in [(TextureFormat::Rgba8, "rgba8"), (TextureFormat::Bc, "bc")] {
         let file = write(dir.path(), name, &checker_floor(format));
         // Two frames: the second reads the first's history, which the refinement must restart.
@@ -138,10 +136,7 @@ fn headless_output_with_streamed_textures_is_bit_identical_to_a_whole_load() {
 
 #[test]
 fn behind_a_fallback_streamed_textures_still_give_the_chosen_techniques_output() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = write(dir.path(), "rt", &checker_floor(TextureFormat::Rgba8));
     let WrittenExr { bytes: both, times, .. } =
         written_exr(dir.path(), "both", traced(Options::new(&file, W, H)).progressive().streaming(), 2);
@@ -160,10 +155,7 @@ fn behind_a_fallback_streamed_textures_still_give_the_chosen_techniques_output()
 
 #[test]
 fn the_first_frame_samples_the_coarse_levels_and_the_next_the_full_chain() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let file = write(dir.path(), "checker", &checker_floor(TextureFormat::Rgba8));
     let open = |o: Options| {
         let mut o = o.build();
@@ -201,10 +193,7 @@ fn the_first_frame_samples_the_coarse_levels_and_the_next_the_full_chain() {
 
 #[test]
 fn bench_counts_the_coarse_and_fine_texture_bytes_and_times_the_refinement() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     for (format, name) in [(TextureFormat::Rgba8, "rgba8"), (TextureFormat::Bc, "bc")] {
         let bytes = checker_floor(format);
         let (pixel, mips) = stored(&bytes);

@@ -10,7 +10,8 @@ use kiln_format::manifest::Sky;
 use kiln_player::camera::{CameraOverride, CameraPath};
 use kiln_player::render::Aa;
 use kiln_player::render::techniques;
-use kiln_tests::{Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, render, render_frames, square, srgb8};
 
@@ -115,10 +116,7 @@ fn supersampled(dir: &Path, bytes: &[u8], camera: Option<CameraOverride>) -> Vec
 
 #[test]
 fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let cam = Pinhole::new([0.0, 3.2, 3.2], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
     let bytes = strips_scene(&cam);
     let reference = supersampled(dir.path(), &bytes, None);
@@ -159,10 +157,7 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
 
 #[test]
 fn taa_on_a_moving_camera_leaves_no_ghost_behind_disoccluded_edges() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let cam = Pinhole::new([0.0, 3.2, 3.2], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
     let bytes = strips_scene(&cam);
     // A sideways dolly of 1.2 units: the strips move about 12 pixels against the floor.

@@ -9,7 +9,8 @@ use kiln_format::manifest::{LightKind, Wrap};
 use kiln_format::sections::{self, PixelFormat};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::render::TexelDecode;
-use kiln_tests::{GBuffer, Options, compile, scene_of, vulkan};
+use kiln_test_support::gpu_test;
+use kiln_tests::{GBuffer, Options, compile, scene_of};
 
 use crate::harness::{H, Pinhole, W, fast_settings, light, render, square};
 
@@ -75,10 +76,7 @@ fn textured_floor(format: TextureFormat) -> Vec<u8> {
 
 #[test]
 fn bc_textures_render_within_a_small_flip_of_rgba8() {
-    if !vulkan() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
+    let dir = gpu_test!();
     let bc = textured_floor(TextureFormat::Bc);
     let rgba8 = textured_floor(TextureFormat::Rgba8);
     // The files hold what the names say: BC7, BC5 (two uses) and RGBA8.

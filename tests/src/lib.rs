@@ -33,23 +33,6 @@ pub fn shared_scenes() -> Option<PathBuf> {
     Some(dir)
 }
 
-/// Says why a test is skipped and returns false, or fails when the environment variable
-/// `require` is set (as `.ci/run` sets them, so that nothing skips in CI).
-pub fn skip(require: &str, why: String) -> bool {
-    assert!(std::env::var_os(require).is_none(), "{why}, but {require} is set");
-    eprintln!("skipping: {why}");
-    false
-}
-
-/// Whether a Vulkan device is here; the player tests skip without one, unless
-/// `KILN_REQUIRE_VULKAN` is set.
-pub fn vulkan() -> bool {
-    match kiln_player::gpu::list_devices() {
-        Ok(d) if !d.is_empty() => true,
-        other => skip("KILN_REQUIRE_VULKAN", format!("no Vulkan device ({other:?})")),
-    }
-}
-
 /// A scene of the given triangles (one grey Lambertian material, flat normals; a Lambertian
 /// scene needs no BRDF table, which keeps compiling thousands of test scenes quick).
 pub fn scene_of(tris: &[[Vec3; 3]]) -> Scene {
