@@ -254,6 +254,27 @@ fn help_explains_every_command() {
     }
 }
 
+/// `kiln completions SHELL` and `kiln man` cover every subcommand and a nested flag; an
+/// unknown shell is a usage error.
+#[test]
+fn completions_and_man_page_name_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    for shell in ["bash", "zsh", "fish"] {
+        let run = kiln(dir.path(), &["completions", shell]);
+        assert_eq!(run.code, 0, "{shell}: {}", run.stderr);
+        for word in ["compile", "plan", "demo", "inspect", "verify", "cache", "max-size", "bvh-preset"] {
+            assert!(run.stdout.contains(word), "{shell} completions lack {word}");
+        }
+    }
+    let run = kiln(dir.path(), &["man"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.starts_with(".ie") && run.stdout.contains(".TH kiln 1"), "not roff");
+    for cmd in ["compile", "plan", "demo", "inspect", "verify", "cache"] {
+        assert!(run.stdout.contains(&format!("kiln\\-{cmd}")), "man page lacks {cmd}");
+    }
+    assert_eq!(kiln(dir.path(), &["completions", "cmd.exe"]).code, 2);
+}
+
 #[test]
 fn demo_is_deterministic_across_thread_counts() {
     let dir = tempfile::tempdir().unwrap();

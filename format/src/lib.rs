@@ -29,6 +29,7 @@ mod parallel;
 pub mod projection;
 pub mod query;
 pub mod read;
+pub mod readers;
 pub mod scene;
 pub mod sections;
 pub mod table;

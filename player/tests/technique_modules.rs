@@ -182,3 +182,22 @@ fn the_name_check_sees_a_planted_reference() {
     assert!(!names_module("ao::gtao_like::X", "ao", "gtao"));
     assert!(!names_module("gi::rt::Rt", "ao", "rt"));
 }
+
+/// The compiler names the player's techniques only through kiln-format's readers table (which
+/// the player's catalogue checks), never as its own list of flags.
+#[test]
+fn the_compiler_names_techniques_only_through_the_readers_table() {
+    let mut sources = Vec::new();
+    for dir in ["compiler/src", "format/src", "gpubake/src"] {
+        files(&root().join(dir), "rs", &mut sources);
+    }
+    let flags: Vec<String> = technique_modules().iter().map(|(e, m)| format!("--{e} {m}")).collect();
+    let mut named = Vec::new();
+    for path in sources.iter().filter(|p| !p.ends_with("format/src/readers.rs")) {
+        let text = code(path);
+        for flag in flags.iter().filter(|f| text.contains(f.as_str())) {
+            named.push(format!("{} names {flag}", path.strip_prefix(root()).unwrap().display()));
+        }
+    }
+    assert!(named.is_empty(), "{named:#?}");
+}

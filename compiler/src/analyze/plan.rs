@@ -5,6 +5,7 @@ use serde::Serialize;
 
 use crate::ir::Scene;
 use kiln_format::manifest::LightKind;
+use kiln_format::readers;
 
 use crate::analyze::budget::{self, Choice, Request};
 use crate::analyze::geometry::SceneGeometry;
@@ -159,11 +160,11 @@ impl Plan {
             run(
                 Stage::ShadowMaps,
                 format!(
-                    "{} maps of {1}x{1}, {cubes} cube maps of 6x{2}x{2}; read by kiln-play --shadows shadowmap \
-                     (the default) and --media toth",
+                    "{} maps of {1}x{1}, {cubes} cube maps of 6x{2}x{2}; read by kiln-play {3}",
                     casters - cubes,
                     settings.shadow_res,
-                    (settings.shadow_res / 2).max(1)
+                    (settings.shadow_res / 2).max(1),
+                    readers::list(readers::SHADOW_MAPS)
                 ),
             )
         });
@@ -175,9 +176,9 @@ impl Plan {
             run(
                 Stage::MediaVisibility,
                 format!(
-                    "medium 0, {casters} lights, {} cells on the longest axis; read by kiln-play --media march \
-                     (toth reads the shadow maps; mitchell and sousa neither)",
-                    settings.media_volume_res
+                    "medium 0, {casters} lights, {} cells on the longest axis; read by kiln-play {}",
+                    settings.media_volume_res,
+                    readers::list(readers::MEDIA_VISIBILITY)
                 ),
             )
         });
@@ -295,7 +296,7 @@ impl Plan {
                     Stage::LineSpace,
                     format!(
                         "N = {shaft_res} (shafts span 1/{shaft_res} of a cell: patches of {} scene units), {}{}, about {}{budget} ({}); \
-                         read by kiln-play --shadows linespace and --gi linespace{default_why}",
+                         read by kiln-play {}{default_why}",
                         short(e.patch()),
                         variants_name(shaft_variants),
                         if shaft_variants & Variants::PNMT != 0 {
@@ -308,7 +309,8 @@ impl Plan {
                             String::new()
                         },
                         mib(c.bytes),
-                        c.why
+                        c.why,
+                        readers::list(readers::LINE_SPACE)
                     ),
                 ));
             }

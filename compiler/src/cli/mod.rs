@@ -42,6 +42,14 @@ pub enum Command {
     /// Show or trim a stage cache (see `kiln compile --cache`).
     #[command(subcommand)]
     Cache(CacheCommand),
+    /// Write shell completions for SHELL to stdout (e.g. `kiln completions bash >
+    /// /etc/bash_completion.d/kiln`).
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
+    /// Write the man page (roff) to stdout (`kiln man > kiln.1`).
+    Man,
 }
 
 /// `kiln cache`.

@@ -20,5 +20,19 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Inspect(args) => inspect::run(&args),
         Command::Verify(args) => verify::run(&args),
         Command::Cache(c) => cache::run(&c),
+        Command::Completions { shell } => {
+            let mut cmd = <Cli as clap::CommandFactory>::command();
+            clap_complete::generate(shell, &mut cmd, "kiln", &mut std::io::stdout().lock());
+            Ok(())
+        }
+        Command::Man => {
+            let cmd = <Cli as clap::CommandFactory>::command();
+            clap_mangen::Man::new(cmd).render(&mut std::io::stdout().lock()).map_err(|e| {
+                crate::exit::CliError::new(
+                    crate::exit::Exit::Io,
+                    format!("could not write the man page: {e}"),
+                )
+            })
+        }
     }
 }
