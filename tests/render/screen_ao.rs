@@ -70,6 +70,14 @@ fn scene(with_wall: bool) -> Vec<u8> {
     compile(scene, fast_settings())
 }
 
+fn gtao(slices: u32, steps: u32) -> Ao {
+    Ao::Gtao(techniques::ao::gtao::Gtao {
+        radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
+        slices,
+        steps,
+    })
+}
+
 fn sao(resolution: ScreenFraction) -> Ao {
     Ao::Sao(techniques::ao::sao::Sao {
         radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
@@ -106,15 +114,7 @@ fn screen_space_ao_of_a_flat_floor_is_one() {
     for (name, ao, tolerance) in [
         ("sao-full", sao(ScreenFraction::Full), 1e-3),
         ("sao-half", sao(ScreenFraction::Half), 1e-3),
-        (
-            "gtao",
-            Ao::Gtao(techniques::ao::gtao::Gtao {
-                radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
-                slices: 3,
-                steps: 3,
-            }),
-            0.03,
-        ),
+        ("gtao", gtao(3, 3), 0.03),
     ] {
         let img = ao_image(dir.path(), name, &bytes, ao);
         let (mean, worst, n) = compare(&img, floor);
@@ -299,15 +299,7 @@ fn screen_space_ao_does_not_bleed_across_depth_edges() {
     for (name, ao, tolerance) in [
         ("sao-plate", sao(ScreenFraction::Full), 1e-3),
         ("sao-plate-half", sao(ScreenFraction::Half), 1e-3),
-        (
-            "gtao-plate",
-            Ao::Gtao(techniques::ao::gtao::Gtao {
-                radius: techniques::ao::Radius { radius: Some(RADIUS as f32), reach: 0.05 },
-                slices: 3,
-                steps: 3,
-            }),
-            0.03,
-        ),
+        ("gtao-plate", gtao(3, 3), 0.03),
     ] {
         let img = ao_image(dir.path(), name, &bytes, ao);
         let (mean, worst, n) = compare(&img, top);

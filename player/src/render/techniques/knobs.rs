@@ -84,21 +84,13 @@ pub const fn number(
     }
 }
 
-/// A whole-number knob (a count) that trades time for error.
-pub const fn count(
-    name: &'static str,
-    help: &'static str,
-    min: f32,
-    max: f32,
-    default: f32,
-    sweep: &'static [f32],
-) -> Knob {
-    Knob {
-        name,
-        help,
-        range: KnobRange::Number { min, max, sweep, whole: true },
-        default: KnobValue::Number(default),
-        role: KnobRole::Quality,
+/// `knob` (a [`number`]) taking whole numbers only: a count.
+pub const fn whole(knob: Knob) -> Knob {
+    match knob.range {
+        KnobRange::Number { min, max, sweep, .. } => {
+            Knob { range: KnobRange::Number { min, max, sweep, whole: true }, ..knob }
+        }
+        KnobRange::Choice(_) => knob,
     }
 }
 

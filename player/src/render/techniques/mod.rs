@@ -236,6 +236,26 @@ macro_rules! techniques {
 }
 pub(crate) use techniques;
 
+/// A technique without knobs: its unit struct and its registration (`NAME`, `HELP`); the module
+/// still writes `impl Technique`.
+macro_rules! plain_technique {
+    ($(#[$doc:meta])* $ty:ident, $name:literal, $help:expr) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+        pub struct $ty;
+
+        impl $crate::render::techniques::Registered for $ty {
+            const NAME: &'static str = $name;
+            const HELP: &'static str = $help;
+
+            fn new(_: &$crate::render::techniques::Knobs) -> Result<$ty, String> {
+                Ok($ty)
+            }
+        }
+    };
+}
+pub(crate) use plain_technique;
+
 /// One technique per effect: what a frame renders.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Techniques {

@@ -1,19 +1,13 @@
 //! `--aa accumulate`: a running mean of the stochastic passes while the camera is still; any
 //! change of view, projection or size restarts it.
 
-use crate::render::techniques::{History, Knobs, Registered, Technique};
+use crate::render::techniques::{History, Technique, plain_technique};
 
-/// A running mean while the camera is still.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Accumulate;
-
-impl Registered for Accumulate {
-    const NAME: &'static str = "accumulate";
-    const HELP: &'static str = "a running mean of the stochastic passes while the camera is still";
-
-    fn new(_: &Knobs) -> Result<Accumulate, String> {
-        Ok(Accumulate)
-    }
+plain_technique! {
+    /// A running mean while the camera is still.
+    Accumulate,
+    "accumulate",
+    "a running mean of the stochastic passes while the camera is still"
 }
 
 impl Technique for Accumulate {

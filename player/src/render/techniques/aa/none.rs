@@ -1,18 +1,12 @@
 //! `--aa none`: every frame shows its own samples.
 
-use crate::render::techniques::{Knobs, Registered, Technique};
+use crate::render::techniques::{Technique, plain_technique};
 
-/// Every frame its own samples.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Off;
-
-impl Registered for Off {
-    const NAME: &'static str = "none";
-    const HELP: &'static str = "every frame shows its own samples";
-
-    fn new(_: &Knobs) -> Result<Off, String> {
-        Ok(Off)
-    }
+plain_technique! {
+    /// Every frame its own samples.
+    Off,
+    "none",
+    "every frame shows its own samples"
 }
 
 impl Technique for Off {}

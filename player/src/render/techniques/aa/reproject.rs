@@ -4,7 +4,7 @@
 
 use super::reproject_rays;
 use crate::render::frame::FrameBuild;
-use crate::render::techniques::knobs::count;
+use crate::render::techniques::knobs::{number, whole};
 use crate::render::techniques::{History, Knob, Knobs, Registered, Technique};
 
 /// The ray-traced passes' running mean, reprojected.
@@ -19,7 +19,7 @@ impl Registered for Reproject {
     const HELP: &'static str = "the running mean of the ray-traced passes carried along while the camera moves: \
                                 each pixel's history read where its surface point was last frame, restarted only \
                                 where that point was hidden (see --history-frames)";
-    const KNOBS: &'static [Knob] = &[count(
+    const KNOBS: &'static [Knob] = &[whole(number(
         "history-frames",
         "the longest history while the camera moves: a new frame weighs at least 1/FRAMES \
          (a still camera's running mean is unbounded)",
@@ -27,7 +27,7 @@ impl Registered for Reproject {
         1024.0,
         32.0,
         &[8.0, 32.0],
-    )];
+    ))];
     const STOCHASTIC: bool = true;
 
     fn new(k: &Knobs) -> Result<Reproject, String> {

@@ -7,7 +7,7 @@
 use super::reproject_rays;
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::taa::TaaPass;
-use crate::render::techniques::knobs::{choice, count};
+use crate::render::techniques::knobs::{choice, number, whole};
 use crate::render::techniques::{History, Knob, Knobs, Registered, Technique};
 
 /// Temporal anti-aliasing.
@@ -29,7 +29,7 @@ impl Registered for Taa {
                                 as with reproject, at most --taa-frames long while moving; see --taa-frames, \
                                 --taa-weights";
     const KNOBS: &'static [Knob] = &[
-        count(
+        whole(number(
             "taa-frames",
             "the longest history in frames: a new frame weighs at least 1/FRAMES (the seed's \
              blend 0.88–0.97 is 8–33 frames); longer converges further on a still camera and \
@@ -38,7 +38,7 @@ impl Registered for Taa {
             1024.0,
             16.0,
             &[4.0, 8.0, 16.0, 32.0],
-        ),
+        )),
         choice(
             "taa-weights",
             "luma: blend c/(1 + luma) (Karis's, the seed's: damps fireflies, darkens \

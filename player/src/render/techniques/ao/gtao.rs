@@ -6,15 +6,13 @@
 //! blur ([`ScreenAoPass`]). Full resolution, as Intel's XeGTAO (whose "High" preset is 3 slices
 //! × 3 steps, the defaults here). Deterministic per frame.
 
-use kiln_format::gpu::{FrameFlags, ScreenAoConstants};
+use kiln_format::gpu::ScreenAoConstants;
 
 use super::{AO_RADIUS, Radius, ao_reach};
-use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::ao::ScreenAoPass;
-use crate::render::passes::depth_pyramid::Reduction;
+use crate::render::frame::FrameBuild;
 use crate::render::spirv;
-use crate::render::techniques::knobs::count;
-use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::knobs::{number, whole};
+use crate::render::techniques::{Knob, Knobs, Registered, Technique};
 
 /// Ground-truth ambient occlusion.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,8 +34,8 @@ impl Registered for Gtao {
     const KNOBS: &'static [Knob] = &[
         AO_RADIUS,
         ao_reach(0.05, &[0.05]),
-        count("ao-slices", "screen directions per pixel (XeGTAO High: 3)", 1.0, 32.0, 3.0, &[2.0, 3.0, 9.0]),
-        count("ao-steps", "samples along each side of a slice (XeGTAO High: 3)", 1.0, 64.0, 3.0, &[2.0, 3.0, 8.0]),
+        whole(number("ao-slices", "screen directions per pixel (XeGTAO High: 3)", 1.0, 32.0, 3.0, &[2.0, 3.0, 9.0])),
+        whole(number("ao-steps", "samples along each side of a slice (XeGTAO High: 3)", 1.0, 64.0, 3.0, &[2.0, 3.0, 8.0])),
     ];
 
     fn new(k: &Knobs) -> Result<Gtao, String> {
@@ -46,26 +44,12 @@ impl Registered for Gtao {
 }
 
 impl Technique for Gtao {
+    super::ao_image!();
+
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
+        let constants =
+            ScreenAoConstants { count: self.slices.max(1), steps: self.steps.max(1), step: 1, ..Default::default() };
         // Level 0 only: the horizons are searched at full resolution.
-        frame.depth_pyramid(Reduction::Nearest, false, 0);
-        let gpu = frame.gpu;
-        frame.add(Stage::Ao, move || {
-            let constants = ScreenAoConstants {
-                count: self.slices.max(1),
-                steps: self.steps.max(1),
-                step: 1,
-                ..Default::default()
-            };
-            ScreenAoPass::new(gpu, spirv::shader!("gtao/gtao.comp"), constants, self.radius)
-        });
-    }
-
-    fn flags(&self) -> u32 {
-        FrameFlags::RT_AO
-    }
-
-    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
-        inputs.rt.ao_radius = self.radius.world(scene.diagonal).max(1e-6);
+        super::screen_ao(frame, 0, spirv::shader!("gtao/gtao.comp"), constants, self.radius);
     }
 }

@@ -1,18 +1,12 @@
 //! `--ao none`: no ambient occlusion (the material's occlusion texture still applies).
 
-use crate::render::techniques::{Knobs, Registered, Technique};
+use crate::render::techniques::{Technique, plain_technique};
 
-/// No ambient occlusion.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Off;
-
-impl Registered for Off {
-    const NAME: &'static str = "none";
-    const HELP: &'static str = "no ambient occlusion (the material's occlusion texture still applies)";
-
-    fn new(_: &Knobs) -> Result<Off, String> {
-        Ok(Off)
-    }
+plain_technique! {
+    /// No ambient occlusion.
+    Off,
+    "none",
+    "no ambient occlusion (the material's occlusion texture still applies)"
 }
 
 impl Technique for Off {}

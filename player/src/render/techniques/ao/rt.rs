@@ -1,14 +1,13 @@
 //! `--ao rt`: one cosine-weighted ray per pixel per frame through the BVH; a hit at t weighs
 //! (t/R)² (`passes/rt_ao.rs`, `shaders/rt/ao.comp`).
 
-use kiln_format::gpu::FrameFlags;
 
 use super::{AO_RADIUS, Radius, ao_reach};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::ao;
 use crate::render::passes::rt_ao::RtAoPass;
 use crate::render::passes::rt_history::{Accumulated, Kind};
-use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::{Knob, Knobs, Registered, Technique};
 
 /// Ray-traced ambient occlusion.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -30,6 +29,8 @@ impl Registered for Rt {
 }
 
 impl Technique for Rt {
+    super::ao_image!();
+
     fn ray_traced(&self) -> bool {
         true
     }
@@ -39,18 +40,9 @@ impl Technique for Rt {
         frame.add(Stage::Ao, move || RtAoPass::new(gpu, decode));
     }
 
-    fn flags(&self) -> u32 {
-        // The direct pass multiplies the sky's ambient by the AO image, whichever technique
-        // makes it (the flag's name predates the screen-space ones).
-        FrameFlags::RT_AO
-    }
 
     fn accumulated(&self, _: usize) -> Option<Accumulated> {
         let histories = ["rt ao history a", "rt ao history b"];
         Some(Accumulated::new(ao::AO, histories, Kind::One, 1, 1))
-    }
-
-    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
-        inputs.rt.ao_radius = self.radius.world(scene.diagonal).max(1e-6);
     }
 }

@@ -4,15 +4,13 @@
 //! with depth weights that also upsamples ([`ScreenAoPass`]). Deterministic per frame: the AO
 //! image is overwritten, never accumulated.
 
-use kiln_format::gpu::{FrameFlags, ScreenAoConstants};
+use kiln_format::gpu::ScreenAoConstants;
 
 use super::{AO_RADIUS, Radius, ao_reach};
-use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::ao::ScreenAoPass;
-use crate::render::passes::depth_pyramid::Reduction;
+use crate::render::frame::FrameBuild;
 use crate::render::spirv;
-use crate::render::techniques::knobs::{UNBOUNDED, choice, count, number};
-use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, ScreenFraction, Technique};
+use crate::render::techniques::knobs::{UNBOUNDED, choice, number, whole};
+use crate::render::techniques::{Knob, Knobs, Registered, ScreenFraction, Technique};
 
 /// The coarsest depth-pyramid level SAO's samples read (`SAO_TOP` in `shaders/sao/sao.comp`;
 /// McGuire et al. 2012 stop at 5).
@@ -40,7 +38,7 @@ impl Registered for Sao {
     const KNOBS: &'static [Knob] = &[
         AO_RADIUS,
         ao_reach(0.05, &[0.05]),
-        count("ao-samples", "samples per AO pixel on the spiral (the seed's N)", 1.0, 64.0, 16.0, &[8.0, 16.0, 32.0]),
+        whole(number("ao-samples", "samples per AO pixel on the spiral (the seed's N)", 1.0, 64.0, 16.0, &[8.0, 16.0, 32.0])),
         number(
             "ao-turns",
             "turns of the sample spiral (τ; 7: McGuire et al.'s prime for few samples)",
@@ -69,25 +67,15 @@ impl Registered for Sao {
 }
 
 impl Technique for Sao {
+    super::ao_image!();
+
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
-        frame.depth_pyramid(Reduction::Nearest, false, TOP_LEVEL);
-        let gpu = frame.gpu;
-        frame.add(Stage::Ao, move || {
-            let constants = ScreenAoConstants {
-                count: self.samples.max(1),
-                turns: self.turns,
-                step: self.resolution.divisor(),
-                ..Default::default()
-            };
-            ScreenAoPass::new(gpu, spirv::shader!("sao/sao.comp"), constants, self.radius)
-        });
-    }
-
-    fn flags(&self) -> u32 {
-        FrameFlags::RT_AO
-    }
-
-    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
-        inputs.rt.ao_radius = self.radius.world(scene.diagonal).max(1e-6);
+        let constants = ScreenAoConstants {
+            count: self.samples.max(1),
+            turns: self.turns,
+            step: self.resolution.divisor(),
+            ..Default::default()
+        };
+        super::screen_ao(frame, TOP_LEVEL, spirv::shader!("sao/sao.comp"), constants, self.radius);
     }
 }

@@ -2,19 +2,13 @@
 
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::gbuffer::GBufferPass;
-use crate::render::techniques::{Knobs, Registered, Technique};
+use crate::render::techniques::{Technique, plain_technique};
 
-/// Rasterised with every material evaluated per fragment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Raster;
-
-impl Registered for Raster {
-    const NAME: &'static str = "raster";
-    const HELP: &'static str = "rasterise every material attribute (five targets)";
-
-    fn new(_: &Knobs) -> Result<Raster, String> {
-        Ok(Raster)
-    }
+plain_technique! {
+    /// Rasterised with every material evaluated per fragment.
+    Raster,
+    "raster",
+    "rasterise every material attribute (five targets)"
 }
 
 impl Technique for Raster {

@@ -5,20 +5,14 @@
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::resolve::ResolvePass;
 use crate::render::passes::visibility::VisibilityPass;
-use crate::render::techniques::{Knobs, Needs, Registered, Technique};
+use crate::render::techniques::{Needs, Technique, plain_technique};
 
-/// A visibility buffer rasterised, the materials resolved in compute.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Visibility;
-
-impl Registered for Visibility {
-    const NAME: &'static str = "visibility";
-    const HELP: &'static str = "rasterise a visibility buffer (triangle per pixel), evaluate materials in compute: \
-                                faster on GPUs with little raster hardware (e.g. NVIDIA H100/H200)";
-
-    fn new(_: &Knobs) -> Result<Visibility, String> {
-        Ok(Visibility)
-    }
+plain_technique! {
+    /// A visibility buffer rasterised, the materials resolved in compute.
+    Visibility,
+    "visibility",
+    "rasterise a visibility buffer (triangle per pixel), evaluate materials in compute: \
+                                faster on GPUs with little raster hardware (e.g. NVIDIA H100/H200)"
 }
 
 impl Technique for Visibility {

@@ -3,15 +3,13 @@
 //! specular bounces and emissive hits through the BVH (`passes/rt_gi.rs`,
 //! `shaders/rt/gi_linespace*.comp`).
 
-use kiln_format::gpu::FrameFlags;
 
 use super::GI_BOUNCES;
 use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_gi::RtGiPass;
 use crate::render::spirv;
 use crate::render::techniques::knobs::choice;
-use crate::render::techniques::{Knob, Knobs, Needs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::{Knob, Knobs, Needs, Registered, Technique};
 use crate::scene::linespace::LsArrays;
 
 /// Path-traced diffuse GI through the line space.
@@ -63,6 +61,8 @@ impl Registered for LineSpace {
 }
 
 impl Technique for LineSpace {
+    super::traced_gi!();
+
     fn needs(&self) -> Needs {
         let line_space = match self.structure {
             GiStructure::Pnmt => LsArrays::PNMT_QUERY | LsArrays::BINARY_QUERY,
@@ -72,9 +72,6 @@ impl Technique for LineSpace {
         Needs { line_space, ..Needs::TRACED_SURFACES }
     }
 
-    fn ray_traced(&self) -> bool {
-        true
-    }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, decode) = (frame.gpu, frame.decode);
@@ -84,17 +81,5 @@ impl Technique for LineSpace {
             GiStructure::Preillum => spirv::shader!("rt/gi_linespace_preillum.comp"),
         };
         frame.add(Stage::Gi, move || RtGiPass::with_line_space(gpu, code, decode));
-    }
-
-    fn flags(&self) -> u32 {
-        FrameFlags::RT_GI
-    }
-
-    fn accumulated(&self, _: usize) -> Option<Accumulated> {
-        super::accumulated()
-    }
-
-    fn rays(&self, _: &RayScene, inputs: &mut RayInputs) {
-        inputs.rt.gi_bounces = self.bounces;
     }
 }

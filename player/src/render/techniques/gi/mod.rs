@@ -1,9 +1,7 @@
 //! Indirect diffuse light: what replaces the sky's diffuse ambient.
 
-use super::knobs::{Knob, count};
+use super::knobs::{Knob, number, whole};
 use super::techniques;
-use crate::render::passes::rt_gi;
-use crate::render::passes::rt_history::{Accumulated, Kind};
 
 techniques! {
     /// Indirect diffuse light.
@@ -15,7 +13,7 @@ techniques! {
 }
 
 /// Bounces of the path-traced GI techniques.
-pub const GI_BOUNCES: Knob = count(
+pub const GI_BOUNCES: Knob = whole(number(
     "gi-bounces",
     "bounces of indirect light after the visible surface (1: the sky, emissive surfaces and \
      the light the first surface hit receives directly; each more adds one bounce)",
@@ -23,13 +21,36 @@ pub const GI_BOUNCES: Knob = count(
     8.0,
     1.0,
     &[1.0, 2.0],
-);
+));
 
-/// The GI image the reprojected accumulation carries (every path-traced technique's).
-fn accumulated() -> Option<Accumulated> {
-    let histories = ["rt gi history a", "rt gi history b"];
-    Some(Accumulated::new(rt_gi::GI, histories, Kind::Four, 1, 1))
+/// The `Technique` methods the path-traced GI techniques share (their settings' `bounces`): ray
+/// traced, the GI image accumulated, the bounce count set.
+macro_rules! traced_gi {
+    () => {
+        fn ray_traced(&self) -> bool {
+            true
+        }
+
+        fn flags(&self) -> u32 {
+            kiln_format::gpu::FrameFlags::RT_GI
+        }
+
+        fn accumulated(&self, _: usize) -> Option<$crate::render::passes::rt_history::Accumulated> {
+            use $crate::render::passes::rt_history::{Accumulated, Kind};
+            let histories = ["rt gi history a", "rt gi history b"];
+            Some(Accumulated::new($crate::render::passes::rt_gi::GI, histories, Kind::Four, 1, 1))
+        }
+
+        fn rays(
+            &self,
+            _: &$crate::render::techniques::RayScene,
+            inputs: &mut $crate::render::techniques::RayInputs,
+        ) {
+            inputs.rt.gi_bounces = self.bounces;
+        }
+    };
 }
+use traced_gi;
 
 impl Gi {
     /// The bounce count of a path-traced technique.

@@ -1,14 +1,12 @@
 //! `--gi rt`: path traced from the G-buffer through the CWBVH: one cosine-weighted path per
 //! pixel per frame, next-event estimation at its hits (`passes/rt_gi.rs`, `shaders/rt/gi.glsl`).
 
-use kiln_format::gpu::FrameFlags;
 
 use super::GI_BOUNCES;
 use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_gi::RtGiPass;
 use crate::render::spirv;
-use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::{Knob, Knobs, Registered, Technique};
 
 /// Path-traced diffuse GI through the BVH.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,24 +31,10 @@ impl Registered for Rt {
 }
 
 impl Technique for Rt {
-    fn ray_traced(&self) -> bool {
-        true
-    }
+    super::traced_gi!();
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, decode) = (frame.gpu, frame.decode);
         frame.add(Stage::Gi, move || RtGiPass::new(gpu, spirv::shader!("rt/gi.comp"), decode));
-    }
-
-    fn flags(&self) -> u32 {
-        FrameFlags::RT_GI
-    }
-
-    fn accumulated(&self, _: usize) -> Option<Accumulated> {
-        super::accumulated()
-    }
-
-    fn rays(&self, _: &RayScene, inputs: &mut RayInputs) {
-        inputs.rt.gi_bounces = self.bounces;
     }
 }

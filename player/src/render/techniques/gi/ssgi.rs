@@ -7,7 +7,7 @@ use kiln_format::gpu::FrameFlags;
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::depth_pyramid::{self, Reduction};
 use crate::render::passes::ssgi::SsgiPass;
-use crate::render::techniques::knobs::{choice, count};
+use crate::render::techniques::knobs::{choice, number, whole};
 use crate::render::techniques::{Knob, Knobs, Registered, ScreenFraction, Technique};
 
 /// Screen-space diffuse GI.
@@ -38,14 +38,14 @@ impl Registered for Ssgi {
                                 still; added to the sky's ambient. No visibility: light passes through what the \
                                 screen shows, and what it does not show (off screen, hidden) gives none";
     const KNOBS: &'static [Knob] = &[
-        count(
+        whole(number(
             "ssgi-samples",
             "spiral samples per pixel on each level (the seed's 128; tested 16 to 256)",
             1.0,
             1024.0,
             128.0,
             &[16.0, 32.0, 64.0, 128.0, 256.0],
-        ),
+        )),
         choice(
             "ssgi-res",
             "the finest level gathered, upsampled to the screen: full, half (the seed's \
@@ -53,7 +53,7 @@ impl Registered for Ssgi {
             &["full", "half", "quarter"],
             1,
         ),
-        count(
+        whole(number(
             "ssgi-radius",
             "sample radius R in pixels of each level (the seed's 40); levels go up until one \
              radius spans the screen",
@@ -61,7 +61,7 @@ impl Registered for Ssgi {
             256.0,
             40.0,
             &[],
-        ),
+        )),
         choice(
             "ssgi-mip",
             "how the depth and normal pyramids pick each coarser texel: nearest (the \
@@ -76,7 +76,7 @@ impl Registered for Ssgi {
             &["off", "on"],
             0,
         ),
-        count(
+        whole(number(
             "ssgi-frames",
             "the most frames the GI's running mean averages while the camera is still (then \
              exponential, as the bounces build up)",
@@ -84,7 +84,7 @@ impl Registered for Ssgi {
             4096.0,
             16.0,
             &[],
-        ),
+        )),
         choice(
             "ssgi-rotation",
             "how the sample spirals turn: pixel (a random angle per texel, the seed's) or \

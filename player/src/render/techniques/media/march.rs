@@ -5,7 +5,7 @@
 use super::{casters, no_medium};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::media::MediaMarchPass;
-use crate::render::techniques::knobs::count;
+use crate::render::techniques::knobs::{number, whole};
 use crate::render::techniques::{Knob, Knobs, Needs, Registered, Technique};
 
 /// Single scattering by ray marching.
@@ -20,14 +20,14 @@ impl Registered for March {
     const HELP: &'static str = "single scattering: each pixel's view ray marched through the media in world space \
                                 (light visibility from the compiler's baked volume, transmittance analytic; works \
                                 with the light off screen), see --media-steps";
-    const KNOBS: &'static [Knob] = &[count(
+    const KNOBS: &'static [Knob] = &[whole(number(
         "media-steps",
         "steps along the view ray through each medium",
         1.0,
         1024.0,
         32.0,
         &[8.0, 16.0, 32.0, 64.0],
-    )];
+    ))];
 
     fn new(k: &Knobs) -> Result<March, String> {
         Ok(March { steps: k.whole("media-steps")? })

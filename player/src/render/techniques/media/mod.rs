@@ -1,6 +1,6 @@
 //! Participating media.
 
-use super::knobs::{Knob, count};
+use super::knobs::{Knob, number, whole};
 use super::techniques;
 
 techniques! {
@@ -14,7 +14,7 @@ techniques! {
 }
 
 /// Samples along the way of the media techniques that take a fixed count (Mitchell, Tóth).
-pub const MEDIA_SAMPLES: Knob = count(
+pub const MEDIA_SAMPLES: Knob = whole(number(
     "media-samples",
     "samples per pixel: mitchell, towards the light; toth, along the view ray (over an \
      interleaving block)",
@@ -22,7 +22,7 @@ pub const MEDIA_SAMPLES: Knob = count(
     1024.0,
     60.0,
     &[18.0, 60.0, 100.0],
-);
+));
 
 /// Resolution of the image-space god rays' first image.
 pub const MEDIA_RES: Knob = super::knobs::choice(

@@ -1,18 +1,12 @@
 //! `--media none`: no participating media.
 
-use crate::render::techniques::{Knobs, Registered, Technique};
+use crate::render::techniques::{Technique, plain_technique};
 
-/// No participating media.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Off;
-
-impl Registered for Off {
-    const NAME: &'static str = "none";
-    const HELP: &'static str = "no participating media";
-
-    fn new(_: &Knobs) -> Result<Off, String> {
-        Ok(Off)
-    }
+plain_technique! {
+    /// No participating media.
+    Off,
+    "none",
+    "no participating media"
 }
 
 impl Technique for Off {}

@@ -5,7 +5,7 @@
 use super::{MEDIA_RES, no_medium};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::sousa::SousaPass;
-use crate::render::techniques::knobs::{UNBOUNDED, count, number, scene};
+use crate::render::techniques::knobs::{UNBOUNDED, number, scene, whole};
 use crate::render::techniques::{Knob, Knobs, Needs, Registered, ScreenFraction, Technique};
 
 /// Sousa's sun shafts.
@@ -26,7 +26,7 @@ impl Registered for Sousa {
                                 of the screen); image space, as mitchell; see --media-taps, --media-res, \
                                 --media-brightness";
     const KNOBS: &'static [Knob] = &[
-        count("media-taps", "samples per pass (TAPS; 3 passes)", 1.0, 64.0, 6.0, &[3.0, 6.0, 10.0]),
+        whole(number("media-taps", "samples per pass (TAPS; 3 passes)", 1.0, 64.0, 6.0, &[3.0, 6.0, 10.0])),
         MEDIA_RES,
         // Artistic: a sweep holds it at its default.
         scene(number(

@@ -7,7 +7,7 @@ use kiln_format::gpu::Phases;
 use super::{MEDIA_SAMPLES, casters, no_medium};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::toth::TothPass;
-use crate::render::techniques::knobs::{choice, count, scene};
+use crate::render::techniques::knobs::{choice, number, whole, scene};
 use crate::render::techniques::{Knob, Knobs, Needs, Registered, Technique};
 
 /// Tóth & Umenhoffer's shadow-map ray march.
@@ -38,7 +38,7 @@ impl Registered for Toth {
                                 light off screen; see --media-samples, --media-block, --media-phase";
     const KNOBS: &'static [Knob] = &[
         MEDIA_SAMPLES,
-        count(
+        whole(number(
             "media-block",
             "side of the interleaving block: each of its block² pixels takes every block²-th \
              sample, a block-wide blur joins them (1: every pixel takes all)",
@@ -46,7 +46,7 @@ impl Registered for Toth {
             8.0,
             4.0,
             &[1.0, 2.0, 4.0],
-        ),
+        )),
         // What the reference renders: a sweep holds it.
         scene(choice(
             "media-phase",

@@ -9,7 +9,7 @@ use kiln_format::gpu::FrameFlags;
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::hiz::HizPass;
 use crate::render::passes::ssr::SsrPass;
-use crate::render::techniques::knobs::{count, number};
+use crate::render::techniques::knobs::{number, whole};
 use crate::render::techniques::{Knob, Knobs, Registered, Technique};
 
 /// Screen-space reflections.
@@ -29,7 +29,7 @@ impl Registered for Ssr {
                                 the split-sum ambient where the ray misses or leaves the screen (faded near its \
                                 edges) and above --ssr-max-roughness; see --ssr-steps";
     const KNOBS: &'static [Knob] = &[
-        count(
+        whole(number(
             "ssr-steps",
             "most iterations of the hierarchical march per pixel: each skips a cell of empty space \
              (a level up) or refines a potential hit (a level down); 48 crosses a 1080p screen \
@@ -38,7 +38,7 @@ impl Registered for Ssr {
             1024.0,
             48.0,
             &[16.0, 32.0, 48.0, 96.0],
-        ),
+        )),
         number(
             "ssr-max-roughness",
             "surfaces rougher than this keep the split-sum ambient (faded over the last fifth): \

@@ -1,15 +1,13 @@
 //! `--shadows linespace`: the ray-traced estimator with its shadow feelers through the binary
 //! line space (seed 004; `passes/rt_shadows.rs`, `shaders/rt/shadows_linespace*.comp`).
 
-use kiln_format::gpu::FrameFlags;
 
-use super::{LIGHT_RADIUS, SUN_ANGLE, traced_fallback, traced_rays};
+use super::{LIGHT_RADIUS, SUN_ANGLE};
 use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_shadows::RtShadowsPass;
 use crate::render::spirv;
 use crate::render::techniques::knobs::choice;
-use crate::render::techniques::{Knob, Knobs, Needs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::{Knob, Knobs, Needs, Registered, Technique};
 use crate::scene::linespace::LsArrays;
 
 /// Soft shadows with the rays through the binary line space.
@@ -62,17 +60,13 @@ impl Registered for LineSpace {
 }
 
 impl Technique for LineSpace {
+    super::traced_shadows!();
+
     fn needs(&self) -> Needs {
         Needs { line_space: LsArrays::BINARY_QUERY, ..Needs::TRACED_SURFACES }
     }
 
-    fn ray_traced(&self) -> bool {
-        true
-    }
 
-    fn fallback(&self, shadow_maps: bool) -> Option<&'static str> {
-        traced_fallback(shadow_maps)
-    }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
@@ -81,17 +75,5 @@ impl Technique for LineSpace {
             LsShadowTest::Filled => spirv::shader!("rt/shadows_linespace_exact.comp"),
         };
         frame.add(Stage::Shadows, move || RtShadowsPass::new(gpu, code, true, lights, decode));
-    }
-
-    fn flags(&self) -> u32 {
-        FrameFlags::RT_SHADOWS
-    }
-
-    fn accumulated(&self, lights: usize) -> Option<Accumulated> {
-        super::accumulated(lights)
-    }
-
-    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
-        traced_rays(self.light_radius, self.sun_degrees, scene, inputs);
     }
 }

@@ -1,9 +1,7 @@
 //! Shadows of the analytic lights.
 
 use super::knobs::{Knob, UNBOUNDED, number, scene};
-use super::{RayInputs, RayScene, techniques};
-use crate::render::passes::rt_history::{Accumulated, Kind};
-use crate::render::passes::rt_shadows;
+use super::techniques;
 
 techniques! {
     /// Shadows of the analytic lights.
@@ -34,23 +32,43 @@ pub const SUN_ANGLE: Knob = scene(number(
     &[0.0, 0.53, 2.0],
 ));
 
-/// The lights' sizes and the shadow pass's layer count of a traced technique.
-fn traced_rays(light_radius: f32, sun_degrees: f32, scene: &RayScene, inputs: &mut RayInputs) {
-    inputs.light_radius = light_radius;
-    inputs.sun_degrees = sun_degrees;
-    inputs.rt.shadow_lights = rt_shadows::layers(scene.lights_used).min(scene.lights_used as u32);
-}
+/// The `Technique` methods the traced shadow techniques share (their settings'
+/// `light_radius` and `sun_degrees`): ray traced, falling back to the file's shadow maps (else
+/// none), the shadow pass's layers accumulated and sized, the lights sized.
+macro_rules! traced_shadows {
+    () => {
+        fn ray_traced(&self) -> bool {
+            true
+        }
 
-/// The shadow layers the reprojected accumulation carries, one per light.
-fn accumulated(lights: usize) -> Option<Accumulated> {
-    let histories = ["rt shadows history a", "rt shadows history b"];
-    Some(Accumulated::new(rt_shadows::SHADOWS, histories, Kind::Layers, 1, rt_shadows::layers(lights)))
-}
+        fn fallback(&self, shadow_maps: bool) -> Option<&'static str> {
+            Some(if shadow_maps { "shadowmap" } else { "none" })
+        }
 
-/// What a traced technique falls back to: the file's shadow maps, else none.
-fn traced_fallback(shadow_maps: bool) -> Option<&'static str> {
-    Some(if shadow_maps { "shadowmap" } else { "none" })
+        fn flags(&self) -> u32 {
+            kiln_format::gpu::FrameFlags::RT_SHADOWS
+        }
+
+        fn accumulated(&self, lights: usize) -> Option<$crate::render::passes::rt_history::Accumulated> {
+            use $crate::render::passes::rt_history::{Accumulated, Kind};
+            use $crate::render::passes::rt_shadows::{SHADOWS, layers};
+            let histories = ["rt shadows history a", "rt shadows history b"];
+            Some(Accumulated::new(SHADOWS, histories, Kind::Layers, 1, layers(lights)))
+        }
+
+        fn rays(
+            &self,
+            scene: &$crate::render::techniques::RayScene,
+            inputs: &mut $crate::render::techniques::RayInputs,
+        ) {
+            inputs.light_radius = self.light_radius;
+            inputs.sun_degrees = self.sun_degrees;
+            let layers = $crate::render::passes::rt_shadows::layers(scene.lights_used);
+            inputs.rt.shadow_lights = layers.min(scene.lights_used as u32);
+        }
+    };
 }
+use traced_shadows;
 
 impl Shadows {
     /// The light sizes of a traced technique (point/spot radius, sun degrees); `None` for the

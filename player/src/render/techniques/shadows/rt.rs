@@ -1,14 +1,12 @@
 //! `--shadows rt`: one ray per light per pixel per frame towards a point sampled on the light,
 //! through the BVH (`passes/rt_shadows.rs`, `shaders/rt/shadows.comp`).
 
-use kiln_format::gpu::FrameFlags;
 
-use super::{LIGHT_RADIUS, SUN_ANGLE, traced_fallback, traced_rays};
+use super::{LIGHT_RADIUS, SUN_ANGLE};
 use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::rt_history::Accumulated;
 use crate::render::passes::rt_shadows::RtShadowsPass;
 use crate::render::spirv;
-use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::{Knob, Knobs, Registered, Technique};
 
 /// Ray-traced soft shadows.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -32,28 +30,11 @@ impl Registered for Rt {
 }
 
 impl Technique for Rt {
-    fn ray_traced(&self) -> bool {
-        true
-    }
+    super::traced_shadows!();
 
-    fn fallback(&self, shadow_maps: bool) -> Option<&'static str> {
-        traced_fallback(shadow_maps)
-    }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
         let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
         frame.add(Stage::Shadows, move || RtShadowsPass::new(gpu, spirv::shader!("rt/shadows.comp"), false, lights, decode));
-    }
-
-    fn flags(&self) -> u32 {
-        FrameFlags::RT_SHADOWS
-    }
-
-    fn accumulated(&self, lights: usize) -> Option<Accumulated> {
-        super::accumulated(lights)
-    }
-
-    fn rays(&self, scene: &RayScene, inputs: &mut RayInputs) {
-        traced_rays(self.light_radius, self.sun_degrees, scene, inputs);
     }
 }

@@ -1,19 +1,13 @@
 //! `--shadows shadowmap`: the compiler's baked shadow maps (PCF; PCSS for rect lights), read by
 //! the direct-light pass.
 
-use crate::render::techniques::{Knobs, Needs, Registered, Technique};
+use crate::render::techniques::{Needs, Technique, plain_technique};
 
-/// The compiler's baked shadow maps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct ShadowMap;
-
-impl Registered for ShadowMap {
-    const NAME: &'static str = "shadowmap";
-    const HELP: &'static str = "the compiler's baked shadow maps (PCF; PCSS for rect lights)";
-
-    fn new(_: &Knobs) -> Result<ShadowMap, String> {
-        Ok(ShadowMap)
-    }
+plain_technique! {
+    /// The compiler's baked shadow maps.
+    ShadowMap,
+    "shadowmap",
+    "the compiler's baked shadow maps (PCF; PCSS for rect lights)"
 }
 
 impl Technique for ShadowMap {
