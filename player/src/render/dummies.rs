@@ -7,7 +7,8 @@ use crate::gpu::{Gpu, Image};
 use crate::scene::sampled_desc;
 use crate::scene::upload::Uploader;
 
-/// Placeholder images for descriptors that must be valid but are never read.
+/// Placeholder images for descriptors that must be valid but are never read (released when
+/// dropped, after every frame that bound them).
 #[derive(Debug)]
 pub struct Dummies {
     /// 1 × 1 white RGBA8 (absent textures, absent BRDF table).
@@ -33,12 +34,5 @@ impl Dummies {
         let faces: Vec<(u32, u32, u32, u32, &[u8])> = (0..6).map(|f| (0, f, 1, 1, &far[..])).collect();
         up.image(&shadow_cube, 4, &faces)?;
         Ok(Dummies { white, shadow_2d, shadow_cube })
-    }
-
-    /// Releases the images.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.white.destroy(gpu);
-        self.shadow_2d.destroy(gpu);
-        self.shadow_cube.destroy(gpu);
     }
 }

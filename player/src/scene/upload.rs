@@ -3,8 +3,9 @@
 //! device has one). Large sections are split at half boundaries: buffers anywhere, images at
 //! row boundaries.
 //!
-//! After an error in an upload, what was recorded is not submitted (its commands may name a
-//! resource the error released): the batch is discarded.
+//! Dropping the ring waits for the batches it submitted; what is recorded and not submitted
+//! never runs. After an error in an upload, what was recorded is not submitted either (its
+//! commands may name a resource the error released): the batch is discarded.
 
 use crate::gpu::vk;
 use gpu_allocator::MemoryLocation;
@@ -17,8 +18,9 @@ use crate::gpu::{Buffer, CommandPool, Gpu, Image, ImageRows, Recorder, Semaphore
 const ALIGN: u64 = 16;
 
 struct Half {
-    staging: Buffer,
+    /// Dropped first: waits for the half's last batch, which reads `staging`.
     pool: CommandPool,
+    staging: Buffer,
     used: u64,
     recording: bool,
 }
@@ -45,18 +47,14 @@ impl<'g> Uploader<'g> {
     /// as batches complete.
     pub fn new(gpu: &'g Gpu, half_bytes: u64, timeline: vk::Semaphore) -> PlayResult<Uploader<'g>> {
         let make = |i: usize| -> PlayResult<Half> {
-            Ok(Half {
-                staging: Buffer::new(
-                    gpu,
-                    &format!("staging {i}"),
-                    half_bytes,
-                    vk::BufferUsageFlags::TRANSFER_SRC,
-                    MemoryLocation::CpuToGpu,
-                )?,
-                pool: CommandPool::new(gpu, gpu.upload_family())?,
-                used: 0,
-                recording: false,
-            })
+            let staging = Buffer::new(
+                gpu,
+                &format!("staging {i}"),
+                half_bytes,
+                vk::BufferUsageFlags::TRANSFER_SRC,
+                MemoryLocation::CpuToGpu,
+            )?;
+            Ok(Half { pool: CommandPool::new(gpu, gpu.upload_family())?, staging, used: 0, recording: false })
         };
         let halves = [make(0)?, make(1)?];
         Ok(Uploader { gpu, halves, current: 0, timeline, signalled: 0, bytes: 0 })
@@ -261,13 +259,11 @@ impl<'g> Uploader<'g> {
         Ok(self.signalled)
     }
 
-    /// Waits for every batch and releases the ring.
-    pub fn destroy(mut self) -> PlayResult {
-        self.flush()?;
-        for half in &mut self.halves {
+    /// Waits for every batch submitted, then releases the ring (as dropping it does, with the
+    /// wait's error returned).
+    pub fn finish(self) -> PlayResult {
+        for half in &self.halves {
             half.pool.wait(self.gpu)?;
-            half.pool.destroy(self.gpu);
-            half.staging.destroy(self.gpu);
         }
         Ok(())
     }
