@@ -666,7 +666,9 @@ fn pick_device(
 impl Drop for Gpu {
     /// Waits for the device, then saves and releases the pipeline cache. The device goes with
     /// the last holder of its [`Owner`]: this `Gpu` when the objects made on the device went
-    /// first, as their holders make them.
+    /// first, as their holders make them. One that outlives the `Gpu` is counted as a validation
+    /// error: the layer reports objects never released only when the device is destroyed, which
+    /// would then come after whoever reads the counts (`Session::close`) has read them.
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
@@ -680,6 +682,11 @@ impl Drop for Gpu {
             }
             // SAFETY: pipelines are made through a `&Gpu`, so none is being made now.
             self.device.destroy_pipeline_cache(self.pipeline_cache, None);
+        }
+        let outliving = Arc::strong_count(&self.owner) - 1;
+        if outliving > 0 {
+            self.validation.errors.fetch_add(1, Ordering::Relaxed);
+            eprintln!("vulkan: {outliving} object(s) made on the device outlive its Gpu");
         }
     }
 }
