@@ -43,7 +43,7 @@ fn check(bytes: &[u8], rays: &[Ray], what: &str) -> usize {
     let batch: Vec<GpuRay> = rays.iter().map(gpu_ray).collect();
     let (closest, _) = query.trace(&session.gpu, bvh, &batch, false).unwrap();
     let (any, _) = query.trace(&session.gpu, bvh, &batch, true).unwrap();
-    query.destroy(&session.gpu);
+    drop(query);
     let (mut hits, mut ties) = (0, 0);
     for (i, ray) in rays.iter().enumerate() {
         let want = cpu.closest_hit(ray);

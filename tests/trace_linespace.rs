@@ -61,7 +61,7 @@ fn gpu_answers(bytes: &[u8], rays: &[GpuRay], normals: &[[f32; 4]], cap: Option<
         .iter()
         .map(|&q| query.trace(&session.gpu, bvh, ls, rays, normals, q).unwrap().0)
         .collect();
-    query.destroy(&session.gpu);
+    drop(query);
     assert_eq!(session.close(), 0, "validation errors");
     answers
 }

@@ -43,10 +43,9 @@ fn main() {
         };
         let t = std::time::Instant::now();
         match Kernel::specialized(&gpu, &DirectPass::bindings(), &code, 0, &constants) {
-            Ok(mut k) => {
+            Ok(_kernel) => {
                 let how = if default { "specialised for the defaults" } else { "every path" };
                 println!("{path} {how} {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
-                k.destroy(&gpu);
             }
             Err(e) => println!("{path} failed: {e}"),
         }

@@ -25,12 +25,14 @@ struct Push {
     any_hit: u32,
 }
 
-/// Acceleration structures, pipeline and shader binding table.
+/// Acceleration structures, pipeline and shader binding table, released when dropped (the GPU
+/// must be done with them: each trace waits for itself, and the owner waits for the GPU).
 pub struct RtPipelinePeer {
-    structures: AccelerationStructures,
-    pipeline: RayTracingPipeline,
+    /// Dropped first: waits for the last trace.
     pool: CommandPool,
     timestamps: TimestampPool,
+    pipeline: RayTracingPipeline,
+    structures: AccelerationStructures,
     /// GPU milliseconds of the acceleration-structure build.
     pub build_ms: f64,
     /// Untimed traces recorded before each timed one (see [`crate::trace::WARMUP_TRACES`]).
@@ -51,36 +53,22 @@ impl RtPipelinePeer {
         if !gpu.ray_tracing_pipeline || corners.is_empty() {
             return Ok(None);
         }
-        let mut pool = CommandPool::new(gpu, gpu.family)?;
-        let mut timestamps = match TimestampPool::new(gpu, 2) {
-            Ok(t) => t,
-            Err(e) => {
-                pool.destroy(gpu);
-                return Err(e);
-            }
-        };
-        match Self::make(gpu, corners, &pool, &timestamps) {
-            Ok((structures, pipeline, build_ms)) => {
-                Ok(Some(RtPipelinePeer { structures, pipeline, pool, timestamps, build_ms, warmup: 0 }))
-            }
-            Err(e) => {
-                let _ = gpu.wait_idle();
-                timestamps.destroy(gpu);
-                pool.destroy(gpu);
-                Err(e)
-            }
-        }
+        let pool = CommandPool::new(gpu, gpu.family)?;
+        let timestamps = TimestampPool::new(gpu, 2)?;
+        // On an error `make` has waited for the GPU before the pools are dropped.
+        let (structures, pipeline, build_ms) = Self::make(gpu, corners, &pool, &timestamps)?;
+        Ok(Some(RtPipelinePeer { pool, timestamps, pipeline, structures, build_ms, warmup: 0 }))
     }
 
     /// The structures (built, with the build's GPU milliseconds) and the pipeline; on failure
-    /// the structures are released once the GPU is idle.
+    /// the structures are released (dropped) once the GPU is idle.
     fn make(
         gpu: &Gpu,
         corners: &[[f32; 3]],
         pool: &CommandPool,
         timestamps: &TimestampPool,
     ) -> PlayResult<(AccelerationStructures, RayTracingPipeline, f64)> {
-        let mut structures = AccelerationStructures::new(gpu, corners)?;
+        let structures = AccelerationStructures::new(gpu, corners)?;
         let shaders = RayTracingShaders {
             raygen: spirv::shader!("peer/trace.rgen"),
             miss: spirv::shader!("peer/trace.rmiss"),
@@ -93,7 +81,6 @@ impl RtPipelinePeer {
             Ok((pipeline, build_ms)) => Ok((structures, pipeline, build_ms)),
             Err(e) => {
                 let _ = gpu.wait_idle();
-                structures.destroy(gpu);
                 Err(e)
             }
         }
@@ -139,13 +126,5 @@ impl RtPipelinePeer {
                 rec.trace_rays(&this.pipeline, bytemuck::bytes_of(&push), count)
             },
         )
-    }
-
-    /// Releases everything (the GPU must be idle).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.structures.destroy(gpu);
-        self.timestamps.destroy(gpu);
-        self.pool.destroy(gpu);
     }
 }

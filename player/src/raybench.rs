@@ -177,21 +177,14 @@ pub fn run(options: &SessionOptions, repeats: u32, start: Instant) -> PlayResult
     let mut query = RayQuery::new(&session.gpu)?;
     query.warmup = WARMUP_TRACES;
     let mut ls_query =
-        match session.scene.line_space.as_ref().map(|_| LineSpaceQuery::new(&session.gpu)).transpose() {
-            Ok(q) => q,
-            Err(e) => {
-                query.destroy(&session.gpu);
-                return Err(e);
-            }
-        };
+        session.scene.line_space.as_ref().map(|_| LineSpaceQuery::new(&session.gpu)).transpose()?;
     if let Some(q) = &mut ls_query {
         q.warmup = WARMUP_TRACES;
     }
     let result = measure(&session, &mut query, ls_query.as_mut(), &o, repeats.max(1));
-    query.destroy(&session.gpu);
-    if let Some(q) = &mut ls_query {
-        q.destroy(&session.gpu);
-    }
+    // Before the session closes: what is made on its device goes first (each query's pool waits
+    // for its last trace).
+    drop((query, ls_query));
     let errors = session.close();
     let report = result?;
     if errors > 0 {
@@ -315,9 +308,9 @@ fn measure(
     ];
     let result = trace_sets(gpu, bvh, query, peer.as_mut(), ls, repeats, sets);
     let peer_build_ms = peer.as_ref().map(|p| p.build_ms);
-    if let Some(p) = &mut peer {
+    if let Some(p) = peer {
         let _ = gpu.wait_idle();
-        p.destroy(gpu);
+        drop(p);
     }
     Ok(RayBenchReport {
         device: gpu.name.clone(),

@@ -217,11 +217,14 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
             mean,
         ))
     })();
-    owned.destroy(session);
+    // Whatever happened, the GPU is done with the resources before they are dropped.
+    let _ = gpu.wait_idle();
+    drop(owned);
     result
 }
 
-/// Resources of one reference render, released together whatever happened.
+/// Resources of one reference render, dropped together whatever happened (once the GPU is
+/// idle).
 #[derive(Default)]
 struct Owned {
     ubo: Option<Buffer>,
@@ -230,25 +233,6 @@ struct Owned {
     readback: Option<Buffer>,
     pass: Option<PathTracePass>,
     pool: Option<crate::gpu::CommandPool>,
-}
-
-impl Owned {
-    fn destroy(&mut self, session: &Session) {
-        let gpu = &session.gpu;
-        let _ = gpu.wait_idle();
-        if let Some(p) = &mut self.pool {
-            p.destroy(gpu);
-        }
-        if let Some(p) = &mut self.pass {
-            p.destroy(gpu);
-        }
-        for b in [&mut self.ubo, &mut self.lights, &mut self.readback].into_iter().flatten() {
-            b.destroy(gpu);
-        }
-        if let Some(i) = &mut self.images {
-            i.destroy(gpu);
-        }
-    }
 }
 
 /// Writes linear RGB radiance as float EXR with the sample count in the header.

@@ -12,14 +12,13 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::gpu::vk;
 use kiln_format::error::ErrorKind;
 use kiln_format::read::{Checksums, KilnFile};
 use kiln_format::sections;
 
 use crate::camera::{Camera, CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, SemaphoreOp};
+use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, Semaphore, SemaphoreOp};
 use crate::render::Needs;
 use crate::render::background::{Built, FrameBuild};
 use crate::render::frame::{Frame, SceneLights};
@@ -175,7 +174,8 @@ pub struct LoadTimes {
     pub fallback_shown_ms: f64,
 }
 
-/// An open file, ready to render.
+/// An open file, ready to render. Dropping it waits for the GPU and for the pipeline thread,
+/// then drops what it holds, the device last.
 pub struct Session {
     /// Camera used by the next frame.
     pub camera: Camera,
@@ -196,7 +196,7 @@ pub struct Session {
     upgrade: Option<Upgrade>,
     dummies: Dummies,
     pool: CommandPool,
-    timeline: vk::Semaphore,
+    timeline: Semaphore,
     ready: u64,
     waited: bool,
     _file: KilnFile,
@@ -205,7 +205,8 @@ pub struct Session {
     /// What the passes read, when sections of it wait for [`Session::upload_rest`].
     rest: Option<Needs>,
     fallback_since: Option<Instant>,
-    /// The device (dropped last; shared with the thread that builds pipelines).
+    /// The device (dropped last, after everything made on it; shared with the thread that
+    /// builds pipelines).
     pub gpu: Arc<Gpu>,
 }
 
@@ -317,73 +318,41 @@ impl Session {
         let decode = prepared.texel_decode();
         // The chosen techniques' pipelines behind a fallback compile on a thread of their own,
         // started first: they take longest. Dropped on an error below, it waits for the thread
-        // and releases what it built.
+        // and drops what it built.
         let background = match fallback {
-            Some(_) => match FrameBuild::spawn(&gpu, requested, lights, decode, width, height) {
-                Ok(b) => Some(b),
-                Err(e) => {
-                    gpu.destroy_semaphore(timeline);
-                    return Err(e);
-                }
-            },
+            Some(_) => Some(FrameBuild::spawn(&gpu, requested, lights, decode, width, height)?),
             None => None,
         };
         let first = fallback.unwrap_or(requested);
+        // On an error below, what was made is dropped on return: the GPU is done with it (the
+        // upload waits for itself; nothing else was submitted).
         let (pipelines, loaded) = std::thread::scope(|s| {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
                 // The frame's targets too: allocating them costs milliseconds on some drivers.
-                let mut frame = Frame::new(&gpu, &first, lights, decode, width, height)?;
-                match readback.map(|r| Readback::new(&gpu, r, width, height)).transpose() {
-                    Ok(rb) => Ok((frame, rb, ms(t), Instant::now())),
-                    Err(e) => {
-                        frame.destroy(&gpu);
-                        Err(e)
-                    }
-                }
+                let frame = Frame::new(&gpu, &first, lights, decode, width, height)?;
+                let rb = readback.map(|r| Readback::new(&gpu, r, width, height)).transpose()?;
+                Ok((frame, rb, ms(t), Instant::now()))
             });
             let loaded = (|| -> PlayResult<(GpuScene, Dummies, u64, u64)> {
-                let mut up = Uploader::new(&gpu, ring_bytes(&gpu), timeline)?;
-                let result = (|| {
-                    let dummies = Dummies::new(&gpu, &mut up)?;
-                    match GpuScene::load(&gpu, &file, &prepared, first_needs, options.textures, &mut up) {
-                        Ok(scene) => Ok((scene, dummies)),
-                        Err(e) => {
-                            let mut d = dummies;
-                            let _ = up.flush();
-                            let _ = gpu.wait_idle();
-                            d.destroy(&gpu);
-                            Err(e)
-                        }
-                    }
-                })();
+                // Dropped on an error, the ring waits for what it submitted (`GpuScene::load`
+                // waits for the GPU itself before it drops what it made).
+                let mut up = Uploader::new(&gpu, ring_bytes(&gpu), timeline.raw)?;
+                let dummies = Dummies::new(&gpu, &mut up)?;
+                let scene = GpuScene::load(&gpu, &file, &prepared, first_needs, options.textures, &mut up)?;
                 let flushed = up.flush();
                 let bytes = up.bytes;
-                let destroyed = up.destroy();
-                let (scene, dummies) = result?;
-                let value = flushed?;
-                destroyed?;
-                Ok((scene, dummies, value, bytes))
+                let finished = up.finish();
+                let ready = flushed?;
+                finished?;
+                Ok((scene, dummies, ready, bytes))
             })();
             let pipes =
                 pipes.join().unwrap_or_else(|_| Err(PlayError::new(Exit::Gpu, "pipeline creation panicked")));
             (pipes, loaded)
         });
-        let cleanup = |gpu: &Gpu| gpu.destroy_semaphore(timeline);
         let scene_deferred = loaded.as_ref().is_ok_and(|(scene, ..)| scene.deferred());
-        let (scene, dummies, ready, bytes) = match loaded {
-            Ok(l) => l,
-            Err(e) => {
-                if let Ok((mut f, rb, _, _)) = pipelines {
-                    f.destroy(&gpu);
-                    if let Some(mut rb) = rb {
-                        rb.destroy(&gpu);
-                    }
-                }
-                cleanup(&gpu);
-                return Err(e);
-            }
-        };
+        let (scene, dummies, ready, bytes) = loaded?;
         times.upload_ms = ms(upload_start);
         times.decode_ms = file.decode_time().as_secs_f64() * 1e3;
         times.upload_bytes = bytes;
@@ -397,17 +366,7 @@ impl Session {
             times.textures_refined_since_start_ms = times.resident_since_start_ms;
         }
         let resident = Instant::now();
-        let mut scene = scene;
-        let (frame, readback, pipelines_ms, pipelines_done) = match pipelines {
-            Ok(p) => p,
-            Err(e) => {
-                let mut d = dummies;
-                d.destroy(&gpu);
-                scene.destroy(&gpu);
-                cleanup(&gpu);
-                return Err(e);
-            }
-        };
+        let (frame, readback, pipelines_ms, pipelines_done) = pipelines?;
         times.pipelines_ms = pipelines_ms;
         times.pipelines_by_pass = frame.build_ms.iter().map(|&(pass, ms)| PassBuild { pass, ms }).collect();
         if background.is_none() {
@@ -415,48 +374,15 @@ impl Session {
             times.full_ready_since_start_ms =
                 pipelines_done.max(resident).duration_since(start).as_secs_f64() * 1e3;
         }
-        let camera = match Camera::initial(
+        let camera = Camera::initial(
             &scene.manifest.cameras,
             scene.manifest.orthographic(0),
             &scene.manifest.bounds,
             options.camera,
-        ) {
-            Ok(c) => c,
-            Err(e) => {
-                let (mut f, mut d) = (frame, dummies);
-                f.destroy(&gpu);
-                if let Some(mut rb) = readback {
-                    rb.destroy(&gpu);
-                }
-                d.destroy(&gpu);
-                scene.destroy(&gpu);
-                cleanup(&gpu);
-                return Err(e);
-            }
-        };
-        let mut dummies = dummies;
-        let made =
-            Renderer::new(&gpu, frame, &dummies, &scene, RenderSettings { techniques: first, ..render })
-                .and_then(|r| match CommandPool::new(&gpu, gpu.family) {
-                    Ok(pool) => Ok((r, pool)),
-                    Err(e) => {
-                        let mut r = r;
-                        r.destroy(&gpu);
-                        Err(e)
-                    }
-                });
-        let (renderer, pool) = match made {
-            Ok(made) => made,
-            Err(e) => {
-                if let Some(mut rb) = readback {
-                    rb.destroy(&gpu);
-                }
-                dummies.destroy(&gpu);
-                scene.destroy(&gpu);
-                cleanup(&gpu);
-                return Err(e);
-            }
-        };
+        )?;
+        let renderer =
+            Renderer::new(&gpu, frame, &dummies, &scene, RenderSettings { techniques: first, ..render })?;
+        let pool = CommandPool::new(&gpu, gpu.family)?;
         warnings.extend(renderer.warnings.iter().cloned());
         let mut notes = Vec::new();
         if let Some(f) = &fallback {
@@ -507,14 +433,14 @@ impl Session {
         let Some(needs) = self.rest.take() else { return Ok(()) };
         let t = Instant::now();
         let (prepared, _) = Prepared::new(&self._file, needs, needs)?;
-        let mut up = Uploader::new(&self.gpu, ring_bytes(&self.gpu), self.timeline)?.after(self.ready);
+        let mut up = Uploader::new(&self.gpu, ring_bytes(&self.gpu), self.timeline.raw)?.after(self.ready);
         let loaded = self.scene.load_rest(&self.gpu, &self._file, &prepared, &mut up);
         let flushed = up.flush();
         let bytes = up.bytes;
-        let destroyed = up.destroy();
+        let finished = up.finish();
         loaded?;
         self.ready = flushed?;
-        destroyed?;
+        finished?;
         // Made visible to the frames' queue by the timeline, as the first upload is.
         self.waited = false;
         self.times.rest_upload_ms = ms(t);
@@ -534,7 +460,7 @@ impl Session {
     /// for the previous), and only then releases the coarse views.
     fn use_refined_textures(&mut self) -> PlayResult {
         self.pool.wait(&self.gpu)?;
-        self.scene.use_refined_views(&self.gpu);
+        self.scene.use_refined_views();
         self.renderer.textures_refined(&self.gpu, &self.scene, &self.dummies)?;
         let t = &mut self.times;
         t.refined_texture_bytes = self.scene.fine_texture_bytes;
@@ -589,20 +515,14 @@ impl Session {
         let Built { mut frame, ms: built_ms, done } = build.join()?;
         let images = self.renderer.images();
         let (width, height) = (images.width, images.height);
-        let sized = self.gpu.wait_idle().and_then(|()| {
-            if (frame.images.width, frame.images.height) == (width, height) {
-                Ok(())
-            } else {
-                frame.resize(&self.gpu, width, height)
-            }
-        });
-        if let Err(e) = sized {
-            frame.destroy(&self.gpu);
-            return Err(e);
+        self.gpu.wait_idle()?;
+        if (frame.images.width, frame.images.height) != (width, height) {
+            frame.resize(&self.gpu, width, height)?;
         }
         let full = Renderer::new(&self.gpu, frame, &self.dummies, &self.scene, settings)?;
-        let mut fallback = std::mem::replace(&mut self.renderer, full);
-        fallback.destroy(&self.gpu);
+        // The fallback's renderer goes: the GPU is idle (waited above), and the new frame has
+        // not been submitted yet.
+        drop(std::mem::replace(&mut self.renderer, full));
         let t = &mut self.times;
         t.full_pipelines_ms = built_ms;
         t.full_ready_since_start_ms = done.max(self.resident).duration_since(self.start).as_secs_f64() * 1e3;
@@ -675,7 +595,7 @@ impl Session {
         extra(&rec, &mut self.renderer);
         let mut waits = wait.to_vec();
         if !self.waited {
-            waits.push(SemaphoreOp::timeline(self.timeline, self.ready));
+            waits.push(SemaphoreOp::timeline(self.timeline.raw, self.ready));
             self.waited = true;
         }
         self.pool.submit(&self.gpu, &waits, signal)
@@ -734,18 +654,14 @@ impl Session {
 }
 
 impl Drop for Session {
+    /// What a frame or an upload uses may be dropped only once the GPU is done with it: waits
+    /// for the GPU; the fields are dropped after this, the device (`gpu`, the last) after
+    /// everything made on it.
     fn drop(&mut self) {
         let _ = self.gpu.wait_idle();
-        // Waits for the pipeline thread and releases what it built.
+        // Waits for the pipeline thread and drops what it built, so that the thread's hold on
+        // the device ends before `gpu` is dropped.
         self.upgrade = None;
-        self.pool.destroy(&self.gpu);
-        if let Some(r) = &mut self.readback {
-            r.destroy(&self.gpu);
-        }
-        self.renderer.destroy(&self.gpu);
-        self.dummies.destroy(&self.gpu);
-        self.scene.destroy(&self.gpu);
-        self.gpu.destroy_semaphore(self.timeline);
     }
 }
 

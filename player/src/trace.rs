@@ -47,27 +47,22 @@ pub const NO_HIT: f32 = 3.402823e38;
 
 /// A compute kernel that traces a buffer of rays: its pipeline over one set (rewritten by every
 /// trace: the previous trace has finished by then), its command pool and timestamps. What the
-/// BVH's and the line space's queries share.
+/// BVH's and the line space's queries share. Dropping it waits for its last trace (the pool
+/// goes first), then releases everything.
 pub(crate) struct TraceKernel {
-    pub(crate) layout: SetLayout,
-    pub(crate) set: vk::DescriptorSet,
-    pub(crate) pipeline: ComputePipeline,
     pub(crate) pool: CommandPool,
     pub(crate) timestamps: TimestampPool,
+    pub(crate) pipeline: ComputePipeline,
+    pub(crate) layout: SetLayout,
+    pub(crate) set: vk::DescriptorSet,
 }
 
 impl TraceKernel {
     /// The kernel of `spirv` over `bindings`, with 8 bytes of push constants (count, mode); on
     /// failure nothing is left behind.
     pub(crate) fn new(gpu: &Gpu, bindings: &[Binding], spirv: &[u8]) -> PlayResult<TraceKernel> {
-        let mut layout = SetLayout::new(gpu, bindings, 1)?;
-        let pipeline = match ComputePipeline::new(gpu, spirv, &[&layout], 8) {
-            Ok(p) => p,
-            Err(e) => {
-                layout.destroy(gpu);
-                return Err(e);
-            }
-        };
+        let layout = SetLayout::new(gpu, bindings, 1)?;
+        let pipeline = ComputePipeline::new(gpu, spirv, &[&layout], 8)?;
         let mut kernel = TraceKernel {
             set: vk::DescriptorSet::null(),
             pool: CommandPool::new(gpu, gpu.family)?,
@@ -78,17 +73,10 @@ impl TraceKernel {
         kernel.set = kernel.layout.allocate(gpu)?;
         Ok(kernel)
     }
-
-    /// Releases everything.
-    pub(crate) fn destroy(&mut self, gpu: &Gpu) {
-        self.pool.destroy(gpu);
-        self.timestamps.destroy(gpu);
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
-    }
 }
 
-/// The compute traversal, bound to one scene's BVH.
+/// The compute traversal, bound to one scene's BVH (released when dropped, after its scene's
+/// session has waited for it: each trace waits for itself).
 pub struct RayQuery {
     kernel: TraceKernel,
     /// Untimed traces recorded before each timed one (0; benchmarks set [`WARMUP_TRACES`]).
@@ -144,11 +132,6 @@ impl RayQuery {
             vk::PipelineStageFlags2::COMPUTE_SHADER
         })
     }
-
-    /// Releases the pipeline and its pools.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.kernel.destroy(gpu);
-    }
 }
 
 /// Untimed traces a benchmark records before each timed one (see [`timed_trace`]).
@@ -180,46 +163,36 @@ pub(crate) fn timed_trace(
     let usage = usage | vk::BufferUsageFlags::STORAGE_BUFFER;
     let mut input = Buffer::new(gpu, "rays", bytes.len() as u64, usage, MemoryLocation::CpuToGpu)?;
     let out_size = rays.len() * 16;
-    let mut output = match Buffer::new(gpu, "hits", out_size as u64, usage, MemoryLocation::GpuToCpu) {
-        Ok(o) => o,
-        Err(e) => {
-            input.destroy(gpu);
-            return Err(e);
-        }
-    };
-    let result = (|| -> PlayResult<(Vec<GpuHit>, f64)> {
-        input.write(bytes)?;
-        let rec = pool.begin(gpu)?;
-        rec.reset_timestamps(timestamps);
-        for _ in 0..warmup {
-            let stage = record(&rec, &input, &output, count);
-            // The next trace overwrites the same hits.
-            rec.memory_barrier(
-                stage,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-                stage,
-                vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            );
-        }
-        rec.timestamp(timestamps, 0);
+    let mut output = Buffer::new(gpu, "hits", out_size as u64, usage, MemoryLocation::GpuToCpu)?;
+    input.write(bytes)?;
+    // The buffers are dropped on return, when the trace has finished (`pool.wait`) or failed.
+    let rec = pool.begin(gpu)?;
+    rec.reset_timestamps(timestamps);
+    for _ in 0..warmup {
         let stage = record(&rec, &input, &output, count);
-        rec.timestamp(timestamps, 1);
+        // The next trace overwrites the same hits.
         rec.memory_barrier(
             stage,
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            vk::PipelineStageFlags2::HOST,
-            vk::AccessFlags2::HOST_READ,
+            stage,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
         );
-        pool.submit(gpu, &[], &[])?;
-        pool.wait(gpu)?;
-        let ns = timestamps.read_ns(gpu)?;
-        let hits: Vec<GpuHit> = output
-            .mapped()
-            .map(|m| bytemuck::pod_collect_to_vec(&m[..out_size]))
-            .ok_or_else(|| PlayError::new(Exit::Gpu, "the hit buffer is not host-visible"))?;
-        Ok((hits, (ns[1] - ns[0]) * 1e-6))
-    })();
-    input.destroy(gpu);
-    output.destroy(gpu);
-    result
+    }
+    rec.timestamp(timestamps, 0);
+    let stage = record(&rec, &input, &output, count);
+    rec.timestamp(timestamps, 1);
+    rec.memory_barrier(
+        stage,
+        vk::AccessFlags2::SHADER_STORAGE_WRITE,
+        vk::PipelineStageFlags2::HOST,
+        vk::AccessFlags2::HOST_READ,
+    );
+    pool.submit(gpu, &[], &[])?;
+    pool.wait(gpu)?;
+    let ns = timestamps.read_ns(gpu)?;
+    let hits: Vec<GpuHit> = output
+        .mapped()
+        .map(|m| bytemuck::pod_collect_to_vec(&m[..out_size]))
+        .ok_or_else(|| PlayError::new(Exit::Gpu, "the hit buffer is not host-visible"))?;
+    Ok((hits, (ns[1] - ns[0]) * 1e-6))
 }

@@ -101,42 +101,35 @@ impl LineSpaceQuery {
         if normals.len() == rays.len() {
             bytes[..rays.len() * 16].copy_from_slice(bytemuck::cast_slice(normals));
         }
-        let result = normal_buffer.write(&bytes).and_then(|()| {
-            let k = &self.kernel;
-            let (layout, pipeline, set) = (&k.layout, &k.pipeline, k.set);
-            let written = std::cell::Cell::new(false);
-            let normal_buffer = &normal_buffer;
-            timed_trace(
-                gpu,
-                &k.pool,
-                &k.timestamps,
-                rays,
-                vk::BufferUsageFlags::empty(),
-                self.warmup,
-                |rec, input, output, count| {
-                    if !written.replace(true) {
-                        let mut writes = vec![
-                            Write::Buffer(0, &bvh.nodes),
-                            Write::Buffer(1, &bvh.triangles),
-                            Write::Buffer(2, input),
-                            Write::Buffer(3, output),
-                            Write::Buffer(4, normal_buffer),
-                        ];
-                        writes.extend(line_space.writes(5));
-                        layout.write(gpu, set, &writes);
-                    }
-                    let push: [u32; 2] = [count, query as u32];
-                    rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
-                    vk::PipelineStageFlags2::COMPUTE_SHADER
-                },
-            )
-        });
-        normal_buffer.destroy(gpu);
-        result
-    }
-
-    /// Releases the pipeline and its pools.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.kernel.destroy(gpu);
+        normal_buffer.write(&bytes)?;
+        // `normal_buffer` is dropped on return, when the trace has finished (or failed).
+        let k = &self.kernel;
+        let (layout, pipeline, set) = (&k.layout, &k.pipeline, k.set);
+        let written = std::cell::Cell::new(false);
+        let normal_buffer = &normal_buffer;
+        timed_trace(
+            gpu,
+            &k.pool,
+            &k.timestamps,
+            rays,
+            vk::BufferUsageFlags::empty(),
+            self.warmup,
+            |rec, input, output, count| {
+                if !written.replace(true) {
+                    let mut writes = vec![
+                        Write::Buffer(0, &bvh.nodes),
+                        Write::Buffer(1, &bvh.triangles),
+                        Write::Buffer(2, input),
+                        Write::Buffer(3, output),
+                        Write::Buffer(4, normal_buffer),
+                    ];
+                    writes.extend(line_space.writes(5));
+                    layout.write(gpu, set, &writes);
+                }
+                let push: [u32; 2] = [count, query as u32];
+                rec.dispatch(pipeline, &[set], bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
+                vk::PipelineStageFlags2::COMPUTE_SHADER
+            },
+        )
     }
 }

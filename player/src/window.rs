@@ -20,6 +20,8 @@ use crate::gpu::{SemaphoreOp, Swapchain, Use, surface_extensions};
 use crate::render::Readable;
 use crate::session::{Session, SessionOptions};
 
+/// A playing window. Dropped in field order after `drop` waited for the GPU: the swapchain
+/// (while the window it presents to is still open), then the session, then the window.
 struct Running {
     swapchain: Swapchain,
     session: Session,
@@ -31,8 +33,8 @@ struct Running {
 
 impl Drop for Running {
     fn drop(&mut self) {
+        // The swapchain's images and semaphores may be in use until the GPU is idle.
         let _ = self.session.gpu.wait_idle();
-        self.swapchain.destroy(&self.session.gpu);
     }
 }
 
@@ -183,9 +185,9 @@ impl App {
                 rec.blit(display, image, extent.width, extent.height);
                 rec.transition_raw(image, range, Use::TRANSFER_DST, Use::PRESENT);
             },
-            &[SemaphoreOp::binary(r.swapchain.acquired, vk::PipelineStageFlags2::ALL_COMMANDS)],
+            &[SemaphoreOp::binary(r.swapchain.acquired.raw, vk::PipelineStageFlags2::ALL_COMMANDS)],
             &[SemaphoreOp::binary(
-                r.swapchain.rendered[index as usize],
+                r.swapchain.rendered[index as usize].raw,
                 vk::PipelineStageFlags2::ALL_COMMANDS,
             )],
         )?;

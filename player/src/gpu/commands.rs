@@ -1,11 +1,14 @@
-//! Command recording and submission, barriers, timestamps.
+//! Command recording and submission, barriers, timestamps, semaphores.
+
+use std::sync::Arc;
 
 use ash::vk;
 
-use super::{Buffer, ComputePipeline, Gpu, GraphicsPipeline, Image};
+use super::{Buffer, ComputePipeline, Gpu, GraphicsPipeline, Image, Owner};
 use crate::error::{PlayResult, vk as vk_err};
 
-/// A command pool with one primary command buffer and a fence, for one queue family.
+/// A command pool with one primary command buffer and a fence, for one queue family. Dropping
+/// it waits for its last submission, then releases pool, command buffer and fence.
 #[derive(Debug)]
 pub struct CommandPool {
     pool: vk::CommandPool,
@@ -16,6 +19,23 @@ pub struct CommandPool {
     /// so that no wait can hang on work that never reached the queue.
     fence: std::cell::Cell<vk::Fence>,
     family: u32,
+    owner: Arc<Owner>,
+}
+
+impl Drop for CommandPool {
+    fn drop(&mut self) {
+        let device = &self.owner.device;
+        // SAFETY: made on this device (a null fence is ignored); once the fence is signalled the
+        // command buffer is not pending, and freeing the pool frees it.
+        unsafe {
+            let fence = self.fence.get();
+            if fence != vk::Fence::null() {
+                let _ = device.wait_for_fences(&[fence], true, u64::MAX);
+            }
+            device.destroy_fence(fence, None);
+            device.destroy_command_pool(self.pool, None);
+        }
+    }
 }
 
 impl CommandPool {
@@ -26,18 +46,27 @@ impl CommandPool {
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         let pool = unsafe { gpu.device.create_command_pool(&info, None) }
             .map_err(|e| vk_err("creating a command pool", e))?;
+        // Released on any error below.
+        let mut made = CommandPool {
+            pool,
+            cmd: vk::CommandBuffer::null(),
+            fence: std::cell::Cell::new(vk::Fence::null()),
+            family,
+            owner: gpu.owner(),
+        };
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
-        let cmd = unsafe { gpu.device.allocate_command_buffers(&alloc) }
+        made.cmd = unsafe { gpu.device.allocate_command_buffers(&alloc) }
             .map_err(|e| vk_err("allocating a command buffer", e))?[0];
         let fence = unsafe {
             gpu.device
                 .create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None)
         }
         .map_err(|e| vk_err("creating a fence", e))?;
-        Ok(CommandPool { pool, cmd, fence: std::cell::Cell::new(fence), family })
+        made.fence.set(fence);
+        Ok(made)
     }
 
     /// Waits for the previous submission, then starts recording.
@@ -102,14 +131,20 @@ impl CommandPool {
     pub fn done(&self, gpu: &Gpu) -> bool {
         unsafe { gpu.device.get_fence_status(self.fence.get()) }.unwrap_or(false)
     }
+}
 
-    /// Releases the pool.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        unsafe {
-            let _ = gpu.device.wait_for_fences(&[self.fence.get()], true, u64::MAX);
-            gpu.device.destroy_fence(self.fence.get(), None);
-            gpu.device.destroy_command_pool(self.pool, None);
-        }
+/// A semaphore, released when dropped (no submitted work may still wait on or signal it).
+#[derive(Debug)]
+pub struct Semaphore {
+    /// Handle.
+    pub raw: vk::Semaphore,
+    pub(super) owner: Arc<Owner>,
+}
+
+impl Drop for Semaphore {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; its owner guarantees no submitted work uses it any more.
+        unsafe { self.owner.device.destroy_semaphore(self.raw, None) };
     }
 }
 
@@ -560,11 +595,19 @@ impl<'a> Recorder<'a> {
     }
 }
 
-/// A pool of timestamp queries.
+/// A pool of timestamp queries, released when dropped.
 #[derive(Debug)]
 pub struct TimestampPool {
     raw: vk::QueryPool,
     count: u32,
+    owner: Arc<Owner>,
+}
+
+impl Drop for TimestampPool {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; its owner guarantees no submitted work uses it any more.
+        unsafe { self.owner.device.destroy_query_pool(self.raw, None) };
+    }
 }
 
 impl TimestampPool {
@@ -573,7 +616,7 @@ impl TimestampPool {
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(count);
         let raw = unsafe { gpu.device.create_query_pool(&info, None) }
             .map_err(|e| vk_err("creating a query pool", e))?;
-        Ok(TimestampPool { raw, count })
+        Ok(TimestampPool { raw, count, owner: gpu.owner() })
     }
 
     /// The timestamps in nanoseconds (after the work completed).
@@ -589,10 +632,5 @@ impl TimestampPool {
         }
         .map_err(|e| vk_err("reading timestamps", e))?;
         Ok(data.iter().map(|&t| t as f64 * gpu.timestamp_period()).collect())
-    }
-
-    /// Releases the pool.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        unsafe { gpu.device.destroy_query_pool(self.raw, None) };
     }
 }

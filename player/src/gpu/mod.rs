@@ -3,6 +3,13 @@
 //!
 //! Vulkan 1.3 core with dynamic rendering, synchronization2, timeline semaphores and buffer device
 //! address; memory through `gpu-allocator`; a pipeline cache kept on disk between runs.
+//!
+//! Every type here that owns a Vulkan object or an allocation releases it when dropped. Each
+//! holds the device's [`Owner`] (shared with the [`Gpu`]), so the device, the allocator and the
+//! instance go only after the last object made on them. Vulkan's own rule stays the owner's
+//! to keep: no submitted work may still use an object when it is dropped. The front ends wait
+//! for the GPU (or for the command pool that submitted the work) before they drop what it used,
+//! and say so where they do.
 
 mod commands;
 mod pipelines;
@@ -10,7 +17,7 @@ mod raytracing;
 mod resources;
 mod swapchain;
 
-pub use commands::{CommandPool, ImageRows, Recorder, SemaphoreOp, TimestampPool, Use};
+pub use commands::{CommandPool, ImageRows, Recorder, Semaphore, SemaphoreOp, TimestampPool, Use};
 pub use pipelines::{
     Binding, BindingKind, ComputePipeline, GraphicsDesc, GraphicsPipeline, SetLayout, Write,
 };
@@ -21,8 +28,8 @@ pub use swapchain::{Swapchain, surface_extensions};
 use std::ffi::{CStr, CString, c_void};
 use std::mem::ManuallyDrop;
 use std::path::PathBuf;
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
 
 pub use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -92,12 +99,10 @@ pub struct Gpu {
     pub queue: vk::Queue,
     /// A dedicated transfer queue (family, queue), when the device has one.
     pub transfer: Option<(u32, vk::Queue)>,
-    allocator: ManuallyDrop<Mutex<Allocator>>,
-    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     /// Validation message counts (boxed: the messenger holds a pointer to it).
     /// Shared, so that messages sent while the device is destroyed (leaked objects) can still be
     /// counted by whoever holds a clone.
-    pub validation: std::sync::Arc<ValidationCounts>,
+    pub validation: Arc<ValidationCounts>,
     /// Pipeline cache.
     pub pipeline_cache: vk::PipelineCache,
     cache_path: Option<PathBuf>,
@@ -106,6 +111,67 @@ pub struct Gpu {
     storage_cap: Option<u64>,
     /// The device samples BC-compressed images (`textureCompressionBC`, enabled).
     pub texture_compression_bc: bool,
+    /// Device, allocator and instance, shared with every object made on them (dropped last).
+    owner: Arc<Owner>,
+}
+
+/// The instance and its debug messenger, destroyed when dropped (after the device: an
+/// [`Owner`] holds it).
+struct Instance {
+    instance: ash::Instance,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// The counts the messenger writes (its user data), kept until the instance is gone.
+    _validation: Arc<ValidationCounts>,
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        // SAFETY: no device made on the instance is left (an `Owner` destroys its device before
+        // its `Instance` field is dropped, and `Gpu::new` its own on every error).
+        unsafe {
+            if let Some((utils, messenger)) = &self.debug {
+                utils.destroy_debug_utils_messenger(*messenger, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
+
+/// The logical device, its memory allocator and the instance: what each object made on the
+/// device needs to release itself. The [`Gpu`] and every such object hold it (`Arc`); the last
+/// one to go destroys the allocator, the device and the instance, in that order, so the device
+/// always outlives what was made on it.
+pub(crate) struct Owner {
+    /// Logical device.
+    pub(crate) device: ash::Device,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    /// Dropped after the device (fields drop after `drop`'s body).
+    _instance: Instance,
+}
+
+impl Owner {
+    /// The memory allocator (locked while the guard lives).
+    pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+        self.allocator.lock().unwrap_or_else(|p| p.into_inner())
+    }
+}
+
+impl std::fmt::Debug for Owner {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Owner").finish_non_exhaustive()
+    }
+}
+
+impl Drop for Owner {
+    fn drop(&mut self) {
+        // SAFETY: every object made on the device held this `Owner` and is gone, its memory
+        // returned to the allocator; the `Gpu` waited for the device to go idle when it was
+        // dropped, and nothing was submitted after it.
+        unsafe {
+            ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_device(None);
+        }
+    }
 }
 
 /// Device extensions the ray-tracing-pipeline peer needs.
@@ -128,7 +194,7 @@ unsafe extern "system" fn debug_callback(
     user: *mut c_void,
 ) -> vk::Bool32 {
     // SAFETY: the loader passes valid callback data; `user` is the `ValidationCounts` box, which
-    // outlives the messenger (destroyed first in `Drop`).
+    // outlives the messenger (the `Instance` that destroys the messenger holds it).
     let (counts, message) = unsafe {
         let counts = &*(user as *const ValidationCounts);
         let msg = if data.is_null() || (*data).p_message.is_null() {
@@ -211,7 +277,7 @@ impl Gpu {
         }
         let app_name = CString::new("kiln-play").unwrap_or_default();
         let app = vk::ApplicationInfo::default().application_name(&app_name).api_version(vk::API_VERSION_1_3);
-        let validation = std::sync::Arc::new(ValidationCounts::default());
+        let validation = Arc::new(ValidationCounts::default());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(
                 vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
@@ -222,7 +288,7 @@ impl Gpu {
                     | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
             )
             .pfn_user_callback(Some(debug_callback))
-            .user_data(std::sync::Arc::as_ptr(&validation) as *mut c_void);
+            .user_data(Arc::as_ptr(&validation) as *mut c_void);
         let mut info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_layer_names(&layers)
@@ -237,30 +303,15 @@ impl Gpu {
             ),
             e => vk_err("creating the Vulkan instance", e),
         })?;
-        let debug = if options.validate {
+        // Destroyed when dropped: on an error below, or with the last holder of the device.
+        let mut owned = Instance { instance: instance.clone(), debug: None, _validation: validation.clone() };
+        if options.validate {
             let utils = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let messenger = unsafe { utils.create_debug_utils_messenger(&messenger_info, None) }
                 .map_err(|e| vk_err("creating the debug messenger", e))?;
-            Some((utils, messenger))
-        } else {
-            None
-        };
-        let destroy_instance =
-            |instance: &ash::Instance,
-             debug: &Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>| unsafe {
-                if let Some((u, m)) = debug {
-                    u.destroy_debug_utils_messenger(*m, None);
-                }
-                instance.destroy_instance(None);
-            };
-        let chosen = match pick_device(&instance, options) {
-            Ok(c) => c,
-            Err(e) => {
-                destroy_instance(&instance, &debug);
-                return Err(e);
-            }
-        };
-        let (physical, family, transfer_family) = chosen;
+            owned.debug = Some((utils, messenger));
+        }
+        let (physical, family, transfer_family) = pick_device(&instance, options)?;
         let properties = unsafe { instance.get_physical_device_properties(physical) };
         let name =
             properties.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
@@ -332,16 +383,11 @@ impl Gpu {
         if ray_tracing_pipeline {
             device_info = device_info.push_next(&mut accel).push_next(&mut rtp);
         }
-        let device = match unsafe { instance.create_device(physical, &device_info, None) } {
-            Ok(d) => d,
-            Err(e) => {
-                destroy_instance(&instance, &debug);
-                return Err(vk_err("creating the Vulkan device", e));
-            }
-        };
+        let device = unsafe { instance.create_device(physical, &device_info, None) }
+            .map_err(|e| vk_err("creating the Vulkan device", e))?;
         let queue = unsafe { device.get_device_queue(family, 0) };
         let transfer = transfer_family.map(|t| (t, unsafe { device.get_device_queue(t, 0) }));
-        let allocator = Allocator::new(&AllocatorCreateDesc {
+        let allocator = match Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
             physical_device: physical,
@@ -351,8 +397,17 @@ impl Gpu {
             // 64 MiB (the default): small blocks, and large host buffers get their own.
             allocation_sizes: gpu_allocator::AllocationSizes::new(64 << 20, 4 << 20)
                 .with_max_device_memblock_size(256 << 20),
-        })
-        .map_err(|e| PlayError::new(Exit::Gpu, format!("creating the memory allocator failed: {e}")))?;
+        }) {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: nothing was made on the new device.
+                unsafe { device.destroy_device(None) };
+                return Err(PlayError::new(Exit::Gpu, format!("creating the memory allocator failed: {e}")));
+            }
+        };
+        // From here on the device goes with the last holder of its owner.
+        let allocator = ManuallyDrop::new(Mutex::new(allocator));
+        let owner = Arc::new(Owner { device: device.clone(), allocator, _instance: owned });
         let cache_data =
             options.pipeline_cache.as_ref().and_then(|p| std::fs::read(p).ok()).unwrap_or_default();
         let cache_info = vk::PipelineCacheCreateInfo::default().initial_data(&cache_data);
@@ -372,14 +427,13 @@ impl Gpu {
             family,
             queue,
             transfer,
-            allocator: ManuallyDrop::new(Mutex::new(allocator)),
-            debug,
             validation,
             pipeline_cache,
             cache_path: options.pipeline_cache.clone(),
             ray_tracing_pipeline,
             storage_cap: options.max_storage_buffer,
             texture_compression_bc,
+            owner,
         })
     }
 
@@ -431,8 +485,13 @@ impl Gpu {
         self.storage_cap.map_or(device, |cap| cap.min(device))
     }
 
+    /// What an object made on the device holds to release itself.
+    pub(crate) fn owner(&self) -> Arc<Owner> {
+        Arc::clone(&self.owner)
+    }
+
     pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
-        self.allocator.lock().unwrap_or_else(|p| p.into_inner())
+        self.owner.allocator()
     }
 
     /// The queue families resources are used from: with a dedicated transfer queue, uploaded
@@ -452,19 +511,21 @@ impl Gpu {
     }
 
     /// A binary semaphore (swapchain acquire and present).
-    pub fn binary_semaphore(&self) -> PlayResult<vk::Semaphore> {
-        unsafe { self.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
-            .map_err(|e| vk_err("creating a semaphore", e))
+    pub fn binary_semaphore(&self) -> PlayResult<Semaphore> {
+        let raw = unsafe { self.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }
+            .map_err(|e| vk_err("creating a semaphore", e))?;
+        Ok(Semaphore { raw, owner: self.owner() })
     }
 
     /// A timeline semaphore starting at 0.
-    pub fn timeline_semaphore(&self) -> PlayResult<vk::Semaphore> {
+    pub fn timeline_semaphore(&self) -> PlayResult<Semaphore> {
         let mut kind = vk::SemaphoreTypeCreateInfo::default()
             .semaphore_type(vk::SemaphoreType::TIMELINE)
             .initial_value(0);
         let info = vk::SemaphoreCreateInfo::default().push_next(&mut kind);
-        unsafe { self.device.create_semaphore(&info, None) }
-            .map_err(|e| vk_err("creating a timeline semaphore", e))
+        let raw = unsafe { self.device.create_semaphore(&info, None) }
+            .map_err(|e| vk_err("creating a timeline semaphore", e))?;
+        Ok(Semaphore { raw, owner: self.owner() })
     }
 
     /// Blocks until timeline `semaphore` reaches `value`.
@@ -474,11 +535,6 @@ impl Gpu {
         let info = vk::SemaphoreWaitInfo::default().semaphores(&semaphores).values(&values);
         unsafe { self.device.wait_semaphores(&info, u64::MAX) }
             .map_err(|e| vk_err("waiting for a timeline semaphore", e))
-    }
-
-    /// Releases a semaphore.
-    pub fn destroy_semaphore(&self, semaphore: vk::Semaphore) {
-        unsafe { self.device.destroy_semaphore(semaphore, None) };
     }
 
     /// Waits until the device is idle.
@@ -608,6 +664,11 @@ fn pick_device(
 }
 
 impl Drop for Gpu {
+    /// Waits for the device, then saves and releases the pipeline cache. The device goes with
+    /// the last holder of its [`Owner`]: this `Gpu` when the objects made on the device went
+    /// first, as their holders make them. One that outlives the `Gpu` is counted as a validation
+    /// error: the layer reports objects never released only when the device is destroyed, which
+    /// would then come after whoever reads the counts (`Session::close`) has read them.
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
@@ -619,14 +680,13 @@ impl Drop for Gpu {
                 }
                 let _ = std::fs::write(path, data);
             }
+            // SAFETY: pipelines are made through a `&Gpu`, so none is being made now.
             self.device.destroy_pipeline_cache(self.pipeline_cache, None);
-            // SAFETY: every allocation was freed by its owner before the context is dropped.
-            ManuallyDrop::drop(&mut self.allocator);
-            self.device.destroy_device(None);
-            if let Some((utils, messenger)) = &self.debug {
-                utils.destroy_debug_utils_messenger(*messenger, None);
-            }
-            self.instance.destroy_instance(None);
+        }
+        let outliving = Arc::strong_count(&self.owner) - 1;
+        if outliving > 0 {
+            self.validation.errors.fetch_add(1, Ordering::Relaxed);
+            eprintln!("vulkan: {outliving} object(s) made on the device outlive its Gpu");
         }
     }
 }

@@ -1,17 +1,35 @@
 //! Shader modules, descriptor set layouts (each with its own pool), and compute and graphics
-//! pipelines built through the device's pipeline cache.
+//! pipelines built through the device's pipeline cache. Each releases what it owns when dropped.
+
+use std::sync::Arc;
 
 use ash::vk;
 
-use super::{Buffer, Gpu};
+use super::{Buffer, Gpu, Owner};
 use crate::error::{Exit, PlayError, PlayResult, vk as vk_err};
 
+/// A shader module, released when dropped (once the pipelines made from it are created).
+pub(super) struct ShaderModule {
+    /// Handle.
+    pub(super) raw: vk::ShaderModule,
+    owner: Arc<Owner>,
+}
+
+impl Drop for ShaderModule {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; a module is needed only while pipelines are created.
+        unsafe { self.owner.device.destroy_shader_module(self.raw, None) };
+    }
+}
+
 /// A shader module from SPIR-V bytes.
-pub fn shader_module(gpu: &Gpu, spirv: &[u8]) -> PlayResult<vk::ShaderModule> {
+pub(super) fn shader_module(gpu: &Gpu, spirv: &[u8]) -> PlayResult<ShaderModule> {
     let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
         .map_err(|e| PlayError::new(Exit::Gpu, format!("invalid SPIR-V: {e}")))?;
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
-    unsafe { gpu.device.create_shader_module(&info, None) }.map_err(|e| vk_err("creating a shader module", e))
+    let raw = unsafe { gpu.device.create_shader_module(&info, None) }
+        .map_err(|e| vk_err("creating a shader module", e))?;
+    Ok(ShaderModule { raw, owner: gpu.owner() })
 }
 
 /// Kind of a descriptor binding.
@@ -54,7 +72,8 @@ impl Binding {
     }
 }
 
-/// A descriptor set layout and the pools its sets come from (grown `chunk` sets at a time).
+/// A descriptor set layout and the pools its sets come from (grown `chunk` sets at a time);
+/// dropping it releases the pools, and every set from them, and the layout.
 #[derive(Debug)]
 pub struct SetLayout {
     /// Layout handle.
@@ -62,6 +81,19 @@ pub struct SetLayout {
     pools: Vec<(vk::DescriptorPool, u32)>,
     chunk: u32,
     bindings: Vec<Binding>,
+    owner: Arc<Owner>,
+}
+
+impl Drop for SetLayout {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; its owner guarantees no submitted work uses the sets.
+        unsafe {
+            for (pool, _) in self.pools.drain(..) {
+                self.owner.device.destroy_descriptor_pool(pool, None);
+            }
+            self.owner.device.destroy_descriptor_set_layout(self.raw, None);
+        }
+    }
 }
 
 /// One descriptor write.
@@ -93,7 +125,13 @@ impl SetLayout {
         let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&vk_bindings);
         let raw = unsafe { gpu.device.create_descriptor_set_layout(&info, None) }
             .map_err(|e| vk_err("creating a descriptor set layout", e))?;
-        Ok(SetLayout { raw, pools: Vec::new(), chunk: chunk.max(1), bindings: bindings.to_vec() })
+        Ok(SetLayout {
+            raw,
+            pools: Vec::new(),
+            chunk: chunk.max(1),
+            bindings: bindings.to_vec(),
+            owner: gpu.owner(),
+        })
     }
 
     /// A new set, from a new pool when the last one is full.
@@ -171,16 +209,42 @@ impl SetLayout {
             .collect();
         unsafe { gpu.device.update_descriptor_sets(&vk_writes, &[]) };
     }
+}
 
-    /// Releases layout and pools (and every set from them).
-    pub fn destroy(&mut self, gpu: &Gpu) {
+/// A pipeline and its layout, released when dropped: what [`ComputePipeline`],
+/// [`GraphicsPipeline`] and the ray-tracing pipeline hold.
+#[derive(Debug)]
+pub(super) struct Pipeline {
+    /// Pipeline (null until created).
+    pub(super) raw: vk::Pipeline,
+    /// Layout (null until created).
+    pub(super) layout: vk::PipelineLayout,
+    owner: Arc<Owner>,
+}
+
+impl Pipeline {
+    /// Neither made yet: null handles, filled in by the caller.
+    pub(super) fn none(gpu: &Gpu) -> Pipeline {
+        Pipeline { raw: vk::Pipeline::null(), layout: vk::PipelineLayout::null(), owner: gpu.owner() }
+    }
+}
+
+impl Drop for Pipeline {
+    fn drop(&mut self) {
+        // SAFETY: made on this device (null handles are ignored); its owner guarantees no
+        // submitted work uses it any more.
         unsafe {
-            for (pool, _) in self.pools.drain(..) {
-                gpu.device.destroy_descriptor_pool(pool, None);
-            }
-            gpu.device.destroy_descriptor_set_layout(self.raw, None);
+            self.owner.device.destroy_pipeline(self.raw, None);
+            self.owner.device.destroy_pipeline_layout(self.layout, None);
         }
     }
+}
+
+/// A pipeline layout for `sets` and `push_bytes` of push constants, with no pipeline yet.
+fn layout_only(gpu: &Gpu, sets: &[&SetLayout], push_bytes: u32) -> PlayResult<Pipeline> {
+    let mut p = Pipeline::none(gpu);
+    p.layout = pipeline_layout(gpu, sets, push_bytes)?;
+    Ok(p)
 }
 
 fn pipeline_layout(gpu: &Gpu, sets: &[&SetLayout], push_bytes: u32) -> PlayResult<vk::PipelineLayout> {
@@ -195,13 +259,14 @@ fn pipeline_layout(gpu: &Gpu, sets: &[&SetLayout], push_bytes: u32) -> PlayResul
         .map_err(|e| vk_err("creating a pipeline layout", e))
 }
 
-/// A compute pipeline.
+/// A compute pipeline and its layout, released when dropped.
 #[derive(Debug)]
 pub struct ComputePipeline {
     /// Pipeline.
     pub raw: vk::Pipeline,
     /// Layout.
     pub layout: vk::PipelineLayout,
+    _owned: Pipeline,
 }
 
 impl ComputePipeline {
@@ -222,13 +287,7 @@ impl ComputePipeline {
         constants: &[u32],
     ) -> PlayResult<ComputePipeline> {
         let module = shader_module(gpu, spirv)?;
-        let layout = match pipeline_layout(gpu, sets, push_bytes) {
-            Ok(l) => l,
-            Err(e) => {
-                unsafe { gpu.device.destroy_shader_module(module, None) };
-                return Err(e);
-            }
-        };
+        let mut owned = layout_only(gpu, sets, push_bytes)?;
         let entries: Vec<vk::SpecializationMapEntry> = (0..constants.len() as u32)
             .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
             .collect();
@@ -236,30 +295,15 @@ impl ComputePipeline {
             vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(constants));
         let mut stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
+            .module(module.raw)
             .name(c"main");
         if !constants.is_empty() {
             stage = stage.specialization_info(&spec);
         }
-        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
+        let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(owned.layout);
         let result = unsafe { gpu.device.create_compute_pipelines(gpu.pipeline_cache, &[info], None) };
-        unsafe { gpu.device.destroy_shader_module(module, None) };
-        let raw = match result {
-            Ok(p) => p[0],
-            Err((_, e)) => {
-                unsafe { gpu.device.destroy_pipeline_layout(layout, None) };
-                return Err(vk_err("creating a compute pipeline", e));
-            }
-        };
-        Ok(ComputePipeline { raw, layout })
-    }
-
-    /// Releases the pipeline.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        unsafe {
-            gpu.device.destroy_pipeline(self.raw, None);
-            gpu.device.destroy_pipeline_layout(self.layout, None);
-        }
+        owned.raw = result.map_err(|(_, e)| vk_err("creating a compute pipeline", e))?[0];
+        Ok(ComputePipeline { raw: owned.raw, layout: owned.layout, _owned: owned })
     }
 }
 
@@ -287,13 +331,14 @@ pub struct GraphicsDesc<'a> {
     pub cull_back: bool,
 }
 
-/// A graphics pipeline for dynamic rendering.
+/// A graphics pipeline for dynamic rendering and its layout, released when dropped.
 #[derive(Debug)]
 pub struct GraphicsPipeline {
     /// Pipeline.
     pub raw: vk::Pipeline,
     /// Layout.
     pub layout: vk::PipelineLayout,
+    _owned: Pipeline,
 }
 
 impl GraphicsPipeline {
@@ -302,15 +347,15 @@ impl GraphicsPipeline {
     pub fn new(gpu: &Gpu, d: &GraphicsDesc) -> PlayResult<GraphicsPipeline> {
         let vs = shader_module(gpu, d.vertex)?;
         let fs = shader_module(gpu, d.fragment)?;
-        let layout = pipeline_layout(gpu, d.sets, d.push_bytes)?;
+        let mut owned = layout_only(gpu, d.sets, d.push_bytes)?;
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vs)
+                .module(vs.raw)
                 .name(c"main"),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
-                .module(fs)
+                .module(fs.raw)
                 .name(c"main"),
         ];
         let bindings: Vec<vk::VertexInputBindingDescription> = d
@@ -374,22 +419,10 @@ impl GraphicsPipeline {
             .depth_stencil_state(&depth)
             .color_blend_state(&blend)
             .dynamic_state(&dynamic)
-            .layout(layout)
+            .layout(owned.layout)
             .push_next(&mut rendering);
         let result = unsafe { gpu.device.create_graphics_pipelines(gpu.pipeline_cache, &[info], None) };
-        unsafe {
-            gpu.device.destroy_shader_module(vs, None);
-            gpu.device.destroy_shader_module(fs, None);
-        }
-        let raw = result.map_err(|(_, e)| vk_err("creating a graphics pipeline", e))?[0];
-        Ok(GraphicsPipeline { raw, layout })
-    }
-
-    /// Releases the pipeline.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        unsafe {
-            gpu.device.destroy_pipeline(self.raw, None);
-            gpu.device.destroy_pipeline_layout(self.layout, None);
-        }
+        owned.raw = result.map_err(|(_, e)| vk_err("creating a graphics pipeline", e))?[0];
+        Ok(GraphicsPipeline { raw: owned.raw, layout: owned.layout, _owned: owned })
     }
 }

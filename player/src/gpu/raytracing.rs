@@ -2,10 +2,13 @@
 //! triangle list, and a ray-tracing pipeline (`VK_KHR_ray_tracing_pipeline`) with its shader
 //! binding table. Both need the extensions enabled ([`Gpu::ray_tracing_pipeline`]).
 
+use std::sync::Arc;
+
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::{Buffer, Gpu, Recorder, pipelines::shader_module};
+use super::pipelines::{Pipeline, shader_module};
+use super::{Buffer, Gpu, Owner, Recorder};
 use crate::error::{Exit, PlayError, PlayResult, vk as vk_err};
 
 const ADDRESS: vk::BufferUsageFlags = vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
@@ -28,13 +31,25 @@ struct Level {
 /// One bottom-level acceleration structure over a triangle list and a top level holding one
 /// instance of it (identity transform, mask 0xff), both preferring fast traces. Created empty:
 /// [`Recorder::build_structures`] records their builds. Owns their buffers (vertices, instance,
-/// storage and scratch).
+/// storage and scratch); dropping it releases the structures, then the buffers (the GPU must be
+/// done with them).
 pub struct AccelerationStructures {
     loader: ash::khr::acceleration_structure::Device,
-    buffers: Vec<Buffer>,
     structures: Vec<vk::AccelerationStructureKHR>,
+    /// Dropped after the structures (fields drop after `drop`'s body).
+    buffers: Vec<Buffer>,
     levels: Vec<Level>,
     tlas_address: u64,
+    _owner: Arc<Owner>,
+}
+
+impl Drop for AccelerationStructures {
+    fn drop(&mut self) {
+        for s in self.structures.drain(..) {
+            // SAFETY: created by this loader; the owner guarantees the GPU no longer uses it.
+            unsafe { self.loader.destroy_acceleration_structure(s, None) };
+        }
+    }
 }
 
 impl std::fmt::Debug for AccelerationStructures {
@@ -53,18 +68,14 @@ impl AccelerationStructures {
         }
         let mut s = AccelerationStructures {
             loader: ash::khr::acceleration_structure::Device::new(&gpu.instance, &gpu.device),
-            buffers: Vec::new(),
             structures: Vec::new(),
+            buffers: Vec::new(),
             levels: Vec::new(),
             tlas_address: 0,
+            _owner: gpu.owner(),
         };
-        match s.create(gpu, corners) {
-            Ok(()) => Ok(s),
-            Err(e) => {
-                s.destroy(gpu);
-                Err(e)
-            }
-        }
+        s.create(gpu, corners)?;
+        Ok(s)
     }
 
     /// The top level's device address (what shaders trace against).
@@ -188,7 +199,7 @@ impl AccelerationStructures {
             .buffer(self.buffers[storage].raw)
             .size(sizes.acceleration_structure_size)
             .ty(kind);
-        // SAFETY: the storage buffer is at least the structure's size; released in `destroy`.
+        // SAFETY: the storage buffer is at least the structure's size; released on drop.
         let handle = unsafe { self.loader.create_acceleration_structure(&create, None) }
             .map_err(|e| vk_err("creating an acceleration structure", e))?;
         self.structures.push(handle);
@@ -212,19 +223,6 @@ impl AccelerationStructures {
             scratch: self.buffers[scratch].address(gpu).next_multiple_of(SCRATCH_ALIGNMENT),
         });
         Ok(address)
-    }
-
-    /// Releases the structures and their buffers (the GPU must be done with them).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        for s in self.structures.drain(..) {
-            // SAFETY: created by this loader; the caller guarantees the GPU no longer uses it.
-            unsafe { self.loader.destroy_acceleration_structure(s, None) };
-        }
-        for b in &mut self.buffers {
-            b.destroy(gpu);
-        }
-        self.buffers.clear();
-        self.levels.clear();
     }
 }
 
@@ -256,8 +254,9 @@ impl Recorder<'_> {
     pub fn trace_rays(&self, p: &RayTracingPipeline, push: &[u8], count: u32) -> vk::PipelineStageFlags2 {
         // SAFETY: the pipeline, its layout and its binding table live as long as `p`.
         unsafe {
-            self.gpu.device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, p.raw);
-            self.gpu.device.cmd_push_constants(self.cmd, p.layout, vk::ShaderStageFlags::RAYGEN_KHR, 0, push);
+            let (raw, layout) = (p.pipeline.raw, p.pipeline.layout);
+            self.gpu.device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::RAY_TRACING_KHR, raw);
+            self.gpu.device.cmd_push_constants(self.cmd, layout, vk::ShaderStageFlags::RAYGEN_KHR, 0, push);
             p.loader.cmd_trace_rays(
                 self.cmd,
                 &p.regions[0],
@@ -287,10 +286,10 @@ pub struct RayTracingShaders<'a> {
 /// A ray-tracing pipeline of three groups (ray generation, miss, a triangle hit group with a
 /// closest-hit shader), recursion depth 1, push constants for ray generation only, no descriptor
 /// sets; with its shader binding table: one record per group, each at the base alignment.
+/// Dropping it releases pipeline, layout and table (the GPU must be done with them).
 pub struct RayTracingPipeline {
     loader: ash::khr::ray_tracing_pipeline::Device,
-    layout: vk::PipelineLayout,
-    raw: vk::Pipeline,
+    pipeline: Pipeline,
     table: Option<Buffer>,
     regions: [vk::StridedDeviceAddressRegionKHR; 3],
 }
@@ -310,18 +309,12 @@ impl RayTracingPipeline {
     pub fn new(gpu: &Gpu, shaders: &RayTracingShaders, push_bytes: u32) -> PlayResult<RayTracingPipeline> {
         let mut p = RayTracingPipeline {
             loader: ash::khr::ray_tracing_pipeline::Device::new(&gpu.instance, &gpu.device),
-            layout: vk::PipelineLayout::null(),
-            raw: vk::Pipeline::null(),
+            pipeline: Pipeline::none(gpu),
             table: None,
             regions: [vk::StridedDeviceAddressRegionKHR::default(); 3],
         };
-        match p.create(gpu, shaders, push_bytes) {
-            Ok(()) => Ok(p),
-            Err(e) => {
-                p.destroy(gpu);
-                Err(e)
-            }
-        }
+        p.create(gpu, shaders, push_bytes)?;
+        Ok(p)
     }
 
     fn create(&mut self, gpu: &Gpu, shaders: &RayTracingShaders, push_bytes: u32) -> PlayResult {
@@ -331,35 +324,28 @@ impl RayTracingPipeline {
         if push_bytes > 0 {
             layout_info = layout_info.push_constant_ranges(&pushes);
         }
-        // SAFETY: `layout_info` and its ranges live until the call returns; released in `destroy`.
-        self.layout = unsafe { gpu.device.create_pipeline_layout(&layout_info, None) }
+        // SAFETY: `layout_info` and its ranges live until the call returns; released on drop.
+        self.pipeline.layout = unsafe { gpu.device.create_pipeline_layout(&layout_info, None) }
             .map_err(|e| vk_err("creating the ray-tracing pipeline layout", e))?;
-        let mut modules = Vec::new();
-        for code in [shaders.raygen, shaders.miss, shaders.closest_hit] {
-            match shader_module(gpu, code) {
-                Ok(m) => modules.push(m),
-                Err(e) => {
-                    for m in modules {
-                        // SAFETY: not used by any pipeline yet.
-                        unsafe { gpu.device.destroy_shader_module(m, None) };
-                    }
-                    return Err(e);
-                }
-            }
-        }
+        // Released when this returns, once the pipeline is created.
+        let modules = [
+            shader_module(gpu, shaders.raygen)?,
+            shader_module(gpu, shaders.miss)?,
+            shader_module(gpu, shaders.closest_hit)?,
+        ];
         let main = c"main";
         let stages = [
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::RAYGEN_KHR)
-                .module(modules[0])
+                .module(modules[0].raw)
                 .name(main),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::MISS_KHR)
-                .module(modules[1])
+                .module(modules[1].raw)
                 .name(main),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::CLOSEST_HIT_KHR)
-                .module(modules[2])
+                .module(modules[2].raw)
                 .name(main),
         ];
         let general = |i: u32| {
@@ -384,7 +370,7 @@ impl RayTracingPipeline {
             .stages(&stages)
             .groups(&groups)
             .max_pipeline_ray_recursion_depth(1)
-            .layout(self.layout);
+            .layout(self.pipeline.layout);
         // SAFETY: `info`, its stages and groups live until the call returns.
         let created = unsafe {
             self.loader.create_ray_tracing_pipelines(
@@ -394,11 +380,7 @@ impl RayTracingPipeline {
                 None,
             )
         };
-        for m in modules {
-            // SAFETY: pipeline creation has returned; modules are not needed afterwards.
-            unsafe { gpu.device.destroy_shader_module(m, None) };
-        }
-        self.raw = match created {
+        self.pipeline.raw = match created {
             Ok(p) => p[0],
             Err((_, e)) => return Err(vk_err("creating the ray-tracing pipeline", e)),
         };
@@ -415,8 +397,9 @@ impl RayTracingPipeline {
         let stride = (handle as u64).next_multiple_of(props.shader_group_handle_alignment.max(1) as u64);
         let base = props.shader_group_base_alignment.max(1) as u64;
         // SAFETY: the pipeline has three groups.
-        let handles = unsafe { self.loader.get_ray_tracing_shader_group_handles(self.raw, 0, 3, handle * 3) }
-            .map_err(|e| vk_err("reading shader group handles", e))?;
+        let handles =
+            unsafe { self.loader.get_ray_tracing_shader_group_handles(self.pipeline.raw, 0, 3, handle * 3) }
+                .map_err(|e| vk_err("reading shader group handles", e))?;
         let mut table = vec![0u8; (base * 3) as usize];
         for g in 0..3 {
             let at = (g as u64 * base) as usize;
@@ -446,23 +429,5 @@ impl RayTracingPipeline {
         // The raygen region's size must equal its stride.
         self.regions = [region(0), region(1), region(2)];
         Ok(())
-    }
-
-    /// Releases the pipeline, its layout and its binding table (the GPU must be done with them).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        // SAFETY: made by `new`; the caller guarantees the GPU no longer uses them.
-        unsafe {
-            if self.raw != vk::Pipeline::null() {
-                gpu.device.destroy_pipeline(self.raw, None);
-            }
-            if self.layout != vk::PipelineLayout::null() {
-                gpu.device.destroy_pipeline_layout(self.layout, None);
-            }
-        }
-        self.raw = vk::Pipeline::null();
-        self.layout = vk::PipelineLayout::null();
-        if let Some(mut b) = self.table.take() {
-            b.destroy(gpu);
-        }
     }
 }

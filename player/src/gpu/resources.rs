@@ -1,18 +1,20 @@
-//! Buffers, images and samplers, with their memory from `gpu-allocator`. Each owns its memory and
-//! must be released with `destroy` before the [`Gpu`] is dropped.
+//! Buffers, images and samplers, with their memory from `gpu-allocator`. Each owns its handle
+//! and memory and releases them when dropped (no submitted work may still use it then).
+
+use std::sync::Arc;
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 
-use super::Gpu;
+use super::{Gpu, Owner};
 use crate::error::{Exit, PlayError, PlayResult, vk as vk_err};
 
 fn alloc_err(what: &str, e: gpu_allocator::AllocationError) -> PlayError {
     PlayError::new(Exit::Gpu, format!("allocating memory for {what} failed: {e}"))
 }
 
-/// A buffer and its memory.
+/// A buffer and its memory, released when dropped.
 #[derive(Debug)]
 pub struct Buffer {
     /// Handle.
@@ -20,6 +22,17 @@ pub struct Buffer {
     /// Size in bytes.
     pub size: u64,
     allocation: Option<Allocation>,
+    owner: Arc<Owner>,
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; its owner guarantees no submitted work uses it any more.
+        unsafe { self.owner.device.destroy_buffer(self.raw, None) };
+        if let Some(a) = self.allocation.take() {
+            let _ = self.owner.allocator().free(a);
+        }
+    }
 }
 
 impl Buffer {
@@ -64,6 +77,8 @@ impl Buffer {
         }
         let raw =
             unsafe { gpu.device.create_buffer(&info, None) }.map_err(|e| vk_err("creating a buffer", e))?;
+        // Released on any error below.
+        let mut buffer = Buffer { raw, size, allocation: None, owner: gpu.owner() };
         let requirements = unsafe { gpu.device.get_buffer_memory_requirements(raw) };
         let allocation = gpu
             .allocator()
@@ -74,13 +89,11 @@ impl Buffer {
                 linear: true,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
-            .map_err(|e| {
-                unsafe { gpu.device.destroy_buffer(raw, None) };
-                alloc_err(name, e)
-            })?;
-        unsafe { gpu.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }
-            .map_err(|e| vk_err("binding buffer memory", e))?;
-        Ok(Buffer { raw, size, allocation: Some(allocation) })
+            .map_err(|e| alloc_err(name, e))?;
+        let bound = unsafe { gpu.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) };
+        buffer.allocation = Some(allocation);
+        bound.map_err(|e| vk_err("binding buffer memory", e))?;
+        Ok(buffer)
     }
 
     /// The buffer's device address (it must have been created with SHADER_DEVICE_ADDRESS usage).
@@ -99,14 +112,6 @@ impl Buffer {
         let dst = self.mapped().ok_or_else(|| PlayError::new(Exit::Gpu, "buffer is not host-visible"))?;
         dst[..data.len()].copy_from_slice(data);
         Ok(())
-    }
-
-    /// Releases the buffer.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        if let Some(a) = self.allocation.take() {
-            unsafe { gpu.device.destroy_buffer(self.raw, None) };
-            let _ = gpu.allocator().free(a);
-        }
     }
 }
 
@@ -136,7 +141,8 @@ pub struct ImageDesc {
     pub components: vk::ComponentMapping,
 }
 
-/// An image, its default view and memory.
+/// An image, its default view and memory, released when dropped (extra [`View`]s of it
+/// should go first).
 #[derive(Debug)]
 pub struct Image {
     /// Handle.
@@ -146,6 +152,21 @@ pub struct Image {
     /// Description.
     pub desc: ImageDesc,
     allocation: Option<Allocation>,
+    owner: Arc<Owner>,
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        // SAFETY: made on this device (a null view is ignored); its owner guarantees no
+        // submitted work uses it any more.
+        unsafe {
+            self.owner.device.destroy_image_view(self.view, None);
+            self.owner.device.destroy_image(self.raw, None);
+        }
+        if let Some(a) = self.allocation.take() {
+            let _ = self.owner.allocator().free(a);
+        }
+    }
 }
 
 impl Image {
@@ -172,6 +193,9 @@ impl Image {
         }
         let raw =
             unsafe { gpu.device.create_image(&info, None) }.map_err(|e| vk_err("creating an image", e))?;
+        // Released on any error below.
+        let mut image =
+            Image { raw, view: vk::ImageView::null(), desc, allocation: None, owner: gpu.owner() };
         let requirements = unsafe { gpu.device.get_image_memory_requirements(raw) };
         let allocation = gpu
             .allocator()
@@ -182,20 +206,19 @@ impl Image {
                 linear: false,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
-            .map_err(|e| {
-                unsafe { gpu.device.destroy_image(raw, None) };
-                alloc_err(name, e)
-            })?;
-        unsafe { gpu.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }
-            .map_err(|e| vk_err("binding image memory", e))?;
-        let view = create_view(gpu, raw, &desc, 0)?;
-        Ok(Image { raw, view, desc, allocation: Some(allocation) })
+            .map_err(|e| alloc_err(name, e))?;
+        let bound = unsafe { gpu.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
+        image.allocation = Some(allocation);
+        bound.map_err(|e| vk_err("binding image memory", e))?;
+        image.view = create_view(gpu, raw, &desc, 0)?;
+        Ok(image)
     }
 
     /// A view of mips `base` to the last (every layer), for sampling while only those levels
     /// hold data: a sampler never reads a level outside its view.
     pub fn view_from_mip(&self, gpu: &Gpu, base: u32) -> PlayResult<View> {
-        Ok(View { raw: create_view(gpu, self.raw, &self.desc, base.min(self.desc.mips.max(1) - 1))? })
+        let raw = create_view(gpu, self.raw, &self.desc, base.min(self.desc.mips.max(1) - 1))?;
+        Ok(View { raw, owner: gpu.owner() })
     }
 
     /// Range covering `count` mips from `base` and every layer.
@@ -211,17 +234,6 @@ impl Image {
             level_count: self.desc.mips.max(1),
             base_array_layer: 0,
             layer_count: self.desc.layers.max(1),
-        }
-    }
-
-    /// Releases the image.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        if let Some(a) = self.allocation.take() {
-            unsafe {
-                gpu.device.destroy_image_view(self.view, None);
-                gpu.device.destroy_image(self.raw, None);
-            }
-            let _ = gpu.allocator().free(a);
         }
     }
 }
@@ -251,21 +263,19 @@ fn create_view(gpu: &Gpu, raw: vk::Image, desc: &ImageDesc, base: u32) -> PlayRe
     unsafe { gpu.device.create_image_view(&view_info, None) }.map_err(|e| vk_err("creating an image view", e))
 }
 
-/// An extra view of an image (the image's own is [`Image::view`]), released by its owner
-/// before the image.
+/// An extra view of an image (the image's own is [`Image::view`]), released when dropped; its
+/// owner drops it before the image.
 #[derive(Debug)]
 pub struct View {
-    /// Handle (null once destroyed).
+    /// Handle.
     pub raw: vk::ImageView,
+    owner: Arc<Owner>,
 }
 
-impl View {
-    /// Releases the view (no submitted work may still use it).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        if self.raw != vk::ImageView::null() {
-            unsafe { gpu.device.destroy_image_view(self.raw, None) };
-            self.raw = vk::ImageView::null();
-        }
+impl Drop for View {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; its owner guarantees no submitted work uses it any more.
+        unsafe { self.owner.device.destroy_image_view(self.raw, None) };
     }
 }
 
@@ -290,11 +300,19 @@ pub struct SamplerKey {
     pub wrap_v: vk::SamplerAddressMode,
 }
 
-/// A sampler.
+/// A sampler, released when dropped.
 #[derive(Debug)]
 pub struct Sampler {
     /// Handle.
     pub raw: vk::Sampler,
+    owner: Arc<Owner>,
+}
+
+impl Drop for Sampler {
+    fn drop(&mut self) {
+        // SAFETY: made on this device; its owner guarantees no submitted work uses it any more.
+        unsafe { self.owner.device.destroy_sampler(self.raw, None) };
+    }
 }
 
 impl Sampler {
@@ -315,12 +333,6 @@ impl Sampler {
             .max_lod(if key.mipmaps { vk::LOD_CLAMP_NONE } else { 0.0 });
         let raw =
             unsafe { gpu.device.create_sampler(&info, None) }.map_err(|e| vk_err("creating a sampler", e))?;
-        Ok(Sampler { raw })
-    }
-
-    /// Releases the sampler.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        unsafe { gpu.device.destroy_sampler(self.raw, None) };
-        self.raw = vk::Sampler::null();
+        Ok(Sampler { raw, owner: gpu.owner() })
     }
 }

@@ -4,7 +4,7 @@
 use ash::vk;
 use raw_window_handle::{RawDisplayHandle, RawWindowHandle};
 
-use super::Gpu;
+use super::{Gpu, Semaphore};
 use crate::error::{Exit, PlayError, PlayResult, vk as vk_err};
 
 /// Instance extensions a surface for `display` needs.
@@ -14,7 +14,8 @@ pub fn surface_extensions(display: RawDisplayHandle) -> PlayResult<Vec<*const st
     })
 }
 
-/// A surface and its swapchain.
+/// A surface and its swapchain. Dropping it releases swapchain, surface and semaphores: the GPU
+/// must be idle, and the window must still be open.
 pub struct Swapchain {
     surface_loader: ash::khr::surface::Instance,
     surface: vk::SurfaceKHR,
@@ -25,9 +26,21 @@ pub struct Swapchain {
     /// Their size.
     pub extent: vk::Extent2D,
     /// Signalled when the acquired image may be written.
-    pub acquired: vk::Semaphore,
+    pub acquired: Semaphore,
     /// Per image: signalled when its frame is done, waited on by present.
-    pub rendered: Vec<vk::Semaphore>,
+    pub rendered: Vec<Semaphore>,
+}
+
+impl Drop for Swapchain {
+    fn drop(&mut self) {
+        // SAFETY: made on this device and instance (a null swapchain is ignored); the owner
+        // waited for the GPU. The semaphores, and the `Owner` they hold (device and instance),
+        // go after this body.
+        unsafe {
+            self.loader.destroy_swapchain(self.raw, None);
+            self.surface_loader.destroy_surface(self.surface, None);
+        }
+    }
 }
 
 impl std::fmt::Debug for Swapchain {
@@ -46,32 +59,38 @@ impl Swapchain {
         height: u32,
     ) -> PlayResult<Swapchain> {
         // SAFETY: the handles come from a live winit window that outlives the swapchain (the
-        // window front end destroys the swapchain first).
+        // window front end drops the swapchain first).
         let surface = unsafe { ash_window::create_surface(&gpu.entry, &gpu.instance, display, window, None) }
             .map_err(|e| vk_err("creating a window surface", e))?;
         let surface_loader = ash::khr::surface::Instance::new(&gpu.entry, &gpu.instance);
-        let supported =
-            unsafe { surface_loader.get_physical_device_surface_support(gpu.physical, gpu.family, surface) }
-                .unwrap_or(false);
-        if !supported {
-            unsafe { surface_loader.destroy_surface(surface, None) };
-            return Err(PlayError::new(
-                Exit::Unsupported,
-                format!("{} cannot present to this window from its graphics queue", gpu.name),
-            ));
-        }
-        let loader = ash::khr::swapchain::Device::new(&gpu.instance, &gpu.device);
-        let acquired = gpu.binary_semaphore()?;
+        let acquired = match gpu.binary_semaphore() {
+            Ok(a) => a,
+            Err(e) => {
+                unsafe { surface_loader.destroy_surface(surface, None) };
+                return Err(e);
+            }
+        };
+        // Released on any error below.
         let mut s = Swapchain {
             surface_loader,
             surface,
-            loader,
+            loader: ash::khr::swapchain::Device::new(&gpu.instance, &gpu.device),
             raw: vk::SwapchainKHR::null(),
             images: Vec::new(),
             extent: vk::Extent2D::default(),
             acquired,
             rendered: Vec::new(),
         };
+        let supported = unsafe {
+            s.surface_loader.get_physical_device_surface_support(gpu.physical, gpu.family, s.surface)
+        }
+        .unwrap_or(false);
+        if !supported {
+            return Err(PlayError::new(
+                Exit::Unsupported,
+                format!("{} cannot present to this window from its graphics queue", gpu.name),
+            ));
+        }
         s.recreate(gpu, width, height)?;
         Ok(s)
     }
@@ -134,9 +153,7 @@ impl Swapchain {
         self.images = unsafe { self.loader.get_swapchain_images(self.raw) }
             .map_err(|e| vk_err("listing swapchain images", e))?;
         self.extent = extent;
-        for s in self.rendered.drain(..) {
-            gpu.destroy_semaphore(s);
-        }
+        self.rendered.clear();
         for _ in 0..self.images.len() {
             self.rendered.push(gpu.binary_semaphore()?);
         }
@@ -145,8 +162,8 @@ impl Swapchain {
 
     /// Acquires the next image; `None` when the swapchain must be recreated first.
     pub fn acquire(&self) -> PlayResult<Option<u32>> {
-        match unsafe { self.loader.acquire_next_image(self.raw, u64::MAX, self.acquired, vk::Fence::null()) }
-        {
+        let acquired = self.acquired.raw;
+        match unsafe { self.loader.acquire_next_image(self.raw, u64::MAX, acquired, vk::Fence::null()) } {
             Ok((i, _)) => Ok(Some(i)),
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => Ok(None),
             Err(e) => Err(vk_err("acquiring a swapchain image", e)),
@@ -155,7 +172,7 @@ impl Swapchain {
 
     /// Presents image `index`; returns false when the swapchain should be recreated.
     pub fn present(&self, gpu: &Gpu, index: u32) -> PlayResult<bool> {
-        let waits = [self.rendered[index as usize]];
+        let waits = [self.rendered[index as usize].raw];
         let swapchains = [self.raw];
         let indices = [index];
         let info = vk::PresentInfoKHR::default()
@@ -166,18 +183,6 @@ impl Swapchain {
             Ok(false) => Ok(true),
             Ok(true) | Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => Ok(false),
             Err(e) => Err(vk_err("presenting", e)),
-        }
-    }
-
-    /// Releases swapchain, surface and semaphores (the GPU must be idle).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        unsafe {
-            self.loader.destroy_swapchain(self.raw, None);
-            self.surface_loader.destroy_surface(self.surface, None);
-        }
-        gpu.destroy_semaphore(self.acquired);
-        for s in self.rendered.drain(..) {
-            gpu.destroy_semaphore(s);
         }
     }
 }

@@ -17,12 +17,12 @@ use super::texels::TexelDecode;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::Gpu;
 
-/// A frame that is being built on another thread. Dropping it waits for the thread and
-/// releases what it made, so that no path leaks it.
+/// A frame that is being built on another thread. Dropping it waits for the thread and drops
+/// what it made (nothing of it was used by the GPU), so that no path leaks it and the thread's
+/// hold on the device ends before the session's.
 #[derive(Debug)]
 pub struct FrameBuild {
     thread: Option<JoinHandle<PlayResult<Built>>>,
-    gpu: Arc<Gpu>,
 }
 
 /// What the thread made.
@@ -56,7 +56,7 @@ impl FrameBuild {
                 Ok(Built { frame, ms: t.elapsed().as_secs_f64() * 1e3, done: Instant::now() })
             })
             .map_err(|e| PlayError::new(Exit::Gpu, format!("cannot start the pipeline thread: {e}")))?;
-        Ok(FrameBuild { thread: Some(thread), gpu: Arc::clone(gpu) })
+        Ok(FrameBuild { thread: Some(thread) })
     }
 
     /// Whether the thread has finished (a [`FrameBuild::join`] would not wait).
@@ -73,10 +73,9 @@ impl FrameBuild {
 
 impl Drop for FrameBuild {
     fn drop(&mut self) {
-        if let Some(thread) = self.thread.take()
-            && let Ok(Ok(mut built)) = thread.join()
-        {
-            built.frame.destroy(&self.gpu);
+        if let Some(thread) = self.thread.take() {
+            // The frame it built, if any, is dropped with the result.
+            let _ = thread.join();
         }
     }
 }

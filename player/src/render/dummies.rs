@@ -7,7 +7,8 @@ use crate::gpu::{Gpu, Image};
 use crate::scene::sampled_desc;
 use crate::scene::upload::Uploader;
 
-/// Placeholder images for descriptors that must be valid but are never read.
+/// Placeholder images for descriptors that must be valid but are never read (released when
+/// dropped, after every frame that bound them).
 #[derive(Debug)]
 pub struct Dummies {
     /// 1 × 1 white RGBA8 (absent textures, absent BRDF table).
@@ -19,25 +20,19 @@ pub struct Dummies {
 }
 
 impl Dummies {
-    /// Creates and uploads the placeholders.
+    /// Creates and uploads the placeholders (all three made before any upload is recorded: one
+    /// that fails to be made leaves no upload naming the others).
     pub fn new(gpu: &Gpu, up: &mut Uploader) -> PlayResult<Dummies> {
         let white = Image::new(gpu, "white", sampled_desc(vk::Format::R8G8B8A8_UNORM, 1, 1, 1, 1, false))?;
-        up.image(&white, 4, &[(0, 0, 1, 1, &[255u8; 4])])?;
-        let far = f32::MAX.to_le_bytes();
         let shadow_2d =
             Image::new(gpu, "no shadow 2d", sampled_desc(vk::Format::R32_SFLOAT, 1, 1, 1, 1, false))?;
-        up.image(&shadow_2d, 4, &[(0, 0, 1, 1, &far)])?;
         let shadow_cube =
             Image::new(gpu, "no shadow cube", sampled_desc(vk::Format::R32_SFLOAT, 1, 1, 1, 6, true))?;
+        up.image(&white, 4, &[(0, 0, 1, 1, &[255u8; 4])])?;
+        let far = f32::MAX.to_le_bytes();
+        up.image(&shadow_2d, 4, &[(0, 0, 1, 1, &far)])?;
         let faces: Vec<(u32, u32, u32, u32, &[u8])> = (0..6).map(|f| (0, f, 1, 1, &far[..])).collect();
         up.image(&shadow_cube, 4, &faces)?;
         Ok(Dummies { white, shadow_2d, shadow_cube })
-    }
-
-    /// Releases the images.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.white.destroy(gpu);
-        self.shadow_2d.destroy(gpu);
-        self.shadow_cube.destroy(gpu);
     }
 }

@@ -15,7 +15,8 @@ use super::texels::TexelDecode;
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Gpu, ImageDesc};
 
-/// The passes of a run and the images of the current size.
+/// The passes of a run and the images of the current size. Dropping it releases both: the GPU
+/// must be done with them (the owner of a frame that rendered waits for the GPU first).
 #[derive(Debug)]
 pub struct Frame {
     /// The passes, in order.
@@ -168,6 +169,8 @@ fn passes(
     // Each pass builds its pipelines on a thread of its own: a driver compiles a call's
     // pipelines one after another, and on a cold cache the default frame's took 350 ms in a row
     // on the H100.
+    // Each thread hands back what it made; on an error, the passes the others made are dropped
+    // here (none is used by the GPU yet).
     let results: Vec<PlayResult<(Box<dyn Pass>, f64)>> = std::thread::scope(|s| {
         let threads: Vec<_> = makers
             .into_iter()
@@ -185,21 +188,7 @@ fn passes(
             })
             .collect()
     });
-    let mut made = Vec::with_capacity(results.len());
-    let mut failed = None;
-    for r in results {
-        match r {
-            Ok(p) => made.push(p),
-            Err(e) => failed = failed.or(Some(e)),
-        }
-    }
-    if let Some(e) = failed {
-        for (p, _) in &mut made {
-            p.destroy(gpu);
-        }
-        return Err(e);
-    }
-    Ok(made)
+    results.into_iter().collect()
 }
 
 /// A pass to make: its constructor, run on a thread of its own by [`passes`].
@@ -215,7 +204,7 @@ impl Frame {
     /// The passes of `techniques` and their images at `width` × `height`, for a scene of
     /// `lights` whose texel buffer `decode` reads (known from the file's tables before
     /// its sections upload: the pipelines are built while the scene uploads). On failure
-    /// everything made is released.
+    /// everything made is released (dropped).
     pub fn new(
         gpu: &Gpu,
         techniques: &Techniques,
@@ -224,36 +213,23 @@ impl Frame {
         width: u32,
         height: u32,
     ) -> PlayResult<Frame> {
-        let (mut passes, build_ms): (Vec<_>, Vec<_>) = passes(gpu, techniques, lights, decode)?
+        let (passes, build_ms): (Vec<_>, Vec<_>) = passes(gpu, techniques, lights, decode)?
             .into_iter()
             .map(|(p, ms)| {
                 let name = p.name();
                 (p, (name, ms))
             })
             .unzip();
-        match make_images(gpu, &passes, width, height) {
-            Ok(images) => Ok(Frame { passes, images, decode, build_ms }),
-            Err(e) => {
-                for p in &mut passes {
-                    p.destroy(gpu);
-                }
-                Err(e)
-            }
-        }
+        let images = make_images(gpu, &passes, width, height)?;
+        Ok(Frame { passes, images, decode, build_ms })
     }
 
     /// Remakes the images for a new size (the GPU must be idle); the caller rebinds.
     pub fn resize(&mut self, gpu: &Gpu, width: u32, height: u32) -> PlayResult {
-        self.images.destroy(gpu);
+        // The old images go before the new ones are made: both at once could exceed the
+        // memory either needs.
+        drop(std::mem::take(&mut self.images));
         self.images = make_images(gpu, &self.passes, width, height)?;
         Ok(())
-    }
-
-    /// Releases passes and images.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        for p in &mut self.passes {
-            p.destroy(gpu);
-        }
-        self.images.destroy(gpu);
     }
 }

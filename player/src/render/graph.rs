@@ -108,8 +108,9 @@ fn step(state: Option<State>, access: Access) -> (Option<Use>, State) {
     (from, next)
 }
 
-/// The images of one frame size and their states.
-#[derive(Debug)]
+/// The images of one frame size and their states, released when dropped (the GPU must be done
+/// with them). The default has no image.
+#[derive(Debug, Default)]
 pub struct FrameImages {
     /// Width.
     pub width: u32,
@@ -120,7 +121,7 @@ pub struct FrameImages {
 
 impl FrameImages {
     /// Makes the `made` images, and 1 × 1 placeholders of the `bound` declarations no entry of
-    /// `made` covers. On failure the images already made are released.
+    /// `made` covers. On failure the images already made are released (dropped).
     pub fn new(
         gpu: &Gpu,
         width: u32,
@@ -142,17 +143,11 @@ impl FrameImages {
                 wanted.push((*decl, decl.sized(1, 1, 1)));
             }
         }
-        let mut images = FrameImages { width, height, slots: Vec::with_capacity(wanted.len()) };
-        for (decl, desc) in wanted {
-            match Image::new(gpu, decl.name, desc) {
-                Ok(image) => images.slots.push(Slot { decl, image, state: None }),
-                Err(e) => {
-                    images.destroy(gpu);
-                    return Err(e);
-                }
-            }
-        }
-        Ok(images)
+        let slots = wanted
+            .into_iter()
+            .map(|(decl, desc)| Ok(Slot { decl, image: Image::new(gpu, decl.name, desc)?, state: None }))
+            .collect::<PlayResult<Vec<Slot>>>()?;
+        Ok(FrameImages { width, height, slots })
     }
 
     fn slot(&self, decl: &TargetDecl) -> usize {
@@ -181,14 +176,6 @@ impl FrameImages {
         let list: Vec<(&Image, Use, Use)> =
             barriers.iter().map(|&(i, from, to)| (&self.slots[i].image, from, to)).collect();
         rec.transitions(&list);
-    }
-
-    /// Releases the images.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        for s in &mut self.slots {
-            s.image.destroy(gpu);
-        }
-        self.slots.clear();
     }
 }
 

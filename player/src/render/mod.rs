@@ -84,7 +84,8 @@ impl RenderSettings {
 /// GPU milliseconds of each pass of a frame, by pass name, in frame order.
 pub type PassTimes = Vec<(&'static str, f64)>;
 
-/// Renders a resident scene.
+/// Renders a resident scene. Dropping it releases everything it owns: the GPU must be done with
+/// it (its owner waits for the GPU first).
 pub struct Renderer {
     frame: Frame,
     frame_ubo: Buffer,
@@ -127,7 +128,8 @@ fn host_buffer(gpu: &Gpu, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags)
 
 impl Renderer {
     /// Binds `scene` to the passes of `frame`, with `dummies` where nothing else is bound (the
-    /// session's: they must outlive the renderer). On failure the frame is released.
+    /// session's: they must outlive the renderer). On failure the frame is released (dropped;
+    /// the GPU has not used it).
     pub fn new(
         gpu: &Gpu,
         frame: Frame,
@@ -163,44 +165,16 @@ impl Renderer {
         let mut flags = if plan.shadows_bound && surface_maps { FrameFlags::SHADOW_MAPS } else { 0 };
         flags |= t.flags();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let mut frame = frame;
-        let buffers = (|| {
-            let lights = host_buffer(gpu, "lights", bytemuck::cast_slice(&plan.lights), storage)?;
-            let shadows = host_buffer(gpu, "shadows", bytemuck::cast_slice(&plan.shadows), storage);
-            let frame_ubo = Buffer::new(
-                gpu,
-                "frame",
-                std::mem::size_of::<FrameConstants>() as u64,
-                vk::BufferUsageFlags::UNIFORM_BUFFER,
-                MemoryLocation::CpuToGpu,
-            );
-            let timestamps = TimestampPool::new(gpu, frame.passes.len() as u32 + 1);
-            match (shadows, frame_ubo, timestamps) {
-                (Ok(s), Ok(f), Ok(t)) => Ok((lights, s, f, t)),
-                (s, f, t) => {
-                    let mut lights = lights;
-                    lights.destroy(gpu);
-                    let mut first_error = None;
-                    for r in [
-                        s.map(|mut b| b.destroy(gpu)),
-                        f.map(|mut b| b.destroy(gpu)),
-                        t.map(|mut p| p.destroy(gpu)),
-                    ] {
-                        if let Err(e) = r {
-                            first_error.get_or_insert(e);
-                        }
-                    }
-                    Err(first_error.expect("one of them failed"))
-                }
-            }
-        })();
-        let (lights, shadows, frame_ubo, timestamps) = match buffers {
-            Ok(b) => b,
-            Err(e) => {
-                frame.destroy(gpu);
-                return Err(e);
-            }
-        };
+        let lights = host_buffer(gpu, "lights", bytemuck::cast_slice(&plan.lights), storage)?;
+        let shadows = host_buffer(gpu, "shadows", bytemuck::cast_slice(&plan.shadows), storage)?;
+        let frame_ubo = Buffer::new(
+            gpu,
+            "frame",
+            std::mem::size_of::<FrameConstants>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let timestamps = TimestampPool::new(gpu, frame.passes.len() as u32 + 1)?;
         let warnings = plan.warnings.clone();
         let mut renderer = Renderer {
             frame,
@@ -220,10 +194,7 @@ impl Renderer {
             frame_count: 0,
             warnings,
         };
-        if let Err(e) = renderer.bind(gpu, scene, dummies) {
-            renderer.destroy(gpu);
-            return Err(e);
-        }
+        renderer.bind(gpu, scene, dummies)?;
         Ok(renderer)
     }
 
@@ -393,15 +364,6 @@ impl Renderer {
             .map(|(i, p)| (p.name(), (ns[i + 1] - ns[i]) * 1e-6))
             .collect())
     }
-
-    /// Releases everything the renderer owns (the GPU must be idle).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.frame.destroy(gpu);
-        self.frame_ubo.destroy(gpu);
-        self.lights.destroy(gpu);
-        self.shadows.destroy(gpu);
-        self.timestamps.destroy(gpu);
-    }
 }
 
 /// Length of the jitter sequence: the Halton points of one cycle cover the pixel evenly.
@@ -435,7 +397,7 @@ pub enum Readable {
     Radiance,
 }
 
-/// A host-visible copy of one of a frame's images.
+/// A host-visible copy of one of a frame's images (its buffer released when dropped).
 #[derive(Debug)]
 pub struct Readback {
     /// The pixels, tightly packed.
@@ -464,10 +426,5 @@ impl Readback {
             vk::PipelineStageFlags2::HOST,
             vk::AccessFlags2::HOST_READ,
         );
-    }
-
-    /// Releases the buffer.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.buffer.destroy(gpu);
     }
 }

@@ -255,18 +255,9 @@ impl LineSpaceBuffers {
         };
         for c in 0..count {
             let words = (layout.words - c * chunk_words).clamp(4, chunk_words);
-            match Buffer::uploaded(gpu, &format!("line-space chunk {c}"), words * 4, storage) {
-                Ok(b) => made.chunks.push(b),
-                Err(e) => {
-                    made.destroy(gpu);
-                    return Err(e);
-                }
-            }
+            made.chunks.push(Buffer::uploaded(gpu, &format!("line-space chunk {c}"), words * 4, storage)?);
         }
-        if let Err(e) = up.buffer(&made.grid, 0, bytemuck::bytes_of(&made.header)) {
-            made.destroy(gpu);
-            return Err(e);
-        }
+        up.buffer(&made.grid, 0, bytemuck::bytes_of(&made.header))?;
         Ok(made)
     }
 
@@ -314,14 +305,5 @@ impl LineSpaceBuffers {
             w.push(crate::gpu::Write::Buffer(first + 1 + i, chunk));
         }
         w
-    }
-
-    /// Releases the buffers.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.grid.destroy(gpu);
-        for c in &mut self.chunks {
-            c.destroy(gpu);
-        }
-        self.chunks.clear();
     }
 }

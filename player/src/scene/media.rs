@@ -107,11 +107,4 @@ impl MediaBuffers {
             )),
         }
     }
-
-    /// Releases the buffers.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.table.destroy(gpu);
-        self.volumes.destroy(gpu);
-        self.volume_of.destroy(gpu);
-    }
 }

@@ -76,13 +76,14 @@ pub fn first_coarse_level(width: u32, height: u32, mips: u32) -> u32 {
     (0..=last).find(|&l| (width >> l).max(height >> l).max(1) <= COARSE_SIDE).unwrap_or(last)
 }
 
-/// A texture whose finer levels are still to come: the raster passes sample it through `view`,
-/// which starts at `first`, the finest level uploaded.
+/// A texture whose finer levels are still to come: the raster passes sample it through `view`
+/// (its handle is in [`GpuScene::texture_views`]; held here to be released when dropped), which
+/// starts at `first`, the finest level uploaded.
 #[derive(Debug)]
 struct CoarseTexture {
     texture: usize,
     first: u32,
-    view: View,
+    _view: View,
 }
 
 /// A section and what happened to it.
@@ -314,25 +315,10 @@ pub struct ReferenceBuffers {
     pub media_count: u32,
 }
 
-impl ReferenceBuffers {
-    fn destroy(&mut self, gpu: &Gpu) {
-        for b in [
-            &mut self.indices,
-            &mut self.triangle_materials,
-            &mut self.materials,
-            &mut self.emitters,
-            &mut self.triangle_emitter,
-            &mut self.texels,
-            &mut self.textures,
-            &mut self.raster_materials,
-            &mut self.media,
-        ] {
-            b.destroy(gpu);
-        }
-    }
-}
+impl ReferenceBuffers {}
 
-/// The scene on the GPU.
+/// The scene on the GPU. Dropping it releases every resource: no submitted work may still use
+/// them (its owner waits for the GPU first).
 pub struct GpuScene {
     /// The file's manifest.
     pub manifest: Manifest,
@@ -347,13 +333,14 @@ pub struct GpuScene {
     pub draws: Vec<Draw>,
     /// Materials (pushed as constants per draw).
     pub materials: Vec<GpuMaterial>,
+    /// Textures sampled through a coarse view, waiting for their finer levels (declared before
+    /// `textures`: the views are dropped before their images).
+    coarse: Vec<CoarseTexture>,
     /// Material textures (empty when textures are not needed).
     pub textures: Vec<Image>,
     /// The view the raster passes sample each texture through: the image's own (every level)
     /// or, until its finer levels arrive, one of its coarse levels only.
     pub texture_views: Vec<vk::ImageView>,
-    /// Textures sampled through a coarse view, waiting for their finer levels.
-    coarse: Vec<CoarseTexture>,
     /// Bytes of texture levels uploaded before the first frame (every level without streaming).
     pub coarse_texture_bytes: u64,
     /// Bytes of texture levels uploaded after it (the finer levels of streamed textures).
@@ -501,9 +488,9 @@ impl GpuScene {
             indices,
             draws: prepared.draws.clone(),
             materials: view.materials.to_vec(),
+            coarse: Vec::new(),
             textures: Vec::new(),
             texture_views: Vec::new(),
-            coarse: Vec::new(),
             coarse_texture_bytes: 0,
             fine_texture_bytes: 0,
             texture_samplers: Vec::new(),
@@ -527,10 +514,10 @@ impl GpuScene {
                 Ok(scene)
             }
             Err(e) => {
-                // The uploader may still reference these resources; wait for it before freeing.
+                // The uploader may still reference these resources; wait for it before the scene
+                // is dropped (here, on return).
                 let _ = up.flush();
                 let _ = gpu.wait_idle();
-                scene.destroy(gpu);
                 Err(e)
             }
         }
@@ -568,13 +555,12 @@ impl GpuScene {
         !self.coarse.is_empty()
     }
 
-    /// Makes every texture's view its full chain and releases the coarse views, once
+    /// Makes every texture's view its full chain and releases (drops) the coarse views, once
     /// [`GpuScene::load_rest`]'s finer levels are resident. No submitted work may still use the
     /// coarse views, and the caller rewrites the descriptor sets that named them.
-    pub fn use_refined_views(&mut self, gpu: &Gpu) {
-        for mut c in self.coarse.drain(..) {
+    pub fn use_refined_views(&mut self) {
+        for c in self.coarse.drain(..) {
             self.texture_views[c.texture] = self.textures[c.texture].view;
-            c.view.destroy(gpu);
         }
     }
 
@@ -669,14 +655,7 @@ impl GpuScene {
                 let nodes =
                     Buffer::uploaded(gpu, "bvh nodes", std::mem::size_of_val(view.bvh) as u64, storage)?;
                 let corners: &[u8] = bytemuck::cast_slice(&prepared.bvh_triangles);
-                let triangles = match Buffer::uploaded(gpu, "bvh triangles", corners.len() as u64, storage) {
-                    Ok(t) => t,
-                    Err(e) => {
-                        let mut n = nodes;
-                        n.destroy(gpu);
-                        return Err(e);
-                    }
-                };
+                let triangles = Buffer::uploaded(gpu, "bvh triangles", corners.len() as u64, storage)?;
                 let bvh = BvhBuffers {
                     nodes,
                     triangles,
@@ -851,7 +830,7 @@ impl GpuScene {
         if first > 0 {
             let coarse = self.textures[i].view_from_mip(gpu, first)?;
             self.texture_views[i] = coarse.raw;
-            self.coarse.push(CoarseTexture { texture: i, first, view: coarse });
+            self.coarse.push(CoarseTexture { texture: i, first, _view: coarse });
         }
         let key = SamplerKey {
             linear: info.mag_linear,
@@ -888,44 +867,6 @@ impl GpuScene {
         self.fine_texture_bytes += fine.iter().map(|l| l.4.len() as u64).sum::<u64>();
         Ok(())
     }
-
-    /// Releases every resource (the GPU must be idle).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.vertices.destroy(gpu);
-        self.attributes.destroy(gpu);
-        self.indices.destroy(gpu);
-        // The coarse views before their images.
-        for c in &mut self.coarse {
-            c.view.destroy(gpu);
-        }
-        self.coarse.clear();
-        for t in &mut self.textures {
-            t.destroy(gpu);
-        }
-        if let Some(b) = &mut self.brdf_lut {
-            b.destroy(gpu);
-        }
-        for s in &mut self.shadow_maps {
-            s.image.destroy(gpu);
-        }
-        if let Some(b) = &mut self.bvh {
-            b.nodes.destroy(gpu);
-            b.triangles.destroy(gpu);
-        }
-        if let Some(r) = &mut self.reference {
-            r.destroy(gpu);
-        }
-        if let Some(l) = &mut self.line_space {
-            l.destroy(gpu);
-        }
-        if let Some(m) = &mut self.media {
-            m.destroy(gpu);
-        }
-        for s in self.samplers.values_mut() {
-            s.destroy(gpu);
-        }
-        self.samplers.clear();
-    }
 }
 
 /// A texture's levels as the uploader takes them, finest first: (mip, layer 0, width, height,
@@ -948,19 +889,10 @@ fn raster_materials(draws: &[Draw]) -> Vec<u32> {
 
 /// Storage buffers of the given names and sizes, filled by uploads; on failure none is left.
 pub(crate) fn storage_buffers(gpu: &Gpu, sizes: &[(&str, u64)]) -> PlayResult<Vec<Buffer>> {
-    let mut made: Vec<Buffer> = Vec::new();
-    for &(name, size) in sizes {
-        match Buffer::uploaded(gpu, name, size, vk::BufferUsageFlags::STORAGE_BUFFER) {
-            Ok(b) => made.push(b),
-            Err(e) => {
-                for mut b in made {
-                    b.destroy(gpu);
-                }
-                return Err(e);
-            }
-        }
-    }
-    Ok(made)
+    sizes
+        .iter()
+        .map(|&(name, size)| Buffer::uploaded(gpu, name, size, vk::BufferUsageFlags::STORAGE_BUFFER))
+        .collect()
 }
 
 /// Allocates the reference path tracer's buffers (filled as their sections stream past).

@@ -2,6 +2,10 @@
 //! staging halves while the other half's copies run on the GPU (on the transfer queue when the
 //! device has one). Large sections are split at half boundaries: buffers anywhere, images at
 //! row boundaries.
+//!
+//! Dropping the ring waits for the batches it submitted; what is recorded and not submitted
+//! never runs. After an error in an upload, what was recorded is not submitted either (its
+//! commands may name a resource the error released): the batch is discarded.
 
 use crate::gpu::vk;
 use gpu_allocator::MemoryLocation;
@@ -14,8 +18,9 @@ use crate::gpu::{Buffer, CommandPool, Gpu, Image, ImageRows, Recorder, Semaphore
 const ALIGN: u64 = 16;
 
 struct Half {
-    staging: Buffer,
+    /// Dropped first: waits for the half's last batch, which reads `staging`.
     pool: CommandPool,
+    staging: Buffer,
     used: u64,
     recording: bool,
 }
@@ -42,18 +47,14 @@ impl<'g> Uploader<'g> {
     /// as batches complete.
     pub fn new(gpu: &'g Gpu, half_bytes: u64, timeline: vk::Semaphore) -> PlayResult<Uploader<'g>> {
         let make = |i: usize| -> PlayResult<Half> {
-            Ok(Half {
-                staging: Buffer::new(
-                    gpu,
-                    &format!("staging {i}"),
-                    half_bytes,
-                    vk::BufferUsageFlags::TRANSFER_SRC,
-                    MemoryLocation::CpuToGpu,
-                )?,
-                pool: CommandPool::new(gpu, gpu.upload_family())?,
-                used: 0,
-                recording: false,
-            })
+            let staging = Buffer::new(
+                gpu,
+                &format!("staging {i}"),
+                half_bytes,
+                vk::BufferUsageFlags::TRANSFER_SRC,
+                MemoryLocation::CpuToGpu,
+            )?;
+            Ok(Half { pool: CommandPool::new(gpu, gpu.upload_family())?, staging, used: 0, recording: false })
         };
         let halves = [make(0)?, make(1)?];
         Ok(Uploader { gpu, halves, current: 0, timeline, signalled: 0, bytes: 0 })
@@ -130,8 +131,28 @@ impl<'g> Uploader<'g> {
         Ok(())
     }
 
+    /// Forgets the batch being recorded, if any, without submitting it.
+    fn discard(&mut self) {
+        for half in &mut self.halves {
+            half.recording = false;
+        }
+    }
+
+    /// `result`, discarding the batch being recorded when it is an error.
+    fn checked(&mut self, result: PlayResult) -> PlayResult {
+        if result.is_err() {
+            self.discard();
+        }
+        result
+    }
+
     /// Copies `data` into `dst` at `dst_offset`.
     pub fn buffer(&mut self, dst: &Buffer, dst_offset: u64, data: &[u8]) -> PlayResult {
+        let copied = self.copy_buffer(dst, dst_offset, data);
+        self.checked(copied)
+    }
+
+    fn copy_buffer(&mut self, dst: &Buffer, dst_offset: u64, data: &[u8]) -> PlayResult {
         let mut done = 0u64;
         while done < data.len() as u64 {
             let (offset, n) = self.reserve(data.len() as u64 - done, 1)?;
@@ -151,9 +172,8 @@ impl<'g> Uploader<'g> {
 
     /// Fills `dst` with zeros (no staging needed).
     pub fn zero(&mut self, dst: &Buffer) -> PlayResult {
-        let rec = self.recorder()?;
-        rec.fill_buffer(dst, 0, vk::WHOLE_SIZE, 0);
-        Ok(())
+        let recorded = self.recorder().map(|rec| rec.fill_buffer(dst, 0, vk::WHOLE_SIZE, 0));
+        self.checked(recorded)
     }
 
     /// Uploads an image's texels: `levels` lists (mip, layer, width, height, bytes) with rows
@@ -170,6 +190,17 @@ impl<'g> Uploader<'g> {
     /// them. The other mips are left as they are: a texture's coarse levels, uploaded earlier and
     /// perhaps being sampled, keep their contents and layout while its finer levels arrive.
     pub fn image_blocks(
+        &mut self,
+        image: &Image,
+        block: u32,
+        block_bytes: u64,
+        levels: &[(u32, u32, u32, u32, &[u8])],
+    ) -> PlayResult {
+        let copied = self.copy_image(image, block, block_bytes, levels);
+        self.checked(copied)
+    }
+
+    fn copy_image(
         &mut self,
         image: &Image,
         block: u32,
@@ -228,13 +259,11 @@ impl<'g> Uploader<'g> {
         Ok(self.signalled)
     }
 
-    /// Waits for every batch and releases the ring.
-    pub fn destroy(mut self) -> PlayResult {
-        self.flush()?;
-        for half in &mut self.halves {
+    /// Waits for every batch submitted, then releases the ring (as dropping it does, with the
+    /// wait's error returned).
+    pub fn finish(self) -> PlayResult {
+        for half in &self.halves {
             half.pool.wait(self.gpu)?;
-            half.pool.destroy(self.gpu);
-            half.staging.destroy(self.gpu);
         }
         Ok(())
     }

@@ -167,9 +167,4 @@ impl Pass for ScreenAoPass {
         );
         self.blur.dispatch(ctx.rec, push, ctx.images.width, ctx.images.height);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.estimator.destroy(gpu);
-        self.blur.destroy(gpu);
-    }
 }

@@ -226,12 +226,6 @@ impl Pass for DepthPyramidPass {
             self.reduce.dispatch(ctx.rec, bytemuck::bytes_of(&self.push(level as u32)), w, h);
         }
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.linear.destroy(gpu);
-        self.reduce.destroy(gpu);
-        self.single.destroy(gpu);
-    }
 }
 
 #[cfg(test)]

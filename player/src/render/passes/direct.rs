@@ -148,10 +148,6 @@ impl Pass for DirectPass {
         ctx.images.access(ctx.rec, &io);
         self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
-    }
 }
 
 #[cfg(test)]

@@ -54,29 +54,24 @@ pub fn sampled(targets: &[TargetDecl]) -> Vec<(TargetDecl, Access)> {
 /// The raster G-buffer pass.
 #[derive(Debug)]
 pub struct GBufferPass {
-    draws: SceneDraws,
     pipeline: GraphicsPipeline,
+    draws: SceneDraws,
 }
 
 impl GBufferPass {
     /// Builds the pipeline.
     pub fn new(gpu: &Gpu) -> PlayResult<GBufferPass> {
-        let mut draws = SceneDraws::new(gpu)?;
+        let draws = SceneDraws::new(gpu)?;
         let formats = COLORS.map(|c| c.format);
-        match draws.pipeline(
+        let pipeline = draws.pipeline(
             gpu,
             spirv::shader!("gbuffer/gbuffer.vert"),
             spirv::shader!("gbuffer/gbuffer.frag"),
             &formats,
             DEPTH.format,
             false,
-        ) {
-            Ok(pipeline) => Ok(GBufferPass { draws, pipeline }),
-            Err(e) => {
-                draws.destroy(gpu);
-                Err(e)
-            }
-        }
+        )?;
+        Ok(GBufferPass { pipeline, draws })
     }
 }
 
@@ -102,10 +97,5 @@ impl Pass for GBufferPass {
         ctx.rec.begin_rendering(&colors, ctx.images.get(&DEPTH), true);
         self.draws.draw(ctx.rec, ctx.scene, |_| &self.pipeline);
         ctx.rec.end_rendering();
-    }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.draws.destroy(gpu);
     }
 }

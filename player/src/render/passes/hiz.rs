@@ -115,11 +115,6 @@ impl Pass for HizPass {
             self.reduce.dispatch(ctx.rec, bytemuck::bytes_of(&push), w, h);
         }
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.copy.destroy(gpu);
-        self.reduce.destroy(gpu);
-    }
 }
 
 #[cfg(test)]

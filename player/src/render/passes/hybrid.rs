@@ -31,7 +31,8 @@ pub fn bound() -> Vec<TargetDecl> {
     t
 }
 
-/// A set of the shared layout and one or more compute pipelines over it.
+/// A set of the shared layout and one or more compute pipelines over it (the layout and its set
+/// released when dropped).
 #[derive(Debug)]
 pub struct HybridSet {
     layout: SetLayout,
@@ -123,11 +124,6 @@ impl HybridSet {
         self.layout.write(gpu, self.set, &writes);
         Ok(())
     }
-
-    /// Releases the layout and its set.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.layout.destroy(gpu);
-    }
 }
 
 /// The G-buffer reads of a ray-traced step plus `own` accesses.
@@ -138,11 +134,11 @@ pub fn io(own: &[(TargetDecl, Access)]) -> Vec<(TargetDecl, Access)> {
 }
 
 /// One kernel over the shared table, dispatched over the whole frame: what the single-dispatch
-/// ray-traced passes are.
+/// ray-traced passes are. Released when dropped.
 #[derive(Debug)]
 pub struct HybridKernel {
-    set: HybridSet,
     pipeline: ComputePipeline,
+    set: HybridSet,
 }
 
 impl HybridKernel {
@@ -158,14 +154,9 @@ impl HybridKernel {
     }
 
     fn make(gpu: &Gpu, spirv: &[u8], line_space: bool, decode: TexelDecode) -> PlayResult<HybridKernel> {
-        let mut set = HybridSet::new(gpu, line_space, decode)?;
-        match set.pipeline(gpu, spirv) {
-            Ok(pipeline) => Ok(HybridKernel { set, pipeline }),
-            Err(e) => {
-                set.destroy(gpu);
-                Err(e)
-            }
-        }
+        let set = HybridSet::new(gpu, line_space, decode)?;
+        let pipeline = set.pipeline(gpu, spirv)?;
+        Ok(HybridKernel { pipeline, set })
     }
 
     /// Allocates (once) and writes the set.
@@ -183,11 +174,5 @@ impl HybridKernel {
             bytemuck::bytes_of(ctx.rt),
             [w.div_ceil(8), h.div_ceil(8), 1],
         );
-    }
-
-    /// Releases pipeline, layout and set.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.set.destroy(gpu);
     }
 }

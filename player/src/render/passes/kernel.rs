@@ -5,11 +5,11 @@ use crate::error::PlayResult;
 use crate::gpu::{Binding, ComputePipeline, Gpu, Recorder, SetLayout, Write, vk};
 use crate::render::TexelDecode;
 
-/// Layout, pipeline and sets of one compute kernel.
+/// Layout, pipeline and sets of one compute kernel, released when dropped.
 #[derive(Debug)]
 pub struct Kernel {
-    layout: SetLayout,
     pipeline: ComputePipeline,
+    layout: SetLayout,
     sets: Vec<vk::DescriptorSet>,
 }
 
@@ -27,18 +27,10 @@ impl Kernel {
         specs: [(&[Binding], &[u8]); N],
         push_bytes: u32,
     ) -> PlayResult<[Kernel; N]> {
-        let mut made = Vec::with_capacity(N);
-        for (bindings, spirv) in specs {
-            match Kernel::new(gpu, bindings, spirv, push_bytes) {
-                Ok(k) => made.push(k),
-                Err(e) => {
-                    for k in &mut made {
-                        k.destroy(gpu);
-                    }
-                    return Err(e);
-                }
-            }
-        }
+        let made = specs
+            .into_iter()
+            .map(|(bindings, spirv)| Kernel::new(gpu, bindings, spirv, push_bytes))
+            .collect::<PlayResult<Vec<Kernel>>>()?;
         Ok(made.try_into().unwrap_or_else(|_| unreachable!("one kernel per spec")))
     }
 
@@ -61,14 +53,9 @@ impl Kernel {
         push_bytes: u32,
         constants: &[u32],
     ) -> PlayResult<Kernel> {
-        let mut layout = SetLayout::new(gpu, bindings, 1)?;
-        match ComputePipeline::specialized(gpu, spirv, &[&layout], push_bytes, constants) {
-            Ok(pipeline) => Ok(Kernel { layout, pipeline, sets: Vec::new() }),
-            Err(e) => {
-                layout.destroy(gpu);
-                Err(e)
-            }
-        }
+        let layout = SetLayout::new(gpu, bindings, 1)?;
+        let pipeline = ComputePipeline::specialized(gpu, spirv, &[&layout], push_bytes, constants)?;
+        Ok(Kernel { pipeline, layout, sets: Vec::new() })
     }
 
     /// Writes set 0 (allocated by the first call).
@@ -93,11 +80,5 @@ impl Kernel {
     /// [`Kernel::dispatch`] with set `index` (written before).
     pub fn dispatch_set(&self, rec: &Recorder, index: usize, push: &[u8], width: u32, height: u32) {
         rec.dispatch(&self.pipeline, &[self.sets[index]], push, [width.div_ceil(8), height.div_ceil(8), 1]);
-    }
-
-    /// Releases pipeline and layout (and the set with it).
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.pipeline.destroy(gpu);
-        self.layout.destroy(gpu);
     }
 }

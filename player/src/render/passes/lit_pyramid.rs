@@ -109,9 +109,4 @@ impl Pass for LitPyramidPass {
             self.reduce.dispatch(ctx.rec, bytemuck::bytes_of(&push), w, h);
         }
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.reproject.destroy(gpu);
-        self.reduce.destroy(gpu);
-    }
 }

@@ -24,7 +24,8 @@ pub const ATTRIBUTES: [(u32, u32, vk::Format, u32); 4] = [
     (3, 1, vk::Format::R16G16B16A16_UNORM, 8),
 ];
 
-/// Set layouts, sets and pushed materials of a raster pass.
+/// Set layouts, sets and pushed materials of a raster pass (the layouts, and the sets with
+/// them, released when dropped).
 #[derive(Debug)]
 pub struct SceneDraws {
     frame_layout: SetLayout,
@@ -39,14 +40,7 @@ impl SceneDraws {
     /// The layouts (sets are allocated by [`SceneDraws::bind`]).
     pub fn new(gpu: &Gpu) -> PlayResult<SceneDraws> {
         let frame_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Uniform)], 1)?;
-        let material_layout = match SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); 5], 64) {
-            Ok(l) => l,
-            Err(e) => {
-                let mut f = frame_layout;
-                f.destroy(gpu);
-                return Err(e);
-            }
-        };
+        let material_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); 5], 64)?;
         Ok(SceneDraws {
             frame_layout,
             material_layout,
@@ -150,11 +144,5 @@ impl SceneDraws {
             rec.push_graphics(p, bytemuck::bytes_of(m));
             rec.draw_indexed(d.count, d.first);
         }
-    }
-
-    /// Releases the layouts and their sets.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.frame_layout.destroy(gpu);
-        self.material_layout.destroy(gpu);
     }
 }

@@ -104,8 +104,4 @@ impl Pass for MediaMarchPass {
             ctx.images.height,
         );
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.kernel.destroy(gpu);
-    }
 }

@@ -155,9 +155,4 @@ impl Pass for MitchellPass {
             self.blur.dispatch(ctx.rec, bytemuck::bytes_of(&push), width, height);
         }
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.occlusion.destroy(gpu);
-        self.blur.destroy(gpu);
-    }
 }

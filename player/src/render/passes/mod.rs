@@ -95,7 +95,8 @@ pub struct FrameCtx<'a, 'r> {
     pub rt: &'a RtConstants,
 }
 
-/// One pass of the frame.
+/// One pass of the frame. Dropping it releases what it owns: the GPU must be done with it (the
+/// frame's owner waits for the GPU before it drops a frame that was rendered).
 pub trait Pass: Send + std::fmt::Debug {
     /// Timestamp name.
     fn name(&self) -> &'static str;
@@ -116,7 +117,4 @@ pub trait Pass: Send + std::fmt::Debug {
 
     /// Records its work, declaring each step's reads and writes first.
     fn record(&mut self, ctx: &mut FrameCtx);
-
-    /// Releases what it owns (the GPU must be idle).
-    fn destroy(&mut self, gpu: &Gpu);
 }

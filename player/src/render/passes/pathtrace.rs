@@ -80,9 +80,4 @@ impl PathTracePass {
         images.access(rec, &[(ACCUMULATION, Access::ReadWrite(Use::STORAGE))]);
         self.0.dispatch(rec, bytemuck::bytes_of(&index), images.width, images.height);
     }
-
-    /// Releases the pipeline and layout.
-    pub fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
-    }
 }

@@ -42,8 +42,4 @@ impl Pass for RtAoPass {
     fn record(&mut self, ctx: &mut FrameCtx) {
         self.0.record(ctx, &[(AO, Access::ReadWrite(Use::STORAGE))]);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
-    }
 }

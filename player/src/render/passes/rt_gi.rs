@@ -62,8 +62,4 @@ impl Pass for RtGiPass {
     fn record(&mut self, ctx: &mut FrameCtx) {
         self.0.record(ctx, &[(GI, Access::ReadWrite(Use::STORAGE))]);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
-    }
 }

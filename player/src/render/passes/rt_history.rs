@@ -237,11 +237,4 @@ impl Pass for RtHistoryPass {
         }
         self.turn = before;
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.motion.destroy(gpu);
-        for k in &mut self.blends {
-            k.destroy(gpu);
-        }
-    }
 }

@@ -36,9 +36,9 @@ pub fn lights(lights: usize) -> u32 {
 /// The reflection pass: trace and shade, then the hits' shadow rays.
 #[derive(Debug)]
 pub struct RtReflectionsPass {
-    set: HybridSet,
     trace: ComputePipeline,
     shadows: ComputePipeline,
+    set: HybridSet,
     step: u32,
     lights: u32,
 }
@@ -48,23 +48,10 @@ impl RtReflectionsPass {
     /// lights, decoding the
     /// texel buffer as `decode` says.
     pub fn new(gpu: &Gpu, step: u32, lights: usize, decode: TexelDecode) -> PlayResult<RtReflectionsPass> {
-        let mut set = HybridSet::new(gpu, false, decode)?;
-        let trace = match set.pipeline(gpu, spirv::shader!("rt/reflections.comp")) {
-            Ok(p) => p,
-            Err(e) => {
-                set.destroy(gpu);
-                return Err(e);
-            }
-        };
-        match set.pipeline(gpu, spirv::shader!("rt/reflection_shadows.comp")) {
-            Ok(shadows) => Ok(RtReflectionsPass { set, trace, shadows, step, lights: self::lights(lights) }),
-            Err(e) => {
-                let mut t = trace;
-                t.destroy(gpu);
-                set.destroy(gpu);
-                Err(e)
-            }
-        }
+        let set = HybridSet::new(gpu, false, decode)?;
+        let trace = set.pipeline(gpu, spirv::shader!("rt/reflections.comp"))?;
+        let shadows = set.pipeline(gpu, spirv::shader!("rt/reflection_shadows.comp"))?;
+        Ok(RtReflectionsPass { trace, shadows, set, step, lights: self::lights(lights) })
     }
 }
 
@@ -97,11 +84,5 @@ impl Pass for RtReflectionsPass {
         ctx.images
             .access(ctx.rec, &[(PARTIAL, read), (ORIGINS, read), (LIGHT_TERMS, read), (REFLECTIONS, rw)]);
         ctx.rec.dispatch(&self.shadows, &[self.set.set], push, groups);
-    }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.trace.destroy(gpu);
-        self.shadows.destroy(gpu);
-        self.set.destroy(gpu);
     }
 }

@@ -73,8 +73,4 @@ impl Pass for RtShadowsPass {
     fn record(&mut self, ctx: &mut FrameCtx) {
         self.kernel.record(ctx, &[(SHADOWS, Access::ReadWrite(Use::STORAGE))]);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.kernel.destroy(gpu);
-    }
 }

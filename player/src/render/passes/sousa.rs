@@ -168,10 +168,4 @@ impl Pass for SousaPass {
             self.composite.dispatch(ctx.rec, bytemuck::bytes_of(&push), width, height);
         }
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.depth.destroy(gpu);
-        self.blur.destroy(gpu);
-        self.composite.destroy(gpu);
-    }
 }

@@ -200,12 +200,6 @@ impl Pass for SsgiPass {
         );
         self.resolve.dispatch(ctx.rec, bytemuck::bytes_of(&push), width, height);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.pack.destroy(gpu);
-        self.gather.destroy(gpu);
-        self.resolve.destroy(gpu);
-    }
 }
 
 #[cfg(test)]

@@ -106,8 +106,4 @@ impl Pass for SsrPass {
         let push = bytemuck::bytes_of(&self.constants);
         self.kernel.dispatch(ctx.rec, push, ctx.images.width, ctx.images.height);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.kernel.destroy(gpu);
-    }
 }

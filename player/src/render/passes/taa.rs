@@ -150,9 +150,4 @@ impl Pass for TaaPass {
         );
         self.turn = 1 - self.turn;
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.kernel.destroy(gpu);
-        self.output.destroy(gpu);
-    }
 }

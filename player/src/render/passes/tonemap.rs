@@ -66,8 +66,4 @@ impl Pass for TonemapPass {
         );
         self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.0.destroy(gpu);
-    }
 }

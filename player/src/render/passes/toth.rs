@@ -145,9 +145,4 @@ impl Pass for TothPass {
         );
         self.blur.dispatch(ctx.rec, push, width, height);
     }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.march.destroy(gpu);
-        self.blur.destroy(gpu);
-    }
 }

@@ -14,38 +14,25 @@ use crate::render::spirv;
 /// The visibility raster pass.
 #[derive(Debug)]
 pub struct VisibilityPass {
-    draws: SceneDraws,
     /// Opaque one-sided materials: culled in hardware and a shader without `discard`, so the
     /// depth test runs before shading.
     opaque: GraphicsPipeline,
     /// Masked or double-sided materials: the shader decides.
     raster: GraphicsPipeline,
+    draws: SceneDraws,
 }
 
 impl VisibilityPass {
     /// Builds the pipelines.
     pub fn new(gpu: &Gpu) -> PlayResult<VisibilityPass> {
-        let mut draws = SceneDraws::new(gpu)?;
+        let draws = SceneDraws::new(gpu)?;
         let colors = [TRIANGLE.format];
         let build = |fragment: &[u8], cull: bool| {
             draws.pipeline(gpu, spirv::shader!("gbuffer/gbuffer.vert"), fragment, &colors, DEPTH.format, cull)
         };
-        let opaque = match build(spirv::shader!("gbuffer/visibility_opaque.frag"), true) {
-            Ok(p) => p,
-            Err(e) => {
-                draws.destroy(gpu);
-                return Err(e);
-            }
-        };
-        match build(spirv::shader!("gbuffer/visibility.frag"), false) {
-            Ok(raster) => Ok(VisibilityPass { draws, opaque, raster }),
-            Err(e) => {
-                let mut o = opaque;
-                o.destroy(gpu);
-                draws.destroy(gpu);
-                Err(e)
-            }
-        }
+        let opaque = build(spirv::shader!("gbuffer/visibility_opaque.frag"), true)?;
+        let raster = build(spirv::shader!("gbuffer/visibility.frag"), false)?;
+        Ok(VisibilityPass { opaque, raster, draws })
     }
 }
 
@@ -74,11 +61,5 @@ impl Pass for VisibilityPass {
             if opaque_one_sided { &self.opaque } else { &self.raster }
         });
         ctx.rec.end_rendering();
-    }
-
-    fn destroy(&mut self, gpu: &Gpu) {
-        self.opaque.destroy(gpu);
-        self.raster.destroy(gpu);
-        self.draws.destroy(gpu);
     }
 }
