@@ -7,6 +7,7 @@ pub mod bake;
 pub mod bench_scenes;
 pub mod cache;
 pub mod cli;
+pub mod clobber;
 pub mod commands;
 pub mod exit;
 pub mod import;

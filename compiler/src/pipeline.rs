@@ -58,7 +58,8 @@ pub struct ReportWarning {
 }
 
 /// Imports, applies the sidecar, validates and plans. Warnings are printed to stderr unless
-/// `quiet`; `--strict` and `-W` decide which classes of warning fail it.
+/// `quiet` (for callers that are not the command line: the command line's `-q` never hides a
+/// warning); `--strict` and `-W` decide which classes of warning fail it.
 pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     let start = Instant::now();
     // The sidecar is read first since its `[bake] normals` decides the import; it is recorded
@@ -224,6 +225,11 @@ pub struct Report {
 /// Bakes and writes `loaded` to `output`; writes the report and depfile if asked.
 pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArgs) -> CliResult<Report> {
     let start = Instant::now();
+    // Before any work: no output may replace an input (or another output).
+    let mut outputs: Vec<(&str, &Path)> = vec![("-o", output)];
+    outputs.extend(out.report.as_deref().map(|p| ("--report", p)));
+    outputs.extend(out.depfile.as_deref().map(|p| ("--depfile", p)));
+    crate::clobber::refuse(&outputs, &loaded.scene.inputs)?;
     let threads =
         out.threads.map_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()), usize::from);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -254,7 +254,8 @@ the bake is large enough to gain from it, else the CPU), cpu, or gpu (an error w
 is identical for every device; the GPU bakes the binary and PNMT variants, the CPU the rest"
     )]
     pub line_space_device: crate::bake::linespace::gpu::BakeDevice,
-    /// Print nothing but errors and warnings.
+    /// Print nothing but errors and warnings: no progress, no summary (warnings are hidden only
+    /// by -W CLASS=ignore).
     #[arg(long, short = 'q')]
     pub quiet: bool,
     /// Stage cache directory: each bake stage's output is kept there under the hash of what the

@@ -11,7 +11,8 @@ use crate::pipeline::{self, Report};
 
 /// Runs `kiln compile`.
 pub fn run(args: &CompileArgs) -> CliResult {
-    let loaded = pipeline::load(&args.scene, args.out.quiet)?;
+    // -q hides progress and the summary, never a warning (-W CLASS=ignore does that).
+    let loaded = pipeline::load(&args.scene, false)?;
     let output = args.output.clone().unwrap_or_else(|| {
         PathBuf::from(format!(
             "{}.kiln",
@@ -40,7 +41,7 @@ pub fn demo(args: &DemoArgs) -> CliResult {
         DemoScene::BoxDragon => (cornell_with_object(DRAGON, SEED), "box-dragon"),
     };
     let settings = pipeline::configure(&mut scene, args.config.as_deref(), &args.bake)?;
-    let loaded = pipeline::finish(scene, settings, name, &Default::default(), args.out.quiet, start)?;
+    let loaded = pipeline::finish(scene, settings, name, &Default::default(), false, start)?;
     let report = pipeline::compile(&loaded, name, &args.output, &args.out)?;
     if !args.out.quiet {
         summary(&report);

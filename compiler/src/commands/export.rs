@@ -41,6 +41,7 @@ pub fn run(args: &ExportArgs) -> CliResult {
             EXPORTABLE.join(", ")
         )));
     }
+    crate::clobber::refuse(&[("-o", &args.output)], std::slice::from_ref(&args.file))?;
     let file = KilnFile::open(&args.file, Checksums::OnAccess).map_err(|e| format_error(&args.file, e))?;
     let view = SceneView::new(&file).map_err(|e| format_error(&args.file, e))?;
     let missing = || {

@@ -37,7 +37,8 @@ struct TexturePlan {
 
 /// Runs `kiln plan`.
 pub fn run(args: &PlanArgs) -> CliResult {
-    let loaded = pipeline::load(&args.scene, args.json)?;
+    // Warnings go to stderr, also with --json (its output is stdout's).
+    let loaded = pipeline::load(&args.scene, false)?;
     let s = &loaded.scene;
     let j = PlanJson {
         input: args.scene.input.display().to_string(),
