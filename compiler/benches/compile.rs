@@ -107,6 +107,8 @@ fn tiny(runs: usize) {
         bake: BakeArgs::default(),
         strict: false,
         warning_levels: Vec::new(),
+        max_file_size: None,
+        max_image_side: None,
     };
     let out_args = quiet_output();
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
@@ -166,6 +168,8 @@ fn pica(runs: usize) {
         },
         strict: false,
         warning_levels: Vec::new(),
+        max_file_size: None,
+        max_image_side: None,
     };
     let out_args = quiet_output();
     println!("pica_pica, {runs} runs, {} threads; medians (min..max) in ms", rayon::current_num_threads());

@@ -62,6 +62,10 @@ pub struct ReportWarning {
 /// warning); `--strict` and `-W` decide which classes of warning fail it.
 pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     let start = Instant::now();
+    import::files::set_limits(
+        args.max_file_size.unwrap_or(import::files::DEFAULT_MAX_FILE_BYTES),
+        args.max_image_side.unwrap_or(import::files::DEFAULT_MAX_IMAGE_SIDE),
+    );
     // The sidecar is read first since its `[bake] normals` decides the import; it is recorded
     // as an input after the asset, in the order a reader of the depfile expects.
     let mut sidecar_inputs = Vec::new();

@@ -127,6 +127,14 @@ pub struct SceneArgs {
     /// Ignored warnings are not printed but stay in the --report.
     #[arg(short = 'W', long = "warnings", value_name = "CLASS=LEVEL", value_parser = crate::warnings::parse_setting)]
     pub warning_levels: Vec<(crate::ir::WarningClass, crate::warnings::WarningLevel)>,
+    /// The largest file the import reads (the asset, its buffers, images and MTL libraries):
+    /// bytes, or with a binary unit K, M, G, T. Only regular files are read [default: 4G].
+    #[arg(long, value_name = "SIZE", value_parser = crate::cache::parse_size, help_heading = "Input limits")]
+    pub max_file_size: Option<u64>,
+    /// The largest image side in pixels the import decodes, read from the image's header before
+    /// decoding; a larger image is not decoded (a data-loss warning) [default: 16384].
+    #[arg(long, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Input limits")]
+    pub max_image_side: Option<u32>,
 }
 
 /// Bake settings, shared by `compile`, `plan` and `demo`; each overrides the sidecar's or the

@@ -36,13 +36,7 @@ pub fn decode_all(requests: Vec<TextureRequest>) -> (Vec<Texture>, Vec<String>) 
 }
 
 fn decode(r: TextureRequest) -> (Texture, Option<String>) {
-    let result = r.bytes.and_then(|bytes| {
-        image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| e.to_string())?
-            .decode()
-            .map_err(|e| format!("cannot decode: {e}"))
-    });
+    let result = r.bytes.and_then(|bytes| super::files::decode_image(&bytes));
     let texture = |width, height, rgba| Texture {
         name: r.name.clone(),
         width,

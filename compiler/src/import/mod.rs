@@ -2,6 +2,7 @@
 //! built-in demo scene. This is the only place loader types appear.
 
 pub mod demo;
+pub mod files;
 mod geometry;
 mod gltf;
 mod images;
@@ -45,11 +46,7 @@ impl InputFormat {
 
 /// Reads a whole input file, recording it as an input.
 pub(crate) fn read_input(path: &Path, inputs: &mut Vec<PathBuf>) -> CliResult<Vec<u8>> {
-    let meta = std::fs::metadata(path).map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
-    if !meta.is_file() {
-        return Err(CliError::io(format!("{}: not a regular file", path.display())));
-    }
-    let bytes = std::fs::read(path).map_err(|e| CliError::io(format!("{}: {e}", path.display())))?;
+    let bytes = files::read_bounded(path).map_err(CliError::io)?;
     if !inputs.iter().any(|p| p == path) {
         inputs.push(path.to_path_buf());
     }

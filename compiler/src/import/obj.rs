@@ -53,11 +53,27 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     }
     let options =
         tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
+    // tobj takes its material loader as `Fn`: the warnings it finds go through a RefCell.
+    let mtl_warnings = std::cell::RefCell::new(Vec::new());
     let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(&text), &options, |p| {
         let full = base.join(p);
-        tobj::load_mtl(&full)
+        // Read within bounds, and with the statements tobj would panic on or take as NaN
+        // dropped (each a warning), before tobj parses it.
+        let bytes = super::files::read_bounded(&full).map_err(|e| {
+            mtl_warnings.borrow_mut().push(format!("{file}: {e}"));
+            tobj::LoadError::OpenFileFailed
+        })?;
+        let text = sanitize_mtl(
+            &full.display().to_string(),
+            &String::from_utf8_lossy(&bytes),
+            &mut mtl_warnings.borrow_mut(),
+        );
+        tobj::load_mtl_buf(&mut std::io::Cursor::new(text.as_bytes()))
     })
     .map_err(|e| CliError::input(format!("{file}: cannot read OBJ: {e}")))?;
+    for w in mtl_warnings.into_inner() {
+        scene.warn(w);
+    }
     for lib in &mtllibs {
         let full = base.join(lib);
         if full.is_file() && !scene.inputs.contains(&full) {
@@ -91,7 +107,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
                     return i;
                 }
                 let full = mtl_base(name);
-                let bytes = std::fs::read(&full).map_err(|e| format!("cannot read {}: {e}", full.display()));
+                let bytes = super::files::read_bounded(&full);
                 if bytes.is_ok() && !scene.inputs.contains(&full) {
                     scene.inputs.push(full.clone());
                 }
@@ -221,6 +237,50 @@ pub(crate) fn lambert(kd: [f32; 3]) -> GpuMaterial {
         flags: MaterialFlags::DIFFUSE_ONLY,
         ..GpuMaterial::default()
     }
+}
+
+/// MTL statements whose values are colours: three numbers each.
+const MTL_COLOURS: [&str; 5] = ["Ka", "Kd", "Ks", "Ke", "Tf"];
+/// MTL statements whose value is one number.
+const MTL_NUMBERS: [&str; 12] =
+    ["Ns", "Ni", "d", "Tr", "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor", "illum"];
+
+/// `text` (the MTL file `file`) without the statements whose values are not finite numbers of the
+/// count they need (tobj panics on `Kd 0.5`, and would keep a NaN colour that renders black), and
+/// with negative colour components clamped to 0; each dropped or changed statement a warning with
+/// the file and line.
+fn sanitize_mtl(file: &str, text: &str, warnings: &mut Vec<String>) -> String {
+    let mut out = String::with_capacity(text.len());
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next().unwrap_or_default();
+        let values: Vec<&str> = words.collect();
+        let numbers: Vec<Option<f32>> =
+            values.iter().map(|v| v.parse::<f32>().ok().filter(|x| x.is_finite())).collect();
+        let wanted = if MTL_COLOURS.contains(&key) {
+            3
+        } else if MTL_NUMBERS.contains(&key) {
+            1
+        } else {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        };
+        let at = format!("{file}:{}", i + 1);
+        if numbers.len() < wanted || numbers[..wanted].iter().any(Option::is_none) {
+            let need = if wanted == 3 { "three finite numbers" } else { "a finite number" };
+            warnings.push(format!("{at}: `{}` needs {need}; the statement is ignored", line.trim()));
+            continue;
+        }
+        let mut fixed: Vec<f32> = numbers[..wanted].iter().map(|x| x.unwrap_or(0.0)).collect();
+        if wanted == 3 && fixed.iter().any(|&x| x < 0.0) {
+            warnings.push(format!("{at}: `{}` has a negative component; clamped to 0", line.trim()));
+            fixed.iter_mut().for_each(|x| *x = x.max(0.0));
+        }
+        let values: Vec<String> = fixed.iter().map(|x| x.to_string()).collect();
+        out.push_str(&format!("{key} {}\n", values.join(" ")));
+    }
+    out
 }
 
 fn param(m: &tobj::Material, key: &str) -> Option<f32> {

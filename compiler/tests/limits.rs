@@ -1,0 +1,114 @@
+//! Hostile references in an OBJ/MTL scene finish quickly with a warning or a clear error, never
+//! a panic, an abort or a hang (issue 40): a device or FIFO as a library, texture or the input
+//! itself, an image declaring more pixels than `--max-image-side`, a file over `--max-file-size`,
+//! MTL statements with too few or non-finite values.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The outcome of a `kiln` run that must end within 30 s (killed, and the test failed, if not).
+struct Ended {
+    code: i32,
+    stderr: String,
+}
+
+fn kiln(dir: &Path, args: &[&str]) -> Ended {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("kiln runs");
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut stderr = String::new();
+            std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+            assert!(!stderr.contains("panicked") && status.code() != Some(70), "{args:?}: {stderr}");
+            return Ended { code: status.code().unwrap_or(-1), stderr };
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            child.kill().ok();
+            panic!("kiln {args:?} did not end within 30 s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// A lit one-triangle OBJ naming `mtllib` and the material `m`.
+fn obj(dir: &Path, mtllib: &str) {
+    let text = format!(
+        "mtllib {mtllib}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n"
+    );
+    std::fs::write(dir.join("scene.obj"), text).unwrap();
+}
+
+#[cfg(unix)]
+fn fifo(path: &Path) {
+    let ok = Command::new("mkfifo").arg(path).status().map(|s| s.success()).unwrap_or(false);
+    assert!(ok, "mkfifo {}", path.display());
+}
+
+#[test]
+#[cfg(unix)]
+fn devices_and_fifos_are_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A device as the material library: a warning, the default material, no endless read.
+    obj(d, "/dev/zero");
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains("/dev/zero is not a regular file"), "{}", run.stderr);
+    // A FIFO as the library and as a texture: no blocking open.
+    fifo(&d.join("lib.mtl"));
+    obj(d, "lib.mtl");
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
+    assert!(run.code == 0 && run.stderr.contains("not a regular file"), "{}", run.stderr);
+    std::fs::remove_file(d.join("lib.mtl")).unwrap();
+    fifo(&d.join("tex.png"));
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 1 1 1\nKe 1 1 1\nmap_Kd tex.png\n").unwrap();
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
+    assert!(run.code == 0 && run.stderr.contains("tex.png is not a regular file"), "{}", run.stderr);
+    // A FIFO as the input itself: an I/O error (4).
+    fifo(&d.join("pipe.obj"));
+    let run = kiln(d, &["compile", "pipe.obj", "-o", "out.kiln"]);
+    assert!(run.code == 4 && run.stderr.contains("not a regular file"), "{}", run.stderr);
+}
+
+#[test]
+fn files_and_images_beyond_the_limits_are_refused_with_the_flag_to_raise() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    obj(d, "lib.mtl");
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 1 1 1\nKe 1 1 1\nmap_Kd tex.png\n").unwrap();
+    let img = image::RgbaImage::from_pixel(32, 16, image::Rgba([200, 100, 50, 255]));
+    img.save(d.join("tex.png")).unwrap();
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
+    assert!(run.code == 0 && !run.stderr.contains("tex.png"), "{}", run.stderr);
+    // The image's header says 32 x 16: a 16-pixel side limit refuses it before decoding.
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--max-image-side", "16"]);
+    assert!(run.code == 0 && run.stderr.contains("32 x 16 pixels"), "{}", run.stderr);
+    assert!(run.stderr.contains("--max-image-side"), "{}", run.stderr);
+    // A file over the size limit: the input is an I/O error naming the flag.
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--max-file-size", "20"]);
+    assert!(run.code == 4 && run.stderr.contains("--max-file-size"), "{}", run.stderr);
+}
+
+#[test]
+fn mtl_statements_without_their_numbers_are_warned_and_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    obj(d, "lib.mtl");
+    // tobj panicked on `Kd 0.5`; a NaN colour rendered black; a negative emission is unphysical.
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 0.5\nKs nan nan nan\nNs inf\nKe -1 2 3\n").unwrap();
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--report", "r.json"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    for what in ["lib.mtl:2: `Kd 0.5` needs three finite numbers", "lib.mtl:3:", "lib.mtl:4:", "lib.mtl:5:"] {
+        assert!(run.stderr.contains(what), "{what}: {}", run.stderr);
+    }
+    // The clamped emission is what the file holds: (0, 2, 3).
+    let report = std::fs::read_to_string(d.join("r.json")).unwrap();
+    assert!(report.contains("clamped to 0"), "{report}");
+}
