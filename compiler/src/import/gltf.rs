@@ -64,6 +64,14 @@ impl UvMapping {
 /// World triangles beyond this are refused (instancing can multiply a small file's geometry).
 const MAX_TRIANGLES: usize = 1 << 28;
 
+/// An accessor without a buffer view (sparse values over zeros) may expand to at most the larger
+/// of this many bytes and [`SPARSE_EXPANSION_RATIO`] times the bytes of the file's buffers: enough
+/// for any sparse morph target, colour or matrix set beside geometry the buffers hold, never the
+/// gigabytes that a `count` in a tiny file would ask for.
+const SPARSE_EXPANSION_FLOOR: usize = 16 << 20;
+/// See [`SPARSE_EXPANSION_FLOOR`].
+const SPARSE_EXPANSION_RATIO: usize = 4;
+
 struct Importer<'a> {
     file: String,
     base: PathBuf,
@@ -79,7 +87,8 @@ struct Importer<'a> {
     requests: Vec<TextureRequest>,
     /// Normals where a primitive has no NORMAL attribute.
     normals: Normals,
-    /// Parent of each node (skins need their joints' scene transforms).
+    /// Parent of each node (skins need their joints' scene transforms), checked by
+    /// [`node_parents`]: one parent at most, no cycle.
     parents: Vec<Option<usize>>,
     /// Per mesh: the nodes that place it, and the triangles one placement adds.
     mesh_uses: HashMap<usize, (usize, usize)>,
@@ -95,7 +104,34 @@ enum Placement {
 }
 
 /// Imports a `.gltf` or `.glb` file into `scene`.
+///
+/// Hostile files are refused by validation before the `gltf` crate sees what it would panic
+/// on ([`check_references`], [`node_parents`], the accessor checks). As a last line of defence,
+/// a panic that still escapes the import (in the `gltf` crate or here) is caught and reported as
+/// a bad input, naming the file, rather than as kiln's internal error: it can only come from
+/// something in the file that the checks missed (and is then a bug to report as well).
 pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()> {
+    let file = path.display().to_string();
+    guard(&file, || import_checked(path, scene, normals))
+}
+
+/// Runs `f`, turning a panic into a bad-input error about `file`.
+fn guard<T>(file: &str, f: impl FnOnce() -> CliResult<T>) -> CliResult<T> {
+    // The scene `f` fills is dropped by the caller on error, so nothing sees it half-built.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".into());
+        Err(CliError::input(format!(
+            "{file}: malformed glTF that kiln's checks missed: reading it failed ({what}); please \
+             report this file as a kiln bug too"
+        )))
+    })
+}
+
+fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()> {
     let bytes = read_input(path, &mut scene.inputs)?;
     let file = path.display().to_string();
     let gltf = Gltf::from_slice_without_validation(&bytes)
@@ -110,6 +146,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
     }
     let blob = gltf.blob;
     let mut json = gltf.document.into_json();
+    check_references(&json, &file)?;
     let invalid =
         |e: ::gltf::Error| CliError::input(format!("{file}: invalid glTF: {}", describe_validation(&e)));
     let doc = match Document::from_json(json.clone()) {
@@ -130,7 +167,11 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
     for ext in doc.extensions_used().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)) {
         scene.warn(format!("{file}: extension {ext} is used but not supported; its effect is ignored"));
     }
+    let parents = node_parents(&doc, &file)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    // NOTE: external buffers are read through `load_uri` (std::fs::read); bounding referenced
+    // files (regular files of bounded size) is being done in a shared helper elsewhere, which
+    // this call site should adopt.
     let buffers = load_buffers(&doc, blob, &file, &base, &mut scene.inputs)?;
     let mut imp = Importer {
         file,
@@ -143,15 +184,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
         uv_mappings: HashMap::new(),
         requests: Vec::new(),
         normals,
-        parents: {
-            let mut p = vec![None; doc.nodes().len()];
-            for n in doc.nodes() {
-                for c in n.children() {
-                    p[c.index()] = Some(n.index());
-                }
-            }
-            p
-        },
+        parents,
         mesh_uses: HashMap::new(),
     };
     imp.walk_scene()?;
@@ -184,6 +217,129 @@ fn describe_validation(e: &::gltf::Error) -> String {
             .join("; "),
         other => other.to_string(),
     }
+}
+
+/// `kind index 'name'`, or `kind index` for an unnamed object.
+fn named(kind: &str, index: usize, name: Option<&str>) -> String {
+    match name {
+        Some(n) => format!("{kind} {index} '{n}'"),
+        None => format!("{kind} {index}"),
+    }
+}
+
+/// Checks what the `gltf` crate would panic on instead of reporting, before it validates or reads
+/// the document: the accessors a primitive names (its validation indexes the accessors with
+/// POSITION's index unchecked), an image's source (read by `unwrap`: a `uri` or a `bufferView`,
+/// the latter with a `mimeType`), and a camera's projection (the object its `type` names is
+/// unwrapped). Every other index is checked by `gltf`'s validation, which reports rather than
+/// panics.
+fn check_references(json: &::gltf::json::Root, file: &str) -> CliResult<()> {
+    use ::gltf::json::camera::Type;
+    use ::gltf::json::validation::Checked;
+    let bad = |msg: String| Err(CliError::input(format!("{file}: invalid glTF: {msg}")));
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let mut refs: Vec<(String, usize)> = prim
+                .attributes
+                .iter()
+                .map(|(k, a)| (format!("attribute {}", k.to_string()), a.value()))
+                .collect();
+            refs.extend(prim.indices.map(|a| ("indices".to_string(), a.value())));
+            for (t, target) in prim.targets.iter().flatten().enumerate() {
+                for (what, a) in
+                    [("POSITION", target.positions), ("NORMAL", target.normals), ("TANGENT", target.tangents)]
+                {
+                    refs.extend(a.map(|a| (format!("morph target {t} {what}"), a.value())));
+                }
+            }
+            if let Some((what, a)) = refs.into_iter().find(|&(_, a)| a >= accessors) {
+                let plural = if accessors == 1 { "" } else { "s" };
+                return bad(format!(
+                    "{} primitive {p}: {what} names accessor {a}, but the file has {accessors} \
+                     accessor{plural}",
+                    named("mesh", m, mesh.name.as_deref())
+                ));
+            }
+        }
+    }
+    for (i, img) in json.images.iter().enumerate() {
+        let at = named("image", i, img.name.as_deref());
+        if img.uri.is_none() && img.buffer_view.is_none() {
+            return bad(format!("{at} has neither a uri nor a bufferView"));
+        }
+        if img.buffer_view.is_some() && img.mime_type.is_none() {
+            return bad(format!("{at} has a bufferView but no mimeType"));
+        }
+    }
+    for (c, cam) in json.cameras.iter().enumerate() {
+        let missing = match cam.type_ {
+            Checked::Valid(Type::Perspective) if cam.perspective.is_none() => "perspective",
+            Checked::Valid(Type::Orthographic) if cam.orthographic.is_none() => "orthographic",
+            _ => continue,
+        };
+        return bad(format!(
+            "{} has type {missing} but no {missing} object",
+            named("camera", c, cam.name.as_deref())
+        ));
+    }
+    Ok(())
+}
+
+/// The parent of every node, checking that the nodes form disjoint strict trees as glTF 2.0
+/// requires ("Nodes and Hierarchy"): a node is listed once among its parent's children and has
+/// one parent at most (a child listed twice, chained, doubles the walk at every level), and no
+/// node is its own ancestor. Linear in nodes and children, without recursion.
+fn node_parents(doc: &Document, file: &str) -> CliResult<Vec<Option<usize>>> {
+    let mut parents: Vec<Option<usize>> = vec![None; doc.nodes().len()];
+    for node in doc.nodes() {
+        let p = node.index();
+        for child in node.children() {
+            let c = child.index();
+            let at = named("node", c, child.name());
+            match parents[c] {
+                None => parents[c] = Some(p),
+                Some(q) if q == p => {
+                    return Err(CliError::input(format!(
+                        "{file}: invalid glTF: {at} is listed twice among the children of node {p}; a \
+                         node has one parent"
+                    )));
+                }
+                Some(q) => {
+                    return Err(CliError::input(format!(
+                        "{file}: invalid glTF: {at} is a child of both node {q} and node {p}; a node \
+                         has one parent"
+                    )));
+                }
+            }
+        }
+    }
+    // Each node has one parent at most, so a cycle is found by following parents. State per node:
+    // 0 not seen, 1 on the path being followed, 2 known to reach a root.
+    let mut state = vec![0u8; parents.len()];
+    let mut path = Vec::new();
+    for start in 0..parents.len() {
+        let mut at = Some(start);
+        while let Some(n) = at {
+            match state[n] {
+                2 => break,
+                1 => {
+                    return Err(CliError::input(format!(
+                        "{file}: invalid glTF: node hierarchy has a cycle through node {n}"
+                    )));
+                }
+                _ => {
+                    state[n] = 1;
+                    path.push(n);
+                    at = parents[n];
+                }
+            }
+        }
+        for n in path.drain(..) {
+            state[n] = 2;
+        }
+    }
+    Ok(parents)
 }
 
 fn load_buffers(
@@ -283,16 +439,8 @@ impl Importer<'_> {
         let doc = self.doc;
         let roots: Vec<::gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
             Some(s) => s.nodes().collect(),
-            None => {
-                // No scene: every node that is nobody's child is a root.
-                let mut child = vec![false; doc.nodes().len()];
-                for n in doc.nodes() {
-                    for c in n.children() {
-                        child[c.index()] = true;
-                    }
-                }
-                doc.nodes().filter(|n| !child[n.index()]).collect()
-            }
+            // No scene: every node that is nobody's child is a root.
+            None => doc.nodes().filter(|n| self.parents[n.index()].is_none()).collect(),
         };
         let animations = doc.animations().count();
         if animations > 0 {
@@ -302,21 +450,22 @@ impl Importer<'_> {
                 self.file
             ));
         }
-        let mut path = Vec::new();
-        for root in roots {
-            self.visit(root, DMat4::IDENTITY, &mut path)?;
+        // Depth first, children in their order, on a stack of its own: the hierarchy's depth is
+        // bounded by the file, not by the thread's stack. [`node_parents`] made it a forest, so
+        // the walk ends and visits a node once per root above it.
+        let mut stack: Vec<(::gltf::Node, DMat4)> =
+            roots.into_iter().rev().map(|r| (r, DMat4::IDENTITY)).collect();
+        while let Some((node, parent)) = stack.pop() {
+            let world = self.visit(&node, parent)?;
+            let children: Vec<::gltf::Node> = node.children().collect();
+            stack.extend(children.into_iter().rev().map(|c| (c, world)));
         }
         Ok(())
     }
 
-    fn visit(&mut self, node: ::gltf::Node, parent: DMat4, path: &mut Vec<usize>) -> CliResult<()> {
-        if path.contains(&node.index()) {
-            return Err(CliError::input(format!(
-                "{}: node hierarchy has a cycle through node {}",
-                self.file,
-                node.index()
-            )));
-        }
+    /// Adds what `node` places (mesh, camera, light) under its parent's transform `parent`;
+    /// returns its own scene transform.
+    fn visit(&mut self, node: &::gltf::Node, parent: DMat4) -> CliResult<DMat4> {
         let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
         let world = parent * local;
         if !world.is_finite() {
@@ -343,12 +492,7 @@ impl Importer<'_> {
         if let Some(light) = node.light() {
             self.add_light(&light, &world, node.index())?;
         }
-        path.push(node.index());
-        for child in node.children() {
-            self.visit(child, world, path)?;
-        }
-        path.pop();
-        Ok(())
+        Ok(world)
     }
 
     /// The transform of `node` in the scene: its ancestors' local transforms composed with its
@@ -431,10 +575,7 @@ impl Importer<'_> {
     }
 
     fn mesh_name(mesh: &::gltf::Mesh) -> String {
-        match mesh.name() {
-            Some(n) => format!("mesh {} '{n}'", mesh.index()),
-            None => format!("mesh {}", mesh.index()),
-        }
+        named("mesh", mesh.index(), mesh.name())
     }
 
     fn add_mesh(&mut self, mesh: &::gltf::Mesh, placement: &Placement, weights: &[f32]) -> CliResult<()> {
@@ -510,7 +651,13 @@ impl Importer<'_> {
                 if !w.is_finite() {
                     return Err(CliError::input(format!("{at}: morph weight {k} is not finite: {w}")));
                 }
-                for (acc, what) in [(target.positions(), "POSITION"), (target.normals(), "NORMAL")] {
+                // TANGENT deltas are not applied, but reading the targets reads them too.
+                let accessors = [
+                    (target.positions(), "POSITION"),
+                    (target.normals(), "NORMAL"),
+                    (target.tangents(), "TANGENT"),
+                ];
+                for (acc, what) in accessors {
                     if let Some(acc) = acc {
                         let name = format!("morph target {k} {what}");
                         self.check_accessor(&acc, &at, &name, &[Dimensions::Vec3], &[DataType::F32], false)?;
@@ -841,6 +988,21 @@ impl Importer<'_> {
             if sc == 0 || sc > count {
                 return bad(format!("has {sc} sparse elements for {count} elements"));
             }
+            if acc.view().is_none() {
+                // Zeros but for the sparse values: no buffer bounds `count`, so the file's size
+                // bounds what the accessor may expand to (checked before anything is allocated).
+                let file_bytes: usize = self.buffers.iter().map(Vec::len).sum();
+                let limit = SPARSE_EXPANSION_FLOOR.max(SPARSE_EXPANSION_RATIO.saturating_mul(file_bytes));
+                if count.checked_mul(elem).is_none_or(|b| b > limit) {
+                    return bad(format!(
+                        "has no buffer view: its {count} elements of {elem} bytes would be zeros but for \
+                         {sc} sparse values, more than such an accessor may expand to ({limit} bytes: \
+                         {} MiB or {SPARSE_EXPANSION_RATIO} × the file's {file_bytes} buffer bytes, the \
+                         larger)",
+                        SPARSE_EXPANSION_FLOOR >> 20
+                    ));
+                }
+            }
             let idx = sparse.indices();
             let isize = idx.index_type().size();
             self.check_range(&format!("{name} sparse indices"), Some(idx.view()), idx.offset(), isize, sc)?;
@@ -919,30 +1081,47 @@ impl Importer<'_> {
             (None, None) => "default".to_string(),
         };
         let pbr = m.pbr_metallic_roughness();
-        let strength = m.emissive_strength().unwrap_or(1.0);
+        let at = format!("{}: material '{name}'", self.file);
+        // Factors outside their physical range (glTF 2.0's, and ≥ 0 for emission) are clamped
+        // with a warning naming the field; a non-finite one is refused (JSON has no NaN and
+        // serde_json refuses a number past f32's range, so only a product can overflow).
+        let pbr_field = |f: &str| format!("pbrMetallicRoughness.{f}");
+        let base_color =
+            self.physical(&at, &pbr_field("baseColorFactor"), pbr.base_color_factor(), 0.0, 1.0)?;
+        let [metallic] =
+            self.physical(&at, &pbr_field("metallicFactor"), [pbr.metallic_factor()], 0.0, 1.0)?;
+        let [roughness] =
+            self.physical(&at, &pbr_field("roughnessFactor"), [pbr.roughness_factor()], 0.0, 1.0)?;
+        let emissive = self.physical(&at, "emissiveFactor", m.emissive_factor(), 0.0, f32::INFINITY)?;
+        let [strength] = self.physical(
+            &at,
+            "KHR_materials_emissive_strength.emissiveStrength",
+            [m.emissive_strength().unwrap_or(1.0)],
+            0.0,
+            f32::INFINITY,
+        )?;
         let mut gpu = GpuMaterial {
-            base_color: pbr.base_color_factor(),
-            emission: m.emissive_factor().map(|e| e * strength),
-            metallic: pbr.metallic_factor(),
-            roughness: pbr.roughness_factor(),
+            base_color,
+            emission: emissive.map(|e| e * strength),
+            metallic,
+            roughness,
             alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
             normal_scale: m.normal_texture().map_or(1.0, |t| t.scale()),
             occlusion_strength: m.occlusion_texture().map_or(1.0, |t| t.strength()),
             ..GpuMaterial::default()
         };
-        let params = [
-            gpu.metallic,
-            gpu.roughness,
-            gpu.alpha_cutoff,
-            gpu.normal_scale,
-            gpu.occlusion_strength,
-            strength,
-        ];
-        if !gpu.base_color.iter().chain(&gpu.emission).chain(&params).all(|v| v.is_finite()) {
+        if !gpu.emission.iter().all(|v| v.is_finite()) {
             return Err(CliError::input(format!(
-                "{}: material '{name}' has a non-finite parameter",
-                self.file
+                "{at}: emissiveFactor {emissive:?} × KHR_materials_emissive_strength.emissiveStrength \
+                 {strength:?} is not finite"
             )));
+        }
+        for (field, v) in [
+            ("alphaCutoff", gpu.alpha_cutoff),
+            ("normalTexture.scale", gpu.normal_scale),
+            ("occlusionTexture.strength", gpu.occlusion_strength),
+        ] {
+            self.physical(&at, field, [v], f32::NEG_INFINITY, f32::INFINITY)?;
         }
         let alpha = match m.alpha_mode() {
             ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
@@ -1003,6 +1182,30 @@ impl Importer<'_> {
         self.scene.materials.push(Material { name, gpu });
         self.materials.insert(m.index(), index);
         Ok(index)
+    }
+
+    /// `v`, the value of material field `field` (of the material `at` names), clamped into
+    /// [`lo`, `hi`] with a warning (class data-loss) when it lies outside; an error when it is
+    /// not finite (JSON has no NaN, but a number past f32's range reads as infinite).
+    fn physical<const N: usize>(
+        &mut self,
+        at: &str,
+        field: &str,
+        v: [f32; N],
+        lo: f32,
+        hi: f32,
+    ) -> CliResult<[f32; N]> {
+        let show = |v: &[f32; N]| if N == 1 { v[0].to_string() } else { format!("{v:?}") };
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(CliError::input(format!("{at}: {field} is {}, not a finite number", show(&v))));
+        }
+        let clamped = v.map(|x| x.clamp(lo, hi));
+        if clamped != v {
+            let range =
+                if hi == f32::INFINITY { "negative".to_string() } else { format!("outside [{lo}, {hi}]") };
+            self.scene.warn(format!("{at}: {field} {} is {range}; clamped to {}", show(&v), show(&clamped)));
+        }
+        Ok(clamped)
     }
 
     fn texture(&mut self, t: ::gltf::Texture, role: TextureRole) -> u32 {
@@ -1174,4 +1377,19 @@ fn assemble(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
 /// Vertex `i`'s entry of `m`: one per vertex (skinned), or one for all (rigid).
 fn per_vertex<T: Copy>(m: &[T], i: usize) -> T {
     m[if m.len() == 1 { 0 } else { i }]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_escaping_the_checks_is_reported_as_bad_input() {
+        // The last line of defence of `import`: no known input reaches it, so it is tested here.
+        let e = guard::<()>("x.gltf", || panic!("index out of bounds")).unwrap_err();
+        assert_eq!(e.exit, Exit::BadInput);
+        assert!(e.message.starts_with("x.gltf: malformed glTF"), "{}", e.message);
+        assert!(e.message.contains("(index out of bounds)"), "{}", e.message);
+        assert_eq!(guard("x.gltf", || Ok(7)).unwrap(), 7);
+    }
 }
