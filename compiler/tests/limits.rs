@@ -112,3 +112,21 @@ fn mtl_statements_without_their_numbers_are_warned_and_dropped() {
     let report = std::fs::read_to_string(d.join("r.json")).unwrap();
     assert!(report.contains("clamped to 0"), "{report}");
 }
+
+#[test]
+#[cfg(unix)]
+fn a_gltf_buffer_that_is_a_device_is_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let gltf = r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"/dev/zero","byteLength":36}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
+        "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]}"#;
+    std::fs::write(dir.path().join("dev.gltf"), gltf).unwrap();
+    let run = kiln(dir.path(), &["compile", "dev.gltf", "-o", "out.kiln"]);
+    assert!(
+        run.code == 1 && run.stderr.contains("/dev/zero is not a regular file"),
+        "{}: {}",
+        run.code,
+        run.stderr
+    );
+}

@@ -169,9 +169,7 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
     }
     let parents = node_parents(&doc, &file)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    // NOTE: external buffers are read through `load_uri` (std::fs::read); bounding referenced
-    // files (regular files of bounded size) is being done in a shared helper elsewhere, which
-    // this call site should adopt.
+    // External buffers and images are read through `load_uri`, within `super::files`' bounds.
     let buffers = load_buffers(&doc, blob, &file, &base, &mut scene.inputs)?;
     let mut imp = Importer {
         file,
@@ -409,7 +407,7 @@ fn load_uri(uri: &str, base: &Path, inputs: &mut Vec<PathBuf>) -> Result<Vec<u8>
     }
     let rel = percent_decode(uri)?;
     let path = base.join(&rel);
-    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let bytes = super::files::read_bounded(&path)?;
     if !inputs.contains(&path) {
         inputs.push(path);
     }
