@@ -3,19 +3,21 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::builder::{PossibleValue, PossibleValuesParser};
-use clap::{Arg, ArgAction, ArgMatches, Command, CommandFactory, FromArgMatches, Parser};
+use clap::{Arg, Command, CommandFactory, FromArgMatches, Parser};
 
 use crate::bench;
 use crate::camera::{CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
-use crate::render::techniques::{Effect, Knob, KnobRange, KnobValue, Techniques, catalogue, techniques_of};
+use crate::render::techniques::{Effect, KnobValue, Techniques, techniques_of};
 use crate::render::{Purpose, RenderSettings};
 use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions};
 use crate::window;
+
+mod technique_flags;
+pub use technique_flags::TechniqueFlags;
 
 const AFTER_HELP: &str = "\
 Examples:
@@ -222,156 +224,12 @@ impl Args {
     }
 }
 
-/// What the catalogue's flags say: each effect's technique and the knob values given.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct TechniqueFlags {
-    /// (effect, technique name), every effect (its default when not given).
-    chosen: Vec<(Effect, String)>,
-    /// (knob, value) of every knob flag given.
-    knobs: Vec<(&'static str, KnobValue)>,
-    /// `--no-accumulate`.
-    no_accumulate: bool,
-}
-
-impl TechniqueFlags {
-    /// The technique chosen for `effect` (its catalogue default when the flag is absent).
-    fn technique(&self, effect: Effect) -> &str {
-        self.chosen.iter().find(|(e, _)| *e == effect).map_or_else(|| default_technique(effect), |(_, n)| n)
-    }
-
-    /// The value the command line gives the knob `name`.
-    fn knob(&self, name: &str) -> Option<KnobValue> {
-        self.knobs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
-    }
-
-    fn from_matches(m: &ArgMatches) -> TechniqueFlags {
-        let chosen = Effect::ALL
-            .into_iter()
-            .filter_map(|e| m.get_one::<String>(e.name()).map(|n| (e, n.clone())))
-            .collect();
-        let knobs = knob_flags()
-            .into_iter()
-            .filter_map(|k| m.get_one::<KnobValue>(k.name).map(|v| (k.name, *v)))
-            .collect();
-        TechniqueFlags { chosen, knobs, no_accumulate: m.get_flag("no_accumulate") }
-    }
-}
-
-/// The technique `Techniques::default()` uses for `effect`.
-fn default_technique(effect: Effect) -> &'static str {
-    Techniques::default().name_of(effect)
-}
-
-/// Every knob of the catalogue once (knobs shared by several techniques, e.g. `--ao-radius`,
-/// have one flag), in catalogue order.
-fn knob_flags() -> Vec<&'static Knob> {
-    let mut seen: Vec<&'static Knob> = Vec::new();
-    for info in catalogue() {
-        for k in info.knobs {
-            if !seen.iter().any(|s| s.name == k.name) {
-                seen.push(k);
-            }
-        }
-    }
-    seen
-}
-
-/// The `--help` text of the knob flag `knob` of `effect`: which techniques read it, what it
-/// does, its range and each technique's default.
-fn knob_help(effect: Effect, knob: &Knob) -> String {
-    let users: Vec<(&str, &Knob)> = techniques_of(effect)
-        .filter_map(|t| t.knobs.iter().find(|k| k.name == knob.name).map(|k| (t.name, k)))
-        .collect();
-    let names: Vec<&str> = users.iter().map(|(n, _)| *n).collect();
-    let range = match knob.range {
-        KnobRange::Number { min, max, whole, .. } => {
-            let max = if max.is_infinite() { "∞".to_string() } else { max.to_string() };
-            format!("{}{min} to {max}", if whole { "a whole number, " } else { "" })
-        }
-        KnobRange::Choice(options) => options.join(", "),
-    };
-    let defaults: Vec<String> = if users.iter().all(|(_, k)| k.default == knob.default) {
-        vec![knob.default_text()]
-    } else {
-        users.iter().map(|(n, k)| format!("{n} {}", k.default_text())).collect()
-    };
-    let names = match names.split_last() {
-        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-        _ => names.join(""),
-    };
-    format!("With --{effect} {names}: {} ({range}) [default: {}]", knob.help, defaults.join(", "))
-}
-
-/// A knob flag's parser: the text as the knob's value, checked against its range (whichever
-/// technique is chosen: a bad value is an error even where no technique reads it).
-fn knob_parser(
-    knob: &'static Knob,
-) -> impl Fn(&str) -> Result<KnobValue, String> + Clone + Send + Sync + 'static {
-    move |s: &str| {
-        let v = knob.parse(s)?;
-        knob.check(v)?;
-        Ok(v)
-    }
-}
-
 /// `kiln-play`'s command line: the fixed flags of [`Args`] and, under a heading per effect,
 /// each effect's technique flag and its techniques' knob flags, made from the catalogue
 /// ([`crate::render::techniques::catalogue`]); `completions` and `man` write the shell
 /// completions and the man page.
 pub fn command() -> Command {
-    let mut cmd = Args::command();
-    for effect in Effect::ALL {
-        let heading = effect.title();
-        let values = techniques_of(effect).map(|t| PossibleValue::new(t.name).help(t.help));
-        cmd = cmd.arg(
-            Arg::new(effect.name())
-                .long(effect.name())
-                .value_name("TECHNIQUE")
-                .value_parser(PossibleValuesParser::new(values))
-                .help(format!("{} technique [default: {}]", heading, default_technique(effect)))
-                .help_heading(heading),
-        );
-        if effect == Effect::Aa {
-            cmd = cmd.arg(
-                Arg::new("no_accumulate")
-                    .long("no-accumulate")
-                    .action(ArgAction::SetTrue)
-                    .conflicts_with("aa")
-                    .help("Do not average the ray-traced passes over frames (every frame shows one sample): the same as --aa none")
-                    .help_heading(heading)
-                    .hide_short_help(true),
-            );
-        }
-        // A knob shared across effects would sit under the first one's heading.
-        let own: Vec<&'static Knob> = knob_flags()
-            .into_iter()
-            .filter(|k| techniques_of(effect).any(|t| t.knobs.iter().any(|tk| tk.name == k.name)))
-            .filter(|k| {
-                !Effect::ALL[..Effect::ALL.iter().position(|e| *e == effect).unwrap_or(0)]
-                    .iter()
-                    .any(|e| techniques_of(*e).any(|t| t.knobs.iter().any(|tk| tk.name == k.name)))
-            })
-            .collect();
-        for knob in own {
-            let value_name = match knob.range {
-                KnobRange::Number { whole: true, .. } => "N".to_string(),
-                KnobRange::Number { .. } => "X".to_string(),
-                KnobRange::Choice(_) => "CHOICE".to_string(),
-            };
-            let mut arg = Arg::new(knob.name)
-                .long(knob.name)
-                .value_name(value_name)
-                .allow_negative_numbers(true)
-                .value_parser(clap::builder::ValueParser::new(knob_parser(knob)))
-                .help(knob_help(effect, knob))
-                .help_heading(heading)
-                .hide_short_help(true);
-            if let KnobRange::Choice(options) = knob.range {
-                arg = arg.hide_possible_values(true).value_name(options.join("|"));
-            }
-            cmd = cmd.arg(arg);
-        }
-    }
+    let cmd = technique_flags::add(Args::command());
     let shell = Arg::new("shell")
         .required(true)
         .value_parser(clap::value_parser!(clap_complete::Shell))
@@ -544,6 +402,7 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 mod tests {
     use super::*;
     use crate::render::techniques::ao::{self, Radius};
+    use crate::render::techniques::catalogue;
     use crate::render::techniques::reflections::rt::ReflectionRes;
     use crate::render::techniques::{aa, gi, reflections, shadows};
     use crate::render::{Aa, Ao, GBuffer, Gi, Reflections, ScreenFraction, Shadows};
