@@ -196,13 +196,18 @@ impl Knobs {
         Ok(())
     }
 
-    fn get(&self, name: &str) -> KnobValue {
+    /// Where the knob `name` is among the technique's knobs.
+    fn position(&self, name: &str) -> usize {
         match self.knobs.iter().position(|k| k.name == name) {
-            Some(at) => self.values[at],
+            Some(at) => at,
             // A technique reading a knob it does not declare: caught by the test that builds
             // every catalogue entry.
             None => panic!("{} reads a knob it does not declare: {name}", self.technique),
         }
+    }
+
+    fn get(&self, name: &str) -> KnobValue {
+        self.values[self.position(name)]
     }
 
     /// A number knob's value.
@@ -221,9 +226,9 @@ impl Knobs {
 
     /// A choice knob's option, by name.
     pub fn choice(&self, name: &str) -> &'static str {
-        let at = self.knobs.iter().position(|k| k.name == name);
-        match (at.map(|i| self.knobs[i].range), self.get(name)) {
-            (Some(KnobRange::Choice(options)), KnobValue::Choice(i)) => options[i],
+        let at = self.position(name);
+        match (self.knobs[at].range, self.values[at]) {
+            (KnobRange::Choice(options), KnobValue::Choice(i)) => options[i],
             _ => panic!("{}: {name} is not a choice knob", self.technique),
         }
     }
