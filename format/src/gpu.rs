@@ -363,6 +363,18 @@ gpu_struct! {
         pub gi_bounces: u32 => "uint",
         /// GI: entries of the emitter table (`GpuEmitter`s) its next-event estimation chooses from.
         pub emitters: u32 => "uint",
+        /// Direct light of emissive surfaces: entries of the emissive-triangle table (the emitter
+        /// table's triangles, renormalised) its candidates are drawn from.
+        pub emissive: u32 => "uint",
+        /// Direct light: candidates per pixel and frame (resampled importance sampling).
+        pub direct_candidates: u32 => "uint",
+        /// Direct light: neighbouring reservoirs combined per pixel (spatial reuse; 0: none).
+        pub direct_spatial: u32 => "uint",
+        /// Direct light: the previous frame's reservoir weighs at most this many times the
+        /// candidates (temporal reuse; 0: none).
+        pub direct_temporal: u32 => "uint",
+        /// Direct light: 1 where shadow rays decide visibility, 0 for unshadowed light.
+        pub direct_visibility: u32 => "uint",
     }
 }
 
@@ -466,6 +478,10 @@ impl FrameFlags {
     /// Screen-space reflections in the reflection image: rgb the incoming radiance along the
     /// mirror direction, a the confidence in it; the split-sum ambient makes up the rest.
     pub const SCREEN_REFLECTIONS: u32 = 1 << 7;
+    /// The light of the emissive triangles at the visible surfaces from the direct-light image
+    /// (`--direct`): the composition adds it, and the GI pass leaves out the emission its first
+    /// rays hit, so that every path counts once.
+    pub const RT_DIRECT: u32 = 1 << 8;
 }
 
 /// Shadow maps of each kind (2D and cube) the direct-light pass can bind: the length of its
@@ -555,6 +571,7 @@ pub fn glsl_layout() -> String {
         ("FRAME_RT_GI", FrameFlags::RT_GI),
         ("FRAME_SCREEN_GI", FrameFlags::SCREEN_GI),
         ("FRAME_SCREEN_REFLECTIONS", FrameFlags::SCREEN_REFLECTIONS),
+        ("FRAME_RT_DIRECT", FrameFlags::RT_DIRECT),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),

@@ -22,6 +22,7 @@ use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, Semaphore, SemaphoreOp}
 use crate::render::Needs;
 use crate::render::background::{Built, FrameBuild};
 use crate::render::frame::{Frame, SceneLights};
+use crate::render::techniques::Effect;
 use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer, Techniques};
 use crate::scene::upload::Uploader;
 use crate::scene::{GpuScene, Prepared, TextureUpload};
@@ -240,6 +241,11 @@ impl Plan {
         let has_bvh = file.find(sections::BVH_NODES, 0).is_some_and(|s| s.entry.raw_size > 0);
         let mut warnings = Vec::new();
         let mut render = *render;
+        if !has_emission(file)? {
+            // Nothing emits: the direct light of emissive surfaces would sample nothing, and its
+            // passes (and their pipelines) are skipped.
+            render.techniques.set(Effect::Direct, "none", &[]).map_err(|e| PlayError::new(Exit::Usage, e))?;
+        }
         if render.techniques.ray_traced() && !has_bvh {
             warnings.push("the ray-traced passes are off: the file has no BVH".to_string());
             render.techniques = render.techniques.without_rays();
@@ -253,6 +259,15 @@ impl Plan {
         };
         Ok(Plan { requested, fallback, first_needs, warnings })
     }
+}
+
+/// Whether a material of the file emits (what the emissive triangles' table is made of).
+pub fn has_emission(file: &KilnFile) -> PlayResult<bool> {
+    let materials: &[kiln_format::sections::GpuMaterial] = file
+        .pod(sections::MATERIALS, 0)
+        .map_err(|e| PlayError::new(Exit::BadInput, e.to_string()))?
+        .unwrap_or(&[]);
+    Ok(materials.iter().any(|m| m.emission.iter().any(|&e| e > 0.0)))
 }
 
 fn ms(since: Instant) -> f64 {

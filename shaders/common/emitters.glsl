@@ -51,6 +51,35 @@ struct EmitterSample {
     vec3 target;      // the shadow ray's end (moved off an emissive triangle)
 };
 
+// A point on emissive triangle `tri` (leaf order), uniform in area for xi uniform in [0, 1)²:
+// where it lies, the triangle's unit normal (its winding's) and area, whether its material
+// emits from both sides, and the radiance it emits there (the emissive texture included).
+struct EmissivePoint {
+    vec3 q;
+    vec3 nl;
+    float area;
+    bool double_sided;
+    vec3 le;
+};
+
+EmissivePoint emissive_point(uint tri, vec2 xi) {
+    vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
+    float su = sqrt(xi.x);
+    float b1 = 1.0 - su, b2 = xi.y * su;
+    EmissivePoint ep;
+    ep.q = (1.0 - b1 - b2) * p0 + b1 * p1 + b2 * p2;
+    vec3 c = cross(p1 - p0, p2 - p0);
+    ep.area = 0.5 * length(c);
+    ep.nl = c / max(2.0 * ep.area, 1e-30);
+    GpuMaterialLayout m = materials[tri_materials[tri]];
+    ep.double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
+    ep.le = m.emission;
+    if (m.emissive_texture != NO_TEXTURE) {
+        ep.le *= sample_texture(m.emissive_texture, triangle_uv(tri, b1, b2)).rgb;
+    }
+    return ep;
+}
+
 #ifdef EMITTER_TRANSMITTANCE
 vec3 emitter_transmittance(vec3 from, EmitterSample es);
 vec3 emitter_seen_weight(float t);
@@ -70,38 +99,27 @@ EmitterSample sample_emitter_light(vec3 origin) {
     }
     GpuEmitter e = emitters[choose_emitter(rnd())];
     if (e.kind == EMITTER_TRIANGLE) {
-        uint tri = e.index;
-        vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
-        float su = sqrt(rnd());
-        float b1 = 1.0 - su, b2 = rnd() * su;
-        vec3 q = (1.0 - b1 - b2) * p0 + b1 * p1 + b2 * p2;
-        vec3 c = cross(p1 - p0, p2 - p0);
-        float area = 0.5 * length(c);
-        vec3 nl = c / max(2.0 * area, 1e-30);
-        vec3 to = q - origin;
+        float xi = rnd();
+        EmissivePoint ep = emissive_point(e.index, vec2(xi, rnd()));
+        vec3 to = ep.q - origin;
         float d2 = dot(to, to);
         float d = sqrt(d2);
         vec3 wi = to / d;
-        float cos_l = -dot(nl, wi);
-        GpuMaterialLayout m = materials[tri_materials[tri]];
-        if ((m.flags & MATERIAL_DOUBLE_SIDED) != 0u) {
+        float cos_l = -dot(ep.nl, wi);
+        if (ep.double_sided) {
             cos_l = abs(cos_l);
         }
-        if (cos_l <= 0.0 || area <= 0.0) {
+        if (cos_l <= 0.0 || ep.area <= 0.0) {
             return es;
-        }
-        vec3 le = m.emission;
-        if (m.emissive_texture != NO_TEXTURE) {
-            le *= sample_texture(m.emissive_texture, triangle_uv(tri, b1, b2)).rgb;
         }
         es.valid = true;
         es.delta = false;
         es.wi = wi;
-        es.li = le;
-        es.pdf = e.pdf * d2 / (cos_l * area);
+        es.li = ep.le;
+        es.pdf = e.pdf * d2 / (cos_l * ep.area);
         // The sampled point, moved off the emitter towards the origin: the shadow ray must not
         // reach the emitter's own surface.
-        es.target = offset_ray_origin(q, dot(nl, wi) < 0.0 ? nl : -nl);
+        es.target = offset_ray_origin(ep.q, dot(ep.nl, wi) < 0.0 ? ep.nl : -ep.nl);
         return es;
     }
     GpuLight l = lights[e.index];

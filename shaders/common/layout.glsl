@@ -108,7 +108,12 @@ struct RtConstants {
     uint reflection_lights; // offset 24
     uint gi_bounces; // offset 28
     uint emitters; // offset 32
-}; // 36 bytes
+    uint emissive; // offset 36
+    uint direct_candidates; // offset 40
+    uint direct_spatial; // offset 44
+    uint direct_temporal; // offset 48
+    uint direct_visibility; // offset 52
+}; // 56 bytes
 
 struct MarchConstants {
     uint steps; // offset 0
@@ -187,6 +192,7 @@ const uint FRAME_REFLECTIONS_HALF = 16u;
 const uint FRAME_RT_GI = 32u;
 const uint FRAME_SCREEN_GI = 64u;
 const uint FRAME_SCREEN_REFLECTIONS = 128u;
+const uint FRAME_RT_DIRECT = 256u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;

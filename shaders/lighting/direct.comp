@@ -1,7 +1,8 @@
 #version 460
 #extension GL_EXT_control_flow_attributes : require
 // Direct light and composition: every analytic light over the G-buffer, shadowed by the baked
-// shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, plus the constant sky
+// shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, the emissive
+// triangles' light from the direct-light image (`--direct`), plus the constant sky
 // through the split-sum table (its diffuse part times the ray-traced AO, or replaced by the
 // ray-traced GI; its specular part replaced by the ray-traced reflections where they were
 // traced, or blended with the screen-space reflections' radiance by their confidence) and
@@ -25,6 +26,7 @@ layout(constant_id = 4) const bool DIRECT_GI = true;
 layout(constant_id = 5) const bool DIRECT_SCREEN_REFLECTIONS = true;
 layout(constant_id = 6) const bool DIRECT_MEDIA = true;
 layout(constant_id = 7) const bool DIRECT_RECT_LIGHTS = true;
+layout(constant_id = 8) const bool DIRECT_EMISSIVE = true;
 
 // Shadow maps: MAX_SHADOW_MAPS (layout.glsl) of each kind, indexed by `GpuShadow::slot`.
 // The shadow tap loops are [[dont_unroll]]: each tap samples through a dynamically indexed
@@ -52,6 +54,9 @@ layout(set = 0, binding = 15, rgba32f) uniform readonly image2D rt_gi;
 // Participating media between surfaces and lights (`frame.sky.w` boxes: with a media technique).
 layout(set = 0, binding = 16, std430) readonly buffer Media { GpuMedium media[]; };
 #include "../common/media.glsl"
+// The light of the emissive triangles at each pixel's surface (`--direct`: rgb, reflected
+// towards the camera, shadowed as its technique says).
+layout(set = 0, binding = 17, rgba32f) uniform readonly image2D rt_direct;
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -239,6 +244,9 @@ void main() {
     float angle = 6.2831853 * hash(uvec2(pixel));
 
     vec3 radiance = texelFetch(g_emission, pixel, 0).rgb;
+    if (DIRECT_EMISSIVE && (frame.size.w & FRAME_RT_DIRECT) != 0u) {
+        radiance += imageLoad(rt_direct, pixel).rgb;
+    }
     float occlusion = mat.a;
     if (DIRECT_AO && (frame.size.w & FRAME_RT_AO) != 0u) {
         occlusion *= imageLoad(rt_ao, pixel).r;

@@ -12,9 +12,11 @@
 // replaces its diffuse sky ambient. So along the first ray:
 //  - the sky on a miss counts (it is no longer in the direct pass; the sky is no emitter of the
 //    table, no next-event estimation reaches it);
-//  - an emissive triangle it hits counts with weight 1: the direct pass does not sample emissive
-//    triangles, so BRDF (cosine) sampling is the only strategy for them at the primary surface
-//    and there is nothing to weigh it against;
+//  - an emissive triangle of the emitter table it hits counts with weight 1 when the frame has
+//    no direct light of emissive surfaces (`--direct none`): BRDF (cosine) sampling is then the
+//    only strategy for them at the primary surface and there is nothing to weigh it against;
+//    with it (FRAME_RT_DIRECT) weight 0: the direct-light image integrates every emitter of the
+//    table at the primary surface, whatever strategy (RIS, reuse) chose its samples;
 //  - a rect light it crosses does not count: the direct pass integrates rect lights.
 // At each hit, next-event estimation towards one emitter of the table (analytic lights and
 // emissive triangles, the path tracer's `sample_emitter`). At the last hit (`rt.gi_bounces`
@@ -107,7 +109,8 @@ vec3 gi_sample(Primary s) {
             result += throughput * frame.sky.rgb;
             break;
         }
-        if (any(greaterThan(h.emission, vec3(0.0)))) {
+        bool direct_counts = bounce == 1u && (frame.size.w & FRAME_RT_DIRECT) != 0u && tri_emitter[h.triangle] >= 0;
+        if (any(greaterThan(h.emission, vec3(0.0))) && !direct_counts) {
             float d = length(h.p - r.origin);
             float cos_l = abs(dot(h.ng, r.direction));
             result += throughput * h.emission * triangle_emission_weight(h.triangle, d, cos_l, pdf_brdf);

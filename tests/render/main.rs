@@ -11,6 +11,7 @@ mod harness;
 // The tests, by topic.
 mod analytic; // one light on a diffuse plane against its closed form, per pixel
 mod colors; // vertex colours in both G-buffers and the reference, against closed forms
+mod emitters; // emissive triangles as lights (ris, restir): polygon irradiance, textured emission, a white furnace
 mod files; // damaged files fail with the right exit code; minimal files render
 mod gi; // path-traced GI plus direct light against the two-bounce reference
 mod godrays; // Mitchell's and Sousa's image-space blurs, their failure with the light behind the camera

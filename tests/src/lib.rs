@@ -12,7 +12,9 @@ use kiln_player::gpu::GpuOptions;
 use kiln_player::render::techniques::gi::linespace::GiStructure;
 use kiln_player::render::techniques::reflections::rt::ReflectionRes;
 use kiln_player::render::techniques::shadows::linespace::LsShadowTest;
-use kiln_player::render::techniques::{ao as ao_techniques, gbuffer, gi, media, reflections, shadows};
+use kiln_player::render::techniques::{
+    Direct, ao as ao_techniques, direct, gbuffer, gi, media, reflections, shadows,
+};
 use kiln_player::render::{
     Aa, Ao, Effect, GBuffer as GBufferTechnique, Gi, Media, Purpose, Reflections as ReflectionsTechnique,
     Shadows,
@@ -82,12 +84,38 @@ pub struct Options(SessionOptions);
 
 impl Options {
     /// `file` at `width` × `height` with the validation layer on, otherwise what `kiln-play` does
-    /// without flags: shadow maps, raster G-buffer, no ray-traced pass.
+    /// without flags but for its one ray-traced pass: shadow maps, raster G-buffer, and no direct
+    /// light of emissive surfaces (`--direct none`; [`Options::ris`], [`Options::restir`] turn
+    /// it on).
     pub fn new(file: impl Into<PathBuf>, width: u32, height: u32) -> Options {
-        Options(SessionOptions {
+        let mut o = SessionOptions {
             gpu: GpuOptions { validate: true, ..Default::default() },
             ..SessionOptions::new(file, width, height)
-        })
+        };
+        o.render.techniques.direct = Direct::Off(direct::none::Off);
+        Options(o)
+    }
+
+    /// The emissive surfaces' direct light by resampled importance sampling of `candidates`
+    /// candidates per pixel and frame (`--direct ris`).
+    pub fn ris(mut self, candidates: u32) -> Options {
+        self.0.render.techniques.direct =
+            Direct::Ris(direct::ris::Ris { candidates, spatial: 0, temporal: 0 });
+        self
+    }
+
+    /// The emissive surfaces' direct light by ReSTIR DI (`--direct restir`): `candidates` per
+    /// pixel, `spatial` neighbours, the previous frame capped at `temporal` times the candidates.
+    pub fn restir(mut self, candidates: u32, spatial: u32, temporal: u32) -> Options {
+        self.0.render.techniques.direct =
+            Direct::Restir(direct::restir::Restir { candidates, spatial, temporal });
+        self
+    }
+
+    /// The player's default direct light of emissive surfaces (`kiln-play` without `--direct`).
+    pub fn default_direct(mut self) -> Options {
+        self.0.render.techniques.direct = Direct::default();
+        self
     }
 
     /// No shadow maps (`--shadows none`; with a ray-traced pass, only what that pass gives).

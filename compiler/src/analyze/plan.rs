@@ -60,6 +60,34 @@ impl Stage {
     }
 }
 
+/// What the player's emitter table will hold (it is built at load from the materials and
+/// triangles): the emissive triangles, how many materials they use and their total power.
+fn emitters(scene: &Scene) -> String {
+    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let emits: Vec<f32> = scene.materials.iter().map(|m| luminance(m.gpu.emission)).collect();
+    let (mut triangles, mut power) = (0usize, 0.0f64);
+    let mut used = vec![false; emits.len()];
+    for (t, &m) in scene.triangles.iter().zip(&scene.triangle_materials) {
+        let e = emits.get(m as usize).copied().unwrap_or(0.0);
+        if e > 0.0 {
+            let p = t.map(|v| glam::Vec3::from(scene.vertices[v as usize].position).as_dvec3());
+            triangles += 1;
+            power += std::f64::consts::PI * e as f64 * 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+            used[m as usize] = true;
+        }
+    }
+    if triangles == 0 {
+        return "no emissive triangles (nothing for kiln-play --direct to sample)".to_string();
+    }
+    let materials = used.iter().filter(|&&u| u).count();
+    format!(
+        "emitter table: {triangles} emissive triangles of {materials} material{}, total power {power:.4} (pi x \
+         luminance x area; {} KiB at load), read by kiln-play --direct ris|restir (the default) and --gi rt",
+        if materials == 1 { "" } else { "s" },
+        (triangles * 16).div_ceil(1024)
+    )
+}
+
 /// One stage's decision.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Decision {
@@ -114,7 +142,7 @@ impl Plan {
             } else {
                 run(Stage::VertexColors, format!("{} vertices coloured", scene.colors.len()))
             },
-            run(Stage::Materials, format!("{} materials", scene.materials.len())),
+            run(Stage::Materials, format!("{} materials; {}", scene.materials.len(), emitters(scene))),
             if scene.textures.is_empty() {
                 skip(Stage::Textures, "the scene has no textures")
             } else {

@@ -71,6 +71,8 @@ pub enum Stage {
     Reflections,
     /// Global illumination.
     Gi,
+    /// Direct light of emissive surfaces.
+    Emitters,
     /// The ray-traced passes' reprojected accumulation.
     Accumulate,
     /// Direct light and composition.

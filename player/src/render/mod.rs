@@ -160,10 +160,19 @@ impl Renderer {
                 _ => 0.0,
             };
         }
-        let rt_constants =
-            RtConstants { emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count), ..rays.rt };
+        let emissive = scene.reference.as_ref().map_or(0, |r| r.emissive_count);
+        let rt_constants = RtConstants {
+            emitters: scene.reference.as_ref().map_or(0, |r| r.emitter_count),
+            emissive,
+            ..rays.rt
+        };
         let mut flags = if plan.shadows_bound && surface_maps { FrameFlags::SHADOW_MAPS } else { 0 };
         flags |= t.flags();
+        if emissive == 0 {
+            // Nothing for the direct light of emissive surfaces to sample: the composition skips
+            // its image and GI counts what its first rays hit.
+            flags &= !FrameFlags::RT_DIRECT;
+        }
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let lights = host_buffer(gpu, "lights", bytemuck::cast_slice(&plan.lights), storage)?;
         let shadows = host_buffer(gpu, "shadows", bytemuck::cast_slice(&plan.shadows), storage)?;

@@ -299,6 +299,8 @@ pub struct ReferenceBuffers {
     pub emitters: Buffer,
     /// Emitter of each triangle (i32, −1 for none).
     pub triangle_emitter: Buffer,
+    /// `GpuEmitter` table of the emissive triangles alone.
+    pub emissive: Buffer,
     /// Mip 0 of every texture, RGBA8 words.
     pub texels: Buffer,
     /// `GpuTexture` table.
@@ -311,6 +313,8 @@ pub struct ReferenceBuffers {
     pub texel_decode: TexelDecode,
     /// Entries in `emitters`.
     pub emitter_count: u32,
+    /// Entries in `emissive`.
+    pub emissive_count: u32,
     /// Entries in `media`.
     pub media_count: u32,
 }
@@ -754,6 +758,7 @@ impl GpuScene {
         if let (Some(r), Some(tables), true) = (&self.reference, &prepared.reference, now.scene_buffers) {
             up.buffer(&r.emitters, 0, bytemuck::cast_slice(&tables.emitters))?;
             up.buffer(&r.triangle_emitter, 0, bytemuck::cast_slice(&tables.triangle_emitter))?;
+            up.buffer(&r.emissive, 0, bytemuck::cast_slice(&tables.emissive))?;
             up.buffer(&r.textures, 0, bytemuck::cast_slice(&tables.textures))?;
             up.buffer(&r.raster_materials, 0, bytemuck::cast_slice(&raster_materials(&prepared.draws)))?;
             up.buffer(&r.media, 0, bytemuck::cast_slice(&tables.media))?;
@@ -907,6 +912,7 @@ fn reference_buffers(
         ("materials", std::mem::size_of_val(view.materials)),
         ("emitters", std::mem::size_of_val(tables.emitters.as_slice())),
         ("triangle emitters", std::mem::size_of_val(tables.triangle_emitter.as_slice())),
+        ("emissive triangles", std::mem::size_of_val(tables.emissive.as_slice())),
         ("texels", tables.texel_words as usize * 4),
         ("texture table", std::mem::size_of_val(tables.textures.as_slice())),
         ("raster materials", view.triangles.len() * 4),
@@ -921,12 +927,14 @@ fn reference_buffers(
         materials: next(),
         emitters: next(),
         triangle_emitter: next(),
+        emissive: next(),
         texels: next(),
         textures: next(),
         raster_materials: next(),
         media: next(),
         texel_decode: TexelDecode::of(&tables.textures),
         emitter_count: tables.emitters.len() as u32,
+        emissive_count: tables.emissive.len() as u32,
         media_count: tables.media.len() as u32,
     })
 }

@@ -11,6 +11,11 @@ use kiln_format::sections::{GpuMaterial, PixelFormat, Swizzle, Vertex};
 pub struct ReferenceTables {
     /// Emitters with cumulative selection probabilities (empty when nothing emits).
     pub emitters: Vec<GpuEmitter>,
+    /// The emissive triangles alone, chosen in proportion to their power (the triangle entries
+    /// of `emitters`, renormalised): what the direct light of emissive surfaces draws from.
+    pub emissive: Vec<GpuEmitter>,
+    /// Total power of the emissive triangles (π · luminance · area, summed).
+    pub emissive_power: f64,
     /// Per triangle (leaf order): its index in `emitters`, or −1.
     pub triangle_emitter: Vec<i32>,
     /// Per texture: where its mip chain lies in the texel buffer.
@@ -46,6 +51,29 @@ fn light_power(l: &kiln_format::manifest::Light, scene_radius: f32) -> f32 {
         LightKind::Rect { width, height } => std::f32::consts::PI * width * height * i,
     };
     if p.is_finite() { p.max(0.0) } else { 0.0 }
+}
+
+/// The triangle entries of (kind, index, power), chosen in proportion to power among
+/// themselves.
+fn emissive_table(power: &[(u32, u32, f32)]) -> Vec<GpuEmitter> {
+    let triangles: Vec<(u32, f32)> =
+        power.iter().filter(|p| p.0 == EmitterKinds::TRIANGLE).map(|p| (p.1, p.2)).collect();
+    let total: f64 = triangles.iter().map(|t| t.1 as f64).sum();
+    let mut cumulative = 0.0f64;
+    triangles
+        .iter()
+        .enumerate()
+        .map(|(i, &(index, p))| {
+            cumulative += p as f64;
+            GpuEmitter {
+                kind: EmitterKinds::TRIANGLE,
+                index,
+                // The last entry is exactly 1 so that every draw in [0, 1) finds one.
+                cdf: if i + 1 == triangles.len() { 1.0 } else { (cumulative / total) as f32 },
+                pdf: (p as f64 / total) as f32,
+            }
+        })
+        .collect()
 }
 
 /// Builds the tables of a validated scene.
@@ -92,6 +120,8 @@ pub fn tables(
             tables.triangle_emitter[index as usize] = i as i32;
         }
     }
+    tables.emissive = emissive_table(&power);
+    tables.emissive_power = power.iter().filter(|p| p.0 == EmitterKinds::TRIANGLE).map(|p| p.2 as f64).sum();
     tables.media = super::media::table(manifest);
     for (i, t) in manifest.textures.iter().enumerate() {
         // How the texels are stored (the section header): RGBA8 where unknown.

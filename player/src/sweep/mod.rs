@@ -113,6 +113,8 @@ fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Ca
             .and_then(|h| h.first())
             .map_or(0, |h| h.variants),
         media: !manifest.media.is_empty(),
+        emission: crate::session::has_emission(&file)?,
+        lights: !manifest.lights.is_empty(),
     };
     if !offers.bvh {
         return Err(PlayError::new(

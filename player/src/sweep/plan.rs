@@ -21,8 +21,9 @@ pub enum Target {
 
 impl Target {
     /// Every target `--effects` accepts, in the order they are swept.
-    pub const ALL: [Target; 7] = [
+    pub const ALL: [Target; 8] = [
         Target::Effect(Effect::Shadows),
+        Target::Effect(Effect::Direct),
         Target::Effect(Effect::Ao),
         Target::Effect(Effect::Reflections),
         Target::Effect(Effect::Gi),
@@ -67,7 +68,7 @@ pub fn bounces(target: Target) -> u32 {
     match target {
         // The anti-aliasing chart holds the frame at shadow maps and the sky's ambient: direct
         // light.
-        Target::Effect(Effect::Shadows | Effect::Ao | Effect::Media | Effect::Aa) => 1,
+        Target::Effect(Effect::Shadows | Effect::Direct | Effect::Ao | Effect::Media | Effect::Aa) => 1,
         Target::Effect(Effect::Reflections) => 2,
         _ => 0,
     }
@@ -93,6 +94,11 @@ pub struct Offers {
     pub line_space: u32,
     /// A participating medium.
     pub media: bool,
+    /// An emissive material (the direct light of emissive surfaces has something to sample).
+    pub emission: bool,
+    /// An analytic light (without one, shadow maps have nothing to shadow: a technique that
+    /// reads them renders what the default frame does).
+    pub lights: bool,
 }
 
 impl Offers {
@@ -102,7 +108,7 @@ impl Offers {
         let variants = variants_needed(n.line_space);
         if n.bvh && !self.bvh {
             Some("needs the BVH, which the file does not have (compiled without one)".into())
-        } else if n.shadow_maps && !self.shadow_maps {
+        } else if n.shadow_maps && !self.shadow_maps && self.lights {
             Some(
                 "needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)"
                     .into(),
@@ -229,7 +235,7 @@ pub fn names(target: Target) -> Vec<&'static str> {
 type Preset = (&'static str, &'static str, fn(&mut Techniques));
 
 /// The frame presets, each with both G-buffers.
-const PRESETS: [Preset; 7] = [
+const PRESETS: [Preset; 8] = [
     ("baked", "shadow maps, no AO, split-sum reflections", |t| {
         set(t, Effect::Shadows, "shadowmap");
     }),
@@ -262,6 +268,12 @@ const PRESETS: [Preset; 7] = [
             set(t, Effect::Aa, "taa");
         },
     ),
+    ("rt-gi", "as rt with path-traced GI (--gi rt, one bounce)", |t| {
+        set(t, Effect::Shadows, "rt");
+        set(t, Effect::Ao, "rt");
+        set(t, Effect::Reflections, "rt");
+        set(t, Effect::Gi, "rt");
+    }),
     ("rt-half", "as rt with half-resolution reflections", |t| {
         set(t, Effect::Shadows, "rt");
         set(t, Effect::Ao, "rt");
@@ -275,11 +287,24 @@ fn set(t: &mut Techniques, effect: Effect, name: &str) {
 }
 
 /// The techniques effect charts hold fixed: raster G-buffer, shadow maps where the file has
-/// them (else none), every other effect off, accumulation on.
+/// them (else none), every other effect off (the emissive surfaces' direct light too),
+/// accumulation on.
 pub fn fixed(offers: &Offers) -> Techniques {
     let mut t = Techniques::default();
     set(&mut t, Effect::Shadows, if offers.shadow_maps { "shadowmap" } else { "none" });
+    set(&mut t, Effect::Direct, "none");
     set(&mut t, Effect::Aa, "accumulate");
+    t
+}
+
+/// What an effect's chart holds fixed: [`fixed`], except that the chart of the emissive
+/// surfaces' direct light traces their shadow rays (`--shadows none` would leave them
+/// unshadowed).
+fn fixed_for(effect: Effect, offers: &Offers) -> Techniques {
+    let mut t = fixed(offers);
+    if effect == Effect::Direct && offers.bvh {
+        set(&mut t, Effect::Shadows, "rt");
+    }
     t
 }
 
@@ -325,8 +350,12 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                     if !request.wants(target, info.name) {
                         continue;
                     }
+                    if effect == Effect::Direct && info.name != "none" && !offers.emission {
+                        push_skip(&mut skipped, target, info.name, "nothing in the file emits light");
+                        continue;
+                    }
                     for combo in knob_combinations(info) {
-                        let mut t = fixed;
+                        let mut t = fixed_for(effect, offers);
                         let knobs: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
                         t.set(effect, info.name, &knobs).expect("catalogue values are valid");
                         if let Some(reason) = offers.lacks(&t) {
@@ -352,6 +381,10 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                         let mut t = Techniques::default();
                         set(&mut t, Effect::Aa, "accumulate");
                         set(&mut t, Effect::GBuffer, gbuffer.name);
+                        if !offers.emission {
+                            // What a session does with such a file: nothing to sample.
+                            set(&mut t, Effect::Direct, "none");
+                        }
                         apply(&mut t);
                         if let Some(reason) = offers.lacks(&t) {
                             push_skip(&mut skipped, target, name, &reason);
@@ -410,8 +443,14 @@ mod tests {
         }
     }
 
-    const ALL_OFFERED: Offers =
-        Offers { bvh: true, shadow_maps: true, line_space: Variants::ALL, media: true };
+    const ALL_OFFERED: Offers = Offers {
+        bvh: true,
+        shadow_maps: true,
+        line_space: Variants::ALL,
+        media: true,
+        emission: true,
+        lights: true,
+    };
 
     #[test]
     fn every_catalogue_technique_of_an_effect_is_swept() {
@@ -444,7 +483,14 @@ mod tests {
     fn missing_sections_skip_with_a_reason() {
         let p = plan(
             &request(Target::ALL.to_vec(), &[]),
-            &Offers { bvh: false, shadow_maps: false, line_space: 0, media: false },
+            &Offers {
+                bvh: false,
+                shadow_maps: false,
+                line_space: 0,
+                media: false,
+                emission: false,
+                lights: true,
+            },
         );
         assert!(
             p.configs
@@ -457,7 +503,14 @@ mod tests {
         assert!(p.skipped.iter().any(|s| s.technique == "shadowmap" && s.reason.contains("shadow maps")));
         assert!(p.skipped.iter().any(|s| s.technique == "march" && s.reason.contains("[[medium]]")));
         // With the BVH but no line space, the feelers are skipped, naming the variant they need.
-        let offers = Offers { bvh: true, shadow_maps: true, line_space: 0, media: false };
+        let offers = Offers {
+            bvh: true,
+            shadow_maps: true,
+            line_space: 0,
+            media: false,
+            emission: false,
+            lights: true,
+        };
         let p = plan(&request(vec![Target::Effect(Effect::Shadows)], &[]), &offers);
         assert!(
             p.skipped

@@ -9,7 +9,7 @@ use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, ao, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared, ao, rt_direct, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -39,7 +39,7 @@ pub enum SpecInput {
 
 /// The inputs of `direct.comp`'s specialization constants, by id from 1 (`DIRECT_*` there; each
 /// a bool defaulting to true, so that a pipeline made without constants has every path).
-pub const SPEC_INPUTS: [(SpecInput, &str); 7] = [
+pub const SPEC_INPUTS: [(SpecInput, &str); 8] = [
     (SpecInput::Flag(FrameFlags::RT_SHADOWS), "DIRECT_RT_SHADOWS"),
     (SpecInput::Flag(FrameFlags::RT_AO), "DIRECT_AO"),
     (SpecInput::Flag(FrameFlags::RT_REFLECTIONS), "DIRECT_RT_REFLECTIONS"),
@@ -47,13 +47,15 @@ pub const SPEC_INPUTS: [(SpecInput, &str); 7] = [
     (SpecInput::Flag(FrameFlags::SCREEN_REFLECTIONS), "DIRECT_SCREEN_REFLECTIONS"),
     (SpecInput::Media, "DIRECT_MEDIA"),
     (SpecInput::RectLights, "DIRECT_RECT_LIGHTS"),
+    (SpecInput::Flag(FrameFlags::RT_DIRECT), "DIRECT_EMISSIVE"),
 ];
 
 /// The G-buffer targets it samples, in binding order (6–10).
 const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
 
-/// The ray-traced results it composites, in binding order (12–15).
-const RAY_TRACED: [TargetDecl; 4] = [rt_shadows::SHADOWS, ao::AO, rt_reflections::REFLECTIONS, rt_gi::GI];
+/// The ray-traced results it composites, in binding order (12–15, then 17).
+const RAY_TRACED: [TargetDecl; 5] =
+    [rt_shadows::SHADOWS, ao::AO, rt_reflections::REFLECTIONS, rt_gi::GI, rt_direct::DIRECT];
 
 /// The direct-light pass.
 #[derive(Debug)]
@@ -97,6 +99,7 @@ impl DirectPass {
         bindings.extend([Binding::one(Sampled); 5]);
         bindings.extend([Binding::one(StorageImage); 5]);
         bindings.push(Binding::one(Storage));
+        bindings.push(Binding::one(StorageImage));
         bindings
     }
 }
@@ -133,7 +136,9 @@ impl Pass for DirectPass {
         }
         writes.push(Write::StorageImage(11, img(&RADIANCE)));
         for (i, t) in RAY_TRACED.iter().enumerate() {
-            writes.push(Write::StorageImage(12 + i as u32, img(t)));
+            // The media table sits between GI (15) and the direct light of emitters (17).
+            let binding = if i < 4 { 12 + i as u32 } else { 17 };
+            writes.push(Write::StorageImage(binding, img(t)));
         }
         // The media table when a media technique uploaded it (the frame constants then count
         // its entries), else any storage buffer: no entry is read.
@@ -174,7 +179,8 @@ mod tests {
     }
 
     /// Each input's constant is on exactly when the frame may need it: every flag a set of
-    /// techniques can raise keeps its code, and the default techniques keep only the shadow maps.
+    /// techniques can raise keeps its code, and the default techniques keep only the shadow maps and
+    /// the emissive triangles' light.
     #[test]
     fn constants_follow_the_flags_media_and_rect_lights() {
         let all = FrameFlags::RT_SHADOWS
@@ -183,12 +189,18 @@ mod tests {
             | FrameFlags::REFLECTIONS_HALF
             | FrameFlags::RT_GI
             | FrameFlags::SCREEN_GI
-            | FrameFlags::SCREEN_REFLECTIONS;
-        assert_eq!(DirectPass::constants(all, true, true), [0, 1, 1, 1, 1, 1, 1, 1]);
-        assert_eq!(DirectPass::constants(0, false, false), [0; 8]);
-        assert_eq!(DirectPass::constants(FrameFlags::SCREEN_GI, false, true), [0, 0, 0, 0, 1, 0, 0, 1]);
-        assert_eq!(DirectPass::constants(FrameFlags::RT_GI, true, false), [0, 0, 0, 0, 1, 0, 1, 0]);
+            | FrameFlags::SCREEN_REFLECTIONS
+            | FrameFlags::RT_DIRECT;
+        assert_eq!(DirectPass::constants(all, true, true), [0, 1, 1, 1, 1, 1, 1, 1, 1]);
+        assert_eq!(DirectPass::constants(0, false, false), [0; 9]);
+        assert_eq!(DirectPass::constants(FrameFlags::SCREEN_GI, false, true), [0, 0, 0, 0, 1, 0, 0, 1, 0]);
+        assert_eq!(DirectPass::constants(FrameFlags::RT_GI, true, false), [0, 0, 0, 0, 1, 0, 1, 0, 0]);
+        assert_eq!(DirectPass::constants(FrameFlags::RT_DIRECT, false, false), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
         let defaults = Techniques::default().flags();
-        assert_eq!(DirectPass::constants(defaults, false, false), [0; 8], "default flags {defaults:#x}");
+        assert_eq!(
+            DirectPass::constants(defaults, false, false),
+            [0, 0, 0, 0, 0, 0, 0, 0, 1],
+            "default flags {defaults:#x}"
+        );
     }
 }

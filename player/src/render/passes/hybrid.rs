@@ -1,14 +1,15 @@
 //! The binding table every ray-traced pass of the hybrid pipeline shares
 //! (`shaders/rt/hybrid.glsl`): the frame constants, the scene as the traversal and shading read
 //! it, the G-buffer, every ray-traced target (those of passes that are off are 1 × 1
-//! placeholders), and the emitter table of next-event estimation. Each pass has its own set of
+//! placeholders), the emitter table of next-event estimation and the emissive triangles' table of
+//! the direct light of emissive surfaces. Each pass has its own set of
 //! this layout.
 
 use crate::gpu::vk;
 use kiln_format::gpu::RtConstants;
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
-use super::{FrameCtx, Shared, ao, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Shared, ao, rt_direct, rt_gi, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::TexelDecode;
@@ -17,7 +18,7 @@ use crate::scene::bindings as scene_bindings;
 use crate::scene::linespace::LineSpaceBuffers;
 
 /// The first of the line space's bindings (`LS_BINDING` in the line-space kernels).
-pub const LINE_SPACE_BINDING: u32 = 25;
+pub const LINE_SPACE_BINDING: u32 = 30;
 
 /// The G-buffer targets the ray-traced passes sample.
 pub const GBUFFER_READS: [TargetDecl; 4] = [TRIANGLE, NORMAL, ALBEDO, MATERIAL];
@@ -28,6 +29,7 @@ pub fn bound() -> Vec<TargetDecl> {
     t.extend([rt_shadows::SHADOWS, ao::AO]);
     t.extend(rt_reflections::TARGETS);
     t.push(rt_gi::GI);
+    t.extend(rt_direct::TARGETS);
     t
 }
 
@@ -55,6 +57,8 @@ impl HybridSet {
         bindings.extend([Binding::one(StorageImage); 6]);
         bindings.extend([Binding::one(Storage); 2]);
         bindings.push(Binding::one(StorageImage));
+        bindings.push(Binding::one(Storage));
+        bindings.extend([Binding::one(StorageImage); 4]);
         debug_assert_eq!(bindings.len() as u32, LINE_SPACE_BINDING);
         if line_space {
             bindings.extend(LineSpaceBuffers::bindings());
@@ -114,7 +118,11 @@ impl HybridSet {
             Write::Buffer(22, &r.emitters),
             Write::Buffer(23, &r.triangle_emitter),
             Write::StorageImage(24, img(&rt_gi::GI)),
+            Write::Buffer(25, &r.emissive),
         ]);
+        for (i, t) in rt_direct::TARGETS.iter().enumerate() {
+            writes.push(Write::StorageImage(26 + i as u32, img(t)));
+        }
         if self.line_space {
             let ls = scene.line_space.as_ref().ok_or_else(|| {
                 PlayError::new(Exit::Gpu, "a line-space pass is bound to a scene without its line space")

@@ -22,6 +22,7 @@ pub mod mitchell;
 pub mod pathtrace;
 pub mod resolve;
 pub mod rt_ao;
+pub mod rt_direct;
 pub mod rt_gi;
 pub mod rt_history;
 pub mod rt_reflections;

@@ -19,6 +19,7 @@ pub mod knobs;
 
 pub mod aa;
 pub mod ao;
+pub mod direct;
 pub mod gbuffer;
 pub mod gi;
 pub mod media;
@@ -27,6 +28,7 @@ pub mod shadows;
 
 pub use aa::Aa;
 pub use ao::Ao;
+pub use direct::Direct;
 pub use gbuffer::GBuffer;
 pub use gi::Gi;
 pub use knobs::{Knob, KnobRange, KnobRole, KnobValue, Knobs};
@@ -161,6 +163,7 @@ impl RayInputs {
                 ao_radius: (0.1 * scene.diagonal).max(1e-6),
                 max_roughness: 1.0,
                 reflection_step: 1,
+                direct_visibility: 1,
                 ..Default::default()
             },
             light_radius: 0.0,
@@ -228,8 +231,11 @@ macro_rules! techniques {
         }
 
         impl Default for $enum {
+            /// The default technique at its knobs' defaults.
             fn default() -> $enum {
-                $enum::$dty($dmod::$dty)
+                use $crate::render::techniques::{Knobs, Registered};
+                let knobs = Knobs::defaults(String::new(), <$dmod::$dty as Registered>::KNOBS);
+                $enum::$dty(<$dmod::$dty as Registered>::new(&knobs).expect("a technique builds at its defaults"))
             }
         }
     };
@@ -263,6 +269,8 @@ pub struct Techniques {
     pub gbuffer: GBuffer,
     /// Shadows.
     pub shadows: Shadows,
+    /// Direct light of emissive surfaces.
+    pub direct: Direct,
     /// Ambient occlusion.
     pub ao: Ao,
     /// Reflections.
@@ -382,6 +390,7 @@ impl Techniques {
         match effect {
             Effect::GBuffer => self.gbuffer.technique(),
             Effect::Shadows => self.shadows.technique(),
+            Effect::Direct => self.direct.technique(),
             Effect::Ao => self.ao.technique(),
             Effect::Reflections => self.reflections.technique(),
             Effect::Gi => self.gi.technique(),
@@ -395,6 +404,7 @@ impl Techniques {
         match effect {
             Effect::GBuffer => self.gbuffer.name(),
             Effect::Shadows => self.shadows.name(),
+            Effect::Direct => self.direct.name(),
             Effect::Ao => self.ao.name(),
             Effect::Reflections => self.reflections.name(),
             Effect::Gi => self.gi.name(),
@@ -534,6 +544,7 @@ impl Techniques {
         match effect {
             Effect::GBuffer => self.gbuffer = built(GBuffer::build(name, &values))?,
             Effect::Shadows => self.shadows = built(Shadows::build(name, &values))?,
+            Effect::Direct => self.direct = built(Direct::build(name, &values))?,
             Effect::Ao => self.ao = built(Ao::build(name, &values))?,
             Effect::Reflections => self.reflections = built(Reflections::build(name, &values))?,
             Effect::Gi => self.gi = built(Gi::build(name, &values))?,
@@ -551,6 +562,8 @@ pub enum Effect {
     GBuffer,
     /// Shadows of analytic lights.
     Shadows,
+    /// Direct light of emissive surfaces.
+    Direct,
     /// Ambient occlusion.
     Ao,
     /// Specular reflections.
@@ -565,9 +578,10 @@ pub enum Effect {
 
 impl Effect {
     /// Every effect, in frame order.
-    pub const ALL: [Effect; 7] = [
+    pub const ALL: [Effect; 8] = [
         Effect::GBuffer,
         Effect::Shadows,
+        Effect::Direct,
         Effect::Ao,
         Effect::Reflections,
         Effect::Gi,
@@ -580,6 +594,7 @@ impl Effect {
         match self {
             Effect::GBuffer => "gbuffer",
             Effect::Shadows => "shadows",
+            Effect::Direct => "direct",
             Effect::Ao => "ao",
             Effect::Reflections => "reflections",
             Effect::Gi => "gi",
@@ -593,6 +608,7 @@ impl Effect {
         match self {
             Effect::GBuffer => "G-buffer",
             Effect::Shadows => "Shadows",
+            Effect::Direct => "Direct light of emissive surfaces",
             Effect::Ao => "Ambient occlusion",
             Effect::Reflections => "Reflections",
             Effect::Gi => "Global illumination",
@@ -606,6 +622,7 @@ impl Effect {
         match self {
             Effect::GBuffer => GBuffer::catalogue(),
             Effect::Shadows => Shadows::catalogue(),
+            Effect::Direct => Direct::catalogue(),
             Effect::Ao => Ao::catalogue(),
             Effect::Reflections => Reflections::catalogue(),
             Effect::Gi => Gi::catalogue(),

@@ -1,0 +1,259 @@
+//! Emissive surfaces as lights (`--direct ris|restir`), against closed forms computed here:
+//! - a quad of two emissive triangles over a diffuse floor: every floor pixel against the
+//!   polygon (Lambert) irradiance of the quad;
+//! - the same quad with an emissive texture whose right half is black: the irradiance of the
+//!   left half alone;
+//! - a white furnace, a closed box whose walls emit Le and reflect ρ: the direct light alone is
+//!   Le (1 + ρ) everywhere, and with `--gi rt` of b bounces Le (1 + ρ + … + ρ^(b+1)): a lamp
+//!   counted twice (by the GI pass's first rays and by the direct light) or missed shows there.
+//!
+//! The irradiance at p (normal +y) from a polygon of radiance L, its corners aᵢ seen from p as
+//! unit vectors, is E = L/2 · |Σᵢ angle(aᵢ, aᵢ₊₁) · (normalize(aᵢ × aᵢ₊₁))·y| while the whole
+//! polygon is above p's horizon, and the floor shows albedo/π · E.
+
+use glam::{DVec3, Vec3};
+use kiln_compiler::import::demo::lambert_material;
+use kiln_compiler::ir::{Material, Scene, Texture, TextureRole};
+use kiln_format::manifest::{Sky, Wrap};
+use kiln_format::sections::MaterialFlags;
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile, scene_of};
+
+use crate::harness::{
+    ALBEDO, H, Pinhole, W, albedo, compare_plane, fast_settings, floor_pixels, ratio_stats, render_frames,
+    square, srgb8,
+};
+
+/// Per-pixel tolerance: the G-buffer's 1 % (lavapipe's approximate sRGB decode) and the
+/// estimator's noise after the frames averaged (measured below 0.4 % at 256 frames).
+const TOLERANCE: f64 = 0.015;
+
+/// The emissive quad: 1 × 0.6 at height 2, tilted 22° towards +x, emitting downwards.
+struct Quad {
+    centre: DVec3,
+    facing: DVec3,
+    right: DVec3,
+    up: DVec3,
+    width: f64,
+    height: f64,
+    radiance: f64,
+}
+
+impl Quad {
+    fn new() -> Quad {
+        let facing = DVec3::new(0.4, -1.0, 0.0).normalize();
+        let right = DVec3::Z;
+        Quad {
+            centre: DVec3::new(0.5, 2.0, -0.3),
+            facing,
+            right,
+            up: facing.cross(right),
+            width: 1.0,
+            height: 0.6,
+            radiance: 4.0,
+        }
+    }
+
+    /// The point at (s, t) ∈ [0, 1]².
+    fn at(&self, s: f64, t: f64) -> DVec3 {
+        self.centre + self.right * ((s - 0.5) * self.width) + self.up * ((t - 0.5) * self.height)
+    }
+
+    /// The part s ∈ [0, s_max] as two triangles wound so that their normal is `facing`, with
+    /// each corner's (s, t).
+    fn triangles(&self, s_max: f64) -> ([[Vec3; 3]; 2], [[[f32; 2]; 3]; 2]) {
+        let st = [(0.0, 0.0), (s_max, 0.0), (s_max, 1.0), (0.0, 1.0)];
+        let p = st.map(|(s, t)| self.at(s, t).as_vec3());
+        let uv = st.map(|(s, t)| [s as f32, t as f32]);
+        let mut tris = [[p[0], p[1], p[2]], [p[0], p[2], p[3]]];
+        let mut uvs = [[uv[0], uv[1], uv[2]], [uv[0], uv[2], uv[3]]];
+        let n = (tris[0][1] - tris[0][0]).cross(tris[0][2] - tris[0][0]);
+        if n.as_dvec3().dot(self.facing) < 0.0 {
+            for (t, u) in tris.iter_mut().zip(&mut uvs) {
+                t.swap(1, 2);
+                u.swap(1, 2);
+            }
+        }
+        (tris, uvs)
+    }
+
+    /// The closed-form irradiance at p (normal +y) from the part s ∈ [0, s_max].
+    fn irradiance(&self, p: DVec3, s_max: f64) -> f64 {
+        let corners = [self.at(0.0, 0.0), self.at(s_max, 0.0), self.at(s_max, 1.0), self.at(0.0, 1.0)];
+        let a = corners.map(|q| (q - p).normalize());
+        let mut sum = 0.0;
+        for i in 0..4 {
+            let (u, v) = (a[i], a[(i + 1) % 4]);
+            sum += u.dot(v).clamp(-1.0, 1.0).acos() * u.cross(v).normalize().y;
+        }
+        self.radiance / 2.0 * sum.abs()
+    }
+
+    /// Whether p sees the emitting side, with a margin.
+    fn in_front(&self, p: DVec3) -> bool {
+        (p - self.centre).dot(self.facing) > 0.3
+    }
+
+    /// Whether the ray o + t d (t > 0) passes within `margin` of the quad (the camera sees it
+    /// rather than the floor).
+    fn crossed_by(&self, o: DVec3, d: DVec3, margin: f64) -> bool {
+        let denom = d.dot(self.facing);
+        let t = (self.centre - o).dot(self.facing) / denom;
+        let q = o + d * t - self.centre;
+        denom != 0.0
+            && t > 0.0
+            && q.dot(self.right).abs() <= 0.5 * self.width + margin
+            && q.dot(self.up).abs() <= 0.5 * self.height + margin
+    }
+}
+
+fn camera() -> Pinhole {
+    Pinhole::new([2.0, 7.0, 6.0], [0.5, 0.0, -0.5], [0.0, 1.0, 0.0], 60.0, W, H)
+}
+
+/// A floor of the analytic albedo under the quad's part s ∈ [0, s_max], or with `textured` the
+/// whole quad with an emissive texture black on its right half.
+fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
+    let quad = Quad::new();
+    let (lamp, lamp_uv) = quad.triangles(if textured { 1.0 } else { s_max });
+    let mut tris = square(0.0, 10.0).to_vec();
+    tris.extend(lamp);
+    let mut scene = scene_of(&tris);
+    scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
+    let mut glow = lambert_material([0.0; 3]);
+    glow.emission = [quad.radiance as f32; 3];
+    if textured {
+        // Two texels, nearest: white on the left (u < 0.5), black on the right.
+        scene.textures.push(Texture {
+            name: "half".into(),
+            width: 2,
+            height: 1,
+            rgba: vec![255, 255, 255, 255, 0, 0, 0, 255],
+            role: TextureRole::Color,
+            wrap_u: Wrap::ClampToEdge,
+            wrap_v: Wrap::ClampToEdge,
+            mag_linear: false,
+        });
+        glow.emissive_texture = 0;
+        let mut uvs = vec![[0.0f32; 2]; 6];
+        uvs.extend(lamp_uv.iter().flatten());
+        scene.uvs = uvs;
+    }
+    scene.materials.push(Material { name: "lamp".into(), gpu: glow });
+    let n = scene.triangle_materials.len();
+    scene.triangle_materials[n - 2..].fill(1);
+    scene.sky = Sky { radiance: [0.0; 3] };
+    scene.cameras.push(cam.file_camera());
+    compile(scene, fast_settings())
+}
+
+/// Renders `frames` frames of `options` and compares every floor pixel in front of the quad
+/// (and not hidden by it) with the polygon irradiance of its part s ∈ [0, lit].
+fn check_quad(name: &str, bytes: &[u8], lit: f64, frames: u32, options: impl Fn(Options) -> Options) {
+    let dir = gpu_test!();
+    let cam = camera();
+    let quad = Quad::new();
+    let (rgb, _) = render_frames(dir.path(), name, bytes, frames, |f| options(Options::new(f, W, H)));
+    let a = albedo();
+    let expected = |p: DVec3| a.map(|k| k / std::f64::consts::PI * quad.irradiance(p, lit));
+    let keep = |p: DVec3, d: DVec3| quad.in_front(p) && !quad.crossed_by(cam.eye, d, 0.05);
+    let pixels: Vec<_> = floor_pixels(&cam, 9.5).into_iter().filter(|&(_, p, d)| keep(p, d)).collect();
+    let (mean, spread) = ratio_stats(&rgb, &pixels, |p, _| expected(p)[0]);
+    eprintln!("{name}: mean ratio to the closed form {mean:.5}, spread {spread:.5}");
+    let n = compare_plane(&rgb, &cam, 9.5, keep, expected, TOLERANCE);
+    assert!(n > (W * H / 2) as usize, "{name}: only {n} pixels compared");
+}
+
+#[test]
+fn emissive_quad_lights_a_diffuse_floor_by_the_polygon_irradiance_with_ris() {
+    let cam = camera();
+    check_quad("quad-ris", &quad_scene(&cam, 1.0, false), 1.0, 256, |o| o.rt_shadows(0.0, 0.0).ris(32));
+}
+
+#[test]
+fn emissive_quad_lights_a_diffuse_floor_by_the_polygon_irradiance_with_restir() {
+    let cam = camera();
+    check_quad("quad-restir", &quad_scene(&cam, 1.0, false), 1.0, 256, |o| {
+        o.rt_shadows(0.0, 0.0).restir(32, 4, 20)
+    });
+}
+
+#[test]
+fn an_emissive_texture_with_a_dark_half_lights_the_floor_from_its_bright_half() {
+    let cam = camera();
+    check_quad("quad-textured", &quad_scene(&cam, 1.0, true), 0.5, 256, |o| {
+        o.rt_shadows(0.0, 0.0).restir(32, 4, 20)
+    });
+}
+
+/// A closed box (the cube |x|, |y|, |z| ≤ 1) whose walls emit `le` from both sides and reflect
+/// `rho` (Lambert), seen from inside.
+fn furnace(le: f32, rho: f32) -> Vec<u8> {
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let face = square(0.0, 1.0).map(|t| {
+                t.map(|p| {
+                    // The square y = 0 moved to the face `axis` = sign.
+                    let q = Vec3::new(p.x, sign, p.z);
+                    match axis {
+                        0 => Vec3::new(q.y, q.x, q.z),
+                        1 => q,
+                        _ => Vec3::new(q.x, q.z, q.y),
+                    }
+                })
+            });
+            tris.extend(face);
+        }
+    }
+    let mut scene: Scene = scene_of(&tris);
+    let mut m = lambert_material([rho; 3]);
+    m.emission = [le; 3];
+    m.flags |= MaterialFlags::DOUBLE_SIDED;
+    scene.materials[0].gpu = m;
+    scene.sky = Sky { radiance: [0.0; 3] };
+    let cam = Pinhole::new([0.1, -0.2, 0.15], [-1.0, 0.4, -0.7], [0.0, 1.0, 0.0], 70.0, W, H);
+    scene.cameras.push(cam.file_camera());
+    compile(scene, fast_settings())
+}
+
+/// The mean over the image (every pixel shows a wall) and the 95th percentile of the pixels'
+/// relative errors (area sampling's 1/d² makes rare fireflies where walls meet).
+fn image_mean(rgb: &[f32], expected: f64) -> (f64, f64) {
+    let mean = rgb.iter().map(|&v| v as f64).sum::<f64>() / rgb.len() as f64;
+    let mut errors: Vec<f64> = rgb.iter().map(|&v| (v as f64 / expected - 1.0).abs()).collect();
+    errors.sort_by(f64::total_cmp);
+    (mean, errors[errors.len() * 95 / 100])
+}
+
+#[test]
+fn a_white_furnace_converges_to_the_geometric_series_of_its_bounces() {
+    let dir = gpu_test!();
+    // ρ an sRGB code's value: the G-buffer stores it exactly. The image mean must
+    // hold within 1 %: a lamp counted twice by GI and the direct light adds ρ² Le (13 %), a
+    // missing cosine at the emitter or Jacobian more. Pixels are noisy where walls meet (area
+    // sampling's 1/d²): 95 % of them within 10 %.
+    let (le, rho) = (1.0f32, srgb8(188));
+    let bytes = furnace(le, rho);
+    let series = |terms: u32| (0..terms).map(|k| (rho as f64).powi(k as i32)).sum::<f64>() * le as f64;
+    // The direct light alone: the emission seen plus one reflection of the emitting walls.
+    let (rgb, _) = render_frames(dir.path(), "furnace-direct", &bytes, 64, |f| {
+        Options::new(f, W, H).rt_shadows(0.0, 0.0).restir(32, 4, 20)
+    });
+    let (mean, worst) = image_mean(&rgb, series(2));
+    eprintln!("direct: mean {mean:.5} (expected {:.5}), 95th percentile {:.3}%", series(2), worst * 100.0);
+    assert!((mean / series(2) - 1.0).abs() < 0.01, "direct light: mean {mean}, expected {}", series(2));
+    assert!(worst < 0.1, "direct light: 5 % of the pixels are over {:.2}% off", worst * 100.0);
+    // Direct light plus GI of two bounces: four terms after the emission.
+    let (rgb, _) = render_frames(dir.path(), "furnace-gi", &bytes, 64, |f| {
+        Options::new(f, W, H).rt_shadows(0.0, 0.0).restir(32, 4, 20).rt_gi(2)
+    });
+    let (mean, worst) = image_mean(&rgb, series(4));
+    eprintln!(
+        "direct + GI 2: mean {mean:.5} (expected {:.5}), 95th percentile {:.3}%",
+        series(4),
+        worst * 100.0
+    );
+    assert!((mean / series(4) - 1.0).abs() < 0.01, "direct + GI: mean {mean}, expected {}", series(4));
+    assert!(worst < 0.1, "direct + GI: 5 % of the pixels are over {:.2}% off", worst * 100.0);
+}
