@@ -24,7 +24,8 @@ pub const CANDIDATES: Knob = whole(number(
     1.0,
     64.0,
     8.0,
-    &[4.0, 16.0],
+    // 1: plain next-event estimation, the many-light baseline.
+    &[1.0, 4.0, 16.0],
 ));
 
 /// The `Technique` methods the direct-light techniques share (their settings' `candidates`,

@@ -12,7 +12,7 @@ pub const SPATIAL: Knob = whole(number(
     "direct-spatial",
     "neighbours' reservoirs each pixel joins (spatial reuse; 0: none)",
     0.0,
-    16.0,
+    8.0,
     4.0,
     &[0.0, 4.0],
 ));
