@@ -318,3 +318,22 @@ fn line_space_device_is_reported_and_gpu_without_one_is_an_error() {
     }
     kiln(dir.path(), &["demo", "-q", "--line-space-device", "tpu"]).expect(2);
 }
+
+#[test]
+fn plan_names_the_emitter_table_with_its_total_power() {
+    let dir = tempfile::tempdir().unwrap();
+    // One emissive quad, 1 × 0.5 (two triangles), Ke 2 0.5 1, over a grey one: the power is
+    // π · luminance · area = π · (0.2126·2 + 0.7152·0.5 + 0.0722·1) · 0.5.
+    let mtl = "newmtl lamp\nKd 0 0 0\nKe 2 0.5 1\n\nnewmtl grey\nKd 0.5 0.5 0.5\n";
+    let obj = "mtllib lamp.mtl\nv 0 1 0\nv 1 1 0\nv 1 1 0.5\nv 0 1 0.5\nv 0 0 0\nv 3 0 0\nv 0 0 3\n\
+               usemtl lamp\nf 1 2 3\nf 1 3 4\nusemtl grey\nf 5 6 7\n";
+    std::fs::write(dir.path().join("lamp.mtl"), mtl).unwrap();
+    std::fs::write(dir.path().join("lamp.obj"), obj).unwrap();
+    let power = std::f64::consts::PI * (0.2126 * 2.0 + 0.7152 * 0.5 + 0.0722 * 1.0) * 0.5;
+    let plan = kiln(dir.path(), &["plan", "lamp.obj"]);
+    let expected = format!("2 emissive triangles of 1 material, total power {power:.4}");
+    assert!(plan.expect(0).stdout.contains(&expected), "{expected:?} not in {}", plan.stdout);
+    std::fs::write(dir.path().join("dark.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let plan = kiln(dir.path(), &["plan", "dark.obj"]);
+    assert!(plan.expect(0).stdout.contains("no emissive triangles"), "{}", plan.stdout);
+}

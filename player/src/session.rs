@@ -241,11 +241,6 @@ impl Plan {
         let has_bvh = file.find(sections::BVH_NODES, 0).is_some_and(|s| s.entry.raw_size > 0);
         let mut warnings = Vec::new();
         let mut render = *render;
-        if !has_emission(file)? {
-            // Nothing emits: the direct light of emissive surfaces would sample nothing, and its
-            // passes (and their pipelines) are skipped.
-            render.techniques.set(Effect::Direct, "none", &[]).map_err(|e| PlayError::new(Exit::Usage, e))?;
-        }
         if render.techniques.ray_traced() && !has_bvh {
             warnings.push("the ray-traced passes are off: the file has no BVH".to_string());
             render.techniques = render.techniques.without_rays();
@@ -293,6 +288,11 @@ impl Session {
         let file = open_file(&options.file)?;
         times.open_file_ms = ms(t);
         let mut render = options.render;
+        if !has_emission(&file)? {
+            // Nothing emits: the direct light of emissive surfaces would sample nothing; its
+            // passes, their pipelines and the sections only they read (the BVH) are skipped.
+            render.techniques.set(Effect::Direct, "none", &[]).map_err(|e| PlayError::new(Exit::Usage, e))?;
+        }
         let progressive = options.pipelines == PipelineStart::Progressive;
         // The fallback's sections are uploaded too (the shadow maps that stand in for
         // ray-traced shadows); whether the file has maps is known once it is validated.

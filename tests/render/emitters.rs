@@ -23,52 +23,31 @@ use crate::harness::{
     ALBEDO, H, Pinhole, W, albedo, compare_plane, fast_settings, floor_pixels, ratio_stats, render_frames,
     square, srgb8,
 };
+use crate::rect::Rect;
 
 /// Per-pixel tolerance: the G-buffer's 1 % (lavapipe's approximate sRGB decode) and the
 /// estimator's noise after the frames averaged (measured below 0.4 % at 256 frames).
 const TOLERANCE: f64 = 0.015;
 
-/// The emissive quad: 1 × 0.6 at height 2, tilted 22° towards +x, emitting downwards.
-struct Quad {
-    centre: DVec3,
-    facing: DVec3,
-    right: DVec3,
-    up: DVec3,
-    width: f64,
-    height: f64,
-    radiance: f64,
-}
+/// The emissive quad: the rect light of `rect.rs` (1 × 0.6 at height 2, tilted 22° towards +x,
+/// radiance 4) made of two emissive triangles, emitting downwards.
+struct Quad(Rect);
 
 impl Quad {
     fn new() -> Quad {
-        let facing = DVec3::new(0.4, -1.0, 0.0).normalize();
-        let right = DVec3::Z;
-        Quad {
-            centre: DVec3::new(0.5, 2.0, -0.3),
-            facing,
-            right,
-            up: facing.cross(right),
-            width: 1.0,
-            height: 0.6,
-            radiance: 4.0,
-        }
-    }
-
-    /// The point at (s, t) ∈ [0, 1]².
-    fn at(&self, s: f64, t: f64) -> DVec3 {
-        self.centre + self.right * ((s - 0.5) * self.width) + self.up * ((t - 0.5) * self.height)
+        Quad(Rect::new())
     }
 
     /// The part s ∈ [0, s_max] as two triangles wound so that their normal is `facing`, with
     /// each corner's (s, t).
     fn triangles(&self, s_max: f64) -> ([[Vec3; 3]; 2], [[[f32; 2]; 3]; 2]) {
         let st = [(0.0, 0.0), (s_max, 0.0), (s_max, 1.0), (0.0, 1.0)];
-        let p = st.map(|(s, t)| self.at(s, t).as_vec3());
+        let p = st.map(|(s, t)| self.0.at(s, t).as_vec3());
         let uv = st.map(|(s, t)| [s as f32, t as f32]);
         let mut tris = [[p[0], p[1], p[2]], [p[0], p[2], p[3]]];
         let mut uvs = [[uv[0], uv[1], uv[2]], [uv[0], uv[2], uv[3]]];
         let n = (tris[0][1] - tris[0][0]).cross(tris[0][2] - tris[0][0]);
-        if n.as_dvec3().dot(self.facing) < 0.0 {
+        if n.as_dvec3().dot(self.0.facing) < 0.0 {
             for (t, u) in tris.iter_mut().zip(&mut uvs) {
                 t.swap(1, 2);
                 u.swap(1, 2);
@@ -77,33 +56,29 @@ impl Quad {
         (tris, uvs)
     }
 
-    /// The closed-form irradiance at p (normal +y) from the part s ∈ [0, s_max].
+    /// The closed-form irradiance at p (normal +y) from the part s ∈ [0, s_max] (the polygon
+    /// formula over that part's corners; `Rect::irradiance` is the whole).
     fn irradiance(&self, p: DVec3, s_max: f64) -> f64 {
-        let corners = [self.at(0.0, 0.0), self.at(s_max, 0.0), self.at(s_max, 1.0), self.at(0.0, 1.0)];
+        let r = &self.0;
+        let corners = [r.at(0.0, 0.0), r.at(s_max, 0.0), r.at(s_max, 1.0), r.at(0.0, 1.0)];
         let a = corners.map(|q| (q - p).normalize());
         let mut sum = 0.0;
         for i in 0..4 {
             let (u, v) = (a[i], a[(i + 1) % 4]);
             sum += u.dot(v).clamp(-1.0, 1.0).acos() * u.cross(v).normalize().y;
         }
-        self.radiance / 2.0 * sum.abs()
+        r.radiance / 2.0 * sum.abs()
     }
 
     /// Whether p sees the emitting side, with a margin.
     fn in_front(&self, p: DVec3) -> bool {
-        (p - self.centre).dot(self.facing) > 0.3
+        self.0.in_front(p)
     }
 
     /// Whether the ray o + t d (t > 0) passes within `margin` of the quad (the camera sees it
     /// rather than the floor).
     fn crossed_by(&self, o: DVec3, d: DVec3, margin: f64) -> bool {
-        let denom = d.dot(self.facing);
-        let t = (self.centre - o).dot(self.facing) / denom;
-        let q = o + d * t - self.centre;
-        denom != 0.0
-            && t > 0.0
-            && q.dot(self.right).abs() <= 0.5 * self.width + margin
-            && q.dot(self.up).abs() <= 0.5 * self.height + margin
+        self.0.crossing(o, d, margin).is_some()
     }
 }
 
@@ -121,14 +96,15 @@ fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
     let mut scene = scene_of(&tris);
     scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
     let mut glow = lambert_material([0.0; 3]);
-    glow.emission = [quad.radiance as f32; 3];
+    glow.emission = [quad.0.radiance as f32; 3];
     if textured {
-        // Two texels, nearest: white on the left (u < 0.5), black on the right.
+        // 64 texels: white on the left (u < 0.5), black on the right; filtered or not, the edge
+        // blurs over at most one texel (1/64 of the quad).
         scene.textures.push(Texture {
             name: "half".into(),
-            width: 2,
+            width: 64,
             height: 1,
-            rgba: vec![255, 255, 255, 255, 0, 0, 0, 255],
+            rgba: (0..64).flat_map(|x| if x < 32 { [255; 4] } else { [0, 0, 0, 255] }).collect(),
             role: TextureRole::Color,
             wrap_u: Wrap::ClampToEdge,
             wrap_v: Wrap::ClampToEdge,
@@ -149,7 +125,14 @@ fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
 
 /// Renders `frames` frames of `options` and compares every floor pixel in front of the quad
 /// (and not hidden by it) with the polygon irradiance of its part s ∈ [0, lit].
-fn check_quad(name: &str, bytes: &[u8], lit: f64, frames: u32, options: impl Fn(Options) -> Options) {
+fn check_quad(
+    name: &str,
+    bytes: &[u8],
+    lit: f64,
+    frames: u32,
+    tolerance: f64,
+    options: impl Fn(Options) -> Options,
+) {
     let dir = gpu_test!();
     let cam = camera();
     let quad = Quad::new();
@@ -160,20 +143,41 @@ fn check_quad(name: &str, bytes: &[u8], lit: f64, frames: u32, options: impl Fn(
     let pixels: Vec<_> = floor_pixels(&cam, 9.5).into_iter().filter(|&(_, p, d)| keep(p, d)).collect();
     let (mean, spread) = ratio_stats(&rgb, &pixels, |p, _| expected(p)[0]);
     eprintln!("{name}: mean ratio to the closed form {mean:.5}, spread {spread:.5}");
-    let n = compare_plane(&rgb, &cam, 9.5, keep, expected, TOLERANCE);
+    assert!((mean - 1.0).abs() < 0.005, "{name}: the floor's mean ratio to the closed form is {mean}");
+    // The mean over each 6 × 6 block of pixels within 1.5 %: a misplaced or missing part of
+    // the light shows there even where the per-pixel bound is loose.
+    for by in 0..H / 6 {
+        for bx in 0..W / 6 {
+            let block: Vec<_> = pixels
+                .iter()
+                .copied()
+                .filter(|&(i, _, _)| {
+                    let (x, y) = crate::harness::pixel_xy(i);
+                    (x / 6, y / 6) == (bx, by)
+                })
+                .collect();
+            if block.len() >= 18 {
+                let (m, _) = ratio_stats(&rgb, &block, |p, _| expected(p)[0]);
+                assert!((m - 1.0).abs() < 0.015, "{name}: block ({bx}, {by}) has the mean ratio {m}");
+            }
+        }
+    }
+    let n = compare_plane(&rgb, &cam, 9.5, keep, expected, tolerance);
     assert!(n > (W * H / 2) as usize, "{name}: only {n} pixels compared");
 }
 
 #[test]
 fn emissive_quad_lights_a_diffuse_floor_by_the_polygon_irradiance_with_ris() {
     let cam = camera();
-    check_quad("quad-ris", &quad_scene(&cam, 1.0, false), 1.0, 256, |o| o.rt_shadows(0.0, 0.0).ris(32));
+    check_quad("quad-ris", &quad_scene(&cam, 1.0, false), 1.0, 256, TOLERANCE, |o| {
+        o.rt_shadows(0.0, 0.0).ris(32)
+    });
 }
 
 #[test]
 fn emissive_quad_lights_a_diffuse_floor_by_the_polygon_irradiance_with_restir() {
     let cam = camera();
-    check_quad("quad-restir", &quad_scene(&cam, 1.0, false), 1.0, 256, |o| {
+    check_quad("quad-restir", &quad_scene(&cam, 1.0, false), 1.0, 256, TOLERANCE, |o| {
         o.rt_shadows(0.0, 0.0).restir(32, 4, 20)
     });
 }
@@ -181,8 +185,14 @@ fn emissive_quad_lights_a_diffuse_floor_by_the_polygon_irradiance_with_restir() 
 #[test]
 fn an_emissive_texture_with_a_dark_half_lights_the_floor_from_its_bright_half() {
     let cam = camera();
-    check_quad("quad-textured", &quad_scene(&cam, 1.0, true), 0.5, 256, |o| {
-        o.rt_shadows(0.0, 0.0).restir(32, 4, 20)
+    // Both triangles span the dark and the bright half, so no power table can tell them apart:
+    // of 32 candidates a binomial number lands on the bright half, and where the light is far
+    // (the target nearly flat over it) that count is the estimate: about 18 % per frame,
+    // measured 1.6 % per pixel at 128 frames with tails to 7 %, and no structure in the 6 × 6
+    // block means (within 0.9 %). So the blocks within 1.5 % and the floor's mean within 0.5 %
+    // judge it, each pixel only within 15 %; ignoring the texture doubles the light.
+    check_quad("quad-textured", &quad_scene(&cam, 1.0, true), 0.5, 128, 0.15, |o| {
+        o.rt_shadows(0.0, 0.0).ris(32)
     });
 }
 

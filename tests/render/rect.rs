@@ -25,19 +25,20 @@ use crate::harness::{
 /// closed form over a 0.5-unit grid of the floor), added to the G-buffer's 1 %.
 const DIRECT_TOLERANCE: f64 = TOLERANCE + 0.005;
 
-/// The light: a 1 × 0.6 rectangle at height 2, tilted 22° towards +x, radiance 4.
-struct Rect {
-    centre: DVec3,
-    facing: DVec3,
-    right: DVec3,
-    up: DVec3,
-    width: f64,
-    height: f64,
-    radiance: f64,
+/// The light: a 1 × 0.6 rectangle at height 2, tilted 22° towards +x, radiance 4 (also the
+/// emissive quad of `emitters.rs`).
+pub(crate) struct Rect {
+    pub(crate) centre: DVec3,
+    pub(crate) facing: DVec3,
+    pub(crate) right: DVec3,
+    pub(crate) up: DVec3,
+    pub(crate) width: f64,
+    pub(crate) height: f64,
+    pub(crate) radiance: f64,
 }
 
 impl Rect {
-    fn new() -> Rect {
+    pub(crate) fn new() -> Rect {
         let facing = DVec3::new(0.4, -1.0, 0.0).normalize();
         let right = DVec3::Z;
         Rect {
@@ -64,18 +65,18 @@ impl Rect {
     }
 
     /// The point at (s, t) ∈ [0, 1]² of the rectangle.
-    fn at(&self, s: f64, t: f64) -> DVec3 {
+    pub(crate) fn at(&self, s: f64, t: f64) -> DVec3 {
         self.centre + self.right * ((s - 0.5) * self.width) + self.up * ((t - 0.5) * self.height)
     }
 
     /// Whether p sees the emitting side (with a margin: the closed form and the midpoint rule
     /// both hold there).
-    fn in_front(&self, p: DVec3) -> bool {
+    pub(crate) fn in_front(&self, p: DVec3) -> bool {
         (p - self.centre).dot(self.facing) > 0.3
     }
 
     /// The closed-form irradiance at p on the floor (normal +y).
-    fn irradiance(&self, p: DVec3) -> f64 {
+    pub(crate) fn irradiance(&self, p: DVec3) -> f64 {
         let corners = [self.at(0.0, 0.0), self.at(1.0, 0.0), self.at(1.0, 1.0), self.at(0.0, 1.0)];
         let a = corners.map(|q| (q - p).normalize());
         let mut sum = 0.0;
@@ -88,7 +89,7 @@ impl Rect {
 
     /// Whether the ray o + t d (t > 0) crosses the rectangle grown by `margin` on every side
     /// (shrunk where negative), and if so whether from its emitting side (`Some(true)`).
-    fn crossing(&self, o: DVec3, d: DVec3, margin: f64) -> Option<bool> {
+    pub(crate) fn crossing(&self, o: DVec3, d: DVec3, margin: f64) -> Option<bool> {
         let denom = d.dot(self.facing);
         let t = (self.centre - o).dot(self.facing) / denom;
         let q = o + d * t - self.centre;

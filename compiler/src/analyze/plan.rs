@@ -77,12 +77,13 @@ fn emitters(scene: &Scene) -> String {
         }
     }
     if triangles == 0 {
-        return "no emissive triangles (nothing for kiln-play --direct to sample)".to_string();
+        return "no emissive triangles (the player's direct light of emissive surfaces has nothing to sample)".to_string();
     }
     let materials = used.iter().filter(|&&u| u).count();
     format!(
         "emitter table: {triangles} emissive triangles of {materials} material{}, total power {power:.4} (pi x \
-         luminance x area; {} KiB at load), read by kiln-play --direct ris|restir (the default) and --gi rt",
+         luminance x area; {} KiB at load), sampled by the player's direct light of emissive surfaces and its \
+         path tracers",
         if materials == 1 { "" } else { "s" },
         (triangles * 16).div_ceil(1024)
     )

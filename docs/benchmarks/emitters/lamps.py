@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""Writes a room lit only by N small emissive lamps: lamps.py N OUT_DIR.
+"""Writes a room lit only by N small emissive lamps: lamps.py N OUT_DIR [QUADS].
 
 The room is 12 x 4 x 12 (y up) with two boxes on the floor and a dividing wall; the lamps are
 0.08 x 0.08 quads facing down, scattered with a fixed seed over heights 2.2..3.9 and the whole
 floor plan, their radiance scaled so that the total emitted power is the same for every N: what
-changes with N is only how many emitters share it. Writes OUT_DIR/lamps-N.obj, .mtl and a
-sidecar lamps-N.toml with the camera.
+changes with N is only how many emitters share it. With QUADS (>= N), QUADS quads are placed and
+only the first N emit (the others are black): the geometry, and so the cost of every ray, is
+the same for every N. Writes OUT_DIR/lamps-N[-of-QUADS].obj, .mtl and a sidecar .toml with the
+camera.
 """
 import os
 import random
@@ -20,6 +22,8 @@ def quad(out, corners, material):
 def main():
     n = int(sys.argv[1])
     out_dir = sys.argv[2]
+    quads = int(sys.argv[3]) if len(sys.argv) > 3 else n
+    assert quads >= n, "QUADS must be at least N"
     os.makedirs(out_dir, exist_ok=True)
     rng = random.Random(41)
     vertices = []
@@ -53,21 +57,23 @@ def main():
     half = 0.04
     total_power = 400.0  # radiance x area x N, kept fixed
     radiance = total_power / (n * (2 * half) ** 2)
-    for i in range(n):
+    for i in range(quads):
         x = rng.uniform(-s + 0.2, s - 0.2)
         z = rng.uniform(-s + 0.2, s - 0.2)
         y = rng.uniform(2.2, 3.9)
         # Facing down: counter-clockwise seen from below.
         face([(x - half, y, z - half), (x + half, y, z - half), (x + half, y, z + half), (x - half, y, z + half)],
-             "lamp")
-    base = os.path.join(out_dir, f"lamps-{n}")
+             "lamp" if i < n else "dark")
+    stem = f"lamps-{n}" if quads == n else f"lamps-{n}-of-{quads}"
+    base = os.path.join(out_dir, stem)
     with open(base + ".mtl", "w") as f:
         for name, kd in [("floor", (0.7, 0.7, 0.7)), ("wall", (0.6, 0.6, 0.6)), ("red", (0.6, 0.1, 0.1)),
                          ("green", (0.1, 0.6, 0.1))]:
             f.write(f"newmtl {name}\nKd {kd[0]} {kd[1]} {kd[2]}\nKs 0 0 0\n\n")
-        f.write(f"newmtl lamp\nKd 0 0 0\nKs 0 0 0\nKe {radiance:.6g} {radiance * 0.9:.6g} {radiance * 0.75:.6g}\n")
+        f.write(f"newmtl lamp\nKd 0 0 0\nKs 0 0 0\nKe {radiance:.6g} {radiance * 0.9:.6g} {radiance * 0.75:.6g}\n\n")
+        f.write("newmtl dark\nKd 0.05 0.05 0.05\nKs 0 0 0\n")
     with open(base + ".obj", "w") as f:
-        f.write(f"mtllib lamps-{n}.mtl\n")
+        f.write(f"mtllib {stem}.mtl\n")
         for p in vertices:
             f.write(f"v {p[0]:.6g} {p[1]:.6g} {p[2]:.6g}\n")
         current = None

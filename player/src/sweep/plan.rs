@@ -525,6 +525,6 @@ mod tests {
         assert!(request(vec![], &["ao:rt", "shadowmap", "frame:rt-half"]).check().is_ok());
         let e = request(vec![], &["ao:shadowmap"]).check().unwrap_err();
         assert!(e.contains("ao:shadowmap"), "{e}");
-        assert!(Target::parse("fog").unwrap_err().contains("shadows, ao"));
+        assert!(Target::parse("fog").unwrap_err().contains("shadows, direct, ao"));
     }
 }

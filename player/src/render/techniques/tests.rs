@@ -9,6 +9,25 @@ use super::shadows::linespace::{LineSpace as ShadowLineSpace, LsShadowTest};
 use super::shadows::rt::Rt as ShadowRt;
 use super::*;
 
+/// The default techniques without the one ray-traced default (`--direct restir`, which a session
+/// drops for a file whose materials emit nothing): the frame from baked data alone.
+fn baked() -> Techniques {
+    let mut t = Techniques::default();
+    t.set(Effect::Direct, "none", &[]).unwrap();
+    t
+}
+
+#[test]
+fn the_default_lights_with_emissive_surfaces_by_restir_which_is_ray_traced() {
+    let d = Techniques::default();
+    assert_eq!(d.name_of(Effect::Direct), "restir");
+    assert!(d.ray_traced() && d.needs().bvh && d.needs().scene_buffers);
+    assert_eq!(d.flags(), kiln_format::gpu::FrameFlags::RT_DIRECT);
+    // While its pipelines compile, frames show no emitters' light; without a BVH it is off.
+    assert_eq!(d.fallback(true).unwrap(), baked());
+    assert_eq!(d.without_rays(), baked());
+}
+
 #[test]
 fn every_catalogue_entry_builds_its_technique() {
     for info in catalogue() {
@@ -33,7 +52,7 @@ fn every_catalogue_entry_builds_its_technique() {
 /// in (the catalogue used to be read by position).
 #[test]
 fn knobs_reach_the_fields_they_name() {
-    let mut t = Techniques::default();
+    let mut t = baked();
     t.set(
         Effect::Ao,
         "sao",
@@ -137,7 +156,7 @@ fn knobs_reach_the_fields_they_name() {
 
 #[test]
 fn knobs_are_checked_and_named_in_errors() {
-    let mut t = Techniques::default();
+    let mut t = baked();
     let e = t.set(Effect::Shadows, "rt", &[("light-radius", KnobValue::Number(-1.0))]).unwrap_err();
     assert!(e.contains("light-radius"), "{e}");
     let e = t.set(Effect::Shadows, "rt", &[("radius", KnobValue::Number(1.0))]).unwrap_err();
@@ -172,7 +191,7 @@ fn knobs_sharing_a_name_share_their_range() {
 
 #[test]
 fn needs_follow_the_techniques() {
-    let d = Techniques::default();
+    let d = baked();
     assert_eq!(d.needs(), Needs { shadow_maps: true, ..Needs::FRAME });
     let rt_ao = Ao::Rt(AoRt { radius: Radius { radius: None, reach: 0.1 } });
     let rt = Techniques { ao: rt_ao, shadows: Shadows::Off(super::shadows::none::Off), ..d };
@@ -203,7 +222,7 @@ fn needs_follow_the_techniques() {
 
 #[test]
 fn the_fallback_keeps_effects_from_baked_data_and_compiles_no_ray_traced_pass() {
-    let d = Techniques::default();
+    let d = baked();
     assert_eq!(d.fallback(true), None, "nothing ray traced: no fallback");
     let ssgi = Gi::Ssgi(Ssgi {
         samples: 8,
@@ -269,7 +288,7 @@ fn the_fallback_keeps_effects_from_baked_data_and_compiles_no_ray_traced_pass() 
 fn media_techniques_read_only_the_sections_they_use() {
     // What `kiln plan` says of the MVIS and SHDW stages: march reads the visibility volumes,
     // toth the shadow maps, the image-space blurs neither; all read the media table.
-    let none = Techniques { shadows: Shadows::Off(super::shadows::none::Off), ..Techniques::default() };
+    let none = Techniques { shadows: Shadows::Off(super::shadows::none::Off), ..baked() };
     let with = |media| Techniques { media, ..none };
     let march = with(Media::March(March { steps: 8 }));
     assert!(march.needs().media && march.needs().media_volumes && !march.needs().shadow_maps);
@@ -287,9 +306,9 @@ fn media_techniques_read_only_the_sections_they_use() {
     assert_eq!(with(Media::default()).needs(), Needs::FRAME);
     assert!(march.dims_surfaces() && toth.dims_surfaces());
     // Surfaces are lit with the shadow maps only when the shadows technique reads them.
-    assert!(!toth.shadow_mapped_surfaces() && Techniques::default().shadow_mapped_surfaces());
+    assert!(!toth.shadow_mapped_surfaces() && baked().shadow_mapped_surfaces());
     // The block splits the samples: block² of them at least.
-    let mut t = Techniques::default();
+    let mut t = baked();
     let e = t.set(Effect::Media, "toth", &[("media-samples", KnobValue::Number(8.0))]).unwrap_err();
     assert!(e.contains("media-block 4") && e.contains("16"), "{e}");
     t.set(Effect::Media, "toth", &[("media-phase", KnobValue::Choice(1))]).unwrap();
@@ -301,7 +320,7 @@ fn media_techniques_read_only_the_sections_they_use() {
 
 #[test]
 fn the_catalogue_builds_ssr_with_its_knobs_and_it_needs_no_rays() {
-    let mut t = Techniques::default();
+    let mut t = baked();
     t.set(Effect::Reflections, "ssr", &[]).unwrap();
     assert_eq!(t.reflections, Reflections::Ssr(Ssr { steps: 48, max_roughness: 0.6 }));
     assert_eq!(t.name_of(Effect::Reflections), "ssr");
@@ -324,7 +343,7 @@ fn the_catalogue_builds_ssr_with_its_knobs_and_it_needs_no_rays() {
 
 #[test]
 fn the_catalogue_builds_gi_rt_with_its_bounces() {
-    let mut t = Techniques::default();
+    let mut t = baked();
     t.set(Effect::Gi, "rt", &[]).unwrap();
     assert_eq!(t.gi, Gi::Rt(GiRt { bounces: 1 }));
     assert_eq!(t.name_of(Effect::Gi), "rt");
@@ -352,11 +371,11 @@ fn the_catalogue_builds_gi_rt_with_its_bounces() {
 fn flags_follow_the_techniques() {
     use kiln_format::gpu::FrameFlags as F;
     let flags = |e: Effect, name: &str, knobs: &[(&str, KnobValue)]| {
-        let mut t = Techniques::default();
+        let mut t = baked();
         t.set(e, name, knobs).unwrap();
         t.flags()
     };
-    assert_eq!(Techniques::default().flags(), 0);
+    assert_eq!(baked().flags(), 0);
     assert_eq!(flags(Effect::Shadows, "rt", &[]), F::RT_SHADOWS);
     assert_eq!(flags(Effect::Shadows, "linespace", &[]), F::RT_SHADOWS);
     for ao in ["rt", "sao", "gtao"] {

@@ -7,7 +7,8 @@ plain_technique! {
     /// The compiler's baked shadow maps.
     ShadowMap,
     "shadowmap",
-    "the compiler's baked shadow maps (PCF; PCSS for rect lights)"
+    "the compiler's baked shadow maps (PCF; PCSS for rect lights); emissive surfaces have none: --direct traces \
+     their shadow rays through the BVH"
 }
 
 impl Technique for ShadowMap {
