@@ -363,8 +363,8 @@ gpu_struct! {
         pub gi_bounces: u32 => "uint",
         /// GI: entries of the emitter table (`GpuEmitter`s) its next-event estimation chooses from.
         pub emitters: u32 => "uint",
-        /// Direct light of emissive surfaces: entries of the emissive-triangle table (the emitter
-        /// table's triangles, renormalised) its candidates are drawn from.
+        /// Direct light of emissive surfaces: entries of the emissive-triangle table
+        /// (`GpuEmissive`s) its candidates are drawn from.
         pub emissive: u32 => "uint",
         /// Direct light: candidates per pixel and frame (resampled importance sampling).
         pub direct_candidates: u32 => "uint",
@@ -391,6 +391,44 @@ gpu_struct! {
         /// Selection probability of this entry.
         pub pdf: f32 => "float",
     }
+}
+
+gpu_struct! {
+    /// One emissive triangle as the direct light of emissive surfaces draws it (std430, 64
+    /// bytes): everything a candidate reads in one place (the path tracer's table reaches the
+    /// triangle and its material through two more lookups), chosen in O(1) by Walker's alias
+    /// method: entry i = ⌊ξ·N⌋ is kept with probability `keep`, else `alias` is taken.
+    pub struct GpuEmissive {
+        /// First corner.
+        pub p0: [f32; 3] => "vec3",
+        /// Probability of choosing this triangle (proportional to its power).
+        pub pdf: f32 => "float",
+        /// Second corner minus the first.
+        pub e1: [f32; 3] => "vec3",
+        /// Probability that a draw landing on this entry keeps it.
+        pub keep: f32 => "float",
+        /// Third corner minus the first.
+        pub e2: [f32; 3] => "vec3",
+        /// The entry a draw that does not keep this one takes.
+        pub alias: u32 => "uint",
+        /// The material's emission (linear), before its emissive texture.
+        pub emission: [f32; 3] => "vec3",
+        /// The triangle (leaf order) in bits 0–29; [`EmissiveFlags`] above.
+        pub triangle: u32 => "uint",
+    }
+}
+
+/// Flags in [`GpuEmissive::triangle`]'s top bits.
+#[derive(Debug)]
+pub struct EmissiveFlags;
+
+impl EmissiveFlags {
+    /// The material emits from both sides.
+    pub const DOUBLE_SIDED: u32 = 1 << 31;
+    /// The material has an emissive texture (read through the triangle's material).
+    pub const TEXTURED: u32 = 1 << 30;
+    /// The bits holding the triangle.
+    pub const TRIANGLE_MASK: u32 = (1 << 30) - 1;
 }
 
 /// Kinds in [`GpuEmitter::kind`].
@@ -543,6 +581,7 @@ pub fn glsl_layout() -> String {
     declare::<GpuMaterialLayout>(&mut s);
     declare::<ReferenceConstants>(&mut s);
     declare::<GpuEmitter>(&mut s);
+    declare::<GpuEmissive>(&mut s);
     declare::<GpuMedium>(&mut s);
     declare::<GpuTexture>(&mut s);
     declare::<GpuVertexAttributes>(&mut s);
@@ -578,6 +617,9 @@ pub fn glsl_layout() -> String {
         ("NO_TEXTURE", crate::sections::NO_TEXTURE),
         ("EMITTER_LIGHT", EmitterKinds::LIGHT),
         ("EMITTER_TRIANGLE", EmitterKinds::TRIANGLE),
+        ("EMISSIVE_DOUBLE_SIDED", EmissiveFlags::DOUBLE_SIDED),
+        ("EMISSIVE_TEXTURED", EmissiveFlags::TEXTURED),
+        ("EMISSIVE_TRIANGLE_MASK", EmissiveFlags::TRIANGLE_MASK),
         ("TEXTURE_WRAP_U_SHIFT", TextureFlags::WRAP_U_SHIFT),
         ("TEXTURE_WRAP_V_SHIFT", TextureFlags::WRAP_V_SHIFT),
         ("TEXTURE_SRGB", TextureFlags::SRGB),
@@ -804,6 +846,7 @@ mod tests {
         check::<GpuMaterialLayout>();
         check::<ReferenceConstants>();
         check::<GpuEmitter>();
+        check::<GpuEmissive>();
         check::<GpuMedium>();
         check::<GpuTexture>();
         check::<GpuVertexAttributes>();

@@ -79,6 +79,17 @@ struct GpuEmitter {
     float pdf; // offset 12
 }; // 16 bytes
 
+struct GpuEmissive {
+    vec3 p0; // offset 0
+    float pdf; // offset 12
+    vec3 e1; // offset 16
+    float keep; // offset 28
+    vec3 e2; // offset 32
+    uint alias; // offset 44
+    vec3 emission; // offset 48
+    uint triangle; // offset 60
+}; // 64 bytes
+
 struct GpuMedium {
     vec4 min; // offset 0
     vec4 max; // offset 16
@@ -199,6 +210,9 @@ const uint MATERIAL_DIFFUSE_ONLY = 8u;
 const uint NO_TEXTURE = 4294967295u;
 const uint EMITTER_LIGHT = 0u;
 const uint EMITTER_TRIANGLE = 1u;
+const uint EMISSIVE_DOUBLE_SIDED = 2147483648u;
+const uint EMISSIVE_TEXTURED = 1073741824u;
+const uint EMISSIVE_TRIANGLE_MASK = 1073741823u;
 const uint TEXTURE_WRAP_U_SHIFT = 0u;
 const uint TEXTURE_WRAP_V_SHIFT = 2u;
 const uint TEXTURE_SRGB = 16u;

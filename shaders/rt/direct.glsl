@@ -4,7 +4,7 @@
 // shades.
 //
 // A sample y is a point on an emissive triangle: an entry of the emissive-triangle table
-// (`emissive`, chosen in proportion to power, as the path tracer's emitter table does) and two
+// (`emissive`, chosen in proportion to power by an alias table) and two
 // numbers that place it uniformly on the triangle. Its source density is the area measure's
 // p(y) = P(entry) / area. The target at a surface s is the unshadowed light it sends there,
 //   p̂_s(y) = lum(Le(y)) · max(n·wi, 0) · max(−n_l·wi, 0) / d²      (0 below s's geometric plane),
@@ -93,18 +93,34 @@ bool stream(inout Reservoir r, uint entry, vec2 xi, float w) {
     return false;
 }
 
-// The emissive-table entry whose cumulative probability first reaches xi.
+// An emissive-table entry, in proportion to power, by Walker's alias method: one or two reads
+// whatever the number of emitters (a binary search over 10,000 took 14 dependent reads per
+// candidate).
 uint choose_emissive(float xi) {
-    uint lo = 0u, hi = rt.emissive - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi) / 2u;
-        if (emissive[mid].cdf < xi) {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
+    float x = xi * float(rt.emissive);
+    uint i = min(uint(x), rt.emissive - 1u);
+    return x - float(i) < emissive[i].keep ? i : emissive[i].alias;
+}
+
+// The point at xi on the triangle of table entry `entry`, as `emissive_point` places it, from
+// the entry alone (the material is read only for an emissive texture).
+EmissivePoint entry_point(uint entry, vec2 xi) {
+    GpuEmissive e = emissive[entry];
+    float su = sqrt(xi.x);
+    float b1 = 1.0 - su, b2 = xi.y * su;
+    EmissivePoint ep;
+    ep.q = e.p0 + b1 * e.e1 + b2 * e.e2;
+    vec3 c = cross(e.e1, e.e2);
+    ep.area = 0.5 * length(c);
+    ep.nl = c / max(2.0 * ep.area, 1e-30);
+    ep.double_sided = (e.triangle & EMISSIVE_DOUBLE_SIDED) != 0u;
+    ep.le = e.emission;
+    if ((e.triangle & EMISSIVE_TEXTURED) != 0u) {
+        uint tri = e.triangle & EMISSIVE_TRIANGLE_MASK;
+        GpuMaterialLayout m = materials[tri_materials[tri]];
+        ep.le *= sample_texture(m.emissive_texture, triangle_uv(tri, b1, b2)).rgb;
     }
-    return lo;
+    return ep;
 }
 
 // A sample as a surface at p sees it.
@@ -119,7 +135,7 @@ struct LightPoint {
 };
 
 LightPoint light_point(uint entry, vec2 xi, vec3 p) {
-    EmissivePoint ep = emissive_point(emissive[entry].index, xi);
+    EmissivePoint ep = entry_point(entry, xi);
     LightPoint lp;
     vec3 to = ep.q - p;
     lp.d2 = dot(to, to);

@@ -41,12 +41,12 @@ layout(set = 0, binding = 22, std430) readonly buffer Emitters { GpuEmitter emit
 layout(set = 0, binding = 23, std430) readonly buffer TriEmitters { int tri_emitter[]; };
 layout(set = 0, binding = 24, rgba32f) uniform image2D rt_gi;
 // Direct light of the emissive triangles (`direct.glsl`): the emissive-triangle table its
-// candidates are drawn from (`rt.emissive` entries: the emitter table's triangles, renormalised),
+// candidates are drawn from (`rt.emissive` entries: corners, emission and an alias table by power),
 // the light it estimates (rgb, reflected towards the camera), each pixel's reservoir as the last
 // frame left it and as this frame's candidates leave it (emissive entry, the point on it as two
 // unorm16, the contribution weight's bits, the candidates it stands for), and the surface each
 // reservoir was made at (position, octahedral normal as two halves).
-layout(set = 0, binding = 25, std430) readonly buffer Emissive { GpuEmitter emissive[]; };
+layout(set = 0, binding = 25, std430) readonly buffer Emissive { GpuEmissive emissive[]; };
 layout(set = 0, binding = 26, rgba32f) uniform image2D rt_direct;
 layout(set = 0, binding = 27, rgba32ui) uniform uimage2D reservoirs_then;
 layout(set = 0, binding = 28, rgba32ui) uniform uimage2D reservoirs_now;

@@ -2,9 +2,11 @@
 //! proportion to their power, the emitter of each triangle, and the layout of the texel buffer.
 
 use glam::Vec3;
-use kiln_format::gpu::{EmitterKinds, GpuEmitter, GpuMedium, GpuTexture, TextureFlags};
+use kiln_format::gpu::{
+    EmissiveFlags, EmitterKinds, GpuEmissive, GpuEmitter, GpuMedium, GpuTexture, TextureFlags,
+};
 use kiln_format::manifest::{ColorSpace, LightKind, Manifest, Wrap};
-use kiln_format::sections::{GpuMaterial, PixelFormat, Swizzle, Vertex};
+use kiln_format::sections::{GpuMaterial, MaterialFlags, NO_TEXTURE, PixelFormat, Swizzle, Vertex};
 
 /// The derived tables.
 #[derive(Debug, Default)]
@@ -12,8 +14,9 @@ pub struct ReferenceTables {
     /// Emitters with cumulative selection probabilities (empty when nothing emits).
     pub emitters: Vec<GpuEmitter>,
     /// The emissive triangles alone, chosen in proportion to their power (the triangle entries
-    /// of `emitters`, renormalised): what the direct light of emissive surfaces draws from.
-    pub emissive: Vec<GpuEmitter>,
+    /// of `emitters`, renormalised, as an alias table): what the direct light of emissive
+    /// surfaces draws from.
+    pub emissive: Vec<GpuEmissive>,
     /// Total power of the emissive triangles (π · luminance · area, summed).
     pub emissive_power: f64,
     /// Per triangle (leaf order): its index in `emitters`, or −1.
@@ -53,24 +56,66 @@ fn light_power(l: &kiln_format::manifest::Light, scene_radius: f32) -> f32 {
     if p.is_finite() { p.max(0.0) } else { 0.0 }
 }
 
-/// The triangle entries of (kind, index, power), chosen in proportion to power among
-/// themselves.
-fn emissive_table(power: &[(u32, u32, f32)]) -> Vec<GpuEmitter> {
-    let triangles: Vec<(u32, f32)> =
+/// Walker's alias table of `weights` (Vose's construction): per entry, the probability that a
+/// draw landing on it keeps it and the entry it takes otherwise, so that entry i is chosen with
+/// probability weights[i] / Σ weights. Empty weights give an empty table.
+pub fn alias_table(weights: &[f64]) -> Vec<(f32, u32)> {
+    let n = weights.len();
+    let total: f64 = weights.iter().sum();
+    let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
+    let mut table = vec![(1.0f32, 0u32); n];
+    for (i, t) in table.iter_mut().enumerate() {
+        t.1 = i as u32;
+    }
+    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
+    while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+        small.pop();
+        table[s] = (scaled[s] as f32, l as u32);
+        scaled[l] -= 1.0 - scaled[s];
+        if scaled[l] < 1.0 {
+            large.pop();
+            small.push(l);
+        }
+    }
+    // What is left keeps itself (rounding leaves entries near 1 in either list).
+    table
+}
+
+/// The emissive triangles of `power` ((kind, index, power) entries) as the direct light of
+/// emissive surfaces reads them: corners, emission, flags and an alias table by power.
+fn emissive_table(
+    power: &[(u32, u32, f32)],
+    vertices: &[Vertex],
+    triangles: &[[u32; 3]],
+    triangle_materials: &[u32],
+    materials: &[GpuMaterial],
+) -> Vec<GpuEmissive> {
+    let entries: Vec<(u32, f32)> =
         power.iter().filter(|p| p.0 == EmitterKinds::TRIANGLE).map(|p| (p.1, p.2)).collect();
-    let total: f64 = triangles.iter().map(|t| t.1 as f64).sum();
-    let mut cumulative = 0.0f64;
-    triangles
+    let total: f64 = entries.iter().map(|e| e.1 as f64).sum();
+    let alias = alias_table(&entries.iter().map(|e| e.1 as f64).collect::<Vec<_>>());
+    entries
         .iter()
-        .enumerate()
-        .map(|(i, &(index, p))| {
-            cumulative += p as f64;
-            GpuEmitter {
-                kind: EmitterKinds::TRIANGLE,
-                index,
-                // The last entry is exactly 1 so that every draw in [0, 1) finds one.
-                cdf: if i + 1 == triangles.len() { 1.0 } else { (cumulative / total) as f32 },
+        .zip(alias)
+        .map(|(&(t, p), (keep, alias))| {
+            let c = triangles[t as usize].map(|v| Vec3::from(vertices[v as usize].position));
+            let m = &materials[triangle_materials[t as usize] as usize];
+            let mut triangle = t & EmissiveFlags::TRIANGLE_MASK;
+            if m.flags & MaterialFlags::DOUBLE_SIDED != 0 {
+                triangle |= EmissiveFlags::DOUBLE_SIDED;
+            }
+            if m.emissive_texture != NO_TEXTURE {
+                triangle |= EmissiveFlags::TEXTURED;
+            }
+            GpuEmissive {
+                p0: c[0].to_array(),
                 pdf: (p as f64 / total) as f32,
+                e1: (c[1] - c[0]).to_array(),
+                keep,
+                e2: (c[2] - c[0]).to_array(),
+                alias,
+                emission: m.emission,
+                triangle,
             }
         })
         .collect()
@@ -120,7 +165,7 @@ pub fn tables(
             tables.triangle_emitter[index as usize] = i as i32;
         }
     }
-    tables.emissive = emissive_table(&power);
+    tables.emissive = emissive_table(&power, vertices, triangles, triangle_materials, materials);
     tables.emissive_power = power.iter().filter(|p| p.0 == EmitterKinds::TRIANGLE).map(|p| p.2 as f64).sum();
     tables.media = super::media::table(manifest);
     for (i, t) in manifest.textures.iter().enumerate() {
@@ -168,6 +213,39 @@ mod tests {
             intensity,
             range: 0.0,
             casts_shadows: true,
+        }
+    }
+
+    /// The distribution an alias table samples (entry ⌊ξN⌋ kept with its probability, else its
+    /// alias), summed entry by entry, against the weights normalised.
+    #[test]
+    fn the_alias_table_chooses_in_proportion_to_the_weights() {
+        let mut x = 12345u64;
+        for n in [1usize, 2, 3, 7, 100, 1000] {
+            let weights: Vec<f64> = (0..n)
+                .map(|i| {
+                    x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                    // Spread over six decades, one entry in seven a hundred times heavier.
+                    let u = (x >> 11) as f64 / (1u64 << 53) as f64;
+                    10f64.powf(6.0 * u - 3.0) * if i % 7 == 0 { 100.0 } else { 1.0 }
+                })
+                .collect();
+            let table = alias_table(&weights);
+            let mut chosen = vec![0.0f64; n];
+            for (i, &(keep, alias)) in table.iter().enumerate() {
+                assert!((0.0..=1.0).contains(&keep), "n {n}: entry {i} keeps with {keep}");
+                chosen[i] += keep as f64 / n as f64;
+                chosen[alias as usize] += (1.0 - keep as f64) / n as f64;
+            }
+            let total: f64 = weights.iter().sum();
+            for i in 0..n {
+                let want = weights[i] / total;
+                assert!(
+                    (chosen[i] - want).abs() <= 1e-6 * want.max(1.0 / n as f64),
+                    "n {n}: entry {i} chosen with {} instead of {want}",
+                    chosen[i]
+                );
+            }
         }
     }
 
