@@ -11,7 +11,9 @@ use kiln_format::sections::{GpuMaterial, MaterialFlags, NO_TEXTURE, PixelFormat,
 /// The derived tables.
 #[derive(Debug, Default)]
 pub struct ReferenceTables {
-    /// Emitters with cumulative selection probabilities (empty when nothing emits).
+    /// Emitters with cumulative selection probabilities (empty when nothing emits): the
+    /// analytic lights first, then the emissive triangles (`rect_lights_seen` in
+    /// `shaders/common/emitters.glsl` stops at the first triangle).
     pub emitters: Vec<GpuEmitter>,
     /// The emissive triangles alone, chosen in proportion to their power (the triangle entries
     /// of `emitters`, renormalised, as an alias table): what the direct light of emissive
@@ -247,6 +249,38 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The shaders' loop over the rect lights stops at the first triangle entry: every light
+    /// must come before every triangle, whatever their powers.
+    #[test]
+    fn the_lights_come_before_the_emissive_triangles() {
+        let mut manifest = Manifest::default();
+        manifest.bounds.max = [1.0; 3];
+        let rect = LightKind::Rect { width: 1.0, height: 1.0 };
+        manifest.lights = vec![
+            light(LightKind::Point, 1e-6),
+            light(rect, 5.0),
+            light(LightKind::Point, 0.0),
+            light(rect, 1e-6),
+        ];
+        let v = |x: f32, z: f32| Vertex { position: [x, 0.0, z], normal: [0.0, 1.0, 0.0] };
+        let vertices = vec![v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
+        let glow = GpuMaterial { emission: [100.0; 3], ..Default::default() };
+        let t = tables(
+            &manifest,
+            &vertices,
+            &[[0, 1, 2], [0, 2, 1], [1, 0, 2], [2, 1, 0]],
+            &[1, 0, 1, 1],
+            &[GpuMaterial::default(), glow],
+            &[],
+        );
+        let kinds: Vec<u32> = t.emitters.iter().map(|e| e.kind).collect();
+        let lights = kinds.iter().filter(|&&k| k == EmitterKinds::LIGHT).count();
+        assert_eq!(lights, 3, "the dark light is dropped, the other three kept: {kinds:?}");
+        assert!(kinds[..lights].iter().all(|&k| k == EmitterKinds::LIGHT), "{kinds:?}");
+        assert!(kinds[lights..].iter().all(|&k| k == EmitterKinds::TRIANGLE), "{kinds:?}");
+        assert_eq!(kinds.len(), 6);
     }
 
     #[test]
