@@ -379,17 +379,21 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// One entry of the reference path tracer's emitter table (std430, 16 bytes): emitters are
-    /// chosen with probability proportional to their power.
+    /// One entry of the emitter table of next-event estimation (std430, 20 bytes): emitters are
+    /// chosen with probability proportional to their power, in O(1) by Walker's alias method
+    /// (entry i = ⌊ξ·N⌋ kept with probability `keep`, else `alias`; a search of cumulative
+    /// probabilities took 17 dependent reads per vertex over ToyCar's 88,837 emitters).
     pub struct GpuEmitter {
         /// [`EmitterKinds`].
         pub kind: u32 => "uint",
         /// Light index (analytic) or triangle (leaf order).
         pub index: u32 => "uint",
-        /// Cumulative selection probability up to and including this entry.
-        pub cdf: f32 => "float",
+        /// Probability that a draw landing on this entry keeps it.
+        pub keep: f32 => "float",
         /// Selection probability of this entry.
         pub pdf: f32 => "float",
+        /// The entry a draw that does not keep this one takes.
+        pub alias: u32 => "uint",
     }
 }
 
@@ -397,7 +401,7 @@ gpu_struct! {
     /// One emissive triangle as the direct light of emissive surfaces draws it (std430, 64
     /// bytes): everything a candidate reads in one place (the path tracer's table reaches the
     /// triangle and its material through two more lookups), chosen in O(1) by Walker's alias
-    /// method: entry i = ⌊ξ·N⌋ is kept with probability `keep`, else `alias` is taken.
+    /// method as [`GpuEmitter`]s are.
     pub struct GpuEmissive {
         /// First corner.
         pub p0: [f32; 3] => "vec3",

@@ -24,17 +24,11 @@ float power_heuristic(float a, float b) {
     return a2 / max(a2 + b * b, 1e-30);
 }
 
+// An entry of the table in proportion to power, by Walker's alias method (GpuEmitter).
 uint choose_emitter(float xi) {
-    uint lo = 0u, hi = emitter_count() - 1u;
-    while (lo < hi) {
-        uint mid = (lo + hi) / 2u;
-        if (emitters[mid].cdf < xi) {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
-    }
-    return lo;
+    float x = xi * float(emitter_count());
+    uint i = min(uint(x), emitter_count() - 1u);
+    return x - float(i) < emitters[i].keep ? i : emitters[i].alias;
 }
 
 // One emitter of the table sampled from a point: the direction to it, the radiance it sends

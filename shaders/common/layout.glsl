@@ -75,9 +75,10 @@ struct ReferenceConstants {
 struct GpuEmitter {
     uint kind; // offset 0
     uint index; // offset 4
-    float cdf; // offset 8
+    float keep; // offset 8
     float pdf; // offset 12
-}; // 16 bytes
+    uint alias; // offset 16
+}; // 20 bytes
 
 struct GpuEmissive {
     vec3 p0; // offset 0

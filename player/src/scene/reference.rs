@@ -152,17 +152,9 @@ pub fn tables(
     power.retain(|p| p.2 > 0.0 && p.2.is_finite());
     let total: f64 = power.iter().map(|p| p.2 as f64).sum();
     let mut tables = ReferenceTables { triangle_emitter: vec![-1; triangles.len()], ..Default::default() };
-    let mut cumulative = 0.0f64;
-    for (i, &(kind, index, p)) in power.iter().enumerate() {
-        cumulative += p as f64;
-        let last = i + 1 == power.len();
-        tables.emitters.push(GpuEmitter {
-            kind,
-            index,
-            // The last entry is exactly 1 so that every draw in [0, 1) finds an emitter.
-            cdf: if last { 1.0 } else { (cumulative / total) as f32 },
-            pdf: (p as f64 / total) as f32,
-        });
+    let alias = alias_table(&power.iter().map(|p| p.2 as f64).collect::<Vec<_>>());
+    for (i, (&(kind, index, p), (keep, alias))) in power.iter().zip(alias).enumerate() {
+        tables.emitters.push(GpuEmitter { kind, index, keep, pdf: (p as f64 / total) as f32, alias });
         if kind == EmitterKinds::TRIANGLE {
             tables.triangle_emitter[index as usize] = i as i32;
         }
@@ -304,7 +296,16 @@ mod tests {
         let p: Vec<f32> = t.emitters.iter().map(|e| e.pdf).collect();
         assert!((p[1] / p[0] - 3.0).abs() < 1e-5);
         assert!((p.iter().sum::<f32>() - 1.0).abs() < 1e-6);
-        assert_eq!(t.emitters[2].cdf, 1.0);
+        // What the alias table draws, entry by entry, is the pdf each entry states.
+        let n = t.emitters.len();
+        let mut chosen = vec![0.0f32; n];
+        for (i, e) in t.emitters.iter().enumerate() {
+            chosen[i] += e.keep / n as f32;
+            chosen[e.alias as usize] += (1.0 - e.keep) / n as f32;
+        }
+        for (c, e) in chosen.iter().zip(&t.emitters) {
+            assert!((c - e.pdf).abs() < 1e-6, "drawn with {c}, stated {}", e.pdf);
+        }
         assert_eq!(t.triangle_emitter, vec![-1, 2]);
     }
 }
