@@ -56,18 +56,9 @@ impl Quad {
         (tris, uvs)
     }
 
-    /// The closed-form irradiance at p (normal +y) from the part s ∈ [0, s_max] (the polygon
-    /// formula over that part's corners; `Rect::irradiance` is the whole).
+    /// The closed-form irradiance at p (normal +y) from the part s ∈ [0, s_max].
     fn irradiance(&self, p: DVec3, s_max: f64) -> f64 {
-        let r = &self.0;
-        let corners = [r.at(0.0, 0.0), r.at(s_max, 0.0), r.at(s_max, 1.0), r.at(0.0, 1.0)];
-        let a = corners.map(|q| (q - p).normalize());
-        let mut sum = 0.0;
-        for i in 0..4 {
-            let (u, v) = (a[i], a[(i + 1) % 4]);
-            sum += u.dot(v).clamp(-1.0, 1.0).acos() * u.cross(v).normalize().y;
-        }
-        r.radiance / 2.0 * sum.abs()
+        self.0.part_irradiance(p, s_max)
     }
 
     /// Whether p sees the emitting side, with a margin.

@@ -77,7 +77,13 @@ impl Rect {
 
     /// The closed-form irradiance at p on the floor (normal +y).
     pub(crate) fn irradiance(&self, p: DVec3) -> f64 {
-        let corners = [self.at(0.0, 0.0), self.at(1.0, 0.0), self.at(1.0, 1.0), self.at(0.0, 1.0)];
+        self.part_irradiance(p, 1.0)
+    }
+
+    /// The closed-form irradiance at p on the floor (normal +y) from the part s ∈ [0, s_max] of
+    /// the rectangle (the polygon formula over that part's corners).
+    pub(crate) fn part_irradiance(&self, p: DVec3, s_max: f64) -> f64 {
+        let corners = [self.at(0.0, 0.0), self.at(s_max, 0.0), self.at(s_max, 1.0), self.at(0.0, 1.0)];
         let a = corners.map(|q| (q - p).normalize());
         let mut sum = 0.0;
         for i in 0..4 {
