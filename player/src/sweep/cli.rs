@@ -170,7 +170,7 @@ fn list() -> String {
             s.push_str(&format!("      --{}: {} ({role})\n", k.name, k.help));
         }
     }
-    s.push_str("frame presets (frame:NAME):\n");
+    s.push_str("frame presets (frame:NAME; each with the default --direct restir where the file has emissive materials):\n");
     for p in preset_help() {
         s.push_str(&format!("  {p}\n"));
     }

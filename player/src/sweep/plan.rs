@@ -231,7 +231,9 @@ pub fn names(target: Target) -> Vec<&'static str> {
     }
 }
 
-/// Whole-frame presets: (name, what it is, how it sets the techniques).
+/// Whole-frame presets: (name, what it is, how it sets the techniques). Each keeps the default
+/// `--direct restir` where the file has emissive materials (`--direct none` elsewhere): the light
+/// of emissive surfaces is part of every frame a user sees.
 type Preset = (&'static str, &'static str, fn(&mut Techniques));
 
 /// The frame presets, each with both G-buffers.
