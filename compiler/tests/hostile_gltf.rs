@@ -269,3 +269,29 @@ fn malformed_morph_target_tangents() {
     });
     refused(d.path(), g, "tangent", "mesh 0 primitive 0: morph target 0 TANGENT accessor 2 has no elements");
 }
+
+#[test]
+fn animations_the_gltf_crate_cannot_parse_are_dropped_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    // A channel target without `node` (the spec allows it: KHR_animation_pointer names the
+    // target instead); the gltf crate's reader requires the field.
+    let pointer = |g: &mut Gltf| {
+        g.json["animations"] = json!([{
+            "channels": [{"sampler": 0, "target": {"path": "pointer",
+                "extensions": {"KHR_animation_pointer": {"pointer": "/nodes/0/translation"}}}}],
+            "samplers": [{"input": 0, "output": 0}]
+        }]);
+    };
+    let mut g = quad_with(pointer);
+    let f = g.write(d.path(), "pointer");
+    compile(d.path(), &f, &[]).expect(0).says("1 animation(s) dropped unread").says("missing field `node`");
+    let f = g.write_glb(d.path(), "pointer");
+    compile(d.path(), &f, &[]).expect(0).says("1 animation(s) dropped unread");
+    // Something else that does not parse is still refused, whatever the animations.
+    let mut g = quad_with(|g| {
+        pointer(g);
+        g.json["meshes"] = json!("not a list");
+    });
+    let f = g.write(d.path(), "broken");
+    compile(d.path(), &f, &[]).expect(1).says("not a valid glTF 2.0 file");
+}

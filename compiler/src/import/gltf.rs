@@ -121,8 +121,22 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
 fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()> {
     let bytes = read_input(path, &mut scene.inputs)?;
     let file = path.display().to_string();
-    let gltf = Gltf::from_slice_without_validation(&bytes)
-        .map_err(|e| CliError::input(format!("{file}: not a valid glTF 2.0 file: {e}")))?;
+    let gltf = match Gltf::from_slice_without_validation(&bytes) {
+        Ok(gltf) => gltf,
+        Err(e) => {
+            let invalid = || CliError::input(format!("{file}: not a valid glTF 2.0 file: {e}"));
+            // The gltf crate reads animations strictly (a channel target without `node`, which
+            // the spec allows for extensions such as KHR_animation_pointer, is a parse error);
+            // kiln bakes none, so a file that parses without them compiles, with a warning.
+            let (stripped, dropped) = without_animations(&bytes).ok_or_else(invalid)?;
+            let gltf = Gltf::from_slice_without_validation(&stripped).map_err(|_| invalid())?;
+            scene.warn(format!(
+                "{file}: {dropped} animation(s) dropped unread: the gltf crate does not parse them ({e}); \
+                 kiln bakes no animation"
+            ));
+            gltf
+        }
+    };
     let unsupported: Vec<&str> =
         gltf.document.extensions_required().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
     if !unsupported.is_empty() {
@@ -180,6 +194,24 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
     }
     imp.scene.textures.extend(textures);
     Ok(())
+}
+
+/// The glTF or GLB `bytes` without their `animations` array and how many it held; `None` when
+/// the JSON does not parse or holds no animation.
+fn without_animations(bytes: &[u8]) -> Option<(Vec<u8>, usize)> {
+    let strip = |json: &[u8]| -> Option<(Vec<u8>, usize)> {
+        let mut value: serde_json::Value = serde_json::from_slice(json).ok()?;
+        let dropped = value.as_object_mut()?.remove("animations")?.as_array().map_or(1, Vec::len);
+        Some((serde_json::to_vec(&value).ok()?, dropped))
+    };
+    if bytes.starts_with(b"glTF") {
+        let glb = ::gltf::Glb::from_slice(bytes).ok()?;
+        let (json, dropped) = strip(&glb.json)?;
+        let stripped = ::gltf::Glb { header: glb.header, json: json.into(), bin: glb.bin }.to_vec().ok()?;
+        Some((stripped, dropped))
+    } else {
+        strip(bytes)
+    }
 }
 
 /// Whether every validation error of `e` lies inside the `animations` array.
