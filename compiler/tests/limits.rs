@@ -130,3 +130,33 @@ fn a_gltf_buffer_that_is_a_device_is_not_read() {
         run.stderr
     );
 }
+
+#[test]
+fn texture_paths_with_other_case_or_backslashes_are_found_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    obj(d, "lib.mtl");
+    std::fs::create_dir(d.join("maps")).unwrap();
+    let img = image::RgbaImage::from_pixel(8, 8, image::Rgba([200, 100, 50, 255]));
+    img.save(d.join("maps").join("wall_skap.png")).unwrap();
+    // Sponza's MTL names 00_SKAP.JPG for 00_skap.JPG; Windows exports write backslashes.
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 1 1 1\nmap_Kd MAPS\\WALL_SKAP.PNG\n").unwrap();
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--report", "r.json"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("texture 'MAPS\\WALL_SKAP.PNG' is not there as written; using"),
+        "{}",
+        run.stderr
+    );
+    assert!(run.stderr.contains("maps/wall_skap.png"), "{}", run.stderr);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("r.json")).unwrap()).unwrap();
+    assert_eq!(report["counts"]["textures"], 1, "the texture is in the file");
+    assert!(!run.stderr.contains("cannot read"), "{}", run.stderr);
+    // Two names that differ only in case: ambiguous, so the texture is not read (the
+    // placeholder's warning says so).
+    img.save(d.join("maps").join("Wall_Skap.png")).unwrap();
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(!run.stderr.contains("using") && run.stderr.contains("cannot read"), "{}", run.stderr);
+}

@@ -8,7 +8,7 @@
 //! ([`set_limits`]), and the importers and the parallel image decoder read them.
 
 use std::io::Read;
-use std::path::Path;
+use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 /// The default largest file an import reads: 4 GiB.
@@ -63,6 +63,38 @@ pub fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
         return Err(too_large(bytes.len() as u64));
     }
     Ok(bytes)
+}
+
+/// `rel` under `base` with each component that does not exist as written matched to the one
+/// entry of its folder whose name differs only in case (an asset made on a file system that does
+/// not tell case apart, e.g. Sponza's `00_SKAP.JPG` for `00_skap.JPG`); `None` when a component
+/// matches nothing, or several entries. Backslashes in `rel` are folder separators.
+pub fn resolve_case_insensitive(base: &Path, rel: &str) -> Option<PathBuf> {
+    let rel = rel.replace('\\', "/");
+    // An input in the working folder has an empty parent.
+    let mut at = if base.as_os_str().is_empty() { PathBuf::from(".") } else { base.to_path_buf() };
+    for c in Path::new(&rel).components() {
+        let Component::Normal(name) = c else {
+            at.push(c.as_os_str());
+            continue;
+        };
+        let exact = at.join(name);
+        if exact.exists() {
+            at = exact;
+            continue;
+        }
+        let want = name.to_str()?.to_lowercase();
+        let mut found = std::fs::read_dir(&at)
+            .ok()?
+            .filter_map(Result::ok)
+            .filter(|e| e.file_name().to_str().is_some_and(|n| n.to_lowercase() == want));
+        let first = found.next()?;
+        if found.next().is_some() {
+            return None;
+        }
+        at = first.path();
+    }
+    Some(at)
 }
 
 /// Decodes an image whose dimensions, read from its header first, are within the image limit;

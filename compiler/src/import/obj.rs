@@ -98,6 +98,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     let first_material = scene.materials.len() as u32;
     let mtl_base = |name: &str| base.join(name);
     let mut material_warnings = Vec::new();
+    let mut texture_warnings = Vec::new();
     for m in &materials {
         let mut warnings = Vec::new();
         let gpu = convert_material(
@@ -106,7 +107,17 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
                 if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
                     return i;
                 }
-                let full = mtl_base(name);
+                let mut full = mtl_base(name);
+                if !full.exists() {
+                    // Written on Windows (backslashes) or on a file system that ignores case.
+                    if let Some(found) = super::files::resolve_case_insensitive(&base, name) {
+                        texture_warnings.push(format!(
+                            "{file}: texture '{name}' is not there as written; using {}",
+                            found.display()
+                        ));
+                        full = found;
+                    }
+                }
                 let bytes = super::files::read_bounded(&full);
                 if bytes.is_ok() && !scene.inputs.contains(&full) {
                     scene.inputs.push(full.clone());
@@ -128,7 +139,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         material_warnings.extend(warnings.into_iter().map(|w| format!("{file}: material '{}': {w}", m.name)));
         scene.materials.push(Material { name: m.name.clone(), gpu });
     }
-    for w in material_warnings {
+    for w in material_warnings.into_iter().chain(texture_warnings) {
         scene.warn(w);
     }
     let mut default_material: Option<u32> = None;
