@@ -45,9 +45,9 @@ struct EmitterSample {
     vec3 target;      // the shadow ray's end (moved off an emissive triangle)
 };
 
-// A point on emissive triangle `tri` (leaf order), uniform in area for xi uniform in [0, 1)²:
-// where it lies, the triangle's unit normal (its winding's) and area, whether its material
-// emits from both sides, and the radiance it emits there (the emissive texture included).
+// A point on an emissive triangle, uniform in area for xi uniform in [0, 1)²: where it lies,
+// the triangle's unit normal (its winding's) and area, whether its material emits from both
+// sides, and the radiance it emits there (the emissive texture included).
 struct EmissivePoint {
     vec3 q;
     vec3 nl;
@@ -56,22 +56,59 @@ struct EmissivePoint {
     vec3 le;
 };
 
-EmissivePoint emissive_point(uint tri, vec2 xi) {
-    vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
+// The point at xi on the triangle p0 + (e1, e2) (triangle `tri`, leaf order, for its texture
+// coordinates) of a material emitting `emission` through `texture` (NO_TEXTURE: none).
+EmissivePoint point_on_emitter(vec3 p0, vec3 e1, vec3 e2, vec3 emission, uint texture, bool double_sided, uint tri,
+                               vec2 xi) {
     float su = sqrt(xi.x);
     float b1 = 1.0 - su, b2 = xi.y * su;
     EmissivePoint ep;
-    ep.q = (1.0 - b1 - b2) * p0 + b1 * p1 + b2 * p2;
-    vec3 c = cross(p1 - p0, p2 - p0);
+    ep.q = p0 + b1 * e1 + b2 * e2;
+    vec3 c = cross(e1, e2);
     ep.area = 0.5 * length(c);
     ep.nl = c / max(2.0 * ep.area, 1e-30);
-    GpuMaterialLayout m = materials[tri_materials[tri]];
-    ep.double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
-    ep.le = m.emission;
-    if (m.emissive_texture != NO_TEXTURE) {
-        ep.le *= sample_texture(m.emissive_texture, triangle_uv(tri, b1, b2)).rgb;
+    ep.double_sided = double_sided;
+    ep.le = emission;
+    if (texture != NO_TEXTURE) {
+        ep.le *= sample_texture(texture, triangle_uv(tri, b1, b2)).rgb;
     }
     return ep;
+}
+
+// The point at xi on emissive triangle `tri` (leaf order), from the BVH's triangles.
+EmissivePoint emissive_point(uint tri, vec2 xi) {
+    vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
+    GpuMaterialLayout m = materials[tri_materials[tri]];
+    return point_on_emitter(p0, p1 - p0, p2 - p0, m.emission, m.emissive_texture,
+                            (m.flags & MATERIAL_DOUBLE_SIDED) != 0u, tri, xi);
+}
+
+// An emissive point as a surface at p sees it.
+struct LightPoint {
+    bool valid;   // in front of the emitter's emitting side, at a distance
+    vec3 wi;      // towards the point
+    float d2;     // squared distance
+    float cos_l;  // at the emitter
+    vec3 le;      // emitted radiance
+    vec3 target;  // the shadow ray's end, moved off the emitter towards p
+    float area;   // the triangle's
+};
+
+LightPoint seen_from(EmissivePoint ep, vec3 p) {
+    LightPoint lp;
+    vec3 to = ep.q - p;
+    lp.d2 = dot(to, to);
+    lp.wi = to * inversesqrt(max(lp.d2, 1e-37));
+    lp.cos_l = -dot(ep.nl, lp.wi);
+    if (ep.double_sided) {
+        lp.cos_l = abs(lp.cos_l);
+    }
+    lp.le = ep.le;
+    lp.area = ep.area;
+    lp.valid = lp.cos_l > 0.0 && ep.area > 0.0 && lp.d2 > 0.0;
+    // The shadow ray must not reach the emitter's own surface.
+    lp.target = offset_ray_origin(ep.q, dot(ep.nl, lp.wi) < 0.0 ? ep.nl : -ep.nl);
+    return lp;
 }
 
 #ifdef EMITTER_TRANSMITTANCE
@@ -94,26 +131,16 @@ EmitterSample sample_emitter_light(vec3 origin) {
     GpuEmitter e = emitters[choose_emitter(rnd())];
     if (e.kind == EMITTER_TRIANGLE) {
         float xi = rnd();
-        EmissivePoint ep = emissive_point(e.index, vec2(xi, rnd()));
-        vec3 to = ep.q - origin;
-        float d2 = dot(to, to);
-        float d = sqrt(d2);
-        vec3 wi = to / d;
-        float cos_l = -dot(ep.nl, wi);
-        if (ep.double_sided) {
-            cos_l = abs(cos_l);
-        }
-        if (cos_l <= 0.0 || ep.area <= 0.0) {
+        LightPoint lp = seen_from(emissive_point(e.index, vec2(xi, rnd())), origin);
+        if (!lp.valid) {
             return es;
         }
         es.valid = true;
         es.delta = false;
-        es.wi = wi;
-        es.li = ep.le;
-        es.pdf = e.pdf * d2 / (cos_l * ep.area);
-        // The sampled point, moved off the emitter towards the origin: the shadow ray must not
-        // reach the emitter's own surface.
-        es.target = offset_ray_origin(ep.q, dot(ep.nl, wi) < 0.0 ? ep.nl : -ep.nl);
+        es.wi = lp.wi;
+        es.li = lp.le;
+        es.pdf = e.pdf * lp.d2 / (lp.cos_l * lp.area);
+        es.target = lp.target;
         return es;
     }
     GpuLight l = lights[e.index];

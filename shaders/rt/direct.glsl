@@ -106,49 +106,13 @@ uint choose_emissive(float xi) {
 // the entry alone (the material is read only for an emissive texture).
 EmissivePoint entry_point(uint entry, vec2 xi) {
     GpuEmissive e = emissive[entry];
-    float su = sqrt(xi.x);
-    float b1 = 1.0 - su, b2 = xi.y * su;
-    EmissivePoint ep;
-    ep.q = e.p0 + b1 * e.e1 + b2 * e.e2;
-    vec3 c = cross(e.e1, e.e2);
-    ep.area = 0.5 * length(c);
-    ep.nl = c / max(2.0 * ep.area, 1e-30);
-    ep.double_sided = (e.triangle & EMISSIVE_DOUBLE_SIDED) != 0u;
-    ep.le = e.emission;
-    if ((e.triangle & EMISSIVE_TEXTURED) != 0u) {
-        uint tri = e.triangle & EMISSIVE_TRIANGLE_MASK;
-        GpuMaterialLayout m = materials[tri_materials[tri]];
-        ep.le *= sample_texture(m.emissive_texture, triangle_uv(tri, b1, b2)).rgb;
-    }
-    return ep;
+    uint tri = e.triangle & EMISSIVE_TRIANGLE_MASK;
+    uint texture = (e.triangle & EMISSIVE_TEXTURED) != 0u ? materials[tri_materials[tri]].emissive_texture : NO_TEXTURE;
+    return point_on_emitter(e.p0, e.e1, e.e2, e.emission, texture, (e.triangle & EMISSIVE_DOUBLE_SIDED) != 0u, tri, xi);
 }
 
-// A sample as a surface at p sees it.
-struct LightPoint {
-    bool valid;   // in front of the emitter's emitting side, at a distance
-    vec3 wi;      // towards the point
-    float d2;     // squared distance
-    float cos_l;  // at the emitter
-    vec3 le;      // emitted radiance
-    vec3 target;  // the shadow ray's end, moved off the emitter
-    float area;   // the triangle's
-};
-
 LightPoint light_point(uint entry, vec2 xi, vec3 p) {
-    EmissivePoint ep = entry_point(entry, xi);
-    LightPoint lp;
-    vec3 to = ep.q - p;
-    lp.d2 = dot(to, to);
-    lp.wi = to * inversesqrt(max(lp.d2, 1e-37));
-    lp.cos_l = -dot(ep.nl, lp.wi);
-    if (ep.double_sided) {
-        lp.cos_l = abs(lp.cos_l);
-    }
-    lp.le = ep.le;
-    lp.area = ep.area;
-    lp.valid = lp.cos_l > 0.0 && ep.area > 0.0 && lp.d2 > 0.0;
-    lp.target = offset_ray_origin(ep.q, dot(ep.nl, lp.wi) < 0.0 ? ep.nl : -ep.nl);
-    return lp;
+    return seen_from(entry_point(entry, xi), p);
 }
 
 // p̂ at a surface (point p, shading normal n, geometric normal ng) for a sample it sees as lp.
@@ -230,9 +194,11 @@ Reservoir combine(Primary s, uint count) {
         out_r.W = 0.0;
         return out_r;
     }
+    // The chosen point once; each input's surface sees it from where it is.
+    EmissivePoint y = entry_point(out_r.entry, out_r.xi);
     float z = 0.0;
     for (uint i = 0u; i < count; i++) {
-        bool could = i == 0u || target_at(out_r.entry, out_r.xi, inputs[i].p, inputs[i].n, inputs[i].ng) > 0.0;
+        bool could = i == 0u || target_of(seen_from(y, inputs[i].p), inputs[i].n, inputs[i].ng) > 0.0;
         z += could ? inputs[i].r.M : 0.0;
     }
     out_r.W = z > 0.0 ? out_r.w_sum / (z * chosen_target) : 0.0;

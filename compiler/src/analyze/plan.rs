@@ -63,16 +63,22 @@ impl Stage {
 /// What the player's emitter table will hold (it is built at load from the materials and
 /// triangles): the emissive triangles, how many materials they use and their total power.
 fn emitters(scene: &Scene) -> String {
-    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-    let emits: Vec<f32> = scene.materials.iter().map(|m| luminance(m.gpu.emission)).collect();
+    use kiln_format::gpu::{emitted_power, luminance};
     let (mut triangles, mut power) = (0usize, 0.0f64);
-    let mut used = vec![false; emits.len()];
+    let mut used = vec![false; scene.materials.len()];
     for (t, &m) in scene.triangles.iter().zip(&scene.triangle_materials) {
-        let e = emits.get(m as usize).copied().unwrap_or(0.0);
-        if e > 0.0 {
-            let p = t.map(|v| glam::Vec3::from(scene.vertices[v as usize].position).as_dvec3());
+        let Some(material) = scene.materials.get(m as usize) else { continue };
+        let emission = material.gpu.emission;
+        if luminance(emission) <= 0.0 {
+            continue;
+        }
+        // The player's rule (scene/reference.rs): f32 corners, and a triangle enters the table
+        // when its power is positive and finite.
+        let p = t.map(|v| glam::Vec3::from(scene.vertices[v as usize].position));
+        let p = emitted_power(emission, 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length());
+        if p > 0.0 && p.is_finite() {
             triangles += 1;
-            power += std::f64::consts::PI * e as f64 * 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+            power += p as f64;
             used[m as usize] = true;
         }
     }

@@ -3,7 +3,8 @@
 
 use glam::Vec3;
 use kiln_format::gpu::{
-    EmissiveFlags, EmitterKinds, GpuEmissive, GpuEmitter, GpuMedium, GpuTexture, TextureFlags,
+    EmissiveFlags, EmitterKinds, GpuEmissive, GpuEmitter, GpuMedium, GpuTexture, TextureFlags, emitted_power,
+    luminance,
 };
 use kiln_format::manifest::{ColorSpace, LightKind, Manifest, Wrap};
 use kiln_format::sections::{GpuMaterial, MaterialFlags, NO_TEXTURE, PixelFormat, Swizzle, Vertex};
@@ -11,16 +12,14 @@ use kiln_format::sections::{GpuMaterial, MaterialFlags, NO_TEXTURE, PixelFormat,
 /// The derived tables.
 #[derive(Debug, Default)]
 pub struct ReferenceTables {
-    /// Emitters with cumulative selection probabilities (empty when nothing emits): the
-    /// analytic lights first, then the emissive triangles (`rect_lights_seen` in
+    /// Emitters with an alias table by power (empty when nothing emits): the analytic lights
+    /// first, then the emissive triangles (`rect_lights_seen` in
     /// `shaders/common/emitters.glsl` stops at the first triangle).
     pub emitters: Vec<GpuEmitter>,
     /// The emissive triangles alone, chosen in proportion to their power (the triangle entries
     /// of `emitters`, renormalised, as an alias table): what the direct light of emissive
     /// surfaces draws from.
     pub emissive: Vec<GpuEmissive>,
-    /// Total power of the emissive triangles (π · luminance · area, summed).
-    pub emissive_power: f64,
     /// Per triangle (leaf order): its index in `emitters`, or −1.
     pub triangle_emitter: Vec<i32>,
     /// Per texture: where its mip chain lies in the texel buffer.
@@ -29,10 +28,6 @@ pub struct ReferenceTables {
     pub texel_words: u64,
     /// The participating media (the manifest's, validated when the file was opened).
     pub media: Vec<GpuMedium>,
-}
-
-fn luminance(c: [f32; 3]) -> f32 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
 fn wrap_bits(w: Wrap) -> u32 {
@@ -65,10 +60,8 @@ pub fn alias_table(weights: &[f64]) -> Vec<(f32, u32)> {
     let n = weights.len();
     let total: f64 = weights.iter().sum();
     let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
-    let mut table = vec![(1.0f32, 0u32); n];
-    for (i, t) in table.iter_mut().enumerate() {
-        t.1 = i as u32;
-    }
+    // Each entry keeps itself until a smaller one is paired with it.
+    let mut table: Vec<(f32, u32)> = (0..n as u32).map(|i| (1.0, i)).collect();
     let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
     while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
         small.pop();
@@ -142,11 +135,11 @@ pub fn tables(
         .map(|(i, l)| (EmitterKinds::LIGHT, i as u32, light_power(l, radius)))
         .collect();
     for (t, (tri, &m)) in triangles.iter().zip(triangle_materials).enumerate() {
-        let e = luminance(materials[m as usize].emission);
-        if e > 0.0 {
+        let emission = materials[m as usize].emission;
+        if luminance(emission) > 0.0 {
             let p = tri.map(|v| Vec3::from(vertices[v as usize].position));
             let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-            power.push((EmitterKinds::TRIANGLE, t as u32, std::f32::consts::PI * e * area));
+            power.push((EmitterKinds::TRIANGLE, t as u32, emitted_power(emission, area)));
         }
     }
     power.retain(|p| p.2 > 0.0 && p.2.is_finite());
@@ -160,7 +153,6 @@ pub fn tables(
         }
     }
     tables.emissive = emissive_table(&power, vertices, triangles, triangle_materials, materials);
-    tables.emissive_power = power.iter().filter(|p| p.0 == EmitterKinds::TRIANGLE).map(|p| p.2 as f64).sum();
     tables.media = super::media::table(manifest);
     for (i, t) in manifest.textures.iter().enumerate() {
         // How the texels are stored (the section header): RGBA8 where unknown.

@@ -53,9 +53,14 @@ pub const SPEC_INPUTS: [(SpecInput, &str); 8] = [
 /// The G-buffer targets it samples, in binding order (6–10).
 const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
 
-/// The ray-traced results it composites, in binding order (12–15, then 17).
-const RAY_TRACED: [TargetDecl; 5] =
-    [rt_shadows::SHADOWS, ao::AO, rt_reflections::REFLECTIONS, rt_gi::GI, rt_direct::DIRECT];
+/// The ray-traced results it composites and their bindings (the media table takes 16).
+const RAY_TRACED: [(TargetDecl, u32); 5] = [
+    (rt_shadows::SHADOWS, 12),
+    (ao::AO, 13),
+    (rt_reflections::REFLECTIONS, 14),
+    (rt_gi::GI, 15),
+    (rt_direct::DIRECT, 17),
+];
 
 /// The direct-light pass.
 #[derive(Debug)]
@@ -114,7 +119,7 @@ impl Pass for DirectPass {
     }
 
     fn binds(&self) -> Vec<TargetDecl> {
-        GBUFFER.iter().chain(&RAY_TRACED).copied().collect()
+        GBUFFER.iter().copied().chain(RAY_TRACED.iter().map(|(t, _)| *t)).collect()
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
@@ -135,10 +140,8 @@ impl Pass for DirectPass {
             writes.push(Write::Sampled(6 + i as u32, vec![(img(t), near)]));
         }
         writes.push(Write::StorageImage(11, img(&RADIANCE)));
-        for (i, t) in RAY_TRACED.iter().enumerate() {
-            // The media table sits between GI (15) and the direct light of emitters (17).
-            let binding = if i < 4 { 12 + i as u32 } else { 17 };
-            writes.push(Write::StorageImage(binding, img(t)));
+        for (t, binding) in &RAY_TRACED {
+            writes.push(Write::StorageImage(*binding, img(t)));
         }
         // The media table when a media technique uploaded it (the frame constants then count
         // its entries), else any storage buffer: no entry is read.
@@ -148,7 +151,7 @@ impl Pass for DirectPass {
 
     fn record(&mut self, ctx: &mut FrameCtx) {
         let mut io = super::gbuffer::sampled(&GBUFFER);
-        io.extend(RAY_TRACED.iter().map(|t| (*t, Access::Read(Use::STORAGE))));
+        io.extend(RAY_TRACED.iter().map(|(t, _)| (*t, Access::Read(Use::STORAGE))));
         io.push((RADIANCE, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
         self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
