@@ -187,6 +187,16 @@ struct SsrConstants {
     uint level; // offset 16
 }; // 20 bytes
 
+struct DenoiseConstants {
+    uint samples; // offset 0
+    uint step; // offset 4
+    uint demodulate; // offset 8
+    uint last; // offset 12
+    float sigma_luminance; // offset 16
+    float sigma_normal; // offset 20
+    float sigma_plane; // offset 24
+}; // 28 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;

@@ -1,4 +1,5 @@
-// Octahedral normal encoding (Meyer et al. 2010), as in format/src/linespace/pnmt.rs.
+// Octahedral normal encoding (Meyer et al. 2010), as in format/src/linespace/pnmt.rs; colour
+// helpers (sRGB, luminance, the denoiser's albedo demodulation).
 #ifndef KILN_PACKING_GLSL
 #define KILN_PACKING_GLSL
 
@@ -24,6 +25,19 @@ vec3 srgb_to_linear(vec3 c) {
 vec3 linear_to_srgb(vec3 l) {
     l = clamp(l, 0.0, 1.0);
     return mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, greaterThan(l, vec3(0.0031308)));
+}
+
+// Relative luminance of linear Rec. 709 (sRGB primaries) radiance.
+float luminance(vec3 c) {
+    return dot(c, vec3(0.2126, 0.7152, 0.0722));
+}
+
+// What the denoiser (shaders/denoise/) divides a demodulated signal by before it filters and
+// multiplies back after (albedo demodulation): the surface's linear base colour, at least 0.05
+// per channel so that black and purely specular surfaces keep their light. The signal's
+// second moment (its alpha) is taken of the same quotient.
+vec3 demodulator(vec3 base) {
+    return max(base, vec3(0.05));
 }
 
 #endif

@@ -147,10 +147,6 @@ bool trace_surface(TraceRay r, out Surface s) {
 }
 
 // ---------------------------------------------------------------- BRDF sampling
-float luminance(vec3 c) {
-    return dot(c, vec3(0.2126, 0.7152, 0.0722));
-}
-
 // f(wo, wi) · |n·wi|, zero below the geometric surface.
 vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
     if (dot(s.ng, wi) <= 0.0) {

@@ -17,6 +17,9 @@ layout(set = 0, binding = 2) uniform sampler2D depth_before;     // the previous
 layout(set = 0, binding = 3) uniform sampler2D motion_before;    // the previous frame's motion
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D motion;  // at.xy, frames, 0
 layout(set = 0, binding = 5, r32f) uniform writeonly image2D depth_now;
+// The samples in each pixel's mean after this frame's blend (frames + 1): what the denoiser
+// divides the per-sample variance by (shaders/denoise/).
+layout(set = 0, binding = 6, r32f) uniform writeonly image2D samples;
 layout(push_constant) uniform Push { float cap; } push;
 
 #include "../common/reproject.glsl"
@@ -50,4 +53,5 @@ void main() {
         frames = still ? min(frames, 16777216.0) : min(frames, push.cap);
     }
     imageStore(motion, pixel, vec4(at, frames, 0.0));
+    imageStore(samples, pixel, vec4(frames + 1.0));
 }

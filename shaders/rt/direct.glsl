@@ -325,7 +325,10 @@ void reuse_main() {
     } else {
         imageStore(reservoirs_then, pixel, pack_reservoir(empty_reservoir()));
     }
-    imageStore(rt_direct, pixel, accumulate(imageLoad(rt_direct, pixel), vec4(l, 1.0)));
+    // Alpha: the square of the demodulated sample's luminance, whose running mean is the second
+    // moment the denoiser estimates the noise from (shaders/denoise/).
+    float m = luminance(l / demodulator(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb)));
+    imageStore(rt_direct, pixel, accumulate(imageLoad(rt_direct, pixel), vec4(l, min(m * m, 3.0e38))));
 }
 
 #endif

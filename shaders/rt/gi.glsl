@@ -152,7 +152,9 @@ void gi_main() {
             l = vec3(0.0);
         }
     }
-    imageStore(rt_gi, pixel, accumulate(imageLoad(rt_gi, pixel), vec4(l, 1.0)));
+    // Alpha: the square of the sample's luminance, whose running mean is the second moment the
+    // denoiser estimates the noise from (shaders/denoise/).
+    imageStore(rt_gi, pixel, accumulate(imageLoad(rt_gi, pixel), vec4(l, min(luminance(l) * luminance(l), 3.0e38))));
 }
 
 #endif

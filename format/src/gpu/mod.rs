@@ -345,6 +345,30 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of the spatiotemporal denoiser (`shaders/denoise/*`; 28 bytes).
+    pub struct DenoiseConstants {
+        /// Samples in every pixel's running mean (a still camera without reprojection); 0: read
+        /// them per pixel from the reprojected history's samples image.
+        pub samples: u32 => "uint",
+        /// À-trous: the spacing of this iteration's taps in pixels (1, 2, 4, …).
+        pub step: u32 => "uint",
+        /// 1: the signal is divided by the albedo's demodulator before filtering and multiplied
+        /// back after; 0: it is filtered as it is.
+        pub demodulate: u32 => "uint",
+        /// 1: this iteration is the last and writes the output image.
+        pub last: u32 => "uint",
+        /// Luminance edge-stopping: differences are measured in this many standard deviations
+        /// of the noise (SVGF's σ_l).
+        pub sigma_luminance: f32 => "float",
+        /// Normal edge-stopping: the exponent of max(0, n_p · n_q) (SVGF's σ_n).
+        pub sigma_normal: f32 => "float",
+        /// Depth edge-stopping: a tap's distance from the pixel's tangent plane is measured in
+        /// this many pixel footprints per pixel of separation.
+        pub sigma_plane: f32 => "float",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
@@ -533,6 +557,7 @@ pub fn glsl_layout() -> String {
     declare::<ScreenAoConstants>(&mut s);
     declare::<ScreenGiConstants>(&mut s);
     declare::<SsrConstants>(&mut s);
+    declare::<DenoiseConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -707,6 +732,7 @@ mod tests {
         check::<TothConstants>();
         check::<ScreenAoConstants>();
         check::<SsrConstants>();
+        check::<DenoiseConstants>();
         check::<GpuGrid>();
         check::<BakeParams>();
         check::<BakeCell>();

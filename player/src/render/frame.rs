@@ -75,6 +75,8 @@ pub enum Stage {
     Emitters,
     /// The ray-traced passes' reprojected accumulation.
     Accumulate,
+    /// Denoising of the ray-traced signals.
+    Denoise,
     /// Direct light and composition.
     Direct,
     /// Participating media.

@@ -62,9 +62,10 @@ const RAY_TRACED: [(TargetDecl, u32); 5] = [
     (rt_direct::DIRECT, 17),
 ];
 
-/// The direct-light pass.
+/// The direct-light pass: its kernel and the ray-traced images it reads, by binding (each
+/// signal's denoised image where the denoiser filters it).
 #[derive(Debug)]
-pub struct DirectPass(Kernel);
+pub struct DirectPass(Kernel, [(TargetDecl, u32); 5]);
 
 impl DirectPass {
     /// Builds the pipeline, specialised for `techniques` (and rect lights or none): the code for
@@ -72,13 +73,22 @@ impl DirectPass {
     /// pass on the H100 (docs/benchmarks/codec/auto-default).
     pub fn new(gpu: &Gpu, techniques: &Techniques, rect_lights: bool) -> PlayResult<DirectPass> {
         let constants = Self::constants(techniques.flags(), techniques.dims_surfaces(), rect_lights);
-        Ok(DirectPass(Kernel::specialized(
+        let kernel = Kernel::specialized(
             gpu,
             &Self::bindings(),
             spirv::shader!("lighting/direct.comp"),
             0,
             &constants,
-        )?))
+        )?;
+        let mut inputs = RAY_TRACED;
+        for noisy in techniques.noisy() {
+            for (t, _) in &mut inputs {
+                if *t == noisy.target {
+                    *t = noisy.output;
+                }
+            }
+        }
+        Ok(DirectPass(kernel, inputs))
     }
 
     /// Specialization constants by id (`direct.comp`): 0 is unused (the texel decoders' id), then
@@ -119,7 +129,7 @@ impl Pass for DirectPass {
     }
 
     fn binds(&self) -> Vec<TargetDecl> {
-        GBUFFER.iter().copied().chain(RAY_TRACED.iter().map(|(t, _)| *t)).collect()
+        GBUFFER.iter().copied().chain(self.1.iter().map(|(t, _)| *t)).collect()
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
@@ -140,7 +150,7 @@ impl Pass for DirectPass {
             writes.push(Write::Sampled(6 + i as u32, vec![(img(t), near)]));
         }
         writes.push(Write::StorageImage(11, img(&RADIANCE)));
-        for (t, binding) in &RAY_TRACED {
+        for (t, binding) in &self.1 {
             writes.push(Write::StorageImage(*binding, img(t)));
         }
         // The media table when a media technique uploaded it (the frame constants then count
@@ -151,7 +161,7 @@ impl Pass for DirectPass {
 
     fn record(&mut self, ctx: &mut FrameCtx) {
         let mut io = super::gbuffer::sampled(&GBUFFER);
-        io.extend(RAY_TRACED.iter().map(|(t, _)| (*t, Access::Read(Use::STORAGE))));
+        io.extend(self.1.iter().map(|(t, _)| (*t, Access::Read(Use::STORAGE))));
         io.push((RADIANCE, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
         self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);

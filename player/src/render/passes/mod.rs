@@ -8,6 +8,7 @@
 //! their descriptor sets at the scene and the frame's images (again after every resize).
 
 pub mod ao;
+pub mod denoise;
 pub mod depth_pyramid;
 pub mod direct;
 pub mod gbuffer;

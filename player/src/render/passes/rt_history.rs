@@ -35,6 +35,8 @@ const MOTION: [TargetDecl; 2] = [
     image("rt motion a", vk::Format::R32G32B32A32_SFLOAT, false),
     image("rt motion b", vk::Format::R32G32B32A32_SFLOAT, false),
 ];
+/// Per pixel: the samples in its running mean after this frame's blend (read by the denoiser).
+pub const SAMPLES: TargetDecl = image("rt samples", vk::Format::R32_SFLOAT, false);
 /// The depth each frame's motion was made at.
 const DEPTHS: [TargetDecl; 2] =
     [image("rt depth a", vk::Format::R32_SFLOAT, false), image("rt depth b", vk::Format::R32_SFLOAT, false)];
@@ -116,6 +118,7 @@ impl RtHistoryPass {
             Binding::one(Sampled),
             Binding::one(StorageImage),
             Binding::one(StorageImage),
+            Binding::one(StorageImage),
         ];
         let push = std::mem::size_of::<BlendPush>() as u32;
         let [motion, layers, one, four] = Kernel::several(
@@ -149,7 +152,7 @@ impl Pass for RtHistoryPass {
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
         let mut made: Vec<(TargetDecl, ImageDesc)> =
-            MOTION.iter().chain(&DEPTHS).map(|t| (*t, t.sized(width, height, 1))).collect();
+            MOTION.iter().chain(&DEPTHS).chain([&SAMPLES]).map(|t| (*t, t.sized(width, height, 1))).collect();
         for a in &self.targets {
             let (w, h) = (width.div_ceil(a.step), height.div_ceil(a.step));
             made.extend(a.histories.iter().map(|t| (*t, t.sized(w, h, a.layers))));
@@ -177,6 +180,7 @@ impl Pass for RtHistoryPass {
                     Write::Sampled(3, vec![(img(&MOTION[1 - turn]), near)]),
                     Write::StorageImage(4, img(&MOTION[turn])),
                     Write::StorageImage(5, img(&DEPTHS[turn])),
+                    Write::StorageImage(6, img(&SAMPLES)),
                 ],
             )?;
             for i in 0..self.targets.len() {
@@ -211,6 +215,7 @@ impl Pass for RtHistoryPass {
                 (MOTION[before], Access::Read(Use::SAMPLED)),
                 (MOTION[now], Access::Write(Use::STORAGE)),
                 (DEPTHS[now], Access::Write(Use::STORAGE)),
+                (SAMPLES, Access::Write(Use::STORAGE)),
             ],
         );
         let (w, h) = (ctx.images.width, ctx.images.height);

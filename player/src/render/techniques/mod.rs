@@ -19,6 +19,7 @@ pub mod knobs;
 
 pub mod aa;
 pub mod ao;
+pub mod denoise;
 pub mod direct;
 pub mod gbuffer;
 pub mod gi;
@@ -28,6 +29,7 @@ pub mod shadows;
 
 pub use aa::Aa;
 pub use ao::Ao;
+pub use denoise::Denoise;
 pub use direct::Direct;
 pub use gbuffer::GBuffer;
 pub use gi::Gi;
@@ -37,6 +39,7 @@ pub use reflections::Reflections;
 pub use shadows::Shadows;
 
 use super::frame::FrameBuild;
+use super::passes::denoise::Noisy;
 use super::passes::rt_history::Accumulated;
 
 /// What a technique does beyond its passes, each with the answer of a technique that does
@@ -76,6 +79,12 @@ pub trait Technique: fmt::Debug + Send + Sync {
     /// The target it makes that the reprojected accumulation carries across frames, for a
     /// scene of `lights` lights (the ray-traced techniques' one sample per pixel per frame).
     fn accumulated(&self, _lights: usize) -> Option<Accumulated> {
+        None
+    }
+
+    /// The noisy signal it makes that a denoiser may filter (its one sample per pixel per frame
+    /// of light the composition reads).
+    fn noisy(&self) -> Option<Noisy> {
         None
     }
 
@@ -281,6 +290,8 @@ pub struct Techniques {
     pub media: Media,
     /// Accumulation / anti-aliasing.
     pub aa: Aa,
+    /// Denoising of the ray-traced signals.
+    pub denoise: Denoise,
 }
 
 /// The sections of a `.kiln` file the chosen passes read (geometry always).
@@ -396,6 +407,7 @@ impl Techniques {
             Effect::Gi => self.gi.technique(),
             Effect::Media => self.media.technique(),
             Effect::Aa => self.aa.technique(),
+            Effect::Denoise => self.denoise.technique(),
         }
     }
 
@@ -410,6 +422,7 @@ impl Techniques {
             Effect::Gi => self.gi.name(),
             Effect::Media => self.media.name(),
             Effect::Aa => self.aa.name(),
+            Effect::Denoise => self.denoise.name(),
         }
     }
 
@@ -472,6 +485,15 @@ impl Techniques {
     /// read the lit pyramid): the first frame lacks it, so the image depends on the frame count.
     pub fn reads_previous_frame(&self) -> bool {
         self.each().any(|t| t.reads_previous_frame())
+    }
+
+    /// The noisy signals the denoiser filters: none without a denoiser, else those of the
+    /// ray-traced techniques that make one, in frame order.
+    pub fn noisy(&self) -> Vec<Noisy> {
+        if self.denoise.name() == "none" {
+            return Vec::new();
+        }
+        self.each().filter_map(|t| t.noisy()).collect()
     }
 
     /// Whether any ray-traced pass runs.
@@ -550,6 +572,7 @@ impl Techniques {
             Effect::Gi => self.gi = built(Gi::build(name, &values))?,
             Effect::Media => self.media = built(Media::build(name, &values))?,
             Effect::Aa => self.aa = built(Aa::build(name, &values))?,
+            Effect::Denoise => self.denoise = built(Denoise::build(name, &values))?,
         }
         Ok(())
     }
@@ -574,11 +597,13 @@ pub enum Effect {
     Media,
     /// Accumulation and anti-aliasing.
     Aa,
+    /// Denoising of the ray-traced signals.
+    Denoise,
 }
 
 impl Effect {
     /// Every effect, in frame order.
-    pub const ALL: [Effect; 8] = [
+    pub const ALL: [Effect; 9] = [
         Effect::GBuffer,
         Effect::Shadows,
         Effect::Direct,
@@ -587,6 +612,7 @@ impl Effect {
         Effect::Gi,
         Effect::Media,
         Effect::Aa,
+        Effect::Denoise,
     ];
 
     /// The effect's name (also its command-line flag without `--`).
@@ -600,6 +626,7 @@ impl Effect {
             Effect::Gi => "gi",
             Effect::Media => "media",
             Effect::Aa => "aa",
+            Effect::Denoise => "denoise",
         }
     }
 
@@ -614,6 +641,7 @@ impl Effect {
             Effect::Gi => "Global illumination",
             Effect::Media => "Participating media",
             Effect::Aa => "Accumulation and anti-aliasing",
+            Effect::Denoise => "Denoising of the ray-traced signals",
         }
     }
 
@@ -628,6 +656,7 @@ impl Effect {
             Effect::Gi => Gi::catalogue(),
             Effect::Media => Media::catalogue(),
             Effect::Aa => Aa::catalogue(),
+            Effect::Denoise => Denoise::catalogue(),
         }
     }
 }

@@ -57,6 +57,16 @@ macro_rules! traced_direct {
             inputs.rt.direct_temporal = self.temporal;
         }
 
+        fn noisy(&self) -> Option<$crate::render::passes::denoise::Noisy> {
+            use $crate::render::passes::denoise::{DIRECT_DENOISED, Noisy};
+            // Outgoing radiance: the BRDF, and so the albedo, is in it.
+            Some(Noisy {
+                target: $crate::render::passes::rt_direct::DIRECT,
+                output: DIRECT_DENOISED,
+                demodulate: true,
+            })
+        }
+
         fn passes<'a>(&'a self, frame: &mut $crate::render::frame::FrameBuild<'a>) {
             use $crate::render::frame::Stage;
             use $crate::render::passes::rt_direct::RtDirectPass;

@@ -48,6 +48,12 @@ macro_rules! traced_gi {
         ) {
             inputs.rt.gi_bounces = self.bounces;
         }
+
+        fn noisy(&self) -> Option<$crate::render::passes::denoise::Noisy> {
+            use $crate::render::passes::denoise::{GI_DENOISED, Noisy};
+            // Mean incoming radiance: no albedo in it.
+            Some(Noisy { target: $crate::render::passes::rt_gi::GI, output: GI_DENOISED, demodulate: false })
+        }
     };
 }
 use traced_gi;
