@@ -188,14 +188,15 @@ struct SsrConstants {
 }; // 20 bytes
 
 struct DenoiseConstants {
-    uint samples; // offset 0
-    uint step; // offset 4
-    uint demodulate; // offset 8
-    uint last; // offset 12
-    float sigma_luminance; // offset 16
-    float sigma_normal; // offset 20
-    float sigma_plane; // offset 24
-}; // 28 bytes
+    uint signals; // offset 0
+    uint samples; // offset 4
+    uint step; // offset 8
+    uint demodulate; // offset 12
+    uint last; // offset 16
+    float sigma_luminance; // offset 20
+    float sigma_normal; // offset 24
+    float sigma_plane; // offset 28
+}; // 32 bytes
 
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;

@@ -5,13 +5,13 @@
 // image converges to the same mean as without the denoiser. Per frame:
 // 1. guide.comp: each pixel's camera-relative position and normal, read by every tap;
 // 2. variance.comp, per signal: the signal divided by the albedo's demodulator where it carries
-//    the albedo, and the variance of its running mean: the second moment's (alpha) variance
+//    the albedo, and the standard deviation of its running mean (half floats from here on): the second moment's (alpha) variance
 //    over the samples averaged, or, with fewer than 4 samples, the variance of the 5 × 5
 //    neighbours on the same surface;
 // 3. atrous.comp, per signal and iteration: the à-trous wavelet filter (5 × 5 B3-spline taps
 //    2^i pixels apart), each tap weighted by the distance from the pixel's tangent plane, the
 //    normals' agreement and the luminance difference in standard deviations of the noise; the
-//    variance filtered with the squared weights; the last iteration multiplies the demodulator
+//    variance filtered with the squared weights (kept as its square root, for half floats' range); the last iteration multiplies the demodulator
 //    back and writes the image the composition reads.
 // As the samples grow the variance of the mean falls as 1/n and the luminance weight closes:
 // the filter fades into the identity.
@@ -25,22 +25,31 @@ layout(push_constant) uniform Push { DenoiseConstants push; };
 
 #include "../common/pixel.glsl"
 
-// The guide of a pixel that shows the sky (no surface): a NaN's bits, which no stored position
-// has.
+// The guide of a pixel: its distance along the camera ray through its centre (the ray
+// pixel_ray(), not normalised, from pixel_origin()) and its packed normal; a pixel that shows
+// the sky (no surface) has a NaN's bits as its distance, which no surface has. 8 bytes a tap:
+// positions are rebuilt from the pixel's ray.
 const uint GUIDE_SKY = 0x7FC00000u;
 
 struct Guide {
-    vec3 p;      // position relative to the camera
+    vec3 p;      // position relative to frame.camera.xyz
     vec3 n;      // shading normal
     bool surface;
 };
 
-Guide unpack_guide(uvec4 g) {
+Guide unpack_guide(ivec2 pixel, uvec2 g) {
     Guide o;
     o.surface = g.x != GUIDE_SKY;
-    o.p = uintBitsToFloat(g.xyz);
-    o.n = oct_decode(unpackSnorm2x16(g.w));
+    vec2 at = vec2(pixel) + 0.5;
+    o.p = (pixel_origin(at) - frame.camera.xyz) + pixel_ray(at) * uintBitsToFloat(g.x);
+    o.n = oct_decode(unpackSnorm2x16(g.y));
     return o;
+}
+
+// What the filter's half-float images keep of a value: at most the largest half (radiance
+// beyond 65504 is clipped there while filtering; the running means keep full floats).
+vec4 half_range(vec4 v) {
+    return min(v, vec4(65504.0));
 }
 
 // The side of a pixel's footprint at camera-relative point p (world units).

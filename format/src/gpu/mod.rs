@@ -345,15 +345,17 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Push constants of the spatiotemporal denoiser (`shaders/denoise/*`; 28 bytes).
+    /// Push constants of the spatiotemporal denoiser (`shaders/denoise/*`; 32 bytes).
     pub struct DenoiseConstants {
+        /// Signals filtered together (1 or 2: image arrays of two, sharing each tap's geometry).
+        pub signals: u32 => "uint",
         /// Samples in every pixel's running mean (a still camera without reprojection); 0: read
         /// them per pixel from the reprojected history's samples image.
         pub samples: u32 => "uint",
         /// À-trous: the spacing of this iteration's taps in pixels (1, 2, 4, …).
         pub step: u32 => "uint",
-        /// 1: the signal is divided by the albedo's demodulator before filtering and multiplied
-        /// back after; 0: it is filtered as it is.
+        /// Bit i set: signal i is divided by the albedo's demodulator before filtering and
+        /// multiplied back after; clear: it is filtered as it is.
         pub demodulate: u32 => "uint",
         /// 1: this iteration is the last and writes the output image.
         pub last: u32 => "uint",

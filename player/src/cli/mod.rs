@@ -10,6 +10,7 @@ use crate::camera::{CameraOverride, CameraPath};
 use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
+use crate::render::presets::Preset;
 use crate::render::techniques::{Effect, KnobValue, Techniques, techniques_of};
 use crate::render::{Purpose, RenderSettings};
 use crate::scene::TextureUpload;
@@ -90,6 +91,12 @@ pub struct Args {
     /// (default 100), or to show before closing the window (default: until closed).
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
+    /// A named technique set for the whole frame (each carries indirect light; those that
+    /// trace GI rays denoise it): baked, baked-taa (no rays), hybrid, rt, rt-taa, rt-2,
+    /// rt-2-taa, linespace. Technique and knob flags given beside it override its choices;
+    /// `kiln-bench --list` says what each sets.
+    #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
+    pub preset: Option<String>,
     /// Headless output: .png (tone-mapped sRGB) or .exr (linear radiance).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -167,13 +174,27 @@ impl Args {
     fn techniques(&self) -> PlayResult<Techniques> {
         let usage = |e: String| PlayError::new(Exit::Usage, e);
         let mut t = Techniques::default();
+        let preset = self.preset.as_deref().map(Preset::named).transpose().map_err(usage)?;
         for effect in Effect::ALL {
             let none = effect == Effect::Aa && self.choices.no_accumulate;
-            let name = if none { "none" } else { self.choices.technique(effect) };
+            let given = if none { Some("none") } else { self.choices.given(effect) };
+            // The preset's choice (and its knobs) unless a flag names another technique.
+            let preset_choice =
+                preset.and_then(|p| p.choice(effect)).filter(|c| given.is_none_or(|g| g == c.technique));
+            let name = given
+                .or(preset_choice.map(|c| c.technique))
+                .unwrap_or_else(|| self.choices.technique(effect));
             let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
                 .find(|i| i.name == name)
                 .map(|i| {
-                    i.knobs.iter().filter_map(|k| self.choices.knob(k.name).map(|v| (k.name, v))).collect()
+                    i.knobs
+                        .iter()
+                        .filter_map(|k| {
+                            let from_preset =
+                                preset_choice.and_then(|c| c.knobs.iter().find(|(n, _)| *n == k.name));
+                            self.choices.knob(k.name).or(from_preset.map(|(_, v)| *v)).map(|v| (k.name, v))
+                        })
+                        .collect()
                 })
                 .unwrap_or_default();
             t.set(effect, name, &knobs).map_err(|e| usage(format!("--{effect} {name}: {e}")))?;
@@ -736,5 +757,20 @@ mod tests {
             }
         }
         assert!(checked >= 10, "only {checked} documented command lines found");
+    }
+
+    /// `--preset` sets its techniques and knobs; flags beside it override a technique or a knob
+    /// and keep the rest of the preset.
+    #[test]
+    fn a_preset_sets_techniques_and_flags_override_it() {
+        let t = techniques(&["f.kiln", "--preset", "rt-2"]);
+        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2 }));
+        assert_eq!((t.name_of(Effect::Shadows), t.name_of(Effect::Denoise)), ("rt", "svgf"));
+        let t = techniques(&["f.kiln", "--preset", "rt-2", "--gi-bounces", "3", "--denoise", "none"]);
+        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 3 }));
+        assert_eq!((t.name_of(Effect::Shadows), t.name_of(Effect::Denoise)), ("rt", "none"));
+        let t = techniques(&["f.kiln", "--preset", "rt-2-taa", "--gi", "ssgi", "--no-accumulate"]);
+        assert_eq!((t.name_of(Effect::Gi), t.name_of(Effect::Aa)), ("ssgi", "none"));
+        assert!(refusal(&["f.kiln", "--preset", "fast"]).contains("rt-taa"));
     }
 }

@@ -25,6 +25,11 @@ impl TechniqueFlags {
         self.chosen.iter().find(|(e, _)| *e == effect).map_or_else(|| default_technique(effect), |(_, n)| n)
     }
 
+    /// The technique a flag names for `effect`, if one does.
+    pub(super) fn given(&self, effect: Effect) -> Option<&str> {
+        self.chosen.iter().find(|(e, _)| *e == effect).map(|(_, n)| n.as_str())
+    }
+
     /// The value the command line gives the knob `name`.
     pub(super) fn knob(&self, name: &str) -> Option<KnobValue> {
         self.knobs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)

@@ -97,7 +97,7 @@ impl Drop for SetLayout {
 }
 
 /// One descriptor write.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub enum Write<'a> {
     /// A whole buffer at a binding.
     Buffer(u32, &'a Buffer),
@@ -106,6 +106,8 @@ pub enum Write<'a> {
     Sampled(u32, Vec<(vk::ImageView, vk::Sampler)>),
     /// A storage image (GENERAL layout).
     StorageImage(u32, vk::ImageView),
+    /// Storage images at a binding, from array element 0 (GENERAL layout).
+    StorageImages(u32, Vec<vk::ImageView>),
 }
 
 impl SetLayout {
@@ -182,6 +184,16 @@ impl SetLayout {
                     image_view: *view,
                     image_layout: vk::ImageLayout::GENERAL,
                 }]),
+                Write::StorageImages(_, views) => image_infos.push(
+                    views
+                        .iter()
+                        .map(|&image_view| vk::DescriptorImageInfo {
+                            sampler: vk::Sampler::null(),
+                            image_view,
+                            image_layout: vk::ImageLayout::GENERAL,
+                        })
+                        .collect(),
+                ),
             }
         }
         let (mut bi, mut ii) = (0, 0);
@@ -189,9 +201,10 @@ impl SetLayout {
             .iter()
             .map(|w| {
                 let (binding, base) = match w {
-                    Write::Buffer(b, _) | Write::Sampled(b, _) | Write::StorageImage(b, _) => {
-                        (*b, vk::WriteDescriptorSet::default().dst_set(set))
-                    }
+                    Write::Buffer(b, _)
+                    | Write::Sampled(b, _)
+                    | Write::StorageImage(b, _)
+                    | Write::StorageImages(b, _) => (*b, vk::WriteDescriptorSet::default().dst_set(set)),
                 };
                 let ty = self.bindings[binding as usize].kind.vk();
                 let base = base.dst_binding(binding).descriptor_type(ty);

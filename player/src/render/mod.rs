@@ -14,6 +14,7 @@ pub mod frame;
 pub mod graph;
 pub mod lights;
 pub mod passes;
+pub mod presets;
 pub mod spirv;
 pub mod techniques;
 pub mod texels;

@@ -41,10 +41,15 @@ pub struct Args {
     /// its own reference and charts.
     #[arg(long = "camera", allow_negative_numbers = true)]
     pub cameras: Vec<CameraOverride>,
-    /// Charts to make, comma-separated: shadows, direct, ao, reflections, gi, media, aa, frame.
-    #[arg(long, value_delimiter = ',', default_value = "shadows,direct,ao,reflections,gi,media,aa,frame")]
+    /// Charts to make, comma-separated: shadows, direct, ao, reflections, gi, denoise, media,
+    /// aa, frame.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "shadows,direct,ao,reflections,gi,denoise,media,aa,frame"
+    )]
     pub effects: Vec<String>,
-    /// Only these techniques, comma-separated: EFFECT:TECHNIQUE (e.g. ao:rt, frame:rt-half)
+    /// Only these techniques, comma-separated: EFFECT:TECHNIQUE (e.g. ao:rt, frame:rt-taa)
     /// or TECHNIQUE in any effect. Default: all (--list shows them).
     #[arg(long, value_delimiter = ',')]
     pub techniques: Vec<String>,

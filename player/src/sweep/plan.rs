@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
+use crate::render::presets::PRESETS;
 use crate::render::techniques::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
 use crate::render::{Effect, Needs, Techniques};
 use crate::scene::linespace::variants_needed;
@@ -21,12 +22,13 @@ pub enum Target {
 
 impl Target {
     /// Every target `--effects` accepts, in the order they are swept.
-    pub const ALL: [Target; 8] = [
+    pub const ALL: [Target; 9] = [
         Target::Effect(Effect::Shadows),
         Target::Effect(Effect::Direct),
         Target::Effect(Effect::Ao),
         Target::Effect(Effect::Reflections),
         Target::Effect(Effect::Gi),
+        Target::Effect(Effect::Denoise),
         Target::Effect(Effect::Media),
         Target::Effect(Effect::Aa),
         Target::Frame,
@@ -227,62 +229,9 @@ impl Request {
 pub fn names(target: Target) -> Vec<&'static str> {
     match target {
         Target::Effect(e) => techniques_of(e).map(|t| t.name).collect(),
-        Target::Frame => PRESETS.iter().map(|p| p.0).collect(),
+        Target::Frame => PRESETS.iter().map(|p| p.name).collect(),
     }
 }
-
-/// Whole-frame presets: (name, what it is, how it sets the techniques). Each keeps the default
-/// `--direct restir` where the file has emissive materials (`--direct none` elsewhere): the light
-/// of emissive surfaces is part of every frame a user sees.
-type Preset = (&'static str, &'static str, fn(&mut Techniques));
-
-/// The frame presets, each with both G-buffers.
-const PRESETS: [Preset; 8] = [
-    ("baked", "shadow maps, no AO, split-sum reflections", |t| {
-        set(t, Effect::Shadows, "shadowmap");
-    }),
-    ("baked-ssr", "as baked with screen-space reflections (--reflections ssr)", |t| {
-        set(t, Effect::Shadows, "shadowmap");
-        set(t, Effect::Reflections, "ssr");
-    }),
-    ("baked-taa", "as baked with temporal anti-aliasing (--aa taa)", |t| {
-        set(t, Effect::Shadows, "shadowmap");
-        set(t, Effect::Aa, "taa");
-    }),
-    ("rt", "ray-traced shadows, AO and full-resolution reflections (seed 001)", |t| {
-        set(t, Effect::Shadows, "rt");
-        set(t, Effect::Ao, "rt");
-        set(t, Effect::Reflections, "rt");
-    }),
-    ("rt-reproject", "as rt with the running mean following a moving camera (--aa reproject)", |t| {
-        set(t, Effect::Shadows, "rt");
-        set(t, Effect::Ao, "rt");
-        set(t, Effect::Reflections, "rt");
-        set(t, Effect::Aa, "reproject");
-    }),
-    (
-        "rt-taa",
-        "as rt with temporal anti-aliasing (--aa taa): its history is reprojected while the camera moves",
-        |t| {
-            set(t, Effect::Shadows, "rt");
-            set(t, Effect::Ao, "rt");
-            set(t, Effect::Reflections, "rt");
-            set(t, Effect::Aa, "taa");
-        },
-    ),
-    ("rt-gi", "as rt with path-traced GI (--gi rt, one bounce)", |t| {
-        set(t, Effect::Shadows, "rt");
-        set(t, Effect::Ao, "rt");
-        set(t, Effect::Reflections, "rt");
-        set(t, Effect::Gi, "rt");
-    }),
-    ("rt-half", "as rt with half-resolution reflections", |t| {
-        set(t, Effect::Shadows, "rt");
-        set(t, Effect::Ao, "rt");
-        t.set(Effect::Reflections, "rt", &[("reflection-res", KnobValue::Choice(1))])
-            .expect("a catalogue knob");
-    }),
-];
 
 fn set(t: &mut Techniques, effect: Effect, name: &str) {
     t.set(effect, name, &[]).expect("a catalogue technique");
@@ -301,11 +250,18 @@ pub fn fixed(offers: &Offers) -> Techniques {
 
 /// What an effect's chart holds fixed: [`fixed`], except that the chart of the emissive
 /// surfaces' direct light traces their shadow rays (`--shadows none` would leave them
-/// unshadowed).
+/// unshadowed), and the denoiser's chart renders what it filters: path-traced GI, and the
+/// emissive surfaces' direct light (ray-traced shadows) where the file emits.
 fn fixed_for(effect: Effect, offers: &Offers) -> Techniques {
     let mut t = fixed(offers);
-    if effect == Effect::Direct && offers.bvh {
+    if matches!(effect, Effect::Direct | Effect::Denoise) && offers.bvh {
         set(&mut t, Effect::Shadows, "rt");
+    }
+    if effect == Effect::Denoise && offers.bvh {
+        set(&mut t, Effect::Gi, "rt");
+        if offers.emission {
+            set(&mut t, Effect::Direct, "restir");
+        }
     }
     t
 }
@@ -369,13 +325,16 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                             technique: info.name.to_string(),
                             knobs: combo.iter().map(|(n, _, text)| (n.to_string(), text.clone())).collect(),
                             techniques: t,
-                            checkpoints: checkpoints(info.stochastic, &t),
+                            // A frame that traces rays improves with frames whatever the
+                            // effect's technique (the denoiser's `none` among them).
+                            checkpoints: checkpoints(info.stochastic || t.ray_traced(), &t),
                         });
                     }
                 }
             }
             Target::Frame => {
-                for (name, _, apply) in PRESETS {
+                for preset in &PRESETS {
+                    let name = preset.name;
                     if !request.wants(target, name) {
                         continue;
                     }
@@ -387,7 +346,7 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                             // What a session does with such a file: nothing to sample.
                             set(&mut t, Effect::Direct, "none");
                         }
-                        apply(&mut t);
+                        preset.apply(&mut t);
                         if let Some(reason) = offers.lacks(&t) {
                             push_skip(&mut skipped, target, name, &reason);
                             continue;
@@ -430,7 +389,7 @@ pub fn describe_fixed_map(fixed: &BTreeMap<String, String>, except: &str) -> Str
 
 /// One line per preset for `--list`.
 pub fn preset_help() -> Vec<String> {
-    PRESETS.iter().map(|(n, help, _)| format!("{n}: {help} (with each G-buffer)")).collect()
+    PRESETS.iter().map(|p| format!("{}: {} (with each G-buffer)", p.name, p.help)).collect()
 }
 
 #[cfg(test)]
@@ -524,7 +483,7 @@ mod tests {
 
     #[test]
     fn filters_are_checked() {
-        assert!(request(vec![], &["ao:rt", "shadowmap", "frame:rt-half"]).check().is_ok());
+        assert!(request(vec![], &["ao:rt", "shadowmap", "frame:rt-taa"]).check().is_ok());
         let e = request(vec![], &["ao:shadowmap"]).check().unwrap_err();
         assert!(e.contains("ao:shadowmap"), "{e}");
         assert!(Target::parse("fog").unwrap_err().contains("shadows, direct, ao"));

@@ -23,13 +23,24 @@ const fn storage(name: &'static str, format: vk::Format) -> TargetDecl {
 pub const DIRECT_DENOISED: TargetDecl = storage("rt direct denoised", vk::Format::R32G32B32A32_SFLOAT);
 /// The denoised GI (in place of `rt_gi::GI`).
 pub const GI_DENOISED: TargetDecl = storage("rt gi denoised", vk::Format::R32G32B32A32_SFLOAT);
-/// Per pixel: camera-relative position and packed normal.
-const GUIDE: TargetDecl = storage("denoise guide", vk::Format::R32G32B32A32_UINT);
-/// The filter's two images (demodulated rgb, variance), taking turns.
-const PING_PONG: [TargetDecl; 2] = [
-    storage("denoise a", vk::Format::R32G32B32A32_SFLOAT),
-    storage("denoise b", vk::Format::R32G32B32A32_SFLOAT),
+/// Per pixel: distance along its camera ray and packed normal (8 bytes a tap).
+const GUIDE: TargetDecl = storage("denoise guide", vk::Format::R32G32_UINT);
+/// The filter's two pairs of images (per signal of a pair: demodulated rgb, the noise's
+/// standard deviation) in half floats, taking turns: half the bytes a tap reads of full floats.
+const PING_PONG: [[TargetDecl; 2]; 2] = [
+    [
+        storage("denoise a0", vk::Format::R16G16B16A16_SFLOAT),
+        storage("denoise a1", vk::Format::R16G16B16A16_SFLOAT),
+    ],
+    [
+        storage("denoise b0", vk::Format::R16G16B16A16_SFLOAT),
+        storage("denoise b1", vk::Format::R16G16B16A16_SFLOAT),
+    ],
 ];
+
+/// Signals filtered by one dispatch (the kernels' image arrays): each tap's geometry weight,
+/// most of a tap's cost, serves both.
+const PER_DISPATCH: usize = 2;
 
 /// A noisy signal a ray-traced technique makes (`Technique::noisy`): its running mean (rgb, and
 /// the mean of its demodulated luminance squared in alpha) and where the denoised image goes.
@@ -80,21 +91,24 @@ impl DenoisePass {
             Binding::one(Sampled),
             Binding::one(StorageImage),
         ];
-        let filtering: &[Binding] = &[
+        let pairs = Binding { kind: StorageImage, count: PER_DISPATCH as u32 };
+        let variance: &[Binding] = &[
             Binding::one(Uniform),
             Binding::one(Sampled),
             Binding::one(StorageImage),
+            pairs,
             Binding::one(StorageImage),
-            Binding::one(StorageImage),
-            Binding::one(StorageImage),
+            pairs,
         ];
+        let atrous: &[Binding] =
+            &[Binding::one(Uniform), Binding::one(Sampled), Binding::one(StorageImage), pairs, pairs, pairs];
         let push = std::mem::size_of::<DenoiseConstants>() as u32;
         let [guide, variance, atrous] = Kernel::several(
             gpu,
             [
                 (guide, spirv::shader!("denoise/guide.comp")),
-                (filtering, spirv::shader!("denoise/variance.comp")),
-                (filtering, spirv::shader!("denoise/atrous.comp")),
+                (variance, spirv::shader!("denoise/variance.comp")),
+                (atrous, spirv::shader!("denoise/atrous.comp")),
             ],
             push,
         )?;
@@ -102,17 +116,44 @@ impl DenoisePass {
         Ok(DenoisePass { guide, variance, atrous, signals, filter, reprojected })
     }
 
-    fn constants(&self, signal: &Noisy, samples: u32, iteration: u32) -> DenoiseConstants {
+    fn constants(&self, group: &[Noisy], samples: u32, iteration: u32) -> DenoiseConstants {
         DenoiseConstants {
+            signals: group.len() as u32,
             samples,
             step: 1 << iteration,
-            demodulate: signal.demodulate as u32,
+            demodulate: group.iter().enumerate().map(|(i, s)| (s.demodulate as u32) << i).sum(),
             last: (iteration + 1 == self.filter.iterations) as u32,
             sigma_luminance: self.filter.sigma_luminance,
             sigma_normal: self.filter.sigma_normal,
             sigma_plane: self.filter.sigma_plane,
         }
     }
+
+    /// The signals in the groups one dispatch filters.
+    fn groups(&self) -> std::slice::Chunks<'_, Noisy> {
+        self.signals.chunks(PER_DISPATCH)
+    }
+}
+
+/// Both kernels' bindings 0-2 (`head`), then 3-5 as `rest` gives them (each an image or a
+/// pair; their own binding numbers are replaced).
+fn with_bindings<'a>(head: &[Write<'a>; 3], rest: [Write<'a>; 3]) -> Vec<Write<'a>> {
+    let mut w = head.to_vec();
+    for (binding, write) in (3..).zip(rest) {
+        w.push(match write {
+            Write::StorageImages(_, v) => Write::StorageImages(binding, v),
+            Write::StorageImage(_, v) => Write::StorageImage(binding, v),
+            other => other,
+        });
+    }
+    w
+}
+
+/// A group's images at one binding: `pick` of each signal, the first repeated where the group
+/// has one signal (that slot is never read).
+fn pair(group: &[Noisy], pick: impl Fn(usize, &Noisy) -> TargetDecl) -> [TargetDecl; 2] {
+    let first = pick(0, &group[0]);
+    [first, group.get(1).map_or(first, |s| pick(1, s))]
 }
 
 impl Pass for DenoisePass {
@@ -121,7 +162,9 @@ impl Pass for DenoisePass {
     }
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
-        let mut made: Vec<TargetDecl> = vec![GUIDE, PING_PONG[0], PING_PONG[1]];
+        let mut made: Vec<TargetDecl> = vec![GUIDE];
+        let [a, b] = PING_PONG;
+        made.extend(a.into_iter().zip(b).take(self.signals.len()).flat_map(|(a, b)| [a, b]));
         made.extend(self.signals.iter().map(|s| s.output));
         made.into_iter().map(|t| (t, t.sized(width, height, 1))).collect()
     }
@@ -132,7 +175,7 @@ impl Pass for DenoisePass {
         b
     }
 
-    fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
+    fn bind<'a>(&mut self, gpu: &Gpu, shared: &Shared<'a>) -> PlayResult {
         let img = |t: &TargetDecl| shared.images.get(t).view;
         let near = shared.scene.nearest_clamp;
         self.guide.write(
@@ -144,21 +187,24 @@ impl Pass for DenoisePass {
                 Write::StorageImage(3, img(&GUIDE)),
             ],
         )?;
-        let common = |set: [TargetDecl; 3]| {
-            vec![
-                Write::Buffer(0, shared.frame_ubo),
-                Write::Sampled(1, vec![(img(&ALBEDO), near)]),
-                Write::StorageImage(2, img(&GUIDE)),
-                Write::StorageImage(3, img(&set[0])),
-                Write::StorageImage(4, img(&set[1])),
-                Write::StorageImage(5, img(&set[2])),
-            ]
-        };
-        for (i, s) in self.signals.iter().enumerate() {
-            self.variance.write_set(gpu, i, &common([s.target, SAMPLES, PING_PONG[0]]))?;
+        let views = |t: [TargetDecl; 2]| Write::StorageImages(0, t.iter().map(img).collect());
+        let head = [
+            Write::Buffer(0, shared.frame_ubo),
+            Write::Sampled(1, vec![(img(&ALBEDO), near)]),
+            Write::StorageImage(2, img(&GUIDE)),
+        ];
+        let set = |rest: [Write<'a>; 3]| with_bindings(&head, rest);
+        let groups: Vec<Vec<Noisy>> = self.groups().map(|g| g.to_vec()).collect();
+        for (g, group) in groups.iter().enumerate() {
+            let noisy = pair(group, |_, s| s.target);
+            let first = pair(group, |i, _| PING_PONG[0][i]);
+            let samples = Write::StorageImage(0, img(&SAMPLES));
+            self.variance.write_set(gpu, g, &set([views(noisy), samples, views(first)]))?;
             for turn in 0..2 {
-                let set = common([PING_PONG[turn], PING_PONG[1 - turn], s.output]);
-                self.atrous.write_set(gpu, 2 * i + turn, &set)?;
+                let src = pair(group, |i, _| PING_PONG[turn][i]);
+                let dst = pair(group, |i, _| PING_PONG[1 - turn][i]);
+                let out = pair(group, |_, s| s.output);
+                self.atrous.write_set(gpu, 2 * g + turn, &set([views(src), views(dst), views(out)]))?;
             }
         }
         Ok(())
@@ -177,38 +223,37 @@ impl Pass for DenoisePass {
                 (GUIDE, Access::Write(Use::STORAGE)),
             ],
         );
-        let first = self.constants(&self.signals[0], 0, 0);
+        let first = self.constants(&self.signals[..1], 0, 0);
         self.guide.dispatch(ctx.rec, bytemuck::bytes_of(&first), w, h);
         // A still camera's running mean holds the frames accumulated before this one and this
         // one; a reprojected history says per pixel.
         let samples = if self.reprojected { 0 } else { ctx.rt.accumulated + 1 };
-        for (i, s) in self.signals.iter().enumerate() {
-            ctx.images.access(
-                ctx.rec,
-                &[
-                    (ALBEDO, Access::Read(Use::SAMPLED)),
-                    (GUIDE, Access::Read(Use::STORAGE)),
-                    (s.target, Access::Read(Use::STORAGE)),
-                    (SAMPLES, Access::Read(Use::STORAGE)),
-                    (PING_PONG[0], Access::Write(Use::STORAGE)),
-                ],
-            );
-            let c = self.constants(s, samples, 0);
-            self.variance.dispatch_set(ctx.rec, i, bytemuck::bytes_of(&c), w, h);
+        for (g, group) in self.groups().enumerate() {
+            let mut io = vec![
+                (ALBEDO, Access::Read(Use::SAMPLED)),
+                (GUIDE, Access::Read(Use::STORAGE)),
+                (SAMPLES, Access::Read(Use::STORAGE)),
+            ];
+            for (i, s) in group.iter().enumerate() {
+                io.push((s.target, Access::Read(Use::STORAGE)));
+                io.push((PING_PONG[0][i], Access::Write(Use::STORAGE)));
+            }
+            ctx.images.access(ctx.rec, &io);
+            let c = self.constants(group, samples, 0);
+            self.variance.dispatch_set(ctx.rec, g, bytemuck::bytes_of(&c), w, h);
             for it in 0..self.filter.iterations {
                 let turn = it as usize % 2;
-                // Both images an iteration may write are bound (and so must be in the storage
+                // Every image an iteration may write is bound (and so must be in the storage
                 // layout), whichever it writes.
-                ctx.images.access(
-                    ctx.rec,
-                    &[
-                        (PING_PONG[turn], Access::Read(Use::STORAGE)),
-                        (PING_PONG[1 - turn], Access::Write(Use::STORAGE)),
-                        (s.output, Access::Write(Use::STORAGE)),
-                    ],
-                );
-                let c = self.constants(s, samples, it);
-                self.atrous.dispatch_set(ctx.rec, 2 * i + turn, bytemuck::bytes_of(&c), w, h);
+                let mut io = Vec::new();
+                for (i, s) in group.iter().enumerate() {
+                    io.push((PING_PONG[turn][i], Access::Read(Use::STORAGE)));
+                    io.push((PING_PONG[1 - turn][i], Access::Write(Use::STORAGE)));
+                    io.push((s.output, Access::Write(Use::STORAGE)));
+                }
+                ctx.images.access(ctx.rec, &io);
+                let c = self.constants(group, samples, it);
+                self.atrous.dispatch_set(ctx.rec, 2 * g + turn, bytemuck::bytes_of(&c), w, h);
             }
         }
     }

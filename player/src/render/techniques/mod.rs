@@ -542,6 +542,13 @@ impl Techniques {
     /// Warnings for what the file lacks that the chosen techniques read.
     pub fn warnings(&self, manifest: &kiln_format::Manifest) -> Vec<String> {
         let mut warnings = Vec::new();
+        if self.denoise.name() != "none" && self.noisy().is_empty() {
+            warnings.push(format!(
+                "--denoise {}: no ray-traced signal to filter in this frame (it filters --gi rt|linespace and \
+                 --direct ris|restir); it does nothing",
+                self.denoise.name()
+            ));
+        }
         for e in Effect::ALL {
             let flag = format!("--{e} {}", self.name_of(e));
             self.get(e).warnings(&flag, manifest, &mut warnings);

@@ -32,7 +32,7 @@ impl Registered for Svgf {
             1.0,
             8.0,
             4.0,
-            &[2.0, 5.0],
+            &[2.0, 4.0, 5.0],
         )),
         number(
             "denoise-sigma-luminance",
@@ -41,7 +41,7 @@ impl Registered for Svgf {
             0.5,
             64.0,
             4.0,
-            &[2.0, 8.0],
+            &[2.0, 4.0, 8.0],
         ),
     ];
     const STOCHASTIC: bool = true;
