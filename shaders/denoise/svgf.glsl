@@ -58,13 +58,11 @@ float footprint(vec3 p) {
     return camera_orthographic() ? per_unit : per_unit * length(p);
 }
 
-// The edge-stopping weight of geometry between pixel p and a tap q `pixels` away: the tap's
-// distance from p's tangent plane against σ_plane footprints per pixel of separation, and the
-// normals' agreement to the power σ_n.
-float geometry_weight(Guide p, Guide q, float pixels) {
+// The edge-stopping weight of geometry between pixel p and a tap q: the tap's distance from
+// p's tangent plane against `scale` (σ_plane pixel footprints at p times the taps' separation
+// in pixels), and the normals' agreement to the power σ_n.
+float geometry_weight(Guide p, Guide q, float scale) {
     float plane = abs(dot(p.n, q.p - p.p));
-    float scale = push.sigma_plane * footprint(p.p) * pixels;
-    float wz = exp(-plane / max(scale, 1e-30));
     float wn = pow(max(dot(p.n, q.n), 0.0), push.sigma_normal);
-    return wz * wn;
+    return exp(-plane / max(scale, 1e-30)) * wn;
 }

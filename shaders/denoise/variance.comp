@@ -52,7 +52,7 @@ void main() {
     }
     // Too few samples for the pixel's own moments: those of the 5 × 5 neighbours on the same
     // surface (weighted by geometry alone).
-    float sw = 0.0;
+    float sw = 0.0, scale = push.sigma_plane * footprint(g.p);
     vec2 sl = vec2(0.0), sm = vec2(0.0);
     for (int dy = -2; dy <= 2; ++dy) {
         for (int dx = -2; dx <= 2; ++dx) {
@@ -64,18 +64,23 @@ void main() {
             if (!gq.surface) {
                 continue;
             }
-            float w = (dx == 0 && dy == 0) ? 1.0 : geometry_weight(g, gq, length(vec2(dx, dy)));
+            float w = (dx == 0 && dy == 0) ? 1.0 : geometry_weight(g, gq, scale * length(vec2(dx, dy)));
             sw += w;
-            for (uint i = 0u; i < signals; ++i) {
+            for (uint i = 0u; i < 2u; ++i) {
+                if (i >= signals) {
+                    break;
+                }
                 vec4 cq = load_noisy(i, q);
                 sl[i] += w * luminance(cq.rgb / demodulation(i, q));
                 sm[i] += w * cq.a;
             }
         }
     }
-    for (uint i = 0u; i < signals; ++i) {
-        float mean = sl[i] / sw;
-        float variance = max(sm[i] / sw - mean * mean, 0.0);
-        store(i, pixel, vec4(load_noisy(i, pixel).rgb / demodulation(i, pixel), sqrt(variance / n)));
+    for (uint i = 0u; i < 2u; ++i) {
+        if (i < signals) {
+            float mean = sl[i] / sw;
+            float variance = max(sm[i] / sw - mean * mean, 0.0);
+            store(i, pixel, vec4(load_noisy(i, pixel).rgb / demodulation(i, pixel), sqrt(variance / n)));
+        }
     }
 }

@@ -92,8 +92,8 @@ pub struct Args {
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
     /// A named technique set for the whole frame (each carries indirect light; those that
-    /// trace GI rays denoise it): baked, baked-taa (no rays), hybrid, rt, rt-taa, rt-2,
-    /// rt-2-taa, linespace. Technique and knob flags given beside it override its choices;
+    /// trace GI rays denoise it): baked, baked-taa (no rays), hybrid, rt, rt-taa, rt-2, rt-4,
+    /// rt-4-taa, linespace. Technique and knob flags given beside it override its choices;
     /// `kiln-bench --list` says what each sets.
     #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
     pub preset: Option<String>,
@@ -769,7 +769,7 @@ mod tests {
         let t = techniques(&["f.kiln", "--preset", "rt-2", "--gi-bounces", "3", "--denoise", "none"]);
         assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 3 }));
         assert_eq!((t.name_of(Effect::Shadows), t.name_of(Effect::Denoise)), ("rt", "none"));
-        let t = techniques(&["f.kiln", "--preset", "rt-2-taa", "--gi", "ssgi", "--no-accumulate"]);
+        let t = techniques(&["f.kiln", "--preset", "rt-4-taa", "--gi", "ssgi", "--no-accumulate"]);
         assert_eq!((t.name_of(Effect::Gi), t.name_of(Effect::Aa)), ("ssgi", "none"));
         assert!(refusal(&["f.kiln", "--preset", "fast"]).contains("rt-taa"));
     }

@@ -41,11 +41,13 @@ const RT_REFLECTIONS: Choice = pick(Effect::Reflections, "rt");
 const RT_GI: Choice = pick(Effect::Gi, "rt");
 const RT_GI_2: Choice =
     Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(2.0))] };
+const RT_GI_4: Choice =
+    Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(4.0))] };
 const SVGF: Choice = pick(Effect::Denoise, "svgf");
 const TAA: Choice = pick(Effect::Aa, "taa");
 
 /// The presets, cheapest first.
-pub const PRESETS: [Preset; 8] = [
+pub const PRESETS: [Preset; 9] = [
     Preset {
         name: "baked",
         help: "no rays: shadow maps, screen-space GI and reflections",
@@ -77,9 +79,14 @@ pub const PRESETS: [Preset; 8] = [
         choices: &[RT_SHADOWS, RT_REFLECTIONS, RT_GI_2, SVGF],
     },
     Preset {
-        name: "rt-2-taa",
-        help: "as rt-2 with temporal anti-aliasing",
-        choices: &[RT_SHADOWS, RT_REFLECTIONS, RT_GI_2, SVGF, TAA],
+        name: "rt-4",
+        help: "as rt with four bounces of GI (--gi-bounces 4): closed, bright rooms keep their light",
+        choices: &[RT_SHADOWS, RT_REFLECTIONS, RT_GI_4, SVGF],
+    },
+    Preset {
+        name: "rt-4-taa",
+        help: "as rt-4 with temporal anti-aliasing",
+        choices: &[RT_SHADOWS, RT_REFLECTIONS, RT_GI_4, SVGF, TAA],
     },
     Preset {
         name: "linespace",

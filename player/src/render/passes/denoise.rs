@@ -66,6 +66,8 @@ pub struct Filter {
     pub sigma_normal: f32,
     /// Depth edge-stopping in pixel footprints per pixel of separation.
     pub sigma_plane: f32,
+    /// Taps an iteration along each axis: 5 (SVGF's B3 spline) or 3 (the linear B-spline).
+    pub taps: u32,
 }
 
 /// The pass.
@@ -108,7 +110,14 @@ impl DenoisePass {
             [
                 (guide, spirv::shader!("denoise/guide.comp")),
                 (variance, spirv::shader!("denoise/variance.comp")),
-                (atrous, spirv::shader!("denoise/atrous.comp")),
+                (
+                    atrous,
+                    if filter.taps == 3 {
+                        spirv::shader!("denoise/atrous3.comp")
+                    } else {
+                        spirv::shader!("denoise/atrous.comp")
+                    },
+                ),
             ],
             push,
         )?;
