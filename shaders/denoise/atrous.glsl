@@ -97,7 +97,7 @@ void main() {
                 if (!gq.surface) {
                     continue;
                 }
-                wg *= geometry_weight(g, gq, scale * length(vec2(dx, dy)) * float(step));
+                wg *= geometry_weight(g, gq, scale);
             }
             for (uint i = 0u; i < 2u; ++i) {
                 if (i >= signals) {

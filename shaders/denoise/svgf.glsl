@@ -59,8 +59,9 @@ float footprint(vec3 p) {
 }
 
 // The edge-stopping weight of geometry between pixel p and a tap q: the tap's distance from
-// p's tangent plane against `scale` (σ_plane pixel footprints at p times the taps' separation
-// in pixels), and the normals' agreement to the power σ_n.
+// p's tangent plane against `scale` (σ_plane pixel footprints at p, whatever the taps'
+// separation: a surface one unit behind another is as far from it 16 pixels away as 1), and
+// the normals' agreement to the power σ_n.
 float geometry_weight(Guide p, Guide q, float scale) {
     float plane = abs(dot(p.n, q.p - p.p));
     float wn = pow(max(dot(p.n, q.n), 0.0), push.sigma_normal);

@@ -64,7 +64,7 @@ void main() {
             if (!gq.surface) {
                 continue;
             }
-            float w = (dx == 0 && dy == 0) ? 1.0 : geometry_weight(g, gq, scale * length(vec2(dx, dy)));
+            float w = (dx == 0 && dy == 0) ? 1.0 : geometry_weight(g, gq, scale);
             sw += w;
             for (uint i = 0u; i < 2u; ++i) {
                 if (i >= signals) {

@@ -31,10 +31,10 @@ const TOLERANCE: f64 = 0.015;
 
 /// The emissive quad: the rect light of `rect.rs` (1 × 0.6 at height 2, tilted 22° towards +x,
 /// radiance 4) made of two emissive triangles, emitting downwards.
-struct Quad(Rect);
+pub(crate) struct Quad(pub(crate) Rect);
 
 impl Quad {
-    fn new() -> Quad {
+    pub(crate) fn new() -> Quad {
         Quad(Rect::new())
     }
 
@@ -57,32 +57,46 @@ impl Quad {
     }
 
     /// The closed-form irradiance at p (normal +y) from the part s ∈ [0, s_max].
-    fn irradiance(&self, p: DVec3, s_max: f64) -> f64 {
+    pub(crate) fn irradiance(&self, p: DVec3, s_max: f64) -> f64 {
         self.0.part_irradiance(p, s_max)
     }
 
     /// Whether p sees the emitting side, with a margin.
-    fn in_front(&self, p: DVec3) -> bool {
+    pub(crate) fn in_front(&self, p: DVec3) -> bool {
         self.0.in_front(p)
     }
 
     /// Whether the ray o + t d (t > 0) passes within `margin` of the quad (the camera sees it
     /// rather than the floor).
-    fn crossed_by(&self, o: DVec3, d: DVec3, margin: f64) -> bool {
+    pub(crate) fn crossed_by(&self, o: DVec3, d: DVec3, margin: f64) -> bool {
         self.0.crossing(o, d, margin).is_some()
     }
 }
 
-fn camera() -> Pinhole {
+pub(crate) fn camera() -> Pinhole {
     Pinhole::new([2.0, 7.0, 6.0], [0.5, 0.0, -0.5], [0.0, 1.0, 0.0], 60.0, W, H)
 }
 
 /// A floor of the analytic albedo under the quad's part s ∈ [0, s_max], or with `textured` the
 /// whole quad with an emissive texture black on its right half.
 fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
-    let quad = Quad::new();
+    quad_scene_with(cam, &Quad::new(), s_max, textured, &[], ALBEDO)
+}
+
+/// [`quad_scene`] with the lamp `quad` and `extra` triangles of a Lambert material of base
+/// colour `extra_base` (sRGB codes).
+pub(crate) fn quad_scene_with(
+    cam: &Pinhole,
+    quad: &Quad,
+    s_max: f64,
+    textured: bool,
+    extra: &[[Vec3; 3]],
+    extra_base: [u8; 3],
+) -> Vec<u8> {
+    assert!(!(textured && !extra.is_empty()), "the texture's UVs assume the floor alone before the lamp");
     let (lamp, lamp_uv) = quad.triangles(if textured { 1.0 } else { s_max });
     let mut tris = square(0.0, 10.0).to_vec();
+    tris.extend_from_slice(extra);
     tris.extend(lamp);
     let mut scene = scene_of(&tris);
     scene.materials[0].gpu = lambert_material(ALBEDO.map(srgb8));
@@ -109,6 +123,10 @@ fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
     scene.materials.push(Material { name: "lamp".into(), gpu: glow });
     let n = scene.triangle_materials.len();
     scene.triangle_materials[n - 2..].fill(1);
+    if !extra.is_empty() {
+        scene.materials.push(Material { name: "extra".into(), gpu: lambert_material(extra_base.map(srgb8)) });
+        scene.triangle_materials[2..2 + extra.len()].fill(2);
+    }
     scene.sky = Sky { radiance: [0.0; 3] };
     scene.cameras.push(cam.file_camera());
     compile(scene, fast_settings())

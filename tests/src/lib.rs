@@ -13,7 +13,7 @@ use kiln_player::render::techniques::gi::linespace::GiStructure;
 use kiln_player::render::techniques::reflections::rt::ReflectionRes;
 use kiln_player::render::techniques::shadows::linespace::LsShadowTest;
 use kiln_player::render::techniques::{
-    Direct, ao as ao_techniques, direct, gbuffer, gi, media, reflections, shadows,
+    Direct, KnobValue, ao as ao_techniques, direct, gbuffer, gi, media, reflections, shadows,
 };
 use kiln_player::render::{
     Aa, Ao, Effect, GBuffer as GBufferTechnique, Gi, Media, Purpose, Reflections as ReflectionsTechnique,
@@ -109,6 +109,17 @@ impl Options {
     pub fn restir(mut self, candidates: u32, spatial: u32, temporal: u32) -> Options {
         self.0.render.techniques.direct =
             Direct::Restir(direct::restir::Restir { candidates, spatial, temporal });
+        self
+    }
+
+    /// The denoiser (`--denoise svgf`) with `iterations` à-trous iterations of `taps` × `taps`
+    /// (3 or 5), the other knobs at their defaults.
+    pub fn svgf(mut self, iterations: u32, taps: u32) -> Options {
+        let knobs = [
+            ("denoise-iterations", KnobValue::Number(iterations as f32)),
+            ("denoise-taps", KnobValue::Choice(if taps == 5 { 1 } else { 0 })),
+        ];
+        self.0.render.techniques.set(Effect::Denoise, "svgf", &knobs).expect("svgf's knobs");
         self
     }
 

@@ -365,7 +365,7 @@ gpu_struct! {
         /// Normal edge-stopping: the exponent of max(0, n_p · n_q) (SVGF's σ_n).
         pub sigma_normal: f32 => "float",
         /// Depth edge-stopping: a tap's distance from the pixel's tangent plane is measured in
-        /// this many pixel footprints per pixel of separation.
+        /// this many pixel footprints (at the pixel).
         pub sigma_plane: f32 => "float",
     }
 }

@@ -64,7 +64,7 @@ pub struct Filter {
     pub sigma_luminance: f32,
     /// Normal edge-stopping exponent.
     pub sigma_normal: f32,
-    /// Depth edge-stopping in pixel footprints per pixel of separation.
+    /// Depth edge-stopping in pixel footprints.
     pub sigma_plane: f32,
     /// Taps an iteration along each axis: 5 (SVGF's B3 spline) or 3 (the linear B-spline).
     pub taps: u32,
