@@ -52,7 +52,7 @@ fn atrous_power(taps: &[f64], iterations: u32) -> f64 {
 /// form.
 fn floor(cam: &Pinhole, quad: &Quad, blocked: impl Fn(DVec3, DVec3) -> bool) -> Vec<(usize, f64)> {
     let a = albedo()[0];
-    floor_pixels(&cam, 9.5)
+    floor_pixels(cam, 9.5)
         .into_iter()
         .filter(|&(_, p, d)| quad.in_front(p) && !quad.crossed_by(cam.eye, d, 0.05) && !blocked(p, d))
         .map(|(i, p, _)| (i, a / std::f64::consts::PI * quad.irradiance(p, 1.0)))
