@@ -15,6 +15,7 @@ use crate::render::techniques::{Effect, KnobValue, Techniques, techniques_of};
 use crate::render::{Purpose, RenderSettings};
 use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions};
+use crate::sweep::budget::{self, Measurements};
 use crate::window;
 
 mod technique_flags;
@@ -97,6 +98,16 @@ pub struct Args {
     /// `kiln-bench --list` says what each sets.
     #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
     pub preset: Option<String>,
+    /// Choose the whole frame by a GPU budget: of the frame presets measured (by
+    /// --bench-results, else by the table built in from pica_pica on an H200), the one with the
+    /// lowest error whose frame fits X ms (times scaled by the pixel count to --size); prints
+    /// what it chose and why, and refuses (exit 2) when none fits. Technique and knob flags
+    /// beside it override its choice.
+    #[arg(long, value_name = "X", conflicts_with = "preset")]
+    pub budget_ms: Option<f64>,
+    /// With --budget-ms: the scene's own kiln-bench results.json (its frame chart).
+    #[arg(long, value_name = "RESULTS.json", requires = "budget_ms")]
+    pub bench_results: Option<PathBuf>,
     /// Headless output: .png (tone-mapped sRGB) or .exr (linear radiance).
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -174,15 +185,33 @@ impl Args {
     fn techniques(&self) -> PlayResult<Techniques> {
         let usage = |e: String| PlayError::new(Exit::Usage, e);
         let mut t = Techniques::default();
-        let preset = self.preset.as_deref().map(Preset::named).transpose().map_err(usage)?;
+        let mut preset = self.preset.as_deref().map(Preset::named).transpose().map_err(usage)?;
+        let mut gbuffer = None;
+        if let Some(budget) = self.budget_ms {
+            if !(budget > 0.0 && budget.is_finite()) {
+                return Err(usage(format!(
+                    "--budget-ms must be a positive number of milliseconds, not {budget}"
+                )));
+            }
+            let measured = match &self.bench_results {
+                Some(path) => Measurements::read(path)?,
+                None => Measurements::built_in(),
+            };
+            let chosen = budget::choose(&measured, budget, self.size.width, self.size.height)?;
+            eprintln!("{}", chosen.why);
+            preset = Some(chosen.point.preset);
+            gbuffer = Some(chosen.point.gbuffer.clone());
+        }
         for effect in Effect::ALL {
             let none = effect == Effect::Aa && self.choices.no_accumulate;
             let given = if none { Some("none") } else { self.choices.given(effect) };
             // The preset's choice (and its knobs) unless a flag names another technique.
             let preset_choice =
                 preset.and_then(|p| p.choice(effect)).filter(|c| given.is_none_or(|g| g == c.technique));
+            let budget_gbuffer = gbuffer.as_deref().filter(|_| effect == Effect::GBuffer);
             let name = given
                 .or(preset_choice.map(|c| c.technique))
+                .or(budget_gbuffer)
                 .unwrap_or_else(|| self.choices.technique(effect));
             let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
                 .find(|i| i.name == name)

@@ -8,6 +8,7 @@
 //! two points of a chart differ by their effect alone. [`report`] writes the JSON, CSV, charts
 //! and page.
 
+pub mod budget;
 pub mod cli;
 pub mod measure;
 pub mod plan;
