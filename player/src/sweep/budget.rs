@@ -47,16 +47,17 @@ pub struct Measurements {
 }
 
 /// The built-in table: pica_pica (`tests/scenes/pica_pica.toml`) at 1600 × 900 on an NVIDIA
-/// H200 against a 4096-spp all-bounce reference, one frame (`docs/benchmarks/denoise/`).
+/// H200 against a 4096-spp all-bounce reference, one frame, the visibility G-buffer (the raster
+/// one measured slower at equal error) (`docs/benchmarks/denoise/h200-call5-pica.txt`).
 const BUILT_IN: [(&str, &str, f64, f64); 8] = [
-    ("visibility", "baked", 1.269, 0.0924),
-    ("visibility", "baked-taa", 1.331, 0.0939),
-    ("visibility", "hybrid", 1.608, 0.0928),
-    ("visibility", "rt", 4.797, 0.0679),
-    ("visibility", "rt-taa", 4.957, 0.0697),
-    ("visibility", "rt-2", 6.470, 0.0582),
-    ("visibility", "rt-4", 8.544, 0.0544),
-    ("visibility", "rt-4-taa", 8.704, 0.0562),
+    ("visibility", "baked", 1.272, 0.0924),
+    ("visibility", "baked-taa", 1.335, 0.0939),
+    ("visibility", "hybrid", 1.609, 0.0928),
+    ("visibility", "rt", 4.616, 0.0643),
+    ("visibility", "rt-taa", 4.777, 0.0660),
+    ("visibility", "rt-2", 6.293, 0.0537),
+    ("visibility", "rt-4", 8.354, 0.0497),
+    ("visibility", "rt-4-taa", 8.518, 0.0516),
 ];
 
 impl Measurements {
@@ -213,7 +214,7 @@ mod tests {
                 Err(e) => {
                     assert!(fits.is_empty(), "budget {budget}: refused ({e}) though {} fit", fits.len());
                     assert_eq!(e.exit, Exit::Usage);
-                    assert!(e.message.contains("1.269 ms"), "{}", e.message);
+                    assert!(e.message.contains("1.272 ms"), "{}", e.message);
                 }
             }
         }
