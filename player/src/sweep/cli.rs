@@ -87,6 +87,12 @@ pub struct Args {
     /// Also write every measured image and the reference as EXR into OUT/images/.
     #[arg(long)]
     pub keep_images: bool,
+    /// Measure every combination of every technique's quality knobs. By default each knob is
+    /// varied alone around the defaults, then the combinations of the values the chart's Pareto
+    /// front shows are measured (at most 8 more per technique): the default sweep stays minutes
+    /// long however many knobs a technique has.
+    #[arg(long)]
+    pub exhaustive: bool,
     /// List the effects, techniques, knobs and presets, and exit.
     #[arg(long)]
     pub list: bool,
@@ -121,7 +127,8 @@ impl Args {
         let mut frames = self.frames_accumulated.clone();
         frames.sort_unstable();
         frames.dedup();
-        let request = Request { targets, techniques: self.techniques.clone(), frames };
+        let request =
+            Request { targets, techniques: self.techniques.clone(), frames, exhaustive: self.exhaustive };
         request.check().map_err(|e| PlayError::new(Exit::Usage, e))?;
         super::check_size(self.size.width, self.size.height)?;
         Ok(SweepOptions {

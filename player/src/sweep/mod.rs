@@ -33,7 +33,7 @@ use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions, open_file};
 
 use measure::{Measured, Timing, measure};
-use plan::{Offers, Plan, Request, Skipped, Target};
+use plan::{Config, Offers, Plan, Request, Skipped, Target};
 use results::{Figures, Point, Results, SceneInfo, TimingInfo};
 use truth::Reference;
 
@@ -380,7 +380,8 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             };
         let fixed = measure_once(plan.fixed, &[1], "fixed frame")?;
         let fixed_passes: Vec<String> = fixed.passes.iter().map(|p| p.pass.clone()).collect();
-        for config in &plan.configs {
+        let mut camera_points = Vec::new();
+        let mut measure_config = |config: &Config, points: &mut Vec<Point>| -> PlayResult {
             let label = config.label(*config.checkpoints.last().unwrap_or(&1));
             let m = match measure_once(config.techniques, &config.checkpoints, &label) {
                 Ok(m) => m,
@@ -390,7 +391,7 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
                         technique: config.technique.clone(),
                         reason: e.message,
                     });
-                    continue;
+                    return Ok(());
                 }
                 Err(e) => return Err(e),
             };
@@ -401,7 +402,25 @@ pub fn run(options: &SweepOptions) -> PlayResult<Outcome> {
             }
             let reference = &refs[&plan::bounces(config.target)];
             points.extend(points_of(options, config, &m, &fixed_passes, reference, &name, &mut failures)?);
+            Ok(())
+        };
+        for config in &plan.configs {
+            measure_config(config, &mut camera_points)?;
         }
+        // One knob at a time, then the combinations the fronts point to.
+        let mut marked = camera_points.clone();
+        results::mark_front(&mut marked);
+        let front: Vec<(Target, String, BTreeMap<String, String>)> = marked
+            .iter()
+            .filter(|p| p.on_front)
+            .filter_map(|p| Target::parse(&p.effect).ok().map(|t| (t, p.technique.clone(), p.knobs.clone())))
+            .collect();
+        let refined = plan::refine(&options.request, &offers, &plan.configs, &front);
+        progress.inc_length(refined.iter().map(|c| c.checkpoints.len() as u64).sum());
+        for config in &refined {
+            measure_config(config, &mut camera_points)?;
+        }
+        points.extend(camera_points);
     }
     progress.finish_and_clear();
     results::mark_front(&mut points);

@@ -6,7 +6,9 @@ use std::collections::BTreeMap;
 use std::fmt;
 
 use crate::render::presets::PRESETS;
-use crate::render::techniques::{KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of};
+use crate::render::techniques::{
+    Knob, KnobRange, KnobRole, KnobValue, TechniqueInfo, catalogue, techniques_of,
+};
 use crate::render::{Effect, Needs, Techniques};
 use crate::scene::linespace::variants_needed;
 use kiln_format::linespace::Variants;
@@ -191,6 +193,9 @@ pub struct Request {
     pub techniques: Vec<String>,
     /// Frames accumulated at which stochastic techniques are measured.
     pub frames: Vec<u32>,
+    /// Every combination of every technique's quality knobs (`--exhaustive`); otherwise one
+    /// knob at a time around the defaults, refined along the Pareto front ([`refine`]).
+    pub exhaustive: bool,
 }
 
 impl Request {
@@ -266,19 +271,54 @@ fn fixed_for(effect: Effect, offers: &Offers) -> Techniques {
     t
 }
 
-/// Every combination of a technique's quality knobs (scene knobs stay at their defaults).
-fn knob_combinations(info: &TechniqueInfo) -> Vec<Vec<(&'static str, KnobValue, String)>> {
-    let mut combos: Vec<Vec<(&'static str, KnobValue, String)>> = vec![Vec::new()];
+/// A technique's knob values as a sweep sets them: (knob, value, its text).
+type Combo = Vec<(&'static str, KnobValue, String)>;
+
+/// A knob, the values a sweep measures (each with its text) and its default.
+type SweptKnob = (&'static Knob, Vec<(KnobValue, String)>, (KnobValue, String));
+
+/// The values a sweep measures of each of a technique's quality knobs (scene knobs stay at their
+/// defaults; a number knob with fewer than two sweep values is not varied), in sweep order, and
+/// the knob's default.
+fn swept_values(info: &TechniqueInfo) -> Vec<SweptKnob> {
+    let mut out = Vec::new();
     for k in info.knobs.iter().filter(|k| k.role == KnobRole::Quality) {
-        let values: Vec<(KnobValue, String)> = match k.range {
+        let text = |v: KnobValue| match k.range {
+            KnobRange::Choice(options) => options[v.number() as usize].to_string(),
+            KnobRange::Number { .. } => v.number().to_string(),
+        };
+        let values: Vec<KnobValue> = match k.range {
             KnobRange::Number { sweep, .. } if sweep.len() > 1 => {
-                sweep.iter().map(|&v| (KnobValue::Number(v), v.to_string())).collect()
+                sweep.iter().map(|&v| KnobValue::Number(v)).collect()
             }
             KnobRange::Number { .. } => continue,
-            KnobRange::Choice(options) => {
-                options.iter().enumerate().map(|(i, o)| (KnobValue::Choice(i), o.to_string())).collect()
-            }
+            KnobRange::Choice(options) => (0..options.len()).map(KnobValue::Choice).collect(),
         };
+        out.push((k, values.into_iter().map(|v| (v, text(v))).collect(), (k.default, text(k.default))));
+    }
+    out
+}
+
+/// The knob combinations a sweep measures of a technique: with `exhaustive` every combination of
+/// the swept values; otherwise the defaults and each knob varied alone over its other swept
+/// values (1 + Σ values instead of Π values: SSGI's 2 × 2 × 3 × 2 × 5 = 120 become at most
+/// 15), which [`refine`] completes along the Pareto front once they are measured.
+fn knob_combinations(info: &TechniqueInfo, exhaustive: bool) -> Vec<Combo> {
+    let knobs = swept_values(info);
+    if !exhaustive {
+        let defaults: Combo = knobs.iter().map(|(k, _, d)| (k.name, d.0, d.1.clone())).collect();
+        let mut combos = vec![defaults.clone()];
+        for (i, (_, values, default)) in knobs.iter().enumerate() {
+            for (v, text) in values.iter().filter(|(v, _)| *v != default.0) {
+                let mut c = defaults.clone();
+                c[i] = (c[i].0, *v, text.clone());
+                combos.push(c);
+            }
+        }
+        return combos;
+    }
+    let mut combos: Vec<Combo> = vec![Vec::new()];
+    for (k, values, _) in &knobs {
         combos = combos
             .into_iter()
             .flat_map(|c| {
@@ -291,6 +331,81 @@ fn knob_combinations(info: &TechniqueInfo) -> Vec<Vec<(&'static str, KnobValue, 
             .collect();
     }
     combos
+}
+
+/// The most configurations [`refine`] adds per technique.
+pub const REFINE_PER_TECHNIQUE: usize = 8;
+
+/// The refinement of a one-knob-at-a-time sweep: for each technique with two or more varied
+/// knobs, the combinations of the values its points on the chart's Pareto front (`front`: chart,
+/// technique, knob texts) show for each knob, not measured yet (`planned`), at most
+/// [`REFINE_PER_TECHNIQUE`], best-guess first (the front points' own values come first).
+pub fn refine(
+    request: &Request,
+    offers: &Offers,
+    planned: &[Config],
+    front: &[(Target, String, BTreeMap<String, String>)],
+) -> Vec<Config> {
+    let mut out = Vec::new();
+    if request.exhaustive {
+        return out;
+    }
+    for info in catalogue() {
+        let target = Target::Effect(info.effect);
+        let on_front: Vec<&BTreeMap<String, String>> =
+            front.iter().filter(|(t, n, _)| *t == target && n == info.name).map(|(_, _, k)| k).collect();
+        let knobs = swept_values(info);
+        if on_front.is_empty() || knobs.len() < 2 {
+            continue;
+        }
+        let template = planned.iter().find(|c| c.target == target && c.technique == info.name);
+        let Some(template) = template else { continue };
+        let mut combos: Vec<Combo> = vec![Vec::new()];
+        for (k, values, default) in &knobs {
+            let mut values = values.clone();
+            if !values.contains(default) {
+                values.insert(0, default.clone());
+            }
+            let seen: Vec<(KnobValue, String)> = values
+                .into_iter()
+                .filter(|(_, text)| on_front.iter().any(|f| f.get(k.name) == Some(text)))
+                .collect();
+            combos = combos
+                .into_iter()
+                .flat_map(|c| {
+                    seen.clone().into_iter().map(move |(v, text)| {
+                        let mut c = c.clone();
+                        c.push((k.name, v, text));
+                        c
+                    })
+                })
+                .collect();
+        }
+        let mut added = 0;
+        for combo in combos {
+            let knobs: BTreeMap<String, String> =
+                combo.iter().map(|(n, _, t)| (n.to_string(), t.clone())).collect();
+            let known = planned
+                .iter()
+                .chain(&out)
+                .any(|c| c.target == target && c.technique == info.name && c.knobs == knobs);
+            if known || added == REFINE_PER_TECHNIQUE {
+                continue;
+            }
+            let mut t = fixed_for(info.effect, offers);
+            let values: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
+            t.set(info.effect, info.name, &values).expect("catalogue values are valid");
+            out.push(Config {
+                target,
+                technique: info.name.to_string(),
+                knobs,
+                techniques: t,
+                checkpoints: template.checkpoints.clone(),
+            });
+            added += 1;
+        }
+    }
+    out
 }
 
 /// The plan for `request` on a file that `offers` what it offers.
@@ -312,7 +427,7 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                         push_skip(&mut skipped, target, info.name, "nothing in the file emits light");
                         continue;
                     }
-                    for combo in knob_combinations(info) {
+                    for combo in knob_combinations(info, request.exhaustive) {
                         let mut t = fixed_for(effect, offers);
                         let knobs: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
                         t.set(effect, info.name, &knobs).expect("catalogue values are valid");
@@ -401,6 +516,7 @@ mod tests {
             targets,
             techniques: techniques.iter().map(|s| s.to_string()).collect(),
             frames: vec![1, 4],
+            exhaustive: true,
         }
     }
 
@@ -438,6 +554,74 @@ mod tests {
             expected.extend([2, 3, 8].map(|steps| format!("gtao {slices} {steps}")));
         }
         assert_eq!(ao.configs.iter().map(|c| c.label(1)).collect::<Vec<_>>(), expected);
+    }
+
+    /// The default sweep varies one knob at a time: per technique the defaults and each knob's
+    /// other swept values (counted here from the catalogue's data), not the product of the
+    /// swept values; the whole default sweep of a file that offers everything stays within 120
+    /// configurations (before the refinement's at most 8 per technique) while the exhaustive one
+    /// is more than twice as large.
+    #[test]
+    fn the_default_sweep_varies_one_knob_at_a_time_and_is_bounded() {
+        let mut one = request(Target::ALL.to_vec(), &[]);
+        one.exhaustive = false;
+        let all = request(Target::ALL.to_vec(), &[]);
+        let (p1, px) = (plan(&one, &ALL_OFFERED), plan(&all, &ALL_OFFERED));
+        for info in catalogue() {
+            let counts: Vec<(usize, usize)> = info
+                .knobs
+                .iter()
+                .filter(|k| k.role == KnobRole::Quality)
+                .filter_map(|k| match k.range {
+                    KnobRange::Choice(o) => Some((o.len(), 1)),
+                    KnobRange::Number { sweep, .. } if sweep.len() > 1 => {
+                        Some((sweep.len(), sweep.contains(&k.default.number()) as usize))
+                    }
+                    KnobRange::Number { .. } => None,
+                })
+                .collect();
+            // Each knob's swept values but its default, if swept, beside the defaults.
+            let expected_one = 1 + counts.iter().map(|(n, has_default)| n - has_default).sum::<usize>();
+            let expected_all: usize = counts.iter().map(|(n, _)| n).product();
+            let target = Target::Effect(info.effect);
+            let n = |p: &Plan| {
+                p.configs.iter().filter(|c| c.target == target && c.technique == info.name).count()
+            };
+            if n(&px) == 0 {
+                continue; // skipped (e.g. nothing emits) in both
+            }
+            assert_eq!(n(&p1), expected_one, "{} {}", info.effect, info.name);
+            assert_eq!(n(&px), expected_all, "{} {}", info.effect, info.name);
+        }
+        // Measured: 109 against 258 (frame presets 18 of them in both).
+        assert!(p1.configs.len() <= 120, "the default sweep plans {} configurations", p1.configs.len());
+        assert!(px.configs.len() > 2 * p1.configs.len(), "{} against {}", px.configs.len(), p1.configs.len());
+    }
+
+    /// The refinement measures the combinations of the values the front shows per knob, and
+    /// nothing already measured; nothing for an exhaustive sweep.
+    #[test]
+    fn refinement_combines_the_fronts_values() {
+        let mut one = request(vec![Target::Effect(Effect::Denoise)], &[]);
+        one.exhaustive = false;
+        let p = plan(&one, &ALL_OFFERED);
+        let knobs = |i: &str, s: &str, t: &str| -> BTreeMap<String, String> {
+            [("denoise-iterations", i), ("denoise-sigma-luminance", s), ("denoise-taps", t)]
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .into()
+        };
+        let target = Target::Effect(Effect::Denoise);
+        // The front holds iterations 3 (sigma 8) and sigma 16 (iterations 5): both values of
+        // each, 3x3 alone: 2 × 2 × 1 combinations, of which (5, 8) and (3, 8) and (5, 16) were
+        // measured: (3, 16) is new.
+        let front = vec![
+            (target, "svgf".to_string(), knobs("3", "8", "3x3")),
+            (target, "svgf".to_string(), knobs("5", "16", "3x3")),
+        ];
+        let r = refine(&one, &ALL_OFFERED, &p.configs, &front);
+        assert_eq!(r.iter().map(|c| c.knobs.clone()).collect::<Vec<_>>(), [knobs("3", "16", "3x3")]);
+        assert_eq!(r[0].techniques.name_of(Effect::Gi), "rt", "the chart's fixed frame");
+        assert!(refine(&request(vec![target], &[]), &ALL_OFFERED, &p.configs, &front).is_empty());
     }
 
     #[test]
