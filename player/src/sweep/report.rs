@@ -99,7 +99,8 @@ pub fn charts(results: &Results) -> Vec<(String, String, Chart)> {
                 format!("reference: path traced, {}, {spp} spp", transport(bounces)),
             ];
             if effect != "frame" {
-                subtitle.push(format!("fixed: {}", describe_fixed_map(&results.fixed, &effect)));
+                subtitle
+                    .push(format!("fixed: {}", describe_fixed_map(chart_fixed(results, &effect), &effect)));
             }
             let chart = Chart {
                 title: if cameras > 1 {
@@ -280,7 +281,7 @@ pub fn text(results: &Results) -> String {
         let bounces = points.first().map_or(0, |p| p.reference_bounces);
         s.push_str(&format!("\n{effect} (camera {camera}; against {})", transport(bounces)));
         if effect != "frame" {
-            s.push_str(&format!("; fixed: {}", describe_fixed_map(&results.fixed, &effect)));
+            s.push_str(&format!("; fixed: {}", describe_fixed_map(chart_fixed(results, &effect), &effect)));
         }
         s.push_str(&format!(
             "\n  {:<28} {:>9} {:>9} {:>10} {:>8} {:>10}  {}\n",
@@ -303,4 +304,10 @@ pub fn text(results: &Results) -> String {
         s.push_str(&format!("skipped {} {}: {}\n", sk.effect, sk.technique, sk.reason));
     }
     s
+}
+
+/// What the chart of `effect` held fixed: its points' other techniques (the direct and denoise
+/// charts hold more than the sweep's common fixed set), else that set.
+fn chart_fixed<'a>(results: &'a Results, effect: &str) -> &'a BTreeMap<String, String> {
+    results.points.iter().find(|p| p.effect == effect).map_or(&results.fixed, |p| &p.techniques)
 }
