@@ -103,7 +103,7 @@ pub struct Args {
     /// lowest error whose frame fits X ms (times scaled by the pixel count to --size); prints
     /// what it chose and why, and refuses (exit 2) when none fits. Technique and knob flags
     /// beside it override its choice.
-    #[arg(long, value_name = "X", conflicts_with = "preset")]
+    #[arg(long, value_name = "X", conflicts_with = "preset", allow_negative_numbers = true)]
     pub budget_ms: Option<f64>,
     /// With --budget-ms: the scene's own kiln-bench results.json (its frame chart).
     #[arg(long, value_name = "RESULTS.json", requires = "budget_ms")]
@@ -801,5 +801,16 @@ mod tests {
         let t = techniques(&["f.kiln", "--preset", "rt-4-taa", "--gi", "ssgi", "--no-accumulate"]);
         assert_eq!((t.name_of(Effect::Gi), t.name_of(Effect::Aa)), ("ssgi", "none"));
         assert!(refusal(&["f.kiln", "--preset", "fast"]).contains("rt-taa"));
+    }
+
+    /// A budget that is not a positive number of milliseconds is refused with the reason.
+    #[test]
+    fn a_budget_must_be_positive_milliseconds() {
+        for bad in ["-2", "0", "nan", "inf"] {
+            assert!(
+                refusal(&["f.kiln", "--budget-ms", bad]).contains("positive number of milliseconds"),
+                "{bad}"
+            );
+        }
     }
 }
