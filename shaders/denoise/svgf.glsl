@@ -2,17 +2,19 @@
 // Variance-Guided Filtering", HPG 2017), over the running means the ray-traced passes already
 // keep: their temporal accumulation (a still camera's running mean, or the reprojected history
 // of `--aa reproject|taa`) is the temporal filter, and it stays unfiltered, so that a still
-// image converges to the same mean as without the denoiser. Per frame:
-// 1. guide.comp: each pixel's camera-relative position and normal, read by every tap;
-// 2. variance.comp, per signal: the signal divided by the albedo's demodulator where it carries
-//    the albedo, and the standard deviation of its running mean (half floats from here on): the second moment's (alpha) variance
-//    over the samples averaged, or, with fewer than 4 samples, the variance of the 5 × 5
+// image converges to the same mean as without the denoiser. One or two signals at once (image
+// arrays of two, each tap's geometry weighed once for both). Per frame:
+// 1. guide.comp: each pixel's distance along its camera ray and its normal, read by every tap;
+// 2. variance.comp: each signal divided by the albedo's demodulator where it carries the albedo,
+//    and the standard deviation of its running mean (half floats from here on): from the second
+//    moment (alpha) over the samples averaged, or, with fewer than 4 samples, from the 5 × 5
 //    neighbours on the same surface;
-// 3. atrous.comp, per signal and iteration: the à-trous wavelet filter (5 × 5 B3-spline taps
-//    2^i pixels apart), each tap weighted by the distance from the pixel's tangent plane, the
+// 3. atrous.glsl (atrous.comp 5 × 5 B3-spline taps, atrous3.comp 3 × 3), per iteration i: taps
+//    2^i pixels apart, each weighted by its distance from the pixel's tangent plane, the
 //    normals' agreement and the luminance difference in standard deviations of the noise; the
-//    variance filtered with the squared weights (kept as its square root, for half floats' range); the last iteration multiplies the demodulator
-//    back and writes the image the composition reads.
+//    variance filtered with the squared weights (kept as its square root, for half floats'
+//    range); the last iteration multiplies the demodulator back and writes the image the
+//    composition reads.
 // As the samples grow the variance of the mean falls as 1/n and the luminance weight closes:
 // the filter fades into the identity.
 #include "../common/layout.glsl"
