@@ -97,7 +97,7 @@ impl Drop for SetLayout {
 }
 
 /// One descriptor write.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub enum Write<'a> {
     /// A whole buffer at a binding.
     Buffer(u32, &'a Buffer),

@@ -137,25 +137,6 @@ impl DenoisePass {
             sigma_plane: self.filter.sigma_plane,
         }
     }
-
-    /// The signals in the groups one dispatch filters.
-    fn groups(&self) -> std::slice::Chunks<'_, Noisy> {
-        self.signals.chunks(PER_DISPATCH)
-    }
-}
-
-/// Both kernels' bindings 0-2 (`head`), then 3-5 as `rest` gives them (each an image or a
-/// pair; their own binding numbers are replaced).
-fn with_bindings<'a>(head: &[Write<'a>; 3], rest: [Write<'a>; 3]) -> Vec<Write<'a>> {
-    let mut w = head.to_vec();
-    for (binding, write) in (3..).zip(rest) {
-        w.push(match write {
-            Write::StorageImages(_, v) => Write::StorageImages(binding, v),
-            Write::StorageImage(_, v) => Write::StorageImage(binding, v),
-            other => other,
-        });
-    }
-    w
 }
 
 /// A group's images at one binding: `pick` of each signal, the first repeated where the group
@@ -196,24 +177,33 @@ impl Pass for DenoisePass {
                 Write::StorageImage(3, img(&GUIDE)),
             ],
         )?;
-        let views = |t: [TargetDecl; 2]| Write::StorageImages(0, t.iter().map(img).collect());
-        let head = [
-            Write::Buffer(0, shared.frame_ubo),
-            Write::Sampled(1, vec![(img(&ALBEDO), near)]),
-            Write::StorageImage(2, img(&GUIDE)),
-        ];
-        let set = |rest: [Write<'a>; 3]| with_bindings(&head, rest);
-        let groups: Vec<Vec<Noisy>> = self.groups().map(|g| g.to_vec()).collect();
-        for (g, group) in groups.iter().enumerate() {
+        let views =
+            |binding: u32, t: [TargetDecl; 2]| Write::StorageImages(binding, t.iter().map(img).collect());
+        // Bindings 0-2 are the same in both kernels' sets; 3-5 are the group's images.
+        let set = |rest: [Write<'a>; 3]| -> Vec<Write<'a>> {
+            [
+                Write::Buffer(0, shared.frame_ubo),
+                Write::Sampled(1, vec![(img(&ALBEDO), near)]),
+                Write::StorageImage(2, img(&GUIDE)),
+            ]
+            .into_iter()
+            .chain(rest)
+            .collect()
+        };
+        for (g, group) in self.signals.chunks(PER_DISPATCH).enumerate() {
             let noisy = pair(group, |_, s| s.target);
             let first = pair(group, |i, _| PING_PONG[0][i]);
-            let samples = Write::StorageImage(0, img(&SAMPLES));
-            self.variance.write_set(gpu, g, &set([views(noisy), samples, views(first)]))?;
+            let samples = Write::StorageImage(4, img(&SAMPLES));
+            self.variance.write_set(gpu, g, &set([views(3, noisy), samples, views(5, first)]))?;
             for turn in 0..2 {
                 let src = pair(group, |i, _| PING_PONG[turn][i]);
                 let dst = pair(group, |i, _| PING_PONG[1 - turn][i]);
                 let out = pair(group, |_, s| s.output);
-                self.atrous.write_set(gpu, 2 * g + turn, &set([views(src), views(dst), views(out)]))?;
+                self.atrous.write_set(
+                    gpu,
+                    2 * g + turn,
+                    &set([views(3, src), views(4, dst), views(5, out)]),
+                )?;
             }
         }
         Ok(())
@@ -237,7 +227,7 @@ impl Pass for DenoisePass {
         // A still camera's running mean holds the frames accumulated before this one and this
         // one; a reprojected history says per pixel.
         let samples = if self.reprojected { 0 } else { ctx.rt.accumulated + 1 };
-        for (g, group) in self.groups().enumerate() {
+        for (g, group) in self.signals.chunks(PER_DISPATCH).enumerate() {
             let mut io = vec![
                 (ALBEDO, Access::Read(Use::SAMPLED)),
                 (GUIDE, Access::Read(Use::STORAGE)),
