@@ -34,8 +34,7 @@ void emit(uint i, ivec2 pixel, vec4 v) {
         }
         return;
     }
-    vec3 d = (push.demodulate & (1u << i)) != 0u
-        ? demodulator(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb)) : vec3(1.0);
+    vec3 d = signal_demodulator(i, texelFetch(g_albedo, pixel, 0).rgb);
     if (i == 0u) {
         imageStore(result[0], pixel, vec4(v.rgb * d, 1.0));
     } else {

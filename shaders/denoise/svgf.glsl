@@ -48,6 +48,12 @@ Guide unpack_guide(ivec2 pixel, uvec2 g) {
     return o;
 }
 
+// What signal i is divided by at a surface of sRGB base colour `base`: the albedo's demodulator
+// where `push.demodulate` has bit i (the signal carries the albedo), else 1.
+vec3 signal_demodulator(uint i, vec3 base) {
+    return (push.demodulate & (1u << i)) != 0u ? demodulator(srgb_to_linear(base)) : vec3(1.0);
+}
+
 // What the filter's half-float images keep of a value: at most the largest half (radiance
 // beyond 65504 is clipped there while filtering; the running means keep full floats).
 vec4 half_range(vec4 v) {

@@ -9,10 +9,9 @@ layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D filtered[2]; // 
 
 #include "svgf.glsl"
 
-// What signal i (a constant: image arrays are indexed by constants only) is divided by at q.
+// What signal i is divided by at pixel q.
 vec3 demodulation(uint i, ivec2 q) {
-    return (push.demodulate & (1u << i)) != 0u ? demodulator(srgb_to_linear(texelFetch(g_albedo, q, 0).rgb))
-                                                : vec3(1.0);
+    return signal_demodulator(i, texelFetch(g_albedo, q, 0).rgb);
 }
 
 vec4 load_noisy(uint i, ivec2 q) {
