@@ -317,20 +317,45 @@ fn knob_combinations(info: &TechniqueInfo, exhaustive: bool) -> Vec<Combo> {
         }
         return combos;
     }
+    product(knobs.into_iter().map(|(k, values, _)| (k.name, values)))
+}
+
+/// Every combination of one value of each knob: (knob, its values) in order.
+fn product(knobs: impl Iterator<Item = (&'static str, Vec<(KnobValue, String)>)>) -> Vec<Combo> {
     let mut combos: Vec<Combo> = vec![Vec::new()];
-    for (k, values, _) in &knobs {
+    for (name, values) in knobs {
         combos = combos
             .into_iter()
             .flat_map(|c| {
                 values.iter().map(move |(v, text)| {
                     let mut c = c.clone();
-                    c.push((k.name, *v, text.clone()));
+                    c.push((name, *v, text.clone()));
                     c
                 })
             })
             .collect();
     }
     combos
+}
+
+/// The configuration of `info`'s chart at the knob values `combo`, the chart's other effects
+/// fixed ([`fixed_for`]); `checkpoints` says at which frame counts, from its techniques.
+fn effect_config(
+    info: &TechniqueInfo,
+    combo: &Combo,
+    offers: &Offers,
+    checkpoints: impl FnOnce(&Techniques) -> Vec<u32>,
+) -> Config {
+    let mut t = fixed_for(info.effect, offers);
+    let values: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
+    t.set(info.effect, info.name, &values).expect("catalogue values are valid");
+    Config {
+        target: Target::Effect(info.effect),
+        technique: info.name.to_string(),
+        knobs: combo.iter().map(|(n, _, text)| (n.to_string(), text.clone())).collect(),
+        checkpoints: checkpoints(&t),
+        techniques: t,
+    }
 }
 
 /// The most configurations [`refine`] adds per technique.
@@ -360,49 +385,27 @@ pub fn refine(
         }
         let template = planned.iter().find(|c| c.target == target && c.technique == info.name);
         let Some(template) = template else { continue };
-        let mut combos: Vec<Combo> = vec![Vec::new()];
-        for (k, values, default) in &knobs {
-            let mut values = values.clone();
-            if !values.contains(default) {
-                values.insert(0, default.clone());
+        let seen = knobs.into_iter().map(|(k, mut values, default)| {
+            if !values.contains(&default) {
+                values.insert(0, default);
             }
-            let seen: Vec<(KnobValue, String)> = values
-                .into_iter()
-                .filter(|(_, text)| on_front.iter().any(|f| f.get(k.name) == Some(text)))
-                .collect();
-            combos = combos
-                .into_iter()
-                .flat_map(|c| {
-                    seen.clone().into_iter().map(move |(v, text)| {
-                        let mut c = c.clone();
-                        c.push((k.name, v, text));
-                        c
-                    })
-                })
-                .collect();
-        }
+            values.retain(|(_, text)| on_front.iter().any(|f| f.get(k.name) == Some(text)));
+            (k.name, values)
+        });
         let mut added = 0;
-        for combo in combos {
-            let knobs: BTreeMap<String, String> =
-                combo.iter().map(|(n, _, t)| (n.to_string(), t.clone())).collect();
+        for combo in product(seen) {
+            if added == REFINE_PER_TECHNIQUE {
+                break;
+            }
+            let config = effect_config(info, &combo, offers, |_| template.checkpoints.clone());
             let known = planned
                 .iter()
                 .chain(&out)
-                .any(|c| c.target == target && c.technique == info.name && c.knobs == knobs);
-            if known || added == REFINE_PER_TECHNIQUE {
-                continue;
+                .any(|c| c.target == target && c.technique == info.name && c.knobs == config.knobs);
+            if !known {
+                out.push(config);
+                added += 1;
             }
-            let mut t = fixed_for(info.effect, offers);
-            let values: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
-            t.set(info.effect, info.name, &values).expect("catalogue values are valid");
-            out.push(Config {
-                target,
-                technique: info.name.to_string(),
-                knobs,
-                techniques: t,
-                checkpoints: template.checkpoints.clone(),
-            });
-            added += 1;
         }
     }
     out
@@ -428,22 +431,16 @@ pub fn plan(request: &Request, offers: &Offers) -> Plan {
                         continue;
                     }
                     for combo in knob_combinations(info, request.exhaustive) {
-                        let mut t = fixed_for(effect, offers);
-                        let knobs: Vec<(&str, KnobValue)> = combo.iter().map(|(n, v, _)| (*n, *v)).collect();
-                        t.set(effect, info.name, &knobs).expect("catalogue values are valid");
-                        if let Some(reason) = offers.lacks(&t) {
+                        // A frame that traces rays improves with frames whatever the effect's
+                        // technique (the denoiser's `none` among them).
+                        let config = effect_config(info, &combo, offers, |t| {
+                            checkpoints(info.stochastic || t.ray_traced(), t)
+                        });
+                        if let Some(reason) = offers.lacks(&config.techniques) {
                             push_skip(&mut skipped, target, info.name, &reason);
                             continue;
                         }
-                        configs.push(Config {
-                            target,
-                            technique: info.name.to_string(),
-                            knobs: combo.iter().map(|(n, _, text)| (n.to_string(), text.clone())).collect(),
-                            techniques: t,
-                            // A frame that traces rays improves with frames whatever the
-                            // effect's technique (the denoiser's `none` among them).
-                            checkpoints: checkpoints(info.stochastic || t.ray_traced(), &t),
-                        });
+                        configs.push(config);
                     }
                 }
             }
