@@ -22,7 +22,7 @@ use kiln_test_support::gpu_test;
 use kiln_tests::Options;
 
 use crate::emitters::{Quad, camera, quad_scene_with};
-use crate::harness::{H, Pinhole, W, albedo, floor_pixels, pixel_xy, render_frames, square};
+use crate::harness::{H, Pinhole, W, albedo, floor_pixels, pixel_xy, ratio_stats, render_frames, square};
 use crate::rect::Rect;
 
 /// Σ w² of `iterations` à-trous iterations of the separable kernel `taps` (weights at 0, ±1,
@@ -48,15 +48,18 @@ fn atrous_power(taps: &[f64], iterations: u32) -> f64 {
     one_axis * one_axis
 }
 
-/// Floor pixels of `cam` in front of `quad`, not hidden by it nor by `blocked`, with the closed
-/// form.
-fn floor(cam: &Pinhole, quad: &Quad, blocked: impl Fn(DVec3, DVec3) -> bool) -> Vec<(usize, f64)> {
-    let a = albedo()[0];
+/// Floor pixels of `cam` in front of `quad`, not hidden by it nor by `blocked`.
+fn floor(cam: &Pinhole, quad: &Quad, blocked: impl Fn(DVec3, DVec3) -> bool) -> Vec<(usize, DVec3, DVec3)> {
     floor_pixels(cam, 9.5)
         .into_iter()
         .filter(|&(_, p, d)| quad.in_front(p) && !quad.crossed_by(cam.eye, d, 0.05) && !blocked(p, d))
-        .map(|(i, p, _)| (i, a / std::f64::consts::PI * quad.irradiance(p, 1.0)))
         .collect()
+}
+
+/// The closed form a floor point under `quad` shows: albedo/π times the polygon irradiance.
+fn lit(quad: &Quad) -> impl Fn(DVec3, DVec3) -> f64 + '_ {
+    let a = albedo()[0];
+    move |p, _| a / std::f64::consts::PI * quad.irradiance(p, 1.0)
 }
 
 /// A 16 × 16 ceiling of radiance 1 one unit above the floor, emitting downwards.
@@ -74,11 +77,10 @@ fn ceiling() -> Quad {
     })
 }
 
-/// Mean and variance of got / expected over `pixels`.
-fn ratios(rgb: &[f32], pixels: &[(usize, f64)]) -> (f64, f64) {
-    let r: Vec<f64> = pixels.iter().map(|&(i, e)| rgb[i] as f64 / e).collect();
-    let mean = r.iter().sum::<f64>() / r.len() as f64;
-    (mean, r.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / r.len() as f64)
+/// Mean and variance of got / expected over floor `pixels` under `quad`.
+fn ratios(rgb: &[f32], pixels: &[(usize, DVec3, DVec3)], quad: &Quad) -> (f64, f64) {
+    let (mean, spread) = ratio_stats(rgb, pixels, lit(quad));
+    (mean, spread * spread)
 }
 
 #[test]
@@ -97,8 +99,8 @@ fn svgf_keeps_a_flat_lit_floors_mean_and_cuts_its_noise() {
     let (den, _) =
         render_frames(dir.path(), "flat-svgf", &bytes, 1, |f| noisy(Options::new(f, W, H)).svgf(5, 3));
     let pixels = floor(&cam, &quad, |_, _| false);
-    let (raw_mean, raw_var) = ratios(&raw, &pixels);
-    let (mean, var) = ratios(&den, &pixels);
+    let (raw_mean, raw_var) = ratios(&raw, &pixels, &quad);
+    let (mean, var) = ratios(&den, &pixels, &quad);
     let bound = atrous_power(&[0.5, 0.25], 5);
     eprintln!(
         "flat floor ({} pixels): raw mean ratio {raw_mean:.4} variance {raw_var:.4}; svgf {mean:.4} {var:.5}: \
@@ -133,7 +135,7 @@ fn svgf_bleeds_no_floor_light_into_a_black_block() {
     let (den, _) =
         render_frames(dir.path(), "edge-svgf", &bytes, 1, |f| noisy(Options::new(f, W, H)).svgf(5, 3));
     // The floor's brightest, against which a bleed is measured.
-    let peak = floor(&cam, &quad, |_, _| false).iter().map(|&(_, e)| e).fold(0.0, f64::max);
+    let peak = floor(&cam, &quad, |_, _| false).iter().map(|&(_, p, d)| lit(&quad)(p, d)).fold(0.0, f64::max);
     let mut worst = 0.0f64;
     let mut block = 0;
     for y in 0..H {
@@ -197,7 +199,7 @@ fn svgf_converges_to_the_undenoised_image_and_the_closed_form() {
         near_occluder || behind
     };
     let pixels = floor(&cam, &quad, shadowed);
-    let (mean, _) = ratios(&den, &pixels);
+    let (mean, _) = ratios(&den, &pixels, &quad);
     eprintln!("unshadowed floor ({} pixels): mean ratio {mean:.5}", pixels.len());
     assert!(pixels.len() > 1000, "only {} pixels", pixels.len());
     assert!((mean - 1.0).abs() < 0.005, "the converged floor's mean ratio is {mean}");
