@@ -93,9 +93,8 @@ pub struct Args {
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
     /// A named technique set for the whole frame (each carries indirect light; those that
-    /// trace GI rays denoise it): baked, baked-taa (no rays), hybrid, rt, rt-taa, rt-2, rt-4,
-    /// rt-4-taa, linespace. Technique and knob flags given beside it override its choices;
-    /// `kiln-bench --list` says what each sets.
+    /// trace GI rays denoise it; `baked` and `baked-taa` trace no rays). Technique and knob
+    /// flags given beside it override its choices; `kiln-bench --list` says what each sets.
     #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
     pub preset: Option<String>,
     /// Choose the whole frame by a GPU budget: of the frame presets measured (by

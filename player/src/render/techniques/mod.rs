@@ -490,7 +490,7 @@ impl Techniques {
     /// The noisy signals the denoiser filters: none without a denoiser, else those of the
     /// ray-traced techniques that make one, in frame order.
     pub fn noisy(&self) -> Vec<Noisy> {
-        if self.denoise.name() == "none" {
+        if matches!(self.denoise, Denoise::Off(_)) {
             return Vec::new();
         }
         self.each().filter_map(|t| t.noisy()).collect()
@@ -542,7 +542,7 @@ impl Techniques {
     /// Warnings for what the file lacks that the chosen techniques read.
     pub fn warnings(&self, manifest: &kiln_format::Manifest) -> Vec<String> {
         let mut warnings = Vec::new();
-        if self.denoise.name() != "none" && self.noisy().is_empty() {
+        if !matches!(self.denoise, Denoise::Off(_)) && self.noisy().is_empty() {
             warnings.push(format!(
                 "--denoise {}: no ray-traced signal to filter in this frame (it filters --gi rt|linespace and \
                  --direct ris|restir); it does nothing",
