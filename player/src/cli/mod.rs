@@ -11,7 +11,7 @@ use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{GpuOptions, default_cache_path, list_devices};
 use crate::headless;
 use crate::render::presets::Preset;
-use crate::render::techniques::{Effect, KnobValue, Techniques, techniques_of};
+use crate::render::techniques::{KnobValue, Techniques};
 use crate::render::{Purpose, RenderSettings};
 use crate::scene::TextureUpload;
 use crate::session::{PipelineStart, SessionOptions};
@@ -183,7 +183,6 @@ impl Args {
     /// The techniques the flags choose, each with the knobs the command line sets.
     fn techniques(&self) -> PlayResult<Techniques> {
         let usage = |e: String| PlayError::new(Exit::Usage, e);
-        let mut t = Techniques::default();
         let mut preset = self.preset.as_deref().map(Preset::named).transpose().map_err(usage)?;
         let mut gbuffer = None;
         if let Some(budget) = self.budget_ms {
@@ -201,33 +200,7 @@ impl Args {
             preset = Some(chosen.point.preset);
             gbuffer = Some(chosen.point.gbuffer.clone());
         }
-        for effect in Effect::ALL {
-            let none = effect == Effect::Aa && self.choices.no_accumulate;
-            let given = if none { Some("none") } else { self.choices.given(effect) };
-            // The preset's choice (and its knobs) unless a flag names another technique.
-            let preset_choice =
-                preset.and_then(|p| p.choice(effect)).filter(|c| given.is_none_or(|g| g == c.technique));
-            let budget_gbuffer = gbuffer.as_deref().filter(|_| effect == Effect::GBuffer);
-            let name = given
-                .or(preset_choice.map(|c| c.technique))
-                .or(budget_gbuffer)
-                .unwrap_or_else(|| self.choices.technique(effect));
-            let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
-                .find(|i| i.name == name)
-                .map(|i| {
-                    i.knobs
-                        .iter()
-                        .filter_map(|k| {
-                            let from_preset =
-                                preset_choice.and_then(|c| c.knobs.iter().find(|(n, _)| *n == k.name));
-                            self.choices.knob(k.name).or(from_preset.map(|(_, v)| *v)).map(|v| (k.name, v))
-                        })
-                        .collect()
-                })
-                .unwrap_or_default();
-            t.set(effect, name, &knobs).map_err(|e| usage(format!("--{effect} {name}: {e}")))?;
-        }
-        Ok(t)
+        self.choices.techniques(preset, gbuffer.as_deref()).map_err(usage)
     }
 
     fn session(&self, file: PathBuf) -> PlayResult<SessionOptions> {
@@ -451,8 +424,8 @@ pub fn run(args: Args, start: Instant) -> PlayResult {
 mod tests {
     use super::*;
     use crate::render::techniques::ao::{self, Radius};
-    use crate::render::techniques::catalogue;
     use crate::render::techniques::reflections::rt::ReflectionRes;
+    use crate::render::techniques::{Effect, catalogue};
     use crate::render::techniques::{aa, gi, reflections, shadows};
     use crate::render::{Aa, Ao, GBuffer, Gi, Reflections, ScreenFraction, Shadows};
 

@@ -6,6 +6,7 @@
 use clap::builder::{PossibleValue, PossibleValuesParser};
 use clap::{Arg, ArgAction, ArgMatches, Command};
 
+use crate::render::presets::Preset;
 use crate::render::techniques::{Effect, Knob, KnobRange, KnobValue, Techniques, catalogue, techniques_of};
 
 /// What the catalogue's flags say: each effect's technique and the knob values given.
@@ -33,6 +34,45 @@ impl TechniqueFlags {
     /// The value the command line gives the knob `name`.
     pub(super) fn knob(&self, name: &str) -> Option<KnobValue> {
         self.knobs.iter().find(|(k, _)| *k == name).map(|(_, v)| *v)
+    }
+
+    /// The techniques the flags choose over `preset`'s choices (and its knobs), with
+    /// `gbuffer` (the budget's choice) unless `--gbuffer` is given: a flag naming another
+    /// technique than the preset's replaces it, knob flags override the preset's knobs. Errors
+    /// name the flag and the valid values.
+    pub(super) fn techniques(
+        &self,
+        preset: Option<&Preset>,
+        gbuffer: Option<&str>,
+    ) -> Result<Techniques, String> {
+        let mut t = Techniques::default();
+        for effect in Effect::ALL {
+            let none = effect == Effect::Aa && self.no_accumulate;
+            let given = if none { Some("none") } else { self.given(effect) };
+            // The preset's choice (and its knobs) unless a flag names another technique.
+            let preset_choice =
+                preset.and_then(|p| p.choice(effect)).filter(|c| given.is_none_or(|g| g == c.technique));
+            let budget_gbuffer = gbuffer.filter(|_| effect == Effect::GBuffer);
+            let name = given
+                .or(preset_choice.map(|c| c.technique))
+                .or(budget_gbuffer)
+                .unwrap_or_else(|| self.technique(effect));
+            let knobs: Vec<(&str, KnobValue)> = techniques_of(effect)
+                .find(|i| i.name == name)
+                .map(|i| {
+                    i.knobs
+                        .iter()
+                        .filter_map(|k| {
+                            let from_preset =
+                                preset_choice.and_then(|c| c.knobs.iter().find(|(n, _)| *n == k.name));
+                            self.knob(k.name).or(from_preset.map(|(_, v)| *v)).map(|v| (k.name, v))
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            t.set(effect, name, &knobs).map_err(|e| format!("--{effect} {name}: {e}"))?;
+        }
+        Ok(t)
     }
 
     pub(super) fn from_matches(m: &ArgMatches) -> TechniqueFlags {
