@@ -9,7 +9,7 @@ use kiln_compiler::settings::{PnmtRecords, Settings, VoxelRes};
 use kiln_format::linespace::{LineSpace, PnmtLayout, Variants};
 use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile, SceneView, sections};
 use kiln_tests::shapes::{height_grid, soup};
-use kiln_tests::{compile, scene_of};
+use kiln_tests::{compile, rewrite, scene_of};
 use proptest::prelude::*;
 
 fn settings(res: u32, n: u32) -> Settings {
@@ -120,22 +120,6 @@ fn one_cell_one_triangle_and_extreme_shaft_resolutions() {
     check(&tris, 1, 8, 2000, 6).unwrap();
     check(&tris, 3, 1, 2000, 7).unwrap();
     check(&tris, 3, 8, 2000, 8).unwrap();
-}
-
-/// Re-writes a file with one section's bytes changed (checksums made right again), so that
-/// only the contents' validation can refuse it.
-fn rewrite(bytes: &[u8], kind: kiln_format::SectionKind, edit: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
-    let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
-    let mut w = FileWriter::new();
-    let mut edit = Some(edit);
-    for s in file.sections() {
-        let mut data = file.section_bytes(s).unwrap().into_owned();
-        if s.entry.kind == kind {
-            (edit.take().unwrap())(&mut data);
-        }
-        w.raw(s.entry.kind, s.entry.index, s.entry.version, data, ContentHash::default()).unwrap();
-    }
-    w.to_bytes().unwrap()
 }
 
 #[test]

@@ -34,6 +34,48 @@ impl BvhPreset {
     }
 }
 
+/// Whether the irradiance probe volume is baked (`--probes`, `[bake] probes`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum Probes {
+    /// Baked whenever something lights the scene.
+    #[default]
+    Auto,
+    /// Never baked.
+    Off,
+}
+
+impl Probes {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Probes::Auto => "auto",
+            Probes::Off => "off",
+        }
+    }
+
+    /// Parses a sidecar value.
+    pub fn parse(s: &str) -> Option<Probes> {
+        <Probes as ValueEnum>::from_str(s, false).ok()
+    }
+}
+
+/// Distance between probes in scene units (`--probe-spacing`): finite and positive; compared
+/// bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProbeSpacing(pub f32);
+
+impl Eq for ProbeSpacing {}
+
+impl ProbeSpacing {
+    /// Parses a positive, finite number.
+    pub fn parse(s: &str) -> Result<ProbeSpacing, String> {
+        match s.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(ProbeSpacing(v)),
+            _ => Err(format!("'{s}' is not a positive distance in scene units")),
+        }
+    }
+}
+
 /// How PNMT records are stored (`--pnmt-records`, `[bake] pnmt_records`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum PnmtRecords {
@@ -153,6 +195,13 @@ pub const SHADOW_RES: Ranged = Ranged { key: "shadow_res", default: 1024, min: 1
 
 /// Light-visibility volume cells along the medium box's longest axis.
 pub const MEDIA_VOLUME_RES: Ranged = Ranged { key: "media_volume_res", default: 64, min: 2, max: 512 };
+
+/// Rays traced per probe of the irradiance volume (each a path of every bounce; a quarter as
+/// many next-event samples of the emissive triangles join them).
+pub const PROBE_RAYS: Ranged = Ranged { key: "probe_rays", default: 256, min: 16, max: 65536 };
+
+/// Size budget of the probe volume, MiB, when its spacing is chosen from the scene's size.
+pub const PROBE_BUDGET: Ranged = Ranged { key: "probe_budget", default: 2, min: 1, max: 4096 };
 
 /// Voxel grid cells along the scene's longest axis when given as a number (the default is
 /// [`VoxelRes::Auto`], so [`Ranged::default`] is unused here).
@@ -337,6 +386,14 @@ pub struct Settings {
     pub shadow_res: u32,
     /// Light-visibility volume cells along the medium's longest axis.
     pub media_volume_res: u32,
+    /// Whether the probe volume is baked.
+    pub probes: Probes,
+    /// Probe spacing; `None`: from the scene's size within [`PROBE_BUDGET`].
+    pub probe_spacing: Option<ProbeSpacing>,
+    /// Rays per probe.
+    pub probe_rays: u32,
+    /// Probe volume budget, MiB (when the spacing is chosen).
+    pub probe_budget: u32,
     /// Normals where the asset gives none (applied at import).
     pub normals: Normals,
     /// Which sections are stored compressed. Changes the stored bytes only, never a section's
@@ -359,6 +416,10 @@ impl Default for Settings {
             brdf_lut_res: BRDF_LUT_RES.default,
             shadow_res: SHADOW_RES.default,
             media_volume_res: MEDIA_VOLUME_RES.default,
+            probes: Probes::Auto,
+            probe_spacing: None,
+            probe_rays: PROBE_RAYS.default,
+            probe_budget: PROBE_BUDGET.default,
             normals: Normals::Asset,
             codec: Codec::Auto,
             texture_format: TextureFormat::default(),
@@ -394,6 +455,8 @@ impl Settings {
             (BRDF_LUT_RES, b.brdf_lut_res, &mut self.brdf_lut_res),
             (SHADOW_RES, b.shadow_res, &mut self.shadow_res),
             (MEDIA_VOLUME_RES, b.media_volume_res, &mut self.media_volume_res),
+            (PROBE_RAYS, b.probe_rays, &mut self.probe_rays),
+            (PROBE_BUDGET, b.probe_budget, &mut self.probe_budget),
         ] {
             if let Some(n) = value {
                 *setting = table.check(n)?;
@@ -409,6 +472,13 @@ impl Settings {
         if let Some(p) = &b.pnmt_records {
             self.pnmt_records =
                 PnmtRecords::parse(p).ok_or_else(|| format!("pnmt_records is '{p}'; use compact or full"))?;
+        }
+        if let Some(p) = &b.probes {
+            self.probes = Probes::parse(p).ok_or_else(|| format!("probes is '{p}'; use auto or off"))?;
+        }
+        if let Some(v) = b.probe_spacing {
+            self.probe_spacing =
+                Some(ProbeSpacing::parse(&v.to_string()).map_err(|e| format!("probe_spacing: {e}"))?);
         }
         if let Some(n) = &b.normals {
             self.normals = Normals::parse(n).map_err(|e| format!("normals: {e}"))?;
@@ -434,6 +504,10 @@ impl Settings {
             ("brdf-lut-res".into(), self.brdf_lut_res.to_string()),
             ("shadow-res".into(), self.shadow_res.to_string()),
             ("media-volume-res".into(), self.media_volume_res.to_string()),
+            ("probes".into(), self.probes.name().into()),
+            ("probe-spacing".into(), self.probe_spacing.map_or_else(|| "plan".into(), |s| s.0.to_string())),
+            ("probe-rays".into(), self.probe_rays.to_string()),
+            ("probe-budget".into(), self.probe_budget.to_string()),
             ("normals".into(), self.normals.name()),
             ("codec".into(), self.codec.name().into()),
             ("texture-format".into(), self.texture_format.name().into()),

@@ -112,8 +112,8 @@ fn a_warm_cache_reuses_every_stage_and_writes_the_same_bytes() {
     assert_eq!(with(&warm, false), Vec::<&str>::new(), "every stage is reused: {warm:?}");
     assert_eq!(
         warm.len(),
-        7,
-        "geometry, materials, bvh, brdf-lut, shadow-maps, voxel-grid, line-space: {warm:?}"
+        8,
+        "geometry, materials, bvh, brdf-lut, shadow-maps, probes, voxel-grid, line-space: {warm:?}"
     );
     assert!(!stderr.contains("warning"), "{stderr}");
     same(d, "plain.kiln", "cold.kiln");
@@ -166,7 +166,8 @@ fn a_light_change_rebakes_the_shadow_maps_and_reuses_geometry_bvh_and_line_space
     let (stages, _) = demo(d, "b.kiln", Some("c"), &["-c", b.to_str().unwrap()]);
     demo(d, "b-plain.kiln", None, &["-c", b.to_str().unwrap()]);
     same(d, "b-plain.kiln", "b.kiln");
-    assert_eq!(with(&stages, false), ["shadow-maps"], "{stages:?}");
+    // The probes are lit by the lights too.
+    assert_eq!(with(&stages, false), ["shadow-maps", "probes"], "{stages:?}");
     for s in ["geometry", "materials", "bvh", "brdf-lut", "voxel-grid", "line-space"] {
         assert!(with(&stages, true).contains(&s), "{s} not reused: {stages:?}");
     }
@@ -191,7 +192,7 @@ fn the_pre_illuminated_line_space_depends_on_the_lights() {
     let (stages, _) = demo(d, "b.kiln", Some("c"), &b_args);
     demo(d, "b-plain.kiln", None, &b_args);
     same(d, "b-plain.kiln", "b.kiln");
-    assert_eq!(with(&stages, false), ["shadow-maps", "voxel-grid", "line-space"], "{stages:?}");
+    assert_eq!(with(&stages, false), ["shadow-maps", "probes", "voxel-grid", "line-space"], "{stages:?}");
     assert!(with(&stages, true).contains(&"bvh"), "{stages:?}");
 }
 
@@ -202,12 +203,16 @@ fn a_setting_change_misses_exactly_the_stages_that_read_it() {
     let side = sidecar(d, "a.toml", [0.2, 1.2, 0.1]);
     let side = side.to_str().unwrap();
     demo(d, "base.kiln", Some("c"), &["-c", side]);
-    let cases: [(&[&str], &[&str]); 4] = [
+    let cases: [(&[&str], &[&str]); 5] = [
         (&["--shadow-res", "128"], &["shadow-maps"]),
-        (&["--brdf-lut-res", "32"], &["brdf-lut"]),
+        (&["--probe-rays", "64"], &["probes"]),
+        (&["--brdf-lut-res", "32"], &["brdf-lut", "probes"]),
         (&["--shaft-res", "3"], &["voxel-grid", "line-space"]),
         // Everything stored in BVH order, and everything that traces rays through it.
-        (&["--bvh-preset", "fast"], &["geometry", "bvh", "shadow-maps", "voxel-grid", "line-space"]),
+        (
+            &["--bvh-preset", "fast"],
+            &["geometry", "bvh", "shadow-maps", "probes", "voxel-grid", "line-space"],
+        ),
     ];
     for (i, (args, missed)) in cases.iter().enumerate() {
         let args = &[&["-c", side][..], args].concat();
@@ -400,14 +405,14 @@ fn a_material_change_misses_only_the_material_table() {
     let a = sidecar(d, "a.toml", [0.2, 1.2, 0.1]);
     demo(d, "a.kiln", Some("c"), &["-c", a.to_str().unwrap()]);
     // The same light, the red wall rougher: PNMT records hold material numbers, not parameters,
-    // and shadows ignore materials.
+    // and shadows ignore materials; the probes' light bounces off it.
     let b = d.join("b.toml");
     std::fs::write(&b, std::fs::read_to_string(&a).unwrap().replace("roughness = 0.4", "roughness = 0.7"))
         .unwrap();
     let (stages, _) = demo(d, "b.kiln", Some("c"), &["-c", b.to_str().unwrap()]);
     demo(d, "b-plain.kiln", None, &["-c", b.to_str().unwrap()]);
     same(d, "b-plain.kiln", "b.kiln");
-    assert_eq!(with(&stages, false), ["materials"], "{stages:?}");
+    assert_eq!(with(&stages, false), ["materials", "probes"], "{stages:?}");
 }
 
 #[test]
@@ -431,5 +436,6 @@ fn a_light_colour_change_rebakes_no_shadow_map() {
         std::fs::read(d.join("b.kiln")).unwrap(),
         "the light changed"
     );
-    assert_eq!(with(&stages, false), Vec::<&str>::new(), "{stages:?}");
+    // Only the probes hold the light's colour.
+    assert_eq!(with(&stages, false), ["probes"], "{stages:?}");
 }

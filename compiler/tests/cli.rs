@@ -14,14 +14,14 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.3");
+    assert_eq!(j["format_version"], "1.4");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(
         kinds,
         [
-            "MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV", "SHDW", "VGRD", "VOXO", "VOXT", "LSLT", "LSBN",
-            "LSRK", "LSCO", "LSCE", "LSPN"
+            "MANI", "MATL", "VERT", "TRIS", "TMAT", "CWBV", "SHDW", "PRBG", "PRBS", "PRBI", "PRBV", "VGRD",
+            "VOXO", "VOXT", "LSLT", "LSBN", "LSRK", "LSCO", "LSCE", "LSPN"
         ]
     );
     assert_eq!(j["line_space"]["shaft_res"], 4);

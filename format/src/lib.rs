@@ -26,6 +26,7 @@ pub mod header;
 pub mod linespace;
 pub mod manifest;
 mod parallel;
+pub mod probes;
 pub mod projection;
 pub mod query;
 pub mod read;

@@ -13,6 +13,9 @@ pub const MEDIA_VISIBILITY: &[&str] = &["--media march"];
 /// The line space's arrays (binary, candidates, PNMT, pre-illuminated records).
 pub const LINE_SPACE: &[&str] = &["--shadows linespace", "--gi linespace"];
 
+/// The irradiance probe volume (`PRBG`, `PRBS`, `PRBI`, `PRBV`).
+pub const PROBES: &[&str] = &["--gi probes"];
+
 /// `readers` as prose: `--a x`, `--a x and --b y`, `--a x, --b y and --c z`.
 pub fn list(readers: &[&str]) -> String {
     match readers.split_last() {

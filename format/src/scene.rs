@@ -316,6 +316,7 @@ impl<'a> SceneView<'a> {
                 )));
             }
         }
+        crate::probes::ProbeVolume::read(file)?;
         let volumes = file.all_of(MEDIA_VISIBILITY).len();
         match &m.media_visibility {
             None if volumes == 0 => {}

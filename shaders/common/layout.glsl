@@ -198,6 +198,17 @@ struct DenoiseConstants {
     float sigma_plane; // offset 28
 }; // 32 bytes
 
+struct ProbeConstants {
+    vec3 origin; // offset 0
+    float spacing; // offset 12
+    uvec3 dims; // offset 16
+    uint layers; // offset 28
+    uint irradiance_texels; // offset 32
+    uint visibility_texels; // offset 36
+    float normal_bias; // offset 40
+    float view_bias; // offset 44
+}; // 48 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;

@@ -172,9 +172,15 @@ pub fn metal(base: f32, roughness: f32) -> GpuMaterial {
     m
 }
 
-/// Compiler settings that keep the test scenes quick to bake: no shafts, 512² shadow maps.
+/// Compiler settings that keep the test scenes quick to bake: no shafts, 512² shadow maps, no
+/// probes (`probes.rs` asks for its own).
 pub fn fast_settings() -> Settings {
-    Settings { shaft_variants: Some(0), shadow_res: 512, ..Default::default() }
+    Settings {
+        shaft_variants: Some(0),
+        shadow_res: 512,
+        probes: kiln_compiler::settings::Probes::Off,
+        ..Default::default()
+    }
 }
 
 /// The analytic scenes' albedo, as sRGB codes.

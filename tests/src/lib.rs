@@ -22,6 +22,7 @@ use kiln_player::render::{
 use kiln_player::scene::TextureUpload;
 use kiln_player::session::{PipelineStart, SessionOptions};
 
+pub mod boxes;
 pub mod exact;
 
 /// The shared scene folder (`../shared/scenes` beside the checkout), if present; if not, says
@@ -56,6 +57,23 @@ pub fn scene_of(tris: &[[Vec3; 3]]) -> Scene {
 /// Compiles a scene in memory (as `kiln compile` would) and returns the file's bytes.
 pub fn compile(scene: Scene, settings: Settings) -> Vec<u8> {
     kiln_compiler::pipeline::compile_to_bytes(scene, settings, "test").expect("valid scene")
+}
+
+/// Re-writes a file with one section's bytes changed by `edit` (checksums made right again), so
+/// that only the contents' validation can refuse it.
+pub fn rewrite(bytes: &[u8], kind: kiln_format::SectionKind, edit: impl FnOnce(&mut Vec<u8>)) -> Vec<u8> {
+    use kiln_format::{Checksums, ContentHash, FileWriter, KilnFile};
+    let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
+    let mut w = FileWriter::new();
+    let mut edit = Some(edit);
+    for s in file.sections() {
+        let mut data = file.section_bytes(s).unwrap().into_owned();
+        if s.entry.kind == kind {
+            (edit.take().unwrap())(&mut data);
+        }
+        w.raw(s.entry.kind, s.entry.index, s.entry.version, data, ContentHash::default()).unwrap();
+    }
+    w.to_bytes().unwrap()
 }
 
 /// How a G-buffer is made, as the tests name it (see [`Options::gbuffer`]).

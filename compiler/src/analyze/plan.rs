@@ -35,6 +35,8 @@ pub enum Stage {
     ShadowMaps,
     /// Light-visibility volume of the participating medium.
     MediaVisibility,
+    /// Irradiance probe volume, path traced.
+    Probes,
     /// Cell triangle lists of the voxel grid.
     VoxelGrid,
     /// Shafts per non-empty cell: binary, candidates, PNMT.
@@ -54,6 +56,7 @@ impl Stage {
             Stage::BrdfLut => "brdf-lut",
             Stage::ShadowMaps => "shadow-maps",
             Stage::MediaVisibility => "media-visibility",
+            Stage::Probes => "probes",
             Stage::VoxelGrid => "voxel-grid",
             Stage::LineSpace => "line-space",
         }
@@ -96,6 +99,63 @@ fn emitters(scene: &Scene) -> String {
     )
 }
 
+/// The probe stage's decision and layout; the error (a usage error) says why the spacing asked
+/// for does not fit.
+fn probe_plan(
+    scene: &Scene,
+    geometry: &SceneGeometry,
+    settings: &Settings,
+    lit: bool,
+) -> Result<(Decision, Option<crate::bake::probes::ProbeLayout>), String> {
+    use crate::bake::probes;
+    let skip = |why: &str| Ok((Decision { stage: Stage::Probes, run: false, reason: why.into() }, None));
+    if settings.probes == crate::settings::Probes::Off {
+        return skip("disabled by --probes off");
+    }
+    if scene.triangles.is_empty() {
+        return skip("the scene has no triangles: nothing to light or to occlude");
+    }
+    if !lit {
+        return skip(
+            "nothing lights the scene (no light, emissive surface or sky): every probe would be black",
+        );
+    }
+    let emits = scene.triangle_materials.iter().any(|&m| {
+        scene.materials.get(m as usize).is_some_and(|m| kiln_format::gpu::luminance(m.gpu.emission) > 0.0)
+    });
+    let layers = if emits { 2 } else { 1 };
+    let budget = settings.probe_budget as u64 * (1 << 20);
+    let layout = probes::layout(
+        &geometry.bounds,
+        settings.probe_spacing.map(|s| s.0),
+        budget,
+        layers,
+        settings.probe_rays,
+    )?;
+    let [x, y, z] = layout.dims;
+    let why_spacing = match settings.probe_spacing {
+        Some(_) => String::new(),
+        None => format!(
+            " (the longest extent over {}, within --probe-budget {} MiB)",
+            probes::AUTO_PROBES,
+            settings.probe_budget
+        ),
+    };
+    let reason = format!(
+        "{x}x{y}x{z} probes every {} scene units{why_spacing}, {}, {} paths each{}; read by kiln-play {}",
+        short(layout.spacing as f64),
+        if layout.bytes() < 1 << 20 {
+            format!("{:.1} KiB", layout.bytes() as f64 / 1024.0)
+        } else {
+            mib(layout.bytes())
+        },
+        layout.rays,
+        if emits { ", emissive surfaces' direct light in a layer of its own" } else { "" },
+        readers::list(readers::PROBES)
+    );
+    Ok((Decision { stage: Stage::Probes, run: true, reason }, Some(layout)))
+}
+
 /// One stage's decision.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct Decision {
@@ -124,6 +184,9 @@ pub struct Plan {
     pub pnmt_layout: PnmtLayout,
     /// The line space's configuration, its estimated size and why (when baked).
     pub line_space: Option<Choice>,
+    /// Where the irradiance probes go (when baked).
+    #[serde(skip)]
+    pub probes: Option<crate::bake::probes::ProbeLayout>,
 }
 
 impl Plan {
@@ -218,6 +281,11 @@ impl Plan {
                 ),
             )
         });
+        let lit = !scene.lights.is_empty()
+            || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
+            || scene.sky.radiance.iter().any(|&r| r > 0.0);
+        let (probe_decision, probes) = probe_plan(scene, geometry, settings, lit)?;
+        stages.push(probe_decision);
         let requested_res = match settings.voxel_res {
             VoxelRes::Auto => auto_resolution(scene.triangles.len()),
             VoxelRes::Cells(n) => n,
@@ -231,9 +299,6 @@ impl Plan {
         // than the player's CWBVH where their answer is usable; the technique that pays there is
         // GI from pre-illuminated records, which needs `--shaft-variants …,preillum` (its bake
         // shades every record: 90 s for the bunny-count box on 16 cores, too slow for a default).
-        let lit = !scene.lights.is_empty()
-            || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
-            || scene.sky.radiance.iter().any(|&r| r > 0.0);
         let wanted = match settings.shaft_variants {
             Some(v) => v != 0,
             None => lit,
@@ -351,7 +416,7 @@ impl Plan {
                 ));
             }
         }
-        Ok(Plan { stages, voxel_res, shaft_res, shaft_variants, pnmt_layout, line_space: choice })
+        Ok(Plan { stages, voxel_res, shaft_res, shaft_variants, pnmt_layout, line_space: choice, probes })
     }
 
     /// Whether `stage` runs.

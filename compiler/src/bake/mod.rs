@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod linespace;
 pub mod materials;
 pub mod media;
+pub mod probes;
 pub mod shadow;
 pub mod textures;
 pub mod uvs;
@@ -307,6 +308,30 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
                 .part("bounds", &bounds(&ctx.geometry.bounds))
                 .hash("geometry", &ctx.geometry_key);
         }
+        Stage::Probes => {
+            // Paths through the stored geometry, shaded by the materials, textures, lights and
+            // sky; the layout (spacing, dims, rays) as the plan resolved it.
+            let l = ctx.plan.probes.map(|l| {
+                format!(
+                    "{:?} {} {:?} {} {}",
+                    l.origin.to_array(),
+                    l.spacing.to_bits(),
+                    l.dims,
+                    l.layers,
+                    l.rays
+                )
+            });
+            let lut = if ctx.plan.runs(Stage::BrdfLut) { s.brdf_lut_res } else { 0 };
+            h.part("layout", l.unwrap_or_default().as_bytes())
+                .hash("geometry", &ctx.geometry_key)
+                .part("triangle-materials", bytemuck::cast_slice(&ctx.triangle_materials))
+                .part("uvs", bytemuck::cast_slice(&scene.uvs))
+                .part("materials", bytemuck::cast_slice(&ctx.materials))
+                .part("lights", &records_bytes(&scene.lights, &[]))
+                .part("sky", bytemuck::cast_slice(&scene.sky.radiance))
+                .part("lut", &lut.to_le_bytes());
+            hash_textures(&mut h, scene);
+        }
         Stage::MediaVisibility => {
             h.part("res", &s.media_volume_res.to_le_bytes())
                 .part("lights-media", &records_bytes(&scene.lights, &scene.media))
@@ -384,6 +409,7 @@ fn cached_stage(ctx: &BakeContext, stage: Stage, key: &ContentHash) -> (Sections
         Stage::BrdfLut => brdf_lut::stage(ctx),
         Stage::ShadowMaps => shadow::stage(ctx),
         Stage::MediaVisibility => media::stage(ctx),
+        Stage::Probes => probes::stage(ctx),
         // Made by the context (BVH) and by `grid_and_line_space`.
         Stage::Bvh | Stage::VoxelGrid | Stage::LineSpace => Sections::default(),
     };

@@ -190,6 +190,27 @@ sidecar's bake.pnmt_records]"
     #[arg(long, value_name = "N", value_parser = MEDIA_VOLUME_RES.parser(), help_heading = "Lighting bakes",
           help = MEDIA_VOLUME_RES.help("Light-visibility volume cells along the medium's longest axis"))]
     pub media_volume_res: Option<u32>,
+    /// Whether the irradiance probe volume is baked.
+    #[arg(
+        long,
+        value_enum,
+        help_heading = "Lighting bakes",
+        help = format!("Irradiance probes (read by kiln-play {}): auto (a volume of probes path traced at every \
+bounce, whenever something lights the scene) or off [default: auto, or the sidecar's bake.probes]", kiln_format::readers::list(kiln_format::readers::PROBES))
+    )]
+    pub probes: Option<crate::settings::Probes>,
+    /// Distance between probes.
+    #[arg(long, value_name = "UNITS", value_parser = crate::settings::ProbeSpacing::parse, help_heading = "Lighting bakes",
+          help = format!("Distance between irradiance probes in scene units [default: the longest extent over {}, widened until the volume fits --probe-budget]", crate::bake::probes::AUTO_PROBES))]
+    pub probe_spacing: Option<crate::settings::ProbeSpacing>,
+    /// Rays per probe.
+    #[arg(long, value_name = "N", value_parser = crate::settings::PROBE_RAYS.parser(), help_heading = "Lighting bakes",
+          help = crate::settings::PROBE_RAYS.help("Paths traced per probe (more: less noise, longer bake)"))]
+    pub probe_rays: Option<u32>,
+    /// Budget of the probe volume.
+    #[arg(long, value_name = "MiB", value_parser = crate::settings::PROBE_BUDGET.parser(), help_heading = "Lighting bakes",
+          help = crate::settings::PROBE_BUDGET.help("Size budget of the probe volume in MiB when --probe-spacing is not given"))]
+    pub probe_budget: Option<u32>,
     /// Normals where the asset gives none.
     #[arg(long, value_name = "flat|smooth[:ANGLE]", value_parser = Normals::parse, help_heading = "Import",
           help = "Normals where the asset gives none (given normals are kept): flat (face normals), smooth \
@@ -232,6 +253,10 @@ impl BakeArgs {
         set(&mut settings.brdf_lut_res, self.brdf_lut_res);
         set(&mut settings.shadow_res, self.shadow_res);
         set(&mut settings.media_volume_res, self.media_volume_res);
+        set(&mut settings.probes, self.probes);
+        set(&mut settings.probe_spacing, self.probe_spacing.map(Some));
+        set(&mut settings.probe_rays, self.probe_rays);
+        set(&mut settings.probe_budget, self.probe_budget);
         set(&mut settings.normals, self.normals);
         set(&mut settings.codec, self.codec);
         set(&mut settings.texture_format, self.texture_format);

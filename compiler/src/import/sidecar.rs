@@ -193,6 +193,14 @@ pub struct BakeToml {
     pub shadow_res: Option<u32>,
     /// Light-visibility volume resolution.
     pub media_volume_res: Option<u32>,
+    /// `"auto"` or `"off"`: whether the irradiance probe volume is baked.
+    pub probes: Option<String>,
+    /// Distance between probes, scene units.
+    pub probe_spacing: Option<f64>,
+    /// Rays per probe.
+    pub probe_rays: Option<u32>,
+    /// Budget of the probe volume, MiB.
+    pub probe_budget: Option<u32>,
     /// Normals where the asset gives none: `"flat"`, `"smooth"` or `"smooth:ANGLE"`.
     pub normals: Option<String>,
     /// Which sections are compressed: `"auto"`, `"none"` or `"zstd"`.

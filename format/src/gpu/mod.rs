@@ -371,6 +371,29 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of the probe GI pass (`shaders/probes/gi.comp`; 48 bytes): the volume's
+    /// header ([`crate::probes::ProbeHeader`]) and the lookup's biases.
+    pub struct ProbeConstants {
+        /// Grid point of probe (0, 0, 0).
+        pub origin: [f32; 3] => "vec3",
+        /// Distance between neighbouring probes.
+        pub spacing: f32 => "float",
+        /// Probes along x, y, z.
+        pub dims: [u32; 3] => "uvec3",
+        /// Irradiance layers (2: emissive surfaces' direct light in the second).
+        pub layers: u32 => "uint",
+        /// Interior texels of an irradiance tile's edge.
+        pub irradiance_texels: u32 => "uint",
+        /// Interior texels of a visibility tile's edge.
+        pub visibility_texels: u32 => "uint",
+        /// The lookup point moves this far along the surface normal (scene units).
+        pub normal_bias: f32 => "float",
+        /// … and this far towards the camera.
+        pub view_bias: f32 => "float",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
@@ -560,6 +583,7 @@ pub fn glsl_layout() -> String {
     declare::<ScreenGiConstants>(&mut s);
     declare::<SsrConstants>(&mut s);
     declare::<DenoiseConstants>(&mut s);
+    declare::<ProbeConstants>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -735,6 +759,7 @@ mod tests {
         check::<ScreenAoConstants>();
         check::<SsrConstants>();
         check::<DenoiseConstants>();
+        check::<ProbeConstants>();
         check::<GpuGrid>();
         check::<BakeParams>();
         check::<BakeCell>();

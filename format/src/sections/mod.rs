@@ -68,6 +68,15 @@ pub const SHADOW_MAP: SectionKind = SectionKind(*b"SHDW");
 /// Light-visibility volume of one light: u8 per cell; index = position in the manifest's list.
 pub const MEDIA_VISIBILITY: SectionKind = SectionKind(*b"MVIS");
 
+/// Irradiance probe volume header ([`crate::probes::ProbeHeader`], one element).
+pub const PROBE_GRID: SectionKind = SectionKind(*b"PRBG");
+/// Probe states ([`crate::probes::ProbeState`]: offset and on/off), one per probe.
+pub const PROBE_STATES: SectionKind = SectionKind(*b"PRBS");
+/// Probe irradiance atlas: `E5B9G9R9` texels (see [`crate::probes`]).
+pub const PROBE_IRRADIANCE: SectionKind = SectionKind(*b"PRBI");
+/// Probe visibility atlas: binary16 (mean, mean square) distance per texel.
+pub const PROBE_VISIBILITY: SectionKind = SectionKind(*b"PRBV");
+
 /// What the format knows of a section kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct KindInfo {
@@ -180,6 +189,10 @@ pub const KNOWN: &[KindInfo] = &[
         indexed: true,
         description: "shadow map depths (f32)",
     },
+    pod_kind(PROBE_GRID, "probe-grid", 64, "irradiance probe volume header"),
+    pod_kind(PROBE_STATES, "probe-states", 16, "probe offsets and on/off"),
+    pod_kind(PROBE_IRRADIANCE, "probe-irradiance", 4, "probe irradiance atlas (E5B9G9R9, octahedral)"),
+    pod_kind(PROBE_VISIBILITY, "probe-visibility", 4, "probe distance moments atlas (binary16, octahedral)"),
     KindInfo {
         kind: MEDIA_VISIBILITY,
         name: "media-visibility",

@@ -46,12 +46,20 @@ const RT_GI_4: Choice =
 const SVGF: Choice = pick(Effect::Denoise, "svgf");
 const TAA: Choice = pick(Effect::Aa, "taa");
 
+const PROBES: Choice = pick(Effect::Gi, "probes");
+
 /// The presets, cheapest first.
-pub const PRESETS: [Preset; 9] = [
+pub const PRESETS: [Preset; 10] = [
     Preset {
         name: "baked",
         help: "no rays: shadow maps, screen-space GI and reflections",
         choices: &[SHADOW_MAPS, SCREEN_GI, SCREEN_REFLECTIONS],
+    },
+    Preset {
+        name: "probes",
+        help: "no rays: shadow maps, the compiler's irradiance probes for indirect light, screen-space \
+               reflections (needs a file compiled with probes)",
+        choices: &[SHADOW_MAPS, PROBES, SCREEN_REFLECTIONS],
     },
     Preset {
         name: "baked-taa",

@@ -13,6 +13,7 @@
 pub mod bindings;
 pub mod linespace;
 pub mod media;
+pub mod probes;
 pub mod reference;
 pub mod upload;
 
@@ -151,6 +152,10 @@ struct Part {
     textures: TextureUpload,
 }
 
+/// The probe volume's sections.
+const PROBE_KINDS: [kiln_format::table::SectionKind; 4] =
+    [sections::PROBE_GRID, sections::PROBE_STATES, sections::PROBE_IRRADIANCE, sections::PROBE_VISIBILITY];
+
 /// Whether a section of `kind` is uploaded under `needs` (geometry always).
 fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
     kind == sections::VERTICES
@@ -162,6 +167,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
         || (kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
+        || (PROBE_KINDS.contains(&kind) && needs.probes)
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
@@ -367,6 +373,8 @@ pub struct GpuScene {
     pub line_space: Option<linespace::LineSpaceBuffers>,
     /// The media table and light-visibility volumes, when a media technique reads them.
     pub media: Option<media::MediaBuffers>,
+    /// The irradiance probe volume, when `--gi probes` reads it.
+    pub probes: Option<probes::ProbeImages>,
     /// Every section of the file and its fate.
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
@@ -506,6 +514,7 @@ impl GpuScene {
             reference: None,
             line_space: None,
             media: None,
+            probes: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
             resident: Needs::default(),
@@ -588,6 +597,16 @@ impl GpuScene {
         }
         if now.media && !view.manifest.media.is_empty() {
             self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, all.media_volumes, up)?);
+        }
+        if now.probes {
+            let volume = kiln_format::probes::ProbeVolume::read(file).map_err(bad)?.ok_or_else(|| {
+                PlayError::new(
+                    Exit::BadInput,
+                    "--gi probes: the file has no irradiance probes; recompile it with kiln compile \
+                     (probes are baked unless --probes off is given or nothing lights the scene)",
+                )
+            })?;
+            self.probes = Some(probes::ProbeImages::new(gpu, &volume, up)?);
         }
         for s in file.sections() {
             let kind = s.entry.kind;
@@ -702,6 +721,9 @@ impl GpuScene {
                     }
                     _ => fate.after_first_frame = first,
                 }
+            } else if PROBE_KINDS.contains(&kind) && all.probes {
+                // Uploaded together before this loop.
+                fate.after_first_frame = !now.probes && first;
             } else if (kind == sections::BRDF_LUT && all.brdf_lut && !now.brdf_lut)
                 || (kind == sections::SHADOW_MAP && all.shadow_maps && !now.shadow_maps)
             {
@@ -742,6 +764,8 @@ impl GpuScene {
                     "no pass reads the BRDF table".into()
                 } else if kind == sections::MEDIA_VISIBILITY {
                     no_reader(|n| n.media_volumes)
+                } else if PROBE_KINDS.contains(&kind) {
+                    no_reader(|n| n.probes)
                 } else if kind == sections::SHADOW_MAP {
                     no_reader(|n| n.shadow_maps)
                 } else {

@@ -116,6 +116,7 @@ fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Ca
         media: !manifest.media.is_empty(),
         emission: crate::session::has_emission(&file)?,
         lights: !manifest.lights.is_empty(),
+        probes: file.find(kiln_format::sections::PROBE_GRID, 0).is_some(),
     };
     if !offers.bvh {
         return Err(PlayError::new(

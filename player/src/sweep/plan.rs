@@ -103,6 +103,8 @@ pub struct Offers {
     /// An analytic light (without one, shadow maps have nothing to shadow: a technique that
     /// reads them renders what the default frame does).
     pub lights: bool,
+    /// The irradiance probe volume.
+    pub probes: bool,
 }
 
 impl Offers {
@@ -117,6 +119,8 @@ impl Offers {
                 "needs shadow maps, which the file does not have (compiled with shadows skipped, or no lights)"
                     .into(),
             )
+        } else if n.probes && !self.probes {
+            Some("needs irradiance probes, which the file does not have (compiled with --probes off, or nothing lights it)".into())
         } else if n.media && !self.media {
             Some("needs a participating medium, which the file does not have (add a [[medium]] to the sidecar)".into())
         } else if variants & !self.line_space != 0 {
@@ -524,6 +528,7 @@ mod tests {
         media: true,
         emission: true,
         lights: true,
+        probes: true,
     };
 
     #[test]
@@ -632,6 +637,7 @@ mod tests {
                 media: false,
                 emission: false,
                 lights: true,
+                probes: false,
             },
         );
         assert!(
@@ -652,6 +658,7 @@ mod tests {
             media: false,
             emission: false,
             lights: true,
+            probes: false,
         };
         let p = plan(&request(vec![Target::Effect(Effect::Shadows)], &[]), &offers);
         assert!(

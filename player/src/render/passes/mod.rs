@@ -21,6 +21,7 @@ pub mod materials;
 pub mod media;
 pub mod mitchell;
 pub mod pathtrace;
+pub mod probes;
 pub mod resolve;
 pub mod rt_ao;
 pub mod rt_direct;

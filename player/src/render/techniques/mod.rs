@@ -314,6 +314,8 @@ pub struct Needs {
     pub media: bool,
     /// The light-visibility volumes (`MVIS` sections).
     pub media_volumes: bool,
+    /// The irradiance probe volume (`PRBG`, `PRBS`, `PRBI`, `PRBV`).
+    pub probes: bool,
 }
 
 impl Needs {
@@ -328,6 +330,7 @@ impl Needs {
             line_space: self.line_space | o.line_space,
             media: self.media || o.media,
             media_volumes: self.media_volumes || o.media_volumes,
+            probes: self.probes || o.probes,
         }
     }
 
@@ -342,6 +345,7 @@ impl Needs {
             line_space: self.line_space & !o.line_space,
             media: self.media && !o.media,
             media_volumes: self.media_volumes && !o.media_volumes,
+            probes: self.probes && !o.probes,
         }
     }
 
@@ -355,6 +359,7 @@ impl Needs {
         line_space: 0,
         media: false,
         media_volumes: false,
+        probes: false,
     };
     /// What ray queries through the BVH read.
     pub const RAYS: Needs = Needs { bvh: true, ..Needs::NONE };

@@ -403,5 +403,6 @@ fn the_format_names_the_readers_the_catalogue_has() {
     assert_eq!(readers(|n| n.shadow_maps), readers::SHADOW_MAPS);
     assert_eq!(readers(|n| n.media_volumes), readers::MEDIA_VISIBILITY);
     assert_eq!(readers(|n| n.line_space != 0), readers::LINE_SPACE);
+    assert_eq!(readers(|n| n.probes), readers::PROBES);
     assert_eq!(readers::list(&["--a x", "--b y", "--c z"]), "--a x, --b y and --c z");
 }

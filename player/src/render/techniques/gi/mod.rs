@@ -10,6 +10,7 @@ techniques! {
     rt => Rt,
     linespace => LineSpace,
     ssgi => Ssgi,
+    probes => Probes,
 }
 
 /// Bounces of the path-traced GI techniques.
@@ -63,7 +64,7 @@ impl Gi {
     pub fn bounces(&self) -> Option<u32> {
         match *self {
             Gi::Rt(rt::Rt { bounces }) | Gi::LineSpace(linespace::LineSpace { bounces, .. }) => Some(bounces),
-            Gi::Off(_) | Gi::Ssgi(_) => None,
+            Gi::Off(_) | Gi::Ssgi(_) | Gi::Probes(_) => None,
         }
     }
 }

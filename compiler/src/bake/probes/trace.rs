@@ -1,0 +1,333 @@
+//! The probe bake's path tracer on the CPU: the light arriving at a point from a direction, split
+//! into what the player's direct pass may compute itself (emissive surfaces seen directly) and
+//! the rest (the sky, and everything surfaces reflect: every bounce of every emitter kind).
+//!
+//! - Paths start at the probe, continue by cosine-weighted sampling of the surface's BRDF (full
+//!   Cook–Torrance evaluated, so glossy surfaces reflect with the right weight; the sampling is
+//!   diffuse) and end by Russian roulette after [`ROULETTE_AFTER`] events, at most
+//!   [`MAX_BOUNCES`].
+//! - At every surface vertex: the analytic lights by kiln's direct shading (`crate::shading`,
+//!   shadow rays through the BVH) and the emissive triangles by next-event estimation (one
+//!   triangle by power, a uniform point on it), combined with the BRDF-sampled hits of emitters by
+//!   the balance heuristic. A miss sees the sky.
+//! - Emissive triangles emit from their front face (counter-clockwise), and from both faces when
+//!   their material is double-sided, as in the player's path tracer. Alpha is not tested: every
+//!   triangle is opaque to the bake.
+//!
+//! Random numbers come from a counter-based hash of (probe, ray, dimension), so that the bytes do
+//! not depend on thread count or order.
+
+use glam::{Vec2, Vec3};
+use kiln_format::query::{BvhQuery, Hit, IndexedTriangles, Ray, offset_origin};
+use kiln_format::sections::MaterialFlags;
+
+use crate::shading::{ShadingScene, Surface, light_samples};
+
+/// Scattering events after which paths continue only by Russian roulette.
+pub const ROULETTE_AFTER: u32 = 3;
+/// Scattering events a path counts at most.
+pub const MAX_BOUNCES: u32 = 64;
+
+/// Counter-based random numbers: a stream per (probe, path), one value per call.
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// The stream of path `path` of probe `probe`.
+    pub fn new(probe: u32, path: u32) -> Rng {
+        Rng(((probe as u64) << 32 | path as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x2545_f491_4f6c_dd1d)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f32 {
+        // SplitMix64 (Steele et al. 2014): a bijective mix of a Weyl sequence.
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        (z >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// Direction `i` of `n` spread evenly over the sphere (spherical Fibonacci points).
+pub fn fibonacci_direction(i: u32, n: u32) -> Vec3 {
+    let golden = (1.0 + 5f32.sqrt()) / 2.0;
+    let z = 1.0 - (2.0 * i as f32 + 1.0) / n as f32;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * (i as f32 / golden).fract();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// An orthonormal basis around unit `n` (Duff et al. 2017).
+fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    (Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x), Vec3::new(b, s + n.y * n.y * a, -n.y))
+}
+
+/// Emissive triangles, chosen in proportion to their power (a cumulative table searched).
+#[derive(Debug, Default)]
+struct Emitters {
+    /// Triangle (stored order) per entry.
+    triangles: Vec<u32>,
+    /// Cumulative probabilities, the last 1.
+    cdf: Vec<f32>,
+    /// Probability of choosing each triangle (0 for non-emitters), by triangle.
+    pdf: Vec<f32>,
+}
+
+/// A ray's first surface, as shading reads it.
+#[derive(Debug, Clone, Copy)]
+pub struct SurfaceHit {
+    /// Distance along the unit ray.
+    pub t: f32,
+    /// The point.
+    pub p: Vec3,
+    /// Unit geometric normal, of the counter-clockwise front face.
+    pub ng: Vec3,
+    /// Unit shading normal.
+    pub n: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Material.
+    pub material: u32,
+    /// Triangle (stored order).
+    pub triangle: u32,
+    /// Area of the triangle.
+    pub area: f32,
+}
+
+/// What the bake traces against.
+pub struct Tracer<'a> {
+    /// Materials, textures, lights, BVH.
+    pub shading: ShadingScene<'a>,
+    /// Texture coordinates per vertex (empty: none).
+    pub uvs: &'a [[f32; 2]],
+    /// Material per stored triangle.
+    pub triangle_materials: &'a [u32],
+    /// The sky's radiance.
+    pub sky: Vec3,
+    tris: IndexedTriangles<'a>,
+    emitters: Emitters,
+}
+
+impl std::fmt::Debug for Tracer<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Tracer").field("emitters", &self.emitters.triangles.len()).finish()
+    }
+}
+
+impl<'a> Tracer<'a> {
+    /// A tracer over `shading`'s scene; emissive triangles enter the emitter table by their
+    /// material's emission × area (their emissive texture is read where a sample lands).
+    pub fn new(
+        shading: ShadingScene<'a>,
+        uvs: &'a [[f32; 2]],
+        triangle_materials: &'a [u32],
+        sky: Vec3,
+    ) -> Tracer<'a> {
+        let tris = IndexedTriangles { vertices: shading.vertices, triangles: shading.triangles };
+        let mut emitters = Emitters { pdf: vec![0.0; shading.triangles.len()], ..Default::default() };
+        let mut power = Vec::new();
+        for (t, &m) in triangle_materials.iter().enumerate() {
+            let e = Vec3::from(shading.materials[m as usize].emission);
+            let [a, b, c] = kiln_format::query::TriangleSource::corners(&tris, t);
+            let p = kiln_format::gpu::luminance(e.to_array()) * 0.5 * (b - a).cross(c - a).length();
+            if p > 0.0 && p.is_finite() {
+                emitters.triangles.push(t as u32);
+                power.push(p as f64);
+            }
+        }
+        let total: f64 = power.iter().sum();
+        let mut sum = 0.0;
+        for (&t, &p) in emitters.triangles.iter().zip(&power) {
+            sum += p;
+            emitters.cdf.push((sum / total) as f32);
+            emitters.pdf[t as usize] = (p / total) as f32;
+        }
+        if let Some(last) = emitters.cdf.last_mut() {
+            *last = 1.0;
+        }
+        Tracer { shading, uvs, triangle_materials, sky, tris, emitters }
+    }
+
+    /// Whether the scene has emissive triangles.
+    pub fn has_emitters(&self) -> bool {
+        !self.emitters.triangles.is_empty()
+    }
+
+    fn query(&self) -> BvhQuery<'_, IndexedTriangles<'a>> {
+        BvhQuery::new(self.shading.bvh, &self.tris)
+    }
+
+    /// The surface `hit` of a unit ray from `o` along `d`.
+    fn surface_hit(&self, o: Vec3, d: Vec3, hit: Hit) -> SurfaceHit {
+        let tri = self.shading.triangles[hit.triangle as usize];
+        let v = tri.map(|i| self.shading.vertices[i as usize]);
+        let [a, b, c] = v.map(|v| Vec3::from(v.position));
+        let cross = (b - a).cross(c - a);
+        let w = [1.0 - hit.u - hit.v, hit.u, hit.v];
+        let ng = cross.normalize_or(-d);
+        let n = (Vec3::from(v[0].normal) * w[0]
+            + Vec3::from(v[1].normal) * w[1]
+            + Vec3::from(v[2].normal) * w[2])
+            .normalize_or(ng);
+        let uv = if self.uvs.is_empty() {
+            Vec2::ZERO
+        } else {
+            tri.iter().zip(w).map(|(&i, w)| Vec2::from(self.uvs[i as usize]) * w).sum()
+        };
+        SurfaceHit {
+            t: hit.t,
+            p: o + d * hit.t,
+            ng,
+            n,
+            uv,
+            material: self.triangle_materials[hit.triangle as usize],
+            triangle: hit.triangle,
+            area: 0.5 * cross.length(),
+        }
+    }
+
+    /// The first surface along the unit ray from `o` (a free point: no offset) along `d`.
+    pub fn trace(&self, o: Vec3, d: Vec3, tmax: f32) -> Option<SurfaceHit> {
+        self.query().closest_hit(&Ray::new(o, d, 0.0, tmax)).map(|h| self.surface_hit(o, d, h))
+    }
+
+    /// Whether `material` is double-sided.
+    pub fn double_sided(&self, material: u32) -> bool {
+        self.shading.materials[material as usize].flags & MaterialFlags::DOUBLE_SIDED != 0
+    }
+
+    /// Radiance the surface `h` emits back along `d` (the ray that found it).
+    fn emitted(&self, h: &SurfaceHit, d: Vec3, s: &Surface) -> Vec3 {
+        if s.emission == Vec3::ZERO || (h.ng.dot(d) > 0.0 && !self.double_sided(h.material)) {
+            Vec3::ZERO
+        } else {
+            s.emission
+        }
+    }
+
+    /// Solid-angle density with which next-event estimation from a point `t` away picks the
+    /// direction to emissive surface `h` (0 for surfaces not in the emitter table).
+    fn light_pdf(&self, h: &SurfaceHit, d: Vec3) -> f32 {
+        let select = self.emitters.pdf[h.triangle as usize];
+        let cos = h.ng.dot(d).abs();
+        if select <= 0.0 || cos <= 0.0 || h.area <= 0.0 { 0.0 } else { select * h.t * h.t / (h.area * cos) }
+    }
+
+    /// One next-event sample of the emissive triangles from `p` (leaving the side of `ng`; a
+    /// free point when `ng` is zero): direction, emitted radiance (zero where occluded or facing
+    /// away) and the solid-angle density of having picked that direction.
+    pub fn sample_emitter(&self, p: Vec3, ng: Vec3, rng: &mut Rng) -> Option<(Vec3, Vec3, f32)> {
+        let e = &self.emitters;
+        if e.triangles.is_empty() {
+            return None;
+        }
+        let u = rng.uniform();
+        let k = e.cdf.partition_point(|&c| c <= u).min(e.triangles.len() - 1);
+        let t = e.triangles[k];
+        let [a, b, c] = kiln_format::query::TriangleSource::corners(&self.tris, t as usize);
+        let (r1, r2) = (rng.uniform().sqrt(), rng.uniform());
+        let q = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+        let to = q - p;
+        let dist = to.length();
+        if !(dist > 0.0) {
+            return None;
+        }
+        let d = to / dist;
+        let o = if ng == Vec3::ZERO { p } else { offset_origin(p, if ng.dot(d) >= 0.0 { ng } else { -ng }) };
+        // The barycentrics of q, for the emitter's own texture coordinates.
+        let hit = Hit { t: dist, triangle: t, u: r1 * (1.0 - r2), v: r1 * r2 };
+        let h = self.surface_hit(p, d, hit);
+        let s = self.shading.surface(h.material, h.uv);
+        let le = self.emitted(&h, d, &s);
+        let pdf = self.light_pdf(&h, d);
+        if le == Vec3::ZERO || pdf <= 0.0 {
+            return Some((d, Vec3::ZERO, pdf));
+        }
+        let blocked = self.query().any_hit(&Ray::new(o, d, 0.0, (q - o).length() * (1.0 - 1e-4)));
+        Some((d, if blocked { Vec3::ZERO } else { le }, pdf))
+    }
+
+    /// Radiance leaving surface `h` back along `d` (the ray that found it), without its own
+    /// emission: every light's direct light and every further bounce, `bounce` events already
+    /// behind the path.
+    pub fn reflected(&self, h: SurfaceHit, d: Vec3, rng: &mut Rng) -> Vec3 {
+        let (mut h, mut v) = (h, -d);
+        let mut throughput = Vec3::ONE;
+        let mut out = Vec3::ZERO;
+        for bounce in 1..=MAX_BOUNCES {
+            let s = self.shading.surface(h.material, h.uv);
+            // Shade the side the ray came from.
+            let (mut n, ng) = if h.ng.dot(v) < 0.0 { (-h.n, -h.ng) } else { (h.n, h.ng) };
+            if n.dot(v) <= 0.0 {
+                n = ng;
+            }
+            for light in self.shading.lights {
+                for (l, e, tmax) in light_samples(light, h.p) {
+                    let n_l = n.dot(l);
+                    if n_l <= 0.0 || e == Vec3::ZERO || self.shading.occluded(h.p, ng, l, tmax) {
+                        continue;
+                    }
+                    out += throughput * self.shading.brdf(&s, n, v, l) * e * n_l;
+                }
+            }
+            if let Some((l, le, pdf_light)) = self.sample_emitter(h.p, ng, rng) {
+                let n_l = n.dot(l);
+                if le != Vec3::ZERO && n_l > 0.0 && ng.dot(l) > 0.0 {
+                    let pdf_brdf = n_l / std::f32::consts::PI;
+                    let w = pdf_light / (pdf_light + pdf_brdf);
+                    out += throughput * self.shading.brdf(&s, n, v, l) * le * (n_l * w / pdf_light);
+                }
+            }
+            if bounce > ROULETTE_AFTER {
+                let keep = throughput.max_element().min(0.95);
+                if rng.uniform() >= keep {
+                    break;
+                }
+                throughput /= keep;
+            }
+            // Cosine-weighted direction around n: weight f · cos / pdf = f · π.
+            let (r1, r2) = (rng.uniform(), rng.uniform());
+            let (t1, t2) = basis(n);
+            let (r, phi) = (r1.sqrt(), std::f32::consts::TAU * r2);
+            let l =
+                (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + n * (1.0 - r1).max(0.0).sqrt()).normalize();
+            if ng.dot(l) <= 0.0 {
+                break;
+            }
+            throughput *= self.shading.brdf(&s, n, v, l) * std::f32::consts::PI;
+            if throughput.max_element() <= 0.0 {
+                break;
+            }
+            let o = offset_origin(h.p, ng);
+            let Some(next) = self.trace(o, l, f32::INFINITY) else {
+                out += throughput * self.sky;
+                break;
+            };
+            let ns = self.shading.surface(next.material, next.uv);
+            let le = self.emitted(&next, l, &ns);
+            if le != Vec3::ZERO {
+                let pdf_brdf = n.dot(l) / std::f32::consts::PI;
+                let pdf_light = self.light_pdf(&next, l);
+                out += throughput * le * (pdf_brdf / (pdf_brdf + pdf_light));
+            }
+            (h, v) = (next, -l);
+        }
+        out
+    }
+
+    /// Emitted radiance of surface `h` found along `d`.
+    pub fn emission(&self, h: &SurfaceHit, d: Vec3) -> Vec3 {
+        let s = self.shading.surface(h.material, h.uv);
+        self.emitted(h, d, &s)
+    }
+
+    /// The solid-angle density of next-event estimation towards surface `h` along `d`.
+    pub fn emitter_pdf(&self, h: &SurfaceHit, d: Vec3) -> f32 {
+        self.light_pdf(h, d)
+    }
+}

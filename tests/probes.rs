@@ -1,0 +1,378 @@
+//! The irradiance probe bake against closed forms: a furnace (a closed box emitting and
+//! reflecting everywhere), an emissive plane below a probe (the octahedral layout, the cosine,
+//! the distance moments), probes inside a slab (relocation and classification), the same bytes
+//! on one thread as on two, and damaged probe sections refused by name.
+//!
+//! Every expected value is computed here with this file's own arithmetic: the octahedral
+//! directions, the shared-exponent decoding and the border rule are written out again from
+//! FORMAT.md, not taken from `kiln_format::probes`.
+
+use glam::Vec3;
+use kiln_compiler::ir::{Material, Scene};
+use kiln_compiler::settings::{ProbeSpacing, Settings};
+use kiln_format::sections;
+use kiln_format::{Checksums, KilnFile, SceneView};
+use kiln_tests::boxes::{cuboid, quad};
+use kiln_tests::{compile, rewrite};
+
+/// Settings for a quick bake: no line space, `rays` paths a probe.
+fn settings(rays: u32, spacing: Option<f32>) -> Settings {
+    Settings {
+        shaft_variants: Some(0),
+        probe_rays: rays,
+        probe_spacing: spacing.map(ProbeSpacing),
+        ..Default::default()
+    }
+}
+
+/// A material of albedo `kd` emitting `ke`.
+fn material(kd: f32, ke: [f32; 3]) -> Material {
+    let mut gpu = kiln_compiler::import::demo::lambert_material([kd; 3]);
+    gpu.emission = ke;
+    Material { name: "m".into(), gpu }
+}
+
+/// E5B9G9R9 as the Vulkan specification decodes it.
+fn rgb9e5(t: u32) -> Vec3 {
+    let scale = 2f32.powi((t >> 27) as i32 - 24);
+    Vec3::new((t & 511) as f32, ((t >> 9) & 511) as f32, ((t >> 18) & 511) as f32) * scale
+}
+
+/// The direction of octahedral point (u, v) ∈ [−1, 1]²: the diamond |u| + |v| ≤ 1 is the upper
+/// hemisphere (z = 1 − |u| − |v|); outside it, the lower one, x and y folded back over the edge.
+fn octahedral(u: f32, v: f32) -> Vec3 {
+    let z = 1.0 - u.abs() - v.abs();
+    let s = |a: f32| if a >= 0.0 { 1.0 } else { -1.0 };
+    let (x, y) = if z >= 0.0 { (u, v) } else { ((1.0 - v.abs()) * s(u), (1.0 - u.abs()) * s(v)) };
+    Vec3::new(x, y, z).normalize()
+}
+
+/// A probe volume read from the sections' bytes by FORMAT.md's layout.
+struct Volume {
+    origin: Vec3,
+    spacing: f32,
+    dims: [u32; 3],
+    ti: u32,
+    tv: u32,
+    layers: u32,
+    states: Vec<[f32; 4]>,
+    irradiance: Vec<u32>,
+    visibility: Vec<[u16; 2]>,
+}
+
+impl Volume {
+    fn read(bytes: &[u8]) -> Volume {
+        let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
+        SceneView::new(&file).expect("the file is valid");
+        let sec = |k| file.section_bytes(file.find(k, 0).expect("probe section")).unwrap().into_owned();
+        let h = sec(sections::PROBE_GRID);
+        let f = |i: usize| f32::from_le_bytes(h[4 * i..4 * i + 4].try_into().unwrap());
+        let u = |i: usize| u32::from_le_bytes(h[4 * i..4 * i + 4].try_into().unwrap());
+        Volume {
+            origin: Vec3::new(f(0), f(1), f(2)),
+            spacing: f(3),
+            dims: [u(4), u(5), u(6)],
+            ti: u(7),
+            tv: u(8),
+            layers: u(9),
+            states: bytemuck::pod_collect_to_vec(&sec(sections::PROBE_STATES)),
+            irradiance: bytemuck::pod_collect_to_vec(&sec(sections::PROBE_IRRADIANCE)),
+            visibility: bytemuck::pod_collect_to_vec(&sec(sections::PROBE_VISIBILITY)),
+        }
+    }
+
+    fn probe(&self, x: u32, y: u32, z: u32) -> usize {
+        (x + self.dims[0] * (y + self.dims[1] * z)) as usize
+    }
+
+    /// Where probe (x, y, z) is and whether it is on.
+    fn position(&self, x: u32, y: u32, z: u32) -> (Vec3, bool) {
+        let s = self.states[self.probe(x, y, z)];
+        let g = self.origin + Vec3::new(x as f32, y as f32, z as f32) * self.spacing;
+        (g + Vec3::new(s[0], s[1], s[2]), s[3] == 1.0)
+    }
+
+    /// Texel (i, j) of probe (x, y, z)'s irradiance tile in `layer`, i and j from −1 (border).
+    fn irradiance(&self, p: [u32; 3], layer: u32, i: i32, j: i32) -> Vec3 {
+        let tile = self.ti + 2;
+        let (w, h) = (self.dims[0] * tile, self.dims[1] * tile);
+        let (ax, ay) = (p[0] * tile + (i + 1) as u32, p[1] * tile + (j + 1) as u32);
+        rgb9e5(self.irradiance[(((layer * self.dims[2] + p[2]) * h + ay) * w + ax) as usize])
+    }
+
+    /// Mean and mean square distance (spacings) of visibility texel (i, j).
+    fn visibility(&self, p: [u32; 3], i: i32, j: i32) -> [f32; 2] {
+        let tile = self.tv + 2;
+        let (w, h) = (self.dims[0] * tile, self.dims[1] * tile);
+        let (ax, ay) = (p[0] * tile + (i + 1) as u32, p[1] * tile + (j + 1) as u32);
+        self.visibility[((p[2] * h + ay) * w + ax) as usize].map(|b| half::f16::from_bits(b).to_f32())
+    }
+}
+
+/// Direction of interior texel (i, j) of an n × n tile: its centre on the octahedral square.
+fn texel(i: u32, j: u32, n: u32) -> Vec3 {
+    octahedral((i as f32 + 0.5) / n as f32 * 2.0 - 1.0, (j as f32 + 0.5) / n as f32 * 2.0 - 1.0)
+}
+
+/// FORMAT.md's border rule for an n × n tile: a corner copies the opposite corner; an edge
+/// texel copies the interior texel beside that edge mirrored along it.
+fn fold(i: i32, j: i32, n: i32) -> (i32, i32) {
+    let last = n - 1;
+    match (i, j) {
+        (-1, -1) => (last, last),
+        (-1, y) if y == n => (last, 0),
+        (x, -1) if x == n => (0, last),
+        (x, y) if x == n && y == n => (0, 0),
+        (x, -1) => (last - x, 0),
+        (x, y) if y == n => (last - x, last),
+        (-1, y) => (0, last - y),
+        (_, y) => (last, last - y),
+    }
+}
+
+/// Furnace: inside a closed box whose walls have albedo ρ and emit Le, radiance is Le / (1 − ρ)
+/// in every direction, so every probe's mean cosine-weighted radiance is Le (seen directly, the
+/// emitted layer) plus Le ρ / (1 − ρ) (reflected, the other layer).
+#[test]
+fn furnace_probes_hold_the_closed_form() {
+    let (rho, le) = (0.5f32, Vec3::new(1.0, 0.5, 0.25));
+    let mut s = Scene { name: "furnace".into(), ..Default::default() };
+    s.materials.push(material(rho, le.to_array()));
+    cuboid(&mut s, Vec3::splat(-1.0), Vec3::new(1.0, 0.6, 1.4), 0, true);
+    let v = Volume::read(&compile(s, settings(1024, None)));
+    assert_eq!(v.layers, 2, "emissive walls: their direct light in a layer of its own");
+    let (mut sum, mut count) = ([Vec3::ZERO; 2], 0);
+    for z in 0..v.dims[2] {
+        for y in 0..v.dims[1] {
+            for x in 0..v.dims[0] {
+                let (p, on) = v.position(x, y, z);
+                assert!(on, "probe ({x}, {y}, {z}) at {p} is inside the furnace and was switched off");
+                for j in 0..v.ti as i32 {
+                    for i in 0..v.ti as i32 {
+                        for (layer, want) in [(0, le * rho / (1.0 - rho)), (1, le)] {
+                            let got = v.irradiance([x, y, z], layer, i, j);
+                            // One probe's texel: 1,024 paths and 256 emitter samples.
+                            assert!(
+                                (got - want).abs().max_element() <= 0.15 * want.max_element(),
+                                "probe ({x}, {y}, {z}) layer {layer} texel ({i}, {j}): {got} against {want}"
+                            );
+                            sum[layer as usize] += got;
+                        }
+                        count += 1;
+                    }
+                }
+            }
+        }
+    }
+    for (layer, want) in [(0, le * rho / (1.0 - rho)), (1, le)] {
+        let mean = sum[layer] / count as f32;
+        eprintln!("layer {layer}: mean {mean} against {want}");
+        assert!(
+            (mean - want).abs().max_element() <= 0.01 * want.max_element(),
+            "layer {layer}: mean {mean} against {want}"
+        );
+    }
+}
+
+/// A large emissive floor below the probes: a probe at height h sees it fill the lower
+/// hemisphere, so the texel of direction t holds Le (1 − t·ŷ) / 2 (the irradiance of a uniform
+/// hemisphere onto a tilted plane, over π); the distance along t is h / (−t·ŷ) below the
+/// horizon and the clamp above it. Each texel is checked at the direction this file's own
+/// octahedral formula gives it, and each border texel against the interior texel FORMAT.md's
+/// fold names.
+#[test]
+fn an_emissive_floor_fills_the_octahedral_maps_by_their_formula() {
+    let le = 2.0f32;
+    let mut s = Scene { name: "floor".into(), ..Default::default() };
+    s.materials.push(material(0.0, [le; 3]));
+    s.materials.push(material(0.0, [0.0; 3]));
+    let r = 100.0;
+    quad(
+        &mut s,
+        [Vec3::new(-r, 0.0, r), Vec3::new(r, 0.0, r), Vec3::new(r, 0.0, -r), Vec3::new(-r, 0.0, -r)],
+        0,
+    );
+    // A speck high in a corner: the bounds reach y = 2, so the probes sit at y = 1.
+    quad(
+        &mut s,
+        [
+            Vec3::new(99.0, 2.0, 99.0),
+            Vec3::new(99.0, 2.0, 99.01),
+            Vec3::new(99.01, 2.0, 99.01),
+            Vec3::new(99.01, 2.0, 99.0),
+        ],
+        1,
+    );
+    let v = Volume::read(&compile(s, settings(2048, Some(8.0))));
+    assert_eq!(v.dims, [25, 1, 25]);
+    let c = [12, 0, 12];
+    let (p, on) = v.position(c[0], c[1], c[2]);
+    assert!(on && (p - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-4, "the centre probe at {p}");
+    let h = p.y / v.spacing;
+    for j in 0..v.ti {
+        for i in 0..v.ti {
+            let t = texel(i, j, v.ti);
+            let want = le * (1.0 - t.y) / 2.0;
+            let got = v.irradiance(c, 1, i as i32, j as i32);
+            assert!(
+                (got - Vec3::splat(want)).abs().max_element() <= 0.04 * le,
+                "texel ({i}, {j}) of direction {t}: {got}, want {want}"
+            );
+            assert!(
+                v.irradiance(c, 0, i as i32, j as i32).max_element() < 1e-3 * le,
+                "a black floor reflects"
+            );
+        }
+    }
+    let n = v.ti as i32;
+    for k in -1..=n {
+        for (i, j) in [(k, -1), (k, n), (-1, k), (n, k)] {
+            let (si, sj) = fold(i, j, n);
+            assert_eq!(
+                v.irradiance(c, 1, i, j),
+                v.irradiance(c, 1, si, sj),
+                "border texel ({i}, {j}) should copy ({si}, {sj})"
+            );
+        }
+    }
+    // The distance moments by quadrature over the sphere (a 600 × 1200 latitude-longitude grid),
+    // each texel's lobe cos^50 around its direction, distances clamped at 4 spacings.
+    let (rows, cols) = (600, 1200);
+    let cells: Vec<(Vec3, f32)> = (0..rows * cols)
+        .map(|k| {
+            let (r, c) = (k / cols, k % cols);
+            let theta = (r as f32 + 0.5) / rows as f32 * std::f32::consts::PI;
+            let phi = (c as f32 + 0.5) / cols as f32 * std::f32::consts::TAU;
+            let w = theta.sin();
+            (Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()), w)
+        })
+        .collect();
+    for j in 0..v.tv {
+        for i in 0..v.tv {
+            let t = texel(i, j, v.tv);
+            let (mut sw, mut s1, mut s2) = (0.0f64, 0.0f64, 0.0f64);
+            for &(d, area) in &cells {
+                let c = t.dot(d);
+                if c > 0.0 {
+                    let w = (c as f64).powi(50) * area as f64;
+                    let dist = if d.y < 0.0 { (h / -d.y).min(4.0) } else { 4.0 } as f64;
+                    (sw, s1, s2) = (sw + w, s1 + w * dist, s2 + w * dist * dist);
+                }
+            }
+            let want = [(s1 / sw) as f32, (s2 / sw) as f32];
+            let got = v.visibility(c, i as i32, j as i32);
+            for k in 0..2 {
+                assert!(
+                    (got[k] - want[k]).abs() <= 0.05 * want[k] + 0.002,
+                    "texel ({i}, {j}) along {t}: moments {got:?}, want {want:?}"
+                );
+            }
+        }
+    }
+}
+
+/// Two slabs through the middle of the grid: in the thin one, probes whose grid point lies
+/// within reach of a face move out of it; in the thick one they are too deep and are switched
+/// off. No probe that is on lies inside a slab.
+#[test]
+fn probes_inside_geometry_move_out_or_switch_off() {
+    let mut s = Scene { name: "slabs".into(), ..Default::default() };
+    s.materials.push(material(0.5, [0.0; 3]));
+    s.materials.push(material(0.5, [1.0; 3]));
+    // The room: emissive, fronts inward; the slabs: fronts outward.
+    cuboid(&mut s, Vec3::splat(-2.0), Vec3::splat(2.0), 1, true);
+    cuboid(&mut s, Vec3::new(-2.0, -0.4, -2.0), Vec3::new(-0.1, 0.4, 2.0), 0, false);
+    cuboid(&mut s, Vec3::new(0.1, -0.6, -2.0), Vec3::new(2.0, 0.6, 2.0), 0, false);
+    let inside = |q: Vec3| (q.x < -0.1 && q.y.abs() < 0.4) || (q.x > 0.1 && q.y.abs() < 0.6);
+    // How deep a point lies in its slab: the distance to the nearest face (the side faces at
+    // x = ±0.1 too; the slabs end at the room's walls).
+    let depth = |q: Vec3| {
+        if q.x < -0.1 { (0.4 - q.y.abs()).min(-0.1 - q.x) } else { (0.6 - q.y.abs()).min(q.x - 0.1) }
+    };
+    // Spacing 0.5: grid points at −1.75 + 0.5 k; the rows y = ±0.25 lie in both slabs, 0.15
+    // deep in the thin one and mostly 0.35 deep in the thick one. A probe moves at most 0.45
+    // spacings (0.225) along an axis, and ends 0.1 spacings past the face it crosses.
+    let v = Volume::read(&compile(s, settings(64, Some(0.5))));
+    assert_eq!(v.dims, [8, 8, 8]);
+    let (mut moved, mut off) = (0, 0);
+    for z in 0..8 {
+        for y in 0..8 {
+            for x in 0..8 {
+                let (p, on) = v.position(x, y, z);
+                let g = v.origin + Vec3::new(x as f32, y as f32, z as f32) * v.spacing;
+                if on {
+                    assert!(!inside(p), "probe ({x}, {y}, {z}) is on inside a slab at {p}");
+                }
+                if inside(g) {
+                    let d = depth(g);
+                    if d + 0.05 <= 0.225 {
+                        assert!(on, "probe ({x}, {y}, {z}) {d} inside a slab at {g} did not move out");
+                        moved += 1;
+                    } else if d > 0.225 {
+                        assert!(!on, "probe ({x}, {y}, {z}) {d} deep in a slab at {g} is on at {p}");
+                        off += 1;
+                    }
+                } else {
+                    assert!(on, "probe ({x}, {y}, {z}) at {g}, outside the slabs, is off");
+                }
+            }
+        }
+    }
+    assert!(moved >= 64 && off >= 32, "{moved} probes moved out, {off} switched off");
+}
+
+/// The same bytes on one thread as on two.
+#[test]
+fn probe_bytes_do_not_depend_on_the_thread_count() {
+    let scene = || {
+        let mut s = Scene { name: "room".into(), ..Default::default() };
+        s.materials.push(material(0.7, [0.0; 3]));
+        s.materials.push(material(0.7, [5.0; 3]));
+        cuboid(&mut s, Vec3::splat(-1.0), Vec3::splat(1.0), 0, true);
+        cuboid(&mut s, Vec3::new(-0.2, 0.9, -0.2), Vec3::new(0.2, 0.95, 0.2), 1, false);
+        s
+    };
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| compile(scene(), settings(32, Some(0.4))))
+    };
+    let (one, two) = (on(1), on(2));
+    let probes = |b: &[u8]| {
+        let f = KilnFile::from_bytes(b, Checksums::Eager).unwrap();
+        [sections::PROBE_STATES, sections::PROBE_IRRADIANCE, sections::PROBE_VISIBILITY]
+            .map(|k| f.section_bytes(f.find(k, 0).unwrap()).unwrap().into_owned())
+    };
+    assert!(probes(&one) == probes(&two), "the probe sections differ between one and two threads");
+    assert!(one == two, "the files differ between one and two threads");
+}
+
+#[test]
+fn damaged_probe_sections_are_refused_by_name() {
+    let mut s = Scene { name: "box".into(), ..Default::default() };
+    s.materials.push(material(0.5, [1.0; 3]));
+    cuboid(&mut s, Vec3::splat(-1.0), Vec3::splat(1.0), 0, true);
+    let good = compile(s, settings(16, Some(1.0)));
+    let refused = |b: Vec<u8>| {
+        let f = KilnFile::from_bytes(&b, Checksums::Eager).unwrap();
+        SceneView::new(&f).map(|_| ()).expect_err("damage accepted").to_string()
+    };
+    let put = |d: &mut Vec<u8>, at: usize, v: [u8; 4]| d[at..at + 4].copy_from_slice(&v);
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (rewrite(&good, sections::PROBE_STATES, |d| put(d, 12, 0.5f32.to_le_bytes())), "probe-states"),
+        (rewrite(&good, sections::PROBE_STATES, |d| put(d, 0, 9.0f32.to_le_bytes())), "probe-states"),
+        (rewrite(&good, sections::PROBE_IRRADIANCE, |d| d.truncate(d.len() - 4)), "probe-irradiance"),
+        (
+            rewrite(&good, sections::PROBE_VISIBILITY, |d| d[..4].copy_from_slice(&[0, 0x7e, 0, 0])),
+            "probe-visibility",
+        ),
+        (rewrite(&good, sections::PROBE_GRID, |d| put(d, 16, 0u32.to_le_bytes())), "dims"),
+        (rewrite(&good, sections::PROBE_GRID, |d| put(d, 36, 3u32.to_le_bytes())), "layers"),
+    ];
+    for (bytes, name) in cases {
+        let e = refused(bytes);
+        assert!(e.contains(name), "{e:?} does not name {name}");
+    }
+}
