@@ -117,7 +117,7 @@ fn exit_codes() {
     let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
-    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.3").says("1.x");
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.4").says("1.x");
 }
 
 #[test]

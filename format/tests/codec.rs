@@ -148,7 +148,7 @@ fn compressed_sections_decode_to_the_uncompressed_files_bytes() {
     assert!(packed.len() < plain.len(), "{} vs {}", packed.len(), plain.len());
     let p = KilnFile::from_bytes(&plain, Checksums::Eager).unwrap();
     let z = KilnFile::from_bytes(&packed, Checksums::Eager).unwrap();
-    assert_eq!(z.header().version_minor, 3);
+    assert_eq!(z.header().version_minor, kiln_format::header::VERSION_MINOR);
     let texture = z.find(sections::TEXTURE, 0).unwrap().entry;
     assert_eq!(texture.codec, Codec::Zstd as u8, "the 32x32 texture is compressed");
     assert!(texture.size < texture.raw_size);

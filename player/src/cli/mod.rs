@@ -93,8 +93,10 @@ pub struct Args {
     #[arg(long, value_name = "N")]
     pub frames: Option<u32>,
     /// A named technique set for the whole frame (each carries indirect light; those that
-    /// trace GI rays denoise it; `baked` and `baked-taa` trace no rays). Technique and knob
-    /// flags given beside it override its choices; `kiln-bench --list` says what each sets.
+    /// trace GI rays denoise it; `baked`, `baked-taa` and `probes` trace no rays). Technique and
+    /// knob flags given beside it override its choices; `kiln-bench --list` says what each sets.
+    /// Without --preset, --budget-ms and --gi, a file compiled with irradiance probes renders
+    /// with `probes` (measured the lowest-error frame under 2 ms on the shared scenes).
     #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
     pub preset: Option<String>,
     /// Choose the whole frame by a GPU budget: of the frame presets measured (by
@@ -180,10 +182,13 @@ pub struct Args {
 }
 
 impl Args {
-    /// The techniques the flags choose, each with the knobs the command line sets.
-    fn techniques(&self) -> PlayResult<Techniques> {
+    /// The techniques the flags choose for `file`, each with the knobs the command line sets.
+    fn techniques(&self, file: &std::path::Path) -> PlayResult<Techniques> {
         let usage = |e: String| PlayError::new(Exit::Usage, e);
         let mut preset = self.preset.as_deref().map(Preset::named).transpose().map_err(usage)?;
+        if preset.is_none() && self.budget_ms.is_none() && !self.reference {
+            preset = crate::render::presets::default_for(file, self.choices.given(crate::render::Effect::Gi));
+        }
         let mut gbuffer = None;
         if let Some(budget) = self.budget_ms {
             if !(budget > 0.0 && budget.is_finite()) {
@@ -210,7 +215,7 @@ impl Args {
         if self.choices.knob("ao-radius") == Some(KnobValue::Number(0.0)) {
             return Err(PlayError::new(Exit::Usage, "--ao-radius must be greater than 0"));
         }
-        let techniques = self.techniques()?;
+        let techniques = self.techniques(&file)?;
         Ok(SessionOptions {
             file,
             gpu: GpuOptions {
@@ -437,7 +442,7 @@ mod tests {
     }
 
     fn techniques(args: &[&str]) -> Techniques {
-        parse(args).unwrap().techniques().unwrap()
+        parse(args).unwrap().techniques(std::path::Path::new("missing.kiln")).unwrap()
     }
 
     /// The message of a refused command line, whether clap or the techniques refuse it; usage
@@ -449,7 +454,7 @@ mod tests {
                 e.to_string()
             }
             Ok(a) => {
-                let e = a.techniques().expect_err("refused");
+                let e = a.techniques(std::path::Path::new("missing.kiln")).expect_err("refused");
                 assert_eq!(e.exit, Exit::Usage);
                 e.message
             }
@@ -749,7 +754,8 @@ mod tests {
                 let parsed = parse_from(args.iter().copied());
                 match parsed {
                     Ok(Invocation::Play(a)) => {
-                        a.techniques().unwrap_or_else(|e| panic!("{}: {line}: {e}", file.display()));
+                        a.techniques(std::path::Path::new("missing.kiln"))
+                            .unwrap_or_else(|e| panic!("{}: {line}: {e}", file.display()));
                     }
                     Ok(_) => {}
                     Err(e) => panic!("{}: `{}` is refused: {e}", file.display(), args.join(" ")),

@@ -104,6 +104,16 @@ pub const PRESETS: [Preset; 10] = [
     },
 ];
 
+/// The preset the default frame of the file at `path` uses when the command line chooses no
+/// preset or budget: `probes` where the file has irradiance probes and `gi` (the `--gi` given)
+/// is none, the best measured point of the frame charts below 2 ms (docs/benchmarks/probes/).
+/// An unreadable file answers none: the session reports it.
+pub fn default_for(path: &std::path::Path, gi: Option<&str>) -> Option<&'static Preset> {
+    let probes =
+        crate::session::open_file(path).is_ok_and(|f| f.find(kiln_format::sections::PROBE_GRID, 0).is_some());
+    (probes && gi.is_none()).then(|| Preset::named("probes").ok()).flatten()
+}
+
 impl Preset {
     /// The preset called `name`; the error lists the names.
     pub fn named(name: &str) -> Result<&'static Preset, String> {
@@ -142,5 +152,30 @@ mod tests {
             }
         }
         assert!(Preset::named("nope").unwrap_err().contains("rt-taa"));
+    }
+
+    /// A file with probes defaults to the probe preset unless --gi is given; one without, or
+    /// one that cannot be read, to no preset.
+    #[test]
+    fn files_with_probes_default_to_the_probe_preset() {
+        use kiln_format::{ContentHash, FileWriter, Manifest, sections};
+        let dir = tempfile::tempdir().unwrap();
+        let write = |name: &str, probes: bool| {
+            let mut w = FileWriter::new();
+            w.manifest(&Manifest::default(), ContentHash::default()).unwrap();
+            if probes {
+                // Only the table is read: the header's bytes need not be a valid volume.
+                w.bytes(sections::PROBE_GRID, 0, vec![0u8; 64], ContentHash::default()).unwrap();
+            }
+            let path = dir.path().join(name);
+            std::fs::write(&path, w.to_bytes().unwrap()).unwrap();
+            path
+        };
+        let (with, without) = (write("with.kiln", true), write("without.kiln", false));
+        let chosen = default_for(&with, None).expect("the probe preset");
+        assert_eq!(chosen.choice(Effect::Gi).map(|c| c.technique), Some("probes"));
+        assert!(default_for(&with, Some("rt")).is_none());
+        assert!(default_for(&without, None).is_none());
+        assert!(default_for(&dir.path().join("missing.kiln"), None).is_none());
     }
 }
