@@ -524,6 +524,10 @@ fn plan_skips_each_lighting_bake_with_its_reason() {
     let p = plan(s);
     assert_eq!(find(&p, "shadow-maps").2, "the scene has no analytic lights");
     assert!(!find(&p, "line-space").1);
+    // Nothing lights it: no probes; lit, they run and say who reads them.
+    assert!(find(&p, "probes").2.starts_with("nothing lights the scene"), "{:?}", find(&p, "probes"));
+    let lit = find(&plan(floor_and_blocker()), "probes");
+    assert!(lit.1 && lit.2.contains("read by kiln-play --gi probes"), "{lit:?}");
     // A glossy material needs the table.
     let mut s = floor_and_blocker();
     s.materials[0].gpu.flags = 0;
@@ -539,7 +543,15 @@ fn export_writes_readable_images() {
         dir.path().join("s.kiln"),
         compile(
             scene,
-            Settings { shadow_res: 32, brdf_lut_res: 16, shaft_variants: Some(0), ..Default::default() },
+            Settings {
+                shadow_res: 32,
+                brdf_lut_res: 16,
+                shaft_variants: Some(0),
+                // 4 × 1 × 4 probes over the 2 × 0.5 × 2 bounds.
+                probe_spacing: Some(kiln_compiler::settings::ProbeSpacing(0.5)),
+                probe_rays: 16,
+                ..Default::default()
+            },
         ),
     )
     .unwrap();
@@ -549,6 +561,8 @@ fn export_writes_readable_images() {
         ("brdf-lut", "lut.exr"),
         ("shadow-map:0", "sm.pfm"),
         ("shadow-map", "sm.png"),
+        ("probe-irradiance", "irr.pfm"),
+        ("probe-visibility:0", "vis.exr"),
     ] {
         run::kiln(dir.path(), &["export", "s.kiln", section, "-o", out]).expect(0);
     }
@@ -560,6 +574,17 @@ fn export_writes_readable_images() {
     assert_eq!((lut.width(), lut.height()), (16, 16));
     let exr = image::open(dir.path().join("lut.exr")).unwrap().into_rgba32f();
     assert!(exr.pixels().all(|p| p[0] + p[1] <= 1.0 + 1e-4 && p[0] >= 0.0));
+    // The probes' z slice: four 10 × 10 irradiance tiles (8 × 8 and a border) side by side.
+    let irr = std::fs::read(dir.path().join("irr.pfm")).unwrap();
+    assert!(irr.starts_with(b"PF\n40 10\n-1.0\n"), "{:?}", String::from_utf8_lossy(&irr[..16]));
+    let vis = image::open(dir.path().join("vis.exr")).unwrap();
+    assert_eq!((vis.width(), vis.height()), (64, 16));
+    // Four z slices, one layer (nothing emits): no slice 4.
+    run::kiln(dir.path(), &["export", "s.kiln", "probe-irradiance:4", "-o", "x.pfm"])
+        .expect(1)
+        .says("no probe-irradiance:4");
+    let inspect = run::kiln(dir.path(), &["inspect", "s.kiln"]);
+    assert!(inspect.expect(0).stdout.contains("irradiance probes 4x1x4 every 0.5000 units"), "{inspect:?}");
     run::kiln(dir.path(), &["export", "s.kiln", "shadow-map:7", "-o", "x.pfm"])
         .expect(1)
         .says("no shadow-map:7");

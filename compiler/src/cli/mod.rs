@@ -327,8 +327,9 @@ pub struct CompileArgs {
 pub struct ExportArgs {
     /// The .kiln file.
     pub file: PathBuf,
-    /// Section name and index, e.g. `brdf-lut`, `shadow-map:1`, `texture:0` (`kiln inspect` lists
-    /// the sections a file has).
+    /// Section name and index, e.g. `brdf-lut`, `shadow-map:1`, `texture:0`, `probe-irradiance:2`
+    /// (the probes' z slice 2; the emitted layer's slices follow) (`kiln inspect` lists the
+    /// sections a file has).
     pub section: String,
     /// Output image: .pfm, .exr or .png.
     #[arg(long, short = 'o', value_name = "PATH")]

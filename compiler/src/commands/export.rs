@@ -24,7 +24,8 @@ struct Image {
 }
 
 /// Section names `export` accepts.
-pub const EXPORTABLE: &[&str] = &["brdf-lut", "shadow-map", "texture", "media-visibility"];
+pub const EXPORTABLE: &[&str] =
+    &["brdf-lut", "shadow-map", "texture", "media-visibility", "probe-irradiance", "probe-visibility"];
 
 /// Runs `kiln export`.
 pub fn run(args: &ExportArgs) -> CliResult {
@@ -97,6 +98,37 @@ pub fn run(args: &ExportArgs) -> CliResult {
                 })
                 .collect();
             Image { width: info.width, height: info.height, channels: 4, data, scale: 1.0, wide: false }
+        }
+        "probe-irradiance" | "probe-visibility" => {
+            // Index = the z slice: its probes' tiles as the atlas lays them out (borders
+            // included), irradiance as RGB (index dims.z + z: the emitted layer), distance
+            // moments as mean and mean square.
+            let v = kiln_format::probes::ProbeVolume::read(&file)
+                .map_err(|e| format_error(&args.file, e))?
+                .ok_or_else(missing)?;
+            let h = v.header;
+            let [w, ht, layers] =
+                if name == "probe-irradiance" { h.irradiance_extent() } else { h.visibility_extent() };
+            if index >= layers {
+                return Err(missing());
+            }
+            let texels = (w * ht) as usize;
+            let at = index as usize * texels;
+            let data = if name == "probe-irradiance" {
+                v.irradiance[at..at + texels]
+                    .iter()
+                    .flat_map(|&t| kiln_format::probes::decode_rgb9e5(t))
+                    .collect()
+            } else {
+                v.visibility[at..at + texels]
+                    .iter()
+                    .flat_map(|t| {
+                        [half::f16::from_bits(t[0]).to_f32(), half::f16::from_bits(t[1]).to_f32(), 0.0]
+                    })
+                    .collect()
+            };
+            let scale = if name == "probe-irradiance" { 1.0 } else { h.max_distance * h.max_distance };
+            Image { width: w, height: ht, channels: 3, data, scale, wide: true }
         }
         _ => {
             let info = view.manifest.media_visibility.as_ref().ok_or_else(missing)?;

@@ -43,6 +43,20 @@ struct InspectJson {
     summary: Summary,
     /// Voxel grid and line space, when present.
     line_space: Option<LineSpaceJson>,
+    /// The irradiance probe volume, when present.
+    probes: Option<ProbesJson>,
+}
+
+#[derive(Serialize)]
+struct ProbesJson {
+    dims: [u32; 3],
+    spacing: f32,
+    probes: u64,
+    active: u32,
+    layers: u32,
+    rays: u32,
+    /// Decoded bytes of the four sections.
+    bytes: u64,
 }
 
 #[derive(Serialize)]
@@ -143,6 +157,29 @@ pub fn run(args: &InspectArgs) -> CliResult {
                 pnmt_records: g.pnmt_records().map(|l| l.name()),
             }
         });
+    let probes = file
+        .pod::<kiln_format::probes::ProbeHeader>(sections::PROBE_GRID, 0)
+        .ok()
+        .flatten()
+        .and_then(|g| g.first().copied())
+        .map(|g| ProbesJson {
+            dims: g.dims,
+            spacing: g.spacing,
+            probes: g.count(),
+            active: g.active,
+            layers: g.layers,
+            rays: g.rays,
+            bytes: [
+                sections::PROBE_GRID,
+                sections::PROBE_STATES,
+                sections::PROBE_IRRADIANCE,
+                sections::PROBE_VISIBILITY,
+            ]
+            .iter()
+            .filter_map(|&k| file.find(k, 0))
+            .map(|s| s.entry.raw_size)
+            .sum(),
+        });
     let h = file.header();
     let report = InspectJson {
         path: args.file.display().to_string(),
@@ -154,6 +191,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
         manifest_error,
         summary,
         line_space,
+        probes,
     };
     if args.json {
         print_json(&report);
@@ -165,6 +203,20 @@ pub fn run(args: &InspectArgs) -> CliResult {
 
 fn print_text(r: &InspectJson) {
     print_sections(r);
+    if let Some(p) = &r.probes {
+        println!(
+            "irradiance probes {}x{}x{} every {:.4} units: {} probes, {} on, {} irradiance layer(s), {} paths each, {}",
+            p.dims[0],
+            p.dims[1],
+            p.dims[2],
+            p.spacing,
+            p.probes,
+            p.active,
+            p.layers,
+            p.rays,
+            size(p.bytes)
+        );
+    }
     if let Some(l) = &r.line_space {
         println!(
             "voxel grid {}x{}x{} (cell {:.4}), {} non-empty; line space N = {}, {}: {} filled shafts, {} candidate entries",
