@@ -198,7 +198,7 @@ impl Args {
             }
             let measured = match &self.bench_results {
                 Some(path) => Measurements::read(path)?,
-                None => Measurements::built_in(),
+                None => Measurements::built_in(crate::render::presets::has_probes(file)),
             };
             let chosen = budget::choose(&measured, budget, self.size.width, self.size.height)?;
             eprintln!("{}", chosen.why);

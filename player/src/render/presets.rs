@@ -109,9 +109,12 @@ pub const PRESETS: [Preset; 10] = [
 /// is none, the best measured point of the frame charts below 2 ms (docs/benchmarks/probes/).
 /// An unreadable file answers none: the session reports it.
 pub fn default_for(path: &std::path::Path, gi: Option<&str>) -> Option<&'static Preset> {
-    let probes =
-        crate::session::open_file(path).is_ok_and(|f| f.find(kiln_format::sections::PROBE_GRID, 0).is_some());
-    (probes && gi.is_none()).then(|| Preset::named("probes").ok()).flatten()
+    (has_probes(path) && gi.is_none()).then(|| Preset::named("probes").ok()).flatten()
+}
+
+/// Whether the file at `path` holds irradiance probes (an unreadable one does not).
+pub fn has_probes(path: &std::path::Path) -> bool {
+    crate::session::open_file(path).is_ok_and(|f| f.find(kiln_format::sections::PROBE_GRID, 0).is_some())
 }
 
 impl Preset {

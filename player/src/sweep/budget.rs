@@ -49,7 +49,9 @@ pub struct Measurements {
 /// The built-in table: pica_pica (`tests/scenes/pica_pica.toml`) at 1600 × 900 on an NVIDIA
 /// H200 against a 4096-spp all-bounce reference, one frame, the visibility G-buffer (the raster
 /// one measured slower at equal error) (`docs/benchmarks/denoise/h200-call5-pica.txt`).
-const BUILT_IN: [(&str, &str, f64, f64); 8] = [
+const BUILT_IN: [(&str, &str, f64, f64); 9] = [
+    // docs/benchmarks/probes/bench-pica.txt (the same scene, GPU and reference).
+    ("visibility", "probes", 0.869, 0.0691),
     ("visibility", "baked", 1.272, 0.0924),
     ("visibility", "baked-taa", 1.335, 0.0939),
     ("visibility", "hybrid", 1.609, 0.0928),
@@ -61,10 +63,11 @@ const BUILT_IN: [(&str, &str, f64, f64); 8] = [
 ];
 
 impl Measurements {
-    /// The table built in.
-    pub fn built_in() -> Measurements {
+    /// The table built in; its probe preset only for a file `with_probes`.
+    pub fn built_in(with_probes: bool) -> Measurements {
         let points = BUILT_IN
             .iter()
+            .filter(|p| with_probes || p.1 != "probes")
             .map(|&(gbuffer, preset, frame_ms, flip)| Measured {
                 gbuffer: gbuffer.into(),
                 preset: Preset::named(preset).expect("the built-in table names presets"),
@@ -74,7 +77,8 @@ impl Measurements {
             })
             .collect();
         Measurements {
-            what: "pica_pica on an NVIDIA H200 (built in: docs/benchmarks/denoise)".into(),
+            what: "pica_pica on an NVIDIA H200 (built in: docs/benchmarks/denoise, docs/benchmarks/probes)"
+                .into(),
             width: 1600,
             height: 900,
             points,
@@ -204,10 +208,11 @@ mod tests {
     /// chosen point is the lowest-error one of those that fit, and none fits below the cheapest.
     #[test]
     fn the_lowest_error_within_the_budget_is_chosen() {
-        let m = Measurements::built_in();
+        let m = Measurements::built_in(false);
         for step in 0..=200 {
             let budget = step as f64 * 0.05;
-            let fits: Vec<&(&str, &str, f64, f64)> = BUILT_IN.iter().filter(|p| p.2 <= budget).collect();
+            let fits: Vec<&(&str, &str, f64, f64)> =
+                BUILT_IN.iter().filter(|p| p.2 <= budget && p.1 != "probes").collect();
             let expected = fits.iter().map(|p| p.3).fold(f64::INFINITY, f64::min);
             match choose(&m, budget, 1600, 900) {
                 Ok(c) => assert_eq!(c.point.flip, expected, "budget {budget}"),
@@ -219,8 +224,15 @@ mod tests {
             }
         }
         // A quarter of the pixels: a quarter of the time.
-        let quarter = BUILT_IN.iter().filter(|p| p.2 / 4.0 <= 1.5).map(|p| p.3).fold(f64::INFINITY, f64::min);
+        let quarter = BUILT_IN
+            .iter()
+            .filter(|p| p.2 / 4.0 <= 1.5 && p.1 != "probes")
+            .map(|p| p.3)
+            .fold(f64::INFINITY, f64::min);
         assert_eq!(choose(&m, 1.5, 800, 450).unwrap().point.flip, quarter);
+        // A file with probes may choose them: below 1.2 ms nothing else fits.
+        let c = choose(&Measurements::built_in(true), 1.0, 1600, 900).unwrap();
+        assert_eq!(c.point.preset.name, "probes");
     }
 
     /// Time per frame, not per image: a point measured at 4 frames (image 4 × its frame time)
