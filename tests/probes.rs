@@ -271,6 +271,60 @@ fn an_emissive_floor_fills_the_octahedral_maps_by_their_formula() {
     }
 }
 
+/// A white-ish floor under a directional light shining straight down (irradiance E, no sky): the
+/// floor's radiance is ρE/π everywhere, so a probe above it holds (ρE/π)(1 − t·ŷ)/2 along t in
+/// the layer of reflected light (one bounce: the floor sees nothing of itself), and nothing
+/// emits.
+#[test]
+fn a_floor_under_the_sun_reflects_into_the_probes_by_the_closed_form() {
+    let (rho, e) = (0.6f32, 3.0f32);
+    let mut s = Scene { name: "sunlit".into(), ..Default::default() };
+    s.materials.push(material(rho, [0.0; 3]));
+    let r = 100.0;
+    quad(
+        &mut s,
+        [Vec3::new(-r, 0.0, r), Vec3::new(r, 0.0, r), Vec3::new(r, 0.0, -r), Vec3::new(-r, 0.0, -r)],
+        0,
+    );
+    // The speck that lifts the bounds to y = 2, far from the centre.
+    quad(
+        &mut s,
+        [
+            Vec3::new(99.0, 2.0, 99.0),
+            Vec3::new(99.0, 2.0, 99.01),
+            Vec3::new(99.01, 2.0, 99.01),
+            Vec3::new(99.01, 2.0, 99.0),
+        ],
+        0,
+    );
+    s.lights.push(kiln_format::manifest::Light {
+        name: "sun".into(),
+        kind: kiln_format::manifest::LightKind::Directional,
+        position: [0.0; 3],
+        direction: [0.0, -1.0, 0.0],
+        right: [1.0, 0.0, 0.0],
+        color: [1.0; 3],
+        intensity: e,
+        range: 0.0,
+        casts_shadows: true,
+    });
+    let v = Volume::read(&compile(s, settings(1024, Some(8.0))));
+    assert_eq!(v.layers, 1, "nothing emits");
+    let c = [12, 0, 12];
+    let floor = rho * e / std::f32::consts::PI;
+    for j in 0..v.ti {
+        for i in 0..v.ti {
+            let t = texel(i, j, v.ti);
+            let want = floor * (1.0 - t.y) / 2.0;
+            let got = v.irradiance(c, 0, i as i32, j as i32);
+            assert!(
+                (got - Vec3::splat(want)).abs().max_element() <= 0.04 * floor,
+                "texel ({i}, {j}) of direction {t}: {got}, want {want}"
+            );
+        }
+    }
+}
+
 /// Two slabs through the middle of the grid: in the thin one, probes whose grid point lies
 /// within reach of a face move out of it; in the thick one they are too deep and are switched
 /// off. No probe that is on lies inside a slab.
