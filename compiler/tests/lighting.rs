@@ -593,3 +593,73 @@ fn export_writes_readable_images() {
         .expect(2)
         .says("unknown image type");
 }
+
+/// Each emissive triangle's mean emitted luminance (`EMLU`): two triangles of one material whose
+/// emissive texture is black on its left half and white on its right (4 × 1 texels, clamped),
+/// one mapped inside the black texels' reach of bilinear filtering, one inside the white's: 0 and
+/// the factor's luminance. A triangle of a material without texture keeps its factor's; a
+/// non-emitter 0.
+#[test]
+fn emitted_luminance_averages_the_emissive_texture_over_each_triangle() {
+    use kiln_compiler::ir::{Texture, TextureRole};
+    use kiln_format::manifest::Wrap;
+    let mut s = Scene { name: "emitters".into(), ..Default::default() };
+    s.textures.push(Texture {
+        name: "half".into(),
+        width: 4,
+        height: 1,
+        rgba: [0u8, 0, 255, 255].iter().flat_map(|&c| [c, c, c, 255]).collect(),
+        role: TextureRole::Color,
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::ClampToEdge,
+        mag_linear: true,
+    });
+    let factor = [2.0f32, 1.0, 0.5];
+    let mut textured = kiln_compiler::import::demo::lambert_material([0.5; 3]);
+    textured.emission = factor;
+    textured.emissive_texture = 0;
+    let mut plain = kiln_compiler::import::demo::lambert_material([0.5; 3]);
+    plain.emission = [0.0, 3.0, 0.0];
+    for (name, gpu) in [
+        ("textured", textured),
+        ("plain", plain),
+        ("dark", kiln_compiler::import::demo::lambert_material([0.5; 3])),
+    ] {
+        s.materials.push(Material { name: name.into(), gpu });
+    }
+    // Four triangles side by side on the floor, with their texture coordinates.
+    let tris: [(f32, [f32; 2], u32); 4] =
+        [(0.0, [0.02, 0.2], 0), (1.0, [0.8, 0.98], 0), (2.0, [0.5, 0.5], 1), (3.0, [0.5, 0.5], 2)];
+    for (x, [u0, u1], m) in tris {
+        let b = s.vertices.len() as u32;
+        for (p, uv) in
+            [([x, 0.0, 0.0], [u0, 0.5]), ([x + 0.9, 0.0, 0.0], [u1, 0.5]), ([x, 0.0, -0.9], [u0, 0.5])]
+        {
+            s.vertices.push(Vertex { position: p, normal: [0.0, 1.0, 0.0] });
+            s.uvs.push(uv);
+        }
+        s.triangles.push([b, b + 1, b + 2]);
+        s.triangle_materials.push(m);
+    }
+    let bytes = compile(s, Settings { shaft_variants: Some(0), ..Default::default() });
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let lum: &[f32] = view.emitter_luminance().unwrap().expect("an emissive texture: the section");
+    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    // By material, in the file's (BVH) order.
+    for (t, &m) in view.triangle_materials.iter().enumerate() {
+        let tri = view.triangles[t];
+        let x = view.vertices[tri[0] as usize].position[0].min(view.vertices[tri[1] as usize].position[0]);
+        let want = match (m, x < 0.5) {
+            (0, true) => 0.0,
+            (0, false) => luminance(factor),
+            (1, _) => luminance([0.0, 3.0, 0.0]),
+            _ => 0.0,
+        };
+        assert!(
+            (lum[t] - want).abs() <= 1e-4 * want.max(1.0),
+            "triangle {t} (material {m}, x {x}): {} against {want}",
+            lum[t]
+        );
+    }
+}

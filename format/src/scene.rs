@@ -114,6 +114,11 @@ impl<'a> SceneView<'a> {
         Ok(view)
     }
 
+    /// The mean emitted luminance of each triangle (`EMLU`), when the file has it.
+    pub fn emitter_luminance(&self) -> Result<Option<&'a [f32]>> {
+        self.file.pod(crate::sections::EMITTER_LUMINANCE, 0)
+    }
+
     /// Texels of texture `i` (its mip chain, level 0 first, with its pixel format and swizzle),
     /// checksummed and checked against the manifest on first access.
     pub fn texture(&self, i: usize) -> Result<TextureData<'a>> {
@@ -317,6 +322,20 @@ impl<'a> SceneView<'a> {
             }
         }
         crate::probes::ProbeVolume::read(file)?;
+        if let Some(l) = self.emitter_luminance()? {
+            if l.len() != self.triangles.len() {
+                return Err(FormatError::invalid(format!(
+                    "emitter-luminance holds {} values for {} triangles",
+                    l.len(),
+                    self.triangles.len()
+                )));
+            }
+            if let Some(t) = l.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(FormatError::invalid(format!(
+                    "emitter-luminance: triangle {t}'s value is negative or not finite"
+                )));
+            }
+        }
         let volumes = file.all_of(MEDIA_VISIBILITY).len();
         match &m.media_visibility {
             None if volumes == 0 => {}

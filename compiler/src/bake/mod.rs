@@ -285,6 +285,13 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
         }
         Stage::Materials => {
             h.part("materials", bytemuck::cast_slice(&ctx.materials));
+            if materials::textured_emission(ctx) {
+                // The emitted luminance per triangle: in stored order, through the uvs and textures.
+                h.part("triangles", bytemuck::cast_slice(&ctx.triangles))
+                    .part("triangle-materials", bytemuck::cast_slice(&ctx.triangle_materials))
+                    .part("uvs", bytemuck::cast_slice(&scene.uvs));
+                hash_textures(&mut h, scene);
+            }
         }
         Stage::Textures => {
             // The format of each texture follows the setting and the material slots reading it.

@@ -68,6 +68,10 @@ pub const SHADOW_MAP: SectionKind = SectionKind(*b"SHDW");
 /// Light-visibility volume of one light: u8 per cell; index = position in the manifest's list.
 pub const MEDIA_VISIBILITY: SectionKind = SectionKind(*b"MVIS");
 
+/// Mean emitted luminance (`f32`) of each triangle (BVH leaf order) over its area: emission
+/// factor × emissive texture; 0 for triangles that do not emit. Present when a material has an
+/// emissive texture: the emitter tables weigh triangles by it.
+pub const EMITTER_LUMINANCE: SectionKind = SectionKind(*b"EMLU");
 /// Irradiance probe volume header ([`crate::probes::ProbeHeader`], one element).
 pub const PROBE_GRID: SectionKind = SectionKind(*b"PRBG");
 /// Probe states ([`crate::probes::ProbeState`]: offset and on/off), one per probe.
@@ -189,6 +193,7 @@ pub const KNOWN: &[KindInfo] = &[
         indexed: true,
         description: "shadow map depths (f32)",
     },
+    pod_kind(EMITTER_LUMINANCE, "emitter-luminance", 4, "mean emitted luminance per triangle"),
     pod_kind(PROBE_GRID, "probe-grid", 64, "irradiance probe volume header"),
     pod_kind(PROBE_STATES, "probe-states", 16, "probe offsets and on/off"),
     pod_kind(PROBE_IRRADIANCE, "probe-irradiance", 4, "probe irradiance atlas (E5B9G9R9, octahedral)"),

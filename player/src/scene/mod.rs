@@ -221,6 +221,7 @@ impl<'f> Prepared<'f> {
         } else {
             Vec::new()
         };
+        let emitter_luminance = view.emitter_luminance().map_err(bad)?;
         let reference = needs.scene_buffers.then(|| {
             reference::tables(
                 &view.manifest,
@@ -229,6 +230,7 @@ impl<'f> Prepared<'f> {
                 view.triangle_materials,
                 view.materials,
                 &storage,
+                emitter_luminance,
             )
         });
         Ok((Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space }, decode_ms))

@@ -116,7 +116,11 @@ fn emissive_table(
         .collect()
 }
 
-/// Builds the tables of a validated scene.
+/// Builds the tables of a validated scene. Emissive triangles are weighed by their emitted
+/// power: π × luminance × area, the luminance the file's mean over each triangle
+/// (`emitter_luminance`, where an emissive texture modulates the factor) or the factor's; a
+/// triangle whose texture lets nothing out leaves the tables (its light, if any, still arrives
+/// through the paths that hit it).
 pub fn tables(
     manifest: &Manifest,
     vertices: &[Vertex],
@@ -124,6 +128,7 @@ pub fn tables(
     triangle_materials: &[u32],
     materials: &[GpuMaterial],
     storage: &[(PixelFormat, [Swizzle; 4])],
+    emitter_luminance: Option<&[f32]>,
 ) -> ReferenceTables {
     let b = &manifest.bounds;
     let radius = (Vec3::from(b.max) - Vec3::from(b.min)).length() * 0.5;
@@ -139,7 +144,12 @@ pub fn tables(
         if luminance(emission) > 0.0 {
             let p = tri.map(|v| Vec3::from(vertices[v as usize].position));
             let area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
-            power.push((EmitterKinds::TRIANGLE, t as u32, emitted_power(emission, area)));
+            let power_of = match emitter_luminance.and_then(|l| l.get(t)) {
+                // The same constant as emitted_power: π × luminance × area.
+                Some(&mean) => std::f32::consts::PI * mean * area,
+                None => emitted_power(emission, area),
+            };
+            power.push((EmitterKinds::TRIANGLE, t as u32, power_of));
         }
     }
     power.retain(|p| p.2 > 0.0 && p.2.is_finite());
@@ -258,6 +268,7 @@ mod tests {
             &[1, 0, 1, 1],
             &[GpuMaterial::default(), glow],
             &[],
+            None,
         );
         let kinds: Vec<u32> = t.emitters.iter().map(|e| e.kind).collect();
         let lights = kinds.iter().filter(|&&k| k == EmitterKinds::LIGHT).count();
@@ -283,6 +294,7 @@ mod tests {
             &[0, 1],
             &[GpuMaterial::default(), glow],
             &[],
+            None,
         );
         assert_eq!(t.emitters.len(), 3, "the dark light is dropped");
         let p: Vec<f32> = t.emitters.iter().map(|e| e.pdf).collect();
@@ -299,5 +311,29 @@ mod tests {
             assert!((c - e.pdf).abs() < 1e-6, "drawn with {c}, stated {}", e.pdf);
         }
         assert_eq!(t.triangle_emitter, vec![-1, 2]);
+    }
+
+    /// With the file's mean emitted luminance, triangles of one material are weighed by it (a
+    /// texture that lets three times the light out: three times as likely) and one whose
+    /// texture lets nothing out leaves the tables.
+    #[test]
+    fn textured_emitters_are_weighed_by_their_mean_luminance() {
+        let mut manifest = Manifest::default();
+        manifest.bounds.max = [1.0; 3];
+        let v = |x: f32, z: f32| Vertex { position: [x, 0.0, z], normal: [0.0, 1.0, 0.0] };
+        let vertices = vec![v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
+        let glow = GpuMaterial { emission: [1.0; 3], emissive_texture: 0, ..Default::default() };
+        let t = tables(
+            &manifest,
+            &vertices,
+            &[[0, 1, 2], [0, 2, 1], [1, 2, 0]],
+            &[0, 0, 0],
+            &[glow],
+            &[],
+            Some(&[1.0, 3.0, 0.0]),
+        );
+        assert_eq!(t.triangle_emitter, vec![0, 1, -1]);
+        assert!((t.emitters[1].pdf / t.emitters[0].pdf - 3.0).abs() < 1e-5);
+        assert_eq!(t.emissive.len(), 2);
     }
 }

@@ -342,11 +342,13 @@ fn sections(layout: &ProbeLayout, probes: &[Baked]) -> Sections {
 /// depend on how many), then lays out the atlases.
 pub fn stage(ctx: &BakeContext) -> Sections {
     let Some(layout) = ctx.plan.probes else { return Sections::default() };
+    let luminance = super::materials::emitted_luminance(ctx);
     let tracer = Tracer::new(
         ctx.shading(),
         &ctx.scene.uvs,
         &ctx.triangle_materials,
         Vec3::from(ctx.scene.sky.radiance),
+        luminance.as_deref(),
     );
     ctx.progress.count("probes", layout.count());
     let header = layout.header(0);

@@ -121,12 +121,15 @@ impl std::fmt::Debug for Tracer<'_> {
 
 impl<'a> Tracer<'a> {
     /// A tracer over `shading`'s scene; emissive triangles enter the emitter table by their
-    /// material's emission × area (their emissive texture is read where a sample lands).
+    /// emitted luminance (`luminance`: the mean over each triangle of factor × emissive texture,
+    /// where a texture modulates it; else the factor's) × area; the texture is read where a
+    /// sample lands.
     pub fn new(
         shading: ShadingScene<'a>,
         uvs: &'a [[f32; 2]],
         triangle_materials: &'a [u32],
         sky: Vec3,
+        luminance: Option<&[f32]>,
     ) -> Tracer<'a> {
         let tris = IndexedTriangles { vertices: shading.vertices, triangles: shading.triangles };
         let mut emitters = Emitters { pdf: vec![0.0; shading.triangles.len()], ..Default::default() };
@@ -134,7 +137,10 @@ impl<'a> Tracer<'a> {
         for (t, &m) in triangle_materials.iter().enumerate() {
             let e = Vec3::from(shading.materials[m as usize].emission);
             let [a, b, c] = kiln_format::query::TriangleSource::corners(&tris, t);
-            let p = kiln_format::gpu::luminance(e.to_array()) * 0.5 * (b - a).cross(c - a).length();
+            let l = luminance
+                .and_then(|l| l.get(t).copied())
+                .unwrap_or(kiln_format::gpu::luminance(e.to_array()));
+            let p = if e == Vec3::ZERO { 0.0 } else { l * 0.5 * (b - a).cross(c - a).length() };
             if p > 0.0 && p.is_finite() {
                 emitters.triangles.push(t as u32);
                 power.push(p as f64);
