@@ -100,6 +100,9 @@ fn every_kind_file_with(codec: Codec) -> Vec<u8> {
         mag_linear: true,
     });
     s.materials[0].gpu.base_color_texture = 0;
+    // Emission through the checker, so that EMLU is written.
+    s.materials[0].gpu.emission = [0.5, 0.25, 0.125];
+    s.materials[0].gpu.emissive_texture = 0;
     let colors = (0..s.vertices.len()).map(|i| [(i * 1031 % 65536) as u16, 7, u16::MAX, 1]).collect();
     s.set_colors(0, Some(colors));
     let metal = &mut s.materials[1].gpu;

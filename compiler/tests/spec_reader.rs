@@ -1171,11 +1171,68 @@ fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> Str
     } else {
         assert_eq!(count(b"MVIS"), 0);
     }
+    // EMLU: one f32 per triangle, finite and non-negative, 0 where the material emits nothing.
+    let emlu =
+        f.section(b"EMLU", 0).map(|b| (0..b.len() / 4).map(|k| spec::f32_at(b, 4 * k)).collect::<Vec<f32>>());
+    if let Some(l) = &emlu {
+        let view = SceneView::new(file).unwrap();
+        assert_eq!(l.len(), view.triangles.len(), "{name}: EMLU values");
+        for (t, (&v, &mat)) in l.iter().zip(view.triangle_materials).enumerate() {
+            assert!(v.is_finite() && v >= 0.0, "{name}: EMLU {t} is {v}");
+            if view.materials[mat as usize].emission == [0.0; 3] {
+                assert_eq!(v, 0.0, "{name}: EMLU {t} of a material that emits nothing");
+            }
+        }
+        assert_eq!(Some(l.as_slice()), view.emitter_luminance().unwrap(), "{name}: EMLU");
+    }
+    // The probe volume: the header's layout sizes the states and both atlases; states are on or
+    // off within half a spacing; E5B9G9R9 texels decode to finite values; distance moments are
+    // finite and non-negative binary16.
+    let probes = f.section(b"PRBG", 0).map(|h| {
+        assert_eq!(h.len(), 64, "{name}: PRBG bytes");
+        let u = |i: usize| spec::u32_at(h, 4 * i);
+        let spacing = spec::f32_at(h, 12);
+        let dims = [u(4), u(5), u(6)];
+        let (ti, tv, layers, active) = (u(7), u(8), u(9), u(13));
+        let probes = dims.iter().product::<u32>() as usize;
+        let states = f.section(b"PRBS", 0).unwrap();
+        assert_eq!(states.len(), 16 * probes, "{name}: PRBS bytes");
+        let on = (0..probes)
+            .filter(|&p| {
+                let w = spec::f32_at(states, 16 * p + 12);
+                assert!(w == 0.0 || w == 1.0, "{name}: probe {p} state {w}");
+                for a in 0..3 {
+                    assert!(spec::f32_at(states, 16 * p + 4 * a).abs() <= 0.5 * spacing * 1.001);
+                }
+                w == 1.0
+            })
+            .count();
+        assert_eq!(on as u32, active, "{name}: probes on");
+        let atlas = |t: u32, l: u32| ((dims[0] * (t + 2)) * (dims[1] * (t + 2)) * dims[2] * l) as usize;
+        let irr = f.section(b"PRBI", 0).unwrap();
+        assert_eq!(irr.len(), 4 * atlas(ti, layers), "{name}: PRBI bytes");
+        for k in 0..irr.len() / 4 {
+            let t = spec::u32_at(irr, 4 * k);
+            let scale = 2f32.powi((t >> 27) as i32 - 24);
+            assert!(((t & 511) as f32 * scale).is_finite());
+        }
+        let vis = f.section(b"PRBV", 0).unwrap();
+        assert_eq!(vis.len(), 4 * atlas(tv, 1), "{name}: PRBV bytes");
+        for k in 0..vis.len() / 2 {
+            let bits = u16::from_le_bytes([vis[2 * k], vis[2 * k + 1]]);
+            // binary16: sign clear, exponent not all ones.
+            assert!(bits & 0x8000 == 0 || bits == 0x8000, "{name}: PRBV value {k} negative");
+            assert_ne!(bits & 0x7c00, 0x7c00, "{name}: PRBV value {k} not finite");
+        }
+        probes
+    });
     format!(
-        "{} textures (formats {formats:?}), BRDF {}, {} shadow maps, {volumes} visibility volumes",
+        "{} textures (formats {formats:?}), BRDF {}, {} shadow maps, {volumes} visibility volumes, EMLU {}, {} probes",
         m.textures.len(),
         m.brdf_lut.is_some(),
-        m.shadow_maps.len()
+        m.shadow_maps.len(),
+        emlu.is_some(),
+        probes.unwrap_or(0)
     )
 }
 
@@ -1222,6 +1279,9 @@ fn fixture_with(codec: Codec) -> Vec<u8> {
     });
     s.materials[0].gpu.normal_texture = 1;
     s.materials[0].gpu.occlusion_texture = 2;
+    // Emission through the checker, so that EMLU is written.
+    s.materials[0].gpu.emission = [0.5, 0.25, 0.125];
+    s.materials[0].gpu.emissive_texture = 0;
     for (i, uv) in s.uvs.iter_mut().enumerate() {
         *uv = [(i % 7) as f32 * 0.37 - 0.5, (i % 5) as f32 * 1.3];
     }
