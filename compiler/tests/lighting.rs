@@ -589,6 +589,17 @@ fn export_writes_readable_images() {
         .expect(1)
         .says("no shadow-map:7");
     run::kiln(dir.path(), &["export", "s.kiln", "bvh", "-o", "x.pfm"]).expect(2).says("exportable");
+    // A bake that would trace more paths than the limit is refused before it starts, saying what
+    // to change; so is a spacing that puts more probes on an axis than an atlas holds.
+    run::kiln(dir.path(), &["demo", "-o", "p.kiln", "--probe-spacing", "0.02", "--probe-rays", "512"])
+        .expect(2)
+        .says("lower --probe-rays or raise --probe-spacing");
+    run::kiln(dir.path(), &["demo", "-o", "p.kiln", "--probe-spacing", "0.001"])
+        .expect(2)
+        .says("raise it to at least");
+    run::kiln(dir.path(), &["demo", "-o", "p.kiln", "--probe-spacing", "-1"])
+        .expect(2)
+        .says("not a positive distance");
     run::kiln(dir.path(), &["export", "s.kiln", "brdf-lut", "-o", "x.bmp"])
         .expect(2)
         .says("unknown image type");

@@ -132,6 +132,15 @@ fn probe_plan(
         layers,
         settings.probe_rays,
     )?;
+    // Paths a bake may trace: 2^28 (minutes on 16 cores; a hostile sidecar asks for more).
+    const MAX_PATHS: u64 = 1 << 28;
+    if layout.count() * layout.rays as u64 > MAX_PATHS {
+        return Err(format!(
+            "{} probes x {} paths each is more than the {MAX_PATHS} paths a bake may trace: lower --probe-rays or raise --probe-spacing",
+            layout.count(),
+            layout.rays
+        ));
+    }
     let [x, y, z] = layout.dims;
     let why_spacing = match settings.probe_spacing {
         Some(_) => String::new(),

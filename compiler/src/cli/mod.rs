@@ -200,7 +200,7 @@ bounce, whenever something lights the scene) or off [default: auto, or the sidec
     )]
     pub probes: Option<crate::settings::Probes>,
     /// Distance between probes.
-    #[arg(long, value_name = "UNITS", value_parser = crate::settings::ProbeSpacing::parse, help_heading = "Lighting bakes",
+    #[arg(long, value_name = "UNITS", value_parser = crate::settings::ProbeSpacing::parse, allow_negative_numbers = true, help_heading = "Lighting bakes",
           help = format!("Distance between irradiance probes in scene units [default: the longest extent over {}, widened until the volume fits --probe-budget]", crate::bake::probes::AUTO_PROBES))]
     pub probe_spacing: Option<crate::settings::ProbeSpacing>,
     /// Rays per probe.
