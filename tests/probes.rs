@@ -114,6 +114,54 @@ fn texel(i: u32, j: u32, n: u32) -> Vec3 {
     octahedral((i as f32 + 0.5) / n as f32 * 2.0 - 1.0, (j as f32 + 0.5) / n as f32 * 2.0 - 1.0)
 }
 
+/// The furnace 10⁵ units from the origin and at a thousandth of the size: the probes' means stay
+/// the closed form's (offsets and epsilons scale with the scene and with floating point).
+#[test]
+fn the_furnace_holds_far_from_the_origin_and_at_small_scales() {
+    let (rho, le) = (0.5f32, Vec3::new(1.0, 0.5, 0.25));
+    for (offset, scale) in
+        [(Vec3::new(1e5, -2e5, 5e4), 1.0f32), (Vec3::new(1e4, -2e4, 5e3), 1.0f32), (Vec3::ZERO, 1e-3)]
+    {
+        let mut s = Scene { name: "furnace".into(), ..Default::default() };
+        s.materials.push(material(rho, le.to_array()));
+        cuboid(
+            &mut s,
+            Vec3::splat(-1.0) * scale + offset,
+            Vec3::new(1.0, 0.6, 1.4) * scale + offset,
+            0,
+            true,
+        );
+        let v = Volume::read(&compile(s, settings(256, None)));
+        let mut sum = [Vec3::ZERO; 2];
+        let mut count = 0;
+        for z in 0..v.dims[2] {
+            for y in 0..v.dims[1] {
+                for x in 0..v.dims[0] {
+                    assert!(
+                        v.position(x, y, z).1,
+                        "probe ({x}, {y}, {z}) off at offset {offset}, scale {scale}"
+                    );
+                    for j in 0..v.ti as i32 {
+                        for i in 0..v.ti as i32 {
+                            for (layer, total) in sum.iter_mut().enumerate() {
+                                *total += v.irradiance([x, y, z], layer as u32, i, j);
+                            }
+                            count += 1;
+                        }
+                    }
+                }
+            }
+        }
+        for (layer, want) in [(0, le * rho / (1.0 - rho)), (1, le)] {
+            let mean = sum[layer] / count as f32;
+            assert!(
+                (mean - want).abs().max_element() <= 0.01 * want.max_element(),
+                "offset {offset}, scale {scale}, layer {layer}: mean {mean} against {want}"
+            );
+        }
+    }
+}
+
 /// FORMAT.md's border rule for an n × n tile: a corner copies the opposite corner; an edge
 /// texel copies the interior texel beside that edge mirrored along it.
 fn fold(i: i32, j: i32, n: i32) -> (i32, i32) {

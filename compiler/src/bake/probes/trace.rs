@@ -18,7 +18,7 @@
 //! not depend on thread count or order.
 
 use glam::{Vec2, Vec3};
-use kiln_format::query::{BvhQuery, Hit, IndexedTriangles, Ray, offset_origin};
+use kiln_format::query::{BvhQuery, Hit, IndexedTriangles, Ray};
 use kiln_format::sections::MaterialFlags;
 
 use crate::shading::{ShadingScene, Surface, light_samples};
@@ -27,6 +27,16 @@ use crate::shading::{ShadingScene, Surface, light_samples};
 pub const ROULETTE_AFTER: u32 = 3;
 /// Scattering events a path counts at most.
 pub const MAX_BOUNCES: u32 = 64;
+
+/// `p` moved off its surface along unit `n` by 8 units in the last place of its largest
+/// coordinate: enough for a hit point interpolated from its triangle's corners (a few ulps off
+/// the plane) not to find its own triangle again, and relative to the magnitude, not absolute nor
+/// the shared `offset_origin`'s 256 ulps (2 units at 10⁵, as wide as a room there: the furnace
+/// 10⁴ away lost 9 % of its light to paths restarted outside their walls).
+fn offset(p: Vec3, n: Vec3) -> Vec3 {
+    let scale = p.abs().max_element().max(f32::MIN_POSITIVE) * (8.0 * f32::EPSILON);
+    p + n * scale
+}
 
 /// Counter-based random numbers: a stream per (probe, path), one value per call.
 #[derive(Debug, Clone)]
@@ -168,8 +178,8 @@ impl<'a> Tracer<'a> {
         BvhQuery::new(self.shading.bvh, &self.tris)
     }
 
-    /// The surface `hit` of a unit ray from `o` along `d`.
-    fn surface_hit(&self, o: Vec3, d: Vec3, hit: Hit) -> SurfaceHit {
+    /// The surface `hit` of a unit ray along `d`.
+    fn surface_hit(&self, d: Vec3, hit: Hit) -> SurfaceHit {
         let tri = self.shading.triangles[hit.triangle as usize];
         let v = tri.map(|i| self.shading.vertices[i as usize]);
         let [a, b, c] = v.map(|v| Vec3::from(v.position));
@@ -187,7 +197,9 @@ impl<'a> Tracer<'a> {
         };
         SurfaceHit {
             t: hit.t,
-            p: o + d * hit.t,
+            // From the corners, not o + d·t: its error is a few ulps of the point, not of the
+            // origin and the distance.
+            p: a * w[0] + b * w[1] + c * w[2],
             ng,
             n,
             uv,
@@ -199,7 +211,14 @@ impl<'a> Tracer<'a> {
 
     /// The first surface along the unit ray from `o` (a free point: no offset) along `d`.
     pub fn trace(&self, o: Vec3, d: Vec3, tmax: f32) -> Option<SurfaceHit> {
-        self.query().closest_hit(&Ray::new(o, d, 0.0, tmax)).map(|h| self.surface_hit(o, d, h))
+        self.query().closest_hit(&Ray::new(o, d, 0.0, tmax)).map(|h| self.surface_hit(d, h))
+    }
+
+    /// Whether the segment from `p` (on a surface of geometric normal `ng`) along unit `d` is
+    /// blocked within `tmax`.
+    fn occluded(&self, p: Vec3, ng: Vec3, d: Vec3, tmax: f32) -> bool {
+        let o = offset(p, if ng.dot(d) >= 0.0 { ng } else { -ng });
+        self.query().any_hit(&Ray::new(o, d, 0.0, tmax))
     }
 
     /// Whether `material` is double-sided.
@@ -244,17 +263,21 @@ impl<'a> Tracer<'a> {
             return None;
         }
         let d = to / dist;
-        let o = if ng == Vec3::ZERO { p } else { offset_origin(p, if ng.dot(d) >= 0.0 { ng } else { -ng }) };
+        let o = if ng == Vec3::ZERO { p } else { offset(p, if ng.dot(d) >= 0.0 { ng } else { -ng }) };
         // The barycentrics of q, for the emitter's own texture coordinates.
         let hit = Hit { t: dist, triangle: t, u: r1 * (1.0 - r2), v: r1 * r2 };
-        let h = self.surface_hit(p, d, hit);
+        let h = self.surface_hit(d, hit);
         let s = self.shading.surface(h.material, h.uv);
         let le = self.emitted(&h, d, &s);
         let pdf = self.light_pdf(&h, d);
         if le == Vec3::ZERO || pdf <= 0.0 {
             return Some((d, Vec3::ZERO, pdf));
         }
-        let blocked = self.query().any_hit(&Ray::new(o, d, 0.0, (q - o).length() * (1.0 - 1e-4)));
+        // To the sample moved off the emitter towards the origin: the emitter's own plane is not
+        // in the way, however far from the world's origin both lie.
+        let end = offset(q, if h.ng.dot(d) < 0.0 { h.ng } else { -h.ng });
+        let to_end = end - o;
+        let blocked = self.query().any_hit(&Ray::new(o, to_end.normalize_or(d), 0.0, to_end.length()));
         Some((d, if blocked { Vec3::ZERO } else { le }, pdf))
     }
 
@@ -281,7 +304,7 @@ impl<'a> Tracer<'a> {
                     ((rng.uniform() * samples.len() as f32) as usize).min(samples.len().saturating_sub(1));
                 if let Some(&(l, e, tmax)) = samples.get(pick) {
                     let n_l = n.dot(l);
-                    if n_l > 0.0 && e != Vec3::ZERO && !self.shading.occluded(h.p, ng, l, tmax) {
+                    if n_l > 0.0 && e != Vec3::ZERO && !self.occluded(h.p, ng, l, tmax) {
                         out += throughput * self.shading.brdf(&s, n, v, l) * e * (n_l * samples.len() as f32);
                     }
                 }
@@ -314,7 +337,7 @@ impl<'a> Tracer<'a> {
             if throughput.max_element() <= 0.0 {
                 break;
             }
-            let o = offset_origin(h.p, ng);
+            let o = offset(h.p, ng);
             let Some(next) = self.trace(o, l, f32::INFINITY) else {
                 out += throughput * self.sky;
                 break;
