@@ -222,6 +222,36 @@ fn furnace_probes_hold_the_closed_form() {
     }
 }
 
+/// A 200 × 200 floor at y = 0 facing up (material `floor`) and a speck high in a far corner
+/// (material `speck`): the bounds reach y = 2, so with spacing 8 the probes sit at y = 1, the
+/// centre one at (0, 1, 0).
+fn floor_and_speck(s: &mut Scene, floor: u32, speck: u32) {
+    let r = 100.0;
+    quad(
+        s,
+        [Vec3::new(-r, 0.0, r), Vec3::new(r, 0.0, r), Vec3::new(r, 0.0, -r), Vec3::new(-r, 0.0, -r)],
+        floor,
+    );
+    let (a, b) = (99.0, 99.01);
+    quad(s, [Vec3::new(a, 2.0, a), Vec3::new(a, 2.0, b), Vec3::new(b, 2.0, b), Vec3::new(b, 2.0, a)], speck);
+}
+
+/// Every interior texel of probe `c`'s `layer` against a lower hemisphere of uniform radiance
+/// `l`: l (1 − t·ŷ) / 2 along direction t, within 4 % of l.
+fn lower_hemisphere(v: &Volume, c: [u32; 3], layer: u32, l: f32) {
+    for j in 0..v.ti {
+        for i in 0..v.ti {
+            let t = texel(i, j, v.ti);
+            let want = l * (1.0 - t.y) / 2.0;
+            let got = v.irradiance(c, layer, i as i32, j as i32);
+            assert!(
+                (got - Vec3::splat(want)).abs().max_element() <= 0.04 * l,
+                "layer {layer} texel ({i}, {j}) of direction {t}: {got}, want {want}"
+            );
+        }
+    }
+}
+
 /// A large emissive floor below the probes: a probe at height h sees it fill the lower
 /// hemisphere, so the texel of direction t holds Le (1 − t·ŷ) / 2 (the irradiance of a uniform
 /// hemisphere onto a tilted plane, over π); the distance along t is h / (−t·ŷ) below the
@@ -234,38 +264,16 @@ fn an_emissive_floor_fills_the_octahedral_maps_by_their_formula() {
     let mut s = Scene { name: "floor".into(), ..Default::default() };
     s.materials.push(material(0.0, [le; 3]));
     s.materials.push(material(0.0, [0.0; 3]));
-    let r = 100.0;
-    quad(
-        &mut s,
-        [Vec3::new(-r, 0.0, r), Vec3::new(r, 0.0, r), Vec3::new(r, 0.0, -r), Vec3::new(-r, 0.0, -r)],
-        0,
-    );
-    // A speck high in a corner: the bounds reach y = 2, so the probes sit at y = 1.
-    quad(
-        &mut s,
-        [
-            Vec3::new(99.0, 2.0, 99.0),
-            Vec3::new(99.0, 2.0, 99.01),
-            Vec3::new(99.01, 2.0, 99.01),
-            Vec3::new(99.01, 2.0, 99.0),
-        ],
-        1,
-    );
+    floor_and_speck(&mut s, 0, 1);
     let v = Volume::read(&compile(s, settings(2048, Some(8.0))));
     assert_eq!(v.dims, [25, 1, 25]);
     let c = [12, 0, 12];
     let (p, on) = v.position(c[0], c[1], c[2]);
     assert!(on && (p - Vec3::new(0.0, 1.0, 0.0)).length() < 1e-4, "the centre probe at {p}");
     let h = p.y / v.spacing;
+    lower_hemisphere(&v, c, 1, le);
     for j in 0..v.ti {
         for i in 0..v.ti {
-            let t = texel(i, j, v.ti);
-            let want = le * (1.0 - t.y) / 2.0;
-            let got = v.irradiance(c, 1, i as i32, j as i32);
-            assert!(
-                (got - Vec3::splat(want)).abs().max_element() <= 0.04 * le,
-                "texel ({i}, {j}) of direction {t}: {got}, want {want}"
-            );
             assert!(
                 v.irradiance(c, 0, i as i32, j as i32).max_element() < 1e-3 * le,
                 "a black floor reflects"
@@ -328,23 +336,7 @@ fn a_floor_under_the_sun_reflects_into_the_probes_by_the_closed_form() {
     let (rho, e) = (0.6f32, 3.0f32);
     let mut s = Scene { name: "sunlit".into(), ..Default::default() };
     s.materials.push(material(rho, [0.0; 3]));
-    let r = 100.0;
-    quad(
-        &mut s,
-        [Vec3::new(-r, 0.0, r), Vec3::new(r, 0.0, r), Vec3::new(r, 0.0, -r), Vec3::new(-r, 0.0, -r)],
-        0,
-    );
-    // The speck that lifts the bounds to y = 2, far from the centre.
-    quad(
-        &mut s,
-        [
-            Vec3::new(99.0, 2.0, 99.0),
-            Vec3::new(99.0, 2.0, 99.01),
-            Vec3::new(99.01, 2.0, 99.01),
-            Vec3::new(99.01, 2.0, 99.0),
-        ],
-        0,
-    );
+    floor_and_speck(&mut s, 0, 0);
     s.lights.push(kiln_format::manifest::Light {
         name: "sun".into(),
         kind: kiln_format::manifest::LightKind::Directional,
@@ -360,17 +352,7 @@ fn a_floor_under_the_sun_reflects_into_the_probes_by_the_closed_form() {
     assert_eq!(v.layers, 1, "nothing emits");
     let c = [12, 0, 12];
     let floor = rho * e / std::f32::consts::PI;
-    for j in 0..v.ti {
-        for i in 0..v.ti {
-            let t = texel(i, j, v.ti);
-            let want = floor * (1.0 - t.y) / 2.0;
-            let got = v.irradiance(c, 0, i as i32, j as i32);
-            assert!(
-                (got - Vec3::splat(want)).abs().max_element() <= 0.04 * floor,
-                "texel ({i}, {j}) of direction {t}: {got}, want {want}"
-            );
-        }
-    }
+    lower_hemisphere(&v, c, 0, floor);
 }
 
 /// Two slabs through the middle of the grid: in the thin one, probes whose grid point lies
