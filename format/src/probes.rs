@@ -14,6 +14,10 @@ use crate::error::{FormatError, Result};
 use crate::read::KilnFile;
 use crate::sections::{PROBE_GRID, PROBE_IRRADIANCE, PROBE_STATES, PROBE_VISIBILITY};
 
+/// The volume's four section kinds: present together or not at all.
+pub const PROBE_KINDS: [crate::SectionKind; 4] =
+    [PROBE_GRID, PROBE_STATES, PROBE_IRRADIANCE, PROBE_VISIBILITY];
+
 /// Probes along one axis, at most: with two irradiance layers a volume's array image has at most
 /// 2 × 128 = 256 layers, Vulkan's guaranteed `maxImageArrayLayers`.
 pub const MAX_PROBE_AXIS: u32 = 128;
@@ -153,8 +157,7 @@ impl<'a> ProbeVolume<'a> {
     /// section's length against it, the states, and the visibility texels finite and
     /// non-negative. The error names the section.
     pub fn read(file: &'a KilnFile) -> Result<Option<ProbeVolume<'a>>> {
-        let present =
-            [PROBE_GRID, PROBE_STATES, PROBE_IRRADIANCE, PROBE_VISIBILITY].map(|k| file.find(k, 0).is_some());
+        let present = PROBE_KINDS.map(|k| file.find(k, 0).is_some());
         if present == [false; 4] {
             return Ok(None);
         }
@@ -211,15 +214,14 @@ impl<'a> ProbeVolume<'a> {
                 header.active
             )));
         }
-        if let Some(i) =
-            visibility.iter().position(|t| t.iter().any(|&h| !(half::f16::from_bits(h).to_f32() >= 0.0)))
-        {
+        let finite_non_negative = |h: u16| {
+            let v = half::f16::from_bits(h).to_f32();
+            v.is_finite() && v >= 0.0
+        };
+        if let Some(i) = visibility.iter().position(|t| !t.iter().all(|&h| finite_non_negative(h))) {
             return Err(FormatError::invalid(format!(
                 "probe-visibility: texel {i} is negative, infinite or NaN"
             )));
-        }
-        if visibility.iter().any(|t| t.iter().any(|&h| half::f16::from_bits(h).is_infinite())) {
-            return Err(FormatError::invalid("probe-visibility: a texel is infinite"));
         }
         Ok(Some(ProbeVolume { header: *header, states, irradiance, visibility }))
     }

@@ -132,30 +132,28 @@ pub fn run(args: &InspectArgs) -> CliResult {
         lights: manifest.as_ref().map_or(0, |m| m.lights.len() as u64),
         cameras: manifest.as_ref().map_or(0, |m| m.cameras.len() as u64),
     };
+    // Decoded bytes of sections: what the structures take in memory, whatever the codec.
+    let size = |kinds: &[kiln_format::SectionKind]| {
+        kinds.iter().filter_map(|&k| file.find(k, 0)).map(|s| s.entry.raw_size).sum::<u64>()
+    };
     let line_space = file
         .pod::<kiln_format::linespace::GridHeader>(sections::GRID, 0)
         .ok()
         .flatten()
         .and_then(|g| g.first().copied())
-        .map(|g| {
-            let size = |kinds: &[kiln_format::SectionKind]| {
-                // Decoded bytes: what the structures take in memory, whatever the codec.
-                kinds.iter().filter_map(|&k| file.find(k, 0)).map(|s| s.entry.raw_size).sum::<u64>()
-            };
-            LineSpaceJson {
-                cells: g.dims,
-                cell_size: g.cell,
-                shaft_res: g.shaft_res,
-                variants: crate::settings::variants_name(g.variants),
-                slots: g.slots,
-                filled_shafts: g.filled,
-                candidate_entries: g.entries,
-                bytes_voxel_grid: size(&[sections::GRID, sections::VOXEL_OFFSETS, sections::VOXEL_TRIANGLES]),
-                bytes_binary: size(&[sections::SHAFT_SLOTS, sections::SHAFT_BITS, sections::SHAFT_RANKS]),
-                bytes_candidates: size(&[sections::CANDIDATE_OFFSETS, sections::CANDIDATES]),
-                bytes_pnmt: size(&[sections::PNMT]),
-                pnmt_records: g.pnmt_records().map(|l| l.name()),
-            }
+        .map(|g| LineSpaceJson {
+            cells: g.dims,
+            cell_size: g.cell,
+            shaft_res: g.shaft_res,
+            variants: crate::settings::variants_name(g.variants),
+            slots: g.slots,
+            filled_shafts: g.filled,
+            candidate_entries: g.entries,
+            bytes_voxel_grid: size(&[sections::GRID, sections::VOXEL_OFFSETS, sections::VOXEL_TRIANGLES]),
+            bytes_binary: size(&[sections::SHAFT_SLOTS, sections::SHAFT_BITS, sections::SHAFT_RANKS]),
+            bytes_candidates: size(&[sections::CANDIDATE_OFFSETS, sections::CANDIDATES]),
+            bytes_pnmt: size(&[sections::PNMT]),
+            pnmt_records: g.pnmt_records().map(|l| l.name()),
         });
     let probes = file
         .pod::<kiln_format::probes::ProbeHeader>(sections::PROBE_GRID, 0)
@@ -169,16 +167,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
             active: g.active,
             layers: g.layers,
             rays: g.rays,
-            bytes: [
-                sections::PROBE_GRID,
-                sections::PROBE_STATES,
-                sections::PROBE_IRRADIANCE,
-                sections::PROBE_VISIBILITY,
-            ]
-            .iter()
-            .filter_map(|&k| file.find(k, 0))
-            .map(|s| s.entry.raw_size)
-            .sum(),
+            bytes: size(&kiln_format::probes::PROBE_KINDS),
         });
     let h = file.header();
     let report = InspectJson {

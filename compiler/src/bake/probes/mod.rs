@@ -23,7 +23,7 @@ use kiln_format::probes::{
 use kiln_format::sections::{PROBE_GRID, PROBE_IRRADIANCE, PROBE_STATES, PROBE_VISIBILITY};
 use rayon::prelude::*;
 
-use self::trace::{Rng, Tracer, fibonacci_direction};
+use self::trace::{Tracer, fibonacci_direction, path_rng};
 use super::{BakeContext, Sections};
 
 /// Interior texels along an irradiance tile's edge (8 × 8 directions: irradiance is smooth).
@@ -157,6 +157,32 @@ struct Baked {
     visibility: Vec<[f32; 2]>,
 }
 
+/// What the relocation test rays from `p` see: how many meet the inside of something, and the
+/// nearest such hit and the nearest other hit (distance, direction).
+struct Survey {
+    inside: bool,
+    nearest_back: Option<(f32, Vec3)>,
+    nearest_front: Option<(f32, Vec3)>,
+}
+
+fn survey(tracer: &Tracer, p: Vec3) -> Survey {
+    let (mut back, mut nearest_back, mut nearest_front) = (0, None::<(f32, Vec3)>, None::<(f32, Vec3)>);
+    for i in 0..RELOCATION_RAYS {
+        let d = fibonacci_direction(i, RELOCATION_RAYS);
+        let Some(h) = tracer.trace(p, d, f32::INFINITY) else { continue };
+        let slot = if tracer.inside(&h, d) {
+            back += 1;
+            &mut nearest_back
+        } else {
+            &mut nearest_front
+        };
+        if slot.is_none_or(|(t, _)| h.t < t) {
+            *slot = Some((h.t, d));
+        }
+    }
+    Survey { inside: back as f32 > INSIDE_FRACTION * RELOCATION_RAYS as f32, nearest_back, nearest_front }
+}
+
 /// Moves the probe at grid point `g` out of geometry and away from surfaces: its position, or
 /// `None` when it stays inside.
 fn relocate(tracer: &Tracer, g: Vec3, spacing: f32) -> Option<Vec3> {
@@ -164,21 +190,7 @@ fn relocate(tracer: &Tracer, g: Vec3, spacing: f32) -> Option<Vec3> {
     let clamp = |p: Vec3| g + (p - g).clamp(Vec3::splat(-limit), Vec3::splat(limit));
     let mut p = g;
     for _ in 0..4 {
-        let (mut back, mut nearest_back, mut nearest_front) = (0, None::<(f32, Vec3)>, None::<(f32, Vec3)>);
-        for i in 0..RELOCATION_RAYS {
-            let d = fibonacci_direction(i, RELOCATION_RAYS);
-            let Some(h) = tracer.trace(p, d, f32::INFINITY) else { continue };
-            let slot = if h.ng.dot(d) > 0.0 && !tracer.double_sided(h.material) {
-                back += 1;
-                &mut nearest_back
-            } else {
-                &mut nearest_front
-            };
-            if slot.is_none_or(|(t, _)| h.t < t) {
-                *slot = Some((h.t, d));
-            }
-        }
-        let inside = back as f32 > INSIDE_FRACTION * RELOCATION_RAYS as f32;
+        let Survey { inside, nearest_back, nearest_front } = survey(tracer, p);
         let moved = match (inside, nearest_back, nearest_front) {
             // Through the nearest back face, a little beyond it.
             (true, Some((t, d)), _) => clamp(p + d * (t + MIN_SURFACE_DISTANCE * spacing)),
@@ -194,15 +206,7 @@ fn relocate(tracer: &Tracer, g: Vec3, spacing: f32) -> Option<Vec3> {
         p = moved;
     }
     // Still moving after four steps: on only if it ended outside.
-    let back = (0..RELOCATION_RAYS)
-        .filter(|&i| {
-            let d = fibonacci_direction(i, RELOCATION_RAYS);
-            tracer
-                .trace(p, d, f32::INFINITY)
-                .is_some_and(|h| h.ng.dot(d) > 0.0 && !tracer.double_sided(h.material))
-        })
-        .count();
-    (back as f32 <= INSIDE_FRACTION * RELOCATION_RAYS as f32).then_some(p)
+    (!survey(tracer, p).inside).then_some(p)
 }
 
 /// What a probe's samples add to its texels: the direction, the light of each layer (already
@@ -230,12 +234,12 @@ fn bake_probe(tracer: &Tracer, layout: &ProbeLayout, index: u32, g: Vec3) -> Bak
     let mut samples = Vec::with_capacity((n + m) as usize);
     for i in 0..n {
         let d = fibonacci_direction(i, n);
-        let mut rng = Rng::new(index, i);
+        let mut rng = path_rng(index, i);
         let sample = match tracer.trace(p, d, f32::INFINITY) {
             None => Sample { d, light: [tracer.sky / uniform, Vec3::ZERO], distance: None },
             Some(h) => {
                 let distance = Some(h.t / spacing);
-                if h.ng.dot(d) > 0.0 && !tracer.double_sided(h.material) {
+                if tracer.inside(&h, d) {
                     // The inside of something: no light comes from there.
                     Sample { d, light: [Vec3::ZERO; 2], distance }
                 } else {
@@ -248,7 +252,7 @@ fn bake_probe(tracer: &Tracer, layout: &ProbeLayout, index: u32, g: Vec3) -> Bak
         samples.push(sample);
     }
     for j in 0..m {
-        let mut rng = Rng::new(index, n + j);
+        let mut rng = path_rng(index, n + j);
         if let Some((d, le, pdf)) = tracer.sample_emitter(p, Vec3::ZERO, &mut rng)
             && le != Vec3::ZERO
         {

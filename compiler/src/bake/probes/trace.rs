@@ -14,13 +14,14 @@
 //!   their material is double-sided, as in the player's path tracer. Alpha is not tested: every
 //!   triangle is opaque to the bake.
 //!
-//! Random numbers come from a counter-based hash of (probe, ray, dimension), so that the bytes do
-//! not depend on thread count or order.
+//! Random numbers come from a stream per (probe, path) ([`path_rng`]), so that the bytes do not
+//! depend on thread count or order.
 
 use glam::{Vec2, Vec3};
 use kiln_format::query::{BvhQuery, Hit, IndexedTriangles, Ray};
 use kiln_format::sections::MaterialFlags;
 
+use crate::raycheck::Rng;
 use crate::shading::{ShadingScene, Surface, light_samples};
 
 /// Scattering events after which paths continue only by Russian roulette.
@@ -38,26 +39,10 @@ fn offset(p: Vec3, n: Vec3) -> Vec3 {
     p + n * scale
 }
 
-/// Counter-based random numbers: a stream per (probe, path), one value per call.
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    /// The stream of path `path` of probe `probe`.
-    pub fn new(probe: u32, path: u32) -> Rng {
-        Rng(((probe as u64) << 32 | path as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x2545_f491_4f6c_dd1d)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f32 {
-        // SplitMix64 (Steele et al. 2014): a bijective mix of a Weyl sequence.
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 40) as f32 / (1u64 << 24) as f32
-    }
+/// The random stream of path `path` of probe `probe` (the compiler's SplitMix64 generator,
+/// seeded by both).
+pub fn path_rng(probe: u32, path: u32) -> Rng {
+    Rng::new(((probe as u64) << 32 | path as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x2545_f491_4f6c_dd1d)
 }
 
 /// Direction `i` of `n` spread evenly over the sphere (spherical Fibonacci points).
@@ -221,23 +206,21 @@ impl<'a> Tracer<'a> {
         self.query().any_hit(&Ray::new(o, d, 0.0, tmax))
     }
 
-    /// Whether `material` is double-sided.
-    pub fn double_sided(&self, material: u32) -> bool {
-        self.shading.materials[material as usize].flags & MaterialFlags::DOUBLE_SIDED != 0
+    /// Whether the ray along `d` that found `h` met the back of a single-sided surface: it
+    /// comes from inside something (a double-sided material has no inside).
+    pub fn inside(&self, h: &SurfaceHit, d: Vec3) -> bool {
+        h.ng.dot(d) > 0.0
+            && self.shading.materials[h.material as usize].flags & MaterialFlags::DOUBLE_SIDED == 0
     }
 
     /// Radiance the surface `h` emits back along `d` (the ray that found it).
     fn emitted(&self, h: &SurfaceHit, d: Vec3, s: &Surface) -> Vec3 {
-        if s.emission == Vec3::ZERO || (h.ng.dot(d) > 0.0 && !self.double_sided(h.material)) {
-            Vec3::ZERO
-        } else {
-            s.emission
-        }
+        if s.emission == Vec3::ZERO || self.inside(h, d) { Vec3::ZERO } else { s.emission }
     }
 
     /// Solid-angle density with which next-event estimation from a point `t` away picks the
     /// direction to emissive surface `h` (0 for surfaces not in the emitter table).
-    fn light_pdf(&self, h: &SurfaceHit, d: Vec3) -> f32 {
+    pub fn emitter_pdf(&self, h: &SurfaceHit, d: Vec3) -> f32 {
         let select = self.emitters.pdf[h.triangle as usize];
         let cos = h.ng.dot(d).abs();
         if select <= 0.0 || cos <= 0.0 || h.area <= 0.0 { 0.0 } else { select * h.t * h.t / (h.area * cos) }
@@ -251,11 +234,11 @@ impl<'a> Tracer<'a> {
         if e.triangles.is_empty() {
             return None;
         }
-        let u = rng.uniform();
+        let u = rng.f32();
         let k = e.cdf.partition_point(|&c| c <= u).min(e.triangles.len() - 1);
         let t = e.triangles[k];
         let [a, b, c] = kiln_format::query::TriangleSource::corners(&self.tris, t as usize);
-        let (r1, r2) = (rng.uniform().sqrt(), rng.uniform());
+        let (r1, r2) = (rng.f32().sqrt(), rng.f32());
         let q = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
         let to = q - p;
         let dist = to.length();
@@ -269,7 +252,7 @@ impl<'a> Tracer<'a> {
         let h = self.surface_hit(d, hit);
         let s = self.shading.surface(h.material, h.uv);
         let le = self.emitted(&h, d, &s);
-        let pdf = self.light_pdf(&h, d);
+        let pdf = self.emitter_pdf(&h, d);
         if le == Vec3::ZERO || pdf <= 0.0 {
             return Some((d, Vec3::ZERO, pdf));
         }
@@ -300,8 +283,7 @@ impl<'a> Tracer<'a> {
                 // paths average over the rest (16 shadow rays a vertex made rect-lit bakes 10×
                 // slower for no less noise at the probe).
                 let samples = light_samples(light, h.p);
-                let pick =
-                    ((rng.uniform() * samples.len() as f32) as usize).min(samples.len().saturating_sub(1));
+                let pick = ((rng.f32() * samples.len() as f32) as usize).min(samples.len().saturating_sub(1));
                 if let Some(&(l, e, tmax)) = samples.get(pick) {
                     let n_l = n.dot(l);
                     if n_l > 0.0 && e != Vec3::ZERO && !self.occluded(h.p, ng, l, tmax) {
@@ -319,13 +301,13 @@ impl<'a> Tracer<'a> {
             }
             if bounce > ROULETTE_AFTER {
                 let keep = throughput.max_element().min(0.95);
-                if rng.uniform() >= keep {
+                if rng.f32() >= keep {
                     break;
                 }
                 throughput /= keep;
             }
             // Cosine-weighted direction around n: weight f · cos / pdf = f · π.
-            let (r1, r2) = (rng.uniform(), rng.uniform());
+            let (r1, r2) = (rng.f32(), rng.f32());
             let (t1, t2) = basis(n);
             let (r, phi) = (r1.sqrt(), std::f32::consts::TAU * r2);
             let l =
@@ -346,7 +328,7 @@ impl<'a> Tracer<'a> {
             let le = self.emitted(&next, l, &ns);
             if le != Vec3::ZERO {
                 let pdf_brdf = n.dot(l) / std::f32::consts::PI;
-                let pdf_light = self.light_pdf(&next, l);
+                let pdf_light = self.emitter_pdf(&next, l);
                 out += throughput * le * (pdf_brdf / (pdf_brdf + pdf_light));
             }
             (h, v) = (next, -l);
@@ -358,10 +340,5 @@ impl<'a> Tracer<'a> {
     pub fn emission(&self, h: &SurfaceHit, d: Vec3) -> Vec3 {
         let s = self.shading.surface(h.material, h.uv);
         self.emitted(h, d, &s)
-    }
-
-    /// The solid-angle density of next-event estimation towards surface `h` along `d`.
-    pub fn emitter_pdf(&self, h: &SurfaceHit, d: Vec3) -> f32 {
-        self.light_pdf(h, d)
     }
 }
