@@ -11,36 +11,32 @@
 //! [`GpuScene::use_refined_views`] hands the raster passes the full chains.
 
 pub mod bindings;
+mod geometry;
 pub mod linespace;
 pub mod media;
 pub mod probes;
 pub mod reference;
+mod textures;
 pub mod upload;
+
+pub use geometry::{Draw, sort_by_material, triangle_corners};
+use geometry::{raster_materials, vertex_attributes};
+use textures::CoarseTexture;
+pub use textures::{COARSE_SIDE, TextureUpload, first_coarse_level};
 
 use std::collections::HashMap;
 
 use crate::gpu::vk;
 use kiln_format::gpu::GpuVertexAttributes;
-use kiln_format::manifest::{ColorSpace, Manifest, ShadowProjection, Wrap};
+use kiln_format::manifest::{Manifest, ShadowProjection};
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
-use kiln_format::sections::{self, GpuMaterial, PixelFormat, Swizzle, Vertex};
+use kiln_format::sections::{self, GpuMaterial};
 
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, View, Write};
+use crate::gpu::{Buffer, Gpu, Image, ImageDesc, Sampler, SamplerKey, Write};
 use crate::render::{Needs, TexelDecode};
 use upload::Uploader;
-
-/// One draw: the triangles of one material, contiguous in the index buffer.
-#[derive(Debug, Clone, Copy)]
-pub struct Draw {
-    /// Material index.
-    pub material: u32,
-    /// First index.
-    pub first: u32,
-    /// Index count.
-    pub count: u32,
-}
 
 /// A resident shadow map.
 #[derive(Debug)]
@@ -49,42 +45,6 @@ pub struct ShadowImage {
     pub map: usize,
     /// The depths (R32F; six layers for cube maps).
     pub image: Image,
-}
-
-/// The largest side, in texels, of the finest level a streamed texture uploads before the first
-/// frame: its levels from the first this small down to 1×1 come first. 256 keeps that part a
-/// small fraction of the bytes (1/64 of a 2048² texture's chain, PICA PICA's size: 1.6 %),
-/// while a level of 256 texels is sharp wherever the texture spans up to 256 pixels on screen,
-/// the common case in a first frame over a scene with many textures.
-pub const COARSE_SIDE: u32 = 256;
-
-/// How textures reach the GPU.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum TextureUpload {
-    /// Every level before the first frame.
-    #[default]
-    Whole,
-    /// Each texture's levels from the first at most [`COARSE_SIDE`] texels on a side before the
-    /// first frame, the finer ones after it ([`GpuScene::load_rest`]).
-    CoarseFirst,
-}
-
-/// The first level of a `width` × `height` texture with `mips` levels that a streamed upload
-/// sends before the first frame: the first whose larger side is at most [`COARSE_SIDE`] (the
-/// last level when none is: a chain cut short), 0 for a texture already that small.
-pub fn first_coarse_level(width: u32, height: u32, mips: u32) -> u32 {
-    let last = mips.max(1) - 1;
-    (0..=last).find(|&l| (width >> l).max(height >> l).max(1) <= COARSE_SIDE).unwrap_or(last)
-}
-
-/// A texture whose finer levels are still to come: the raster passes sample it through `view`
-/// (its handle is in [`GpuScene::texture_views`]; held here to be released when dropped), which
-/// starts at `first`, the finest level uploaded.
-#[derive(Debug)]
-struct CoarseTexture {
-    texture: usize,
-    first: u32,
-    _view: View,
 }
 
 /// A section and what happened to it.
@@ -152,10 +112,6 @@ struct Part {
     textures: TextureUpload,
 }
 
-/// The probe volume's sections.
-const PROBE_KINDS: [kiln_format::table::SectionKind; 4] =
-    [sections::PROBE_GRID, sections::PROBE_STATES, sections::PROBE_IRRADIANCE, sections::PROBE_VISIBILITY];
-
 /// Whether a section of `kind` is uploaded under `needs` (geometry always).
 fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
     kind == sections::VERTICES
@@ -167,7 +123,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
         || (kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
-        || (PROBE_KINDS.contains(&kind) && needs.probes)
+        || (kiln_format::probes::PROBE_KINDS.contains(&kind) && needs.probes)
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
@@ -265,20 +221,6 @@ impl Prepared<'_> {
     pub fn manifest(&self) -> &kiln_format::Manifest {
         &self.view.manifest
     }
-}
-
-/// Triangle corners in leaf (file) order as `vec4`s, three per triangle: what the GPU traversal
-/// reads (one load per corner instead of an index and a vertex fetch).
-pub fn triangle_corners(vertices: &[Vertex], triangles: &[[u32; 3]]) -> Vec<[f32; 4]> {
-    triangles
-        .iter()
-        .flat_map(|t| {
-            t.map(|i| {
-                let p = vertices[i as usize].position;
-                [p[0], p[1], p[2], 0.0]
-            })
-        })
-        .collect()
 }
 
 /// The BVH on the GPU: nodes as in the file and triangle corners in leaf order.
@@ -397,57 +339,6 @@ impl std::fmt::Debug for GpuScene {
 
 fn bad(e: kiln_format::error::FormatError) -> PlayError {
     PlayError::new(Exit::BadInput, format!("invalid .kiln file: {e}"))
-}
-
-fn wrap_mode(w: Wrap) -> vk::SamplerAddressMode {
-    match w {
-        Wrap::Repeat => vk::SamplerAddressMode::REPEAT,
-        Wrap::MirroredRepeat => vk::SamplerAddressMode::MIRRORED_REPEAT,
-        Wrap::ClampToEdge => vk::SamplerAddressMode::CLAMP_TO_EDGE,
-    }
-}
-
-/// Sorts triangle indices by material (a counting sort, stable within a material); returns the
-/// flat index list and one draw per material that has triangles.
-pub fn sort_by_material(
-    triangles: &[[u32; 3]],
-    triangle_materials: &[u32],
-    materials: usize,
-) -> (Vec<u32>, Vec<Draw>) {
-    let mut counts = vec![0u32; materials];
-    for &m in triangle_materials {
-        counts[m as usize] += 1;
-    }
-    let mut starts = vec![0u32; materials];
-    let mut draws = Vec::new();
-    let mut sum = 0u32;
-    for (m, &c) in counts.iter().enumerate() {
-        starts[m] = sum;
-        if c > 0 {
-            draws.push(Draw { material: m as u32, first: sum * 3, count: c * 3 });
-        }
-        sum += c;
-    }
-    let mut indices = vec![0u32; triangles.len() * 3];
-    for (t, &m) in triangles.iter().zip(triangle_materials) {
-        let at = starts[m as usize] as usize * 3;
-        indices[at..at + 3].copy_from_slice(t);
-        starts[m as usize] += 1;
-    }
-    (indices, draws)
-}
-
-/// `UVS0` and `COL0` interleaved per vertex, as the passes read them.
-fn vertex_attributes(view: &SceneView) -> Vec<GpuVertexAttributes> {
-    (0..view.vertices.len())
-        .map(|i| {
-            let c = view.colors.get(i).copied().unwrap_or([u16::MAX; 4]);
-            GpuVertexAttributes {
-                uv: view.uvs.get(i).copied().unwrap_or_default(),
-                color: [c[0] as u32 | (c[1] as u32) << 16, c[2] as u32 | (c[3] as u32) << 16],
-            }
-        })
-        .collect()
 }
 
 impl GpuScene {
@@ -723,7 +614,7 @@ impl GpuScene {
                     }
                     _ => fate.after_first_frame = first,
                 }
-            } else if PROBE_KINDS.contains(&kind) && all.probes {
+            } else if kiln_format::probes::PROBE_KINDS.contains(&kind) && all.probes {
                 // Uploaded together before this loop.
                 fate.after_first_frame = !now.probes && first;
             } else if (kind == sections::BRDF_LUT && all.brdf_lut && !now.brdf_lut)
@@ -766,7 +657,7 @@ impl GpuScene {
                     "no pass reads the BRDF table".into()
                 } else if kind == sections::MEDIA_VISIBILITY {
                     no_reader(|n| n.media_volumes)
-                } else if PROBE_KINDS.contains(&kind) {
+                } else if kiln_format::probes::PROBE_KINDS.contains(&kind) {
                     no_reader(|n| n.probes)
                 } else if kind == sections::SHADOW_MAP {
                     no_reader(|n| n.shadow_maps)
@@ -791,131 +682,6 @@ impl GpuScene {
         }
         Ok(())
     }
-
-    /// Creates texture `i` with its full chain and uploads its levels: all of them, or with
-    /// `coarse_first` those from [`first_coarse_level`] on; returns the finer levels left for
-    /// [`GpuScene::refine_texture`] (finest, coarsest), if any.
-    fn upload_texture(
-        &mut self,
-        gpu: &Gpu,
-        view: &SceneView,
-        i: usize,
-        up: &mut Uploader,
-        coarse_first: bool,
-    ) -> PlayResult<Option<[u32; 2]>> {
-        let info = &view.manifest.textures[i];
-        let data = view.texture(i).map_err(bad)?;
-        let srgb = info.color_space == ColorSpace::Srgb;
-        // The file's colour space and format were checked together (BC4 and BC5 are never sRGB).
-        let format = match (data.format, srgb) {
-            (PixelFormat::Rgba8, true) => vk::Format::R8G8B8A8_SRGB,
-            (PixelFormat::Rgba8, false) => vk::Format::R8G8B8A8_UNORM,
-            (PixelFormat::Bc7, true) => vk::Format::BC7_SRGB_BLOCK,
-            (PixelFormat::Bc7, false) => vk::Format::BC7_UNORM_BLOCK,
-            (PixelFormat::Bc5, _) => vk::Format::BC5_UNORM_BLOCK,
-            (PixelFormat::Bc4, _) => vk::Format::BC4_UNORM_BLOCK,
-        };
-        if data.format.is_block_compressed() && !gpu.texture_compression_bc {
-            return Err(PlayError::new(
-                Exit::Unsupported,
-                format!(
-                    "texture {i} ('{}') is {}-compressed and {} cannot sample BC textures (no \
-                     textureCompressionBC); recompile the scene with kiln compile --texture-format rgba8",
-                    info.name,
-                    data.format.name().to_uppercase(),
-                    gpu.name
-                ),
-            ));
-        }
-        let swizzle = |s: Swizzle| match s {
-            Swizzle::R => vk::ComponentSwizzle::R,
-            Swizzle::G => vk::ComponentSwizzle::G,
-            Swizzle::B => vk::ComponentSwizzle::B,
-            Swizzle::A => vk::ComponentSwizzle::A,
-            Swizzle::Zero => vk::ComponentSwizzle::ZERO,
-            Swizzle::One => vk::ComponentSwizzle::ONE,
-        };
-        let mut desc = sampled_desc(format, info.width, info.height, info.mip_levels, 1, false);
-        desc.components = vk::ComponentMapping {
-            r: swizzle(data.swizzle[0]),
-            g: swizzle(data.swizzle[1]),
-            b: swizzle(data.swizzle[2]),
-            a: swizzle(data.swizzle[3]),
-        };
-        let image = Image::new(gpu, &info.name, desc)?;
-        let first =
-            if coarse_first { first_coarse_level(info.width, info.height, info.mip_levels) } else { 0 };
-        let slices = data.level_slices(info.width, info.height, info.mip_levels);
-        let levels = texture_levels(info.width, info.height, &slices);
-        let resident = &levels[(first as usize).min(levels.len())..];
-        // Uploaded as stored: blocks go to the GPU as they are in the file.
-        let uploaded =
-            up.image_blocks(&image, data.format.block_dim(), data.format.block_bytes() as u64, resident);
-        // Pushed first, so that the scene releases it on any error below. Textures arrive in
-        // index order (file order), so position == texture number.
-        debug_assert_eq!(self.textures.len(), i);
-        self.texture_views.push(image.view);
-        self.textures.push(image);
-        uploaded?;
-        self.coarse_texture_bytes += resident.iter().map(|l| l.4.len() as u64).sum::<u64>();
-        if first > 0 {
-            let coarse = self.textures[i].view_from_mip(gpu, first)?;
-            self.texture_views[i] = coarse.raw;
-            self.coarse.push(CoarseTexture { texture: i, first, _view: coarse });
-        }
-        let key = SamplerKey {
-            linear: info.mag_linear,
-            mipmaps: info.mip_levels > 1,
-            wrap_u: wrap_mode(info.wrap_u),
-            wrap_v: wrap_mode(info.wrap_v),
-        };
-        let raw = match self.samplers.get(&key) {
-            Some(s) => s.raw,
-            None => {
-                let s = Sampler::new(gpu, key)?;
-                let raw = s.raw;
-                self.samplers.insert(key, s);
-                raw
-            }
-        };
-        self.texture_samplers.push(raw);
-        Ok((first > 0).then(|| [0, first - 1]))
-    }
-
-    /// Uploads the finer levels that [`GpuScene::upload_texture`] left out of texture `i`,
-    /// coarse to fine (nothing when it uploaded them all). Only those levels change layout:
-    /// the coarse ones stay as they are, possibly sampled by a frame in flight.
-    fn refine_texture(&mut self, view: &SceneView, i: usize, up: &mut Uploader) -> PlayResult {
-        let Some(first) = self.coarse.iter().find(|c| c.texture == i).map(|c| c.first) else {
-            return Ok(());
-        };
-        let info = &view.manifest.textures[i];
-        let data = view.texture(i).map_err(bad)?;
-        let slices = data.level_slices(info.width, info.height, info.mip_levels);
-        let levels = texture_levels(info.width, info.height, &slices);
-        let fine: Vec<_> = levels[..(first as usize).min(levels.len())].iter().rev().copied().collect();
-        up.image_blocks(&self.textures[i], data.format.block_dim(), data.format.block_bytes() as u64, &fine)?;
-        self.fine_texture_bytes += fine.iter().map(|l| l.4.len() as u64).sum::<u64>();
-        Ok(())
-    }
-}
-
-/// A texture's levels as the uploader takes them, finest first: (mip, layer 0, width, height,
-/// bytes as stored).
-fn texture_levels<'a>(width: u32, height: u32, slices: &[&'a [u8]]) -> Vec<(u32, u32, u32, u32, &'a [u8])> {
-    slices
-        .iter()
-        .enumerate()
-        .map(|(mip, bytes)| {
-            let mip = mip as u32;
-            (mip, 0, (width >> mip).max(1), (height >> mip).max(1), *bytes)
-        })
-        .collect()
-}
-
-/// The material of each triangle in draw (index buffer) order.
-fn raster_materials(draws: &[Draw]) -> Vec<u32> {
-    draws.iter().flat_map(|d| std::iter::repeat_n(d.material, d.count as usize / 3)).collect()
 }
 
 /// Storage buffers of the given names and sizes, filled by uploads; on failure none is left.
@@ -992,32 +758,4 @@ pub fn sampled_desc(
 /// from the catalogue (`--shadows shadowmap or --media toth reads it`).
 fn no_reader(reads: impl Fn(&crate::render::Needs) -> bool) -> String {
     format!("no chosen technique reads it ({} would)", crate::render::techniques::readers(reads).join(" or "))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_first_coarse_level_is_the_first_at_most_coarse_side_texels() {
-        assert_eq!(first_coarse_level(2048, 2048, 12), 3);
-        assert_eq!(first_coarse_level(2048, 512, 12), 3);
-        assert_eq!(first_coarse_level(257, 3, 9), 1);
-        assert_eq!(first_coarse_level(256, 256, 9), 0);
-        assert_eq!(first_coarse_level(37, 29, 6), 0);
-        // A chain cut short: its last level is the coarsest there is.
-        assert_eq!(first_coarse_level(2048, 2048, 2), 1);
-        assert_eq!(first_coarse_level(2048, 2048, 1), 0);
-    }
-
-    #[test]
-    fn sorting_by_material_keeps_every_triangle_once() {
-        let tris = [[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]];
-        let mats = [2, 0, 2, 0];
-        let (idx, draws) = sort_by_material(&tris, &mats, 3);
-        assert_eq!(idx, vec![3, 4, 5, 9, 10, 11, 0, 1, 2, 6, 7, 8]);
-        assert_eq!(draws.len(), 2);
-        assert_eq!((draws[0].material, draws[0].first, draws[0].count), (0, 0, 6));
-        assert_eq!((draws[1].material, draws[1].first, draws[1].count), (2, 6, 6));
-    }
 }
