@@ -134,8 +134,11 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// Which of `cameras` are orthographic, with their extents (indices into `cameras`).
     pub orthographic: Vec<OrthographicCamera>,
-    /// Sky.
+    /// Sky: constant radiance (with an environment, its mean radiance).
     pub sky: Sky,
+    /// The environment's light in every direction, when one was given (`[sky] image`/`model`,
+    /// `--environment`): baked by the `environment` stage.
+    pub environment: Option<EnvironmentImage>,
     /// Participating media.
     pub media: Vec<Medium>,
     /// Every file read (asset, buffers, images, sidecar), in reading order.
@@ -144,6 +147,22 @@ pub struct Scene {
     pub warnings: Vec<Warning>,
     /// Degenerate triangles dropped.
     pub degenerate_triangles: u64,
+}
+
+/// An environment as the import left it: linear RGB radiance in an equirectangular map (the
+/// mapping of `kiln_format::environment`, row 0 the zenith), intensity applied.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EnvironmentImage {
+    /// Where it came from (a path or the model), for messages and the report.
+    pub name: String,
+    /// Width in pixels (twice the height).
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Radiance per pixel, rows top (zenith) to bottom.
+    pub pixels: Vec<[f32; 3]>,
+    /// Rotation about +y, degrees, applied when the bake resamples it.
+    pub rotation_degrees: f32,
 }
 
 impl Scene {

@@ -83,6 +83,7 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some((cfg, sidecar)) = &sidecar {
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
     }
+    args.bake.apply_environment(&mut scene)?;
     let policy = WarningPolicy::new(args.strict, &args.warning_levels);
     finish(scene, settings, &args.input.display().to_string(), &policy, quiet, start)
 }
@@ -105,6 +106,7 @@ pub fn configure(scene: &mut Scene, config: Option<&Path>, bake: &BakeArgs) -> C
     if let Some((cfg, sidecar)) = &sidecar {
         sidecar.apply(scene, &cfg.display().to_string())?;
     }
+    bake.apply_environment(scene)?;
     bake_settings(sidecar.as_ref().map(|(c, s)| (*c, s)), bake)
 }
 

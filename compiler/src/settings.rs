@@ -203,6 +203,10 @@ pub const PROBE_RAYS: Ranged = Ranged { key: "probe_rays", default: 256, min: 16
 /// Size budget of the probe volume, MiB, when its spacing is chosen from the scene's size.
 pub const PROBE_BUDGET: Ranged = Ranged { key: "probe_budget", default: 2, min: 1, max: 4096 };
 
+/// Width of the environment's radiance map in texels (its height is half); a narrower image
+/// keeps its own width.
+pub const ENVIRONMENT_RES: Ranged = Ranged { key: "environment_res", default: 1024, min: 16, max: 8192 };
+
 /// Voxel grid cells along the scene's longest axis when given as a number (the default is
 /// [`VoxelRes::Auto`], so [`Ranged::default`] is unused here).
 pub const VOXEL_RES: Ranged = Ranged { key: "voxel_res", default: 0, min: 1, max: 1024 };
@@ -394,6 +398,8 @@ pub struct Settings {
     pub probe_rays: u32,
     /// Probe volume budget, MiB (when the spacing is chosen).
     pub probe_budget: u32,
+    /// Widest environment radiance map, texels.
+    pub environment_res: u32,
     /// Normals where the asset gives none (applied at import).
     pub normals: Normals,
     /// Which sections are stored compressed. Changes the stored bytes only, never a section's
@@ -420,6 +426,7 @@ impl Default for Settings {
             probe_spacing: None,
             probe_rays: PROBE_RAYS.default,
             probe_budget: PROBE_BUDGET.default,
+            environment_res: ENVIRONMENT_RES.default,
             normals: Normals::Asset,
             codec: Codec::Auto,
             texture_format: TextureFormat::default(),
@@ -457,6 +464,7 @@ impl Settings {
             (MEDIA_VOLUME_RES, b.media_volume_res, &mut self.media_volume_res),
             (PROBE_RAYS, b.probe_rays, &mut self.probe_rays),
             (PROBE_BUDGET, b.probe_budget, &mut self.probe_budget),
+            (ENVIRONMENT_RES, b.environment_res, &mut self.environment_res),
         ] {
             if let Some(n) = value {
                 *setting = table.check(n)?;
@@ -508,6 +516,7 @@ impl Settings {
             ("probe-spacing".into(), self.probe_spacing.map_or_else(|| "plan".into(), |s| s.0.to_string())),
             ("probe-rays".into(), self.probe_rays.to_string()),
             ("probe-budget".into(), self.probe_budget.to_string()),
+            ("environment-res".into(), self.environment_res.to_string()),
             ("normals".into(), self.normals.name()),
             ("codec".into(), self.codec.name().into()),
             ("texture-format".into(), self.texture_format.name().into()),

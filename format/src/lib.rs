@@ -20,6 +20,7 @@ compile_error!("kiln-format reads sections zero-copy and supports little-endian 
 
 pub mod checksum;
 pub mod codec;
+pub mod environment;
 pub mod error;
 pub mod gpu;
 pub mod header;

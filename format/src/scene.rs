@@ -322,6 +322,7 @@ impl<'a> SceneView<'a> {
             }
         }
         crate::probes::ProbeVolume::read(file)?;
+        crate::environment::Environment::read(file)?;
         if let Some(l) = self.emitter_luminance()? {
             if l.len() != self.triangles.len() {
                 return Err(FormatError::invalid(format!(

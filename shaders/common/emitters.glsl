@@ -261,4 +261,44 @@ float triangle_emission_weight(uint tri, float d, float cos_l, float pdf_brdf) {
     return power_heuristic(pdf_brdf, pdf_light);
 }
 
+#ifdef KILN_ENVIRONMENT_GLSL
+// The environment (environment.glsl, included before this file) as an emitter: next-event
+// estimation through its sampling table, weighted with the power heuristic against BRDF
+// sampling (`mis`), shadowed by a ray towards infinity (and dimmed by the media's
+// transmittance with EMITTER_TRANSMITTANCE). Nothing without an environment: the constant sky
+// is then found by BRDF-sampled rays alone, as before.
+vec3 sample_environment(Surface s, vec3 wo, vec3 sky, bool mis) {
+    float pdf;
+    vec3 wi = env_sample(vec3(rnd(), rnd(), rnd()), pdf);
+    if (!(pdf > 0.0)) {
+        return vec3(0.0);
+    }
+    vec3 f = brdf_cos(s, wo, wi);
+    if (all(equal(f, vec3(0.0))) || emitter_occluded_dir(s.p, s.ng, wi)) {
+        return vec3(0.0);
+    }
+    float weight = mis ? power_heuristic(pdf, brdf_pdf(s, wo, wi)) : 1.0;
+    vec3 contribution = f * env_radiance(wi, sky) * weight / pdf;
+#ifdef EMITTER_TRANSMITTANCE
+    EmitterSample es;
+    es.valid = true;
+    es.directional = true;
+    es.delta = false;
+    es.wi = wi;
+    es.pdf = pdf;
+    es.li = vec3(0.0);
+    es.target = vec3(0.0);
+    contribution *= emitter_transmittance(s.p, es);
+#endif
+    return contribution;
+}
+
+// The power-heuristic weight of the environment seen along unit `dir` by a ray BRDF-sampled
+// with density `pdf_brdf` against `sample_environment` (1 for a ray not sampled from a BRDF, or
+// without an environment).
+float environment_seen_weight(vec3 dir, float pdf_brdf) {
+    return (pdf_brdf > 0.0 && env_present()) ? power_heuristic(pdf_brdf, env_pdf(dir)) : 1.0;
+}
+#endif
+
 #endif

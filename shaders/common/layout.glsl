@@ -209,6 +209,20 @@ struct ProbeConstants {
     float view_bias; // offset 44
 }; // 48 bytes
 
+struct EnvironmentHeader {
+    uvec4 map; // offset 0
+    uvec4 filtered; // offset 16
+    uvec4 table; // offset 32
+    vec4[9] sh; // offset 48
+}; // 192 bytes
+
+struct EnvironmentCell {
+    float keep; // offset 0
+    uint alias; // offset 4
+    float density; // offset 8
+    float alias_density; // offset 12
+}; // 16 bytes
+
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
 const uint LIGHT_DIRECTIONAL = 2u;

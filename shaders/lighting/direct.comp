@@ -2,7 +2,7 @@
 #extension GL_EXT_control_flow_attributes : require
 // Direct light and composition: every analytic light over the G-buffer, shadowed by the baked
 // shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, the emissive
-// triangles' light from the direct-light image (`--direct`), plus the constant sky
+// triangles' light from the direct-light image (`--direct`), plus the sky or environment
 // through the split-sum table (its diffuse part times the ray-traced AO, or replaced by the
 // ray-traced GI; its specular part replaced by the ray-traced reflections where they were
 // traced, or blended with the screen-space reflections' radiance by their confidence) and
@@ -57,6 +57,10 @@ layout(set = 0, binding = 16, std430) readonly buffer Media { GpuMedium media[];
 // The light of the emissive triangles at each pixel's surface (`--direct`: rgb, reflected
 // towards the camera, shadowed as its technique says).
 layout(set = 0, binding = 17, rgba32f) uniform readonly image2D rt_direct;
+// The environment (bindings 18-19): the sky seen, its irradiance harmonics and prefiltered levels
+// (the constant sky without one).
+#define ENV_BINDING 18
+#include "../common/environment.glsl"
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -216,7 +220,7 @@ void main() {
     vec3 eye = camera_orthographic() ? world_at(pixel, 1.0) : frame.camera.xyz;
     vec3 toward = world_at(pixel, depth > 0.0 ? depth : 1e-6) - eye;
     float t_seen = depth > 0.0 ? 1.0 : 3.4e38;
-    vec3 seen = frame.sky.rgb;
+    vec3 seen = env_radiance(normalize(toward), frame.sky.rgb);
     for (uint i = 0u; i < frame.size.z; i++) {
         if (DIRECT_RECT_LIGHTS && lights[i].kind == LIGHT_RECT) {
             float t = rect_light_hit(lights[i], eye, toward, t_seen);
@@ -258,13 +262,15 @@ void main() {
         traced = reflection_at(pixel, p, n);
     }
     // Constant sky: Lambert integrates to base · L_sky; the specular lobe to (F0 R + G) L_sky.
+    // An environment: Lambert to base times its irradiance over pi (harmonics), the lobe to
+    // (F0 R + G) times its level prefiltered for the roughness around the mirror direction.
     // With GI the diffuse part is the diffuse weight times the traced mean incoming radiance,
     // which holds the sky (its misses), the emissive surfaces and the indirect light, occluded
     // by the scene itself: no AO or occlusion texture multiplies it.
     // Screen-space GI gathers what the screen shows: the sky's ambient (darkened by AO) stays,
     // and the gathered light adds to it.
     bool gi = DIRECT_GI && (frame.size.w & FRAME_RT_GI) != 0u;
-    vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : frame.sky.rgb * occlusion;
+    vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : env_irradiance(n, frame.sky.rgb) * occlusion;
     if (DIRECT_GI && (frame.size.w & FRAME_SCREEN_GI) != 0u) {
         diffuse_in += imageLoad(rt_gi, pixel).rgb;
     }
@@ -278,7 +284,7 @@ void main() {
         radiance += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
-        vec3 sky_in = frame.sky.rgb * occlusion;
+        vec3 sky_in = env_filtered(reflect(-v, n), m.roughness, frame.sky.rgb) * occlusion;
         if (DIRECT_SCREEN_REFLECTIONS && (frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {
             // The split sum's prefiltered incoming radiance: what the screen showed along the
             // mirror direction, the sky (occluded) where it showed nothing; the same table weighs

@@ -6,7 +6,9 @@
 // towards one emitter chosen in proportion to its power (analytic lights, emissive triangles),
 // and a BRDF-sampled continuation; emitters the continuation hits (emissive triangles, rect
 // lights) count with the power heuristic against the emitter sampling, delta lights by NEE
-// alone. Russian roulette from the fourth vertex; `params.y` caps the length as a safety net.
+// alone; with an environment, one more shadow ray per surface vertex towards a direction drawn
+// from its table, weighed with the power heuristic against the BRDF-sampled ray that escapes.
+// Russian roulette from the fourth vertex; `params.y` caps the length as a safety net.
 // `params.w` > 0 limits the bounces: the light arriving after that many scattering events
 // counts and nothing further (1: direct light alone), what a benchmark compares a frame without
 // indirect light against.
@@ -21,7 +23,8 @@
 // unbiased), between the ray's boundary crossings of the boxes; at a scattering point, next-
 // event estimation with the Henyey–Greenstein phase function (the scattering-weighted mix
 // where boxes overlap) and a phase-sampled continuation, which the power heuristic weighs
-// against each other as at surfaces; shadow rays carry the analytic transmittance of every
+// against each other as at surfaces (the environment, sampled at surfaces only, counts at full
+// weight where a phase-sampled ray escapes); shadow rays carry the analytic transmittance of every
 // box they cross. Scattering in a medium counts as a bounce.
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
@@ -37,6 +40,8 @@ layout(set = 0, binding = 11, std430) readonly buffer Texels { uint texels[]; };
 layout(set = 0, binding = 12, std430) readonly buffer Textures { GpuTexture textures[]; };
 layout(set = 0, binding = 13, rgba32f) uniform image2D accumulation;
 layout(set = 0, binding = 14, std430) readonly buffer Media { GpuMedium media[]; };
+#define ENV_BINDING 15
+#include "../common/environment.glsl"   // bindings 15-16
 // Index of this sample (0 first): 0 overwrites the accumulation, later ones add to it.
 layout(push_constant) uniform Sample { uint sample_index; };
 
@@ -239,6 +244,7 @@ vec3 radiance(TraceRay r) {
     vec3 result = vec3(0.0);
     vec3 throughput = vec3(1.0);
     float pdf_brdf = 0.0;  // density of the last BRDF sample; 0 for camera rays (no MIS)
+    float pdf_env = 0.0;   // pdf_brdf where the last vertex also sampled the environment, else 0
     vec3 last_p = r.origin;
     for (uint depth = 0u; depth < rc.params.y; depth++) {
         TraceHit h = trace(r, false);
@@ -258,6 +264,7 @@ vec3 radiance(TraceRay r) {
             result += throughput * medium_emitter(p, r.direction);
             vec3 wi = sample_phase(p, r.direction);
             vec3 f = phase(p, r.direction, wi, pdf_brdf);
+            pdf_env = 0.0;
             if (pdf_brdf <= 0.0) {
                 break;
             }
@@ -276,7 +283,8 @@ vec3 radiance(TraceRay r) {
             continue;
         }
         if (h.t == NO_HIT) {
-            result += throughput * rc.sky.rgb;
+            vec3 d = normalize(r.direction);
+            result += throughput * env_radiance(d, rc.sky.rgb) * environment_seen_weight(d, pdf_env);
             break;
         }
         Surface s = surface_at(r, h);
@@ -290,8 +298,10 @@ vec3 radiance(TraceRay r) {
         }
         vec3 wo = -normalize(r.direction);
         result += throughput * sample_emitter(s, wo, true);
+        result += throughput * sample_environment(s, wo, rc.sky.rgb, true);
         vec3 wi = sample_brdf(s, wo);
         pdf_brdf = brdf_pdf(s, wo, wi);
+        pdf_env = pdf_brdf;
         if (pdf_brdf <= 0.0) {
             break;
         }

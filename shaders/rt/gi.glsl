@@ -65,6 +65,10 @@ bool emitter_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
 // shadow ray that escapes brings it (rect lights it crosses do not count: the unweighted
 // next-event estimation has them).
 vec3 sky_seen(Surface s, vec3 wo) {
+    if (env_present()) {
+        // An environment has a sampling table: next-event estimation alone (unweighted).
+        return sample_environment(s, wo, frame.sky.rgb, false);
+    }
     if (all(equal(frame.sky.rgb, vec3(0.0)))) {
         return vec3(0.0);
     }
@@ -92,7 +96,7 @@ vec3 gi_sample(Primary s) {
     // The structure stores the light leaving every hit (the pre-illuminated line space): one
     // lookup ends the path, the sky on a miss.
     vec3 stored;
-    return gi_hit_radiance(r, origin_ng, stored) ? stored : frame.sky.rgb;
+    return gi_hit_radiance(r, origin_ng, stored) ? stored : env_radiance(dir, frame.sky.rgb);
 #endif
     bool exact = false;
     vec3 result = vec3(0.0);
@@ -106,7 +110,9 @@ vec3 gi_sample(Primary s) {
             result += throughput * rect_lights_seen(r.origin, r.direction, tmax, pdf_brdf);
         }
         if (!hit) {
-            result += throughput * frame.sky.rgb;
+            // After the first bounce the environment was also sampled at the last hit.
+            float w = bounce > 1u ? environment_seen_weight(r.direction, pdf_brdf) : 1.0;
+            result += throughput * env_radiance(r.direction, frame.sky.rgb) * w;
             break;
         }
         bool direct_counts = bounce == 1u && (frame.size.w & FRAME_RT_DIRECT) != 0u && tri_emitter[h.triangle] >= 0;
@@ -122,6 +128,7 @@ vec3 gi_sample(Primary s) {
             result += throughput * sky_seen(h, wo);
             break;
         }
+        result += throughput * sample_environment(h, wo, frame.sky.rgb, true);
         vec3 wi = sample_brdf_lobe(h, wo, exact);
         pdf_brdf = brdf_pdf(h, wo, wi);
         if (pdf_brdf <= 0.0) {

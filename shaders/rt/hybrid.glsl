@@ -51,6 +51,9 @@ layout(set = 0, binding = 26, rgba32f) uniform image2D rt_direct;
 layout(set = 0, binding = 27, rgba32ui) uniform uimage2D reservoirs_then;
 layout(set = 0, binding = 28, rgba32ui) uniform uimage2D reservoirs_now;
 layout(set = 0, binding = 29, rgba32f) uniform image2D surfaces_then;
+// The environment (`common/environment.glsl`): bindings 30-31; the line space's follow at 32.
+#define ENV_BINDING 30
+#include "../common/environment.glsl"
 layout(push_constant) uniform Params { RtConstants rt; };
 
 #include "../common/random.glsl"

@@ -27,7 +27,12 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, out vec3 origin) 
     vec3 sum = s.emission;
     vec3 f0 = fresnel_f0(s.mat.base, s.mat.metallic);
     vec3 diffuse = s.mat.diffuse_only ? s.mat.base : s.mat.base * (1.0 - s.mat.metallic);
-    sum += frame.sky.rgb * (s.mat.diffuse_only ? diffuse : diffuse + f0);
+    // The sky or environment as unshadowed ambient: diffuse from its irradiance, specular from
+    // its level prefiltered for the hit's roughness.
+    sum += env_irradiance(s.ns, frame.sky.rgb) * diffuse;
+    if (!s.mat.diffuse_only) {
+        sum += env_filtered(reflect(-wo, s.ns), s.mat.roughness, frame.sky.rgb) * f0;
+    }
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight l = lights[i];
         vec3 wi;
@@ -96,7 +101,7 @@ void main() {
                 TraceHit hit = trace(r, false);
                 vec3 scale = fresnel * weight;
                 if (hit.t == NO_HIT) {
-                    radiance = scale * frame.sky.rgb;
+                    radiance = scale * env_radiance(wi, frame.sky.rgb);
                 } else {
                     vec3 o;
                     radiance = scale * shade_hit(r, hit, ivec2(cell), scale, o);

@@ -35,6 +35,8 @@ pub enum Stage {
     ShadowMaps,
     /// Light-visibility volume of the participating medium.
     MediaVisibility,
+    /// The environment: radiance map, prefiltered levels, harmonics, sampling table.
+    Environment,
     /// Irradiance probe volume, path traced.
     Probes,
     /// Cell triangle lists of the voxel grid.
@@ -56,6 +58,7 @@ impl Stage {
             Stage::BrdfLut => "brdf-lut",
             Stage::ShadowMaps => "shadow-maps",
             Stage::MediaVisibility => "media-visibility",
+            Stage::Environment => "environment",
             Stage::Probes => "probes",
             Stage::VoxelGrid => "voxel-grid",
             Stage::LineSpace => "line-space",
@@ -289,6 +292,31 @@ impl Plan {
                     readers::list(readers::MEDIA_VISIBILITY)
                 ),
             )
+        });
+        stages.push(match &scene.environment {
+            None => skip(
+                Stage::Environment,
+                "no environment: the sky is a constant (give [sky] image or model, or --environment)",
+            ),
+            Some(env) => {
+                let w = (settings.environment_res.min(env.width) & !1).max(2);
+                let fw = crate::bake::environment::FILTERED_WIDTH.min(w);
+                run(
+                    Stage::Environment,
+                    format!(
+                        "{} ({}x{}): radiance map {w}x{}, {} GGX levels from {fw}x{}, irradiance harmonics, \
+                         {}x{} sampling table; lights every technique and the reference",
+                        env.name,
+                        env.width,
+                        env.height,
+                        w / 2,
+                        crate::bake::environment::LEVELS,
+                        fw / 2,
+                        crate::bake::environment::TABLE_WIDTH.min(w),
+                        crate::bake::environment::TABLE_WIDTH.min(w) / 2
+                    ),
+                )
+            }
         });
         let lit = !scene.lights.is_empty()
             || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))

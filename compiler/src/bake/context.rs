@@ -99,6 +99,8 @@ pub struct BakeContext<'a> {
     root: ContentHash,
     /// The BRDF table, baked on first use.
     lut: OnceLock<std::sync::Arc<[[u16; 2]]>>,
+    /// The environment, baked on first use (`None`: the scene has none).
+    environment: OnceLock<Option<super::environment::BakedEnvironment>>,
 }
 
 impl<'a> BakeContext<'a> {
@@ -164,6 +166,7 @@ impl<'a> BakeContext<'a> {
             progress,
             inputs,
             lut: OnceLock::new(),
+            environment: OnceLock::new(),
         })
     }
 
@@ -184,6 +187,18 @@ impl<'a> BakeContext<'a> {
             return &[];
         }
         self.lut.get_or_init(|| brdf_lut::table(self.settings.brdf_lut_res))
+    }
+
+    /// The environment as the `environment` stage bakes it, baked on first use (`None` without
+    /// one, or when the plan skips the stage).
+    pub fn environment(&self) -> Option<&super::environment::BakedEnvironment> {
+        if !self.plan.runs(Stage::Environment) {
+            return None;
+        }
+        let env = self.scene.environment.as_ref()?;
+        self.environment
+            .get_or_init(|| Some(super::environment::bake(env, self.settings.environment_res)))
+            .as_ref()
     }
 
     /// The shading view of the scene, over the stored triangles.

@@ -6,6 +6,7 @@ pub mod bc;
 pub mod brdf_lut;
 pub mod bvh;
 pub mod context;
+pub mod environment;
 pub mod geometry;
 pub mod linespace;
 pub mod materials;
@@ -315,6 +316,25 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
                 .part("bounds", &bounds(&ctx.geometry.bounds))
                 .hash("geometry", &ctx.geometry_key);
         }
+        Stage::Environment => {
+            if let Some(env) = &scene.environment {
+                h.part("width", &env.width.to_le_bytes())
+                    .part("pixels", bytemuck::cast_slice(&env.pixels))
+                    .part("rotation", &env.rotation_degrees.to_le_bytes())
+                    .part("res", &s.environment_res.to_le_bytes())
+                    .part(
+                        "filter",
+                        format!(
+                            "{} {} {} {}",
+                            environment::LEVELS,
+                            environment::FILTERED_WIDTH,
+                            environment::TABLE_WIDTH,
+                            environment::FILTER_SAMPLES
+                        )
+                        .as_bytes(),
+                    );
+            }
+        }
         Stage::Probes => {
             // Paths through the stored geometry, shaded by the materials, textures, lights and
             // sky; the layout (spacing, dims, rays) as the plan resolved it.
@@ -337,6 +357,9 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
                 .part("lights", &records_bytes(&scene.lights, &[]))
                 .part("sky", bytemuck::cast_slice(&scene.sky.radiance))
                 .part("lut", &lut.to_le_bytes());
+            if ctx.plan.runs(Stage::Environment) {
+                h.hash("environment", &stage_key(ctx, Stage::Environment));
+            }
             hash_textures(&mut h, scene);
         }
         Stage::MediaVisibility => {
@@ -416,6 +439,7 @@ fn cached_stage(ctx: &BakeContext, stage: Stage, key: &ContentHash) -> (Sections
         Stage::BrdfLut => brdf_lut::stage(ctx),
         Stage::ShadowMaps => shadow::stage(ctx),
         Stage::MediaVisibility => media::stage(ctx),
+        Stage::Environment => environment::stage(ctx),
         Stage::Probes => probes::stage(ctx),
         // Made by the context (BVH) and by `grid_and_line_space`.
         Stage::Bvh | Stage::VoxelGrid | Stage::LineSpace => Sections::default(),

@@ -211,6 +211,35 @@ bounce, whenever something lights the scene) or off [default: auto, or the sidec
     #[arg(long, value_name = "MiB", value_parser = crate::settings::PROBE_BUDGET.parser(), help_heading = "Lighting bakes",
           help = crate::settings::PROBE_BUDGET.help("Size budget of the probe volume in MiB when --probe-spacing is not given"))]
     pub probe_budget: Option<u32>,
+    /// Width of the environment's radiance map.
+    #[arg(long, value_name = "N", value_parser = crate::settings::ENVIRONMENT_RES.parser(), help_heading = "Environment",
+          help = crate::settings::ENVIRONMENT_RES.help("Width of the environment's radiance map in texels (height half of it; a narrower image keeps its width). Its GGX-prefiltered levels (256 wide at most), irradiance harmonics and sampling table (512 wide at most) are baked from it"))]
+    pub environment_res: Option<u32>,
+    /// The environment: studio, preetham, or an HDR image.
+    #[arg(long, value_name = "studio|preetham|FILE", value_parser = crate::import::environment::EnvironmentSpec::parse, help_heading = "Environment",
+          help = "Light from every direction beyond the scene, replacing the sidecar's [sky]: `studio` (a built-in \
+neutral dome with a key softbox and a rim light, for assets that bring no light), `preetham` (Preetham's daylight \
+with its sun as a directional light; the sun's direction and turbidity come from a sidecar's [sky]), or an \
+equirectangular Radiance .hdr or OpenEXR image (see docs/sidecar.md)")]
+    pub environment: Option<crate::import::environment::EnvironmentSpec>,
+    /// Multiplies the environment's radiance.
+    #[arg(
+        long,
+        value_name = "X",
+        requires = "environment",
+        help_heading = "Environment",
+        help = "Multiplies the --environment's radiance (and the Preetham sun's) [default: 1]"
+    )]
+    pub environment_intensity: Option<f32>,
+    /// Rotates the environment about +y.
+    #[arg(
+        long,
+        value_name = "DEGREES",
+        requires = "environment",
+        help_heading = "Environment",
+        help = "Rotates the --environment about +y, counter-clockwise seen from above [default: 0]"
+    )]
+    pub environment_rotation: Option<f32>,
     /// Normals where the asset gives none.
     #[arg(long, value_name = "flat|smooth[:ANGLE]", value_parser = Normals::parse, help_heading = "Import",
           help = "Normals where the asset gives none (given normals are kept): flat (face normals), smooth \
@@ -257,10 +286,25 @@ impl BakeArgs {
         set(&mut settings.probe_spacing, self.probe_spacing.map(Some));
         set(&mut settings.probe_rays, self.probe_rays);
         set(&mut settings.probe_budget, self.probe_budget);
+        set(&mut settings.environment_res, self.environment_res);
         set(&mut settings.normals, self.normals);
         set(&mut settings.codec, self.codec);
         set(&mut settings.texture_format, self.texture_format);
         set(&mut settings.pnmt_records, self.pnmt_records);
+    }
+}
+
+impl BakeArgs {
+    /// Sets `scene`'s environment from `--environment` (when given), replacing the sidecar's.
+    pub fn apply_environment(&self, scene: &mut crate::ir::Scene) -> crate::exit::CliResult<()> {
+        use crate::import::environment::{Placement, apply};
+        let Some(spec) = &self.environment else { return Ok(()) };
+        let d = Placement::default();
+        let placement = Placement {
+            intensity: self.environment_intensity.unwrap_or(d.intensity),
+            rotation_degrees: self.environment_rotation.unwrap_or(d.rotation_degrees),
+        };
+        apply(scene, spec, placement, "--environment")
     }
 }
 

@@ -2,11 +2,13 @@
 //! built-in demo scene. This is the only place loader types appear.
 
 pub mod demo;
+pub mod environment;
 pub mod files;
 mod geometry;
 mod gltf;
 mod images;
 mod obj;
+pub mod preetham;
 pub mod sidecar;
 
 use std::path::{Path, PathBuf};

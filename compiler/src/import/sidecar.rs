@@ -10,6 +10,7 @@ use kiln_format::sections::MaterialFlags;
 use serde::Deserialize;
 
 use crate::exit::{CliError, CliResult};
+use crate::import::environment::{self, EnvironmentSpec, Placement};
 use crate::ir::Scene;
 
 /// A parsed sidecar.
@@ -32,6 +33,9 @@ pub struct Sidecar {
     /// Bake settings (the command line overrides them).
     #[serde(default)]
     pub bake: BakeToml,
+    /// The directory relative paths in it start from.
+    #[serde(skip)]
+    pub dir: std::path::PathBuf,
 }
 
 /// `[camera]`.
@@ -125,12 +129,69 @@ pub struct LightToml {
     pub casts_shadows: bool,
 }
 
-/// `[sky]`.
-#[derive(Debug, Clone, Deserialize)]
+/// `[sky]`: a constant radiance, or an environment (an HDR image or a sky model).
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SkyToml {
-    /// Radiance W/(sr·m²), linear RGB.
-    pub radiance: [f32; 3],
+    /// Constant radiance W/(sr·m²), linear RGB.
+    pub radiance: Option<[f32; 3]>,
+    /// Equirectangular Radiance .hdr or OpenEXR image, relative to the sidecar.
+    pub image: Option<std::path::PathBuf>,
+    /// `"preetham"` (daylight and its sun) or `"studio"` (the built-in neutral environment).
+    pub model: Option<String>,
+    /// Multiplies the environment's radiance (and the Preetham sun's).
+    pub intensity: Option<f32>,
+    /// Rotation of the environment about +y, degrees.
+    pub rotation_degrees: Option<f32>,
+    /// Preetham: unit direction towards the sun (y up).
+    pub sun_direction: Option<[f32; 3]>,
+    /// Preetham: turbidity, 1.7 to 10.
+    pub turbidity: Option<f32>,
+    /// Preetham: whether the sun is added as a directional light (default true).
+    pub sun: Option<bool>,
+}
+
+impl SkyToml {
+    /// The environment this table asks for (`None`: a constant sky at most); the error names
+    /// the key at fault.
+    pub fn environment(&self, dir: &Path) -> Result<Option<(EnvironmentSpec, Placement)>, String> {
+        use crate::import::preetham;
+        let spec = match (&self.image, self.model.as_deref()) {
+            (Some(_), Some(_)) => return Err("give [sky] image or model, not both".into()),
+            (Some(image), None) => EnvironmentSpec::Image { path: dir.join(image) },
+            (None, Some("preetham")) => EnvironmentSpec::Preetham {
+                sun_direction: self.sun_direction.unwrap_or(preetham::DEFAULT_SUN),
+                turbidity: self.turbidity.unwrap_or(preetham::DEFAULT_TURBIDITY),
+                sun: self.sun.unwrap_or(true),
+            },
+            (None, Some("studio")) => EnvironmentSpec::Studio,
+            (None, Some(other)) => {
+                return Err(format!("[sky] model = \"{other}\" is not known: \"preetham\" or \"studio\""));
+            }
+            (None, None) => {
+                if self.intensity.is_some() || self.rotation_degrees.is_some() {
+                    return Err("[sky] intensity and rotation_degrees need an image or a model".into());
+                }
+                return Ok(None);
+            }
+        };
+        if !matches!(spec, EnvironmentSpec::Preetham { .. })
+            && (self.sun_direction.is_some() || self.turbidity.is_some() || self.sun.is_some())
+        {
+            return Err("[sky] sun_direction, turbidity and sun belong to model = \"preetham\"".into());
+        }
+        if self.radiance.is_some() {
+            return Err("[sky] radiance is a constant sky: leave it out with an image or a model".into());
+        }
+        let d = Placement::default();
+        Ok(Some((
+            spec,
+            Placement {
+                intensity: self.intensity.unwrap_or(d.intensity),
+                rotation_degrees: self.rotation_degrees.unwrap_or(d.rotation_degrees),
+            },
+        )))
+    }
 }
 
 /// `[[medium]]`.
@@ -201,6 +262,8 @@ pub struct BakeToml {
     pub probe_rays: Option<u32>,
     /// Budget of the probe volume, MiB.
     pub probe_budget: Option<u32>,
+    /// Widest environment radiance map, texels.
+    pub environment_res: Option<u32>,
     /// Normals where the asset gives none: `"flat"`, `"smooth"` or `"smooth:ANGLE"`.
     pub normals: Option<String>,
     /// Which sections are compressed: `"auto"`, `"none"` or `"zstd"`.
@@ -213,7 +276,10 @@ impl Sidecar {
         let bytes = super::read_input(path, inputs)?;
         let text = String::from_utf8(bytes)
             .map_err(|_| CliError::input(format!("{}: not UTF-8 text", path.display())))?;
-        Self::parse(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))
+        let mut sidecar =
+            Self::parse(&text).map_err(|e| CliError::input(format!("{}: {e}", path.display())))?;
+        sidecar.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok(sidecar)
     }
 
     /// Parses sidecar text. An error inside a table names the table (`in [[light]]: …`): a TOML
@@ -268,10 +334,15 @@ impl Sidecar {
                 .push(convert_light(l, i).map_err(|e| err(format!("light {} ({:?}): {e}", i + 1, l.kind)))?);
         }
         if let Some(s) = &self.sky {
-            if !finite(&s.radiance) || s.radiance.iter().any(|&v| v < 0.0) {
-                return bad("[sky] radiance must be finite and non-negative".into());
+            if let Some(radiance) = s.radiance {
+                if !finite(&radiance) || radiance.iter().any(|&v| v < 0.0) {
+                    return bad("[sky] radiance must be finite and non-negative".into());
+                }
+                scene.sky = Sky { radiance };
             }
-            scene.sky = Sky { radiance: s.radiance };
+            if let Some((spec, placement)) = s.environment(&self.dir).map_err(err)? {
+                environment::apply(scene, &spec, placement, source)?;
+            }
         }
         for (i, m) in self.media.iter().enumerate() {
             let vals = [&m.sigma_a[..], &m.sigma_s, &[m.g]].concat();

@@ -40,6 +40,8 @@ mod emitters;
 pub use emitters::{EmissiveFlags, EmitterKinds, GpuEmissive, GpuEmitter, emitted_power, luminance};
 mod bake;
 pub use bake::{BakeCell, BakeParams, bake_layout};
+mod environment;
+pub use environment::{EnvironmentCell, EnvironmentHeader};
 
 /// Light kinds in [`GpuLight::kind`].
 #[derive(Debug)]
@@ -530,6 +532,7 @@ fn glsl_align_size(ty: &str) -> (usize, usize) {
         "vec3" | "uvec3" | "ivec3" => (16, 12),
         "vec4" | "uvec4" | "ivec4" => (16, 16),
         "mat4" => (16, 64),
+        "vec4[9]" => (16, 144),
         "double" => (8, 8),
         "dvec4" => (32, 32),
         other => panic!("GLSL type {other} has no layout rule here"),
@@ -584,6 +587,8 @@ pub fn glsl_layout() -> String {
     declare::<SsrConstants>(&mut s);
     declare::<DenoiseConstants>(&mut s);
     declare::<ProbeConstants>(&mut s);
+    declare::<EnvironmentHeader>(&mut s);
+    declare::<EnvironmentCell>(&mut s);
     for (name, v) in [
         ("LIGHT_POINT", LightKinds::POINT),
         ("LIGHT_SPOT", LightKinds::SPOT),
@@ -742,6 +747,8 @@ mod tests {
 
     #[test]
     fn rust_and_glsl_layouts_agree() {
+        check::<EnvironmentHeader>();
+        check::<EnvironmentCell>();
         check::<GpuLight>();
         check::<GpuShadow>();
         check::<FrameConstants>();

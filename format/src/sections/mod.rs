@@ -80,6 +80,14 @@ pub const PROBE_STATES: SectionKind = SectionKind(*b"PRBS");
 pub const PROBE_IRRADIANCE: SectionKind = SectionKind(*b"PRBI");
 /// Probe visibility atlas: binary16 (mean, mean square) distance per texel.
 pub const PROBE_VISIBILITY: SectionKind = SectionKind(*b"PRBV");
+/// Environment header ([`crate::environment::EnvironmentHeader`], one element).
+pub const ENVIRONMENT_HEADER: SectionKind = SectionKind(*b"ENVH");
+/// Environment radiance map: `E5B9G9R9` texels, equirectangular (see [`crate::environment`]).
+pub const ENVIRONMENT_MAP: SectionKind = SectionKind(*b"ENVR");
+/// The radiance map prefiltered with GGX lobes of rising roughness: `E5B9G9R9` levels.
+pub const ENVIRONMENT_FILTERED: SectionKind = SectionKind(*b"ENVP");
+/// The environment's sampling table ([`crate::environment::EnvironmentCell`] per cell).
+pub const ENVIRONMENT_TABLE: SectionKind = SectionKind(*b"ENVT");
 
 /// What the format knows of a section kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -193,6 +201,15 @@ pub const KNOWN: &[KindInfo] = &[
         indexed: true,
         description: "shadow map depths (f32)",
     },
+    pod_kind(ENVIRONMENT_HEADER, "environment-header", 192, "environment header and irradiance harmonics"),
+    pod_kind(ENVIRONMENT_MAP, "environment-map", 4, "environment radiance map (E5B9G9R9, equirectangular)"),
+    pod_kind(
+        ENVIRONMENT_FILTERED,
+        "environment-filtered",
+        4,
+        "environment prefiltered for GGX (E5B9G9R9 levels)",
+    ),
+    pod_kind(ENVIRONMENT_TABLE, "environment-table", 16, "environment sampling table (alias cells)"),
     pod_kind(EMITTER_LUMINANCE, "emitter-luminance", 4, "mean emitted luminance per triangle"),
     pod_kind(PROBE_GRID, "probe-grid", 64, "irradiance probe volume header"),
     pod_kind(PROBE_STATES, "probe-states", 16, "probe offsets and on/off"),

@@ -11,6 +11,7 @@
 //! [`GpuScene::use_refined_views`] hands the raster passes the full chains.
 
 pub mod bindings;
+pub mod environment;
 mod geometry;
 pub mod linespace;
 pub mod media;
@@ -124,6 +125,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::BVH_NODES && needs.bvh)
         || (kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
         || (kiln_format::probes::PROBE_KINDS.contains(&kind) && needs.probes)
+        || kiln_format::environment::ENVIRONMENT_KINDS.contains(&kind)
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
@@ -213,6 +215,16 @@ impl GpuScene {
             Write::Buffer(bindings::TRIANGLE_MATERIALS.binding, &r.triangle_materials),
             Write::Buffer(bindings::MATERIALS.binding, &r.materials),
         ])
+    }
+}
+
+impl GpuScene {
+    /// The descriptor writes of the environment's two buffers at `first` and `first + 1`
+    /// (`shaders/common/environment.glsl`'s `ENV_BINDING`).
+    pub fn environment_writes(&self, first: u32) -> PlayResult<[Write<'_>; 2]> {
+        self.environment.as_ref().map(|e| e.writes(first)).ok_or_else(|| {
+            PlayError::new(Exit::Gpu, "the environment's buffers were not uploaded with the geometry")
+        })
     }
 }
 
@@ -319,6 +331,8 @@ pub struct GpuScene {
     pub media: Option<media::MediaBuffers>,
     /// The irradiance probe volume, when `--gi probes` reads it.
     pub probes: Option<probes::ProbeImages>,
+    /// The environment (placeholders without one), uploaded with the geometry.
+    pub environment: Option<environment::EnvironmentBuffers>,
     /// Every section of the file and its fate.
     pub sections: Vec<SectionFate>,
     /// Bytes uploaded.
@@ -408,6 +422,7 @@ impl GpuScene {
             line_space: None,
             media: None,
             probes: None,
+            environment: None,
             sections: Vec::new(),
             uploaded_bytes: 0,
             resident: Needs::default(),
@@ -490,6 +505,9 @@ impl GpuScene {
         }
         if now.media && !view.manifest.media.is_empty() {
             self.media = Some(media::MediaBuffers::new(gpu, &view.manifest, all.media_volumes, up)?);
+        }
+        if first {
+            self.environment = Some(environment::EnvironmentBuffers::new(gpu, file, up)?);
         }
         if now.probes {
             let volume = kiln_format::probes::ProbeVolume::read(file).map_err(bad)?.ok_or_else(|| {
@@ -614,6 +632,8 @@ impl GpuScene {
                     }
                     _ => fate.after_first_frame = first,
                 }
+            } else if kiln_format::environment::ENVIRONMENT_KINDS.contains(&kind) {
+                // Uploaded with the geometry, before this loop.
             } else if kiln_format::probes::PROBE_KINDS.contains(&kind) && all.probes {
                 // Uploaded together before this loop.
                 fate.after_first_frame = !now.probes && first;

@@ -53,28 +53,7 @@ fn light_power(l: &kiln_format::manifest::Light, scene_radius: f32) -> f32 {
     if p.is_finite() { p.max(0.0) } else { 0.0 }
 }
 
-/// Walker's alias table of `weights` (Vose's construction): per entry, the probability that a
-/// draw landing on it keeps it and the entry it takes otherwise, so that entry i is chosen with
-/// probability weights[i] / Σ weights. Empty weights give an empty table.
-pub fn alias_table(weights: &[f64]) -> Vec<(f32, u32)> {
-    let n = weights.len();
-    let total: f64 = weights.iter().sum();
-    let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
-    // Each entry keeps itself until a smaller one is paired with it.
-    let mut table: Vec<(f32, u32)> = (0..n as u32).map(|i| (1.0, i)).collect();
-    let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
-    while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
-        small.pop();
-        table[s] = (scaled[s] as f32, l as u32);
-        scaled[l] -= 1.0 - scaled[s];
-        if scaled[l] < 1.0 {
-            large.pop();
-            small.push(l);
-        }
-    }
-    // What is left keeps itself (rounding leaves entries near 1 in either list).
-    table
-}
+pub use kiln_format::environment::alias_table;
 
 /// The emissive triangles of `power` ((kind, index, power) entries) as the direct light of
 /// emissive surfaces reads them: corners, emission, flags and an alias table by power.

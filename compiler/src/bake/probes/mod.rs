@@ -236,7 +236,7 @@ fn bake_probe(tracer: &Tracer, layout: &ProbeLayout, index: u32, g: Vec3) -> Bak
         let d = fibonacci_direction(i, n);
         let mut rng = path_rng(index, i);
         let sample = match tracer.trace(p, d, f32::INFINITY) {
-            None => Sample { d, light: [tracer.sky / uniform, Vec3::ZERO], distance: None },
+            None => Sample { d, light: [tracer.sky.radiance(d) / uniform, Vec3::ZERO], distance: None },
             Some(h) => {
                 let distance = Some(h.t / spacing);
                 if tracer.inside(&h, d) {
@@ -351,7 +351,10 @@ pub fn stage(ctx: &BakeContext) -> Sections {
         ctx.shading(),
         &ctx.scene.uvs,
         &ctx.triangle_materials,
-        Vec3::from(ctx.scene.sky.radiance),
+        match ctx.environment() {
+            Some(e) => trace::Sky::Environment(e),
+            None => trace::Sky::Constant(Vec3::from(ctx.scene.sky.radiance)),
+        },
         luminance.as_deref(),
     );
     ctx.progress.count("probes", layout.count());

@@ -9,7 +9,7 @@
 //! - At every surface vertex: the analytic lights by kiln's direct shading (`crate::shading`,
 //!   shadow rays through the BVH; one of a rect light's 16 stratified samples, at random) and the emissive triangles by next-event estimation (one
 //!   triangle by power, a uniform point on it), combined with the BRDF-sampled hits of emitters by
-//!   the balance heuristic. A miss sees the sky.
+//!   the balance heuristic. A miss sees the sky (the environment's map where there is one).
 //! - Emissive triangles emit from their front face (counter-clockwise), and from both faces when
 //!   their material is double-sided, as in the player's path tracer. Alpha is not tested: every
 //!   triangle is opaque to the bake.
@@ -94,6 +94,25 @@ pub struct SurfaceHit {
     pub area: f32,
 }
 
+/// The light from beyond the scene: a constant sky or the baked environment.
+#[derive(Debug, Clone, Copy)]
+pub enum Sky<'a> {
+    /// The same radiance in every direction.
+    Constant(Vec3),
+    /// The environment's map.
+    Environment(&'a crate::bake::environment::BakedEnvironment),
+}
+
+impl Sky<'_> {
+    /// Radiance arriving from unit direction `d`.
+    pub fn radiance(&self, d: Vec3) -> Vec3 {
+        match self {
+            Sky::Constant(l) => *l,
+            Sky::Environment(e) => e.radiance(d),
+        }
+    }
+}
+
 /// What the bake traces against.
 pub struct Tracer<'a> {
     /// Materials, textures, lights, BVH.
@@ -102,8 +121,8 @@ pub struct Tracer<'a> {
     pub uvs: &'a [[f32; 2]],
     /// Material per stored triangle.
     pub triangle_materials: &'a [u32],
-    /// The sky's radiance.
-    pub sky: Vec3,
+    /// What a ray that leaves the scene sees.
+    pub sky: Sky<'a>,
     tris: IndexedTriangles<'a>,
     emitters: Emitters,
 }
@@ -123,7 +142,7 @@ impl<'a> Tracer<'a> {
         shading: ShadingScene<'a>,
         uvs: &'a [[f32; 2]],
         triangle_materials: &'a [u32],
-        sky: Vec3,
+        sky: Sky<'a>,
         luminance: Option<&[f32]>,
     ) -> Tracer<'a> {
         let tris = IndexedTriangles { vertices: shading.vertices, triangles: shading.triangles };
@@ -321,7 +340,7 @@ impl<'a> Tracer<'a> {
             }
             let o = offset(h.p, ng);
             let Some(next) = self.trace(o, l, f32::INFINITY) else {
-                out += throughput * self.sky;
+                out += throughput * self.sky.radiance(l);
                 break;
             };
             let ns = self.shading.surface(next.material, next.uv);

@@ -115,6 +115,7 @@ impl DirectPass {
         bindings.extend([Binding::one(StorageImage); 5]);
         bindings.push(Binding::one(Storage));
         bindings.push(Binding::one(StorageImage));
+        bindings.extend([Binding::one(Storage); 2]);
         bindings
     }
 }
@@ -156,6 +157,7 @@ impl Pass for DirectPass {
         // The media table when a media technique uploaded it (the frame constants then count
         // its entries), else any storage buffer: no entry is read.
         writes.push(Write::Buffer(16, scene.media.as_ref().map_or(shared.lights, |m| &m.table)));
+        writes.extend(scene.environment_writes(18)?);
         self.0.write(gpu, &writes)
     }
 

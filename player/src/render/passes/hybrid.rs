@@ -18,7 +18,10 @@ use crate::scene::bindings as scene_bindings;
 use crate::scene::linespace::LineSpaceBuffers;
 
 /// The first of the line space's bindings (`LS_BINDING` in the line-space kernels).
-pub const LINE_SPACE_BINDING: u32 = 30;
+pub const LINE_SPACE_BINDING: u32 = 32;
+
+/// The first of the environment's two bindings (`ENV_BINDING` in `shaders/rt/hybrid.glsl`).
+pub const ENVIRONMENT_BINDING: u32 = 30;
 
 /// The G-buffer targets the ray-traced passes sample.
 pub const GBUFFER_READS: [TargetDecl; 4] = [TRIANGLE, NORMAL, ALBEDO, MATERIAL];
@@ -59,6 +62,7 @@ impl HybridSet {
         bindings.push(Binding::one(StorageImage));
         bindings.push(Binding::one(Storage));
         bindings.extend([Binding::one(StorageImage); 4]);
+        bindings.extend([Binding::one(Storage); 2]);
         debug_assert_eq!(bindings.len() as u32, LINE_SPACE_BINDING);
         if line_space {
             bindings.extend(LineSpaceBuffers::bindings());
@@ -123,6 +127,7 @@ impl HybridSet {
         for (i, t) in rt_direct::TARGETS.iter().enumerate() {
             writes.push(Write::StorageImage(26 + i as u32, img(t)));
         }
+        writes.extend(scene.environment_writes(ENVIRONMENT_BINDING)?);
         if self.line_space {
             let ls = scene.line_space.as_ref().ok_or_else(|| {
                 PlayError::new(Exit::Gpu, "a line-space pass is bound to a scene without its line space")

@@ -36,6 +36,7 @@ impl PathTracePass {
         bindings.extend([Binding::one(Storage); 12]);
         bindings.push(Binding::one(StorageImage));
         bindings.push(Binding::one(Storage));
+        bindings.extend([Binding::one(Storage); 2]);
         Ok(PathTracePass(Kernel::reading_texels(
             gpu,
             &bindings,
@@ -72,6 +73,7 @@ impl PathTracePass {
             Write::StorageImage(13, images.get(&ACCUMULATION).view),
             Write::Buffer(14, &r.media),
         ]);
+        writes.extend(scene.environment_writes(15)?);
         self.0.write(gpu, &writes)
     }
 

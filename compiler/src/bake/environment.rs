@@ -1,0 +1,333 @@
+//! The `environment` stage: from the scene's [`EnvironmentImage`], the radiance map at the
+//! budgeted width (`--environment-res`), its GGX-prefiltered levels for the split-sum specular,
+//! its irradiance as nine spherical harmonics and the alias table that draws directions in
+//! proportion to its light (FORMAT.md, "Environment"; `kiln_format::environment`).
+//!
+//! - Resampling averages the source over each target texel's rectangle in (u, v), fractional
+//!   overlaps included, after the rotation about +y; a map is never enlarged.
+//! - Prefiltered level i (of [`LEVELS`], level 0 [`FILTERED_WIDTH`] wide at most, each next half
+//!   as wide) holds, in direction n, ∫ L(l) D(h) (n·l)⁺ dl / ∫ D(h) (n·l)⁺ dl for GGX's D with
+//!   α = (i / (LEVELS − 1))² and h the half vector of n and l (the split sum's assumption n = v),
+//!   estimated with [`FILTER_SAMPLES`] GGX samples of a fixed Hammersley set, each read from the
+//!   radiance map's box-filtered pyramid at the level its solid angle covers (Křivánek and
+//!   Colbert's filtered importance sampling, as Karis's split sum does). Level 0 is the map
+//!   averaged down to its width.
+//! - The harmonics project the map (each texel weighted by its solid angle) and convolve with the
+//!   clamped cosine (Ramamoorthi and Hanrahan: bands scaled by 1, 2/3, 1/4 after dividing by π).
+//! - The table's cells ([`TABLE_WIDTH`] wide at most) are drawn in proportion to their mean
+//!   luminance times their solid angle; a drawn direction is uniform in (u, v) within the cell.
+//!
+//! Every sum runs in a fixed order per texel (rows in parallel), so the bytes do not depend on
+//! the thread count.
+
+use glam::Vec3;
+use kiln_format::environment::{
+    EnvironmentCell, EnvironmentHeader, alias_table, direction_to_uv, sh_basis, uv_to_direction,
+};
+use kiln_format::probes::{decode_rgb9e5, encode_rgb9e5};
+use kiln_format::sections::{ENVIRONMENT_FILTERED, ENVIRONMENT_HEADER, ENVIRONMENT_MAP, ENVIRONMENT_TABLE};
+use rayon::prelude::*;
+
+use super::{BakeContext, Sections};
+use crate::ir::EnvironmentImage;
+
+/// Prefiltered levels: roughness 0, 0.2, …, 1.
+pub const LEVELS: u32 = 6;
+/// Width of prefiltered level 0, at most.
+pub const FILTERED_WIDTH: u32 = 256;
+/// Width of the sampling table, at most.
+pub const TABLE_WIDTH: u32 = 512;
+/// GGX samples per prefiltered texel.
+pub const FILTER_SAMPLES: u32 = 512;
+
+/// What the stage bakes, kept for the stages that light with it (the probes).
+#[derive(Debug, Clone)]
+pub struct BakedEnvironment {
+    /// The header.
+    pub header: EnvironmentHeader,
+    /// The radiance map, `E5B9G9R9`.
+    pub map: Vec<u32>,
+    /// The prefiltered levels, `E5B9G9R9`.
+    pub filtered: Vec<u32>,
+    /// The sampling table.
+    pub table: Vec<EnvironmentCell>,
+    /// Texel channels beyond what `E5B9G9R9` holds (65,408), clamped.
+    pub clamped: u64,
+}
+
+impl BakedEnvironment {
+    /// Radiance from unit direction `d`: the map's texel (as the player's path tracers read it).
+    pub fn radiance(&self, d: Vec3) -> Vec3 {
+        let [w, h, ..] = self.header.map;
+        let [u, v] = direction_to_uv(d);
+        let x = ((u * w as f32) as u32).min(w - 1);
+        let y = ((v * h as f32) as u32).min(h - 1);
+        Vec3::from(decode_rgb9e5(self.map[(y * w + x) as usize]))
+    }
+}
+
+/// A linear RGB image in f32, rows of `width`.
+#[derive(Debug, Clone)]
+struct Image {
+    width: u32,
+    height: u32,
+    pixels: Vec<Vec3>,
+}
+
+impl Image {
+    fn at(&self, x: i64, y: i64) -> Vec3 {
+        let x = x.rem_euclid(self.width as i64) as u32;
+        let y = y.clamp(0, self.height as i64 - 1) as u32;
+        self.pixels[(y * self.width + x) as usize]
+    }
+
+    /// Bilinear at (u, v), wrapping in u and clamping in v.
+    fn bilinear(&self, u: f32, v: f32) -> Vec3 {
+        let (x, y) = (u * self.width as f32 - 0.5, v * self.height as f32 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let top = self.at(x0, y0).lerp(self.at(x0 + 1, y0), fx);
+        let bottom = self.at(x0, y0 + 1).lerp(self.at(x0 + 1, y0 + 1), fx);
+        top.lerp(bottom, fy)
+    }
+
+    /// Half the width and height, each texel the mean of four.
+    fn halve(&self) -> Image {
+        let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
+        let pixels = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as i64 * 2, (i / w) as i64 * 2);
+                (self.at(x, y) + self.at(x + 1, y) + self.at(x, y + 1) + self.at(x + 1, y + 1)) * 0.25
+            })
+            .collect();
+        Image { width: w, height: h, pixels }
+    }
+}
+
+/// Source texels overlapping [a, b) (in source texel units) with their overlap lengths; indices
+/// wrap modulo `n` when `wrap`, else clamp to the image.
+fn coverage(a: f64, b: f64, n: u32, wrap: bool) -> Vec<(u32, f64)> {
+    let mut out = Vec::new();
+    let mut j = a.floor();
+    while j < b {
+        let w = (j + 1.0).min(b) - j.max(a);
+        if w > 0.0 {
+            let i = if wrap { (j as i64).rem_euclid(n as i64) } else { (j as i64).clamp(0, n as i64 - 1) };
+            out.push((i as u32, w));
+        }
+        j += 1.0;
+    }
+    out
+}
+
+/// `src` averaged over each texel of a `width` × `width / 2` map, rotated by `rotation_degrees`
+/// about +y (the target direction at u sees the source at u − rotation / 360).
+fn resample(src: &Image, width: u32, rotation_degrees: f32) -> Image {
+    let height = width / 2;
+    let shift = (rotation_degrees as f64 / 360.0).rem_euclid(1.0);
+    let cols: Vec<Vec<(u32, f64)>> = (0..width)
+        .map(|x| {
+            let (u0, u1) = (x as f64 / width as f64 - shift, (x + 1) as f64 / width as f64 - shift);
+            coverage(u0 * src.width as f64, u1 * src.width as f64, src.width, true)
+        })
+        .collect();
+    let pixels = (0..height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let rows = coverage(
+                y as f64 / height as f64 * src.height as f64,
+                (y + 1) as f64 / height as f64 * src.height as f64,
+                src.height,
+                false,
+            );
+            let cols = &cols;
+            (0..width).map(move |x| {
+                let (mut sum, mut total) = ([0f64; 3], 0f64);
+                for &(r, wr) in &rows {
+                    for &(c, wc) in &cols[x as usize] {
+                        let p = src.pixels[(r * src.width + c) as usize];
+                        let w = wr * wc;
+                        for k in 0..3 {
+                            sum[k] += w * p[k] as f64;
+                        }
+                        total += w;
+                    }
+                }
+                Vec3::from(sum.map(|s| (s / total) as f32))
+            })
+        })
+        .collect();
+    Image { width, height, pixels }
+}
+
+/// Solid angle of each texel of row `y` of a `width` × `height` map.
+fn texel_solid_angle(y: u32, width: u32, height: u32) -> f64 {
+    let t0 = std::f64::consts::PI * y as f64 / height as f64;
+    let t1 = std::f64::consts::PI * (y + 1) as f64 / height as f64;
+    (t0.cos() - t1.cos()) * std::f64::consts::TAU / width as f64
+}
+
+/// Van der Corput's radical inverse of `i` in base 2.
+fn radical_inverse(i: u32) -> f32 {
+    (i.reverse_bits() as f64 / 4_294_967_296.0) as f32
+}
+
+/// An orthonormal basis (t, b) around unit n (Duff et al. 2017).
+fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let s = 1f32.copysign(n.z);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    (Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x), Vec3::new(b, s + n.y * n.y * a, -n.y))
+}
+
+/// One prefiltered texel: direction `n`, GGX α, the pyramid of the radiance map (level 0 first).
+fn prefilter(n: Vec3, alpha: f32, pyramid: &[Image]) -> Vec3 {
+    let (t, b) = basis(n);
+    let a2 = alpha * alpha;
+    let base = &pyramid[0];
+    let texel = (std::f32::consts::TAU / base.width as f32) * (std::f32::consts::PI / base.height as f32);
+    let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
+    for i in 0..FILTER_SAMPLES {
+        let (xi1, xi2) = ((i as f32 + 0.5) / FILTER_SAMPLES as f32, radical_inverse(i));
+        let cos_h = ((1.0 - xi1) / (1.0 + (a2 - 1.0) * xi1)).max(0.0).sqrt();
+        let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
+        let phi = std::f32::consts::TAU * xi2;
+        let h = t * (sin_h * phi.cos()) + b * (sin_h * phi.sin()) + n * cos_h;
+        let l = (2.0 * n.dot(h) * h - n).normalize();
+        let nl = n.dot(l);
+        if nl <= 0.0 {
+            continue;
+        }
+        // Density of l: D(h) cos_h / (4 v·h) with v = n, i.e. D(h) / 4.
+        let d = a2 / (std::f32::consts::PI * ((a2 - 1.0) * cos_h * cos_h + 1.0).powi(2));
+        let solid = 1.0 / (FILTER_SAMPLES as f32 * d * 0.25);
+        let sin_l = (1.0 - l.y * l.y).max(1e-4).sqrt();
+        let lod = (0.5 * (solid / (texel * sin_l)).log2() + 1.0).clamp(0.0, (pyramid.len() - 1) as f32);
+        let [u, v] = direction_to_uv(l);
+        let (l0, f) = (lod.floor() as usize, lod.fract());
+        let mut c = pyramid[l0].bilinear(u, v);
+        if f > 0.0 && l0 + 1 < pyramid.len() {
+            c = c.lerp(pyramid[l0 + 1].bilinear(u, v), f);
+        }
+        sum += c * nl;
+        weight += nl;
+    }
+    if weight > 0.0 { sum / weight } else { Vec3::ZERO }
+}
+
+/// Bakes `env` with a radiance map at most `max_width` wide.
+pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
+    let src = Image {
+        width: env.width,
+        height: env.height,
+        pixels: env.pixels.iter().map(|&p| Vec3::from(p)).collect(),
+    };
+    let width = (max_width.min(env.width) & !1).max(2);
+    let map = resample(&src, width, env.rotation_degrees);
+    let mut clamped = 0u64;
+    let limit = 511.0 / 512.0 * 65536.0;
+    let map_texels: Vec<u32> = map
+        .pixels
+        .iter()
+        .map(|p| {
+            clamped += p.to_array().iter().filter(|&&c| c > limit).count() as u64;
+            encode_rgb9e5(p.to_array())
+        })
+        .collect();
+    // The pyramid the prefilter reads, from the map itself.
+    let mut pyramid = vec![map.clone()];
+    while pyramid.last().is_some_and(|l| l.width > 8) {
+        let next = pyramid.last().map(Image::halve).unwrap_or_else(|| map.clone());
+        pyramid.push(next);
+    }
+    let fw = FILTERED_WIDTH.min(width);
+    let (tw, th) = (TABLE_WIDTH.min(width), TABLE_WIDTH.min(width) / 2);
+    let mut header = EnvironmentHeader {
+        map: [width, width / 2, 0, 0],
+        filtered: [fw, fw / 2, LEVELS, width * (width / 2)],
+        table: [tw, th, 0, 0],
+        sh: [[0.0; 4]; 9],
+    };
+    let level0 = resample(&map, fw, 0.0);
+    let mut filtered: Vec<u32> = level0.pixels.iter().map(|p| encode_rgb9e5(p.to_array())).collect();
+    for i in 1..LEVELS {
+        let [w, h] = header.filtered_extent(i);
+        let roughness = i as f32 / (LEVELS - 1) as f32;
+        let alpha = roughness * roughness;
+        let level: Vec<u32> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let pyramid = &pyramid;
+                (0..w).map(move |x| {
+                    let n = uv_to_direction((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                    encode_rgb9e5(prefilter(n, alpha, pyramid).to_array())
+                })
+            })
+            .collect();
+        filtered.extend(level);
+    }
+    // Irradiance harmonics from prefiltered level 0's texels (plenty for band 2).
+    let mut sh = [[0f64; 3]; 9];
+    for y in 0..level0.height {
+        let dw = texel_solid_angle(y, level0.width, level0.height);
+        for x in 0..level0.width {
+            let d = uv_to_direction(
+                (x as f32 + 0.5) / level0.width as f32,
+                (y as f32 + 0.5) / level0.height as f32,
+            );
+            let l = level0.pixels[(y * level0.width + x) as usize];
+            for (k, b) in sh_basis(d).iter().enumerate() {
+                for c in 0..3 {
+                    sh[k][c] += l[c] as f64 * *b as f64 * dw;
+                }
+            }
+        }
+    }
+    let band = [1.0, 2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0, 0.25, 0.25, 0.25, 0.25, 0.25];
+    header.sh = std::array::from_fn(|k| {
+        let c = sh[k].map(|v| (v * band[k]) as f32);
+        [c[0], c[1], c[2], 0.0]
+    });
+    // The sampling table.
+    let cells = resample(&map, tw, 0.0);
+    let weights: Vec<f64> = (0..tw * th)
+        .map(|i| {
+            let p = cells.pixels[i as usize].to_array();
+            kiln_format::gpu::luminance(p) as f64 * texel_solid_angle(i / tw, tw, th)
+        })
+        .collect();
+    let total: f64 = weights.iter().sum();
+    let scale = (tw * th) as f64 / (2.0 * std::f64::consts::PI * std::f64::consts::PI);
+    let density: Vec<f32> =
+        weights.iter().map(|w| if total > 0.0 { (w / total * scale) as f32 } else { 0.0 }).collect();
+    let table = alias_table(&weights)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (keep, alias))| EnvironmentCell {
+            keep: keep.clamp(0.0, 1.0),
+            alias,
+            density: density[i],
+            alias_density: density[alias as usize],
+        })
+        .collect();
+    BakedEnvironment { header, map: map_texels, filtered, table, clamped }
+}
+
+/// The stage: the sections of the context's baked environment (none without an environment).
+pub fn stage(ctx: &BakeContext) -> Sections {
+    let mut out = Sections::default();
+    let Some(env) = ctx.environment() else { return out };
+    if env.clamped > 0 {
+        eprintln!(
+            "warning: environment: {} texel channels brighter than 65408 (what E5B9G9R9 holds) were clamped; \
+             lower [sky] intensity and raise the exposure to keep them",
+            env.clamped
+        );
+    }
+    out.push(ENVIRONMENT_HEADER, 0, bytemuck::bytes_of(&env.header).to_vec());
+    out.push(ENVIRONMENT_MAP, 0, bytemuck::cast_slice(&env.map).to_vec());
+    out.push(ENVIRONMENT_FILTERED, 0, bytemuck::cast_slice(&env.filtered).to_vec());
+    out.push(ENVIRONMENT_TABLE, 0, bytemuck::cast_slice(&env.table).to_vec());
+    out
+}

@@ -1,0 +1,232 @@
+//! Environment sources: an equirectangular HDR image (Radiance `.hdr` or OpenEXR), Preetham's
+//! daylight model with its sun, or the built-in studio. Each becomes the scene's
+//! [`EnvironmentImage`] (radiance in every direction, row 0 the zenith, the mapping of
+//! `kiln_format::environment`), which the `environment` bake stage resamples, prefilters and
+//! tabulates. `docs/sidecar.md` ("[sky]") documents the sources and their units.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use kiln_format::environment::uv_to_direction;
+use kiln_format::manifest::Sky;
+
+use super::preetham;
+use crate::exit::{CliError, CliResult};
+use crate::ir::{EnvironmentImage, Scene, WarningClass};
+
+/// Smallest map accepted: below this an equirectangular map cannot resolve a hemisphere.
+pub const MIN_HEIGHT: u32 = 4;
+/// Width at which the analytic sources (Preetham, studio) are generated.
+pub const GENERATED_WIDTH: u32 = 1024;
+
+/// Where the environment comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EnvironmentSpec {
+    /// An equirectangular HDR image file.
+    Image {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Preetham, Shirley and Smits's daylight model (SIGGRAPH 1999) and its sun.
+    Preetham {
+        /// Unit direction towards the sun (y up; above the horizon).
+        sun_direction: [f32; 3],
+        /// Atmospheric turbidity, 2 (clear) to 10 (hazy).
+        turbidity: f32,
+        /// Whether the sun is added as a directional light.
+        sun: bool,
+    },
+    /// The built-in neutral studio (documented in `docs/sidecar.md`).
+    Studio,
+}
+
+/// How the source is placed: a scale on its radiance and a rotation about +y.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    /// Multiplies every radiance.
+    pub intensity: f32,
+    /// Rotation about +y, degrees (counter-clockwise seen from above).
+    pub rotation_degrees: f32,
+}
+
+impl Default for Placement {
+    fn default() -> Placement {
+        Placement { intensity: 1.0, rotation_degrees: 0.0 }
+    }
+}
+
+impl EnvironmentSpec {
+    /// Parses the command line's `--environment` value: `studio`, `preetham` (sun at the
+    /// sidecar's default direction) or a path to an image.
+    pub fn parse(value: &str) -> Result<EnvironmentSpec, String> {
+        Ok(match value {
+            "studio" => EnvironmentSpec::Studio,
+            "preetham" => EnvironmentSpec::Preetham {
+                sun_direction: preetham::DEFAULT_SUN,
+                turbidity: preetham::DEFAULT_TURBIDITY,
+                sun: true,
+            },
+            "" => return Err("give studio, preetham or the path of an .hdr or .exr image".into()),
+            path => EnvironmentSpec::Image { path: PathBuf::from(path) },
+        })
+    }
+}
+
+/// Sets `scene`'s environment from `spec` placed by `placement`; `source` names where the request
+/// came from in messages. The constant sky becomes the environment's mean radiance (what a reader
+/// that ignores the environment sections shows). Replaces any earlier environment (and its sun).
+pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, source: &str) -> CliResult<()> {
+    let bad = |msg: String| CliError::input(format!("{source}: {msg}"));
+    if !(placement.intensity.is_finite() && placement.intensity >= 0.0) {
+        return Err(bad(format!(
+            "environment intensity {} must be finite and non-negative",
+            placement.intensity
+        )));
+    }
+    if !placement.rotation_degrees.is_finite() {
+        return Err(bad("environment rotation must be finite".into()));
+    }
+    scene.lights.retain(|l| l.name != preetham::SUN_NAME);
+    let (name, width, mut pixels) = match spec {
+        EnvironmentSpec::Image { path } => {
+            let (w, pixels) = load_image(path, scene).map_err(bad)?;
+            (path.display().to_string(), w, pixels)
+        }
+        EnvironmentSpec::Preetham { sun_direction, turbidity, sun } => {
+            let model = preetham::Sky::new(Vec3::from(*sun_direction), *turbidity).map_err(bad)?;
+            let pixels = generate(GENERATED_WIDTH, |d| model.radiance(d));
+            if *sun {
+                scene.lights.push(model.sun_light(placement.intensity));
+            }
+            let ground = model.ground(&pixels, GENERATED_WIDTH);
+            let pixels = fill_below_horizon(pixels, GENERATED_WIDTH, ground);
+            (format!("preetham (turbidity {turbidity})"), GENERATED_WIDTH, pixels)
+        }
+        EnvironmentSpec::Studio => ("studio".to_owned(), GENERATED_WIDTH, generate(GENERATED_WIDTH, studio)),
+    };
+    for p in &mut pixels {
+        *p = p.map(|c| c * placement.intensity);
+    }
+    let mean = mean_radiance(&pixels, width);
+    scene.sky = Sky { radiance: mean };
+    scene.environment = Some(EnvironmentImage {
+        name,
+        width,
+        height: width / 2,
+        pixels,
+        rotation_degrees: placement.rotation_degrees,
+    });
+    Ok(())
+}
+
+/// Reads and decodes an HDR image (recording it as an input) and checks its shape; non-finite or
+/// negative pixels become 0 with a warning on `scene`.
+fn load_image(path: &Path, scene: &mut Scene) -> Result<(u32, Vec<[f32; 3]>), String> {
+    let bytes = super::read_input(path, &mut scene.inputs).map_err(|e| e.to_string())?;
+    let named = |msg: String| format!("environment image {}: {msg}", path.display());
+    match image::guess_format(&bytes) {
+        Ok(image::ImageFormat::Hdr | image::ImageFormat::OpenExr) => {}
+        Ok(f) => {
+            return Err(named(format!(
+                "a {f:?} image holds no radiance beyond 1 (the sun, a lamp): give a Radiance .hdr or OpenEXR file"
+            )));
+        }
+        Err(_) => return Err(named("neither Radiance .hdr nor OpenEXR".into())),
+    }
+    let img = super::files::decode_image(&bytes).map_err(named)?.to_rgb32f();
+    let (w, h) = img.dimensions();
+    if h < MIN_HEIGHT || w.abs_diff(2 * h) > (2 * h) / 50 {
+        return Err(named(format!(
+            "{w} x {h} pixels: an equirectangular map is twice as wide as tall, at least {} x {MIN_HEIGHT}",
+            2 * MIN_HEIGHT
+        )));
+    }
+    let mut bad = 0u64;
+    let mut pixels: Vec<[f32; 3]> = img
+        .pixels()
+        .map(|p| {
+            p.0.map(|c| {
+                if c.is_finite() && c >= 0.0 {
+                    c
+                } else {
+                    bad += 1;
+                    0.0
+                }
+            })
+        })
+        .collect();
+    if bad > 0 {
+        scene.warn(named(format!("{bad} pixel channels are NaN, infinite or negative; they count as black")));
+    }
+    // A map a few pixels off 2:1 is resampled to exactly 2:1 (rows kept, columns stretched).
+    if w != 2 * h {
+        scene.warn_as(
+            WarningClass::DataLoss,
+            named(format!("{w} x {h} pixels is not 2:1; stretched to {} x {h}", 2 * h)),
+        );
+        let w2 = 2 * h;
+        pixels = (0..h)
+            .flat_map(|y| {
+                let row = &pixels[(y * w) as usize..((y + 1) * w) as usize];
+                (0..w2).map(move |x| row[((x as u64 * w as u64) / w2 as u64) as usize])
+            })
+            .collect();
+    }
+    Ok((2 * h, pixels))
+}
+
+/// An analytic environment sampled at the centres of a `width` × `width / 2` map.
+pub fn generate(width: u32, f: impl Fn(Vec3) -> Vec3 + Sync) -> Vec<[f32; 3]> {
+    let height = width / 2;
+    (0..width * height)
+        .map(|i| {
+            let (x, y) = (i % width, i / width);
+            let d = uv_to_direction((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
+            f(d).to_array()
+        })
+        .collect()
+}
+
+/// The rows below the horizon replaced by `ground` (a sky model has no value there).
+fn fill_below_horizon(mut pixels: Vec<[f32; 3]>, width: u32, ground: Vec3) -> Vec<[f32; 3]> {
+    let half = (width / 2) as usize / 2;
+    for p in &mut pixels[half * width as usize..] {
+        *p = ground.to_array();
+    }
+    pixels
+}
+
+/// Mean radiance over the sphere (each row weighted by its solid angle).
+pub fn mean_radiance(pixels: &[[f32; 3]], width: u32) -> [f32; 3] {
+    let height = (pixels.len() / width as usize) as u32;
+    let mut sum = [0f64; 3];
+    let mut weight = 0f64;
+    for y in 0..height {
+        let theta0 = std::f64::consts::PI * y as f64 / height as f64;
+        let theta1 = std::f64::consts::PI * (y + 1) as f64 / height as f64;
+        let w = theta0.cos() - theta1.cos();
+        for p in &pixels[(y * width) as usize..((y + 1) * width) as usize] {
+            for c in 0..3 {
+                sum[c] += w * p[c] as f64;
+            }
+            weight += w;
+        }
+    }
+    sum.map(|s| if weight > 0.0 { (s / weight) as f32 } else { 0.0 })
+}
+
+/// The built-in studio (docs/sidecar.md): a neutral dome brightening from 0.8 at the horizon to 1
+/// at the zenith over a grey floor of 0.3, a round key softbox of radiance 6 and 15° radius up
+/// and to the left of −z, and a rim light of radiance 3 and 10° behind and to the right.
+pub fn studio(d: Vec3) -> Vec3 {
+    const KEY: Vec3 = Vec3::new(-0.5, 0.6, -0.624_5);
+    const RIM: Vec3 = Vec3::new(0.6, 0.35, 0.718_6);
+    let mut l = if d.y >= 0.0 { Vec3::splat(0.8 + 0.2 * d.y) } else { Vec3::splat(0.3) };
+    if d.dot(KEY.normalize()) >= 15f32.to_radians().cos() {
+        l = Vec3::splat(6.0);
+    }
+    if d.dot(RIM.normalize()) >= 10f32.to_radians().cos() {
+        l = Vec3::splat(3.0);
+    }
+    l
+}
