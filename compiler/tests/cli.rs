@@ -14,7 +14,7 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.4");
+    assert_eq!(j["format_version"], "1.5");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(
@@ -52,7 +52,7 @@ fn demo_inspect_verify() {
     assert_eq!(j["manifest"]["lights"][0]["name"], "ceiling");
     let skipped: Vec<&str> =
         j["manifest"]["skipped"].as_array().unwrap().iter().map(|s| s["stage"].as_str().unwrap()).collect();
-    assert_eq!(skipped, ["uvs", "vertex-colors", "textures", "brdf-lut", "media-visibility"]);
+    assert_eq!(skipped, ["uvs", "vertex-colors", "textures", "brdf-lut", "media-visibility", "environment"]);
     let run = kiln(dir.path(), &["verify", "demo.kiln", "--rays", "20000", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).unwrap();
@@ -117,7 +117,7 @@ fn exit_codes() {
     let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
-    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.4").says("1.x");
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.5").says("1.x");
 }
 
 #[test]

@@ -120,7 +120,16 @@ fn every_kind_file_with(codec: Codec) -> Vec<u8> {
         sigma_s: [0.2; 3],
         g: 0.3,
     });
+    // A small environment, so that ENVH, ENVR, ENVP and ENVT are written.
+    s.environment = Some(kiln_compiler::ir::EnvironmentImage {
+        name: "gradient".into(),
+        width: 16,
+        height: 8,
+        pixels: (0..128).map(|i| [0.1 + (i % 16) as f32 * 0.05, 0.2, 0.3 + (i / 16) as f32 * 0.1]).collect(),
+        rotation_degrees: 0.0,
+    });
     let settings = Settings {
+        environment_res: kiln_compiler::settings::ENVIRONMENT_RES.min,
         voxel_res: VoxelRes::Cells(4),
         shaft_res: Some(1),
         shaft_variants: Some(Variants::ALL),

@@ -106,6 +106,7 @@ fn check_scene(
             "brdf-lut",
             "shadow-maps",
             "media-visibility",
+            "environment",
             "probes",
             "voxel-grid",
             "line-space",

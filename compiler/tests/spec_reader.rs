@@ -1226,13 +1226,60 @@ fn check_bakes(name: &str, f: &spec::File, m: &Manifest, file: &KilnFile) -> Str
         }
         probes
     });
+    // The environment: the header's map, levels and table size the other three sections; the
+    // direction of a texel follows the mapping (u = atan2(x, -z) / 2pi, v = acos(y) / pi), and
+    // the table's cells are an alias table whose densities integrate to 1 over the sphere.
+    let environment = f.section(b"ENVH", 0).map(|h| {
+        assert_eq!(h.len(), 192, "{name}: ENVH bytes");
+        let u = |i: usize| spec::u32_at(h, 4 * i);
+        let (w, hh) = (u(0), u(1));
+        assert_eq!(w, 2 * hh, "{name}: the map is twice as wide as tall");
+        let (fw, levels, first, tw, th) = (u(4), u(6), u(7), u(8), u(9));
+        assert_eq!(first, w * hh, "{name}: level 0 starts after the map's texels");
+        let level_texels: u32 = (0..levels).map(|l| (fw >> l).max(2) * ((fw >> l).max(2) / 2)).sum();
+        assert_eq!(f.section(b"ENVR", 0).unwrap().len(), 4 * (w * hh) as usize, "{name}: ENVR bytes");
+        assert_eq!(f.section(b"ENVP", 0).unwrap().len(), 4 * level_texels as usize, "{name}: ENVP bytes");
+        let cells = f.section(b"ENVT", 0).unwrap();
+        assert_eq!(cells.len(), 16 * (tw * th) as usize, "{name}: ENVT bytes");
+        let mut total = 0.0f64;
+        for c in 0..(tw * th) as usize {
+            let (keep, alias, density) = (
+                spec::f32_at(cells, 16 * c),
+                spec::u32_at(cells, 16 * c + 4),
+                spec::f32_at(cells, 16 * c + 8),
+            );
+            assert!((0.0..=1.0).contains(&keep) && alias < tw * th && density >= 0.0, "{name}: cell {c}");
+            assert_eq!(spec::f32_at(cells, 16 * c + 12), spec::f32_at(cells, 16 * alias as usize + 8));
+            // density / sin θ over the cell's solid angle (sin θ dθ dφ): density · (π/th)(2π/tw).
+            total +=
+                density as f64 * std::f64::consts::PI / th as f64 * 2.0 * std::f64::consts::PI / tw as f64;
+        }
+        assert!((total - 1.0).abs() < 1e-3, "{name}: the table's density integrates to {total}");
+        let env = kiln_format::environment::Environment::read(file).unwrap().expect("the reference reads it");
+        assert_eq!(bytemuck::cast_slice::<u32, u8>(env.map), f.section(b"ENVR", 0).unwrap(), "{name}: ENVR");
+        for (x, y) in [(0, 0), (w - 1, hh / 2), (w / 3, hh - 1)] {
+            let (phi, theta) = (
+                2.0 * std::f32::consts::PI * (x as f32 + 0.5) / w as f32,
+                std::f32::consts::PI * (y as f32 + 0.5) / hh as f32,
+            );
+            let d = glam::Vec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos());
+            let t = spec::u32_at(f.section(b"ENVR", 0).unwrap(), 4 * (y * w + x) as usize);
+            let scale = 2f32.powi((t >> 27) as i32 - 24);
+            let texel =
+                glam::Vec3::new((t & 511) as f32, ((t >> 9) & 511) as f32, ((t >> 18) & 511) as f32) * scale;
+            assert_eq!(env.radiance(d), texel, "{name}: the texel of direction {d} ({x}, {y})");
+        }
+        w
+    });
     format!(
-        "{} textures (formats {formats:?}), BRDF {}, {} shadow maps, {volumes} visibility volumes, EMLU {}, {} probes",
+        "{} textures (formats {formats:?}), BRDF {}, {} shadow maps, {volumes} visibility volumes, EMLU {}, {} probes, \
+         environment {}",
         m.textures.len(),
         m.brdf_lut.is_some(),
         m.shadow_maps.len(),
         emlu.is_some(),
-        probes.unwrap_or(0)
+        probes.unwrap_or(0),
+        environment.unwrap_or(0)
     )
 }
 
@@ -1298,6 +1345,14 @@ fn fixture_with(codec: Codec) -> Vec<u8> {
     spot.kind = LightKind::Spot { inner_cone: 0.3, outer_cone: 0.5 };
     spot.position = [0.3, 1.9, 0.5];
     s.lights.push(spot);
+    // An environment of 32 x 16 texels, so that ENVH, ENVR, ENVP and ENVT are written.
+    s.environment = Some(kiln_compiler::ir::EnvironmentImage {
+        name: "gradient".into(),
+        width: 32,
+        height: 16,
+        pixels: (0..512).map(|i| [0.05 * (i % 32) as f32, 0.5, 0.1 + 0.05 * (i / 32) as f32]).collect(),
+        rotation_degrees: 0.0,
+    });
     s.media.push(kiln_format::manifest::Medium {
         bounds: Bounds { min: [-0.9, 0.1, -0.9], max: [0.9, 1.3, 0.9] },
         sigma_a: [0.05; 3],

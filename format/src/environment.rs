@@ -8,8 +8,8 @@
 //! mirrors it and a test checks the two agree.
 //!
 //! Directions map as Mitsuba 3's `envmap` emitter maps them (y up): u = atan2(x, −z) / 2π
-//! wrapped into [0, 1), v = acos(y) / π, so that row 0 is the zenith and the image's centre
-//! column looks along −z.
+//! wrapped into [0, 1), v = acos(y) / π, so that row 0 is the zenith, the image's left and right
+//! edges look along −z, its centre column along +z and its first quarter along +x.
 
 use glam::Vec3;
 

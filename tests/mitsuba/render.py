@@ -26,6 +26,9 @@ tracer's (shaders/reference/pathtrace.comp), mapped to Mitsuba's:
 - Pinhole camera, vertical field of view, box filter over the pixel: `perspective` with
   `fov_axis: y` and `rfilter: box` (kiln jitters uniformly over the pixel; a box of radius 0.5
   gives each sample to its own pixel).
+- An environment (the scene's optional `environment`: an .npy of linear RGB, row 0 the zenith,
+  twice as wide as tall) is Mitsuba's `envmap` emitter of that bitmap: kiln maps directions as
+  envmap does (u = atan2(x, -z) / 2pi, v = acos(y) / pi, y up) and both interpolate bilinearly.
 - Unbiased path tracing of unlimited length: `path` with `max_depth: -1`.
 - A participating medium (the scene's optional `medium`: sigma_a, sigma_s per channel, the
   Henyey–Greenstein g) fills the whole space: a `homogeneous` medium (sigma_t = sigma_a +
@@ -137,6 +140,10 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
         if any(v > 0.0 for v in m["emission"]):
             shape["emitter"] = {"type": "area", "radiance": rgb(m["emission"])}
         scene[f"mesh{i}"] = shape
+    env = desc.get("environment")
+    if env is not None:
+        pixels = np.load(env).astype(np.float32)
+        scene["environment"] = {"type": "envmap", "bitmap": mi.Bitmap(pixels)}
     for i, l in enumerate(desc["rect_lights"]):
         d = np.asarray(l["direction"], dtype=float)
         r = np.asarray(l["right"], dtype=float)

@@ -7,11 +7,13 @@
 //!   overlaps included, after the rotation about +y; a map is never enlarged.
 //! - Prefiltered level i (of [`LEVELS`], level 0 [`FILTERED_WIDTH`] wide at most, each next half
 //!   as wide) holds, in direction n, ∫ L(l) D(h) (n·l)⁺ dl / ∫ D(h) (n·l)⁺ dl for GGX's D with
-//!   α = (i / (LEVELS − 1))² and h the half vector of n and l (the split sum's assumption n = v),
-//!   estimated with [`FILTER_SAMPLES`] GGX samples of a fixed Hammersley set, each read from the
-//!   radiance map's box-filtered pyramid at the level its solid angle covers (Křivánek and
-//!   Colbert's filtered importance sampling, as Karis's split sum does). Level 0 is the map
-//!   averaged down to its width.
+//!   α = (i / (LEVELS − 1))² and h the half vector of n and l (the split sum's assumption n = v).
+//!   Narrow lobes (α below 0.15: roughness 0.2) are estimated with [`FILTER_SAMPLES`] GGX samples
+//!   of a fixed Hammersley set, each read from the radiance map's box-filtered pyramid at the
+//!   level its solid angle covers (Křivánek and Colbert's filtered importance sampling, as
+//!   Karis's split sum does); wide ones are summed over every texel of the pyramid level at most
+//!   four times as wide as the output (its mip blur would bias the sampled estimate by several
+//!   per cent). Level 0 is the map averaged down to its width.
 //! - The harmonics project the map (each texel weighted by its solid angle) and convolve with the
 //!   clamped cosine (Ramamoorthi and Hanrahan: bands scaled by 1, 2/3, 1/4 after dividing by π).
 //! - The table's cells ([`TABLE_WIDTH`] wide at most) are drawn in proportion to their mean
@@ -51,8 +53,8 @@ pub struct BakedEnvironment {
     pub filtered: Vec<u32>,
     /// The sampling table.
     pub table: Vec<EnvironmentCell>,
-    /// Texel channels beyond what `E5B9G9R9` holds (65,408), clamped.
-    pub clamped: u64,
+    /// Mean radiance over the sphere of the baked map (solid-angle weighted).
+    pub mean: [f32; 3],
 }
 
 impl BakedEnvironment {
@@ -121,11 +123,12 @@ fn coverage(a: f64, b: f64, n: u32, wrap: bool) -> Vec<(u32, f64)> {
     out
 }
 
-/// `src` averaged over each texel of a `width` × `width / 2` map, rotated by `rotation_degrees`
-/// about +y (the target direction at u sees the source at u − rotation / 360).
+/// `src` averaged over each texel of a `width` × `width / 2` map, turned by `rotation_degrees`
+/// about +y by the right-hand rule (counter-clockwise seen from above: +90° takes what lay along
+/// −z to −x; the target direction at u sees the source at u + rotation / 360).
 fn resample(src: &Image, width: u32, rotation_degrees: f32) -> Image {
     let height = width / 2;
-    let shift = (rotation_degrees as f64 / 360.0).rem_euclid(1.0);
+    let shift = (-rotation_degrees as f64 / 360.0).rem_euclid(1.0);
     let cols: Vec<Vec<(u32, f64)>> = (0..width)
         .map(|x| {
             let (u0, u1) = (x as f64 / width as f64 - shift, (x + 1) as f64 / width as f64 - shift);
@@ -216,6 +219,42 @@ fn prefilter(n: Vec3, alpha: f32, pyramid: &[Image]) -> Vec3 {
     if weight > 0.0 { sum / weight } else { Vec3::ZERO }
 }
 
+/// One prefiltered texel by brute force: the lobe integral summed over every texel of `src` (a
+/// pyramid level whose texels are small against the lobe), each texel's direction at its centre
+/// and its exact solid angle. Used where the lobe is wide (few output texels, a coarse source),
+/// where filtered importance sampling's mip blur would bias it.
+fn convolve(n: Vec3, alpha: f32, src: &Image, dirs: &[(Vec3, f32)]) -> Vec3 {
+    let a2 = alpha * alpha;
+    let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
+    for (&(l, dw), &c) in dirs.iter().zip(&src.pixels) {
+        let nl = n.dot(l);
+        if nl <= 0.0 {
+            continue;
+        }
+        let h = n + l;
+        let nh2 = n.dot(h).powi(2) / h.length_squared();
+        let d = a2 / ((a2 - 1.0) * nh2 + 1.0).powi(2);
+        let w = d * nl * dw;
+        sum += c * w;
+        weight += w;
+    }
+    if weight > 0.0 { sum / weight } else { Vec3::ZERO }
+}
+
+/// The centre direction and solid angle of every texel of a `width` × `height` map.
+fn texel_directions(width: u32, height: u32) -> Vec<(Vec3, f32)> {
+    (0..width * height)
+        .map(|i| {
+            let (x, y) = (i % width, i / width);
+            let d = uv_to_direction((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
+            (d, texel_solid_angle(y, width, height) as f32)
+        })
+        .collect()
+}
+
+/// Levels whose GGX α is at least this are convolved by brute force (roughness 0.4 and up).
+const CONVOLVE_ALPHA: f32 = 0.15;
+
 /// Bakes `env` with a radiance map at most `max_width` wide.
 pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
     let src = Image {
@@ -225,16 +264,16 @@ pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
     };
     let width = (max_width.min(env.width) & !1).max(2);
     let map = resample(&src, width, env.rotation_degrees);
-    let mut clamped = 0u64;
-    let limit = 511.0 / 512.0 * 65536.0;
-    let map_texels: Vec<u32> = map
-        .pixels
-        .iter()
-        .map(|p| {
-            clamped += p.to_array().iter().filter(|&&c| c > limit).count() as u64;
-            encode_rgb9e5(p.to_array())
-        })
-        .collect();
+    let map_texels: Vec<u32> = map.pixels.iter().map(|p| encode_rgb9e5(p.to_array())).collect();
+    let (mut sum, mut total) = ([0f64; 3], 0f64);
+    for (i, &t) in map_texels.iter().enumerate() {
+        let dw = texel_solid_angle(i as u32 / width, width, width / 2);
+        for (s, c) in sum.iter_mut().zip(decode_rgb9e5(t)) {
+            *s += c as f64 * dw;
+        }
+        total += dw;
+    }
+    let mean = sum.map(|s| (s / total) as f32);
     // The pyramid the prefilter reads, from the map itself.
     let mut pyramid = vec![map.clone()];
     while pyramid.last().is_some_and(|l| l.width > 8) {
@@ -255,32 +294,53 @@ pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
         let [w, h] = header.filtered_extent(i);
         let roughness = i as f32 / (LEVELS - 1) as f32;
         let alpha = roughness * roughness;
+        // The brute-force source: the pyramid's level at most four times the output's width.
+        let src = pyramid.iter().find(|l| l.width <= 4 * w).unwrap_or(&pyramid[pyramid.len() - 1]);
+        let dirs = if alpha >= CONVOLVE_ALPHA { texel_directions(src.width, src.height) } else { Vec::new() };
         let level: Vec<u32> = (0..h)
             .into_par_iter()
             .flat_map_iter(|y| {
-                let pyramid = &pyramid;
+                let (pyramid, dirs) = (&pyramid, &dirs);
                 (0..w).map(move |x| {
                     let n = uv_to_direction((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-                    encode_rgb9e5(prefilter(n, alpha, pyramid).to_array())
+                    let c = if dirs.is_empty() {
+                        prefilter(n, alpha, pyramid)
+                    } else {
+                        convolve(n, alpha, src, dirs)
+                    };
+                    encode_rgb9e5(c.to_array())
                 })
             })
             .collect();
         filtered.extend(level);
     }
-    // Irradiance harmonics from prefiltered level 0's texels (plenty for band 2).
-    let mut sh = [[0f64; 3]; 9];
-    for y in 0..level0.height {
-        let dw = texel_solid_angle(y, level0.width, level0.height);
-        for x in 0..level0.width {
-            let d = uv_to_direction(
-                (x as f32 + 0.5) / level0.width as f32,
-                (y as f32 + 0.5) / level0.height as f32,
-            );
-            let l = level0.pixels[(y * level0.width + x) as usize];
-            for (k, b) in sh_basis(d).iter().enumerate() {
-                for c in 0..3 {
-                    sh[k][c] += l[c] as f64 * *b as f64 * dw;
+    // Irradiance harmonics from prefiltered level 0's texels (plenty for band 2), each texel
+    // split into 4 x 4 parts of their own direction and exact solid angle: the integral of the
+    // piecewise-constant map, not a midpoint rule over its texels.
+    const SPLIT: u32 = 4;
+    let (sw, shh) = (level0.width * SPLIT, level0.height * SPLIT);
+    let rows: Vec<[[f64; 3]; 9]> = (0..shh)
+        .into_par_iter()
+        .map(|y| {
+            let dw = texel_solid_angle(y, sw, shh);
+            let mut row = [[0f64; 3]; 9];
+            for x in 0..sw {
+                let d = uv_to_direction((x as f32 + 0.5) / sw as f32, (y as f32 + 0.5) / shh as f32);
+                let l = level0.pixels[((y / SPLIT) * level0.width + x / SPLIT) as usize];
+                for (k, b) in sh_basis(d).iter().enumerate() {
+                    for c in 0..3 {
+                        row[k][c] += l[c] as f64 * *b as f64 * dw;
+                    }
                 }
+            }
+            row
+        })
+        .collect();
+    let mut sh = [[0f64; 3]; 9];
+    for row in &rows {
+        for k in 0..9 {
+            for c in 0..3 {
+                sh[k][c] += row[k][c];
             }
         }
     }
@@ -311,20 +371,13 @@ pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
             alias_density: density[alias as usize],
         })
         .collect();
-    BakedEnvironment { header, map: map_texels, filtered, table, clamped }
+    BakedEnvironment { header, map: map_texels, filtered, table, mean }
 }
 
 /// The stage: the sections of the context's baked environment (none without an environment).
 pub fn stage(ctx: &BakeContext) -> Sections {
     let mut out = Sections::default();
     let Some(env) = ctx.environment() else { return out };
-    if env.clamped > 0 {
-        eprintln!(
-            "warning: environment: {} texel channels brighter than 65408 (what E5B9G9R9 holds) were clamped; \
-             lower [sky] intensity and raise the exposure to keep them",
-            env.clamped
-        );
-    }
     out.push(ENVIRONMENT_HEADER, 0, bytemuck::bytes_of(&env.header).to_vec());
     out.push(ENVIRONMENT_MAP, 0, bytemuck::cast_slice(&env.map).to_vec());
     out.push(ENVIRONMENT_FILTERED, 0, bytemuck::cast_slice(&env.filtered).to_vec());

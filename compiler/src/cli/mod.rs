@@ -219,7 +219,8 @@ bounce, whenever something lights the scene) or off [default: auto, or the sidec
     #[arg(long, value_name = "studio|preetham|FILE", value_parser = crate::import::environment::EnvironmentSpec::parse, help_heading = "Environment",
           help = "Light from every direction beyond the scene, replacing the sidecar's [sky]: `studio` (a built-in \
 neutral dome with a key softbox and a rim light, for assets that bring no light), `preetham` (Preetham's daylight \
-with its sun as a directional light; the sun's direction and turbidity come from a sidecar's [sky]), or an \
+with its sun as a directional light, at the default sun 45° up and turbidity 3; a sidecar's [sky] model = \
+\"preetham\" chooses others), or an \
 equirectangular Radiance .hdr or OpenEXR image (see docs/sidecar.md)")]
     pub environment: Option<crate::import::environment::EnvironmentSpec>,
     /// Multiplies the environment's radiance.
@@ -237,7 +238,7 @@ equirectangular Radiance .hdr or OpenEXR image (see docs/sidecar.md)")]
         value_name = "DEGREES",
         requires = "environment",
         help_heading = "Environment",
-        help = "Rotates the --environment about +y, counter-clockwise seen from above [default: 0]"
+        help = "Rotates the --environment about +y by the right-hand rule (counter-clockwise seen from above: 90 turns what lay along -z to -x) [default: 0]"
     )]
     pub environment_rotation: Option<f32>,
     /// Normals where the asset gives none.

@@ -45,7 +45,7 @@ pub enum EnvironmentSpec {
 pub struct Placement {
     /// Multiplies every radiance.
     pub intensity: f32,
-    /// Rotation about +y, degrees (counter-clockwise seen from above).
+    /// Rotation about +y, degrees, by the right-hand rule (counter-clockwise seen from above).
     pub rotation_degrees: f32,
 }
 
@@ -106,6 +106,15 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
     };
     for p in &mut pixels {
         *p = p.map(|c| c * placement.intensity);
+    }
+    // What E5B9G9R9 holds at most (the bake clamps beyond it).
+    let limit = 511.0 / 512.0 * 65536.0;
+    let clamped = pixels.iter().flatten().filter(|&&c| c > limit).count();
+    if clamped > 0 {
+        scene.warn(format!(
+            "{source}: environment {name}: {clamped} pixel channels are brighter than 65408, what the baked map \
+             holds; they are clamped (lower the intensity and raise the exposure to keep them)"
+        ));
     }
     let mean = mean_radiance(&pixels, width);
     scene.sky = Sky { radiance: mean };

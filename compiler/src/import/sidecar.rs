@@ -172,6 +172,11 @@ impl SkyToml {
                 if self.intensity.is_some() || self.rotation_degrees.is_some() {
                     return Err("[sky] intensity and rotation_degrees need an image or a model".into());
                 }
+                if self.sun_direction.is_some() || self.turbidity.is_some() || self.sun.is_some() {
+                    return Err(
+                        "[sky] sun_direction, turbidity and sun belong to model = \"preetham\"".into()
+                    );
+                }
                 return Ok(None);
             }
         };
