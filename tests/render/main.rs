@@ -13,6 +13,7 @@ mod analytic; // one light on a diffuse plane against its closed form, per pixel
 mod colors; // vertex colours in both G-buffers and the reference, against closed forms
 mod denoise; // svgf: the floor under an emissive quad keeps its closed-form mean, loses its noise, bleeds nothing into the lamp; converges to the undenoised image
 mod emitters; // emissive triangles as lights (ris, restir): polygon irradiance, textured emission, a white furnace
+mod environment; // the environment: background mapping, a constant map against the constant sky, a white sphere against brute force (reference, direct pass)
 mod files; // damaged files fail with the right exit code; minimal files render
 mod gi; // path-traced GI plus direct light against the two-bounce reference
 mod godrays; // Mitchell's and Sousa's image-space blurs, their failure with the light behind the camera

@@ -45,6 +45,22 @@ struct InspectJson {
     line_space: Option<LineSpaceJson>,
     /// The irradiance probe volume, when present.
     probes: Option<ProbesJson>,
+    /// The environment, when present.
+    environment: Option<EnvironmentJson>,
+}
+
+#[derive(Serialize)]
+struct EnvironmentJson {
+    /// Radiance map width and height.
+    map: [u32; 2],
+    /// Prefiltered level 0's width and height, and the level count.
+    filtered: [u32; 3],
+    /// Sampling table width and height.
+    table: [u32; 2],
+    /// Mean radiance (the manifest's sky).
+    mean: Option<[f32; 3]>,
+    /// Decoded bytes of the four sections.
+    bytes: u64,
 }
 
 #[derive(Serialize)]
@@ -169,6 +185,18 @@ pub fn run(args: &InspectArgs) -> CliResult {
             rays: g.rays,
             bytes: size(&kiln_format::probes::PROBE_KINDS),
         });
+    let environment = file
+        .pod::<kiln_format::environment::EnvironmentHeader>(sections::ENVIRONMENT_HEADER, 0)
+        .ok()
+        .flatten()
+        .and_then(|g| g.first().copied())
+        .map(|g| EnvironmentJson {
+            map: [g.map[0], g.map[1]],
+            filtered: [g.filtered[0], g.filtered[1], g.filtered[2]],
+            table: [g.table[0], g.table[1]],
+            mean: manifest.as_ref().map(|m| m.sky.radiance),
+            bytes: size(&kiln_format::environment::ENVIRONMENT_KINDS),
+        });
     let h = file.header();
     let report = InspectJson {
         path: args.file.display().to_string(),
@@ -181,6 +209,7 @@ pub fn run(args: &InspectArgs) -> CliResult {
         summary,
         line_space,
         probes,
+        environment,
     };
     if args.json {
         print_json(&report);
@@ -204,6 +233,22 @@ fn print_text(r: &InspectJson) {
             p.layers,
             p.rays,
             size(p.bytes)
+        );
+    }
+    if let Some(e) = &r.environment {
+        let mean = e
+            .mean
+            .map_or(String::new(), |m| format!(", mean radiance ({:.4}, {:.4}, {:.4})", m[0], m[1], m[2]));
+        println!(
+            "environment {}x{}: {} GGX levels from {}x{}, {}x{} sampling table{mean}, {}",
+            e.map[0],
+            e.map[1],
+            e.filtered[2],
+            e.filtered[0],
+            e.filtered[1],
+            e.table[0],
+            e.table[1],
+            size(e.bytes)
         );
     }
     if let Some(l) = &r.line_space {
