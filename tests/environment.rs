@@ -519,7 +519,8 @@ fn bad_environment_images_are_refused_or_warned() {
         img.save(&path).unwrap();
         let mut s = scene(image(8, |_| [0.0; 3]));
         s.environment = None;
-        let r = apply(&mut s, &EnvironmentSpec::Image { path }, Placement::default(), "test");
+        let r =
+            apply(&mut s, &EnvironmentSpec::Image { path, extract_sun: true }, Placement::default(), "test");
         (r.map_err(|e| e.to_string()), s)
     };
     let (r, _) = try_image("ldr.png", image::DynamicImage::new_rgb8(64, 32));
@@ -536,4 +537,60 @@ fn bad_environment_images_are_refused_or_warned() {
     let env = s.environment.unwrap();
     assert_eq!(env.pixels[3 * 16 + 3], [0.0, 1.0, 0.0]);
     assert_eq!(env.pixels[0], [1.0, 2.0, 3.0]);
+}
+
+#[test]
+fn a_sun_in_an_image_becomes_a_directional_light_of_its_irradiance() {
+    use kiln_compiler::import::environment::{EnvironmentSpec, Placement, apply};
+    // A 512 x 256 sky of radiance 0.4 with a sun of radiance 5000 and 1° radius, 30° up.
+    let (w, h) = (512u32, 256u32);
+    let sun = direction(0.15, 60.0 / 180.0);
+    let cos_r = 1f64.to_radians().cos();
+    let mut img = image::Rgb32FImage::new(w, h);
+    let mut excess = 0.0;
+    for y in 0..h {
+        let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
+        let dw = (t0.cos() - t1.cos()) * 2.0 * PI / w as f64;
+        for x in 0..w {
+            let d = direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+            let on = dot(d, sun) > cos_r;
+            if on {
+                excess += (5000.0 - 0.4) * dw;
+            }
+            img.put_pixel(x, y, image::Rgb([if on { 5000.0 } else { 0.4 }; 3]));
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sun.exr");
+    image::DynamicImage::from(img).save(&path).unwrap();
+    for (rotation, extract) in [(0.0f32, true), (90.0, true), (0.0, false)] {
+        let mut s = scene(image(8, |_| [0.0; 3]));
+        s.environment = None;
+        let spec = EnvironmentSpec::Image { path: path.clone(), extract_sun: extract };
+        apply(&mut s, &spec, Placement { intensity: 2.0, rotation_degrees: rotation }, "test").unwrap();
+        let env = s.environment.as_ref().unwrap();
+        let brightest = env.pixels.iter().map(|p| p[1]).fold(0.0f32, f32::max);
+        let suns: Vec<_> =
+            s.lights.iter().filter(|l| l.kind == kiln_format::manifest::LightKind::Directional).collect();
+        if !extract {
+            assert!(suns.is_empty() && brightest == 10000.0, "the sun stays in the map when asked");
+            continue;
+        }
+        let [l] = suns[..] else { panic!("one sun light: {:?}", s.lights) };
+        // Turned by the right-hand rule about +y, as the bake turns the map.
+        let (sn, cs) = (rotation as f64).to_radians().sin_cos();
+        let want = [sun[0] * cs + sun[2] * sn, sun[1], -sun[0] * sn + sun[2] * cs];
+        let got = l.direction.map(|c| -c as f64);
+        assert!(
+            dot(got, want) > 0.5f64.to_radians().cos(),
+            "rotation {rotation}: the sun at {got:?}, want {want:?}"
+        );
+        let irradiance = l.intensity as f64 * luminance(l.color.map(|c| c as f64));
+        assert!(
+            (irradiance - 2.0 * excess).abs() < 0.01 * 2.0 * excess,
+            "irradiance {irradiance} vs {}",
+            2.0 * excess
+        );
+        assert!(brightest <= 0.8 + 1e-4, "the map keeps the sky only: brightest {brightest}");
+    }
 }

@@ -223,6 +223,12 @@ with its sun as a directional light, at the default sun 45° up and turbidity 3;
 \"preetham\" chooses others), or an \
 equirectangular Radiance .hdr or OpenEXR image (see docs/sidecar.md)")]
     pub environment: Option<crate::import::environment::EnvironmentSpec>,
+    /// Whether a sun in an --environment image becomes a directional light.
+    #[arg(long, value_name = "on|off", value_parser = ["on", "off"], requires = "environment", help_heading = "Environment",
+          help = "With an --environment image: `on` takes a sun found in it (a region under 0.01 sr, 64 times brighter \
+than the map's median) out of the map as a directional light of the same irradiance, which shadow maps and shadow \
+rays then see (the disc's size is lost: hard shadows); `off` leaves it in the map [default: on]")]
+    pub environment_sun: Option<String>,
     /// Multiplies the environment's radiance.
     #[arg(
         long,
@@ -300,12 +306,16 @@ impl BakeArgs {
     pub fn apply_environment(&self, scene: &mut crate::ir::Scene) -> crate::exit::CliResult<()> {
         use crate::import::environment::{Placement, apply};
         let Some(spec) = &self.environment else { return Ok(()) };
+        let mut spec = spec.clone();
+        if let crate::import::environment::EnvironmentSpec::Image { extract_sun, .. } = &mut spec {
+            *extract_sun = self.environment_sun.as_deref() != Some("off");
+        }
         let d = Placement::default();
         let placement = Placement {
             intensity: self.environment_intensity.unwrap_or(d.intensity),
             rotation_degrees: self.environment_rotation.unwrap_or(d.rotation_degrees),
         };
-        apply(scene, spec, placement, "--environment")
+        apply(scene, &spec, placement, "--environment")
     }
 }
 

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use kiln_format::environment::uv_to_direction;
-use kiln_format::manifest::Sky;
+use kiln_format::manifest::{Light, LightKind, Sky};
 
 use super::preetham;
 use crate::exit::{CliError, CliResult};
@@ -26,6 +26,8 @@ pub enum EnvironmentSpec {
     Image {
         /// The file.
         path: PathBuf,
+        /// Whether a sun found in it becomes a directional light ([`extract_sun`]).
+        extract_sun: bool,
     },
     /// Preetham, Shirley and Smits's daylight model (SIGGRAPH 1999) and its sun.
     Preetham {
@@ -67,7 +69,7 @@ impl EnvironmentSpec {
                 sun: true,
             },
             "" => return Err("give studio, preetham or the path of an .hdr or .exr image".into()),
-            path => EnvironmentSpec::Image { path: PathBuf::from(path) },
+            path => EnvironmentSpec::Image { path: PathBuf::from(path), extract_sun: true },
         })
     }
 }
@@ -86,9 +88,9 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
     if !placement.rotation_degrees.is_finite() {
         return Err(bad("environment rotation must be finite".into()));
     }
-    scene.lights.retain(|l| l.name != preetham::SUN_NAME);
-    let (name, width, mut pixels) = match spec {
-        EnvironmentSpec::Image { path } => {
+    scene.lights.retain(|l| l.name != preetham::SUN_NAME && l.name != EXTRACTED_SUN_NAME);
+    let (mut name, width, mut pixels) = match spec {
+        EnvironmentSpec::Image { path, .. } => {
             let (w, pixels) = load_image(path, scene).map_err(bad)?;
             (path.display().to_string(), w, pixels)
         }
@@ -106,6 +108,16 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
     };
     for p in &mut pixels {
         *p = p.map(|c| c * placement.intensity);
+    }
+    if let EnvironmentSpec::Image { extract_sun: true, .. } = spec {
+        if let Some(sun) = extract_sun(&mut pixels, width, placement.rotation_degrees) {
+            name = format!(
+                "{name} (sun of {:.2}° radius taken out as a directional light of {:.4})",
+                (1.0 - sun.solid_angle / std::f64::consts::TAU).acos().to_degrees(),
+                sun.light.intensity
+            );
+            scene.lights.push(sun.light);
+        }
     }
     // What E5B9G9R9 holds at most (the bake clamps beyond it).
     let limit = 511.0 / 512.0 * 65536.0;
@@ -238,4 +250,122 @@ pub fn studio(d: Vec3) -> Vec3 {
         l = Vec3::splat(3.0);
     }
     l
+}
+
+/// Name of the directional light a sun extracted from an image becomes.
+pub const EXTRACTED_SUN_NAME: &str = "sun (environment)";
+
+/// A pixel this many times brighter than the map's median luminance can belong to a sun.
+const SUN_CONTRAST: f32 = 64.0;
+/// The largest solid angle a sun may cover, sr (a cap of about 3.2° radius): a bright region
+/// larger than this is sky (an overcast glare), left in the map.
+const SUN_MAX_SOLID_ANGLE: f64 = 0.01;
+
+/// A sun found in an image: what the map loses and the light that replaces it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExtractedSun {
+    /// The light, shining along −(the region's luminance-weighted mean direction).
+    pub light: Light,
+    /// Pixels replaced.
+    pub pixels: usize,
+    /// Solid angle of the region, sr.
+    pub solid_angle: f64,
+}
+
+/// Finds a sun in an equirectangular map (rows of `width`): the connected region (4-neighbours,
+/// u wrapping) around the brightest pixel of pixels brighter than [`SUN_CONTRAST`] times the
+/// median luminance, when it covers at most [`SUN_MAX_SOLID_ANGLE`]. Its light above the
+/// surrounding sky (the mean of the pixels bordering it) becomes a directional light of that
+/// irradiance, turned by `rotation_degrees` about +y as the bake turns the map, and the region
+/// takes the surrounding sky's radiance. The map keeps the rest of its light, and the total
+/// arriving from the sun's direction is unchanged; what is lost is the disc's size (the light is
+/// a point in direction: hard shadows, where `--sun-angle` does not widen them).
+pub fn extract_sun(pixels: &mut [[f32; 3]], width: u32, rotation_degrees: f32) -> Option<ExtractedSun> {
+    let height = pixels.len() as u32 / width;
+    let lum = |p: &[f32; 3]| kiln_format::gpu::luminance(*p);
+    let mut sample: Vec<f32> = pixels.iter().step_by(7).map(lum).collect();
+    sample.sort_by(f32::total_cmp);
+    let median = sample.get(sample.len() / 2).copied().unwrap_or(0.0);
+    let (brightest, peak) = pixels.iter().map(lum).enumerate().max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let threshold = SUN_CONTRAST * median.max(1e-6);
+    if !(peak > threshold) {
+        return None;
+    }
+    let solid = |y: u32| {
+        let (t0, t1) = (
+            std::f64::consts::PI * y as f64 / height as f64,
+            std::f64::consts::PI * (y + 1) as f64 / height as f64,
+        );
+        (t0.cos() - t1.cos()) * std::f64::consts::TAU / width as f64
+    };
+    let mut inside = vec![false; pixels.len()];
+    let mut region = vec![brightest];
+    inside[brightest] = true;
+    let mut border = Vec::new();
+    let mut solid_angle = 0.0;
+    let mut next = 0;
+    while next < region.len() {
+        let i = region[next];
+        next += 1;
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        solid_angle += solid(y);
+        if solid_angle > SUN_MAX_SOLID_ANGLE {
+            return None;
+        }
+        let left = (x + width - 1) % width;
+        let right = (x + 1) % width;
+        let mut neighbours = vec![y * width + left, y * width + right];
+        if y > 0 {
+            neighbours.push((y - 1) * width + x);
+        }
+        if y + 1 < height {
+            neighbours.push((y + 1) * width + x);
+        }
+        for j in neighbours.into_iter().map(|j| j as usize) {
+            if inside[j] {
+                continue;
+            }
+            if lum(&pixels[j]) > threshold {
+                inside[j] = true;
+                region.push(j);
+            } else {
+                border.push(j);
+            }
+        }
+    }
+    border.sort_unstable();
+    border.dedup();
+    let fill = border.iter().fold(Vec3::ZERO, |s, &j| s + Vec3::from(pixels[j])) / border.len().max(1) as f32;
+    let (mut irradiance, mut axis) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
+    for &i in &region {
+        let (x, y) = (i as u32 % width, i as u32 / width);
+        let d = uv_to_direction((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32).as_dvec3();
+        let excess = (Vec3::from(pixels[i]) - fill).max(Vec3::ZERO).as_dvec3() * solid(y);
+        irradiance += excess;
+        axis += d * kiln_format::gpu::luminance(excess.as_vec3().to_array()) as f64;
+        pixels[i] = fill.to_array();
+    }
+    let (s, c) = (rotation_degrees as f64).to_radians().sin_cos();
+    let axis = axis.normalize_or_zero();
+    let axis = glam::DVec3::new(axis.x * c + axis.z * s, axis.y, -axis.x * s + axis.z * c);
+    let e = irradiance.as_vec3();
+    let l = kiln_format::gpu::luminance(e.to_array());
+    if !(l > 0.0) || axis == glam::DVec3::ZERO {
+        return None;
+    }
+    Some(ExtractedSun {
+        light: Light {
+            name: EXTRACTED_SUN_NAME.into(),
+            kind: LightKind::Directional,
+            position: [0.0; 3],
+            direction: (-axis.as_vec3()).to_array(),
+            right: [0.0; 3],
+            color: (e / l).to_array(),
+            intensity: l,
+            range: 0.0,
+            casts_shadows: true,
+        },
+        pixels: region.len(),
+        solid_angle,
+    })
 }

@@ -147,7 +147,8 @@ pub struct SkyToml {
     pub sun_direction: Option<[f32; 3]>,
     /// Preetham: turbidity, 1.7 to 10.
     pub turbidity: Option<f32>,
-    /// Preetham: whether the sun is added as a directional light (default true).
+    /// Preetham: whether the sun is added as a directional light; an image: whether a sun found
+    /// in it is taken out as a directional light (default true).
     pub sun: Option<bool>,
 }
 
@@ -158,7 +159,9 @@ impl SkyToml {
         use crate::import::preetham;
         let spec = match (&self.image, self.model.as_deref()) {
             (Some(_), Some(_)) => return Err("give [sky] image or model, not both".into()),
-            (Some(image), None) => EnvironmentSpec::Image { path: dir.join(image) },
+            (Some(image), None) => {
+                EnvironmentSpec::Image { path: dir.join(image), extract_sun: self.sun.unwrap_or(true) }
+            }
             (None, Some("preetham")) => EnvironmentSpec::Preetham {
                 sun_direction: self.sun_direction.unwrap_or(preetham::DEFAULT_SUN),
                 turbidity: self.turbidity.unwrap_or(preetham::DEFAULT_TURBIDITY),
@@ -181,9 +184,15 @@ impl SkyToml {
             }
         };
         if !matches!(spec, EnvironmentSpec::Preetham { .. })
-            && (self.sun_direction.is_some() || self.turbidity.is_some() || self.sun.is_some())
+            && (self.sun_direction.is_some() || self.turbidity.is_some())
         {
-            return Err("[sky] sun_direction, turbidity and sun belong to model = \"preetham\"".into());
+            return Err("[sky] sun_direction and turbidity belong to model = \"preetham\"".into());
+        }
+        if matches!(spec, EnvironmentSpec::Studio) && self.sun.is_some() {
+            return Err(
+                "[sky] sun belongs to model = \"preetham\" (add its sun) or an image (take its sun out)"
+                    .into(),
+            );
         }
         if self.radiance.is_some() {
             return Err("[sky] radiance is a constant sky: leave it out with an image or a model".into());
