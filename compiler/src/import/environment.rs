@@ -109,15 +109,15 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
     for p in &mut pixels {
         *p = p.map(|c| c * placement.intensity);
     }
-    if let EnvironmentSpec::Image { extract_sun: true, .. } = spec {
-        if let Some(sun) = extract_sun(&mut pixels, width, placement.rotation_degrees) {
-            name = format!(
-                "{name} (sun of {:.2}° radius taken out as a directional light of {:.4})",
-                (1.0 - sun.solid_angle / std::f64::consts::TAU).acos().to_degrees(),
-                sun.light.intensity
-            );
-            scene.lights.push(sun.light);
-        }
+    if let EnvironmentSpec::Image { extract_sun: true, .. } = spec
+        && let Some(sun) = extract_sun(&mut pixels, width, placement.rotation_degrees)
+    {
+        name = format!(
+            "{name} (sun of {:.2}° radius taken out as a directional light of {:.4})",
+            (1.0 - sun.solid_angle / std::f64::consts::TAU).acos().to_degrees(),
+            sun.light.intensity
+        );
+        scene.lights.push(sun.light);
     }
     // What E5B9G9R9 holds at most (the bake clamps beyond it).
     let limit = 511.0 / 512.0 * 65536.0;
