@@ -39,8 +39,9 @@ pub const LEVELS: u32 = 6;
 pub const FILTERED_WIDTH: u32 = 256;
 /// Width of the sampling table, at most.
 pub const TABLE_WIDTH: u32 = 512;
-/// GGX samples per prefiltered texel.
-pub const FILTER_SAMPLES: u32 = 512;
+/// GGX samples per prefiltered texel of the narrow lobes (each read from the pyramid level its
+/// solid angle covers: few samples suffice; the brute-force levels use none).
+pub const FILTER_SAMPLES: u32 = 256;
 
 /// What the stage bakes, kept for the stages that light with it (the probes).
 #[derive(Debug, Clone)]
@@ -127,6 +128,9 @@ fn coverage(a: f64, b: f64, n: u32, wrap: bool) -> Vec<(u32, f64)> {
 /// about +y by the right-hand rule (counter-clockwise seen from above: +90° takes what lay along
 /// −z to −x; the target direction at u sees the source at u + rotation / 360).
 fn resample(src: &Image, width: u32, rotation_degrees: f32) -> Image {
+    if width == src.width && rotation_degrees.rem_euclid(360.0) == 0.0 {
+        return src.clone();
+    }
     let height = width / 2;
     let shift = (-rotation_degrees as f64 / 360.0).rem_euclid(1.0);
     let cols: Vec<Vec<(u32, f64)>> = (0..width)
@@ -264,14 +268,28 @@ pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
     };
     let width = (max_width.min(env.width) & !1).max(2);
     let map = resample(&src, width, env.rotation_degrees);
-    let map_texels: Vec<u32> = map.pixels.iter().map(|p| encode_rgb9e5(p.to_array())).collect();
+    let map_texels: Vec<u32> = map.pixels.par_iter().map(|p| encode_rgb9e5(p.to_array())).collect();
+    // The mean of the stored texels: rows summed in parallel, then in order.
+    let rows: Vec<([f64; 3], f64)> = map_texels
+        .par_chunks(width as usize)
+        .enumerate()
+        .map(|(y, row)| {
+            let dw = texel_solid_angle(y as u32, width, width / 2);
+            let mut sum = [0f64; 3];
+            for &t in row {
+                for (s, c) in sum.iter_mut().zip(decode_rgb9e5(t)) {
+                    *s += c as f64 * dw;
+                }
+            }
+            (sum, dw * row.len() as f64)
+        })
+        .collect();
     let (mut sum, mut total) = ([0f64; 3], 0f64);
-    for (i, &t) in map_texels.iter().enumerate() {
-        let dw = texel_solid_angle(i as u32 / width, width, width / 2);
-        for (s, c) in sum.iter_mut().zip(decode_rgb9e5(t)) {
-            *s += c as f64 * dw;
+    for (s, w) in rows {
+        for c in 0..3 {
+            sum[c] += s[c];
         }
-        total += dw;
+        total += w;
     }
     let mean = sum.map(|s| (s / total) as f32);
     // The pyramid the prefilter reads, from the map itself.
