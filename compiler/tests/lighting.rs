@@ -674,3 +674,40 @@ fn emitted_luminance_averages_the_emissive_texture_over_each_triangle() {
         );
     }
 }
+
+#[test]
+fn the_environment_on_the_command_line_plans_inspects_and_exports() {
+    let dir = tempfile::tempdir().unwrap();
+    let quick = ["--probes", "off", "--shaft-variants", "none", "--environment-res", "64"];
+    let mut args = vec!["demo", "-o", "e.kiln", "--environment", "studio"];
+    args.extend(quick);
+    run::kiln(dir.path(), &args).expect(0);
+    let inspect = run::kiln(dir.path(), &["inspect", "e.kiln"]);
+    assert!(inspect.expect(0).stdout.contains("environment 64x32: 6 GGX levels from 64x32"), "{inspect:?}");
+    run::kiln(dir.path(), &["export", "e.kiln", "environment-map", "-o", "map.exr"]).expect(0);
+    // The studio (docs/sidecar.md): a dome of 0.8 + 0.2 y over a floor of 0.3; the top row
+    // averages y close to 1, the bottom row is floor.
+    let map = image::open(dir.path().join("map.exr")).unwrap().into_rgb32f();
+    assert_eq!(map.dimensions(), (64, 32));
+    for x in [0, 20, 63] {
+        let (top, bottom) = (map.get_pixel(x, 0)[1], map.get_pixel(x, 31)[1]);
+        assert!((top - 1.0).abs() < 0.01 && (bottom - 0.3).abs() < 0.01, "column {x}: {top}, {bottom}");
+    }
+    run::kiln(dir.path(), &["export", "e.kiln", "environment-filtered:5", "-o", "f5.exr"]).expect(0);
+    assert_eq!(image::open(dir.path().join("f5.exr")).unwrap().into_rgb32f().dimensions(), (2, 1));
+    run::kiln(dir.path(), &["export", "e.kiln", "environment-filtered:6", "-o", "x.exr"])
+        .expect(1)
+        .says("no environment-filtered:6");
+    // Without an environment there is nothing to export.
+    run::kiln(dir.path(), &["demo", "-o", "plain.kiln", "--probes", "off", "--shaft-variants", "none"])
+        .expect(0);
+    run::kiln(dir.path(), &["export", "plain.kiln", "environment-map", "-o", "x.exr"])
+        .expect(1)
+        .says("no environment-map");
+    // Usage: the environment's options need --environment; sun keys need their source.
+    run::kiln(dir.path(), &["demo", "-o", "x.kiln", "--environment-sun", "off"]).expect(2);
+    std::fs::write(dir.path().join("bad.toml"), "[sky]\nturbidity = 4.0\n").unwrap();
+    run::kiln(dir.path(), &["demo", "-o", "x.kiln", "-c", "bad.toml"]).expect(1).says("preetham");
+    std::fs::write(dir.path().join("both.toml"), "[sky]\nmodel = \"studio\"\nimage = \"a.hdr\"\n").unwrap();
+    run::kiln(dir.path(), &["demo", "-o", "x.kiln", "-c", "both.toml"]).expect(1).says("not both");
+}

@@ -383,8 +383,9 @@ pub struct ExportArgs {
     /// The .kiln file.
     pub file: PathBuf,
     /// Section name and index, e.g. `brdf-lut`, `shadow-map:1`, `texture:0`, `probe-irradiance:2`
-    /// (the probes' z slice 2; the emitted layer's slices follow) (`kiln inspect` lists the
-    /// sections a file has).
+    /// (the probes' z slice 2; the emitted layer's slices follow), `environment-map`,
+    /// `environment-filtered:3` (the prefiltered level of roughness 3 / 5) (`kiln inspect` lists
+    /// the sections a file has).
     pub section: String,
     /// Output image: .pfm, .exr or .png.
     #[arg(long, short = 'o', value_name = "PATH")]

@@ -24,8 +24,16 @@ struct Image {
 }
 
 /// Section names `export` accepts.
-pub const EXPORTABLE: &[&str] =
-    &["brdf-lut", "shadow-map", "texture", "media-visibility", "probe-irradiance", "probe-visibility"];
+pub const EXPORTABLE: &[&str] = &[
+    "brdf-lut",
+    "shadow-map",
+    "texture",
+    "media-visibility",
+    "probe-irradiance",
+    "probe-visibility",
+    "environment-map",
+    "environment-filtered",
+];
 
 /// Runs `kiln export`.
 pub fn run(args: &ExportArgs) -> CliResult {
@@ -129,6 +137,29 @@ pub fn run(args: &ExportArgs) -> CliResult {
             };
             let scale = if name == "probe-irradiance" { 1.0 } else { h.max_distance * h.max_distance };
             Image { width: w, height: ht, channels: 3, data, scale, wide: true }
+        }
+        "environment-map" | "environment-filtered" => {
+            // The radiance map (index 0), or prefiltered level `index` (roughness index / (levels
+            // − 1)), as linear RGB, row 0 the zenith.
+            let e = kiln_format::environment::Environment::read(&file)
+                .map_err(|e| format_error(&args.file, e))?
+                .ok_or_else(missing)?;
+            let h = e.header;
+            let (w, ht, texels) = if name == "environment-map" {
+                if index != 0 {
+                    return Err(missing());
+                }
+                (h.map[0], h.map[1], e.map)
+            } else {
+                if index >= h.filtered[2] {
+                    return Err(missing());
+                }
+                let [w, ht] = h.filtered_extent(index);
+                let at = h.filtered_offset(index);
+                (w, ht, &e.filtered[at..at + (w * ht) as usize])
+            };
+            let data = texels.iter().flat_map(|&t| kiln_format::probes::decode_rgb9e5(t)).collect();
+            Image { width: w, height: ht, channels: 3, data, scale: 1.0, wide: true }
         }
         _ => {
             let info = view.manifest.media_visibility.as_ref().ok_or_else(missing)?;
