@@ -201,6 +201,26 @@ impl<'a> Environment<'a> {
         Vec3::from(crate::probes::decode_rgb9e5(self.map[(y * w + x) as usize]))
     }
 
+    /// A direction drawn from the table with three uniforms in [0, 1) (the first picks the cell
+    /// and, by its fraction, whether the cell keeps the draw; the other two place it uniformly in
+    /// the cell's (u, v) rectangle), and its solid-angle density; `None` where it has none (a
+    /// black map, a pole). What `shaders/common/environment.glsl`'s `env_sample` does.
+    pub fn sample(&self, xi: [f32; 3]) -> Option<(Vec3, f32)> {
+        let [w, h] = [self.header.table[0], self.header.table[1]];
+        let cells = w * h;
+        let scaled = xi[0] * cells as f32;
+        let mut cell = (scaled as u32).min(cells - 1);
+        let c = self.table[cell as usize];
+        let mut density = c.density;
+        if scaled - cell as f32 >= c.keep {
+            (cell, density) = (c.alias, c.alias_density);
+        }
+        let (u, v) = (((cell % w) as f32 + xi[1]) / w as f32, ((cell / w) as f32 + xi[2]) / h as f32);
+        let s = (std::f32::consts::PI * v).sin();
+        let pdf = if s > 0.0 { density / s } else { 0.0 };
+        (pdf > 0.0).then(|| (uv_to_direction(u, v), pdf))
+    }
+
     /// Solid-angle density with which the table draws unit direction `d`.
     pub fn pdf(&self, d: Vec3) -> f32 {
         let [w, h] = [self.header.table[0], self.header.table[1]];

@@ -24,7 +24,7 @@
 
 use glam::Vec3;
 use kiln_format::environment::{
-    EnvironmentCell, EnvironmentHeader, alias_table, direction_to_uv, sh_basis, uv_to_direction,
+    Environment, EnvironmentCell, EnvironmentHeader, alias_table, direction_to_uv, sh_basis, uv_to_direction,
 };
 use kiln_format::probes::{decode_rgb9e5, encode_rgb9e5};
 use kiln_format::sections::{ENVIRONMENT_FILTERED, ENVIRONMENT_HEADER, ENVIRONMENT_MAP, ENVIRONMENT_TABLE};
@@ -59,13 +59,9 @@ pub struct BakedEnvironment {
 }
 
 impl BakedEnvironment {
-    /// Radiance from unit direction `d`: the map's texel (as the player's path tracers read it).
-    pub fn radiance(&self, d: Vec3) -> Vec3 {
-        let [w, h, ..] = self.header.map;
-        let [u, v] = direction_to_uv(d);
-        let x = ((u * w as f32) as u32).min(w - 1);
-        let y = ((v * h as f32) as u32).min(h - 1);
-        Vec3::from(decode_rgb9e5(self.map[(y * w + x) as usize]))
+    /// The baked sections as a reader sees them (radiance, density, sampling).
+    pub fn view(&self) -> Environment<'_> {
+        Environment { header: self.header, map: &self.map, filtered: &self.filtered, table: &self.table }
     }
 }
 

@@ -230,13 +230,19 @@ fn bake_probe(tracer: &Tracer, layout: &ProbeLayout, index: u32, g: Vec3) -> Bak
     // A quarter as many next-event samples of the emissive triangles, combined with the rays
     // that hit them by the balance heuristic: a small lamp seen by few rays still lights evenly.
     let m = if tracer.has_emitters() { n / 4 } else { 0 };
+    // As many again of the environment through its table, against the rays that escape: a sun
+    // or a softbox a few degrees across lights the probe without waiting for a ray to find it.
+    let q = if tracer.sky.sampled() { n / 4 } else { 0 };
     let uniform = n as f32 / (4.0 * std::f32::consts::PI);
     let mut samples = Vec::with_capacity((n + m) as usize);
     for i in 0..n {
         let d = fibonacci_direction(i, n);
         let mut rng = path_rng(index, i);
         let sample = match tracer.trace(p, d, f32::INFINITY) {
-            None => Sample { d, light: [tracer.sky.radiance(d) / uniform, Vec3::ZERO], distance: None },
+            None => {
+                let sky = tracer.sky.radiance(d) / (uniform + q as f32 * tracer.sky.pdf(d));
+                Sample { d, light: [sky, Vec3::ZERO], distance: None }
+            }
             Some(h) => {
                 let distance = Some(h.t / spacing);
                 if tracer.inside(&h, d) {
@@ -257,6 +263,15 @@ fn bake_probe(tracer: &Tracer, layout: &ProbeLayout, index: u32, g: Vec3) -> Bak
             && le != Vec3::ZERO
         {
             samples.push(Sample { d, light: [Vec3::ZERO, le / (uniform + m as f32 * pdf)], distance: None });
+        }
+    }
+    for j in 0..q {
+        let mut rng = path_rng(index, n + m + j);
+        if let Some((d, le, pdf)) = tracer.sky.sample(j, q, &mut rng)
+            && le != Vec3::ZERO
+            && tracer.trace(p, d, f32::INFINITY).is_none()
+        {
+            samples.push(Sample { d, light: [le / (uniform + q as f32 * pdf), Vec3::ZERO], distance: None });
         }
     }
     let ti = IRRADIANCE_TEXELS;

@@ -108,8 +108,32 @@ impl Sky<'_> {
     pub fn radiance(&self, d: Vec3) -> Vec3 {
         match self {
             Sky::Constant(l) => *l,
-            Sky::Environment(e) => e.radiance(d),
+            Sky::Environment(e) => e.view().radiance(d),
         }
+    }
+
+    /// Whether it has a sampling table (next-event estimation of the sky).
+    pub fn sampled(&self) -> bool {
+        matches!(self, Sky::Environment(_))
+    }
+
+    /// Solid-angle density of the table's draw of `d` (0 without a table).
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        match self {
+            Sky::Constant(_) => 0.0,
+            Sky::Environment(e) => e.view().pdf(d),
+        }
+    }
+
+    /// Draw `j` of `count` from the table (stratified: draw j's first uniform lies in
+    /// [j, j + 1) / count, so that the draws fall on the table's cells in proportion to their
+    /// probabilities, not by chance), its radiance and density.
+    pub fn sample(&self, j: u32, count: u32, rng: &mut crate::raycheck::Rng) -> Option<(Vec3, Vec3, f32)> {
+        let Sky::Environment(e) = self else { return None };
+        let view = e.view();
+        let first = ((j as f32 + rng.f32()) / count as f32).min(1.0 - f32::EPSILON);
+        let (d, pdf) = view.sample([first, rng.f32(), rng.f32()])?;
+        Some((d, view.radiance(d), pdf))
     }
 }
 
