@@ -439,3 +439,26 @@ fn a_light_colour_change_rebakes_no_shadow_map() {
     // Only the probes hold the light's colour.
     assert_eq!(with(&stages, false), ["probes"], "{stages:?}");
 }
+
+#[test]
+fn an_environment_change_misses_the_environment_and_the_probes_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let env = ["--environment", "studio", "--environment-res", "64", "--shaft-res", "1"];
+    let (first, _) = demo(d, "a.kiln", Some("c"), &env);
+    assert!(first.iter().any(|s| s.0 == "environment"), "{first:?}");
+    // The same environment again: every stage from the cache, the same bytes.
+    let (warm, _) = demo(d, "b.kiln", Some("c"), &env);
+    assert_eq!(with(&warm, false), Vec::<&str>::new(), "{warm:?}");
+    same(d, "a.kiln", "b.kiln");
+    // Turned: the map changes, and the probes that see it; nothing else reads it.
+    let turned = [&env[..], &["--environment-rotation", "90"]].concat();
+    let (stages, _) = demo(d, "c.kiln", Some("c"), &turned);
+    demo(d, "c-plain.kiln", None, &turned);
+    same(d, "c-plain.kiln", "c.kiln");
+    assert_eq!(with(&stages, false), ["environment", "probes"], "{stages:?}");
+    // A finer map: the same.
+    let finer = ["--environment", "studio", "--environment-res", "128", "--shaft-res", "1"];
+    let (stages, _) = demo(d, "d.kiln", Some("c"), &finer);
+    assert_eq!(with(&stages, false), ["environment", "probes"], "{stages:?}");
+}
