@@ -14,6 +14,7 @@ use kiln_compiler::ir::{EnvironmentImage, Scene};
 use kiln_compiler::settings::Settings;
 use kiln_format::sections;
 use kiln_format::{Checksums, KilnFile};
+use kiln_tests::equirect::{direction, image, texels};
 use kiln_tests::{compile, scene_of};
 
 use std::f64::consts::PI;
@@ -28,12 +29,6 @@ fn settings(res: u32) -> Settings {
     }
 }
 
-/// The unit direction at map coordinates (u, v) (FORMAT.md: u = atan2(x, −z) / 2π, v = acos(y) / π).
-fn direction(u: f64, v: f64) -> [f64; 3] {
-    let (phi, theta) = (2.0 * PI * u, PI * v);
-    [theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos()]
-}
-
 /// E5B9G9R9 as the Vulkan specification decodes it.
 fn rgb9e5(t: u32) -> [f64; 3] {
     let scale = 2f64.powi((t >> 27) as i32 - 24);
@@ -46,21 +41,6 @@ fn luminance(c: [f64; 3]) -> f64 {
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// A `width` × `width / 2` environment of `f` at the texel centres.
-fn image(width: u32, f: impl Fn([f64; 3]) -> [f64; 3]) -> EnvironmentImage {
-    let height = width / 2;
-    let pixels = (0..width * height)
-        .map(|i| {
-            let d = direction(
-                ((i % width) as f64 + 0.5) / width as f64,
-                ((i / width) as f64 + 0.5) / height as f64,
-            );
-            f(d).map(|c| c as f32)
-        })
-        .collect();
-    EnvironmentImage { name: "test".into(), width, height, pixels, rotation_degrees: 0.0 }
 }
 
 /// A floor quad lit only by `env`.
@@ -266,15 +246,8 @@ fn the_prefiltered_levels_are_the_ggx_lobe_integral() {
     };
     let b = bake(image(256, |d| [0.1 + 5.0 * dot(d, axis).max(0.0).powi(8); 3]), 256);
     let [w, h] = b.map;
-    let mut texels = Vec::new();
-    for y in 0..h {
-        let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
-        let dw = (t0.cos() - t1.cos()) * 2.0 * PI / w as f64;
-        for x in 0..w {
-            let d = direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-            texels.push((d, rgb9e5(b.texels[(y * w + x) as usize])[0], dw));
-        }
-    }
+    let texels: Vec<([f64; 3], f64, f64)> =
+        texels(w, h).map(|(x, y, d, dw)| (d, rgb9e5(b.texels[(y * w + x) as usize])[0], dw)).collect();
     assert_eq!(b.filtered[2], 6, "six levels");
     let mut worst: f64 = 0.0;
     for i in 1..b.filtered[2] {
@@ -331,13 +304,9 @@ fn the_sampling_table_is_a_density_in_proportion_to_the_light() {
     let (bw, bh) = (16usize, 8usize);
     let [w, h] = b.map;
     let mut expected = vec![0.0; bw * bh];
-    for y in 0..h {
-        let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
-        let dw = t0.cos() - t1.cos();
-        for x in 0..w {
-            let bin = (y as usize * bh / h as usize) * bw + x as usize * bw / w as usize;
-            expected[bin] += luminance(rgb9e5(b.texels[(y * w + x) as usize])) * dw;
-        }
+    for (x, y, _, dw) in texels(w, h) {
+        let bin = (y as usize * bh / h as usize) * bw + x as usize * bw / w as usize;
+        expected[bin] += luminance(rgb9e5(b.texels[(y * w + x) as usize])) * dw;
     }
     let total: f64 = expected.iter().sum();
     let draws = 200_000;
@@ -378,17 +347,11 @@ fn importance_sampling_a_small_sun_beats_uniform_sampling_fourfold() {
     let up = [0.0, 1.0, 0.0];
     let [w, h] = b.map;
     // The exact irradiance of the baked map (every texel, its solid angle).
-    let mut exact = 0.0;
-    for y in 0..h {
-        let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
-        let dw = (t0.cos() - t1.cos()) * 2.0 * PI / w as f64;
-        for x in 0..w {
-            let d = direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-            exact += b.texel((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64)[1]
-                * dot(d, up).max(0.0)
-                * dw;
-        }
-    }
+    let exact: f64 = texels(w, h)
+        .map(|(x, y, d, dw)| {
+            b.texel((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64)[1] * dot(d, up).max(0.0) * dw
+        })
+        .sum();
     let radiance = |d: [f64; 3]| {
         let u = d[0].atan2(-d[2]) / (2.0 * PI);
         b.texel(u - u.floor(), d[1].clamp(-1.0, 1.0).acos() / PI)[1]
@@ -548,17 +511,12 @@ fn a_sun_in_an_image_becomes_a_directional_light_of_its_irradiance() {
     let cos_r = 1f64.to_radians().cos();
     let mut img = image::Rgb32FImage::new(w, h);
     let mut excess = 0.0;
-    for y in 0..h {
-        let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
-        let dw = (t0.cos() - t1.cos()) * 2.0 * PI / w as f64;
-        for x in 0..w {
-            let d = direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-            let on = dot(d, sun) > cos_r;
-            if on {
-                excess += (5000.0 - 0.4) * dw;
-            }
-            img.put_pixel(x, y, image::Rgb([if on { 5000.0 } else { 0.4 }; 3]));
+    for (x, y, d, dw) in texels(w, h) {
+        let on = dot(d, sun) > cos_r;
+        if on {
+            excess += (5000.0 - 0.4) * dw;
         }
+        img.put_pixel(x, y, image::Rgb([if on { 5000.0 } else { 0.4 }; 3]));
     }
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sun.exr");

@@ -483,17 +483,8 @@ fn a_small_bright_patch_of_the_environment_lights_the_probes() {
         }
     };
     let (w, h) = (1024u32, 512u32);
-    let pixels: Vec<[f32; 3]> = (0..w * h)
-        .map(|i| {
-            let (u, v) = (((i % w) as f64 + 0.5) / w as f64, ((i / w) as f64 + 0.5) / h as f64);
-            let (phi, theta) = (2.0 * PI * u, PI * v);
-            let d = Vec3::new(
-                (theta.sin() * phi.sin()) as f32,
-                theta.cos() as f32,
-                (-theta.sin() * phi.cos()) as f32,
-            );
-            [radiance(d); 3]
-        })
+    let pixels: Vec<[f32; 3]> = kiln_tests::equirect::texels(w, h)
+        .map(|(_, _, d, _)| [radiance(Vec3::from(d.map(|c| c as f32))); 3])
         .collect();
     let mut s = Scene { name: "patch".into(), ..Default::default() };
     s.materials.push(material(0.0, [0.0; 3]));
@@ -508,17 +499,14 @@ fn a_small_bright_patch_of_the_environment_lights_the_probes() {
     let v = Volume::read(&compile(s, settings(256, Some(8.0))));
     let c = [12, 0, 12];
     let expected = |t: Vec3| {
-        let mut e = 0.0f64;
-        for y in 0..h / 2 {
-            let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
-            let dw = (t0.cos() - t1.cos()) * 2.0 * PI / w as f64;
-            for x in 0..w {
-                let (phi, theta) = (2.0 * PI * (x as f64 + 0.5) / w as f64, PI * (y as f64 + 0.5) / h as f64);
-                let d = [theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos()];
-                let c = t.x as f64 * d[0] + t.y as f64 * d[1] + t.z as f64 * d[2];
-                e += pixels[(y * w + x) as usize][0] as f64 * c.max(0.0) * dw / PI;
-            }
-        }
+        let t = t.as_dvec3().to_array();
+        let e: f64 = kiln_tests::equirect::texels(w, h)
+            .filter(|&(_, y, _, _)| y < h / 2)
+            .map(|(x, y, d, dw)| {
+                let c = t[0] * d[0] + t[1] * d[1] + t[2] * d[2];
+                pixels[(y * w + x) as usize][0] as f64 * c.max(0.0) * dw / PI
+            })
+            .sum();
         e as f32
     };
     let peak = expected(patch);

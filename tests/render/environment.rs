@@ -26,40 +26,19 @@ use crate::harness::{Pinhole, fast_settings, render};
 const W: u32 = 32;
 const H: u32 = 24;
 
-fn direction(u: f64, v: f64) -> DVec3 {
-    let (phi, theta) = (2.0 * std::f64::consts::PI * u, std::f64::consts::PI * v);
-    DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos())
-}
-
 /// A `width` × `width / 2` environment of `f` at its texel centres.
 fn environment(width: u32, f: impl Fn(DVec3) -> [f64; 3]) -> EnvironmentImage {
-    let height = width / 2;
-    let pixels = (0..width * height)
-        .map(|i| {
-            let d = direction(
-                ((i % width) as f64 + 0.5) / width as f64,
-                ((i / width) as f64 + 0.5) / height as f64,
-            );
-            f(d).map(|c| c as f32)
-        })
-        .collect();
-    EnvironmentImage { name: "test".into(), width, height, pixels, rotation_degrees: 0.0 }
+    kiln_tests::equirect::image(width, |d| f(DVec3::from_array(d)))
 }
 
 /// The cosine-weighted mean of `f` around unit n (irradiance / π), summed over a fine grid.
 fn irradiance_over_pi(n: DVec3, f: &impl Fn(DVec3) -> [f64; 3]) -> [f64; 3] {
-    let (w, h) = (512u32, 256u32);
     let mut sum = [0.0; 3];
-    for y in 0..h {
-        let (t0, t1) =
-            (std::f64::consts::PI * y as f64 / h as f64, std::f64::consts::PI * (y + 1) as f64 / h as f64);
-        let dw = (t0.cos() - t1.cos()) * 2.0 * std::f64::consts::PI / w as f64;
-        for x in 0..w {
-            let d = direction((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
-            let c = n.dot(d).max(0.0) * dw / std::f64::consts::PI;
-            for (s, v) in sum.iter_mut().zip(f(d)) {
-                *s += v * c;
-            }
+    for (_, _, d, dw) in kiln_tests::equirect::texels(512, 256) {
+        let d = DVec3::from_array(d);
+        let c = n.dot(d).max(0.0) * dw / std::f64::consts::PI;
+        for (s, v) in sum.iter_mut().zip(f(d)) {
+            *s += v * c;
         }
     }
     sum

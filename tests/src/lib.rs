@@ -23,6 +23,7 @@ use kiln_player::scene::TextureUpload;
 use kiln_player::session::{PipelineStart, SessionOptions};
 
 pub mod boxes;
+pub mod equirect;
 pub mod exact;
 
 /// The shared scene folder (`../shared/scenes` beside the checkout), if present; if not, says
