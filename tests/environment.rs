@@ -492,6 +492,21 @@ fn bad_environment_images_are_refused_or_warned() {
     let (r, _) = try_image("tiny.exr", image::DynamicImage::new_rgb32f(1, 1));
     let e = r.unwrap_err();
     assert!(e.contains("1 x 1") && e.contains("twice as wide"), "{e}");
+    // A Radiance header claiming 60,000 x 30,000 pixels (7.2 GB of floats) is refused from its
+    // header, before anything is decoded, saying which limit to raise.
+    let huge = dir.path().join("huge.hdr");
+    std::fs::write(&huge, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 60000\n\x02\x02\xea\x60")
+        .unwrap();
+    let mut s = scene(image(8, |_| [0.0; 3]));
+    let e = apply(
+        &mut s,
+        &EnvironmentSpec::Image { path: huge, extract_sun: true },
+        Placement::default(),
+        "test",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("60000 x 30000") && e.contains("--max-image-side"), "{e}");
     let mut nan = image::Rgb32FImage::from_pixel(16, 8, image::Rgb([1.0, 2.0, 3.0]));
     nan.put_pixel(3, 3, image::Rgb([f32::NAN, 1.0, f32::INFINITY]));
     let (r, s) = try_image("nan.exr", nan.into());
