@@ -166,6 +166,15 @@ pub struct EnvironmentImage {
 }
 
 impl Scene {
+    /// Whether anything lights the scene: an analytic light, an emissive material, the constant
+    /// sky or an environment that is not black.
+    pub fn lit(&self) -> bool {
+        !self.lights.is_empty()
+            || self.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
+            || self.sky.radiance.iter().any(|&r| r > 0.0)
+            || self.environment.as_ref().is_some_and(|e| e.pixels.iter().flatten().any(|&c| c > 0.0))
+    }
+
     /// Records a warning of data loss (what most import warnings are).
     pub fn warn(&mut self, message: impl Into<String>) {
         self.warn_as(WarningClass::DataLoss, message);

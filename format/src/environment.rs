@@ -47,6 +47,21 @@ pub fn uv_to_direction(u: f32, v: f32) -> Vec3 {
     Vec3::new(st * phi.sin(), ct, -st * phi.cos())
 }
 
+/// Row-major index of the texel of a `w` × `h` map that holds unit direction `d`.
+fn texel_of(d: Vec3, w: u32, h: u32) -> usize {
+    let [u, v] = direction_to_uv(d);
+    let x = ((u * w as f32) as u32).min(w - 1);
+    let y = ((v * h as f32) as u32).min(h - 1);
+    (y * w + x) as usize
+}
+
+/// Solid angle of each texel of row `y` of a `width` × `height` map, sr.
+pub fn texel_solid_angle(y: u32, width: u32, height: u32) -> f64 {
+    let t0 = std::f64::consts::PI * y as f64 / height as f64;
+    let t1 = std::f64::consts::PI * (y + 1) as f64 / height as f64;
+    (t0.cos() - t1.cos()) * std::f64::consts::TAU / width as f64
+}
+
 /// The nine real spherical-harmonic basis functions at unit direction n (bands 0–2, in the order
 /// of [`EnvironmentHeader::sh`]).
 pub fn sh_basis(n: Vec3) -> [f32; 9] {
@@ -146,21 +161,8 @@ impl<'a> Environment<'a> {
     /// section's length against it, and the table's entries (probabilities in [0, 1], aliases in
     /// range, densities finite and non-negative). The error names the section.
     pub fn read(file: &'a KilnFile) -> Result<Option<Environment<'a>>> {
-        let present = ENVIRONMENT_KINDS.map(|k| file.find(k, 0).is_some());
-        if present == [false; 4] {
+        let Some(header) = file.group_header::<EnvironmentHeader>(&ENVIRONMENT_KINDS, "environment")? else {
             return Ok(None);
-        }
-        if present.contains(&false) {
-            return Err(FormatError::invalid(
-                "environment: environment-header, -map, -filtered and -table must come together",
-            ));
-        }
-        let header: &[EnvironmentHeader] = file.pod(ENVIRONMENT_HEADER, 0)?.unwrap_or(&[]);
-        let [header] = header else {
-            return Err(FormatError::invalid(format!(
-                "environment-header holds {} headers, not one",
-                header.len()
-            )));
         };
         header.check()?;
         let map: &[u32] = file.pod(ENVIRONMENT_MAP, 0)?.unwrap_or(&[]);
@@ -194,11 +196,9 @@ impl<'a> Environment<'a> {
     /// Radiance arriving from unit direction `d`: the map's texel, nearest (what the sampling
     /// table's piecewise-constant density assumes).
     pub fn radiance(&self, d: Vec3) -> Vec3 {
-        let [w, h] = [self.header.map[0], self.header.map[1]];
-        let [u, v] = direction_to_uv(d);
-        let x = ((u * w as f32) as u32).min(w - 1);
-        let y = ((v * h as f32) as u32).min(h - 1);
-        Vec3::from(crate::probes::decode_rgb9e5(self.map[(y * w + x) as usize]))
+        Vec3::from(crate::probes::decode_rgb9e5(
+            self.map[texel_of(d, self.header.map[0], self.header.map[1])],
+        ))
     }
 
     /// A direction drawn from the table with three uniforms in [0, 1) (the first picks the cell
@@ -223,11 +223,8 @@ impl<'a> Environment<'a> {
 
     /// Solid-angle density with which the table draws unit direction `d`.
     pub fn pdf(&self, d: Vec3) -> f32 {
-        let [w, h] = [self.header.table[0], self.header.table[1]];
-        let [u, v] = direction_to_uv(d);
-        let x = ((u * w as f32) as u32).min(w - 1);
-        let y = ((v * h as f32) as u32).min(h - 1);
-        self.table[(y * w + x) as usize].pdf((1.0 - d.y * d.y).max(0.0).sqrt())
+        let cell = texel_of(d, self.header.table[0], self.header.table[1]);
+        self.table[cell].pdf((1.0 - d.y * d.y).max(0.0).sqrt())
     }
 }
 

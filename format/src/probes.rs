@@ -157,18 +157,8 @@ impl<'a> ProbeVolume<'a> {
     /// section's length against it, the states, and the visibility texels finite and
     /// non-negative. The error names the section.
     pub fn read(file: &'a KilnFile) -> Result<Option<ProbeVolume<'a>>> {
-        let present = PROBE_KINDS.map(|k| file.find(k, 0).is_some());
-        if present == [false; 4] {
+        let Some(header) = file.group_header::<ProbeHeader>(&PROBE_KINDS, "probe volume")? else {
             return Ok(None);
-        }
-        if present.contains(&false) {
-            return Err(FormatError::invalid(
-                "probe volume: probe-grid, probe-states, probe-irradiance and probe-visibility must come together",
-            ));
-        }
-        let header: &[ProbeHeader] = file.pod(PROBE_GRID, 0)?.unwrap_or(&[]);
-        let [header] = header else {
-            return Err(FormatError::invalid(format!("probe-grid holds {} headers, not one", header.len())));
         };
         header.check()?;
         let states: &[ProbeState] = file.pod(PROBE_STATES, 0)?.unwrap_or(&[]);

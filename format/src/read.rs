@@ -267,6 +267,26 @@ impl KilnFile {
         }
     }
 
+    /// The one header of a group of section kinds that come together or not at all (`kinds[0]`
+    /// holds exactly one `H`): `None` when none is present; an error naming `group` when only
+    /// some are, or naming the header's kind when it holds other than one header.
+    pub fn group_header<H: Pod>(&self, kinds: &[SectionKind], group: &str) -> Result<Option<&H>> {
+        let present = kinds.iter().filter(|&&k| self.find(k, 0).is_some()).count();
+        if present == 0 {
+            return Ok(None);
+        }
+        let names =
+            || kinds.iter().map(|&k| crate::sections::info(k).map_or("?", |i| i.name)).collect::<Vec<_>>();
+        if present < kinds.len() {
+            return Err(FormatError::invalid(format!("{group}: {} must come together", names().join(", "))));
+        }
+        let header: &[H] = self.pod(kinds[0], 0)?.unwrap_or(&[]);
+        match header {
+            [h] => Ok(Some(h)),
+            _ => Err(FormatError::invalid(format!("{} holds {} headers, not one", names()[0], header.len()))),
+        }
+    }
+
     /// A section of plain-old-data elements: zero-copy from the file when stored as is, from the
     /// cached decoded bytes when compressed. `None` if absent.
     pub fn pod<T: Pod>(&self, kind: SectionKind, index: u32) -> Result<Option<&[T]>> {

@@ -318,10 +318,7 @@ impl Plan {
                 )
             }
         });
-        let lit = !scene.lights.is_empty()
-            || scene.materials.iter().any(|m| m.gpu.emission.iter().any(|&e| e > 0.0))
-            || scene.sky.radiance.iter().any(|&r| r > 0.0)
-            || scene.environment.as_ref().is_some_and(|e| e.pixels.iter().flatten().any(|&c| c > 0.0));
+        let lit = scene.lit();
         let (probe_decision, probes) = probe_plan(scene, geometry, settings, lit)?;
         stages.push(probe_decision);
         let requested_res = match settings.voxel_res {

@@ -94,10 +94,7 @@ pub fn finish(scene: &mut Scene, source: &str) -> CliResult<()> {
             c.znear = diagonal * 1e-4;
         }
     }
-    if scene.lights.is_empty()
-        && scene.materials.iter().all(|m| m.gpu.emission == [0.0; 3])
-        && scene.sky.radiance == [0.0; 3]
-    {
+    if !scene.lit() {
         scene.warn_as(WarningClass::MissingSetup, format!("{source}: the scene has no lights, no emissive materials and a black sky; it will render black (add lights in a sidecar, or light it with --environment studio, a neutral built-in environment)"));
     }
     Ok(())

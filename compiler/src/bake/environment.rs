@@ -24,7 +24,8 @@
 
 use glam::Vec3;
 use kiln_format::environment::{
-    Environment, EnvironmentCell, EnvironmentHeader, alias_table, direction_to_uv, sh_basis, uv_to_direction,
+    Environment, EnvironmentCell, EnvironmentHeader, alias_table, direction_to_uv, sh_basis,
+    texel_solid_angle, uv_to_direction,
 };
 use kiln_format::probes::{decode_rgb9e5, encode_rgb9e5};
 use kiln_format::sections::{ENVIRONMENT_FILTERED, ENVIRONMENT_HEADER, ENVIRONMENT_MAP, ENVIRONMENT_TABLE};
@@ -164,29 +165,15 @@ fn resample(src: &Image, width: u32, rotation_degrees: f32) -> Image {
     Image { width, height, pixels }
 }
 
-/// Solid angle of each texel of row `y` of a `width` × `height` map.
-fn texel_solid_angle(y: u32, width: u32, height: u32) -> f64 {
-    let t0 = std::f64::consts::PI * y as f64 / height as f64;
-    let t1 = std::f64::consts::PI * (y + 1) as f64 / height as f64;
-    (t0.cos() - t1.cos()) * std::f64::consts::TAU / width as f64
-}
-
 /// Van der Corput's radical inverse of `i` in base 2.
 fn radical_inverse(i: u32) -> f32 {
     (i.reverse_bits() as f64 / 4_294_967_296.0) as f32
 }
 
-/// An orthonormal basis (t, b) around unit n (Duff et al. 2017).
-fn basis(n: Vec3) -> (Vec3, Vec3) {
-    let s = 1f32.copysign(n.z);
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    (Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x), Vec3::new(b, s + n.y * n.y * a, -n.y))
-}
-
 /// One prefiltered texel: direction `n`, GGX α, the pyramid of the radiance map (level 0 first).
 fn prefilter(n: Vec3, alpha: f32, pyramid: &[Image]) -> Vec3 {
-    let (t, b) = basis(n);
+    // An orthonormal basis around n (Duff et al. 2017).
+    let (t, b) = n.any_orthonormal_pair();
     let a2 = alpha * alpha;
     let base = &pyramid[0];
     let texel = (std::f32::consts::TAU / base.width as f32) * (std::f32::consts::PI / base.height as f32);
@@ -290,8 +277,7 @@ pub fn bake(env: &EnvironmentImage, max_width: u32) -> BakedEnvironment {
     let mean = sum.map(|s| (s / total) as f32);
     // The pyramid the prefilter reads, from the map itself.
     let mut pyramid = vec![map.clone()];
-    while pyramid.last().is_some_and(|l| l.width > 8) {
-        let next = pyramid.last().map(Image::halve).unwrap_or_else(|| map.clone());
+    while let Some(next) = pyramid.last().filter(|l| l.width > 8).map(Image::halve) {
         pyramid.push(next);
     }
     let fw = FILTERED_WIDTH.min(width);

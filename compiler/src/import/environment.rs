@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use kiln_format::environment::uv_to_direction;
-use kiln_format::manifest::{Light, LightKind, Sky};
+use kiln_format::environment::{texel_solid_angle, uv_to_direction};
+use kiln_format::manifest::{Light, LightKind};
 
 use super::preetham;
 use crate::exit::{CliError, CliResult};
@@ -75,8 +75,9 @@ impl EnvironmentSpec {
 }
 
 /// Sets `scene`'s environment from `spec` placed by `placement`; `source` names where the request
-/// came from in messages. The constant sky becomes the environment's mean radiance (what a reader
-/// that ignores the environment sections shows). Replaces any earlier environment (and its sun).
+/// came from in messages. Replaces any earlier environment (and its sun). The manifest's constant
+/// sky becomes the baked map's mean radiance (what a reader that ignores the environment's
+/// sections shows).
 pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, source: &str) -> CliResult<()> {
     let bad = |msg: String| CliError::input(format!("{source}: {msg}"));
     if !(placement.intensity.is_finite() && placement.intensity >= 0.0) {
@@ -128,8 +129,6 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
              holds; they are clamped (lower the intensity and raise the exposure to keep them)"
         ));
     }
-    let mean = mean_radiance(&pixels, width);
-    scene.sky = Sky { radiance: mean };
     scene.environment = Some(EnvironmentImage {
         name,
         width,
@@ -217,25 +216,6 @@ fn fill_below_horizon(mut pixels: Vec<[f32; 3]>, width: u32, ground: Vec3) -> Ve
     pixels
 }
 
-/// Mean radiance over the sphere (each row weighted by its solid angle).
-pub fn mean_radiance(pixels: &[[f32; 3]], width: u32) -> [f32; 3] {
-    let height = (pixels.len() / width as usize) as u32;
-    let mut sum = [0f64; 3];
-    let mut weight = 0f64;
-    for y in 0..height {
-        let theta0 = std::f64::consts::PI * y as f64 / height as f64;
-        let theta1 = std::f64::consts::PI * (y + 1) as f64 / height as f64;
-        let w = theta0.cos() - theta1.cos();
-        for p in &pixels[(y * width) as usize..((y + 1) * width) as usize] {
-            for c in 0..3 {
-                sum[c] += w * p[c] as f64;
-            }
-            weight += w;
-        }
-    }
-    sum.map(|s| if weight > 0.0 { (s / weight) as f32 } else { 0.0 })
-}
-
 /// The built-in studio (docs/sidecar.md): a neutral dome brightening from 0.8 at the horizon to 1
 /// at the zenith over a grey floor of 0.3, a round key softbox of radiance 6 and 15° radius up
 /// and to the left of −z, and a rim light of radiance 3 and 10° behind and to the right.
@@ -291,13 +271,7 @@ pub fn extract_sun(pixels: &mut [[f32; 3]], width: u32, rotation_degrees: f32) -
     if !(peak > threshold) {
         return None;
     }
-    let solid = |y: u32| {
-        let (t0, t1) = (
-            std::f64::consts::PI * y as f64 / height as f64,
-            std::f64::consts::PI * (y + 1) as f64 / height as f64,
-        );
-        (t0.cos() - t1.cos()) * std::f64::consts::TAU / width as f64
-    };
+    let solid = |y: u32| texel_solid_angle(y, width, height);
     let mut inside = vec![false; pixels.len()];
     let mut region = vec![brightest];
     inside[brightest] = true;

@@ -54,14 +54,6 @@ pub fn fibonacci_direction(i: u32, n: u32) -> Vec3 {
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
-/// An orthonormal basis around unit `n` (Duff et al. 2017).
-fn basis(n: Vec3) -> (Vec3, Vec3) {
-    let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    (Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x), Vec3::new(b, s + n.y * n.y * a, -n.y))
-}
-
 /// Emissive triangles, chosen in proportion to their power (a cumulative table searched).
 #[derive(Debug, Default)]
 struct Emitters {
@@ -351,7 +343,8 @@ impl<'a> Tracer<'a> {
             }
             // Cosine-weighted direction around n: weight f · cos / pdf = f · π.
             let (r1, r2) = (rng.f32(), rng.f32());
-            let (t1, t2) = basis(n);
+            // An orthonormal basis around n (Duff et al. 2017).
+            let (t1, t2) = n.any_orthonormal_pair();
             let (r, phi) = (r1.sqrt(), std::f32::consts::TAU * r2);
             let l =
                 (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + n * (1.0 - r1).max(0.0).sqrt()).normalize();
