@@ -56,9 +56,10 @@ fn fifo(path: &Path) {
 fn devices_and_fifos_are_not_read() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    // A device as the material library: a warning, the default material, no endless read.
+    // A device as the material library: a warning, the default material, no endless read
+    // (outside the input's folder, so only with --allow-any-path).
     obj(d, "/dev/zero");
-    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--allow-any-path"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(run.stderr.contains("/dev/zero is not a regular file"), "{}", run.stderr);
     // A FIFO as the library and as a texture: no blocking open.
@@ -122,7 +123,7 @@ fn a_gltf_buffer_that_is_a_device_is_not_read() {
         "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
         "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]}"#;
     std::fs::write(dir.path().join("dev.gltf"), gltf).unwrap();
-    let run = kiln(dir.path(), &["compile", "dev.gltf", "-o", "out.kiln"]);
+    let run = kiln(dir.path(), &["compile", "dev.gltf", "-o", "out.kiln", "--allow-any-path"]);
     assert!(
         run.code == 1 && run.stderr.contains("/dev/zero is not a regular file"),
         "{}: {}",
@@ -159,4 +160,90 @@ fn texture_paths_with_other_case_or_backslashes_are_found_with_a_warning() {
     let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(!run.stderr.contains("using") && run.stderr.contains("cannot read"), "{}", run.stderr);
+}
+
+/// Writes a glTF triangle at `d/name` whose buffer is the file `buffer` (a relative or absolute
+/// URI) and whose base colour is the image `image`; the buffer's 36 bytes are written beside
+/// the glTF as `tri.bin`.
+fn gltf_naming(d: &Path, name: &str, buffer: &str, image: &str) {
+    let bytes: Vec<u8> =
+        [0f32, 0., 0., 1., 0., 0., 0., 1., 0.].iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(d.join("tri.bin"), bytes).unwrap();
+    let gltf = format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"uri":"{buffer}","byteLength":36}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+        "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
+        "materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}},"emissiveFactor":[1,1,1]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],"nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}]}}"#
+    );
+    std::fs::write(d.join(name), gltf).unwrap();
+}
+
+#[test]
+fn files_an_asset_names_outside_its_folder_are_refused_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let top = dir.path();
+    let d = top.join("asset");
+    std::fs::create_dir(&d).unwrap();
+    let secret = top.join("secret.png");
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([9, 9, 9, 255])).save(&secret).unwrap();
+    std::fs::create_dir(d.join("maps")).unwrap();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([9, 9, 9, 255])).save(d.join("maps/in.png")).unwrap();
+    gltf_naming(&d, "in.gltf", "./tri.bin", "maps/../maps/in.png");
+    let run_in = |args: &[&str]| kiln(&d, args);
+    let refused = |run: &Ended, reference: &str| {
+        assert_eq!(run.code, 1, "{reference}: {}", run.stderr);
+        assert!(
+            run.stderr.contains(reference)
+                && run.stderr.contains("outside the folders an asset may read from")
+                && run.stderr.contains("--search-path")
+                && run.stderr.contains("--allow-any-path"),
+            "{reference}: {}",
+            run.stderr
+        );
+        assert!(!Path::new(&d.join("out.kiln")).exists(), "nothing written");
+    };
+    // A glTF image by a relative path leading out, by an absolute path, and a buffer likewise.
+    gltf_naming(&d, "up.gltf", "tri.bin", "../secret.png");
+    refused(&run_in(&["compile", "up.gltf", "-o", "out.kiln"]), "image 0 ('../secret.png')");
+    let abs = secret.display().to_string();
+    gltf_naming(&d, "abs.gltf", "tri.bin", &abs);
+    refused(&run_in(&["compile", "abs.gltf", "-o", "out.kiln"]), "image 0 (");
+    gltf_naming(&d, "buf.gltf", "../../../../../../../../etc/passwd", "x.png");
+    refused(&run_in(&["compile", "buf.gltf", "-o", "out.kiln"]), "buffer 0 (");
+    // A file outside that does not exist is refused as outside, not reported missing.
+    gltf_naming(&d, "gone.gltf", "tri.bin", "../nothing-here.png");
+    refused(&run_in(&["compile", "gone.gltf", "-o", "out.kiln"]), "image 0 ('../nothing-here.png')");
+    // OBJ: a texture and a material library leading out.
+    std::fs::write(top.join("lib.mtl"), "newmtl m\nKd 1 1 1\nKe 1 1 1\n").unwrap();
+    obj(&d, "../lib.mtl");
+    refused(&run_in(&["compile", "scene.obj", "-o", "out.kiln"]), "material library '../lib.mtl'");
+    obj(&d, "lib.mtl");
+    std::fs::write(d.join("lib.mtl"), format!("newmtl m\nKd 1 1 1\nKe 1 1 1\nmap_Kd {abs}\n")).unwrap();
+    refused(&run_in(&["compile", "scene.obj", "-o", "out.kiln"]), "texture '");
+    // A link inside the folder leading out is refused too.
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&secret, d.join("link.png")).unwrap();
+        gltf_naming(&d, "link.gltf", "tri.bin", "link.png");
+        refused(&run_in(&["compile", "link.gltf", "-o", "out.kiln"]), "image 0 ('link.png')");
+    }
+    // The sidecar's sky image likewise (a file named on the command line is always read).
+    std::fs::write(d.join("sky.toml"), "[sky]\nimage = \"../sky.hdr\"\n").unwrap();
+    refused(&run_in(&["compile", "in.gltf", "-c", "sky.toml", "-o", "out.kiln"]), "environment image");
+    // Allowed: by --search-path naming the folder, or --allow-any-path; the depfile lists it.
+    let run = run_in(&["compile", "up.gltf", "-o", "out.kiln", "--search-path", "..", "--depfile", "d.d"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let deps = std::fs::read_to_string(d.join("d.d")).unwrap();
+    assert!(deps.contains("secret.png"), "{deps}");
+    std::fs::remove_file(d.join("out.kiln")).unwrap();
+    let run = run_in(&["compile", "scene.obj", "-o", "out.kiln", "--allow-any-path"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    // Files beside the asset and in its subfolders stay readable by default.
+    let run = run_in(&["compile", "in.gltf", "-o", "in.kiln", "-W", "missing-setup=ignore"]);
+    assert!(run.code == 0 && run.stderr.is_empty(), "{}", run.stderr);
+    // An asset compiled through a path from elsewhere reads its own folder.
+    let run = kiln(top, &["compile", "asset/in.gltf", "-o", "in2.kiln", "-W", "missing-setup=ignore"]);
+    assert!(run.code == 0 && run.stderr.is_empty(), "{}", run.stderr);
 }

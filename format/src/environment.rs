@@ -165,21 +165,16 @@ impl<'a> Environment<'a> {
             return Ok(None);
         };
         header.check()?;
-        let map: &[u32] = file.pod(ENVIRONMENT_MAP, 0)?.unwrap_or(&[]);
-        let filtered: &[u32] = file.pod(ENVIRONMENT_FILTERED, 0)?.unwrap_or(&[]);
-        let table: &[EnvironmentCell] = file.pod(ENVIRONMENT_TABLE, 0)?.unwrap_or(&[]);
-        let cells = header.table[0] as usize * header.table[1] as usize;
-        for (name, len, want) in [
-            ("environment-map", map.len(), header.map[0] as usize * header.map[1] as usize),
-            ("environment-filtered", filtered.len(), header.filtered_texels()),
-            ("environment-table", table.len(), cells),
-        ] {
-            if len != want {
-                return Err(FormatError::invalid(format!(
-                    "{name} holds {len} elements; the environment header needs {want}"
-                )));
-            }
-        }
+        // Each length against the header before decoding (`pod_exact`).
+        let cells = header.table[0] as u64 * header.table[1] as u64;
+        let map_texels = header.map[0] as u64 * header.map[1] as u64;
+        let map: &[u32] = file.pod_exact(ENVIRONMENT_MAP, 0, map_texels, "environment-map")?.unwrap_or(&[]);
+        let filtered: &[u32] = file
+            .pod_exact(ENVIRONMENT_FILTERED, 0, header.filtered_texels() as u64, "environment-filtered")?
+            .unwrap_or(&[]);
+        let table: &[EnvironmentCell] =
+            file.pod_exact(ENVIRONMENT_TABLE, 0, cells, "environment-table")?.unwrap_or(&[]);
+        let cells = cells as usize;
         for (i, c) in table.iter().enumerate() {
             let density_ok = |d: f32| d.is_finite() && d >= 0.0;
             if !((0.0..=1.0).contains(&c.keep)

@@ -161,22 +161,16 @@ impl<'a> ProbeVolume<'a> {
             return Ok(None);
         };
         header.check()?;
-        let states: &[ProbeState] = file.pod(PROBE_STATES, 0)?.unwrap_or(&[]);
-        let irradiance: &[u32] = file.pod(PROBE_IRRADIANCE, 0)?.unwrap_or(&[]);
-        let visibility: &[[u16; 2]] = file.pod(PROBE_VISIBILITY, 0)?.unwrap_or(&[]);
+        // Each length against the header before decoding (`pod_exact`).
         let texels = |e: [u32; 3]| e.iter().map(|&d| d as u64).product::<u64>();
-        for (name, len, want) in [
-            ("probe-states", states.len() as u64, header.count()),
-            ("probe-irradiance", irradiance.len() as u64, texels(header.irradiance_extent())),
-            ("probe-visibility", visibility.len() as u64, texels(header.visibility_extent())),
-        ] {
-            if len != want {
-                return Err(FormatError::invalid(format!(
-                    "{name} holds {len} elements; the probe-grid header ({:?} probes) needs {want}",
-                    header.dims
-                )));
-            }
-        }
+        let states: &[ProbeState] =
+            file.pod_exact(PROBE_STATES, 0, header.count(), "probe-states")?.unwrap_or(&[]);
+        let irradiance: &[u32] = file
+            .pod_exact(PROBE_IRRADIANCE, 0, texels(header.irradiance_extent()), "probe-irradiance")?
+            .unwrap_or(&[]);
+        let visibility: &[[u16; 2]] = file
+            .pod_exact(PROBE_VISIBILITY, 0, texels(header.visibility_extent()), "probe-visibility")?
+            .unwrap_or(&[]);
         let half = header.spacing * 0.5;
         let mut active = 0;
         for (i, s) in states.iter().enumerate() {

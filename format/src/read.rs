@@ -307,6 +307,33 @@ impl KilnFile {
             .map_err(|e| loc(FormatError::invalid(format!("cannot view section as elements: {e}"))))
     }
 
+    /// [`Self::pod`] of a section that must hold exactly `count` elements (as its manifest record
+    /// or header says), checked against the table's decoded size *before* decoding: a 760 KB
+    /// file whose compressed section claims 4 GiB of zeros is refused without spending them.
+    /// `what` names the section in the error.
+    pub fn pod_exact<T: Pod>(
+        &self,
+        kind: SectionKind,
+        index: u32,
+        count: u64,
+        what: &str,
+    ) -> Result<Option<&[T]>> {
+        let Some(s) = self.find(kind, index) else {
+            return Ok(None);
+        };
+        let want = count.checked_mul(size_of::<T>() as u64);
+        if want != Some(s.entry.raw_size) {
+            return Err(FormatError::invalid(format!(
+                "{what}: the table declares {} bytes, its record {count} elements of {} bytes",
+                s.entry.raw_size,
+                size_of::<T>()
+            ))
+            .in_section(s.position, kind, index)
+            .or_offset(s.entry.offset));
+        }
+        self.pod(kind, index)
+    }
+
     /// Decodes the manifest.
     pub fn manifest(&self) -> Result<Manifest> {
         let s =

@@ -281,7 +281,9 @@ impl<'a> SceneView<'a> {
         match (&m.brdf_lut, file.find(BRDF_LUT, 0)) {
             (None, None) => {}
             (Some(info), Some(_)) => {
-                let texels = file.pod::<[u16; 2]>(BRDF_LUT, 0)?.unwrap_or(&[]).len() as u64;
+                let want = info.resolution as u64 * info.resolution as u64;
+                let texels =
+                    file.pod_exact::<[u16; 2]>(BRDF_LUT, 0, want, "BRDF table")?.unwrap_or(&[]).len() as u64;
                 if info.resolution == 0 || texels != info.resolution as u64 * info.resolution as u64 {
                     return Err(FormatError::invalid(format!(
                         "BRDF table of {texels} texels, manifest says {0}x{0}",
@@ -299,11 +301,11 @@ impl<'a> SceneView<'a> {
             )));
         }
         for (i, info) in m.shadow_maps.iter().enumerate() {
-            let depths: &[f32] = file
-                .pod(SHADOW_MAP, i as u32)?
-                .ok_or_else(|| FormatError::invalid(format!("shadow map {i} is missing")))?;
             let faces = if info.projection == ShadowProjection::Cube { 6 } else { 1 };
             let n = info.resolution as u64;
+            let depths: &[f32] = file
+                .pod_exact(SHADOW_MAP, i as u32, faces * n * n, &format!("shadow map {i}"))?
+                .ok_or_else(|| FormatError::invalid(format!("shadow map {i} is missing")))?;
             if info.light as usize >= m.lights.len() || n == 0 || depths.len() as u64 != faces * n * n {
                 return Err(FormatError::invalid(format!(
                     "shadow map {i}: light {} of {}, {} depths for {faces} face(s) of {n}x{n}",
@@ -353,7 +355,9 @@ impl<'a> SceneView<'a> {
                     )));
                 }
                 for (i, &l) in v.lights.iter().enumerate() {
-                    let data: &[u8] = file.pod(MEDIA_VISIBILITY, i as u32)?.unwrap_or(&[]);
+                    let what = format!("light-visibility volume {i}");
+                    let data: &[u8] =
+                        file.pod_exact(MEDIA_VISIBILITY, i as u32, cells, &what)?.unwrap_or(&[]);
                     if l as usize >= m.lights.len() || data.len() as u64 != cells {
                         return Err(FormatError::invalid(format!(
                             "light-visibility volume {i}: light {l}, {} cells of {cells}",

@@ -69,7 +69,7 @@ fn craft(sections: &[(SectionKind, u8, u64, Vec<u8>)]) -> Vec<u8> {
         file.resize(file.len().div_ceil(64) * 64, 0);
         entries.push(SectionEntry {
             kind: *kind,
-            version: 1,
+            version: if *kind == sections::MANIFEST { kiln_format::manifest::MANIFEST_VERSION } else { 1 },
             codec: *codec,
             align_log2: 6,
             index: 0,
@@ -468,4 +468,78 @@ fn frames_do_not_depend_on_the_worker_count() {
     single.set_parameter(zstd::zstd_safe::CParameter::ChecksumFlag(true)).unwrap();
     assert!(single.compress(&bytes).unwrap() != one, "the single-threaded compressor's frame is another");
     assert!(zstd::bulk::decompress(&one, bytes.len()).unwrap() == bytes, "the frame decodes to the bytes");
+}
+
+/// A zstd frame of `n` zero bytes, written in 1 MiB pieces (never holding `n` bytes).
+fn frame_of_zeros(n: u64) -> Vec<u8> {
+    use std::io::Write;
+    let mut e = zstd::stream::Encoder::new(Vec::new(), 1).unwrap();
+    e.set_pledged_src_size(Some(n)).unwrap();
+    e.include_checksum(true).unwrap();
+    let piece = vec![0u8; 1 << 20];
+    for _ in 0..n / (1 << 20) {
+        e.write_all(&piece).unwrap();
+    }
+    e.finish().unwrap()
+}
+
+#[test]
+fn a_section_whose_declared_size_contradicts_its_record_is_refused_before_decoding() {
+    // A spot light's 16 x 16 shadow map (1 KiB of depths) stored as a frame of 256 MiB of zeros:
+    // a consistent frame and table within the per-section limit, but not what the manifest's
+    // record says. The view must refuse it without allocating the 256 MiB.
+    let declared = 256u64 << 20;
+    let light = kiln_format::manifest::Light {
+        name: "spot".into(),
+        kind: kiln_format::manifest::LightKind::Spot { inner_cone: 0.3, outer_cone: 0.5 },
+        position: [0.0; 3],
+        direction: [0.0, -1.0, 0.0],
+        right: [0.0; 3],
+        color: [1.0; 3],
+        intensity: 1.0,
+        range: 0.0,
+        casts_shadows: true,
+    };
+    let info = kiln_format::manifest::ShadowMapInfo {
+        light: 0,
+        projection: kiln_format::manifest::ShadowProjection::Perspective,
+        resolution: 16,
+        view_proj: [0.0; 16],
+        origin: [0.0; 3],
+        direction: [0.0, -1.0, 0.0],
+        near: 0.1,
+        far: 10.0,
+        texel: 0.01,
+    };
+    let manifest = Manifest {
+        scene_name: "shadow".into(),
+        lights: vec![light],
+        shadow_maps: vec![info],
+        ..Default::default()
+    }
+    .encode();
+    let len = manifest.len() as u64;
+    let zeros = frame_of_zeros(declared);
+    assert!(zeros.len() < 64 << 10, "{} bytes of frame", zeros.len());
+    let bytes = craft(&[
+        (sections::MANIFEST, Codec::None as u8, len, manifest.clone()),
+        (sections::SHADOW_MAP, Codec::Zstd as u8, declared, zeros),
+    ]);
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).expect("the layout is consistent");
+    let (r, largest) = largest_allocation(|| SceneView::new(&file).map(|_| ()));
+    let e = r.expect_err("a 256 MiB shadow map for a 16 x 16 record").to_string();
+    assert!(
+        e.contains("shadow map 0") && e.contains(&declared.to_string()) && e.contains("256 elements"),
+        "{e}"
+    );
+    assert!(largest < 1 << 20, "an allocation of {largest} bytes");
+    // The same record with the 1 KiB it declares is read (the check is not a refusal of all).
+    let depths: Vec<u8> = (0..256).flat_map(|_| 1.0f32.to_le_bytes()).collect();
+    let bytes = craft(&[
+        (sections::MANIFEST, Codec::None as u8, len, manifest),
+        (sections::SHADOW_MAP, Codec::Zstd as u8, 1024, frame(&depths)),
+    ]);
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let r = SceneView::new(&file).map(|_| ());
+    assert!(r.as_ref().is_err_and(|e| !e.to_string().contains("table declares")) || r.is_ok(), "{r:?}");
 }

@@ -1,6 +1,6 @@
 //! Command-line definition (clap). Raw values are checked here; commands turn them into settings.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, Parser, Subcommand};
 
@@ -135,6 +135,46 @@ pub struct SceneArgs {
     /// decoding; a larger image is not decoded (a data-loss warning) [default: 16384].
     #[arg(long, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Input limits")]
     pub max_image_side: Option<u32>,
+    /// Where files the asset names may lie.
+    #[command(flatten)]
+    pub paths: PathArgs,
+}
+
+/// Where the files an asset names (buffers, images, MTL libraries, the sidecar's sky image) may
+/// lie. Files named on the command line are always read.
+#[derive(Debug, Args, Clone, Default)]
+pub struct PathArgs {
+    /// Also let the asset and the sidecar read files under DIR (repeatable). By default they may
+    /// read only under the input's folder and the sidecar's: an asset naming `../../etc/passwd`
+    /// or an absolute path elsewhere is refused.
+    #[arg(long, value_name = "DIR", help_heading = "Input limits")]
+    pub search_path: Vec<PathBuf>,
+    /// Let the asset read files anywhere (only for assets you trust).
+    #[arg(long, help_heading = "Input limits", conflicts_with = "search_path")]
+    pub allow_any_path: bool,
+}
+
+impl PathArgs {
+    /// Sets the confinement for an import of `input` (none for the demo) with `sidecar`, where
+    /// `bake` may name an environment file on the command line.
+    pub fn confine(&self, input: Option<&Path>, sidecar: Option<&Path>, bake: &BakeArgs) {
+        if self.allow_any_path {
+            crate::import::files::confine(None);
+            return;
+        }
+        let folder = |p: &Path| match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let named: Vec<PathBuf> = input.into_iter().chain(sidecar).map(Path::to_path_buf).collect();
+        let mut roots: Vec<PathBuf> = named.iter().map(|p| folder(p)).collect();
+        roots.extend(self.search_path.iter().cloned());
+        let mut files = named;
+        if let Some(crate::import::environment::EnvironmentSpec::Image { path, .. }) = &bake.environment {
+            files.push(path.clone());
+        }
+        crate::import::files::confine(Some((&roots, &files)));
+    }
 }
 
 /// Bake settings, shared by `compile`, `plan` and `demo`; each overrides the sidecar's or the
@@ -441,6 +481,9 @@ pub struct DemoArgs {
     /// Bake settings.
     #[command(flatten)]
     pub bake: BakeArgs,
+    /// Where files the sidecar names may lie.
+    #[command(flatten)]
+    pub paths: PathArgs,
     /// Report, depfile, threads.
     #[command(flatten)]
     pub out: OutputArgs,

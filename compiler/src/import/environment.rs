@@ -142,6 +142,7 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
 /// Reads and decodes an HDR image (recording it as an input) and checks its shape; non-finite or
 /// negative pixels become 0 with a warning on `scene`.
 fn load_image(path: &Path, scene: &mut Scene) -> Result<(u32, Vec<[f32; 3]>), String> {
+    super::files::check_confined("environment image", path)?;
     let bytes = super::read_input(path, &mut scene.inputs).map_err(|e| e.to_string())?;
     let named = |msg: String| format!("environment image {}: {msg}", path.display());
     match image::guess_format(&bytes) {

@@ -4,11 +4,18 @@
 //! `--max-image-side` pixels on a side, checked from the header before decoding (a 141 KB PNG can
 //! declare 12,000 × 12,000 pixels: 2.7 GiB decoded).
 //!
-//! The limits are process-wide: the command line sets them once before importing
-//! ([`set_limits`]), and the importers and the parallel image decoder read them.
+//! Files an asset names (not those named on the command line) are also **confined**: they must
+//! lie under the main input's folder, the sidecar's, or a `--search-path` folder, so that a
+//! service compiling uploaded assets does not read `../../etc/passwd` for them
+//! (`--allow-any-path` lifts it).
+//!
+//! The limits and the confinement are process-wide: the command line sets them once before
+//! importing ([`set_limits`], [`confine`]), and the importers and the parallel image decoder read
+//! them. A library caller that sets no confinement reads any path.
 
 use std::io::Read;
 use std::path::{Component, Path, PathBuf};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 /// The default largest file an import reads: 4 GiB.
@@ -28,6 +35,97 @@ pub fn set_limits(max_file_bytes: u64, max_image_side: u32) {
 /// The largest image side the imports accept.
 pub fn max_image_side() -> u32 {
     MAX_IMAGE_SIDE.load(Ordering::Relaxed)
+}
+
+/// Where referenced files may lie: folders (canonical) and single files named on the command line.
+#[derive(Debug, Clone)]
+struct Confinement {
+    roots: Vec<PathBuf>,
+    files: Vec<PathBuf>,
+}
+
+static CONFINEMENT: Mutex<Option<Confinement>> = Mutex::new(None);
+
+/// Confines the files an asset refers to: each must lie under one of `roots` (folders) or be one
+/// of `files` (named on the command line). `None` lifts the rule (`--allow-any-path`).
+pub fn confine(rule: Option<(&[PathBuf], &[PathBuf])>) {
+    // Each as written and with links resolved: a path is judged in both forms below.
+    let both = |paths: &[PathBuf]| paths.iter().flat_map(|p| [lexical(p), resolved(p)]).collect();
+    let rule = rule.map(|(roots, files)| Confinement { roots: both(roots), files: both(files) });
+    *CONFINEMENT.lock().unwrap_or_else(|e| e.into_inner()) = rule;
+}
+
+/// `path` made absolute against the working folder, with `.` and `..` resolved as written.
+fn lexical(path: &Path) -> PathBuf {
+    let mut out =
+        if path.is_absolute() { PathBuf::new() } else { std::env::current_dir().unwrap_or_default() };
+    for c in path.components() {
+        match c {
+            Component::ParentDir => {
+                out.pop();
+            }
+            Component::CurDir => {}
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
+}
+
+/// `path` with links resolved where it exists (a link inside a root may lead out of it), else
+/// [`lexical`].
+fn resolved(path: &Path) -> PathBuf {
+    path.canonicalize().unwrap_or_else(|_| lexical(path))
+}
+
+/// Whether the asset `what` (e.g. "texture 'wood.png'") may read `path` under the confinement;
+/// the error names the reference, the file and the rule, and how to lift it.
+pub fn check_confined(what: &str, path: &Path) -> Result<(), String> {
+    let guard = CONFINEMENT.lock().unwrap_or_else(|e| e.into_inner());
+    let Some(rule) = guard.as_ref() else { return Ok(()) };
+    let inside = |p: &Path| rule.files.iter().any(|f| f == p) || rule.roots.iter().any(|r| p.starts_with(r));
+    // Inside both as written and with links resolved. A file outside that does not exist is
+    // refused as outside, not reported missing: the error must not tell what exists there.
+    if inside(&lexical(path)) && inside(&resolved(path)) {
+        return Ok(());
+    }
+    let mut roots: Vec<String> = rule.roots.iter().map(|r| r.display().to_string()).collect();
+    roots.dedup();
+    Err(format!(
+        "{what} refers to {}, outside the folders an asset may read from ({}): move the file there, \
+         add its folder with --search-path DIR, or pass --allow-any-path",
+        path.display(),
+        if roots.is_empty() { "none".into() } else { roots.join(", ") }
+    ))
+}
+
+/// Why a file an asset names was not read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ReadError {
+    /// Outside the confinement: the compile fails (an asset reaching out of its folder is not a
+    /// missing texture to warn about).
+    Confined(String),
+    /// Missing, not a regular file, or too large.
+    Unreadable(String),
+}
+
+impl std::fmt::Display for ReadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReadError::Confined(m) | ReadError::Unreadable(m) => f.write_str(m),
+        }
+    }
+}
+
+impl From<ReadError> for String {
+    fn from(e: ReadError) -> String {
+        e.to_string()
+    }
+}
+
+/// [`check_confined`], then [`read_bounded`]: how files an asset names are read.
+pub fn read_referenced(what: &str, path: &Path) -> Result<Vec<u8>, ReadError> {
+    check_confined(what, path).map_err(ReadError::Confined)?;
+    read_bounded(path).map_err(ReadError::Unreadable)
 }
 
 /// Reads `path` whole if it is a regular file of at most the size limit; the error says which

@@ -9,13 +9,14 @@ use std::path::{Path, PathBuf};
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::{Accessor, Document, Gltf};
-use base64::Engine;
 use glam::{DMat3, DMat4, DVec3};
 use kiln_format::manifest::{Camera, Light, LightKind, OrthographicCamera, Wrap};
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
 mod checks;
+mod uri;
 
+use super::files::ReadError;
 use super::geometry::{
     Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
 };
@@ -25,6 +26,7 @@ use crate::exit::{CliError, CliResult, Exit};
 use crate::ir::{Material, Scene, TextureRole, WarningClass};
 use crate::settings::Normals;
 use checks::{check_references, guard, named, node_parents};
+use uri::{load_uri, short};
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
 const SUPPORTED_EXTENSIONS: &[&str] =
@@ -95,6 +97,8 @@ struct Importer<'a> {
     parents: Vec<Option<usize>>,
     /// Per mesh: the nodes that place it, and the triangles one placement adds.
     mesh_uses: HashMap<usize, (usize, usize)>,
+    /// Images that name files outside the confinement (`files::check_confined`): the import fails.
+    escapes: Vec<String>,
 }
 
 /// Where a mesh's vertices go.
@@ -185,8 +189,12 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
         normals,
         parents,
         mesh_uses: HashMap::new(),
+        escapes: Vec::new(),
     };
     imp.walk_scene()?;
+    if !imp.escapes.is_empty() {
+        return Err(CliError::input(format!("{}: {}", imp.file, imp.escapes.join("; "))));
+    }
     imp.warn_flattened_instances();
     let (textures, warnings) = decode_all(std::mem::take(&mut imp.requests));
     for w in warnings {
@@ -256,8 +264,10 @@ fn load_buffers(
                 (data, "GLB binary chunk".to_string())
             }
             ::gltf::buffer::Source::Uri(uri) => {
-                let data = load_uri(uri, base, inputs).map_err(|e| {
-                    CliError::input(format!("{file}: buffer {} ('{}'): {e}", b.index(), short(uri)))
+                let what = format!("buffer {} ('{}')", b.index(), short(uri));
+                let data = load_uri(uri, base, inputs, &what).map_err(|e| match e {
+                    ReadError::Confined(e) => CliError::input(format!("{file}: {e}")),
+                    ReadError::Unreadable(e) => CliError::input(format!("{file}: {what}: {e}")),
                 })?;
                 (data, format!("'{}'", short(uri)))
             }
@@ -273,59 +283,6 @@ fn load_buffers(
         buffers.push(data);
     }
     Ok(buffers)
-}
-
-/// A URI shortened for messages (data URIs can be megabytes long).
-fn short(uri: &str) -> String {
-    if uri.len() > 48 {
-        format!("{}…", &uri[..uri.char_indices().nth(40).map_or(uri.len(), |(i, _)| i)])
-    } else {
-        uri.into()
-    }
-}
-
-/// Reads a data URI or a file relative to `base`.
-fn load_uri(uri: &str, base: &Path, inputs: &mut Vec<PathBuf>) -> Result<Vec<u8>, String> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let (meta, data) = rest.split_once(',').ok_or("malformed data URI (no comma)")?;
-        return if meta.ends_with(";base64") {
-            base64::engine::general_purpose::STANDARD
-                .decode(data.trim())
-                .map_err(|e| format!("malformed base64 in data URI: {e}"))
-        } else {
-            Ok(percent_decode(data)?.into_bytes())
-        };
-    }
-    if uri.contains("://") {
-        return Err(
-            "external URLs are not fetched; download the file and refer to it by a relative path".into()
-        );
-    }
-    let rel = percent_decode(uri)?;
-    let path = base.join(&rel);
-    let bytes = super::files::read_bounded(&path)?;
-    if !inputs.contains(&path) {
-        inputs.push(path);
-    }
-    Ok(bytes)
-}
-
-fn percent_decode(s: &str) -> Result<String, String> {
-    let b = s.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' {
-            let hex = b.get(i + 1..i + 3).and_then(|h| std::str::from_utf8(h).ok());
-            let v = hex.and_then(|h| u8::from_str_radix(h, 16).ok()).ok_or("malformed %-escape in URI")?;
-            out.push(v);
-            i += 3;
-        } else {
-            out.push(b[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).map_err(|_| "URI is not UTF-8 after %-decoding".to_string())
 }
 
 impl Importer<'_> {
@@ -1118,7 +1075,16 @@ impl Importer<'_> {
                     .map(<[u8]>::to_vec)
                     .ok_or_else(|| format!("buffer view {} runs past the end of its buffer", view.index()))
             }
-            ::gltf::image::Source::Uri { uri, .. } => load_uri(uri, &self.base, &mut self.scene.inputs),
+            ::gltf::image::Source::Uri { uri, .. } => {
+                let what = format!("image {} ('{}')", img.index(), short(uri));
+                load_uri(uri, &self.base, &mut self.scene.inputs, &what).map_err(|e| match e {
+                    ReadError::Confined(e) => {
+                        self.escapes.push(e.clone());
+                        e
+                    }
+                    ReadError::Unreadable(e) => e,
+                })
+            }
         };
         let s = t.sampler();
         let wrap = |w: ::gltf::texture::WrappingMode| match w {

@@ -33,6 +33,7 @@ use std::path::Path;
 use kiln_format::manifest::Wrap;
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
+use super::files::ReadError;
 use super::geometry::{
     Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
 };
@@ -55,12 +56,18 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         tobj::LoadOptions { triangulate: true, single_index: true, ignore_points: true, ignore_lines: true };
     // tobj takes its material loader as `Fn`: the warnings it finds go through a RefCell.
     let mtl_warnings = std::cell::RefCell::new(Vec::new());
+    // Files named outside the confinement (`files::check_confined`): the import fails.
+    let escapes = std::cell::RefCell::new(Vec::new());
     let (models, materials) = tobj::load_obj_buf(&mut std::io::Cursor::new(&text), &options, |p| {
         let full = base.join(p);
         // Read within bounds, and with the statements tobj would panic on or take as NaN
         // dropped (each a warning), before tobj parses it.
-        let bytes = super::files::read_bounded(&full).map_err(|e| {
-            mtl_warnings.borrow_mut().push(format!("{file}: {e}"));
+        let what = format!("material library '{}'", p.display());
+        let bytes = super::files::read_referenced(&what, &full).map_err(|e| {
+            match e {
+                ReadError::Confined(e) => escapes.borrow_mut().push(e),
+                ReadError::Unreadable(e) => mtl_warnings.borrow_mut().push(format!("{file}: {e}")),
+            }
             tobj::LoadError::OpenFileFailed
         })?;
         let text = sanitize_mtl(
@@ -71,6 +78,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         tobj::load_mtl_buf(&mut std::io::Cursor::new(text.as_bytes()))
     })
     .map_err(|e| CliError::input(format!("{file}: cannot read OBJ: {e}")))?;
+    let mut escapes = escapes.into_inner();
     for w in mtl_warnings.into_inner() {
         scene.warn(w);
     }
@@ -118,7 +126,12 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
                         full = found;
                     }
                 }
-                let bytes = super::files::read_bounded(&full);
+                let bytes = super::files::read_referenced(&format!("texture '{name}'"), &full).map_err(|e| {
+                    if let ReadError::Confined(e) = &e {
+                        escapes.push(e.clone());
+                    }
+                    e.to_string()
+                });
                 if bytes.is_ok() && !scene.inputs.contains(&full) {
                     scene.inputs.push(full.clone());
                 }
@@ -138,6 +151,9 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         );
         material_warnings.extend(warnings.into_iter().map(|w| format!("{file}: material '{}': {w}", m.name)));
         scene.materials.push(Material { name: m.name.clone(), gpu });
+    }
+    if !escapes.is_empty() {
+        return Err(CliError::input(format!("{file}: {}", escapes.join("; "))));
     }
     for w in material_warnings.into_iter().chain(texture_warnings) {
         scene.warn(w);
