@@ -109,7 +109,7 @@ fn tiny(runs: usize) {
         warning_levels: Vec::new(),
         max_file_size: None,
         max_image_side: None,
-        paths: Default::default(),
+        limits: Default::default(),
     };
     let out_args = quiet_output();
     let res = kiln_compiler::settings::BRDF_LUT_RES.default;
@@ -171,7 +171,7 @@ fn pica(runs: usize) {
         warning_levels: Vec::new(),
         max_file_size: None,
         max_image_side: None,
-        paths: Default::default(),
+        limits: Default::default(),
     };
     let out_args = quiet_output();
     println!("pica_pica, {runs} runs, {} threads; medians (min..max) in ms", rayon::current_num_threads());

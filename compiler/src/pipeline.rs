@@ -66,7 +66,7 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
         args.max_file_size.unwrap_or(import::files::DEFAULT_MAX_FILE_BYTES),
         args.max_image_side.unwrap_or(import::files::DEFAULT_MAX_IMAGE_SIDE),
     );
-    args.paths.confine(Some(&args.input), args.config.as_deref(), &args.bake);
+    args.limits.apply(Some(&args.input), args.config.as_deref(), &args.bake);
     // The sidecar is read first since its `[bake] normals` decides the import; it is recorded
     // as an input after the asset, in the order a reader of the depfile expects.
     let mut sidecar_inputs = Vec::new();

@@ -247,3 +247,75 @@ fn files_an_asset_names_outside_its_folder_are_refused_unless_allowed() {
     let run = kiln(top, &["compile", "asset/in.gltf", "-o", "in2.kiln", "-W", "missing-setup=ignore"]);
     assert!(run.code == 0 && run.stderr.is_empty(), "{}", run.stderr);
 }
+
+/// A three-triangle OBJ in `d` and a sidecar `name.toml` holding `toml`.
+fn tetra_with(d: &Path, name: &str, toml: &str) {
+    std::fs::write(d.join("s.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\n")
+        .unwrap();
+    std::fs::write(d.join(format!("{name}.toml")), toml).unwrap();
+}
+
+#[test]
+fn bake_settings_whose_product_exceeds_the_limits_are_refused_before_baking() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spot = |i: usize| {
+        format!(
+            "[[light]]\nkind = \"spot\"\nposition = [0.{i}, 2, 0]\ndirection = [0, -1, 0]\nintensity = 1\n"
+        )
+    };
+    let point = "[[light]]\nkind = \"point\"\nposition = [0, 2, 0]\nintensity = 1\n";
+    let plan = |name: &str, extra: &[&str]| {
+        let cfg = format!("{name}.toml");
+        let mut args = vec!["plan", "s.obj", "-c", cfg.as_str(), "-W", "missing-setup=ignore"];
+        args.extend_from_slice(extra);
+        let start = Instant::now();
+        let run = kiln(d, &args);
+        assert!(start.elapsed() < Duration::from_secs(10), "{name}: {:?}", start.elapsed());
+        run
+    };
+    let refused = |run: &Ended, parts: &[&str]| {
+        assert_eq!(run.code, 2, "{}", run.stderr);
+        for p in parts {
+            assert!(run.stderr.contains(p), "{p:?} not in: {}", run.stderr);
+        }
+    };
+    // 16 spot lights at 8192: 16 x 8192^2 depths of 4 bytes = 4096 MiB, each setting in range.
+    let spots: String = (0..16).map(spot).collect();
+    tetra_with(d, "spots", &format!("{spots}[bake]\nshadow_res = 8192\n"));
+    let maps_mib = (16u64 * 8192 * 8192 * 4) >> 20;
+    refused(
+        &plan("spots", &[]),
+        &[
+            "16 shadow maps of 8192x8192",
+            "--shadow-res 8192",
+            &format!("{maps_mib} MiB"),
+            "--max-bake-memory",
+        ],
+    );
+    // Raised on the command line, the same settings plan.
+    let run = plan("spots", &["--max-bake-memory", "5G", "--max-bake-rays", "2G"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    // A sidecar cannot raise its own limit.
+    tetra_with(d, "raise", &format!("{spots}[bake]\nshadow_res = 8192\nmax_bake_memory = \"5G\"\n"));
+    let run = plan("raise", &[]);
+    assert!(run.code != 0 && run.stderr.contains("max_bake_memory"), "{}", run.stderr);
+    // One medium at 512 cells a side for one light: 512^3 cells x 8 samples = 1073M rays (the
+    // rays limit: its 128 MiB of volume is within the memory limit).
+    tetra_with(
+        d,
+        "media",
+        &format!("[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n{point}[bake]\nmedia_volume_res = 512\n"),
+    );
+    let rays = 512u64 * 512 * 512 * 8 / 1_000_000;
+    refused(&plan("media", &[]), &["512x512x512 cells for 1 lights", &format!("{rays}M"), "--max-bake-rays"]);
+    // A 1024^3 voxel grid (4 bytes a cell at least: 4 GiB) is refused before it is built.
+    tetra_with(d, "vox", &format!("{point}[bake]\nvoxel_res = 1024\nshaft_res = 8\n"));
+    refused(&plan("vox", &[]), &["a voxel grid of 1024x1024x1024 cells", "--voxel-res 1024"]);
+    // The largest line-space budget does not lift the memory limit.
+    tetra_with(d, "ls", &format!("{point}[bake]\nvoxel_res = 256\nline_space_budget = 1048576\n"));
+    refused(&plan("ls", &[]), &["the line space at 256 cells", "--max-bake-memory"]);
+    // The defaults plan.
+    tetra_with(d, "plain", point);
+    assert_eq!(plan("plain", &[]).code, 0);
+}

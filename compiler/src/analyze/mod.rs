@@ -3,5 +3,6 @@
 
 pub mod budget;
 pub mod geometry;
+pub mod limits;
 pub mod plan;
 pub mod validate;

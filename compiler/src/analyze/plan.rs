@@ -9,6 +9,7 @@ use kiln_format::readers;
 
 use crate::analyze::budget::{self, Choice, Request};
 use crate::analyze::geometry::SceneGeometry;
+use crate::analyze::limits::{Product, Spending};
 use crate::bake::linespace::voxelize::auto_resolution;
 use crate::settings::{PnmtRecords, SHAFT_RES, Settings, VoxelRes, variants_name};
 use kiln_format::linespace::{PnmtLayout, Variants};
@@ -258,6 +259,7 @@ impl Plan {
             )
         });
         let casters = scene.lights.iter().filter(|l| l.casts_shadows).count();
+        let mut spending = Spending::default();
         stages.push(if scene.lights.is_empty() {
             skip(Stage::ShadowMaps, "the scene has no analytic lights")
         } else if casters == 0 {
@@ -268,6 +270,20 @@ impl Plan {
                 .iter()
                 .filter(|l| l.casts_shadows && matches!(l.kind, LightKind::Point | LightKind::Rect { .. }))
                 .count();
+            let (res, face) = (settings.shadow_res as u64, (settings.shadow_res as u64 / 2).max(1));
+            let texels = (casters - cubes) as u64 * res * res + cubes as u64 * 6 * face * face;
+            let maps = [
+                (casters - cubes > 0).then(|| format!("{} shadow maps of {res}x{res}", casters - cubes)),
+                (cubes > 0).then(|| format!("{cubes} cube maps of 6x{face}x{face}")),
+            ];
+            spending.add(Product {
+                what: format!(
+                    "{} (--shadow-res {res})",
+                    maps.into_iter().flatten().collect::<Vec<_>>().join(" and ")
+                ),
+                bytes: texels * 4,
+                rays: texels,
+            })?;
             run(
                 Stage::ShadowMaps,
                 format!(
@@ -284,6 +300,16 @@ impl Plan {
         } else if casters == 0 {
             skip(Stage::MediaVisibility, "no light casts shadows: every cell sees every light")
         } else {
+            let dims = crate::bake::media::dims(&scene.media[0], settings.media_volume_res);
+            let cells = dims.iter().map(|&d| d as u64).product::<u64>() * casters as u64;
+            spending.add(Product {
+                what: format!(
+                    "light-visibility volumes of {}x{}x{} cells for {casters} lights (--media-volume-res {})",
+                    dims[0], dims[1], dims[2], settings.media_volume_res
+                ),
+                bytes: cells,
+                rays: cells * crate::bake::media::SAMPLES as u64,
+            })?;
             run(
                 Stage::MediaVisibility,
                 format!(
@@ -300,6 +326,15 @@ impl Plan {
             ),
             Some(env) => {
                 let w = (settings.environment_res.min(env.width) & !1).max(2);
+                // The map in E5B9G9R9 and its resampling in f32 RGB.
+                spending.add(Product {
+                    what: format!(
+                        "an environment map {w} wide (--environment-res {})",
+                        settings.environment_res
+                    ),
+                    bytes: w as u64 * (w / 2) as u64 * 16,
+                    rays: 0,
+                })?;
                 let fw = crate::bake::environment::FILTERED_WIDTH.min(w);
                 run(
                     Stage::Environment,
@@ -321,6 +356,13 @@ impl Plan {
         let lit = scene.lit();
         let (probe_decision, probes) = probe_plan(scene, geometry, settings, lit)?;
         stages.push(probe_decision);
+        if let Some(p) = &probes {
+            spending.add(Product {
+                what: format!("{} probes (--probe-spacing, --probe-budget)", p.count()),
+                bytes: p.bytes(),
+                rays: 0,
+            })?;
+        }
         let requested_res = match settings.voxel_res {
             VoxelRes::Auto => auto_resolution(scene.triangles.len()),
             VoxelRes::Cells(n) => n,
@@ -360,6 +402,20 @@ impl Plan {
             PnmtRecords::Compact if textured == 0 => (PnmtLayout::CompactNoUv, String::new()),
             PnmtRecords::Compact => (PnmtLayout::Compact, String::new()),
         };
+        if wanted {
+            // The grid the line space's estimate builds first: a count and an offset per cell,
+            // and the count's copy while they are summed.
+            let g = crate::bake::linespace::voxelize::grid(&geometry.bounds, requested_res);
+            let cells = g.dims.iter().map(|&d| d as u64).product::<u64>();
+            spending.add(Product {
+                what: format!(
+                    "a voxel grid of {}x{}x{} cells (--voxel-res {requested_res})",
+                    g.dims[0], g.dims[1], g.dims[2]
+                ),
+                bytes: cells * 12,
+                rays: 0,
+            })?;
+        }
         let choice = if wanted {
             Some(budget::choose(
                 geometry,
@@ -396,6 +452,14 @@ impl Plan {
             }
             Some(c) => {
                 let e = &c.estimate;
+                spending.add(Product {
+                    what: format!(
+                        "the line space at {} cells and N = {} (--voxel-res, --shaft-res, --line-space-budget)",
+                        e.voxel_res, e.shaft_res
+                    ),
+                    bytes: c.bytes,
+                    rays: 0,
+                })?;
                 let auto = match settings.voxel_res {
                     VoxelRes::Auto if voxel_res == requested_res => {
                         format!(" (auto: cube root of {} triangles)", scene.triangles.len())

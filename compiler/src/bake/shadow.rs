@@ -63,8 +63,9 @@ fn corners(b: &Bounds) -> [Vec3; 8] {
 pub struct Layout {
     /// Manifest record.
     pub info: ShadowMapInfo,
-    /// World → clip for 2D maps (for texel rays).
-    view_proj: Mat4,
+    /// Clip → world for 2D maps (for texel rays): the stored (f32) matrix inverted in f64, once
+    /// per map rather than per texel.
+    clip_to_world: DMat4,
 }
 
 /// The map layout of `light` (number `index`) over `bounds`, or `None` if it casts no shadows.
@@ -143,7 +144,7 @@ pub fn layout(light: &Light, index: u32, bounds: &Bounds, res: u32) -> Option<La
             far,
             texel,
         },
-        view_proj,
+        clip_to_world: DMat4::from_cols_array(&view_proj.to_cols_array().map(f64::from)).inverse(),
     })
 }
 
@@ -175,7 +176,7 @@ impl Layout {
                 // tenth of a texel, and the map would not be what its matrix says.
                 let ndc_x = 2.0 * (x as f64 + 0.5) / n as f64 - 1.0;
                 let ndc_y = 1.0 - 2.0 * (y as f64 + 0.5) / n as f64;
-                let inv = DMat4::from_cols_array(&self.view_proj.to_cols_array().map(f64::from)).inverse();
+                let inv = self.clip_to_world;
                 let near = inv.project_point3(DVec3::new(ndc_x, ndc_y, 0.0));
                 let far = inv.project_point3(DVec3::new(ndc_x, ndc_y, 1.0));
                 let d = (far - near).normalize_or(DVec3::from(self.info.direction.map(f64::from))).as_vec3();

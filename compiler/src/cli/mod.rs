@@ -135,15 +135,16 @@ pub struct SceneArgs {
     /// decoding; a larger image is not decoded (a data-loss warning) [default: 16384].
     #[arg(long, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Input limits")]
     pub max_image_side: Option<u32>,
-    /// Where files the asset names may lie.
+    /// Where files the asset names may lie, and what the bake may spend.
     #[command(flatten)]
-    pub paths: PathArgs,
+    pub limits: LimitArgs,
 }
 
 /// Where the files an asset names (buffers, images, MTL libraries, the sidecar's sky image) may
-/// lie. Files named on the command line are always read.
+/// lie (files named on the command line are always read), and what the bake may spend. Limits
+/// are flags only: a sidecar travels with the asset and must not raise them.
 #[derive(Debug, Args, Clone, Default)]
-pub struct PathArgs {
+pub struct LimitArgs {
     /// Also let the asset and the sidecar read files under DIR (repeatable). By default they may
     /// read only under the input's folder and the sidecar's: an asset naming `../../etc/passwd`
     /// or an absolute path elsewhere is refused.
@@ -152,12 +153,28 @@ pub struct PathArgs {
     /// Let the asset read files anywhere (only for assets you trust).
     #[arg(long, help_heading = "Input limits", conflicts_with = "search_path")]
     pub allow_any_path: bool,
+    /// The most memory the baked products the settings size may take together (shadow maps,
+    /// light-visibility volumes, voxel grid and line space, probes, environment): bytes, or with
+    /// a binary unit K, M, G, T. Settings whose product exceeds it are a usage error naming them
+    /// [default: 1G].
+    #[arg(long, value_name = "SIZE", value_parser = crate::cache::parse_size, help_heading = "Input limits")]
+    pub max_bake_memory: Option<u64>,
+    /// The most rays the settings may ask the bakes to trace (a texel of a shadow map, a sample
+    /// of a light-visibility volume), with an optional unit K, M, G (powers of 1024)
+    /// [default: 32M].
+    #[arg(long, value_name = "N", value_parser = crate::cache::parse_size, help_heading = "Input limits")]
+    pub max_bake_rays: Option<u64>,
 }
 
-impl PathArgs {
-    /// Sets the confinement for an import of `input` (none for the demo) with `sidecar`, where
-    /// `bake` may name an environment file on the command line.
-    pub fn confine(&self, input: Option<&Path>, sidecar: Option<&Path>, bake: &BakeArgs) {
+impl LimitArgs {
+    /// Sets the bake limits, and the confinement for an import of `input` (none for the demo)
+    /// with `sidecar`, where `bake` may name an environment file on the command line.
+    pub fn apply(&self, input: Option<&Path>, sidecar: Option<&Path>, bake: &BakeArgs) {
+        use crate::analyze::limits;
+        limits::set_bake_limits(
+            self.max_bake_memory.unwrap_or(limits::DEFAULT_MAX_BAKE_MEMORY),
+            self.max_bake_rays.unwrap_or(limits::DEFAULT_MAX_BAKE_RAYS),
+        );
         if self.allow_any_path {
             crate::import::files::confine(None);
             return;
@@ -481,9 +498,9 @@ pub struct DemoArgs {
     /// Bake settings.
     #[command(flatten)]
     pub bake: BakeArgs,
-    /// Where files the sidecar names may lie.
+    /// Where files the sidecar names may lie, and what the bake may spend.
     #[command(flatten)]
-    pub paths: PathArgs,
+    pub limits: LimitArgs,
     /// Report, depfile, threads.
     #[command(flatten)]
     pub out: OutputArgs,

@@ -40,7 +40,7 @@ pub fn demo(args: &DemoArgs) -> CliResult {
         DemoScene::BoxBunny => (cornell_with_object(BUNNY, SEED), "box-bunny"),
         DemoScene::BoxDragon => (cornell_with_object(DRAGON, SEED), "box-dragon"),
     };
-    args.paths.confine(None, args.config.as_deref(), &args.bake);
+    args.limits.apply(None, args.config.as_deref(), &args.bake);
     let settings = pipeline::configure(&mut scene, args.config.as_deref(), &args.bake)?;
     let loaded = pipeline::finish(scene, settings, name, &Default::default(), false, start)?;
     let report = pipeline::compile(&loaded, name, &args.output, &args.out)?;
