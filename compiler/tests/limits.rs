@@ -319,3 +319,57 @@ fn bake_settings_whose_product_exceeds_the_limits_are_refused_before_baking() {
     tetra_with(d, "plain", point);
     assert_eq!(plan("plain", &[]).code, 0);
 }
+
+#[test]
+fn a_face_of_100000_corners_compiles_quickly_into_triangles_that_tile_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A regular polygon of n corners, counter-clockwise seen from +z, in one face.
+    let n = 100_000usize;
+    let mut text = String::new();
+    let corners: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    for c in &corners {
+        text.push_str(&format!("v {:.7} {:.7} 0\n", c[0], c[1]));
+    }
+    text.push('f');
+    for i in 1..=n {
+        text.push_str(&format!(" {i}"));
+    }
+    text.push('\n');
+    std::fs::write(d.join("disc.obj"), text).unwrap();
+    let start = Instant::now();
+    let run = kiln(
+        d,
+        &["compile", "disc.obj", "-o", "disc.kiln", "-W", "missing-setup=ignore", "-W", "data-loss=ignore"],
+    );
+    let took = start.elapsed();
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(took < Duration::from_secs(10), "{took:?}");
+    let file = kiln_format::KilnFile::open(&d.join("disc.kiln"), kiln_format::Checksums::Eager).unwrap();
+    let view = kiln_format::SceneView::new(&file).unwrap();
+    // The triangles tile the polygon: their areas sum to its area (the shoelace formula over the
+    // corners as written), every one wound as the face (+z), none beyond n - 2.
+    let shoelace: f64 = (0..n)
+        .map(|i| {
+            let (p, q) = (corners[i], corners[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        / 2.0;
+    let mut area = 0.0;
+    for t in view.triangles {
+        let p = t.map(|i| view.vertices[i as usize].position.map(f64::from));
+        let signed =
+            ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1])) / 2.0;
+        // (Near-collinear neighbours, rounded to f32, may come out a rounding error below zero.)
+        assert!(signed > -1e-9, "a triangle wound against the face: {signed}");
+        area += signed;
+    }
+    assert!(view.triangles.len() <= n - 2);
+    assert!((area - shoelace).abs() < 1e-4 * shoelace, "triangles {area}, polygon {shoelace}");
+}

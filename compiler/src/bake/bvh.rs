@@ -35,8 +35,27 @@ pub fn triangles(corners: impl Iterator<Item = [[f32; 3]; 3]>) -> Vec<Triangle> 
 
 /// Builds the BVH over `tris`.
 pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
-    let mut core = std::time::Duration::ZERO;
-    let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(tris, params(preset), &mut core);
+    // obvhs converts its binary tree by recursion as deep as the tree, which hostile geometry
+    // (100,000 slivers through one vertex) makes as deep as the triangle count: on a worker's
+    // 2 MiB stack that overflows and aborts. So the build runs on a thread whose stack grows with
+    // the triangles (reserved, not committed, until used).
+    let stack = (tris.len() as u64 * 512).clamp(8 << 20, 4 << 30) as usize;
+    let bvh = std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("bvh".into())
+            .stack_size(stack)
+            .spawn_scoped(scope, || {
+                let mut core = std::time::Duration::ZERO;
+                obvhs::cwbvh::builder::build_cwbvh_from_tris(tris, params(preset), &mut core)
+            })
+            .map_err(|e| {
+                CliError::io(format!("cannot start the BVH build with a {} MiB stack: {e}", stack >> 20))
+            })?
+            .join()
+            .map_err(|_| {
+                CliError::input("the BVH builder failed (a panic in obvhs): please report the asset")
+            })
+    })?;
     if bvh.primitive_indices.len() != tris.len() {
         return Err(CliError::input(format!(
             "BVH builder returned {} leaf references for {} triangles",

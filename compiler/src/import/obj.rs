@@ -48,7 +48,8 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     let file = path.display().to_string();
     let text = read_input(path, &mut scene.inputs)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let Precheck { libs: mtllibs, groups, warnings } = precheck(&file, &text)?;
+    let Precheck { libs: mtllibs, groups, warnings, large_faces } = precheck(&file, &text)?;
+    let text = if large_faces { split_large_faces(&text) } else { text };
     for w in warnings {
         scene.warn(w);
     }
@@ -410,6 +411,54 @@ struct Precheck {
     groups: Vec<u32>,
     /// Warnings, with line numbers.
     warnings: Vec<String>,
+    /// Whether a face has more than [`FAN_LIMIT`] corners.
+    large_faces: bool,
+}
+
+/// Corners beyond which a face is not fanned (by tobj) but split by halving (here). A fan of
+/// 100,000 corners is 100,000 slivers through one corner, every box overlapping the next: the
+/// BVH builder (PLOC) merges one pair per pass over them, quadratic time and a tree as deep as
+/// the face is wide (a minute, then a stack overflow). Halving gives the same n − 2 triangles,
+/// most of them between neighbouring corners, in the same winding.
+const FAN_LIMIT: usize = 64;
+
+/// `text` with every face of more than [`FAN_LIMIT`] corners written as the triangles of its
+/// halving: the chain of corners a..=b (first the whole face, closed by its last edge) gives the
+/// triangle (a, m, b) at its middle m, then the chains a..=m and m..=b. Linear in the corners.
+/// Other lines are kept (continued lines joined); relative references stay valid, as no vertex
+/// comes between.
+fn split_large_faces(text: &[u8]) -> Vec<u8> {
+    let text = String::from_utf8_lossy(text);
+    let mut out = String::with_capacity(text.len() * 2);
+    let mut logical = String::new();
+    for raw in text.lines() {
+        if let Some(stripped) = raw.strip_suffix('\\') {
+            logical.push_str(stripped);
+            logical.push(' ');
+            continue;
+        }
+        logical.push_str(raw);
+        let line = std::mem::take(&mut logical);
+        let body = line.split('#').next().unwrap_or("");
+        let mut words = body.split_whitespace();
+        let corners: Vec<&str> = if words.next() == Some("f") { words.collect() } else { Vec::new() };
+        if corners.len() <= FAN_LIMIT {
+            out.push_str(&line);
+            out.push('\n');
+            continue;
+        }
+        let mut chains = vec![(0, corners.len() - 1)];
+        while let Some((a, b)) = chains.pop() {
+            if b - a < 2 {
+                continue;
+            }
+            let m = (a + b) / 2;
+            out.push_str(&format!("f {} {} {}\n", corners[a], corners[m], corners[b]));
+            chains.push((m, b));
+            chains.push((a, m));
+        }
+    }
+    out.into_bytes()
 }
 
 /// Checks face references and positions line by line; reads `mtllib` names and smoothing
@@ -419,6 +468,7 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     let (mut nv, mut nt, mut nn) = (0i64, 0i64, 0i64);
     let mut libs = Vec::new();
     let mut faces = 0u64;
+    let mut large_faces = false;
     let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
     let mut logical = String::new();
     let mut first_line = 0;
@@ -471,6 +521,7 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
                     return Err(at(format!("face has {} vertices; a face needs at least 3", corners.len())));
                 }
                 groups.extend(std::iter::repeat_n(group, corners.len() - 2));
+                large_faces |= corners.len() > FAN_LIMIT;
                 for (k, c) in corners.iter().enumerate() {
                     for (slot, (part, count, what)) in c
                         .split('/')
@@ -500,5 +551,5 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     if faces == 0 {
         return Err(CliError::input(format!("{file}: has no faces")));
     }
-    Ok(Precheck { libs, groups, warnings })
+    Ok(Precheck { libs, groups, warnings, large_faces })
 }
