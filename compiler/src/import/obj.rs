@@ -422,6 +422,25 @@ struct Precheck {
 /// most of them between neighbouring corners, in the same winding.
 const FAN_LIMIT: usize = 64;
 
+/// The statements of `text` with the number of the line each starts on: lines ending in a
+/// backslash continue on the next one (joined with a space).
+fn logical_lines(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
+    let mut logical = String::new();
+    let mut first_line = 0;
+    text.lines().enumerate().filter_map(move |(i, raw)| {
+        if logical.is_empty() {
+            first_line = i + 1;
+        }
+        if let Some(stripped) = raw.strip_suffix('\\') {
+            logical.push_str(stripped);
+            logical.push(' ');
+            return None;
+        }
+        logical.push_str(raw);
+        Some((first_line, std::mem::take(&mut logical)))
+    })
+}
+
 /// `text` with every face of more than [`FAN_LIMIT`] corners written as the triangles of its
 /// halving: the chain of corners a..=b (first the whole face, closed by its last edge) gives the
 /// triangle (a, m, b) at its middle m, then the chains a..=m and m..=b. Linear in the corners.
@@ -430,15 +449,7 @@ const FAN_LIMIT: usize = 64;
 fn split_large_faces(text: &[u8]) -> Vec<u8> {
     let text = String::from_utf8_lossy(text);
     let mut out = String::with_capacity(text.len() * 2);
-    let mut logical = String::new();
-    for raw in text.lines() {
-        if let Some(stripped) = raw.strip_suffix('\\') {
-            logical.push_str(stripped);
-            logical.push(' ');
-            continue;
-        }
-        logical.push_str(raw);
-        let line = std::mem::take(&mut logical);
+    for (_, line) in logical_lines(&text) {
         let body = line.split('#').next().unwrap_or("");
         let mut words = body.split_whitespace();
         let corners: Vec<&str> = if words.next() == Some("f") { words.collect() } else { Vec::new() };
@@ -470,20 +481,7 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     let mut faces = 0u64;
     let mut large_faces = false;
     let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
-    let mut logical = String::new();
-    let mut first_line = 0;
-    for (i, raw) in text.lines().enumerate() {
-        // Lines ending in a backslash continue on the next one.
-        if logical.is_empty() {
-            first_line = i + 1;
-        }
-        if let Some(stripped) = raw.strip_suffix('\\') {
-            logical.push_str(stripped);
-            logical.push(' ');
-            continue;
-        }
-        logical.push_str(raw);
-        let line = std::mem::take(&mut logical);
+    for (first_line, line) in logical_lines(&text) {
         let line = line.split('#').next().unwrap_or("");
         let mut words = line.split_whitespace();
         let at = |msg: String| CliError::input(format!("{file}:{first_line}: {msg}"));
