@@ -371,3 +371,55 @@ fn rechecksummed_as_is(bytes: &[u8], position: usize) -> Vec<u8> {
     out[..HEADER_SIZE].copy_from_slice(&header.to_bytes());
     out
 }
+
+/// `good` (stored as is) with section `kind` edited by `edit` and every checksum made right.
+fn edited(good: &[u8], kind: SectionKind, edit: impl FnOnce(&mut [u8])) -> Vec<u8> {
+    let file = KilnFile::from_bytes(good, Checksums::Eager).unwrap();
+    let s = *file.find(kind, 0).expect("the fixture holds the section");
+    assert_eq!(s.entry.codec, 0, "stored as is");
+    let mut out = good.to_vec();
+    edit(&mut out[s.entry.offset as usize..(s.entry.offset + s.entry.size) as usize]);
+    rechecksummed_as_is(&out, s.position)
+}
+
+#[test]
+fn kiln_verify_without_rays_refuses_boxes_and_a_grid_that_do_not_bound_the_scene() {
+    let good = every_kind_file_with(Codec::None);
+    let dir = tempfile::tempdir().unwrap();
+    let verify = |bytes: &[u8]| {
+        std::fs::write(dir.path().join("bad.kiln"), bytes).unwrap();
+        kiln(dir.path(), &["verify", "bad.kiln"])
+    };
+    verify(&good).expect(0);
+    // A node's slot box shrunk to the point at its grid's far corner (every plane 255): a leaf
+    // slot's triangles, or an internal slot's child boxes, no longer lie in it. The byte
+    // offsets are FORMAT.md's CWBV node layout (80 bytes; child_meta at 24, the planes from 32).
+    let nodes = {
+        let file = KilnFile::from_bytes(&good, Checksums::Eager).unwrap();
+        file.pod::<sections::CwbvhNode>(sections::BVH_NODES, 0).unwrap().unwrap().to_vec()
+    };
+    let slot_of = |internal: bool| {
+        nodes.iter().enumerate().find_map(|(i, n)| {
+            (0..8).find(|&s| n.child_meta[s] != 0 && ((n.imask >> s) & 1 == 1) == internal).map(|s| (i, s))
+        })
+    };
+    for (what, internal, says) in
+        [("leaf", false, "lies outside its leaf's box"), ("internal", true, "is not within its parent's box")]
+    {
+        let (node, slot) = slot_of(internal).unwrap_or_else(|| panic!("a {what} slot"));
+        let bad = edited(&good, sections::BVH_NODES, |b| {
+            for plane in 0..6 {
+                b[node * 80 + 32 + plane * 8 + slot] = 255;
+            }
+        });
+        verify(&bad).expect(1).says("BVH node").says(says);
+    }
+    // The grid moved by eight cells along x: it no longer covers the scene (origin at byte 0,
+    // the cell edge at 24, both f64).
+    let bad = edited(&good, sections::GRID, |b| {
+        let origin = f64::from_le_bytes(b[0..8].try_into().unwrap());
+        let cell = f64::from_le_bytes(b[24..32].try_into().unwrap());
+        b[0..8].copy_from_slice(&(origin + 8.0 * cell).to_le_bytes());
+    });
+    verify(&bad).expect(1).says("do not cover the scene");
+}

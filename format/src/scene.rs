@@ -372,7 +372,10 @@ impl<'a> SceneView<'a> {
 
     /// Checks that the BVH is a tree over exactly the triangles: every node reached once, child
     /// and triangle ranges in bounds, every triangle in exactly one leaf, depth within the
-    /// traversal stack.
+    /// traversal stack; and that its boxes bound what they hold (without tracing a ray): a
+    /// child node's boxes lie in its parent's box for it, within the child's own quantisation
+    /// step (each level rounds outwards from its own origin), and a leaf's triangles lie in the
+    /// leaf's box, within a few ulps of the coordinates (decoding adds in f32).
     fn check_bvh(&self) -> Result<()> {
         if self.bvh.is_empty() {
             return Ok(());
@@ -381,9 +384,11 @@ impl<'a> SceneView<'a> {
         let nt = self.triangles.len();
         let mut node_seen = vec![false; n];
         let mut tri_seen = vec![false; nt];
-        let mut stack = vec![(0usize, 1usize)];
+        // (node, depth, the parent's box for it).
+        let mut stack = vec![(0usize, 1usize, None)];
         node_seen[0] = true;
-        while let Some((i, depth)) = stack.pop() {
+        let ulps = |v: f32| 4.0 * f32::EPSILON * v.abs();
+        while let Some((i, depth, parent_box)) = stack.pop() {
             let node = &self.bvh[i];
             let bad = |msg: String| FormatError::invalid(format!("BVH node {i}: {msg}"));
             if depth > BVH_TRAVERSAL_STACK {
@@ -391,6 +396,20 @@ impl<'a> SceneView<'a> {
             }
             if !finite(&node.p) || node.e.iter().any(|&e| e == 0 || e == 255) {
                 return Err(bad("non-finite origin or degenerate scale".into()));
+            }
+            let step = node.extent();
+            for slot in (0..8).filter(|&s| !node.is_empty(s)) {
+                let (lo, hi) = node.child_box(slot);
+                let inside = parent_box.is_none_or(|(plo, phi): ([f32; 3], [f32; 3])| {
+                    (0..3).all(|a| {
+                        lo[a] >= plo[a] - step[a] - ulps(plo[a]) && hi[a] <= phi[a] + step[a] + ulps(phi[a])
+                    })
+                });
+                if !inside || (0..3).any(|a| lo[a] > hi[a]) {
+                    return Err(bad(format!(
+                        "slot {slot}'s box {lo:?}..{hi:?} is not within its parent's box {parent_box:?}"
+                    )));
+                }
             }
             for slot in 0..8 {
                 let meta = node.child_meta[slot];
@@ -405,7 +424,7 @@ impl<'a> SceneView<'a> {
                     if std::mem::replace(&mut node_seen[c as usize], true) {
                         return Err(bad(format!("child {c} is referenced twice")));
                     }
-                    stack.push((c as usize, depth + 1));
+                    stack.push((c as usize, depth + 1, Some(node.child_box(slot))));
                 } else if meta != 0 {
                     let (first, count) = node.leaf_range(slot);
                     let unary = meta >> 5;
@@ -414,9 +433,19 @@ impl<'a> SceneView<'a> {
                             "leaf slot {slot} meta {meta:#010b} invalid for {nt} triangles"
                         )));
                     }
+                    let (lo, hi) = node.child_box(slot);
                     for t in first..first + count as u64 {
                         if std::mem::replace(&mut tri_seen[t as usize], true) {
                             return Err(bad(format!("triangle {t} is in two leaves")));
+                        }
+                        // Indices were checked against the vertices by check_geometry.
+                        for &v in &self.triangles[t as usize] {
+                            let p = self.vertices[v as usize].position;
+                            if (0..3).any(|a| p[a] < lo[a] - ulps(lo[a]) || p[a] > hi[a] + ulps(hi[a])) {
+                                return Err(bad(format!(
+                                    "triangle {t}'s corner {p:?} lies outside its leaf's box {lo:?}..{hi:?}"
+                                )));
+                            }
                         }
                     }
                 }

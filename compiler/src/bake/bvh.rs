@@ -1,7 +1,7 @@
 //! The BVH stage: obvhs builds a CWBVH; we copy its nodes into the format's own node type and
 //! return the leaf order, so that triangles can be stored in it.
 
-use kiln_format::sections::CwbvhNode;
+use kiln_format::sections::{BVH_TRAVERSAL_STACK, CwbvhNode};
 use obvhs::BvhBuildParams;
 use obvhs::triangle::Triangle;
 
@@ -83,7 +83,35 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
         .collect::<Vec<_>>();
     let mut nodes = nodes;
     widen_to_contain(&mut nodes, tris, &bvh.primitive_indices);
+    let depth = depth(&nodes);
+    if depth > BVH_TRAVERSAL_STACK {
+        // Written, the file would be refused by every reader.
+        return Err(CliError::input(format!(
+            "the BVH over these {} triangles is {depth} levels deep, more than the {BVH_TRAVERSAL_STACK} every \
+             reader's traversal stack holds: the geometry is degenerate for a BVH (e.g. thousands of \
+             slivers through one point, as a fanned polygon makes); re-triangulate it",
+            tris.len()
+        )));
+    }
     Ok(BuiltBvh { nodes, order: bvh.primitive_indices })
+}
+
+/// Levels of the tree below and including the root (1 for a root of leaves).
+fn depth(nodes: &[CwbvhNode]) -> usize {
+    let mut deepest = 0;
+    let mut stack = if nodes.is_empty() { vec![] } else { vec![(0usize, 1usize)] };
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let n = &nodes[i];
+        // A child index past the nodes would be the builder's bug; the reader refuses it.
+        stack.extend(
+            (0..8)
+                .filter(|&s| n.is_internal(s))
+                .map(|s| (n.child_node(s) as usize, d + 1))
+                .filter(|&(c, _)| c < nodes.len()),
+        );
+    }
+    deepest
 }
 
 /// Makes every decoded child box contain its subtree's triangles exactly, as FORMAT.md promises.

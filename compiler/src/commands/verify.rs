@@ -130,6 +130,11 @@ fn check(args: &VerifyArgs, report: &mut VerifyJson) -> CliResult {
     }
     let line_space = LineSpace::new(&file, view.triangles.len(), view.materials.len())
         .map_err(|e| format_error(&args.file, e))?;
+    if let Some(ls) = &line_space {
+        let positions: Vec<[f32; 3]> = view.vertices.iter().map(|v| v.position).collect();
+        ls.check_against(&view.manifest.bounds, &positions, view.triangles)
+            .map_err(|e| format_error(&args.file, e))?;
+    }
     report.sections = file.sections().len();
     report.skipped_sections = file
         .skipped()

@@ -329,6 +329,50 @@ impl<'a> LineSpace<'a> {
         Ok(())
     }
 
+    /// Checks the grid against the scene it was baked for (FORMAT.md's "musts" that need the
+    /// geometry): it covers `bounds` widened by four of its margins on every side (in f64), and
+    /// every triangle a cell lists overlaps that cell widened by its margin (its box against the
+    /// cell's). `positions` are the vertices' positions, `triangles` their indices (checked by
+    /// the scene view).
+    pub fn check_against(
+        &self,
+        bounds: &crate::manifest::Bounds,
+        positions: &[[f32; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<()> {
+        let h = &self.header;
+        let m = h.margin;
+        for a in 0..3 {
+            let far = h.origin[a] + h.dims[a] as f64 * h.cell;
+            if h.origin[a] > bounds.min[a] as f64 - 4.0 * m || far < bounds.max[a] as f64 + 4.0 * m {
+                return Err(bad(format!(
+                    "axis {a}: cells {}..{far} do not cover the scene's {}..{} with four margins of {m}",
+                    h.origin[a], bounds.min[a], bounds.max[a]
+                )));
+            }
+        }
+        let (dx, dy) = (h.dims[0] as usize, h.dims[1] as usize);
+        for c in 0..self.voxel_offsets.len().saturating_sub(1) {
+            let at = [c % dx, c / dx % dy, c / (dx * dy)];
+            let lo: [f64; 3] = std::array::from_fn(|a| h.origin[a] + at[a] as f64 * h.cell - m);
+            let hi: [f64; 3] = std::array::from_fn(|a| lo[a] + h.cell + 2.0 * m);
+            for &t in self.cell_triangles(c) {
+                let Some(corners) = triangles.get(t as usize) else { continue };
+                let p = corners.map(|v| positions.get(v as usize).copied().unwrap_or([f32::NAN; 3]));
+                let apart = (0..3).any(|a| {
+                    let (tlo, thi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), q| {
+                        (l.min(q[a] as f64), u.max(q[a] as f64))
+                    });
+                    thi < lo[a] || tlo > hi[a]
+                });
+                if apart {
+                    return Err(bad(format!("cell {c} {at:?} lists triangle {t}, which lies outside it")));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Triangles of cell `c` (linear index).
     pub fn cell_triangles(&self, c: usize) -> &'a [u32] {
         &self.voxel_triangles[self.voxel_offsets[c] as usize..self.voxel_offsets[c + 1] as usize]

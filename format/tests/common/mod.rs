@@ -28,10 +28,11 @@ pub fn small_file_with(texture: u32, compression: Compression) -> Vec<u8> {
     let tmat = [0u32, 0];
     let materials = [GpuMaterial { base_color_texture: 0, ..Default::default() }];
     // One root with one leaf of two triangles; box [0,1]^2 x [0, 0].
-    let mut root = CwbvhNode { p: [0.0; 3], e: [127 - 8, 127 - 8, 127 - 8], ..Default::default() };
+    // Steps of 1/128: 128 steps reach 1 exactly, so the box holds the quad (FORMAT.md's must).
+    let mut root = CwbvhNode { p: [0.0; 3], e: [127 - 7, 127 - 7, 127 - 7], ..Default::default() };
     root.child_meta[0] = 0b0110_0000;
-    root.child_max_x[0] = 255;
-    root.child_max_y[0] = 255;
+    root.child_max_x[0] = 128;
+    root.child_max_y[0] = 128;
     let nodes = [root];
     let mip_levels = kiln_format::scene::mip_levels(texture, texture);
     let texel_count: u32 = (0..mip_levels).map(|l| (texture >> l).max(1).pow(2)).sum();
