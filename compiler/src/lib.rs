@@ -18,4 +18,5 @@ pub mod progress;
 pub mod raycheck;
 pub mod settings;
 pub mod shading;
+pub mod untrusted;
 pub mod warnings;

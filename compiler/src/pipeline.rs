@@ -153,6 +153,11 @@ pub fn finish(
 /// scenes in code).
 pub fn compile_to_bytes(scene: Scene, settings: Settings, source: &str) -> CliResult<Vec<u8>> {
     let loaded = finish(scene, settings, source, &WarningPolicy::default(), true, Instant::now())?;
+    bake_to_bytes(&loaded)
+}
+
+/// Bakes a loaded scene in memory, quietly, with no input files recorded and no cache.
+pub fn bake_to_bytes(loaded: &Loaded) -> CliResult<Vec<u8>> {
     let progress = Progress::hidden();
     let baked = bake::bake(&loaded.context(Vec::new(), &progress, None)?)?;
     bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))

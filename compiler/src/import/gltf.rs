@@ -25,7 +25,7 @@ use super::read_input;
 use crate::exit::{CliError, CliResult, Exit};
 use crate::ir::{Material, Scene, TextureRole, WarningClass};
 use crate::settings::Normals;
-use checks::{check_references, guard, named, node_parents};
+use checks::{check_glb_header, check_references, guard, named, node_parents};
 use uri::{load_uri, short};
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
@@ -125,6 +125,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()>
 fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult<()> {
     let bytes = read_input(path, &mut scene.inputs)?;
     let file = path.display().to_string();
+    check_glb_header(&bytes, &file)?;
     let gltf = match Gltf::from_slice_without_validation(&bytes) {
         Ok(gltf) => gltf,
         Err(e) => {

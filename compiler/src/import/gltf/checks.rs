@@ -23,6 +23,20 @@ pub(super) fn guard<T>(file: &str, f: impl FnOnce() -> CliResult<T>) -> CliResul
     })
 }
 
+/// Refuses a GLB whose header declares fewer bytes than the header itself: the gltf crate
+/// subtracts the header's 12 from the declared length unchecked (an overflow).
+pub(super) fn check_glb_header(bytes: &[u8], file: &str) -> CliResult<()> {
+    if let Some(length) = bytes.strip_prefix(b"glTF").and_then(|b| b.get(4..8)) {
+        let declared = u32::from_le_bytes([length[0], length[1], length[2], length[3]]);
+        if declared < 12 {
+            return Err(CliError::input(format!(
+                "{file}: not a valid glTF 2.0 file: its GLB header declares {declared} bytes, less than the 12 of the header"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// `kind index 'name'`, or `kind index` for an unnamed object.
 pub(super) fn named(kind: &str, index: usize, name: Option<&str>) -> String {
     match name {
