@@ -373,3 +373,35 @@ fn a_face_of_100000_corners_compiles_quickly_into_triangles_that_tile_it() {
     assert!(view.triangles.len() <= n - 2);
     assert!((area - shoelace).abs() < 1e-4 * shoelace, "triangles {area}, polygon {shoelace}");
 }
+
+#[test]
+fn sidecar_material_values_outside_what_a_material_can_be_are_refused_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    obj(d, "lib.mtl");
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 0.5 0.5 0.5\nKe 1 1 1\n").unwrap();
+    for (line, field, value) in [
+        ("metallic = 2.0", "metallic", "2"),
+        ("roughness = -0.1", "roughness", "-0.1"),
+        ("base_color = [1.5, 0.2, 0.2]", "base_color", "1.5"),
+        ("base_color = [0.5, nan, 0.2]", "base_color", "NaN"),
+        ("emission = [-1.0, 0.0, 0.0]", "emission", "-1"),
+        ("emission = [inf, 0.0, 0.0]", "emission", "inf"),
+    ] {
+        std::fs::write(d.join("s.toml"), format!("[material.\"m\"]\n{line}\n")).unwrap();
+        let run = kiln(d, &["compile", "scene.obj", "-c", "s.toml", "-o", "out.kiln"]);
+        assert_eq!(run.code, 1, "{line}: {}", run.stderr);
+        assert!(
+            run.stderr.contains("material \"m\"") && run.stderr.contains(&format!("{field} holds {value}")),
+            "{line}: {}",
+            run.stderr
+        );
+    }
+    // Within range: compiles.
+    std::fs::write(
+        d.join("s.toml"),
+        "[material.\"m\"]\nbase_color = [1.0, 0.0, 0.5]\nmetallic = 1.0\nroughness = 0.0\n",
+    )
+    .unwrap();
+    assert_eq!(kiln(d, &["compile", "scene.obj", "-c", "s.toml", "-o", "out.kiln"]).code, 0);
+}

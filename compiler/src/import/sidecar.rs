@@ -422,9 +422,20 @@ fn apply_material(o: &MaterialToml, gpu: &mut kiln_format::sections::GpuMaterial
             None => {}
         }
     }
-    let vals = [&gpu.base_color[..], &gpu.emission, &[gpu.metallic, gpu.roughness]].concat();
-    if !vals.iter().all(|v| v.is_finite() && *v >= 0.0) || gpu.metallic > 1.0 || gpu.roughness > 1.0 {
-        return Err("values must be finite and non-negative; metallic and roughness at most 1".into());
+    // Each field within what a material can be: a base colour above 1 reflects more light than
+    // arrives (the glTF importer clamps it; a sidecar is written by hand, so it is refused).
+    let fields: [(&str, &[f32], f32); 4] = [
+        ("base_color", &gpu.base_color, 1.0),
+        ("emission", &gpu.emission, f32::INFINITY),
+        ("metallic", &[gpu.metallic], 1.0),
+        ("roughness", &[gpu.roughness], 1.0),
+    ];
+    for (field, values, most) in fields {
+        if let Some(v) = values.iter().find(|v| !(v.is_finite() && (0.0..=most).contains(*v))) {
+            let range =
+                if most.is_finite() { format!("in [0, {most}]") } else { "finite and non-negative".into() };
+            return Err(format!("{field} holds {v}; it must be {range}"));
+        }
     }
     Ok(())
 }
