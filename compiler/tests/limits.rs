@@ -405,3 +405,25 @@ fn sidecar_material_values_outside_what_a_material_can_be_are_refused_naming_the
     .unwrap();
     assert_eq!(kiln(d, &["compile", "scene.obj", "-c", "s.toml", "-o", "out.kiln"]).code, 0);
 }
+
+#[test]
+fn usemtl_of_a_material_no_library_defines_is_a_warning_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(
+        d.join("scene.obj"),
+        "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\nusemtl missing\nf 1 3 2\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 0.5 0.5 0.5\nKe 1 1 1\n").unwrap();
+    let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "-W", "missing-setup=ignore"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("scene.obj:7: usemtl 'missing' names no material of lib.mtl")
+            && !run.stderr.contains("'m'"),
+        "{}",
+        run.stderr
+    );
+    // --strict fails it (a data-loss warning).
+    assert_eq!(kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--strict"]).code, 1);
+}

@@ -132,7 +132,8 @@ pub struct SceneArgs {
     #[arg(long, value_name = "SIZE", value_parser = crate::cache::parse_size, help_heading = "Input limits")]
     pub max_file_size: Option<u64>,
     /// The largest image side in pixels the import decodes, read from the image's header before
-    /// decoding; a larger image is not decoded (a data-loss warning) [default: 16384].
+    /// decoding; a larger image is not decoded (a data-loss warning) [default: 4096; 8K textures and
+    /// environment maps need 8192].
     #[arg(long, value_name = "PIXELS", value_parser = clap::value_parser!(u32).range(1..), help_heading = "Input limits")]
     pub max_image_side: Option<u32>,
     /// Where files the asset names may lie, and what the bake may spend.

@@ -48,7 +48,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     let file = path.display().to_string();
     let text = read_input(path, &mut scene.inputs)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let Precheck { libs: mtllibs, groups, warnings, large_faces } = precheck(&file, &text)?;
+    let Precheck { libs: mtllibs, groups, warnings, large_faces, uses } = precheck(&file, &text)?;
     let text = if large_faces { split_large_faces(&text) } else { text };
     for w in warnings {
         scene.warn(w);
@@ -102,6 +102,15 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         }
     };
 
+    // A name no library defines: tobj gives its faces no material (the default), silently.
+    if !materials.is_empty() {
+        for (line, name) in uses.iter().filter(|(_, n)| !materials.iter().any(|m| &m.name == n)) {
+            scene.warn(format!(
+                "{file}:{line}: usemtl '{name}' names no material of {}; its faces get the default material",
+                mtllibs.join(", ")
+            ));
+        }
+    }
     let mut requests: Vec<TextureRequest> = Vec::new();
     let mut tex_cache: HashMap<(String, TextureRole), u32> = HashMap::new();
     let first_material = scene.materials.len() as u32;
@@ -413,6 +422,8 @@ struct Precheck {
     warnings: Vec<String>,
     /// Whether a face has more than [`FAN_LIMIT`] corners.
     large_faces: bool,
+    /// Each material name `usemtl` names, with the line it is first named on.
+    uses: Vec<(usize, String)>,
 }
 
 /// Corners beyond which a face is not fanned (by tobj) but split by halving (here). A fan of
@@ -480,6 +491,7 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     let mut libs = Vec::new();
     let mut faces = 0u64;
     let mut large_faces = false;
+    let mut uses: Vec<(usize, String)> = Vec::new();
     let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
     for (first_line, line) in logical_lines(&text) {
         let line = line.split('#').next().unwrap_or("");
@@ -499,6 +511,12 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
             Some("vt") => nt += 1,
             Some("vn") => nn += 1,
             Some("mtllib") => libs.extend(words.map(str::to_string)),
+            Some("usemtl") => {
+                let name = words.collect::<Vec<_>>().join(" ");
+                if !uses.iter().any(|(_, n)| *n == name) {
+                    uses.push((first_line, name));
+                }
+            }
             Some("s") => {
                 group = match words.next() {
                     Some("off") => 0,
@@ -549,5 +567,5 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     if faces == 0 {
         return Err(CliError::input(format!("{file}: has no faces")));
     }
-    Ok(Precheck { libs, groups, warnings, large_faces })
+    Ok(Precheck { libs, groups, warnings, large_faces, uses })
 }
