@@ -357,7 +357,7 @@ fn flip_tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
     if width.saturating_mul(height) <= FLIP_WHOLE_TEXELS {
         return vec![(0, 0, width, height)];
     }
-    let (w, h) = ((width / 4).min(256).max(1), (height / 4).min(256).max(1));
+    let (w, h) = ((width / 4).clamp(1, 256), (height / 4).clamp(1, 256));
     let mut out = Vec::with_capacity(16);
     for j in 0..4 {
         for i in 0..4 {
