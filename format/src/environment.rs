@@ -96,6 +96,15 @@ impl EnvironmentHeader {
         self.filtered_offset(self.filtered[2])
     }
 
+    /// Elements of `ENVR`, `ENVP` and `ENVT` (of a header within its limits).
+    pub fn section_counts(&self) -> [u64; 3] {
+        [
+            self.map[0] as u64 * self.map[1] as u64,
+            self.filtered_texels() as u64,
+            self.table[0] as u64 * self.table[1] as u64,
+        ]
+    }
+
     /// Mean radiance over the cosine-weighted hemisphere around unit normal `n` (irradiance / π)
     /// from the spherical harmonics, clamped at zero (band 2 rings below zero behind a bright
     /// source).
@@ -166,12 +175,10 @@ impl<'a> Environment<'a> {
         };
         header.check()?;
         // Each length against the header before decoding (`pod_exact`).
-        let cells = header.table[0] as u64 * header.table[1] as u64;
-        let map_texels = header.map[0] as u64 * header.map[1] as u64;
+        let [map_texels, filtered_texels, cells] = header.section_counts();
         let map: &[u32] = file.pod_exact(ENVIRONMENT_MAP, 0, map_texels, "environment-map")?.unwrap_or(&[]);
-        let filtered: &[u32] = file
-            .pod_exact(ENVIRONMENT_FILTERED, 0, header.filtered_texels() as u64, "environment-filtered")?
-            .unwrap_or(&[]);
+        let filtered: &[u32] =
+            file.pod_exact(ENVIRONMENT_FILTERED, 0, filtered_texels, "environment-filtered")?.unwrap_or(&[]);
         let table: &[EnvironmentCell] =
             file.pod_exact(ENVIRONMENT_TABLE, 0, cells, "environment-table")?.unwrap_or(&[]);
         let cells = cells as usize;

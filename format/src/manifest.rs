@@ -200,6 +200,14 @@ pub struct ShadowMapInfo {
     pub texel: f32,
 }
 
+impl ShadowMapInfo {
+    /// Depths its `SHDW` section holds: one face of `resolution`², six for a cube map.
+    pub fn depth_count(&self) -> u64 {
+        let faces = if self.projection == ShadowProjection::Cube { 6 } else { 1 };
+        faces * self.resolution as u64 * self.resolution as u64
+    }
+}
+
 /// Metadata of the `BRDF` section.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Encode, Decode, Serialize)]
 pub struct BrdfLutInfo {
@@ -220,6 +228,13 @@ pub struct MediaVisibilityInfo {
     pub samples: u32,
     /// The lights with a volume, in `MVIS` index order.
     pub lights: Vec<u32>,
+}
+
+impl MediaVisibilityInfo {
+    /// Cells of each light's `MVIS` section.
+    pub fn cells(&self) -> u64 {
+        self.dims.iter().map(|&d| d as u64).product()
+    }
 }
 
 /// A bake stage the compiler did not run, and why.

@@ -85,6 +85,12 @@ impl ProbeHeader {
         Vec3::from(self.origin) + Vec3::new(x as f32, y as f32, z as f32) * self.spacing
     }
 
+    /// Elements of `PRBS`, `PRBI` and `PRBV` (of a header within its limits).
+    pub fn section_counts(&self) -> [u64; 3] {
+        let texels = |e: [u32; 3]| e.iter().map(|&d| d as u64).product::<u64>();
+        [self.count(), texels(self.irradiance_extent()), texels(self.visibility_extent())]
+    }
+
     /// Width, height and layers of the irradiance atlas.
     pub fn irradiance_extent(&self) -> [u32; 3] {
         let tile = self.irradiance_texels + 2;
@@ -162,15 +168,12 @@ impl<'a> ProbeVolume<'a> {
         };
         header.check()?;
         // Each length against the header before decoding (`pod_exact`).
-        let texels = |e: [u32; 3]| e.iter().map(|&d| d as u64).product::<u64>();
-        let states: &[ProbeState] =
-            file.pod_exact(PROBE_STATES, 0, header.count(), "probe-states")?.unwrap_or(&[]);
-        let irradiance: &[u32] = file
-            .pod_exact(PROBE_IRRADIANCE, 0, texels(header.irradiance_extent()), "probe-irradiance")?
-            .unwrap_or(&[]);
-        let visibility: &[[u16; 2]] = file
-            .pod_exact(PROBE_VISIBILITY, 0, texels(header.visibility_extent()), "probe-visibility")?
-            .unwrap_or(&[]);
+        let [probes, irradiance_texels, visibility_texels] = header.section_counts();
+        let states: &[ProbeState] = file.pod_exact(PROBE_STATES, 0, probes, "probe-states")?.unwrap_or(&[]);
+        let irradiance: &[u32] =
+            file.pod_exact(PROBE_IRRADIANCE, 0, irradiance_texels, "probe-irradiance")?.unwrap_or(&[]);
+        let visibility: &[[u16; 2]] =
+            file.pod_exact(PROBE_VISIBILITY, 0, visibility_texels, "probe-visibility")?.unwrap_or(&[]);
         let half = header.spacing * 0.5;
         let mut active = 0;
         for (i, s) in states.iter().enumerate() {

@@ -308,9 +308,8 @@ impl KilnFile {
     }
 
     /// [`Self::pod`] of a section that must hold exactly `count` elements (as its manifest record
-    /// or header says), checked against the table's decoded size *before* decoding: a 760 KB
-    /// file whose compressed section claims 4 GiB of zeros is refused without spending them.
-    /// `what` names the section in the error.
+    /// or header says), checked against the table's decoded size *before* decoding
+    /// ([`Self::expect_count`]). `what` names the section in the error.
     pub fn pod_exact<T: Pod>(
         &self,
         kind: SectionKind,
@@ -318,20 +317,31 @@ impl KilnFile {
         count: u64,
         what: &str,
     ) -> Result<Option<&[T]>> {
-        let Some(s) = self.find(kind, index) else {
-            return Ok(None);
-        };
-        let want = count.checked_mul(size_of::<T>() as u64);
-        if want != Some(s.entry.raw_size) {
+        self.expect_count(kind, index, count, size_of::<T>(), what)?;
+        self.pod(kind, index)
+    }
+
+    /// Whether the table declares `count` elements of `element_size` bytes for section
+    /// (`kind`, `index`) (absent: yes), without decoding it: a 760 KB file whose compressed
+    /// section claims 4 GiB of zeros is refused without spending them.
+    pub fn expect_count(
+        &self,
+        kind: SectionKind,
+        index: u32,
+        count: u64,
+        element_size: usize,
+        what: &str,
+    ) -> Result<()> {
+        let Some(s) = self.find(kind, index) else { return Ok(()) };
+        if count.checked_mul(element_size as u64) != Some(s.entry.raw_size) {
             return Err(FormatError::invalid(format!(
-                "{what}: the table declares {} bytes, its record {count} elements of {} bytes",
-                s.entry.raw_size,
-                size_of::<T>()
+                "{what}: the table declares {} bytes, its record {count} elements of {element_size} bytes",
+                s.entry.raw_size
             ))
             .in_section(s.position, kind, index)
             .or_offset(s.entry.offset));
         }
-        self.pod(kind, index)
+        Ok(())
     }
 
     /// Decodes the manifest.

@@ -304,7 +304,7 @@ impl<'a> SceneView<'a> {
             let faces = if info.projection == ShadowProjection::Cube { 6 } else { 1 };
             let n = info.resolution as u64;
             let depths: &[f32] = file
-                .pod_exact(SHADOW_MAP, i as u32, faces * n * n, &format!("shadow map {i}"))?
+                .pod_exact(SHADOW_MAP, i as u32, info.depth_count(), &format!("shadow map {i}"))?
                 .ok_or_else(|| FormatError::invalid(format!("shadow map {i} is missing")))?;
             if info.light as usize >= m.lights.len() || n == 0 || depths.len() as u64 != faces * n * n {
                 return Err(FormatError::invalid(format!(
@@ -344,7 +344,7 @@ impl<'a> SceneView<'a> {
             None if volumes == 0 => {}
             None => return Err(FormatError::invalid("light-visibility volumes without a manifest record")),
             Some(v) => {
-                let cells = v.dims.iter().map(|&d| d as u64).product::<u64>();
+                let cells = v.cells();
                 if v.medium as usize >= m.media.len() || v.dims.contains(&0) || volumes != v.lights.len() {
                     return Err(FormatError::invalid(format!(
                         "light-visibility volume: medium {} of {}, dims {:?}, {volumes} sections for {} lights",
@@ -459,6 +459,55 @@ impl<'a> SceneView<'a> {
         }
         Ok(())
     }
+}
+
+/// Compares, without decoding any, the table's decoded size of every section whose length a
+/// manifest record or a header fixes (BRDF table, shadow maps, light-visibility volumes, probe
+/// and environment sections) with that length. Readers that decode sections in bulk before
+/// validating them (`kiln verify`, the player's parallel decode) run it first, so that a small
+/// file claiming gigabytes is refused before they are spent; [`SceneView::new`] makes the same
+/// comparisons as it reads.
+pub fn check_declared_sizes(file: &KilnFile) -> Result<()> {
+    let m = file.manifest()?;
+    if let Some(b) = &m.brdf_lut {
+        let texels = b.resolution as u64 * b.resolution as u64;
+        file.expect_count(BRDF_LUT, 0, texels, 4, "BRDF table")?;
+    }
+    for (i, info) in m.shadow_maps.iter().enumerate() {
+        file.expect_count(SHADOW_MAP, i as u32, info.depth_count(), 4, &format!("shadow map {i}"))?;
+    }
+    if let Some(v) = &m.media_visibility {
+        for i in 0..v.lights.len() {
+            file.expect_count(
+                MEDIA_VISIBILITY,
+                i as u32,
+                v.cells(),
+                1,
+                &format!("light-visibility volume {i}"),
+            )?;
+        }
+    }
+    use crate::environment::ENVIRONMENT_KINDS;
+    use crate::sections::{ENVIRONMENT_FILTERED, ENVIRONMENT_MAP, ENVIRONMENT_TABLE};
+    if let Some(h) = file.group_header::<crate::gpu::EnvironmentHeader>(&ENVIRONMENT_KINDS, "environment")? {
+        h.check()?;
+        let [map, filtered, table] = h.section_counts();
+        file.expect_count(ENVIRONMENT_MAP, 0, map, 4, "environment-map")?;
+        file.expect_count(ENVIRONMENT_FILTERED, 0, filtered, 4, "environment-filtered")?;
+        let cell = size_of::<crate::gpu::EnvironmentCell>();
+        file.expect_count(ENVIRONMENT_TABLE, 0, table, cell, "environment-table")?;
+    }
+    use crate::probes::{PROBE_KINDS, ProbeHeader, ProbeState};
+    use crate::sections::{PROBE_IRRADIANCE, PROBE_STATES, PROBE_VISIBILITY};
+    if let Some(h) = file.group_header::<ProbeHeader>(&PROBE_KINDS, "probe volume")? {
+        h.check()?;
+        let [probes, irradiance, visibility] = h.section_counts();
+        let state = size_of::<ProbeState>();
+        file.expect_count(PROBE_STATES, 0, probes, state, "probe-states")?;
+        file.expect_count(PROBE_IRRADIANCE, 0, irradiance, 4, "probe-irradiance")?;
+        file.expect_count(PROBE_VISIBILITY, 0, visibility, 4, "probe-visibility")?;
+    }
+    Ok(())
 }
 
 /// Bytes of a full RGBA8 mip chain, or `None` if the description is impossible (zero size,

@@ -533,6 +533,11 @@ fn a_section_whose_declared_size_contradicts_its_record_is_refused_before_decodi
         "{e}"
     );
     assert!(largest < 1 << 20, "an allocation of {largest} bytes");
+    // The check bulk decoders (kiln verify, the player) run before decoding anything.
+    let (r, largest) = largest_allocation(|| kiln_format::scene::check_declared_sizes(&file));
+    let e = r.expect_err("refused before decoding").to_string();
+    assert!(e.contains("shadow map 0") && e.contains(&declared.to_string()), "{e}");
+    assert!(largest < 1 << 20, "an allocation of {largest} bytes");
     // The same record with the 1 KiB it declares is read (the check is not a refusal of all).
     let depths: Vec<u8> = (0..256).flat_map(|_| 1.0f32.to_le_bytes()).collect();
     let bytes = craft(&[

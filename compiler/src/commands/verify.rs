@@ -117,6 +117,8 @@ fn check(args: &VerifyArgs, report: &mut VerifyJson) -> CliResult {
     // decoded (one frame, exactly raw_size bytes, zstd's checksum of the decoded bytes), before
     // the content checks below read the decoded bytes, so that a section no check reads is
     // decoded too.
+    // Sections whose length a record fixes are compared with it first, without decoding.
+    kiln_format::scene::check_declared_sizes(&file).map_err(|e| format_error(&args.file, e))?;
     for s in file.sections().iter().filter(|s| s.known.is_some()) {
         file.decode_section(s.position).map_err(|e| format_error(&args.file, e))?;
         if s.entry.codec != kiln_format::table::Codec::None as u8 {

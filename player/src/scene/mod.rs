@@ -146,6 +146,8 @@ impl<'f> Prepared<'f> {
             })
             .map(|s| s.position)
             .collect();
+        // Sections whose length a record fixes are compared with it first, without decoding.
+        kiln_format::scene::check_declared_sizes(file).map_err(bad)?;
         file.decode_sections(&positions).map_err(bad)?;
         let decode_ms = t.elapsed().as_secs_f64() * 1e3;
         let view = SceneView::new(file).map_err(bad)?;
