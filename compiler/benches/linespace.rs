@@ -14,9 +14,6 @@
 //! stay on the CPU); each row's PNMT bits and records are then compared with a CPU bake's, word
 //! for word. `KILN_BENCH_GPU=all` puts every row on the GPU.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::AtomicUsize;
-use std::sync::atomic::Ordering::Relaxed;
 use std::time::Instant;
 
 use kiln_compiler::analyze::budget::Estimate;
@@ -24,6 +21,9 @@ use kiln_compiler::bake::linespace;
 use kiln_compiler::bench_scenes::{TABLE1, attributes, cornell_with_object};
 use kiln_compiler::ir::Scene;
 use kiln_format::linespace::{PnmtLayout, Variants};
+
+#[path = "../tests/util/held.rs"]
+mod held;
 
 /// The records the compiler stores for an untextured scene by default.
 const COMPACT: PnmtLayout = PnmtLayout::CompactNoUv;
@@ -42,58 +42,6 @@ fn pct(estimate: u64, actual: u64) -> f64 {
     100.0 * (estimate as f64 / actual as f64 - 1.0)
 }
 
-/// The system allocator, counting the bytes held and their high-water mark, so that a bake's
-/// peak is measured in bytes it holds (the resident set would miss memory the allocator kept
-/// from an earlier bake and hands out again).
-struct Counting;
-
-static HELD: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-/// Counts `bytes` more held, raising the high-water mark.
-fn grow(bytes: usize) {
-    PEAK.fetch_max(HELD.fetch_add(bytes, Relaxed) + bytes, Relaxed);
-}
-
-// SAFETY: every call forwards to the system allocator with the caller's layout; the counters
-// only observe.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: the caller's contract is forwarded.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            grow(layout.size());
-        }
-        p
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: as above.
-        let p = unsafe { System.alloc_zeroed(layout) };
-        if !p.is_null() {
-            grow(layout.size());
-        }
-        p
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: as above.
-        unsafe { System.dealloc(ptr, layout) };
-        HELD.fetch_sub(layout.size(), Relaxed);
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        // SAFETY: as above.
-        let p = unsafe { System.realloc(ptr, layout, new_size) };
-        if !p.is_null() && new_size >= layout.size() {
-            grow(new_size - layout.size());
-        } else if !p.is_null() {
-            HELD.fetch_sub(layout.size() - new_size, Relaxed);
-        }
-        p
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
 /// Bakes like [`bake`] and measures the most memory the bake held at once beyond what was held
 /// before it, MiB.
 fn bake_measured(
@@ -103,10 +51,9 @@ fn bake_measured(
     variants: u32,
     layout: PnmtLayout,
 ) -> (linespace::BakedLineSpace, f64, f64) {
-    let before = HELD.load(Relaxed);
-    PEAK.store(before, Relaxed);
+    let before = held::start();
     let (ls, ms) = bake(scene, res, n, variants, layout);
-    (ls, ms, mib((PEAK.load(Relaxed) - before) as u64))
+    (ls, ms, mib(held::peak_since(before) as u64))
 }
 
 /// The GPU of `KILN_BENCH_GPU=1` (opened once, before the first row).

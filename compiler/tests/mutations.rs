@@ -1,80 +1,23 @@
 //! Seeded mutations of small assets through the compile, in process (issue 40): the public glTF
 //! samples of `tests/corpus/khronos` (as `.gltf`, and packed here as `.glb`), an OBJ with its MTL
-//! library, and a sidecar. Each mutated case is imported, validated and planned, and every fifth
-//! one that plans is baked. A case must end with a file or an error: never a panic (nor one the
+//! library, and a sidecar. Each mutated case is imported, validated and planned; the `.gltf`
+//! cases and every seventh case that plan are also baked. A case must end with a file or an error: never a panic (nor one the
 //! glTF importer's guard turned into "please report"), within 10 s and 2 GiB of live allocations
-//! (a tracking allocator in this binary). A failing case is written to the temporary folder
+//! (`util/held.rs`, this binary's allocator). A failing case is written to the temporary folder
 //! with its seed, to replay.
 
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use base64::Engine;
+use kiln_compiler::raycheck::Rng;
 use kiln_compiler::untrusted::{Case, Kind, bake, plan};
 
-// ------------------------------------------------------------------ allocation tracking
-
-/// The system allocator, counting live bytes and their peak.
-struct Tracking;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-fn grew(n: usize) {
-    let live = LIVE.fetch_add(n, Ordering::Relaxed) + n;
-    PEAK.fetch_max(live, Ordering::Relaxed);
-}
-
-unsafe impl GlobalAlloc for Tracking {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            grew(layout.size());
-        }
-        p
-    }
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc_zeroed(layout) };
-        if !p.is_null() {
-            grew(layout.size());
-        }
-        p
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let p = unsafe { System.realloc(ptr, layout, new_size) };
-        if !p.is_null() {
-            LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-            grew(new_size);
-        }
-        p
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Tracking = Tracking;
-
-// ------------------------------------------------------------------ seeds
-
-/// xorshift64*: the test's own generator, so that a seed names a case on every machine.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
+#[path = "util/gltf.rs"]
+#[allow(dead_code)] // Only its GLB packer serves here.
+mod gltf_builder;
+#[path = "util/held.rs"]
+mod held;
 
 fn corpus(name: &str) -> Vec<u8> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -92,31 +35,6 @@ fn glb_parts(gltf: &[u8]) -> (serde_json::Value, Vec<u8>) {
     let data = base64::engine::general_purpose::STANDARD.decode(uri.split_once(',').unwrap().1).unwrap();
     json["buffers"][0].as_object_mut().unwrap().remove("uri");
     (json, data)
-}
-
-/// A GLB 2.0 of `json` and `bin`: a 12-byte header, a JSON chunk and a BIN chunk, each padded
-/// to 4 bytes.
-fn pack_glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
-    let mut text = serde_json::to_vec(json).unwrap();
-    while !text.len().is_multiple_of(4) {
-        text.push(b' ');
-    }
-    let mut bin = bin.to_vec();
-    while !bin.len().is_multiple_of(4) {
-        bin.push(0);
-    }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&text);
-    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
-    out.extend_from_slice(&bin);
-    out
 }
 
 /// One to four seeded edits of a glTF document's values, so that mutations reach past the JSON
@@ -271,7 +189,7 @@ fn seeded_mutations_of_small_assets_end_in_a_file_or_an_error_within_bounds() {
     let gltfs: Vec<Vec<u8>> = ["Triangle", "BoxVertexColors", "Cameras", "SimpleMorph"].map(corpus).to_vec();
     let docs: Vec<serde_json::Value> = gltfs.iter().map(|g| serde_json::from_slice(g).unwrap()).collect();
     let parts: Vec<(serde_json::Value, Vec<u8>)> = gltfs.iter().map(|g| glb_parts(g)).collect();
-    let glbs: Vec<Vec<u8>> = parts.iter().map(|(j, b)| pack_glb(j, b)).collect();
+    let glbs: Vec<Vec<u8>> = parts.iter().map(|(j, b)| gltf_builder::glb(j, b)).collect();
     let dir = tempfile::tempdir().unwrap();
     // Unmutated, every seed compiles (else the mutations would test only the first check).
     for (kind, main) in gltfs.iter().map(|g| (Kind::Gltf, g)).chain(glbs.iter().map(|g| (Kind::Glb, g))) {
@@ -291,7 +209,7 @@ fn seeded_mutations_of_small_assets_end_in_a_file_or_an_error_within_bounds() {
     let mut slowest = (Duration::ZERO, 0);
     let mut largest = (0usize, 0);
     for n in 0..cases {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15 ^ (n as u64).wrapping_mul(0x1000_0000_01b3));
+        let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15 ^ (n as u64).wrapping_mul(0x1000_0000_01b3));
         // Cases by turn: glTF, GLB, OBJ, MTL, sidecar; glTF and GLB mutated in their values two
         // times in three, else in their bytes.
         let structured = rng.below(3) < 2;
@@ -308,7 +226,7 @@ fn seeded_mutations_of_small_assets_end_in_a_file_or_an_error_within_bounds() {
             1 => {
                 let (i, j) = (rng.below(glbs.len()), rng.below(glbs.len()));
                 let main = if structured {
-                    pack_glb(&mutate_json(&parts[i].0, &mut rng), &parts[i].1)
+                    gltf_builder::glb(&mutate_json(&parts[i].0, &mut rng), &parts[i].1)
                 } else {
                     mutate(&glbs[i], &glbs[j], &mut rng)
                 };
@@ -326,15 +244,14 @@ fn seeded_mutations_of_small_assets_end_in_a_file_or_an_error_within_bounds() {
         let case = Case { kind, main: &main, mtl: &mtl, sidecar: sidecar.as_deref() };
         let case_dir = dir.path().join(format!("case{n}"));
         std::fs::create_dir(&case_dir).unwrap();
-        let before = LIVE.load(Ordering::Relaxed);
-        PEAK.store(before, Ordering::Relaxed);
+        let before = held::start();
         let start = Instant::now();
         let outcome = std::panic::catch_unwind(|| {
             let loaded = plan(&case_dir, &case)?;
             if n % 5 == 0 || n % 7 == 0 { bake(&loaded).map(|_| true) } else { Ok(false) }
         });
         let took = start.elapsed();
-        let peak = PEAK.load(Ordering::Relaxed).saturating_sub(before);
+        let peak = held::peak_since(before);
         let failed = match &outcome {
             Err(_) => Some("panicked".to_string()),
             Ok(Err(e)) if e.message.contains("please report") => {

@@ -2,7 +2,7 @@
 //! the player and the queries can index without further checks.
 
 use crate::error::{FormatError, Result};
-use crate::manifest::{ColorSpace, LightKind, Manifest, ShadowProjection};
+use crate::manifest::{ColorSpace, LightKind, Manifest};
 use crate::read::KilnFile;
 use crate::sections::{
     BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
@@ -281,14 +281,11 @@ impl<'a> SceneView<'a> {
         match (&m.brdf_lut, file.find(BRDF_LUT, 0)) {
             (None, None) => {}
             (Some(info), Some(_)) => {
+                // The length against the record before decoding; then only a zero size is left.
                 let want = info.resolution as u64 * info.resolution as u64;
-                let texels =
-                    file.pod_exact::<[u16; 2]>(BRDF_LUT, 0, want, "BRDF table")?.unwrap_or(&[]).len() as u64;
-                if info.resolution == 0 || texels != info.resolution as u64 * info.resolution as u64 {
-                    return Err(FormatError::invalid(format!(
-                        "BRDF table of {texels} texels, manifest says {0}x{0}",
-                        info.resolution
-                    )));
+                file.pod_exact::<[u16; 2]>(BRDF_LUT, 0, want, "BRDF table")?;
+                if info.resolution == 0 {
+                    return Err(FormatError::invalid("BRDF table of 0 texels, manifest says 0x0"));
                 }
             }
             _ => return Err(FormatError::invalid("BRDF table and its manifest record must come together")),
@@ -301,14 +298,14 @@ impl<'a> SceneView<'a> {
             )));
         }
         for (i, info) in m.shadow_maps.iter().enumerate() {
-            let faces = if info.projection == ShadowProjection::Cube { 6 } else { 1 };
-            let n = info.resolution as u64;
+            // The length against the record (`depth_count`) before decoding.
             let depths: &[f32] = file
                 .pod_exact(SHADOW_MAP, i as u32, info.depth_count(), &format!("shadow map {i}"))?
                 .ok_or_else(|| FormatError::invalid(format!("shadow map {i} is missing")))?;
-            if info.light as usize >= m.lights.len() || n == 0 || depths.len() as u64 != faces * n * n {
+            let n = info.resolution;
+            if info.light as usize >= m.lights.len() || n == 0 {
                 return Err(FormatError::invalid(format!(
-                    "shadow map {i}: light {} of {}, {} depths for {faces} face(s) of {n}x{n}",
+                    "shadow map {i}: light {} of {}, {} depths for {n}x{n}",
                     info.light,
                     m.lights.len(),
                     depths.len()
@@ -355,13 +352,14 @@ impl<'a> SceneView<'a> {
                     )));
                 }
                 for (i, &l) in v.lights.iter().enumerate() {
+                    // The length against the record before decoding.
                     let what = format!("light-visibility volume {i}");
-                    let data: &[u8] =
-                        file.pod_exact(MEDIA_VISIBILITY, i as u32, cells, &what)?.unwrap_or(&[]);
-                    if l as usize >= m.lights.len() || data.len() as u64 != cells {
+                    file.pod_exact::<u8>(MEDIA_VISIBILITY, i as u32, cells, &what)?
+                        .ok_or_else(|| FormatError::invalid(format!("{what} is missing")))?;
+                    if l as usize >= m.lights.len() {
                         return Err(FormatError::invalid(format!(
-                            "light-visibility volume {i}: light {l}, {} cells of {cells}",
-                            data.len()
+                            "light-visibility volume {i}: light {l} of {}",
+                            m.lights.len()
                         )));
                     }
                 }

@@ -270,8 +270,17 @@ impl Plan {
                 .iter()
                 .filter(|l| l.casts_shadows && matches!(l.kind, LightKind::Point | LightKind::Rect { .. }))
                 .count();
-            let (res, face) = (settings.shadow_res as u64, (settings.shadow_res as u64 / 2).max(1));
-            let texels = (casters - cubes) as u64 * res * res + cubes as u64 * 6 * face * face;
+            // The maps as the bake lays them out (cube faces at half the resolution).
+            let texels: u64 = scene
+                .lights
+                .iter()
+                .enumerate()
+                .filter_map(|(i, l)| {
+                    crate::bake::shadow::layout(l, i as u32, &geometry.bounds, settings.shadow_res)
+                })
+                .map(|l| l.info.depth_count())
+                .sum();
+            let (res, face) = (settings.shadow_res, (settings.shadow_res / 2).max(1));
             let maps = [
                 (casters - cubes > 0).then(|| format!("{} shadow maps of {res}x{res}", casters - cubes)),
                 (cubes > 0).then(|| format!("{cubes} cube maps of 6x{face}x{face}")),

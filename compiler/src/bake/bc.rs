@@ -318,13 +318,8 @@ pub fn error(t: &Texture, choice: &Choice, decoded: &[u8]) -> (Option<f64>, f64)
     let mut weighted = 0.0;
     let mut area = 0.0;
     for (x0, y0, w, h) in tiles {
-        let texels = |src: &[u8]| -> Vec<[u8; 4]> {
-            (y0..y0 + h)
-                .flat_map(|y| (x0..x0 + w).map(move |x| ((y * t.width + x) * 4) as usize))
-                .map(|i| [src[i], src[i + 1], src[i + 2], src[i + 3]])
-                .collect()
-        };
-        let reference = image(&mut texels(&t.rgba).into_iter().map(|s| {
+        let texels = |src| tile_texels(src, t.width, (x0, y0, w, h));
+        let reference = image(&mut texels(&t.rgba).map(|s| {
             let mut p = [0u8; 4];
             for (k, &c) in choice.channels.iter().enumerate() {
                 p[k] = s[c];
@@ -334,9 +329,7 @@ pub fn error(t: &Texture, choice: &Choice, decoded: &[u8]) -> (Option<f64>, f64)
             }
             p
         }));
-        let test = image(
-            &mut texels(decoded).into_iter().map(|d| [d[0], d[1], d[2], if n < 4 { 255 } else { d[3] }]),
-        );
+        let test = image(&mut texels(decoded).map(|d| [d[0], d[1], d[2], if n < 4 { 255 } else { d[3] }]));
         let flip = kiln_metrics::ldr_flip(
             kiln_metrics::RgbImage { width: w, height: h, pixels: &reference },
             kiln_metrics::RgbImage { width: w, height: h, pixels: &test },
@@ -346,6 +339,17 @@ pub fn error(t: &Texture, choice: &Choice, decoded: &[u8]) -> (Option<f64>, f64)
         area += (w * h) as f64;
     }
     (psnr, weighted / area)
+}
+
+/// The RGBA8 texels of `tile` (x, y, width, height) of an image `width` wide, rows in order.
+fn tile_texels(
+    src: &[u8],
+    width: u32,
+    (x0, y0, w, h): (u32, u32, u32, u32),
+) -> impl Iterator<Item = [u8; 4]> + '_ {
+    (y0..y0 + h)
+        .flat_map(move |y| (x0..x0 + w).map(move |x| ((y * width + x) * 4) as usize))
+        .map(move |i| [src[i], src[i + 1], src[i + 2], src[i + 3]])
 }
 
 /// Texels a texture's FLIP is measured over whole: 1024².

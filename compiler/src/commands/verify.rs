@@ -116,8 +116,7 @@ fn check(args: &VerifyArgs, report: &mut VerifyJson) -> CliResult {
     // Opening verified every stored checksum; now every compressed section of a known kind is
     // decoded (one frame, exactly raw_size bytes, zstd's checksum of the decoded bytes), before
     // the content checks below read the decoded bytes, so that a section no check reads is
-    // decoded too.
-    // Sections whose length a record fixes are compared with it first, without decoding.
+    // decoded too; sections whose length a record fixes are first compared with it, undecoded.
     kiln_format::scene::check_declared_sizes(&file).map_err(|e| format_error(&args.file, e))?;
     for s in file.sections().iter().filter(|s| s.known.is_some()) {
         file.decode_section(s.position).map_err(|e| format_error(&args.file, e))?;
@@ -133,8 +132,7 @@ fn check(args: &VerifyArgs, report: &mut VerifyJson) -> CliResult {
     let line_space = LineSpace::new(&file, view.triangles.len(), view.materials.len())
         .map_err(|e| format_error(&args.file, e))?;
     if let Some(ls) = &line_space {
-        let positions: Vec<[f32; 3]> = view.vertices.iter().map(|v| v.position).collect();
-        ls.check_against(&view.manifest.bounds, &positions, view.triangles)
+        ls.check_against(&view.manifest.bounds, view.vertices, view.triangles)
             .map_err(|e| format_error(&args.file, e))?;
     }
     report.sections = file.sections().len();

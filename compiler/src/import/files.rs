@@ -119,12 +119,6 @@ impl std::fmt::Display for ReadError {
     }
 }
 
-impl From<ReadError> for String {
-    fn from(e: ReadError) -> String {
-        e.to_string()
-    }
-}
-
 /// [`check_confined`], then [`read_bounded`]: how files an asset names are read.
 pub fn read_referenced(what: &str, path: &Path) -> Result<Vec<u8>, ReadError> {
     check_confined(what, path).map_err(ReadError::Confined)?;

@@ -492,6 +492,8 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     let mut faces = 0u64;
     let mut large_faces = false;
     let mut uses: Vec<(usize, String)> = Vec::new();
+    // The names in `uses`: a file may name many materials many times.
+    let mut used = std::collections::HashSet::new();
     let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
     for (first_line, line) in logical_lines(&text) {
         let line = line.split('#').next().unwrap_or("");
@@ -513,7 +515,7 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
             Some("mtllib") => libs.extend(words.map(str::to_string)),
             Some("usemtl") => {
                 let name = words.collect::<Vec<_>>().join(" ");
-                if !uses.iter().any(|(_, n)| *n == name) {
+                if used.insert(name.clone()) {
                     uses.push((first_line, name));
                 }
             }

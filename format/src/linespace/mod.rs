@@ -332,12 +332,11 @@ impl<'a> LineSpace<'a> {
     /// Checks the grid against the scene it was baked for (FORMAT.md's "musts" that need the
     /// geometry): it covers `bounds` widened by four of its margins on every side (in f64), and
     /// every triangle a cell lists overlaps that cell widened by its margin (its box against the
-    /// cell's). `positions` are the vertices' positions, `triangles` their indices (checked by
-    /// the scene view).
+    /// cell's). `vertices` and `triangles` are the scene's (indices checked by the scene view).
     pub fn check_against(
         &self,
         bounds: &crate::manifest::Bounds,
-        positions: &[[f32; 3]],
+        vertices: &[crate::sections::Vertex],
         triangles: &[[u32; 3]],
     ) -> Result<()> {
         let h = &self.header;
@@ -358,7 +357,7 @@ impl<'a> LineSpace<'a> {
             let hi: [f64; 3] = std::array::from_fn(|a| lo[a] + h.cell + 2.0 * m);
             for &t in self.cell_triangles(c) {
                 let Some(corners) = triangles.get(t as usize) else { continue };
-                let p = corners.map(|v| positions.get(v as usize).copied().unwrap_or([f32::NAN; 3]));
+                let p = corners.map(|v| vertices.get(v as usize).map_or([f32::NAN; 3], |v| v.position));
                 let apart = (0..3).any(|a| {
                     let (tlo, thi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), q| {
                         (l.min(q[a] as f64), u.max(q[a] as f64))
