@@ -114,7 +114,11 @@ pub struct Warning {
 pub struct Scene {
     /// Scene name (the input's file stem).
     pub name: String,
-    /// Vertices, world space.
+    /// Where positions are measured from (world = stored + origin): zero unless the scene lies
+    /// far from the world's origin for its size (`import::geometry::rebase_origin`). Vertices,
+    /// lights, cameras and media are all stored relative to it.
+    pub origin: [f64; 3],
+    /// Vertices, relative to `origin`.
     pub vertices: Vec<Vertex>,
     /// Texture coordinate per vertex.
     pub uvs: Vec<[f32; 2]>,

@@ -33,6 +33,12 @@ fn main() -> ExitCode {
         }
         Err(_) => {
             let what = PANIC.lock().ok().and_then(|p| p.clone()).unwrap_or_default();
+            // `kiln inspect | head`: the reader closed the pipe after the lines it wanted. Rust
+            // ignores SIGPIPE, so `println!` panics instead of the process ending as a C tool's
+            // would; nothing went wrong that the user needs to hear about.
+            if what.starts_with("failed printing to stdout") && what.contains("Broken pipe") {
+                return ExitCode::SUCCESS;
+            }
             let _ = writeln!(
                 err,
                 "error: internal error ({what}); this is a bug in kiln, please report it with the input"

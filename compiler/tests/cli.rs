@@ -5,6 +5,27 @@ mod run;
 
 use run::kiln;
 
+/// `kiln inspect FILE | head -1`: the reader closes the pipe early. kiln stops quietly (exit 0,
+/// nothing on stderr), as a C tool killed by SIGPIPE would, not with an "internal error".
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    kiln(dir.path(), &["demo", "-o", "demo.kiln"]).expect(0);
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_kiln"))
+        .args(["inspect", "demo.kiln"])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Read nothing: close the pipe at once (the inspect output is longer than one write).
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "stderr: {stderr}");
+    assert!(stderr.is_empty(), "stderr: {stderr}");
+}
+
 #[test]
 fn demo_inspect_verify() {
     let dir = tempfile::tempdir().unwrap();
@@ -14,7 +35,7 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.5");
+    assert_eq!(j["format_version"], "1.6");
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(
@@ -117,7 +138,7 @@ fn exit_codes() {
     let mut b = std::fs::read(dir.path().join("d.kiln")).unwrap();
     b[8] = 9;
     std::fs::write(dir.path().join("d9.kiln"), &b).unwrap();
-    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.5").says("1.x");
+    kiln(dir.path(), &["verify", "d9.kiln"]).expect(3).says("9.6").says("1.x");
 }
 
 #[test]

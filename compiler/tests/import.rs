@@ -764,3 +764,67 @@ fn flattened_instances_are_a_performance_warning() {
     let s = import(&Gltf::quad().write(d.path(), "single")).unwrap();
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
 }
+
+/// A scene far from the origin for its size keeps the precision it has at the origin: positions
+/// are stored relative to an origin near it (`Scene::origin`), so that stored + origin is the
+/// world position to single precision *of the offset from the origin*, not of the world value
+/// (floats 10⁵ out are 8 mm apart). Checked for glTF (node translations), OBJ (`v` digits) and
+/// the sidecar's camera and light, against world positions computed here in double precision.
+#[test]
+fn far_scenes_keep_their_precision_relative_to_a_stored_origin() {
+    let d = tempfile::tempdir().unwrap();
+    // f32 parses of the translation, as glTF's JSON holds single-precision transforms.
+    let t = [100000.3f32, -200000.0, 7.25].map(f64::from);
+    let mut g = Gltf::quad();
+    g.json["cameras"] = json!([{"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}}]);
+    g.json["nodes"] = json!([
+        {"mesh": 0, "translation": [100000.3, -200000.0, 7.25]},
+        {"translation": [100000.8, -199999.5, 9.25], "camera": 0}
+    ]);
+    g.json["scenes"][0]["nodes"] = json!([0, 1]);
+    let s = import(&g.write(d.path(), "far")).unwrap();
+    assert_ne!(s.origin, [0.0; 3], "a quad 10⁵ units out is stored relative to an origin near it");
+    let world = |p: [f32; 3]| std::array::from_fn::<f64, 3, _>(|a| f64::from(p[a]) + s.origin[a]);
+    let quad = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut found = 0;
+    for v in &s.vertices {
+        let w = world(v.position);
+        if let Some(q) = quad.iter().find(|q| (0..3).all(|a| (w[a] - (q[a] + t[a])).abs() < 1e-3)) {
+            found += 1;
+            for a in 0..3 {
+                assert!((w[a] - (q[a] + t[a])).abs() <= 1e-6, "vertex {w:?} for corner {q:?} + {t:?}");
+            }
+        }
+    }
+    assert_eq!(found, s.vertices.len(), "every vertex is a corner of the moved quad");
+    let cam = &s.cameras[0];
+    let eye = world(cam.position);
+    let expected = [100000.8f32, -199999.5, 9.25].map(f64::from);
+    assert!((0..3).all(|a| (eye[a] - expected[a]).abs() <= 1e-6), "camera at {eye:?}");
+    // The view direction (−z) survives to single precision.
+    let fwd = Vec3::from(cam.target) - Vec3::from(cam.position);
+    assert!((fwd - Vec3::NEG_Z).length() < 1e-6, "camera looks along {fwd:?}");
+
+    // OBJ: the file's digits, and a sidecar camera and light in world space.
+    let obj = "v 250000.125 3.5 -90000.75\nv 250001.125 3.5 -90000.75\nv 250000.125 4.5 -90000.75\nf 1 2 3\n";
+    std::fs::write(d.path().join("far.obj"), obj).unwrap();
+    let mut s = import(&d.path().join("far.obj")).unwrap();
+    assert_ne!(s.origin, [0.0; 3]);
+    let sidecar = kiln_compiler::import::sidecar::Sidecar::parse(
+        "[camera]\nposition = [250000.5, 4.0, -89990.75]\ntarget = [250000.5, 4.0, -90000.75]\n\
+         [[light]]\nkind = \"point\"\nposition = [250000.625, 5.0, -89999.75]\nintensity = 1.0\n",
+    )
+    .unwrap();
+    sidecar.apply(&mut s, "far.toml").unwrap();
+    let world = |p: [f32; 3]| std::array::from_fn::<f64, 3, _>(|a| f64::from(p[a]) + s.origin[a]);
+    let v = world(
+        s.vertices
+            .iter()
+            .map(|v| v.position)
+            .fold([f32::MAX; 3], |m, p| [m[0].min(p[0]), m[1].min(p[1]), m[2].min(p[2])]),
+    );
+    assert_eq!(v, [250000.125, 3.5, -90000.75], "the OBJ's smallest corner");
+    assert_eq!(world(s.cameras[0].position), [250000.5, 4.0, -89990.75]);
+    assert_eq!(world(s.cameras[0].target), [250000.5, 4.0, -90000.75]);
+    assert_eq!(world(s.lights[0].position), [250000.625, 5.0, -89999.75]);
+}

@@ -252,6 +252,9 @@ mod spec {
         pub fn f3(&mut self) -> [f32; 3] {
             [self.f32(), self.f32(), self.f32()]
         }
+        pub fn f64(&mut self) -> f64 {
+            f64::from_le_bytes(self.take(8).try_into().unwrap())
+        }
         pub fn bool(&mut self) -> bool {
             match self.byte() {
                 0 => false,
@@ -376,10 +379,15 @@ fn decode_manifest(b: &[u8]) -> Manifest {
         }),
         // Manifest version 2 appends the orthographic cameras; version 1 ends here.
         orthographic: Vec::new(),
+        // Version 3 appends the origin; version 2 ends before it.
+        origin: [0.0; 3],
     };
     let mut m = m;
     if r.at < b.len() {
         m.orthographic = r.vec(|r| OrthographicCamera { camera: r.u32(), xmag: r.f32(), ymag: r.f32() });
+    }
+    if r.at < b.len() {
+        m.origin = [r.f64(), r.f64(), r.f64()];
     }
     assert_eq!(r.at, b.len(), "no bytes after the last field");
     m
@@ -1337,6 +1345,8 @@ fn fixture_with(codec: Codec) -> Vec<u8> {
     ortho.name = "ortho".into();
     s.cameras.push(ortho);
     s.orthographic.push(OrthographicCamera { camera: 1, xmag: 1.25, ymag: 0.75 });
+    // Stored relative to an origin far out, so that manifest version 3's origin is not zero.
+    s.origin = [1.0e5, -0.25, 3.0e6];
     // Vertex colours, so that COL0 is written.
     let colors = (0..s.vertices.len()).map(|i| [(i * 977 % 65536) as u16, 0, u16::MAX, 40000]).collect();
     s.set_colors(0, Some(colors));

@@ -292,6 +292,10 @@ pub struct Manifest {
     pub media_visibility: Option<MediaVisibilityInfo>,
     /// Manifest version 2: the cameras that are orthographic (the others are perspective).
     pub orthographic: Vec<OrthographicCamera>,
+    /// Manifest version 3: where every position of the file is measured from, in world space
+    /// (world = stored + origin). Zero unless the scene lies far from the world's origin for its
+    /// size: single precision around the origin keeps such a scene's detail (FORMAT.md).
+    pub origin: [f64; 3],
 }
 
 /// An orthographic camera (glTF `camera.orthographic`), manifest version 2: the camera
@@ -317,7 +321,7 @@ impl Manifest {
 }
 
 /// Manifest version this crate reads and writes (equals the `MANI` kind's version).
-pub const MANIFEST_VERSION: u16 = 2;
+pub const MANIFEST_VERSION: u16 = 3;
 
 impl Manifest {
     /// Encodes with bincode's standard configuration.
@@ -331,14 +335,19 @@ impl Manifest {
     /// limit, set to the smallest power of two at least four times the section length, so that
     /// no length read from the file can claim more memory than the file could describe.
     pub fn decode(bytes: &[u8], version: u16) -> Result<Manifest> {
-        // Version 1 ends before `orthographic`: read it as version 2 with that list empty (a
-        // zero length, one byte).
-        let v1;
-        let bytes = if version < 2 {
-            v1 = [bytes, &[0u8]].concat();
-            &v1[..]
-        } else {
-            bytes
+        // Version 1 ends before `orthographic`, version 2 before `origin`: read them as version
+        // 3 with the list empty (a zero length, one byte) and the origin zero (24 zero bytes).
+        let old;
+        let bytes = match version {
+            0 | 1 => {
+                old = [bytes, &[0u8; 25]].concat();
+                &old[..]
+            }
+            2 => {
+                old = [bytes, &[0u8; 24]].concat();
+                &old[..]
+            }
+            _ => bytes,
         };
         let (manifest, used) = decode_limited(bytes)?;
         if used != bytes.len() && version <= MANIFEST_VERSION {
@@ -390,21 +399,33 @@ mod tests {
         bincode::encode_to_vec(v, bincode::config::standard()).unwrap()
     }
 
-    /// A version-1 manifest is a version-2 one without its trailing `orthographic` list: it reads
-    /// with the list empty, and version 2 keeps the list.
+    /// A version-1 manifest is a version-3 one without its trailing `orthographic` list and
+    /// `origin`, a version-2 one without `origin`: they read with the list empty and the origin
+    /// zero; version 3 keeps both.
     #[test]
-    fn version_1_manifests_read_with_no_orthographic_cameras() {
+    fn older_manifests_read_with_no_orthographic_cameras_and_a_zero_origin() {
         let mut m = Manifest { scene_name: "s".into(), ..Default::default() };
-        let v1 = m.encode();
-        // The empty list is the last byte (a zero count); version 1 has no such byte.
-        assert_eq!(v1.last(), Some(&0));
-        let v1 = &v1[..v1.len() - 1];
+        let v3 = m.encode();
+        // The origin is the last 24 bytes (three f64 zeros), the empty list the byte before them.
+        assert_eq!(v3[v3.len() - 25..], [0u8; 25]);
+        let v2 = &v3[..v3.len() - 24];
+        let v1 = &v3[..v3.len() - 25];
         assert_eq!(Manifest::decode(v1, 1).unwrap(), m);
+        assert_eq!(Manifest::decode(v2, 2).unwrap(), m);
         assert!(Manifest::decode(v1, 2).is_err(), "version 2 requires the list");
+        assert!(Manifest::decode(v2, 3).is_err(), "version 3 requires the origin");
         m.orthographic.push(OrthographicCamera { camera: 0, xmag: 2.0, ymag: 1.5 });
-        let v2 = m.encode();
-        assert_eq!(&v2[v1.len()..], [1, 0, 0, 0, 0, 0x40, 0, 0, 0xc0, 0x3f]);
-        assert_eq!(Manifest::decode(&v2, 2).unwrap(), m);
+        m.origin = [1.0e5, -2.5, 0.0];
+        let v3 = m.encode();
+        let tail: Vec<u8> = [
+            &[1u8, 0, 0, 0, 0, 0x40, 0, 0, 0xc0, 0x3f][..],
+            &1.0e5f64.to_le_bytes(),
+            &(-2.5f64).to_le_bytes(),
+            &[0; 8],
+        ]
+        .concat();
+        assert_eq!(&v3[v1.len()..], &tail[..]);
+        assert_eq!(Manifest::decode(&v3, 3).unwrap(), m);
     }
 
     /// FORMAT.md's bincode table and its examples.

@@ -104,6 +104,7 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                 lights: vec![0, 2],
             }),
             orthographic: vec![OrthographicCamera { camera: 0, xmag: cam.3, ymag: cam.2[0] }],
+            origin: cam.1.map(|v| f64::from(v) * 1.0e5),
         })
 }
 

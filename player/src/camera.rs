@@ -2,7 +2,7 @@
 //! bounds), its matrices (reversed-Z, computed in f64), and the fly controls of the window.
 
 use glam::{DMat4, DVec3, Vec3};
-use kiln_format::manifest::{Bounds, Camera as FileCamera};
+use kiln_format::manifest::Manifest;
 use kiln_format::projection::{look_to_rh, orthographic_rh, perspective_infinite_reverse_rh, perspective_rh};
 
 use crate::error::{Exit, PlayError, PlayResult};
@@ -145,13 +145,10 @@ impl Camera {
     /// The camera to start with: the override applied to the file's first camera (orthographic
     /// with half-extents `ortho` when the manifest says so), or to a view of the bounds from
     /// above and in front when the file has none. An override's field of view makes it
-    /// perspective.
-    pub fn initial(
-        cameras: &[FileCamera],
-        ortho: Option<(f32, f32)>,
-        bounds: &Bounds,
-        over: Option<CameraOverride>,
-    ) -> PlayResult<Camera> {
+    /// perspective. The override is in world space: it is moved into the file's frame (its
+    /// positions are relative to `manifest.origin`).
+    pub fn initial(manifest: &Manifest, over: Option<CameraOverride>) -> PlayResult<Camera> {
+        let (cameras, ortho, bounds) = (&manifest.cameras, manifest.orthographic(0), &manifest.bounds);
         let lo = d3(bounds.min);
         let hi = d3(bounds.max);
         let valid = lo.is_finite() && hi.is_finite() && lo.cmple(hi).all();
@@ -185,8 +182,9 @@ impl Camera {
             }
         };
         if let Some(o) = over {
-            cam.position = DVec3::from_array(o.position);
-            cam.forward = (DVec3::from_array(o.target) - cam.position).normalize();
+            let origin = DVec3::from_array(manifest.origin);
+            cam.position = DVec3::from_array(o.position) - origin;
+            cam.forward = (DVec3::from_array(o.target) - origin - cam.position).normalize();
             if let Some(f) = o.vfov_degrees {
                 cam.vfov_degrees = f;
                 cam.ortho = None;
@@ -289,7 +287,19 @@ impl Camera {
 
 #[cfg(test)]
 mod tests {
+    use kiln_format::manifest::Bounds;
+
     use super::*;
+
+    /// A `--camera` override is in world space; a file far from the origin stores positions
+    /// relative to `manifest.origin`, so the override lands at world − origin.
+    #[test]
+    fn overrides_are_moved_into_the_files_frame() {
+        let m = Manifest { bounds: bounds(), origin: [1.0e5, -3.0, 0.5], ..Default::default() };
+        let cam = Camera::initial(&m, Some("100000,-3,5.5,100000,-3,0.5".parse().unwrap())).unwrap();
+        assert_eq!(cam.position, DVec3::new(0.0, 0.0, 5.0));
+        assert_eq!(cam.forward, DVec3::NEG_Z);
+    }
 
     fn bounds() -> Bounds {
         Bounds { min: [-1.0, -1.0, -1.0], max: [1.0, 1.0, 1.0] }
@@ -330,7 +340,11 @@ mod tests {
 
     #[test]
     fn reversed_depth_maps_near_to_one_and_far_towards_zero() {
-        let cam = Camera::initial(&[], None, &bounds(), Some("0,0,5,0,0,0,60".parse().unwrap())).unwrap();
+        let cam = Camera::initial(
+            &Manifest { bounds: bounds(), ..Default::default() },
+            Some("0,0,5,0,0,0,60".parse().unwrap()),
+        )
+        .unwrap();
         let exact = cam.projection(1.0) * cam.view();
         let near = exact * glam::DVec4::new(0.0, 0.0, 5.0 - cam.znear, 1.0);
         assert!((near.z / near.w - 1.0).abs() < 1e-9);
@@ -347,7 +361,7 @@ mod tests {
 
     #[test]
     fn default_view_sees_the_bounds() {
-        let cam = Camera::initial(&[], None, &bounds(), None).unwrap();
+        let cam = Camera::initial(&Manifest { bounds: bounds(), ..Default::default() }, None).unwrap();
         let (vp, _) = cam.matrices(64, 64);
         let vp = glam::Mat4::from_cols_array(&vp);
         for corner in [[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0], [1.0, -1.0, 1.0], [-1.0, 1.0, -1.0]] {
@@ -359,7 +373,7 @@ mod tests {
 
     #[test]
     fn turning_keeps_a_unit_forward_below_the_pole() {
-        let mut cam = Camera::initial(&[], None, &bounds(), None).unwrap();
+        let mut cam = Camera::initial(&Manifest { bounds: bounds(), ..Default::default() }, None).unwrap();
         for _ in 0..100 {
             cam.turn(0.1, 0.1);
         }

@@ -389,12 +389,7 @@ impl Session {
             times.full_ready_since_start_ms =
                 pipelines_done.max(resident).duration_since(start).as_secs_f64() * 1e3;
         }
-        let camera = Camera::initial(
-            &scene.manifest.cameras,
-            scene.manifest.orthographic(0),
-            &scene.manifest.bounds,
-            options.camera,
-        )?;
+        let camera = Camera::initial(&scene.manifest, options.camera)?;
         let renderer =
             Renderer::new(&gpu, frame, &dummies, &scene, RenderSettings { techniques: first, ..render })?;
         let pool = CommandPool::new(&gpu, gpu.family)?;
@@ -620,7 +615,7 @@ impl Session {
     /// camera itself).
     pub fn look(&mut self, pose: Option<CameraOverride>) -> PlayResult {
         let m = &self.scene.manifest;
-        self.camera = Camera::initial(&m.cameras, m.orthographic(0), &m.bounds, pose)?;
+        self.camera = Camera::initial(m, pose)?;
         Ok(())
     }
 

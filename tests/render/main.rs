@@ -18,6 +18,7 @@ mod files; // damaged files fail with the right exit code; minimal files render
 mod gi; // path-traced GI plus direct light against the two-bounce reference
 mod godrays; // Mitchell's and Sousa's image-space blurs, their failure with the light behind the camera
 mod media; // single scattering in a lit slab against its closed form (reference, march, toth)
+mod placement; // one room at the origin, 10⁵ out and scaled by 10⁻³ and 10³ renders the same image (reference, rt gi)
 mod probes; // --gi probes: a room against the reference, no light through a wall one probe spacing thick
 mod progressive; // first frames from the fallback while ray-traced pipelines compile: output, bench, switch, teardown
 mod raytraced; // ray-traced AO and reflections against closed forms, accumulation

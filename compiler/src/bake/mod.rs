@@ -612,6 +612,7 @@ fn assemble_manifest(ctx: &BakeContext, all: &Sections) -> (Manifest, ContentHas
         lights: scene.lights.clone(),
         cameras: scene.cameras.clone(),
         orthographic: scene.orthographic.clone(),
+        origin: scene.origin,
         // With an environment, the constant sky is its mean: what a reader that ignores the
         // environment's sections shows.
         sky: ctx.environment().map_or(scene.sky, |e| kiln_format::manifest::Sky { radiance: e.mean }),

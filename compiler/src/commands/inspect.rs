@@ -340,6 +340,16 @@ fn print_sections(r: &InspectJson) {
             );
             let b = &m.bounds;
             println!("  bounds {:?} .. {:?}", b.min, b.max);
+            if m.origin != [0.0; 3] {
+                let world = |p: [f32; 3]| std::array::from_fn::<f64, 3, _>(|a| f64::from(p[a]) + m.origin[a]);
+                println!(
+                    "  positions stored relative to origin {:?} (far from the world's origin for the scene's size); \
+                     world bounds {:?} .. {:?}",
+                    m.origin,
+                    world(b.min),
+                    world(b.max)
+                );
+            }
             if m.degenerate_triangles > 0 {
                 println!("  {} degenerate triangles dropped at import", m.degenerate_triangles);
             }

@@ -14,6 +14,7 @@ use kiln_format::manifest::{Camera, Light, LightKind, OrthographicCamera, Wrap};
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
 mod checks;
+mod extent;
 mod uri;
 
 use super::files::ReadError;
@@ -26,6 +27,7 @@ use crate::exit::{CliError, CliResult, Exit};
 use crate::ir::{Material, Scene, TextureRole, WarningClass};
 use crate::settings::Normals;
 use checks::{check_glb_header, check_references, guard, named, node_parents};
+use extent::declared_extent;
 use uri::{load_uri, short};
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
@@ -305,28 +307,39 @@ impl Importer<'_> {
         // Depth first, children in their order, on a stack of its own: the hierarchy's depth is
         // bounded by the file, not by the thread's stack. [`node_parents`] made it a forest, so
         // the walk ends and visits a node once per root above it.
+        // The transforms first, then the origin positions are stored relative to (from the
+        // meshes' declared extents), then what the nodes place.
         let mut stack: Vec<(::gltf::Node, DMat4)> =
             roots.into_iter().rev().map(|r| (r, DMat4::IDENTITY)).collect();
+        let mut placed = Vec::new();
         while let Some((node, parent)) = stack.pop() {
-            let world = self.visit(&node, parent)?;
+            let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+            let world = parent * local;
+            if !world.is_finite() {
+                return Err(CliError::input(format!(
+                    "{}: node {} has a non-finite transform",
+                    self.file,
+                    node.index()
+                )));
+            }
             let children: Vec<::gltf::Node> = node.children().collect();
             stack.extend(children.into_iter().rev().map(|c| (c, world)));
+            placed.push((node, world));
+        }
+        self.scene.origin = declared_extent(&placed).origin().to_array();
+        for (node, world) in placed {
+            self.visit(&node, world)?;
         }
         Ok(())
     }
 
-    /// Adds what `node` places (mesh, camera, light) under its parent's transform `parent`;
-    /// returns its own scene transform.
-    fn visit(&mut self, node: &::gltf::Node, parent: DMat4) -> CliResult<DMat4> {
-        let local = DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
-        let world = parent * local;
-        if !world.is_finite() {
-            return Err(CliError::input(format!(
-                "{}: node {} has a non-finite transform",
-                self.file,
-                node.index()
-            )));
-        }
+    /// Where positions are measured from ([`Scene::origin`]).
+    fn origin(&self) -> DVec3 {
+        DVec3::from(self.scene.origin)
+    }
+
+    /// Adds what `node` places (mesh, camera, light) under its scene transform `world`.
+    fn visit(&mut self, node: &::gltf::Node, world: DMat4) -> CliResult<()> {
         if let Some(mesh) = node.mesh() {
             // glTF: a node's morph weights override its mesh's; absent weights are 0.
             let weights: Vec<f32> = node.weights().or(mesh.weights()).unwrap_or(&[]).to_vec();
@@ -344,7 +357,7 @@ impl Importer<'_> {
         if let Some(light) = node.light() {
             self.add_light(&light, &world, node.index())?;
         }
-        Ok(world)
+        Ok(())
     }
 
     /// The transform of `node` in the scene: its ancestors' local transforms composed with its
@@ -547,9 +560,11 @@ impl Importer<'_> {
                 },
             };
             let matrix = |i: usize| per_vertex(&matrices, i);
+            let origin = self.origin();
             let mut positions = Vec::with_capacity(count);
             for (i, p) in local_pos.iter().enumerate() {
-                let w = matrix(i).transform_point3(DVec3::from(p.map(f64::from))).as_vec3().to_array();
+                let w =
+                    (matrix(i).transform_point3(DVec3::from(p.map(f64::from))) - origin).as_vec3().to_array();
                 check_position(w, || {
                     format!(
                         "{at}: POSITION accessor {} element {i} (accessor value {p:?}) after its node transform",
@@ -1129,7 +1144,7 @@ impl Importer<'_> {
                 ((2.0 * y.atan()).to_degrees(), o.znear(), o.zfar(), Some((x, y)))
             }
         };
-        let position = world.transform_point3(DVec3::ZERO);
+        let position = world.transform_point3(DVec3::ZERO) - self.origin();
         let forward = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero();
         let up = world.transform_vector3(DVec3::Y).normalize_or_zero();
         let cam = Camera {
@@ -1175,7 +1190,7 @@ impl Importer<'_> {
                 LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
             }
         };
-        let position = world.transform_point3(DVec3::ZERO).as_vec3().to_array();
+        let position = (world.transform_point3(DVec3::ZERO) - self.origin()).as_vec3().to_array();
         let direction = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero().as_vec3().to_array();
         let l = Light {
             name,

@@ -4,7 +4,7 @@
 pub mod demo;
 pub mod environment;
 pub mod files;
-mod geometry;
+pub(crate) mod geometry;
 mod gltf;
 mod images;
 mod obj;

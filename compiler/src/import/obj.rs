@@ -34,8 +34,10 @@ use kiln_format::manifest::Wrap;
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
 use super::files::ReadError;
+use glam::DVec3;
+
 use super::geometry::{
-    Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
+    Extent, Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
 };
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
@@ -48,7 +50,11 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     let file = path.display().to_string();
     let text = read_input(path, &mut scene.inputs)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let Precheck { libs: mtllibs, groups, warnings, large_faces, uses } = precheck(&file, &text)?;
+    let Precheck { libs: mtllibs, groups, warnings, large_faces, uses, extent } = precheck(&file, &text)?;
+    // Positions are stored relative to the origin the `v` lines' extent calls for, from the
+    // file's own digits: tobj reads them in double precision (its `use_f64`).
+    let origin = extent.origin();
+    scene.origin = origin.to_array();
     let text = if large_faces { split_large_faces(&text) } else { text };
     for w in warnings {
         scene.warn(w);
@@ -187,7 +193,11 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     for model in &models {
         let mesh = &model.mesh;
         let at = format!("{file}: object '{}'", model.name);
-        let positions: Vec<[f32; 3]> = mesh.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        let positions: Vec<[f32; 3]> = mesh
+            .positions
+            .chunks_exact(3)
+            .map(|p| (DVec3::new(p[0], p[1], p[2]) - origin).as_vec3().to_array())
+            .collect();
         for (i, p) in positions.iter().enumerate() {
             check_position(*p, || format!("{at}: vertex {i}"))?;
         }
@@ -202,7 +212,9 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
                 .normals
                 .chunks_exact(3)
                 .map(|n| {
-                    glam::Vec3::new(n[0], n[1], n[2]).try_normalize().map_or([f32::NAN; 3], |v| v.to_array())
+                    DVec3::new(n[0], n[1], n[2])
+                        .try_normalize()
+                        .map_or([f32::NAN; 3], |v| v.as_vec3().to_array())
                 })
                 .collect();
             let (corners, replaced) = given_corner_normals(&positions, &tris, &given);
@@ -223,7 +235,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         let (source, normals, tris) = split_by_normal(positions.len(), &tris, &corners);
         // OBJ's v runs up the image; kiln (like glTF) stores v running down.
         let uvs: Vec<[f32; 2]> = if mesh.texcoords.len() / 2 == positions.len() {
-            mesh.texcoords.chunks_exact(2).map(|t| [t[0], 1.0 - t[1]]).collect()
+            mesh.texcoords.chunks_exact(2).map(|t| [t[0] as f32, (1.0 - t[1]) as f32]).collect()
         } else {
             vec![[0.0; 2]; positions.len()]
         };
@@ -245,8 +257,11 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         // The `v x y z r g b` extension (MeshLab, ZBrush), read as linear like glTF's COLOR_0.
         let colors = (mesh.vertex_color.len() == 3 * positions.len())
             .then(|| {
-                let rgb: Vec<[u16; 4]> =
-                    mesh.vertex_color.chunks_exact(3).map(|c| [c[0], c[1], c[2], 1.0].map(unorm16)).collect();
+                let rgb: Vec<[u16; 4]> = mesh
+                    .vertex_color
+                    .chunks_exact(3)
+                    .map(|c| [c[0], c[1], c[2], 1.0].map(|c| unorm16(c as f32)))
+                    .collect();
                 if mesh.vertex_color.iter().any(|c| !c.is_finite()) {
                     return Err(CliError::input(format!("{at}: a vertex colour is not finite")));
                 }
@@ -340,16 +355,24 @@ fn convert_material(
     texture: &mut dyn FnMut(&str, TextureRole) -> u32,
     warnings: &mut Vec<String>,
 ) -> GpuMaterial {
-    let kd = m.diffuse.unwrap_or([0.8; 3]);
-    let ks = m.specular.unwrap_or([0.0; 3]);
+    // tobj reads MTL in double precision (its `use_f64`, for the OBJ's positions); kiln's
+    // materials are single.
+    let f3 = |c: Option<[f64; 3]>| c.map(|c| c.map(|v| v as f32));
+    let kd = f3(m.diffuse).unwrap_or([0.8; 3]);
+    let ks = f3(m.specular).unwrap_or([0.0; 3]);
     let metallic = param(m, "Pm");
-    let alpha = m.dissolve.or_else(|| param(m, "Tr").map(|t| 1.0 - t)).unwrap_or(1.0).clamp(0.0, 1.0);
+    let alpha = m
+        .dissolve
+        .map(|d| d as f32)
+        .or_else(|| param(m, "Tr").map(|t| 1.0 - t))
+        .unwrap_or(1.0)
+        .clamp(0.0, 1.0);
     // `illum` 3 and 5 turn on ray-traced reflection (5 with Fresnel): a mirror.
     let mirror = matches!(m.illumination_model, Some(3 | 5));
     // Roughness: `Pr`, or from the Phong exponent `Ns`; without either 1, or 0 for a mirror.
     let roughness = param(m, "Pr")
         .unwrap_or_else(|| match m.shininess {
-            Some(ns) => (2.0 / (ns.max(0.0) + 2.0)).powf(0.25),
+            Some(ns) => (2.0 / (ns.max(0.0) + 2.0)).powf(0.25) as f32,
             None if mirror => 0.0,
             None => 1.0,
         })
@@ -387,7 +410,7 @@ fn convert_material(
     if alpha < 1.0 {
         gpu.flags |= (AlphaMode::Blend as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
     }
-    gpu.emission = m.emissive.unwrap_or([0.0; 3]);
+    gpu.emission = f3(m.emissive).unwrap_or([0.0; 3]);
     let name_of = |s: &str| s.split_whitespace().last().unwrap_or("").to_string();
     if let Some(t) = &m.diffuse_texture {
         gpu.base_color_texture = texture(&name_of(t), TextureRole::Color);
@@ -424,6 +447,8 @@ struct Precheck {
     large_faces: bool,
     /// Each material name `usemtl` names, with the line it is first named on.
     uses: Vec<(usize, String)>,
+    /// Extent of the `v` positions, in double precision.
+    extent: Extent,
 }
 
 /// Corners beyond which a face is not fanned (by tobj) but split by halving (here). A fan of
@@ -495,6 +520,7 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     // The names in `uses`: a file may name many materials many times.
     let mut used = std::collections::HashSet::new();
     let (mut group, mut groups, mut warnings) = (0u32, Vec::new(), Vec::new());
+    let mut extent = Extent::default();
     for (first_line, line) in logical_lines(&text) {
         let line = line.split('#').next().unwrap_or("");
         let mut words = line.split_whitespace();
@@ -502,13 +528,14 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
         match words.next() {
             Some("v") => {
                 nv += 1;
-                let vals: Vec<f32> = words.take(3).map(|w| w.parse::<f32>().unwrap_or(f32::NAN)).collect();
+                let vals: Vec<f64> = words.take(3).map(|w| w.parse::<f64>().unwrap_or(f64::NAN)).collect();
                 if vals.len() < 3 || vals.iter().any(|v| !v.is_finite()) {
                     return Err(at(format!("vertex position '{}' is not three finite numbers", line.trim())));
                 }
-                check_position([vals[0], vals[1], vals[2]], || {
+                check_position([vals[0] as f32, vals[1] as f32, vals[2] as f32], || {
                     format!("{file}:{first_line}: vertex position")
                 })?;
+                extent.add(DVec3::new(vals[0], vals[1], vals[2]));
             }
             Some("vt") => nt += 1,
             Some("vn") => nn += 1,
@@ -569,5 +596,5 @@ fn precheck(file: &str, text: &[u8]) -> CliResult<Precheck> {
     if faces == 0 {
         return Err(CliError::input(format!("{file}: has no faces")));
     }
-    Ok(Precheck { libs, groups, warnings, large_faces, uses })
+    Ok(Precheck { libs, groups, warnings, large_faces, uses, extent })
 }

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use kiln_format::manifest::{Bounds, Camera, Light, LightKind, Medium, Sky};
 use kiln_format::sections::MaterialFlags;
 use serde::Deserialize;
@@ -42,10 +42,11 @@ pub struct Sidecar {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraToml {
-    /// Eye position.
-    pub position: [f32; 3],
+    /// Eye position (world space; read in double precision, as every position of the sidecar,
+    /// so that a scene far from the origin keeps its precision: see `Scene::origin`).
+    pub position: [f64; 3],
     /// Point looked at.
-    pub target: [f32; 3],
+    pub target: [f64; 3],
     /// Up vector.
     #[serde(default = "up")]
     pub up: [f32; 3],
@@ -106,7 +107,7 @@ pub struct LightToml {
     /// Name (default `light<N>`).
     pub name: Option<String>,
     /// Position (point, spot, rect centre).
-    pub position: Option<[f32; 3]>,
+    pub position: Option<[f64; 3]>,
     /// Linear RGB colour.
     #[serde(default = "white")]
     pub color: [f32; 3],
@@ -213,9 +214,9 @@ impl SkyToml {
 #[serde(deny_unknown_fields)]
 pub struct MediumToml {
     /// Minimum corner of the box it fills (default: the scene bounds).
-    pub min: Option<[f32; 3]>,
+    pub min: Option<[f64; 3]>,
     /// Maximum corner.
-    pub max: Option<[f32; 3]>,
+    pub max: Option<[f64; 3]>,
     /// Absorption per scene unit, RGB.
     #[serde(default)]
     pub sigma_a: [f32; 3],
@@ -313,12 +314,16 @@ impl Sidecar {
         let err = |msg: String| CliError::input(format!("{source}: {msg}"));
         let bad = |msg: String| Err(err(msg));
         let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        // Positions are stored relative to the scene's origin (`Scene::origin`).
+        let origin = DVec3::from(scene.origin);
+        let rel = |p: [f64; 3]| (DVec3::from(p) - origin).as_vec3().to_array();
         if let Some(c) = &self.camera {
-            let vals = [&c.position[..], &c.target, &c.up, &[c.vfov_degrees]].concat();
-            if !finite(&vals) {
+            let vals = [&c.up[..], &[c.vfov_degrees]].concat();
+            let (position, target) = (rel(c.position), rel(c.target));
+            if !finite(&vals) || !finite(&[position, target].concat()) {
                 return bad("[camera] has a non-finite value".into());
             }
-            let fwd = Vec3::from(c.target) - Vec3::from(c.position);
+            let fwd = Vec3::from(target) - Vec3::from(position);
             if fwd.length_squared() == 0.0 || fwd.cross(Vec3::from(c.up)).length_squared() == 0.0 {
                 return bad("[camera] target equals position, or up is parallel to the view direction".into());
             }
@@ -333,8 +338,8 @@ impl Sidecar {
                 0,
                 Camera {
                     name: "sidecar".into(),
-                    position: c.position,
-                    target: c.target,
+                    position,
+                    target,
                     up: c.up,
                     vfov_degrees: c.vfov_degrees,
                     znear: c.znear.unwrap_or(0.0),
@@ -343,9 +348,10 @@ impl Sidecar {
             );
         }
         for (i, l) in self.lights.iter().enumerate() {
-            scene
-                .lights
-                .push(convert_light(l, i).map_err(|e| err(format!("light {} ({:?}): {e}", i + 1, l.kind)))?);
+            scene.lights.push(
+                convert_light(l, i, origin)
+                    .map_err(|e| err(format!("light {} ({:?}): {e}", i + 1, l.kind)))?,
+            );
         }
         if let Some(s) = &self.sky {
             if let Some(radiance) = s.radiance {
@@ -367,7 +373,7 @@ impl Sidecar {
                 ));
             }
             let (min, max) = match (m.min, m.max) {
-                (Some(a), Some(b)) => (a, b),
+                (Some(a), Some(b)) => (rel(a), rel(b)),
                 (None, None) => ([f32::NAN; 3], [f32::NAN; 3]), // filled with the scene bounds later
                 _ => return bad(format!("medium {}: give both min and max, or neither", i + 1)),
             };
@@ -440,8 +446,9 @@ fn apply_material(o: &MaterialToml, gpu: &mut kiln_format::sections::GpuMaterial
     Ok(())
 }
 
-fn convert_light(l: &LightToml, i: usize) -> Result<Light, String> {
+fn convert_light(l: &LightToml, i: usize, origin: DVec3) -> Result<Light, String> {
     let need = |v: Option<[f32; 3]>, what: &str| v.ok_or_else(|| format!("`{what}` is required"));
+    let position = l.position.map(|p| (DVec3::from(p) - origin).as_vec3().to_array());
     let unit = |v: [f32; 3], what: &str| {
         Vec3::from(v)
             .try_normalize()
@@ -460,13 +467,13 @@ fn convert_light(l: &LightToml, i: usize) -> Result<Light, String> {
         casts_shadows: l.casts_shadows,
     };
     match l.kind {
-        LightKindToml::Point => light.position = need(l.position, "position")?,
+        LightKindToml::Point => light.position = need(position, "position")?,
         LightKindToml::Directional => {
             light.kind = LightKind::Directional;
             light.direction = unit(need(l.direction, "direction")?, "direction")?;
         }
         LightKindToml::Spot => {
-            light.position = need(l.position, "position")?;
+            light.position = need(position, "position")?;
             light.direction = unit(need(l.direction, "direction")?, "direction")?;
             let outer = l.outer_cone_degrees.unwrap_or(45.0);
             let inner = l.inner_cone_degrees.unwrap_or(0.8 * outer);
@@ -478,7 +485,7 @@ fn convert_light(l: &LightToml, i: usize) -> Result<Light, String> {
             light.kind = LightKind::Spot { inner_cone: inner.to_radians(), outer_cone: outer.to_radians() };
         }
         LightKindToml::Rect => {
-            light.position = need(l.position, "position")?;
+            light.position = need(position, "position")?;
             let dir = Vec3::from(unit(need(l.direction, "direction")?, "direction")?);
             let right = Vec3::from(need(l.right, "right")?);
             // Keep only the part of `right` orthogonal to the direction.

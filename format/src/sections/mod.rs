@@ -20,7 +20,7 @@ use crate::table::SectionKind;
 
 /// The manifest: scene metadata, bincode 2 (see [`crate::manifest`]).
 pub const MANIFEST: SectionKind = SectionKind(*b"MANI");
-/// Vertices ([`Vertex`]), world space.
+/// Vertices ([`Vertex`]), relative to the manifest's `origin`.
 pub const VERTICES: SectionKind = SectionKind(*b"VERT");
 /// Texture coordinates (`[f32; 2]`, set 0, glTF convention: v down the image), one per vertex.
 pub const UVS: SectionKind = SectionKind(*b"UVS0");

@@ -133,7 +133,7 @@ fn inspect(options: &SweepOptions) -> PlayResult<(Offers, String, String, Vec<Ca
     let mut cameras = Vec::new();
     for c in &options.cameras {
         cameras.push(
-            Camera::initial(&manifest.cameras, manifest.orthographic(0), &manifest.bounds, *c)
+            Camera::initial(&manifest, *c)
                 .map_err(|e| PlayError::new(Exit::Usage, format!("--camera: {e}")))?,
         );
     }
