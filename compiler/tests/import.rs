@@ -10,7 +10,7 @@ use gltf_builder::Gltf;
 use kiln_compiler::import::{import, import_with};
 use kiln_compiler::ir::{Scene, TextureRole};
 use kiln_compiler::settings::Normals;
-use kiln_format::manifest::LightKind;
+use kiln_format::manifest::{LightKind, Wrap};
 use kiln_format::sections::MaterialFlags;
 use serde_json::json;
 
@@ -160,6 +160,45 @@ fn lights_cameras_and_emissive_strength() {
     assert!(close(Vec3::from(cam.target), Vec3::new(0.0, 0.0, 3.0)));
     assert!((cam.vfov_degrees - 0.5f32.to_degrees()).abs() < 1e-4);
     assert_eq!(s.materials[0].gpu.emission, [4.0, 2.0, 0.0]);
+}
+
+/// A bad MTL statement costs that statement, not the library (tobj failed the whole library on
+/// McGuire's `sportsCar.mtl`, whose `Ka 0 0 0c` then left every face the default material): the
+/// materials before and after it keep what the file gives them, the bad lines are warned about
+/// with their line numbers, and texture options are read before a file name with spaces.
+#[test]
+fn a_bad_mtl_statement_costs_that_statement_only() {
+    let d = tempfile::tempdir().unwrap();
+    let mtl = "newmtl before\nKd 0.5 0.25 0.125\nKa 0 0 0c\nillum x\n\nnewmtl\nKd 0.3\n\n\
+               newmtl after\nKd 0.75 0.5 0.25\nmap_Kd\nmap_Kd -clamp on -o 0.5 0 0 -s 1 1 1 my tex.png\n";
+    std::fs::write(d.path().join("m.mtl"), mtl).unwrap();
+    image::RgbaImage::from_pixel(4, 4, image::Rgba([255, 255, 255, 255]))
+        .save(d.path().join("my tex.png"))
+        .unwrap();
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n\
+               usemtl before\nf 1/1 2/2 3/3\nusemtl after\nf 1/1 3/3 2/2\n";
+    std::fs::write(d.path().join("s.obj"), obj).unwrap();
+    let s = import(&d.path().join("s.obj")).unwrap();
+    let m = |n: &str| {
+        s.materials.iter().find(|m| m.name == n).unwrap_or_else(|| panic!("no {n}: {:?}", s.materials)).gpu
+    };
+    assert_eq!(&m("before").base_color[..3], &[0.5, 0.25, 0.125]);
+    assert_eq!(&m("after").base_color[..3], &[0.75, 0.5, 0.25]);
+    // A nameless material is named after its line; `Kd r` is r r r (the MTL specification).
+    assert_eq!(&m("unnamed-6").base_color[..3], &[0.3, 0.3, 0.3]);
+    // Both faces keep their materials.
+    let names: Vec<&str> =
+        s.triangle_materials.iter().map(|&i| s.materials[i as usize].name.as_str()).collect();
+    assert_eq!(names, ["before", "after"]);
+    let warned = |text: &str| s.warnings.iter().any(|w| w.message.contains(text));
+    for line in ["m.mtl:3:", "m.mtl:4:", "m.mtl:6:", "m.mtl:11:"] {
+        assert!(warned(line), "no warning for {line}: {:#?}", s.warnings);
+    }
+    // The texture: its name with a space, clamped, its offset warned about.
+    let t = &s.textures[m("after").base_color_texture as usize];
+    assert_eq!((t.name.as_str(), t.wrap_u, t.wrap_v), ("my tex.png", Wrap::ClampToEdge, Wrap::ClampToEdge));
+    assert!(warned("-o 0.5 0 0 (texture offset) is not applied"), "{:#?}", s.warnings);
+    assert!(!warned("-s"), "-s 1 1 1 is the default: {:#?}", s.warnings);
 }
 
 #[test]

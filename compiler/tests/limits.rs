@@ -102,11 +102,13 @@ fn mtl_statements_without_their_numbers_are_warned_and_dropped() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     obj(d, "lib.mtl");
-    // tobj panicked on `Kd 0.5`; a NaN colour rendered black; a negative emission is unphysical.
-    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 0.5\nKs nan nan nan\nNs inf\nKe -1 2 3\n").unwrap();
+    // tobj panicked on `Kd 0.5 x`; a NaN colour rendered black; a negative emission is unphysical.
+    std::fs::write(d.join("lib.mtl"), "newmtl m\nKd 0.5 x\nKs nan nan nan\nNs inf\nKe -1 2 3\n").unwrap();
     let run = kiln(d, &["compile", "scene.obj", "-o", "out.kiln", "--report", "r.json"]);
     assert_eq!(run.code, 0, "{}", run.stderr);
-    for what in ["lib.mtl:2: `Kd 0.5` needs three finite numbers", "lib.mtl:3:", "lib.mtl:4:", "lib.mtl:5:"] {
+    for what in
+        ["lib.mtl:2: `Kd 0.5 x` needs one or three finite numbers", "lib.mtl:3:", "lib.mtl:4:", "lib.mtl:5:"]
+    {
         assert!(run.stderr.contains(what), "{what}: {}", run.stderr);
     }
     // The clamped emission is what the file holds: (0, 2, 3).

@@ -7,6 +7,7 @@ pub mod files;
 pub(crate) mod geometry;
 mod gltf;
 mod images;
+mod mtl;
 mod obj;
 pub mod preetham;
 pub mod sidecar;

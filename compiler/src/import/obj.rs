@@ -34,6 +34,7 @@ use kiln_format::manifest::Wrap;
 use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 
 use super::files::ReadError;
+use super::mtl::TextureStatement;
 use glam::DVec3;
 
 use super::geometry::{
@@ -77,7 +78,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
             }
             tobj::LoadError::OpenFileFailed
         })?;
-        let text = sanitize_mtl(
+        let text = super::mtl::sanitize(
             &full.display().to_string(),
             &String::from_utf8_lossy(&bytes),
             &mut mtl_warnings.borrow_mut(),
@@ -95,6 +96,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
             scene.inputs.push(full);
         }
     }
+    let loaded = materials.is_ok();
     let materials = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -108,8 +110,9 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         }
     };
 
-    // A name no library defines: tobj gives its faces no material (the default), silently.
-    if !materials.is_empty() {
+    // A name no library defines: tobj gives its faces no material (the default), silently. (A
+    // library that could not be read has its own warning.)
+    if loaded {
         for (line, name) in uses.iter().filter(|(_, n)| !materials.iter().any(|m| &m.name == n)) {
             scene.warn(format!(
                 "{file}:{line}: usemtl '{name}' names no material of {}; its faces get the default material",
@@ -118,7 +121,7 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         }
     }
     let mut requests: Vec<TextureRequest> = Vec::new();
-    let mut tex_cache: HashMap<(String, TextureRole), u32> = HashMap::new();
+    let mut tex_cache: HashMap<(String, TextureRole, bool), u32> = HashMap::new();
     let first_material = scene.materials.len() as u32;
     let mtl_base = |name: &str| base.join(name);
     let mut material_warnings = Vec::new();
@@ -127,8 +130,9 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
         let mut warnings = Vec::new();
         let gpu = convert_material(
             m,
-            &mut |name: &str, role| {
-                if let Some(&i) = tex_cache.get(&(name.to_string(), role)) {
+            &mut |statement: &TextureStatement, role| {
+                let (name, wrap) = (statement.name.as_str(), statement.wrap);
+                if let Some(&i) = tex_cache.get(&(name.to_string(), role, wrap == Wrap::ClampToEdge)) {
                     return i;
                 }
                 let mut full = mtl_base(name);
@@ -156,11 +160,11 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
                     name: name.to_string(),
                     bytes,
                     role,
-                    wrap_u: Wrap::Repeat,
-                    wrap_v: Wrap::Repeat,
+                    wrap_u: wrap,
+                    wrap_v: wrap,
                     mag_linear: true,
                 });
-                tex_cache.insert((name.to_string(), role), i);
+                tex_cache.insert((name.to_string(), role, wrap == Wrap::ClampToEdge), i);
                 i
             },
             &mut warnings,
@@ -291,50 +295,6 @@ pub(crate) fn lambert(kd: [f32; 3]) -> GpuMaterial {
     }
 }
 
-/// MTL statements whose values are colours: three numbers each.
-const MTL_COLOURS: [&str; 5] = ["Ka", "Kd", "Ks", "Ke", "Tf"];
-/// MTL statements whose value is one number.
-const MTL_NUMBERS: [&str; 12] =
-    ["Ns", "Ni", "d", "Tr", "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor", "illum"];
-
-/// `text` (the MTL file `file`) without the statements whose values are not finite numbers of the
-/// count they need (tobj panics on `Kd 0.5`, and would keep a NaN colour that renders black), and
-/// with negative colour components clamped to 0; each dropped or changed statement a warning with
-/// the file and line.
-fn sanitize_mtl(file: &str, text: &str, warnings: &mut Vec<String>) -> String {
-    let mut out = String::with_capacity(text.len());
-    for (i, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        let key = words.next().unwrap_or_default();
-        let values: Vec<&str> = words.collect();
-        let numbers: Vec<Option<f32>> =
-            values.iter().map(|v| v.parse::<f32>().ok().filter(|x| x.is_finite())).collect();
-        let wanted = if MTL_COLOURS.contains(&key) {
-            3
-        } else if MTL_NUMBERS.contains(&key) {
-            1
-        } else {
-            out.push_str(line);
-            out.push('\n');
-            continue;
-        };
-        let at = format!("{file}:{}", i + 1);
-        if numbers.len() < wanted || numbers[..wanted].iter().any(Option::is_none) {
-            let need = if wanted == 3 { "three finite numbers" } else { "a finite number" };
-            warnings.push(format!("{at}: `{}` needs {need}; the statement is ignored", line.trim()));
-            continue;
-        }
-        let mut fixed: Vec<f32> = numbers[..wanted].iter().map(|x| x.unwrap_or(0.0)).collect();
-        if wanted == 3 && fixed.iter().any(|&x| x < 0.0) {
-            warnings.push(format!("{at}: `{}` has a negative component; clamped to 0", line.trim()));
-            fixed.iter_mut().for_each(|x| *x = x.max(0.0));
-        }
-        let values: Vec<String> = fixed.iter().map(|x| x.to_string()).collect();
-        out.push_str(&format!("{key} {}\n", values.join(" ")));
-    }
-    out
-}
-
 fn param(m: &tobj::Material, key: &str) -> Option<f32> {
     m.unknown_param.get(key).and_then(|v| v.split_whitespace().next()?.parse().ok())
 }
@@ -352,7 +312,7 @@ fn max3(c: [f32; 3]) -> f32 {
 /// information go to `warnings`.
 fn convert_material(
     m: &tobj::Material,
-    texture: &mut dyn FnMut(&str, TextureRole) -> u32,
+    texture: &mut dyn FnMut(&TextureStatement, TextureRole) -> u32,
     warnings: &mut Vec<String>,
 ) -> GpuMaterial {
     // tobj reads MTL in double precision (its `use_f64`, for the OBJ's positions); kiln's
@@ -411,18 +371,45 @@ fn convert_material(
         gpu.flags |= (AlphaMode::Blend as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
     }
     gpu.emission = f3(m.emissive).unwrap_or([0.0; 3]);
-    let name_of = |s: &str| s.split_whitespace().last().unwrap_or("").to_string();
+    // The statement's options read, and those kiln does not apply warned about.
+    let mut statement = |key: &str, value: &str| {
+        let t = TextureStatement::parse(value);
+        warnings.extend(t.ignored.iter().map(|why| format!("{key} {}: {why}", t.name)));
+        t
+    };
     if let Some(t) = &m.diffuse_texture {
-        gpu.base_color_texture = texture(&name_of(t), TextureRole::Color);
+        gpu.base_color_texture = texture(&statement("map_Kd", t), TextureRole::Color);
     }
     if let Some(t) = m.unknown_param.get("map_Ke") {
-        gpu.emissive_texture = texture(&name_of(t), TextureRole::Color);
+        gpu.emissive_texture = texture(&statement("map_Ke", t), TextureRole::Color);
         if gpu.emission == [0.0; 3] {
             gpu.emission = [1.0; 3];
         }
     }
-    if let Some(t) = &m.normal_texture {
-        gpu.normal_texture = texture(&name_of(t), TextureRole::Normal);
+    // `bump`/`map_Bump` (tobj's normal texture) or `norm`: kiln reads either as a tangent-space
+    // normal map.
+    if let Some((key, t)) = m
+        .normal_texture
+        .as_ref()
+        .map(|t| ("bump", t))
+        .or_else(|| m.unknown_param.get("norm").map(|t| ("norm", t)))
+    {
+        gpu.normal_texture = texture(&statement(key, t), TextureRole::Normal);
+    }
+    // Maps kiln's materials have no slot for (`map_Ka` is ambient, which physically based
+    // shading replaces by the light itself: not worth a warning).
+    let unused = [
+        ("map_Ks", m.specular_texture.as_ref()),
+        ("map_Ns", m.shininess_texture.as_ref()),
+        ("map_d", m.dissolve_texture.as_ref()),
+    ];
+    for (key, t) in unused.into_iter().filter_map(|(k, t)| Some((k, t?))) {
+        warnings.push(format!("{key} {t} is not applied (kiln's materials have no slot for it)"));
+    }
+    for key in ["disp", "decal", "refl"] {
+        if let Some(t) = m.unknown_param.get(key) {
+            warnings.push(format!("{key} {t} is not applied (kiln's materials have no slot for it)"));
+        }
     }
     // Non-finite MTL values are replaced by defaults here; the validator would refuse them.
     for v in gpu.base_color.iter_mut().chain(gpu.emission.iter_mut()) {
