@@ -15,6 +15,7 @@ use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, V
 
 mod checks;
 mod extent;
+mod spec_defaults;
 mod uri;
 
 use super::files::ReadError;
@@ -132,15 +133,21 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
         Ok(gltf) => gltf,
         Err(e) => {
             let invalid = || CliError::input(format!("{file}: not a valid glTF 2.0 file: {e}"));
-            // The gltf crate reads animations strictly (a channel target without `node`, which
-            // the spec allows for extensions such as KHR_animation_pointer, is a parse error);
-            // kiln bakes none, so a file that parses without them compiles, with a warning.
-            let (stripped, dropped) = without_animations(&bytes).ok_or_else(invalid)?;
-            let gltf = Gltf::from_slice_without_validation(&stripped).map_err(|_| invalid())?;
-            scene.warn(format!(
-                "{file}: {dropped} animation(s) dropped unread: the gltf crate does not parse them ({e}); \
-                 kiln bakes no animation"
-            ));
+            // The gltf crate's parser requires what the spec lets a file omit (`scenes[].nodes`),
+            // and reads animations strictly (a channel target without `node`, which the spec
+            // allows for extensions such as KHR_animation_pointer, is a parse error); kiln bakes
+            // no animation, so a file that parses without them compiles, with a warning.
+            let parse = |drop| {
+                let (fixed, dropped) = spec_defaults::with_defaults(&bytes, drop)?;
+                Some((Gltf::from_slice_without_validation(&fixed).ok()?, dropped))
+            };
+            let (gltf, dropped) = parse(false).or_else(|| parse(true)).ok_or_else(invalid)?;
+            if dropped > 0 {
+                scene.warn(format!(
+                    "{file}: {dropped} animation(s) dropped unread: the gltf crate does not parse them ({e}); \
+                     kiln bakes no animation"
+                ));
+            }
             gltf
         }
     };
@@ -155,6 +162,11 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
     let blob = gltf.blob;
     let mut json = gltf.document.into_json();
     check_references(&json, &file)?;
+    let mut omitted = Vec::new();
+    let zeros = spec_defaults::fill(&mut json, &mut omitted);
+    for w in omitted {
+        scene.warn(format!("{file}: {w}"));
+    }
     let invalid =
         |e: ::gltf::Error| CliError::input(format!("{file}: invalid glTF: {}", describe_validation(&e)));
     let doc = match Document::from_json(json.clone()) {
@@ -178,7 +190,7 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
     let parents = node_parents(&doc, &file)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     // External buffers and images are read through `load_uri`, within `super::files`' bounds.
-    let buffers = load_buffers(&doc, blob, &file, &base, &mut scene.inputs)?;
+    let buffers = load_buffers(&doc, blob, zeros, &file, &base, &mut scene.inputs)?;
     let mut imp = Importer {
         file,
         base,
@@ -207,24 +219,6 @@ fn import_checked(path: &Path, scene: &mut Scene, normals: Normals) -> CliResult
     Ok(())
 }
 
-/// The glTF or GLB `bytes` without their `animations` array and how many it held; `None` when
-/// the JSON does not parse or holds no animation.
-fn without_animations(bytes: &[u8]) -> Option<(Vec<u8>, usize)> {
-    let strip = |json: &[u8]| -> Option<(Vec<u8>, usize)> {
-        let mut value: serde_json::Value = serde_json::from_slice(json).ok()?;
-        let dropped = value.as_object_mut()?.remove("animations")?.as_array().map_or(1, Vec::len);
-        Some((serde_json::to_vec(&value).ok()?, dropped))
-    };
-    if bytes.starts_with(b"glTF") {
-        let glb = ::gltf::Glb::from_slice(bytes).ok()?;
-        let (json, dropped) = strip(&glb.json)?;
-        let stripped = ::gltf::Glb { header: glb.header, json: json.into(), bin: glb.bin }.to_vec().ok()?;
-        Some((stripped, dropped))
-    } else {
-        strip(bytes)
-    }
-}
-
 /// Whether every validation error of `e` lies inside the `animations` array.
 fn only_animations(e: &::gltf::Error) -> bool {
     match e {
@@ -250,12 +244,30 @@ fn describe_validation(e: &::gltf::Error) -> String {
 fn load_buffers(
     doc: &Document,
     mut blob: Option<Vec<u8>>,
+    zeros: Option<spec_defaults::ZeroBuffer>,
     file: &str,
     base: &Path,
     inputs: &mut Vec<PathBuf>,
 ) -> CliResult<Vec<Vec<u8>>> {
-    let mut buffers = Vec::new();
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
     for b in doc.buffers() {
+        if let Some(z) = zeros.filter(|z| z.index == b.index()) {
+            // The zeros of accessors without data (the last buffer): bounded by the file's own
+            // buffers, as a sparse accessor without a view is.
+            let file_bytes: usize = buffers.iter().map(Vec::len).sum();
+            let limit = SPARSE_EXPANSION_FLOOR.max(SPARSE_EXPANSION_RATIO.saturating_mul(file_bytes));
+            if z.length > limit {
+                return Err(CliError::input(format!(
+                    "{file}: accessors without a buffer view (all zeros) would take {} bytes, more than \
+                     such accessors may expand to ({limit} bytes: {} MiB or {SPARSE_EXPANSION_RATIO} × the \
+                     file's {file_bytes} buffer bytes, the larger)",
+                    z.length,
+                    SPARSE_EXPANSION_FLOOR >> 20
+                )));
+            }
+            buffers.push(vec![0; z.length]);
+            continue;
+        }
         let (data, name) = match b.source() {
             ::gltf::buffer::Source::Bin => {
                 let data = blob.take().ok_or_else(|| {
@@ -1079,7 +1091,15 @@ impl Importer<'_> {
         if let Some(&i) = self.textures.get(&(t.index(), role)) {
             return i;
         }
-        let img = t.source();
+        let Some(img) = t.source() else {
+            self.scene.warn(format!(
+                "{}: texture {} has no image (an extension kiln does not read may supply it); the material \
+                 samples no texture there",
+                self.file,
+                t.index()
+            ));
+            return NO_TEXTURE;
+        };
         let name = img.name().map(str::to_string).unwrap_or_else(|| match img.source() {
             ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => uri.to_string(),
             _ => format!("image{}", img.index()),
