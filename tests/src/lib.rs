@@ -23,6 +23,7 @@ use kiln_player::scene::TextureUpload;
 use kiln_player::session::{PipelineStart, SessionOptions};
 
 pub mod boxes;
+pub mod corpus;
 pub mod equirect;
 pub mod exact;
 

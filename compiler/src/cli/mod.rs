@@ -511,3 +511,13 @@ pub struct DemoArgs {
 pub fn parse() -> Cli {
     Cli::parse()
 }
+
+/// Parses a command line (the program's name first), for running `kiln` in process (the public
+/// corpus runner): clap's error on a usage error, as `kiln` would print it.
+pub fn parse_from<I, T>(args: I) -> Result<Cli, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    Cli::try_parse_from(args)
+}
