@@ -867,3 +867,45 @@ fn far_scenes_keep_their_precision_relative_to_a_stored_origin() {
     assert_eq!(world(s.cameras[0].target), [250000.5, 4.0, -90000.75]);
     assert_eq!(world(s.lights[0].position), [250000.625, 5.0, -89999.75]);
 }
+
+/// KHR_materials_transmission is read as coverage: an opaque material transmitting t blends
+/// with alpha 1 − t, a blended one multiplies its alpha by 1 − t, a masked one keeps its mask;
+/// each says what is lost. (The reference path tracer's reading of coverage is checked in
+/// tests/render/reference.rs.)
+#[test]
+fn transmission_is_read_as_coverage_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let mut g = Gltf::quad();
+    g.json["extensionsUsed"] = json!(["KHR_materials_transmission"]);
+    let t = |factor: f32| json!({"KHR_materials_transmission": {"transmissionFactor": factor}});
+    g.json["materials"] = json!([
+        {"name": "glass", "extensions": t(0.75)},
+        {"name": "tinted", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.5]}, "extensions": t(0.5)},
+        {"name": "masked", "alphaMode": "MASK", "extensions": t(0.5)},
+        {"name": "none", "extensions": t(0.0)}
+    ]);
+    let prim = g.json["meshes"][0]["primitives"][0].clone();
+    let prims: Vec<_> = (0..4)
+        .map(|m| {
+            let mut p = prim.clone();
+            p["material"] = m.into();
+            p
+        })
+        .collect();
+    g.json["meshes"][0]["primitives"] = json!(prims);
+    let s = import(&g.write(d.path(), "t")).unwrap();
+    let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
+    let mode = |g: kiln_format::sections::GpuMaterial| g.flags >> MaterialFlags::ALPHA_MODE_SHIFT & 3;
+    let blend = kiln_format::sections::AlphaMode::Blend as u32;
+    assert_eq!((m("glass").base_color[3], mode(m("glass"))), (0.25, blend));
+    assert_eq!((m("tinted").base_color[3], mode(m("tinted"))), (0.25, blend));
+    assert_eq!(mode(m("masked")), kiln_format::sections::AlphaMode::Mask as u32);
+    assert_eq!(
+        (m("none").base_color[3], mode(m("none"))),
+        (1.0, kiln_format::sections::AlphaMode::Opaque as u32)
+    );
+    let warned = |text: &str| s.warnings.iter().filter(|w| w.message.contains(text)).count();
+    assert_eq!(warned("is read as coverage"), 2, "{:#?}", s.warnings);
+    assert_eq!(warned("on an alpha-masked material is not applied"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("used but not supported"), 0, "{:#?}", s.warnings);
+}

@@ -26,17 +26,32 @@ vec4 triangle_color(uint tri, float u, float v) {
     return interpolated_color(idx, u, v);
 }
 
-// Alpha-masked materials are cut out during traversal.
+// A uniform number in [0, 1) for a point of a triangle (PCG's output permutation over the
+// triangle and the hit's barycentrics): what decides whether a ray meets a blended surface.
+float coverage_number(uint tri, float u, float v) {
+    uint x = tri * 747796405u ^ floatBitsToUint(u) * 2891336453u ^ floatBitsToUint(v) * 277803737u;
+    x = x * 747796405u + 2891336453u;
+    x = ((x >> ((x >> 28u) + 4u)) ^ x) * 277803737u;
+    x = (x >> 22u) ^ x;
+    return float(x >> 8u) * (1.0 / 16777216.0);
+}
+
+// Alpha-masked materials are cut out during traversal; alpha-blended ones are met with
+// probability alpha (stochastic coverage: the path tracer's unbiased reading of blending, so
+// that light passes a surface of alpha a with weight 1 − a, on every ray kind alike, shadow rays
+// included). The number comes from the hit point, not the ray: rays meet a blended surface at
+// ever different points, and a ray that returns to one point decides as before.
 bool bvh_alpha_test(uint tri, float u, float v) {
     GpuMaterialLayout m = materials[tri_materials[tri]];
-    if (((m.flags >> MATERIAL_ALPHA_SHIFT) & 3u) != 1u) {
+    uint mode = (m.flags >> MATERIAL_ALPHA_SHIFT) & 3u;
+    if (mode == 0u) {
         return true;
     }
     float a = m.base_color.a * triangle_color(tri, u, v).a;
     if (m.base_color_texture != NO_TEXTURE) {
         a *= sample_texture(m.base_color_texture, triangle_uv(tri, u, v)).a;
     }
-    return a >= m.alpha_cutoff;
+    return mode == 1u ? a >= m.alpha_cutoff : coverage_number(tri, u, v) < a;
 }
 #define BVH_ALPHA_TEST
 #include "../common/traverse.glsl"

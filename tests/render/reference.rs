@@ -105,3 +105,63 @@ fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
         assert!((mean / expected - 1.0).abs() < 0.01, "{bounces} bounces: mean {mean}, expected {expected}");
     }
 }
+
+#[test]
+fn reference_path_tracer_sees_through_blended_surfaces_by_their_coverage() {
+    let dir = gpu_test!();
+    // An emitter of radiance 1 seen through a black, alpha-blended pane of alpha a: rays meet the
+    // pane with probability a (stochastic coverage) and reach the emitter otherwise, so the
+    // pixels behind the pane see 1 − a and the others 1 (the pane reflects nothing). Imported
+    // glTF transmission is read as such coverage (KHR_materials_transmission).
+    let a = 0.3f32;
+    let quad = |z: f32, h: f32| {
+        let p = |x: f32, y: f32| Vec3::new(x, y, z);
+        [[p(-h, -h), p(h, -h), p(h, h)], [p(-h, -h), p(h, h), p(-h, h)]]
+    };
+    let mut tris = quad(-2.0, 4.0).to_vec();
+    tris.extend(quad(-1.0, 0.5));
+    let mut scene = scene_of(&tris);
+    let mut emitter = kiln_compiler::import::demo::lambert_material([0.0; 3]);
+    emitter.emission = [1.0; 3];
+    let mut pane = kiln_compiler::import::demo::lambert_material([0.0; 3]);
+    pane.base_color[3] = a;
+    pane.flags |= (kiln_format::sections::AlphaMode::Blend as u32)
+        << kiln_format::sections::MaterialFlags::ALPHA_MODE_SHIFT;
+    scene.materials = vec![
+        kiln_compiler::ir::Material { name: "emitter".into(), gpu: emitter },
+        kiln_compiler::ir::Material { name: "pane".into(), gpu: pane },
+    ];
+    scene.triangle_materials = vec![0, 0, 1, 1];
+    scene.sky = Sky { radiance: [0.0; 3] };
+    let cam = Pinhole::new([0.0, 0.0, 2.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 40.0, W, H);
+    scene.cameras.push(cam.file_camera());
+    let file = dir.path().join("pane.kiln");
+    std::fs::write(&file, compile(scene, fast_settings())).unwrap();
+    let o = Options::new(&file, W, H).reference().build();
+    let (_, rgb) = kiln_player::reference::render(&o, 256, Instant::now()).expect("reference render");
+    // Pixels whose ray crosses z = −1 well inside the pane, and well outside it.
+    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    for y in 0..H {
+        for x in 0..W {
+            let d = cam.ray(x, y, W, H);
+            let q = DVec3::new(0.0, 0.0, 2.0) + d * (3.0 / -d.z);
+            let r = q.x.abs().max(q.y.abs());
+            let v = rgb[3 * (y * W + x) as usize] as f64;
+            if r < 0.4 {
+                inside.push(v);
+            } else if r > 0.6 {
+                outside.push(v);
+            }
+        }
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (mi, mo) = (mean(&inside), mean(&outside));
+    eprintln!(
+        "behind the pane {mi:.4} ({} pixels), beside it {mo:.4} ({} pixels)",
+        inside.len(),
+        outside.len()
+    );
+    assert!(inside.len() > 300 && outside.len() > 300);
+    assert!((mo - 1.0).abs() < 0.01, "the emitter seen directly: {mo}");
+    assert!((mi - (1.0 - a as f64)).abs() < 0.02, "behind a pane of alpha {a}: {mi}, expected {}", 1.0 - a);
+}

@@ -16,6 +16,7 @@ use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, V
 mod checks;
 mod extent;
 mod spec_defaults;
+mod transmission;
 mod uri;
 
 use super::files::ReadError;
@@ -32,8 +33,12 @@ use extent::declared_extent;
 use uri::{load_uri, short};
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
-const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_texture_transform"];
+const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_transmission",
+    "KHR_texture_transform",
+];
 
 /// How a material's textures map a primitive's texture coordinates: the set they read and the
 /// `KHR_texture_transform` they apply (baked into the stored coordinates, which the format holds
@@ -1002,11 +1007,14 @@ impl Importer<'_> {
         ] {
             self.physical(&at, field, [v], f32::NEG_INFINITY, f32::INFINITY)?;
         }
-        let alpha = match m.alpha_mode() {
+        let mut alpha = match m.alpha_mode() {
             ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             ::gltf::material::AlphaMode::Mask => AlphaMode::Mask,
             ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
+        if let Some(t) = m.transmission() {
+            alpha = self.transmission_as_coverage(&at, &t, alpha, &mut gpu)?;
+        }
         gpu.flags = (alpha as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
         if m.double_sided() {
             gpu.flags |= MaterialFlags::DOUBLE_SIDED;
