@@ -135,7 +135,9 @@ pub struct Args {
     /// List the Vulkan devices and exit.
     #[arg(long, help_heading = "Device and loading")]
     pub list_devices: bool,
-    /// Camera override: position, target and optionally the vertical field of view in degrees.
+    /// Camera override: position, target and optionally the vertical field of view in degrees,
+    /// in world coordinates as the asset gives them (a file stored relative to an origin far
+    /// from the world's, `kiln inspect` says which, is entered in world coordinates all the same).
     #[arg(long, value_name = "PX,PY,PZ,TX,TY,TZ[,VFOV]", allow_hyphen_values = true)]
     pub camera: Option<CameraOverride>,
     /// With -o, --headless or --bench: move the camera through the poses of FILE over the
