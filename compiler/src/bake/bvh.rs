@@ -63,6 +63,81 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
             tris.len()
         )));
     }
+    let (nodes, order) = convert(&bvh, tris);
+    if depth(&nodes) <= BVH_TRAVERSAL_STACK {
+        return Ok(BuiltBvh { nodes, order });
+    }
+    // PLOC's tree of degenerate geometry (100,000 slivers through one point, as a fanned polygon
+    // makes) is as deep as it is wide. Geometry cannot make a median split deeper than log₂ of
+    // its triangle count: slower to trace than PLOC's tree of ordinary geometry, never refused.
+    let median = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+        &median_bvh2(tris),
+        params(preset).max_prims_per_leaf.clamp(1, 3),
+        true,
+        false,
+    );
+    let (nodes, order) = convert(&median, tris);
+    let depth = depth(&nodes);
+    if depth > BVH_TRAVERSAL_STACK {
+        // Written, the file would be refused by every reader.
+        return Err(CliError::input(format!(
+            "the BVH over these {} triangles is {depth} levels deep, more than the {BVH_TRAVERSAL_STACK} every \
+             reader's traversal stack holds",
+            tris.len()
+        )));
+    }
+    Ok(BuiltBvh { nodes, order })
+}
+
+/// A binary tree split at the median of the longest axis of its triangles' centres, a triangle
+/// per leaf: depth ⌈log₂ n⌉ whatever the geometry. Built with an explicit stack.
+fn median_bvh2(tris: &[Triangle]) -> obvhs::bvh2::Bvh2 {
+    use obvhs::aabb::Aabb;
+    use obvhs::bvh2::node::Bvh2Node;
+    let n = tris.len();
+    let boxes: Vec<Aabb> = tris.iter().map(Triangle::aabb).collect();
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut nodes = vec![Bvh2Node::default(); (2 * n).saturating_sub(1).max(1)];
+    let mut next = 1usize;
+    let mut stack = vec![(0usize, 0usize, n)];
+    while let Some((node, start, end)) = stack.pop() {
+        let (mut bounds, mut centres) = (Aabb::empty(), Aabb::empty());
+        for &i in &order[start..end] {
+            bounds = bounds.union(&boxes[i as usize]);
+            centres.extend(boxes[i as usize].center());
+        }
+        if end - start <= 1 {
+            nodes[node] = Bvh2Node::new(bounds, (end - start) as u32, start as u32);
+            continue;
+        }
+        let size = centres.max - centres.min;
+        let axis = if size.x >= size.y && size.x >= size.z {
+            0
+        } else if size.y >= size.z {
+            1
+        } else {
+            2
+        };
+        let mid = (start + end) / 2;
+        order[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+            boxes[a as usize].center_axis(axis).total_cmp(&boxes[b as usize].center_axis(axis))
+        });
+        nodes[node] = Bvh2Node::new(bounds, 0, next as u32);
+        stack.push((next, start, mid));
+        stack.push((next + 1, mid, end));
+        next += 2;
+    }
+    obvhs::bvh2::Bvh2 {
+        nodes,
+        primitive_indices: order,
+        children_are_ordered_after_parents: true,
+        ..Default::default()
+    }
+}
+
+/// kiln's nodes and leaf order from obvhs's compressed wide BVH, boxes widened to contain their
+/// triangles.
+fn convert(bvh: &obvhs::cwbvh::CwBvh, tris: &[Triangle]) -> (Vec<CwbvhNode>, Vec<u32>) {
     let nodes = bvh
         .nodes
         .iter()
@@ -83,17 +158,7 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
         .collect::<Vec<_>>();
     let mut nodes = nodes;
     widen_to_contain(&mut nodes, tris, &bvh.primitive_indices);
-    let depth = depth(&nodes);
-    if depth > BVH_TRAVERSAL_STACK {
-        // Written, the file would be refused by every reader.
-        return Err(CliError::input(format!(
-            "the BVH over these {} triangles is {depth} levels deep, more than the {BVH_TRAVERSAL_STACK} every \
-             reader's traversal stack holds: the geometry is degenerate for a BVH (e.g. thousands of \
-             slivers through one point, as a fanned polygon makes); re-triangulate it",
-            tris.len()
-        )));
-    }
-    Ok(BuiltBvh { nodes, order: bvh.primitive_indices })
+    (nodes, bvh.primitive_indices.clone())
 }
 
 /// Levels of the tree below and including the root (1 for a root of leaves).
@@ -230,6 +295,29 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A disc of n slivers through its centre, given as triangles: PLOC's tree of it is deeper
+    /// than readers traverse (checked here, so that the fallback is what is tested); the build
+    /// falls back to the median split, whose tree holds every triangle once within the depth,
+    /// and whose boxes contain their triangles (a ray test of the result is `kiln verify`'s).
+    #[test]
+    fn a_fan_of_slivers_gets_a_tree_readers_can_traverse() {
+        let n = 20_000;
+        let corner = |i: usize| {
+            let a = std::f32::consts::TAU * i as f32 / (n + 1) as f32;
+            [a.cos(), a.sin(), 0.0]
+        };
+        let tris = triangles((0..n).map(|i| [[0.0; 3], corner(i), corner(i + 1)]));
+        let mut core = std::time::Duration::ZERO;
+        let ploc = obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, params(BvhPreset::Medium), &mut core);
+        let (ploc_nodes, _) = convert(&ploc, &tris);
+        assert!(depth(&ploc_nodes) > BVH_TRAVERSAL_STACK, "PLOC's depth {}", depth(&ploc_nodes));
+        let built = build(&tris, BvhPreset::Medium).expect("the fan builds");
+        assert!(depth(&built.nodes) <= BVH_TRAVERSAL_STACK, "depth {}", depth(&built.nodes));
+        let mut seen = built.order.clone();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..n as u32).collect::<Vec<_>>(), "every triangle once");
+    }
 
     #[test]
     fn planes_move_outwards_and_the_step_doubles_past_255() {
