@@ -39,6 +39,9 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
     // (100,000 slivers through one vertex) makes as deep as the triangle count: on a worker's
     // 2 MiB stack that overflows and aborts. So the build runs on a thread whose stack grows with
     // the triangles (reserved, not committed, until used).
+    if fanned(tris) {
+        return median_tree(tris, preset);
+    }
     let stack = (tris.len() as u64 * 512).clamp(8 << 20, 4 << 30) as usize;
     let bvh = std::thread::scope(|scope| {
         std::thread::Builder::new()
@@ -70,6 +73,33 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
     // PLOC's tree of degenerate geometry (100,000 slivers through one point, as a fanned polygon
     // makes) is as deep as it is wide. Geometry cannot make a median split deeper than log₂ of
     // its triangle count: slower to trace than PLOC's tree of ordinary geometry, never refused.
+    median_tree(tris, preset)
+}
+
+/// Whether one corner position is shared by so many triangles (more than 4,096 and an eighth of
+/// them) that PLOC would spend quadratic time on their nested boxes (a 100,000-sliver fan took
+/// 21 s on 2 cores, for a tree too deep to keep): such geometry goes to the median split at once.
+fn fanned(tris: &[Triangle]) -> bool {
+    let limit = (tris.len() / 8).max(4096);
+    if tris.len() <= limit {
+        return false;
+    }
+    let mut count: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
+    for t in tris {
+        for v in [t.v0, t.v1, t.v2] {
+            let c = count.entry(v.to_array().map(f32::to_bits)).or_default();
+            *c += 1;
+            if *c > limit {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The median split's tree ([`median_bvh2`]) in kiln's nodes, refused only if deeper than
+/// readers traverse (which ⌈log₂ n⌉ levels of a binary tree, collapsed eight-wide, never are).
+fn median_tree(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
     let median = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
         &median_bvh2(tris),
         params(preset).max_prims_per_leaf.clamp(1, 3),
@@ -317,6 +347,17 @@ mod tests {
         let mut seen = built.order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..n as u32).collect::<Vec<_>>(), "every triangle once");
+        // The fan goes to the median split before PLOC spends its time; a grid of as many
+        // triangles (six at a vertex) does not.
+        assert!(fanned(&tris));
+        let k = 100;
+        let p = |i: usize, j: usize| [i as f32, j as f32, 0.0];
+        let grid = triangles((0..k * k).flat_map(|c| {
+            let (i, j) = (c % k, c / k);
+            [[p(i, j), p(i + 1, j), p(i + 1, j + 1)], [p(i, j), p(i + 1, j + 1), p(i, j + 1)]]
+        }));
+        assert_eq!(grid.len(), n);
+        assert!(!fanned(&grid));
     }
 
     #[test]
