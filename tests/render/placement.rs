@@ -16,6 +16,7 @@ use kiln_test_support::gpu_test;
 use kiln_tests::{Options, compile};
 
 use crate::harness::{fast_settings, render_frames};
+use crate::media::mean;
 
 const W: u32 = 32;
 const H: u32 = 24;
@@ -124,18 +125,11 @@ fn render_room(dir: &std::path::Path, name: &str, scale: f64, offset: DVec3, how
     }
 }
 
-/// Mean of each channel.
-fn mean(rgb: &[f32]) -> [f64; 3] {
-    let n = (rgb.len() / 3) as f64;
-    std::array::from_fn(|c| rgb.iter().skip(c).step_by(3).map(|&v| f64::from(v)).sum::<f64>() / n)
-}
-
-/// Relative mean squared error of `b` against `a`, per pixel (the ray-traced estimators' usual
-/// measure: (b − a)² / (a² + 10⁻²) averaged).
-fn rel_mse(a: &[f32], b: &[f32]) -> f64 {
-    let n = a.len() as f64;
-    a.iter().zip(b).map(|(&x, &y)| (f64::from(y - x)).powi(2) / (f64::from(x).powi(2) + 1e-2)).sum::<f64>()
-        / n
+/// Relative mean squared error of `test` against `reference` (kiln-metrics': per channel,
+/// (t − r)² / (r² + 10⁻²) averaged).
+fn rel_mse(reference: &[f32], test: &[f32]) -> f64 {
+    let img = |pixels| kiln_metrics::RgbImage { width: W, height: H, pixels };
+    kiln_metrics::rel_mse(img(reference), img(test)).expect("images of one size")
 }
 
 /// Compares every placement's image with the origin's: means within `mean_tol` (relative), and

@@ -66,7 +66,7 @@ pub fn build(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
             tris.len()
         )));
     }
-    let (nodes, order) = convert(&bvh, tris);
+    let (nodes, order) = convert(bvh, tris);
     if depth(&nodes) <= BVH_TRAVERSAL_STACK {
         return Ok(BuiltBvh { nodes, order });
     }
@@ -106,7 +106,7 @@ fn median_tree(tris: &[Triangle], preset: BvhPreset) -> CliResult<BuiltBvh> {
         true,
         false,
     );
-    let (nodes, order) = convert(&median, tris);
+    let (nodes, order) = convert(median, tris);
     let depth = depth(&nodes);
     if depth > BVH_TRAVERSAL_STACK {
         // Written, the file would be refused by every reader.
@@ -167,7 +167,7 @@ fn median_bvh2(tris: &[Triangle]) -> obvhs::bvh2::Bvh2 {
 
 /// kiln's nodes and leaf order from obvhs's compressed wide BVH, boxes widened to contain their
 /// triangles.
-fn convert(bvh: &obvhs::cwbvh::CwBvh, tris: &[Triangle]) -> (Vec<CwbvhNode>, Vec<u32>) {
+fn convert(bvh: obvhs::cwbvh::CwBvh, tris: &[Triangle]) -> (Vec<CwbvhNode>, Vec<u32>) {
     let nodes = bvh
         .nodes
         .iter()
@@ -188,7 +188,7 @@ fn convert(bvh: &obvhs::cwbvh::CwBvh, tris: &[Triangle]) -> (Vec<CwbvhNode>, Vec
         .collect::<Vec<_>>();
     let mut nodes = nodes;
     widen_to_contain(&mut nodes, tris, &bvh.primitive_indices);
-    (nodes, bvh.primitive_indices.clone())
+    (nodes, bvh.primitive_indices)
 }
 
 /// Levels of the tree below and including the root (1 for a root of leaves).
@@ -340,7 +340,7 @@ mod tests {
         let tris = triangles((0..n).map(|i| [[0.0; 3], corner(i), corner(i + 1)]));
         let mut core = std::time::Duration::ZERO;
         let ploc = obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, params(BvhPreset::Medium), &mut core);
-        let (ploc_nodes, _) = convert(&ploc, &tris);
+        let (ploc_nodes, _) = convert(ploc, &tris);
         assert!(depth(&ploc_nodes) > BVH_TRAVERSAL_STACK, "PLOC's depth {}", depth(&ploc_nodes));
         let built = build(&tris, BvhPreset::Medium).expect("the fan builds");
         assert!(depth(&built.nodes) <= BVH_TRAVERSAL_STACK, "depth {}", depth(&built.nodes));

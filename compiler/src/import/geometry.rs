@@ -52,6 +52,11 @@ pub fn rebase_origin(lo: DVec3, hi: DVec3) -> DVec3 {
     (centre / step).round() * step
 }
 
+/// `world` as the file stores it: relative to `origin` ([`rebase_origin`]), in single precision.
+pub fn stored(world: DVec3, origin: DVec3) -> [f32; 3] {
+    (world - origin).as_vec3().to_array()
+}
+
 /// A scene whose centre lies beyond this many extents from the origin is stored relative to its
 /// centre ([`rebase_origin`]): 16 extents cost positions 4 bits of their 24.
 pub const REBASE_RATIO: f64 = 16.0;

@@ -22,7 +22,7 @@ mod uri;
 
 use super::files::ReadError;
 use super::geometry::{
-    Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
+    Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, stored, unorm16,
 };
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
@@ -86,6 +86,17 @@ const MAX_TRIANGLES: usize = 1 << 28;
 const SPARSE_EXPANSION_FLOOR: usize = 16 << 20;
 /// See [`SPARSE_EXPANSION_FLOOR`].
 const SPARSE_EXPANSION_RATIO: usize = 4;
+
+/// What an accessor without a buffer view may expand to beside `file_bytes` bytes of buffers
+/// ([`SPARSE_EXPANSION_FLOOR`]), with the bound spelled out for an error message.
+fn expansion_limit(file_bytes: usize) -> (usize, String) {
+    let limit = SPARSE_EXPANSION_FLOOR.max(SPARSE_EXPANSION_RATIO.saturating_mul(file_bytes));
+    let why = format!(
+        "{limit} bytes: {} MiB or {SPARSE_EXPANSION_RATIO} × the file's {file_bytes} buffer bytes, the larger",
+        SPARSE_EXPANSION_FLOOR >> 20
+    );
+    (limit, why)
+}
 
 struct Importer<'a> {
     file: String,
@@ -523,8 +534,7 @@ impl Importer<'_> {
             let origin = self.origin();
             let mut positions = Vec::with_capacity(count);
             for (i, p) in local_pos.iter().enumerate() {
-                let w =
-                    (matrix(i).transform_point3(DVec3::from(p.map(f64::from))) - origin).as_vec3().to_array();
+                let w = stored(matrix(i).transform_point3(DVec3::from(p.map(f64::from))), origin);
                 check_position(w, || {
                     format!(
                         "{at}: POSITION accessor {} element {i} (accessor value {p:?}) after its node transform",
@@ -818,15 +828,11 @@ impl Importer<'_> {
             if acc.view().is_none() {
                 // Zeros but for the sparse values: no buffer bounds `count`, so the file's size
                 // bounds what the accessor may expand to (checked before anything is allocated).
-                let file_bytes: usize = self.buffers.iter().map(Vec::len).sum();
-                let limit = SPARSE_EXPANSION_FLOOR.max(SPARSE_EXPANSION_RATIO.saturating_mul(file_bytes));
+                let (limit, why) = expansion_limit(self.buffers.iter().map(Vec::len).sum());
                 if count.checked_mul(elem).is_none_or(|b| b > limit) {
                     return bad(format!(
                         "has no buffer view: its {count} elements of {elem} bytes would be zeros but for \
-                         {sc} sparse values, more than such an accessor may expand to ({limit} bytes: \
-                         {} MiB or {SPARSE_EXPANSION_RATIO} × the file's {file_bytes} buffer bytes, the \
-                         larger)",
-                        SPARSE_EXPANSION_FLOOR >> 20
+                         {sc} sparse values, more than such an accessor may expand to ({why})"
                     ));
                 }
             }
@@ -1161,7 +1167,7 @@ impl Importer<'_> {
                 LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
             }
         };
-        let position = (world.transform_point3(DVec3::ZERO) - self.origin()).as_vec3().to_array();
+        let position = stored(world.transform_point3(DVec3::ZERO), self.origin());
         let direction = world.transform_vector3(DVec3::NEG_Z).normalize_or_zero().as_vec3().to_array();
         let l = Light {
             name,

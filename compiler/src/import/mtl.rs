@@ -29,9 +29,8 @@ const TEXTURES: [&str; 14] = [
 pub fn sanitize(file: &str, text: &str, warnings: &mut Vec<String>) -> String {
     let mut out = String::with_capacity(text.len());
     for (i, line) in text.lines().enumerate() {
-        let at = format!("{file}:{}", i + 1);
         // A dropped statement leaves its line empty: tobj's lines stay the file's.
-        if let Some(s) = statement(line, &at, warnings) {
+        if let Some(s) = statement(line, file, i + 1, warnings) {
             out.push_str(&s);
         }
         out.push('\n');
@@ -39,14 +38,16 @@ pub fn sanitize(file: &str, text: &str, warnings: &mut Vec<String>) -> String {
     out
 }
 
-/// One line made readable (`None`: dropped, with a warning).
-fn statement(line: &str, at: &str, warnings: &mut Vec<String>) -> Option<String> {
+/// Line `line_no` of `file` made readable (`None`: dropped, with a warning).
+fn statement(line: &str, file: &str, line_no: usize, warnings: &mut Vec<String>) -> Option<String> {
+    // Formatted only for a warning: most lines pass unchanged.
+    let at = || format!("{file}:{line_no}");
     let mut words = line.split_whitespace();
     let key = words.next().unwrap_or_default();
     let values: Vec<&str> = words.collect();
     let number = |v: &str| v.parse::<f32>().ok().filter(|x| x.is_finite());
     let mut drop = |why: &str| {
-        warnings.push(format!("{at}: `{}` {why}; the statement is ignored", line.trim()));
+        warnings.push(format!("{}: `{}` {why}; the statement is ignored", at(), line.trim()));
         None
     };
     if COLOURS.contains(&key) {
@@ -60,7 +61,7 @@ fn statement(line: &str, at: &str, warnings: &mut Vec<String>) -> Option<String>
             _ => return drop("needs one or three finite numbers (r, or r g b)"),
         };
         if rgb.iter().any(|&x| x < 0.0) {
-            warnings.push(format!("{at}: `{}` has a negative component; clamped to 0", line.trim()));
+            warnings.push(format!("{}: `{}` has a negative component; clamped to 0", at(), line.trim()));
             rgb = rgb.map(|x| x.max(0.0));
         }
         return Some(format!("{key} {} {} {}", rgb[0], rgb[1], rgb[2]));
@@ -82,8 +83,8 @@ fn statement(line: &str, at: &str, warnings: &mut Vec<String>) -> Option<String>
         return if parsed.name.is_empty() { drop("names no file") } else { Some(line.trim().to_string()) };
     }
     if key == "newmtl" && values.is_empty() {
-        let name = format!("unnamed-{}", at.rsplit(':').next().unwrap_or_default());
-        warnings.push(format!("{at}: `newmtl` without a name; named '{name}'"));
+        let name = format!("unnamed-{line_no}");
+        warnings.push(format!("{}: `newmtl` without a name; named '{name}'", at()));
         return Some(format!("newmtl {name}"));
     }
     Some(line.to_string())

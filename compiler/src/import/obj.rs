@@ -38,7 +38,7 @@ use super::mtl::TextureStatement;
 use glam::DVec3;
 
 use super::geometry::{
-    Extent, Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, unorm16,
+    Extent, Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, stored, unorm16,
 };
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
@@ -197,11 +197,8 @@ pub fn import(path: &Path, scene: &mut Scene, normals_mode: Normals) -> CliResul
     for model in &models {
         let mesh = &model.mesh;
         let at = format!("{file}: object '{}'", model.name);
-        let positions: Vec<[f32; 3]> = mesh
-            .positions
-            .chunks_exact(3)
-            .map(|p| (DVec3::new(p[0], p[1], p[2]) - origin).as_vec3().to_array())
-            .collect();
+        let positions: Vec<[f32; 3]> =
+            mesh.positions.chunks_exact(3).map(|p| stored(DVec3::new(p[0], p[1], p[2]), origin)).collect();
         for (i, p) in positions.iter().enumerate() {
             check_position(*p, || format!("{at}: vertex {i}"))?;
         }

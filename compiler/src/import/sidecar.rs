@@ -11,6 +11,7 @@ use serde::Deserialize;
 
 use crate::exit::{CliError, CliResult};
 use crate::import::environment::{self, EnvironmentSpec, Placement};
+use crate::import::geometry::stored;
 use crate::ir::Scene;
 
 /// A parsed sidecar.
@@ -316,7 +317,7 @@ impl Sidecar {
         let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
         // Positions are stored relative to the scene's origin (`Scene::origin`).
         let origin = DVec3::from(scene.origin);
-        let rel = |p: [f64; 3]| (DVec3::from(p) - origin).as_vec3().to_array();
+        let rel = |p: [f64; 3]| stored(DVec3::from(p), origin);
         if let Some(c) = &self.camera {
             let vals = [&c.up[..], &[c.vfov_degrees]].concat();
             let (position, target) = (rel(c.position), rel(c.target));
@@ -448,7 +449,7 @@ fn apply_material(o: &MaterialToml, gpu: &mut kiln_format::sections::GpuMaterial
 
 fn convert_light(l: &LightToml, i: usize, origin: DVec3) -> Result<Light, String> {
     let need = |v: Option<[f32; 3]>, what: &str| v.ok_or_else(|| format!("`{what}` is required"));
-    let position = l.position.map(|p| (DVec3::from(p) - origin).as_vec3().to_array());
+    let position = l.position.map(|p| stored(DVec3::from(p), origin));
     let unit = |v: [f32; 3], what: &str| {
         Vec3::from(v)
             .try_normalize()

@@ -4,9 +4,9 @@ use std::path::{Path, PathBuf};
 
 use ::gltf::Document;
 
+use super::expansion_limit;
 use super::spec_defaults;
 use super::uri::{load_uri, short};
-use super::{SPARSE_EXPANSION_FLOOR, SPARSE_EXPANSION_RATIO};
 use crate::exit::{CliError, CliResult};
 use crate::import::files::ReadError;
 
@@ -25,15 +25,12 @@ pub(super) fn load_buffers(
         if let Some(z) = zeros.filter(|z| z.index == b.index()) {
             // The zeros of accessors without data (the last buffer): bounded by the file's own
             // buffers, as a sparse accessor without a view is.
-            let file_bytes: usize = buffers.iter().map(Vec::len).sum();
-            let limit = SPARSE_EXPANSION_FLOOR.max(SPARSE_EXPANSION_RATIO.saturating_mul(file_bytes));
+            let (limit, why) = expansion_limit(buffers.iter().map(Vec::len).sum());
             if z.length > limit {
                 return Err(CliError::input(format!(
                     "{file}: accessors without a buffer view (all zeros) would take {} bytes, more than \
-                     such accessors may expand to ({limit} bytes: {} MiB or {SPARSE_EXPANSION_RATIO} × the \
-                     file's {file_bytes} buffer bytes, the larger)",
-                    z.length,
-                    SPARSE_EXPANSION_FLOOR >> 20
+                     such accessors may expand to ({why})",
+                    z.length
                 )));
             }
             buffers.push(vec![0; z.length]);
