@@ -263,7 +263,8 @@ fn reported_errors_are_recomputed_from_the_kept_images() {
                   load = lambda p: np.fromfile(p, dtype='<f4').reshape(h, w, 3)\n\
                   ref = load(sys.argv[3])\n\
                   for test in sys.argv[4:]:\n    \
-                      _, mean, _ = flip.evaluate(ref, load(test), 'HDR')\n    \
+                      errmap, mean, _ = flip.evaluate(ref, load(test), 'HDR', applyMagma=False)\n    \
+                      np.asarray(errmap, dtype='<f4').tofile(test + '.map')\n    \
                       print(repr(float(mean)))\n";
     for (reference, tests) in by_reference {
         let o = Command::new(&python)
@@ -284,8 +285,48 @@ fn reported_errors_are_recomputed_from_the_kept_images() {
                 "{}: kiln-bench FLIP {ours}, flip-evaluator {theirs}",
                 path.display()
             );
+            // The measured images have maps (the noise floor's halves under reference/ do not).
+            if path.parent().is_some_and(|d| d.ends_with("images")) {
+                check_error_map(path);
+            }
         }
     }
+    // `--diff` on a kept pair prints what the sweep reported (itself checked above).
+    let (reference, image, flip) = &pairs[0];
+    let dir = tempfile::tempdir().unwrap();
+    let o = bench(&[
+        "--diff",
+        reference.to_str().unwrap(),
+        image.to_str().unwrap(),
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}{}", String::from_utf8_lossy(&o.stderr));
+    let printed: f64 = text.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN);
+    assert!((printed - flip).abs() <= 1e-4, "--diff printed {text:?}, the sweep {flip}");
+    assert!(dir.path().join("flip.png").is_file(), "--diff wrote no map");
+}
+
+/// The heat map kept beside a measured image (`...-flip.png`: 0 black, 1/3 red, 2/3 yellow, 1
+/// white, so the channels' sum over 765 is the value) against flip-evaluator's per-pixel map
+/// (`IMAGE.f32.map`, written by the script above), within the PNG's 8-bit steps.
+fn check_error_map(image: &Path) {
+    let name = image.file_stem().unwrap().to_string_lossy();
+    let png = image.with_file_name(format!("{name}-flip.png"));
+    let heat = image::open(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display())).into_rgb8();
+    let theirs: Vec<f32> = std::fs::read(image.with_extension("f32.map"))
+        .unwrap()
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    assert_eq!(theirs.len(), heat.pixels().len(), "{}", png.display());
+    let worst = heat
+        .pixels()
+        .zip(&theirs)
+        .map(|(p, t)| ((p[0] as f32 + p[1] as f32 + p[2] as f32) / 765.0 - t.clamp(0.0, 1.0)).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 2.0 / 255.0, "{}: a pixel differs from flip-evaluator's map by {worst}", png.display());
 }
 
 /// RMSE and relMSE of every point recomputed from the kept images; returns (reference image,

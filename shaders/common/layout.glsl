@@ -241,6 +241,7 @@ const uint FRAME_RT_GI = 32u;
 const uint FRAME_SCREEN_GI = 64u;
 const uint FRAME_SCREEN_REFLECTIONS = 128u;
 const uint FRAME_RT_DIRECT = 256u;
+const uint FRAME_PROBE_SPECULAR = 512u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;

@@ -5,7 +5,8 @@
 // triangles' light from the direct-light image (`--direct`), plus the sky or environment
 // through the split-sum table (its diffuse part times the ray-traced AO, or replaced by the
 // ray-traced GI; its specular part replaced by the ray-traced reflections where they were
-// traced, or blended with the screen-space reflections' radiance by their confidence) and
+// traced, or blended with the screen-space reflections' radiance by their confidence; with
+// probes, their irradiance along the mirror direction stands in for the sky's radiance there) and
 // emission.
 // Output: linear scene radiance (before exposure and tone mapping).
 #include "../common/layout.glsl"
@@ -27,6 +28,7 @@ layout(constant_id = 5) const bool DIRECT_SCREEN_REFLECTIONS = true;
 layout(constant_id = 6) const bool DIRECT_MEDIA = true;
 layout(constant_id = 7) const bool DIRECT_RECT_LIGHTS = true;
 layout(constant_id = 8) const bool DIRECT_EMISSIVE = true;
+layout(constant_id = 9) const bool DIRECT_PROBE_SPECULAR = true;
 
 // Shadow maps: MAX_SHADOW_MAPS (layout.glsl) of each kind, indexed by `GpuShadow::slot`.
 // The shadow tap loops are [[dont_unroll]]: each tap samples through a dynamically indexed
@@ -61,6 +63,8 @@ layout(set = 0, binding = 17, rgba32f) uniform readonly image2D rt_direct;
 // (the constant sky without one).
 #define ENV_BINDING 18
 #include "../common/environment.glsl"
+// The probes' irradiance along each pixel's mirror direction (FRAME_PROBE_SPECULAR: `--gi probes`).
+layout(set = 0, binding = 20, rgba16f) uniform readonly image2D probe_specular;
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -284,7 +288,20 @@ void main() {
         radiance += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
-        vec3 sky_in = env_filtered(reflect(-v, n), m.roughness, frame.sky.rgb) * occlusion;
+        vec3 mirror = reflect(-v, n);
+        vec3 sky_in = env_filtered(mirror, m.roughness, frame.sky.rgb) * occlusion;
+        if (DIRECT_PROBE_SPECULAR && (frame.size.w & FRAME_PROBE_SPECULAR) != 0u) {
+            // The probes hold the light that reaches the surface along the mirror direction, the
+            // sky's occluded, the room's indirect; as irradiance (a cosine lobe), so the
+            // environment's own prefiltered-to-irradiance ratio there gives back its sharpness
+            // (1 under the constant sky), bounded where the irradiance is near black. Like the
+            // diffuse GI it replaces the material's occlusion: the probes saw the occluders.
+            const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+            float spread = dot(env_irradiance(mirror, frame.sky.rgb), LUMA);
+            float sharp = dot(env_filtered(mirror, m.roughness, frame.sky.rgb), LUMA);
+            float ratio = spread > 0.0 ? clamp(sharp / spread, 0.0, 8.0) : 1.0;
+            sky_in = imageLoad(probe_specular, pixel).rgb * ratio;
+        }
         if (DIRECT_SCREEN_REFLECTIONS && (frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {
             // The split sum's prefiltered incoming radiance: what the screen showed along the
             // mirror direction, the sky (occluded) where it showed nothing; the same table weighs

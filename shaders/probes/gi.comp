@@ -14,7 +14,11 @@
 // with weights below 0.2 crushed towards 0 (DDGI's). The irradiance (mean cosine-weighted
 // radiance) is read along the normal. Probes switched off (inside geometry) are skipped.
 // Output: the mean incoming radiance of the surface (rgb), which the direct pass multiplies by
-// the diffuse albedo in place of the sky's ambient (FRAME_RT_GI), as for the ray-traced GI.
+// the diffuse albedo in place of the sky's ambient (FRAME_RT_GI), as for the ray-traced GI; and,
+// with the same weights, the irradiance along the mirror direction of the view, which the
+// direct pass's split sum takes for its incoming radiance in place of the sky's
+// (FRAME_PROBE_SPECULAR): a cosine lobe stands in for the glossy lobe, as DDGI's glossy
+// fallback does, so that metal indoors reflects the lit room and not the sky outside it.
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 
@@ -30,6 +34,7 @@ layout(set = 0, binding = 4) uniform sampler2DArray visibility;
 // Per probe: offset from its grid point (scene units), and 1 on / 0 off.
 layout(set = 0, binding = 5, std430) readonly buffer States { vec4 states[]; };
 layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D gi_out;
+layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D specular_out;
 layout(push_constant) uniform Push { ProbeConstants probes; };
 #include "../common/pixel.glsl"
 
@@ -40,6 +45,17 @@ vec2 tile_uv(uvec2 probe, vec3 d, uint n, vec2 size) {
     return (vec2(probe * (n + 2u)) + 1.0 + e * float(n)) / size;
 }
 
+// The mean cosine-weighted radiance probe `c` holds around direction d (and the emitters it
+// sees directly when `emitted`).
+vec3 probe_irradiance(ivec3 c, vec3 d, vec2 size, bool emitted) {
+    vec2 uv = tile_uv(uvec2(c.xy), d, probes.irradiance_texels, size);
+    vec3 e = texture(irradiance, vec3(uv, float(c.z))).rgb;
+    if (emitted) {
+        e += texture(irradiance, vec3(uv, float(c.z + int(probes.dims.z)))).rgb;
+    }
+    return e;
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(uvec2(pixel), frame.size.xy))) {
@@ -48,6 +64,7 @@ void main() {
     float depth = texelFetch(g_depth, pixel, 0).r;
     if (!(depth > 0.0)) {
         imageStore(gi_out, pixel, vec4(0.0));
+        imageStore(specular_out, pixel, vec4(0.0));
         return;
     }
     vec3 p = world_at_depth(vec2(pixel) + 0.5, depth);
@@ -56,6 +73,7 @@ void main() {
     if (dot(n, v) < 0.0) {
         n = -n;
     }
+    vec3 mirror = reflect(-v, n);
     vec3 biased = p + n * probes.normal_bias + v * probes.view_bias;
     ivec3 dims = ivec3(probes.dims);
     vec3 g = (biased - probes.origin) / probes.spacing;
@@ -64,7 +82,7 @@ void main() {
     vec2 irradiance_size = vec2(probes.dims.xy * (probes.irradiance_texels + 2u));
     vec2 visibility_size = vec2(probes.dims.xy * (probes.visibility_texels + 2u));
     bool emitted = probes.layers > 1u && (frame.size.w & FRAME_RT_DIRECT) == 0u;
-    vec3 sum = vec3(0.0);
+    vec3 sum = vec3(0.0), sum_mirror = vec3(0.0);
     float total = 0.0;
     for (int i = 0; i < 8; i++) {
         ivec3 corner = ivec3(i & 1, (i >> 1) & 1, i >> 2);
@@ -95,13 +113,11 @@ void main() {
             weight *= weight * weight / (CRUSH * CRUSH);
         }
         weight *= trilinear.x * trilinear.y * trilinear.z;
-        vec2 uv = tile_uv(uvec2(c.xy), n, probes.irradiance_texels, irradiance_size);
-        vec3 e = texture(irradiance, vec3(uv, float(c.z))).rgb;
-        if (emitted) {
-            e += texture(irradiance, vec3(uv, float(c.z + dims.z))).rgb;
-        }
-        sum += weight * e;
+        sum += weight * probe_irradiance(c, n, irradiance_size, emitted);
+        sum_mirror += weight * probe_irradiance(c, mirror, irradiance_size, emitted);
         total += weight;
     }
-    imageStore(gi_out, pixel, vec4(total > 0.0 ? sum / total : vec3(0.0), 1.0));
+    float inverse = total > 0.0 ? 1.0 / total : 0.0;
+    imageStore(gi_out, pixel, vec4(sum * inverse, 1.0));
+    imageStore(specular_out, pixel, vec4(sum_mirror * inverse, 1.0));
 }

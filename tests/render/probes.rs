@@ -8,6 +8,12 @@
 //! - The dark room's floor, which the reference shows black, stays below 5 % of the lit one's:
 //!   the probes just across the wall see the lit room, and only the Chebyshev test of their
 //!   distance maps keeps their light out.
+//!
+//! And a white furnace for the glossy part: a white metal floor inside a closed box whose black
+//! walls glow with radiance Le sees Le in every direction, so (with the split sum's
+//! multiple-scattering compensation) it reflects exactly Le — a closed form. The sky outside is
+//! black, so a split sum that read the sky instead of the probes along the mirror direction
+//! shows a black floor.
 
 use std::path::Path;
 use std::time::Instant;
@@ -97,4 +103,49 @@ fn probes_light_a_room_as_the_reference_does_and_nothing_through_its_wall() {
     for (name, floor) in [("dark floor", dark), ("floor beside the wall", strip)] {
         assert!(floor <= 0.01 * lit, "light leaks through the wall: the {name} {floor} against {lit}");
     }
+}
+
+/// The furnace: a closed 2-unit box of black walls emitting `LE`, a white metal floor.
+fn furnace() -> Vec<u8> {
+    let mut s = Scene { name: "furnace".into(), ..Default::default() };
+    let mut wall = lambert_material([0.0; 3]);
+    wall.emission = [LE; 3];
+    s.materials.push(Material { name: "glow".into(), gpu: wall });
+    let metal = kiln_format::sections::GpuMaterial {
+        base_color: [1.0; 4],
+        metallic: 1.0,
+        roughness: 0.5,
+        ..Default::default()
+    };
+    s.materials.push(Material { name: "metal".into(), gpu: metal });
+    cuboid(&mut s, Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 2.0, 1.0), 0, true);
+    let y = 0.01;
+    quad(
+        &mut s,
+        [Vec3::new(-0.9, y, 0.9), Vec3::new(0.9, y, 0.9), Vec3::new(0.9, y, -0.9), Vec3::new(-0.9, y, -0.9)],
+        1,
+    );
+    let settings = Settings {
+        probes: kiln_compiler::settings::Probes::Auto,
+        probe_spacing: Some(ProbeSpacing(0.5)),
+        probe_rays: 256,
+        ..fast_settings()
+    };
+    compile(s, settings)
+}
+
+const LE: f32 = 0.75;
+
+#[test]
+fn probes_light_glossy_metal_by_what_it_mirrors() {
+    let dir = gpu_test!();
+    let bytes = furnace();
+    // Looking down at the floor's middle from a little aside, so that the mirror direction is
+    // not the wall straight above only.
+    let camera =
+        CameraOverride { position: [0.3, 1.0, 0.2], target: [0.0, 0.0, 0.0], vfov_degrees: Some(20.0) };
+    let (floor, _) = render(dir.path(), "furnace", &bytes, |f| probes(f, camera));
+    let floor = mean(&floor);
+    eprintln!("metal floor {floor:.4} against Le {LE}");
+    assert!((floor - f64::from(LE)).abs() <= 0.03 * f64::from(LE), "the metal floor {floor} against Le {LE}");
 }

@@ -512,6 +512,10 @@ impl FrameFlags {
     /// (`--direct`): the composition adds it, and the GI pass leaves out the emission its first
     /// rays hit, so that every path counts once.
     pub const RT_DIRECT: u32 = 1 << 8;
+    /// The probes' irradiance along each pixel's mirror direction in the probe-specular image
+    /// (`--gi probes`): the split sum's incoming radiance where no reflection was traced or seen
+    /// on screen, in place of the sky's (shaped by the environment's own sharpness there).
+    pub const PROBE_SPECULAR: u32 = 1 << 9;
 }
 
 /// Shadow maps of each kind (2D and cube) the direct-light pass can bind: the length of its
@@ -608,6 +612,7 @@ pub fn glsl_layout() -> String {
         ("FRAME_SCREEN_GI", FrameFlags::SCREEN_GI),
         ("FRAME_SCREEN_REFLECTIONS", FrameFlags::SCREEN_REFLECTIONS),
         ("FRAME_RT_DIRECT", FrameFlags::RT_DIRECT),
+        ("FRAME_PROBE_SPECULAR", FrameFlags::PROBE_SPECULAR),
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),

@@ -84,9 +84,16 @@ pub struct Args {
     /// time are marked, and the exit code is 6.
     #[arg(long, value_name = "OLD.json")]
     pub compare: Option<PathBuf>,
-    /// Also write every measured image and the reference as EXR into OUT/images/.
+    /// Also write every measured image and the reference as EXR into OUT/images/, each measured
+    /// image with its per-pixel HDR-FLIP as a heat-map PNG (`...-flip.png`).
     #[arg(long)]
     pub keep_images: bool,
+    /// Compare two EXR images instead of sweeping: REFERENCE.exr IMAGE.exr. Prints the mean
+    /// HDR-FLIP, relMSE and RMSE that kiln-bench measures and writes the per-pixel HDR-FLIP as a
+    /// heat map to OUT/flip.png (black none, then red, yellow, white). Renders from
+    /// `kiln-play --headless -o X.exr` and `kiln-play --reference -o X.exr` compare directly.
+    #[arg(long, num_args = 2, value_names = ["REFERENCE.exr", "IMAGE.exr"], conflicts_with_all = ["file", "replot", "compare", "json"])]
+    pub diff: Option<Vec<PathBuf>>,
     /// Measure every combination of every technique's quality knobs. By default each knob is
     /// varied alone around the defaults, then the combinations of the values the chart's Pareto
     /// front shows are measured (at most 8 more per technique): the default sweep stays minutes
@@ -194,6 +201,10 @@ pub fn run(args: Args) -> PlayResult {
     if args.list {
         print!("{}", list());
         return Ok(());
+    }
+    if let Some(files) = &args.diff {
+        super::report::create_dir(&args.out)?;
+        return super::diff::run(&files[0], &files[1], Some(&args.out.join("flip.png")));
     }
     // Read the old results first: a typo in the path should not cost a whole sweep.
     let old = args.compare.as_deref().map(read_results).transpose()?;

@@ -10,6 +10,7 @@
 
 pub mod budget;
 pub mod cli;
+pub mod diff;
 pub mod measure;
 pub mod plan;
 pub mod report;
@@ -260,28 +261,21 @@ fn points_of(
             continue;
         }
         let label = config.label(*frames);
-        let error: Figures =
-            match kiln_metrics::compare(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
-                Ok(e) => e.into(),
-                Err(e) => {
-                    failures.push(Skipped {
-                        effect: config.target.name().into(),
-                        technique: label,
-                        reason: format!("cannot be measured: {e}"),
-                    });
-                    continue;
-                }
-            };
+        let (error, flip_map) = match diff::measure(w, h, &reference.rgb, rgb) {
+            Ok((e, map)) => (Figures::from(e), map),
+            Err(e) => {
+                failures.push(Skipped {
+                    effect: config.target.name().into(),
+                    technique: label,
+                    reason: format!("cannot be measured: {e}"),
+                });
+                continue;
+            }
+        };
         if options.keep_images {
-            report::keep_image(
-                &options.out,
-                camera,
-                &format!("{}-{label}", config.target),
-                w,
-                h,
-                rgb,
-                *frames,
-            )?;
+            let what = format!("{}-{label}", config.target);
+            report::keep_image(&options.out, camera, &what, w, h, rgb, *frames)?;
+            report::keep_error_map(&options.out, camera, &what, w, h, &flip_map)?;
         }
         points.push(Point {
             effect: config.target.name().into(),

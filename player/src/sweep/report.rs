@@ -39,15 +39,39 @@ pub fn keep_image(
 ) -> PlayResult {
     let dir = out.join("images");
     create_dir(&dir)?;
-    let camera = if camera == "file" { "file".to_string() } else { format!("cam{:08x}", short_hash(camera)) };
-    write_exr(&dir.join(file_name(&[&camera, what], "exr")), width, height, rgb, count)
+    write_exr(&dir.join(file_name(&[&camera_label(camera), what], "exr")), width, height, rgb, count)
+}
+
+/// Writes the per-pixel HDR-FLIP of a measured image beside it, as `...-flip.png` (a heat map:
+/// black no error, red, yellow, white the largest).
+pub fn keep_error_map(
+    out: &Path,
+    camera: &str,
+    what: &str,
+    width: u32,
+    height: u32,
+    map: &[f32],
+) -> PlayResult {
+    let dir = out.join("images");
+    create_dir(&dir)?;
+    super::diff::write_map(
+        &dir.join(file_name(&[&camera_label(camera), what, "flip"], "png")),
+        width,
+        height,
+        map,
+    )
+}
+
+fn camera_label(camera: &str) -> String {
+    if camera == "file" { "file".to_string() } else { format!("cam{:08x}", short_hash(camera)) }
 }
 
 fn short_hash(s: &str) -> u32 {
     xxhash_rust::xxh3::xxh3_64(s.as_bytes()) as u32
 }
 
-fn create_dir(dir: &Path) -> PlayResult {
+/// Creates a folder and its parents, or says which could not be.
+pub fn create_dir(dir: &Path) -> PlayResult {
     std::fs::create_dir_all(dir)
         .map_err(|e| PlayError::new(Exit::Io, format!("{}: cannot create the folder: {e}", dir.display())))
 }

@@ -9,7 +9,7 @@ use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, ao, rt_direct, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared, ao, probes, rt_direct, rt_gi, rt_reflections, rt_shadows};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -39,7 +39,7 @@ pub enum SpecInput {
 
 /// The inputs of `direct.comp`'s specialization constants, by id from 1 (`DIRECT_*` there; each
 /// a bool defaulting to true, so that a pipeline made without constants has every path).
-pub const SPEC_INPUTS: [(SpecInput, &str); 8] = [
+pub const SPEC_INPUTS: [(SpecInput, &str); 9] = [
     (SpecInput::Flag(FrameFlags::RT_SHADOWS), "DIRECT_RT_SHADOWS"),
     (SpecInput::Flag(FrameFlags::RT_AO), "DIRECT_AO"),
     (SpecInput::Flag(FrameFlags::RT_REFLECTIONS), "DIRECT_RT_REFLECTIONS"),
@@ -48,24 +48,27 @@ pub const SPEC_INPUTS: [(SpecInput, &str); 8] = [
     (SpecInput::Media, "DIRECT_MEDIA"),
     (SpecInput::RectLights, "DIRECT_RECT_LIGHTS"),
     (SpecInput::Flag(FrameFlags::RT_DIRECT), "DIRECT_EMISSIVE"),
+    (SpecInput::Flag(FrameFlags::PROBE_SPECULAR), "DIRECT_PROBE_SPECULAR"),
 ];
 
 /// The G-buffer targets it samples, in binding order (6–10).
 const GBUFFER: [TargetDecl; 5] = [DEPTH, NORMAL, ALBEDO, MATERIAL, EMISSION];
 
-/// The ray-traced results it composites and their bindings (the media table takes 16).
-const RAY_TRACED: [(TargetDecl, u32); 5] = [
+/// The ray-traced (and probe) results it composites and their bindings (the media table takes
+/// 16, the environment 18–19).
+const RAY_TRACED: [(TargetDecl, u32); 6] = [
     (rt_shadows::SHADOWS, 12),
     (ao::AO, 13),
     (rt_reflections::REFLECTIONS, 14),
     (rt_gi::GI, 15),
     (rt_direct::DIRECT, 17),
+    (probes::SPECULAR, 20),
 ];
 
 /// The direct-light pass: its kernel and the ray-traced images it reads, by binding (each
 /// signal's denoised image where the denoiser filters it).
 #[derive(Debug)]
-pub struct DirectPass(Kernel, [(TargetDecl, u32); 5]);
+pub struct DirectPass(Kernel, [(TargetDecl, u32); 6]);
 
 impl DirectPass {
     /// Builds the pipeline, specialised for `techniques` (and rect lights or none): the code for
@@ -116,6 +119,7 @@ impl DirectPass {
         bindings.push(Binding::one(Storage));
         bindings.push(Binding::one(StorageImage));
         bindings.extend([Binding::one(Storage); 2]);
+        bindings.push(Binding::one(StorageImage));
         bindings
     }
 }
@@ -205,16 +209,24 @@ mod tests {
             | FrameFlags::RT_GI
             | FrameFlags::SCREEN_GI
             | FrameFlags::SCREEN_REFLECTIONS
-            | FrameFlags::RT_DIRECT;
-        assert_eq!(DirectPass::constants(all, true, true), [0, 1, 1, 1, 1, 1, 1, 1, 1]);
-        assert_eq!(DirectPass::constants(0, false, false), [0; 9]);
-        assert_eq!(DirectPass::constants(FrameFlags::SCREEN_GI, false, true), [0, 0, 0, 0, 1, 0, 0, 1, 0]);
-        assert_eq!(DirectPass::constants(FrameFlags::RT_GI, true, false), [0, 0, 0, 0, 1, 0, 1, 0, 0]);
-        assert_eq!(DirectPass::constants(FrameFlags::RT_DIRECT, false, false), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
+            | FrameFlags::RT_DIRECT
+            | FrameFlags::PROBE_SPECULAR;
+        assert_eq!(DirectPass::constants(all, true, true), [0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
+        assert_eq!(DirectPass::constants(0, false, false), [0; 10]);
+        assert_eq!(DirectPass::constants(FrameFlags::SCREEN_GI, false, true), [0, 0, 0, 0, 1, 0, 0, 1, 0, 0]);
+        assert_eq!(DirectPass::constants(FrameFlags::RT_GI, true, false), [0, 0, 0, 0, 1, 0, 1, 0, 0, 0]);
+        assert_eq!(
+            DirectPass::constants(FrameFlags::RT_DIRECT, false, false),
+            [0, 0, 0, 0, 0, 0, 0, 0, 1, 0]
+        );
+        assert_eq!(
+            DirectPass::constants(FrameFlags::RT_GI | FrameFlags::PROBE_SPECULAR, false, false),
+            [0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+        );
         let defaults = Techniques::default().flags();
         assert_eq!(
             DirectPass::constants(defaults, false, false),
-            [0, 0, 0, 0, 0, 0, 0, 0, 1],
+            [0, 0, 0, 0, 0, 0, 0, 0, 1, 0],
             "default flags {defaults:#x}"
         );
     }

@@ -5,7 +5,9 @@
 //! mean incoming radiance in place of the sky's ambient, as the ray-traced GI does
 //! (`FrameFlags::RT_GI`). Deterministic, no history: the image is overwritten every frame. The
 //! irradiance's emitted layer (emissive surfaces seen directly) is added only when the frame
-//! has no direct light of emissive surfaces (`--direct none`).
+//! has no direct light of emissive surfaces (`--direct none`). With the same weights it writes
+//! the irradiance along each pixel's mirror direction ([`SPECULAR`]), the split sum's incoming
+//! radiance where no reflection is traced or seen on screen (`FrameFlags::PROBE_SPECULAR`).
 
 use kiln_format::gpu::ProbeConstants;
 
@@ -14,9 +16,18 @@ use super::kernel::Kernel;
 use super::rt_gi::GI;
 use super::{FrameCtx, Pass, Shared};
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
+use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write, vk};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
+
+/// The probes' irradiance along each pixel's mirror direction (rgb; half floats: it lights
+/// glossy surfaces, whose error the filtering already dwarfs).
+pub const SPECULAR: TargetDecl = TargetDecl {
+    name: "probe specular",
+    format: vk::Format::R16G16B16A16_SFLOAT,
+    usage: vk::ImageUsageFlags::STORAGE,
+    array: false,
+};
 
 /// The G-buffer targets it samples, in binding order (1–2).
 const GBUFFER: [TargetDecl; 2] = [DEPTH, NORMAL];
@@ -43,6 +54,7 @@ impl ProbesPass {
             Binding::one(Sampled),
             Binding::one(Storage),
             Binding::one(StorageImage),
+            Binding::one(StorageImage),
         ];
         let push = std::mem::size_of::<ProbeConstants>() as u32;
         let kernel = Kernel::new(gpu, &bindings, spirv::shader!("probes/gi.comp"), push)?;
@@ -56,7 +68,7 @@ impl Pass for ProbesPass {
     }
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
-        vec![(GI, GI.sized(width, height, 1))]
+        vec![(GI, GI.sized(width, height, 1)), (SPECULAR, SPECULAR.sized(width, height, 1))]
     }
 
     fn binds(&self) -> Vec<TargetDecl> {
@@ -79,6 +91,7 @@ impl Pass for ProbesPass {
             Write::Sampled(4, vec![(probes.visibility.view, scene.linear_clamp)]),
             Write::Buffer(5, &probes.states),
             Write::StorageImage(6, img(&GI)),
+            Write::StorageImage(7, img(&SPECULAR)),
         ]);
         self.kernel.write(gpu, &writes)
     }
@@ -86,6 +99,7 @@ impl Pass for ProbesPass {
     fn record(&mut self, ctx: &mut FrameCtx) {
         let mut io = super::gbuffer::sampled(&GBUFFER);
         io.push((GI, Access::Write(Use::STORAGE)));
+        io.push((SPECULAR, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
         let push = bytemuck::bytes_of(&self.constants);
         self.kernel.dispatch(ctx.rec, push, ctx.images.width, ctx.images.height);

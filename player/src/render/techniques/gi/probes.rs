@@ -23,7 +23,9 @@ impl Registered for Probes {
     const NAME: &'static str = "probes";
     const HELP: &'static str = "the compiler's irradiance probes (path traced at every bounce): the eight probes around \
                                 each pixel's surface, weighted trilinearly, by the normal and by a Chebyshev visibility \
-                                test against light leaking through walls; replaces the sky's diffuse ambient and its AO. \
+                                test against light leaking through walls; replaces the sky's diffuse ambient and its AO, \
+                                and the sky in glossy reflections that are not traced or seen on screen (the probes' \
+                                irradiance along the mirror direction). \
                                 No rays at run time (needs a file compiled with probes: kiln compile bakes them unless \
                                 --probes off). Emissive surfaces' direct light comes from the probes only with \
                                 --direct none";
@@ -59,7 +61,7 @@ impl Technique for Probes {
     }
 
     fn flags(&self) -> u32 {
-        kiln_format::gpu::FrameFlags::RT_GI
+        kiln_format::gpu::FrameFlags::RT_GI | kiln_format::gpu::FrameFlags::PROBE_SPECULAR
     }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
