@@ -6,7 +6,9 @@
 //!   Normal maps are not applied at bake time.
 //! - **BRDF**: `DIFFUSE_ONLY` materials are Lambertian, `base / π`. Others: Cook–Torrance with
 //!   GGX (α = roughness²), Smith height-correlated visibility, Schlick Fresnel with
-//!   F0 = lerp(0.04, base, metalness), plus diffuse `(1 − F)(1 − metalness) base / π`; the specular
+//!   F0 = lerp(F0_d, base, metalness) and F90 = lerp(F90_d, 1, metalness), where the dielectric's
+//!   F0_d and F90_d are glTF's core 0.04 and 1 unless `KHR_materials_ior`/`specular` set them
+//!   ([`GpuMaterial::dielectric`]), plus diffuse `(1 − F)(1 − metalness) base / π`; the specular
 //!   lobe is scaled by `1 + F0 (1 / E − 1)` with E = R + G from the BRDF table at (n·v, roughness):
 //!   multiple-scattering energy compensation (Fdez-Agüera 2019).
 //! - **Lights** (units as in the sidecar): point: `I / d²`; spot: the same times
@@ -98,6 +100,8 @@ pub struct Surface {
     pub emission: Vec3,
     /// Lambertian only.
     pub diffuse_only: bool,
+    /// The dielectric part's F0 (RGB) and F90.
+    pub dielectric: (Vec3, f32),
 }
 
 impl ShadingScene<'_> {
@@ -124,6 +128,10 @@ impl ShadingScene<'_> {
             roughness: roughness.clamp(0.0, 1.0),
             emission,
             diffuse_only: g.flags & MaterialFlags::DIFFUSE_ONLY != 0,
+            dielectric: {
+                let (f0, f90) = g.dielectric();
+                (Vec3::from(f0), f90)
+            },
         }
     }
 
@@ -160,8 +168,9 @@ impl ShadingScene<'_> {
         let d = a2 / (std::f32::consts::PI * (n_h * n_h * (a2 - 1.0) + 1.0).powi(2));
         let vis =
             0.5 / (n_l * (n_v * n_v * (1.0 - a2) + a2).sqrt() + n_v * (n_l * n_l * (1.0 - a2) + a2).sqrt());
-        let f0 = Vec3::splat(0.04).lerp(s.base, s.metallic);
-        let f = f0 + (Vec3::ONE - f0) * (1.0 - v_h).powi(5);
+        let f0 = s.dielectric.0.lerp(s.base, s.metallic);
+        let f90 = Vec3::splat(s.dielectric.1 + (1.0 - s.dielectric.1) * s.metallic);
+        let f = f0 + (f90 - f0) * (1.0 - v_h).powi(5);
         let compensation = Vec3::ONE + f0 * (1.0 / self.directional_albedo(n_v, s.roughness) - 1.0);
         let specular = f * (d * vis) * compensation;
         (Vec3::ONE - f) * (1.0 - s.metallic) * lambert + specular

@@ -258,6 +258,40 @@ fn unphysical_material_factors_are_clamped_with_warnings() {
 }
 
 #[test]
+fn unphysical_ior_and_specular_are_clamped_with_warnings() {
+    let d = tempfile::tempdir().unwrap();
+    let f = quad_with(|g| {
+        g.json["extensionsUsed"] = json!(["KHR_materials_ior", "KHR_materials_specular"]);
+        g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
+        g.json["materials"] = json!([{
+            "name": "odd",
+            "extensions": {
+                "KHR_materials_ior": {"ior": -2.0},
+                "KHR_materials_specular": {"specularFactor": 1.5, "specularColorFactor": [-1.0, 2.0, 1.0]},
+            },
+        }]);
+    })
+    .write(d.path(), "odd");
+    compile(d.path(), &f, &[])
+        .expect(0)
+        .says("material 'odd': KHR_materials_ior.ior -2 is below 1; clamped to 1")
+        .says("material 'odd': KHR_materials_specular.specularFactor 1.5 is outside [0, 1]; clamped to 1")
+        .says("material 'odd': KHR_materials_specular.specularColorFactor [-1.0, 2.0, 1.0] is negative; clamped to [0.0, 2.0, 1.0]");
+    // ior 1 after clamping: no reflection at normal incidence, F90 the clamped factor.
+    let s = kiln_compiler::import::import(&f).unwrap();
+    assert_eq!(s.materials[0].gpu.dielectric(), ([0.0; 3], 1.0));
+    // ior 0, which the specification allows: F0 = 1 (times the colour, at most 1).
+    let zero = quad_with(|g| {
+        g.json["extensionsUsed"] = json!(["KHR_materials_ior"]);
+        g.json["meshes"][0]["primitives"][0]["material"] = 0.into();
+        g.json["materials"] = json!([{"name": "zero", "extensions": {"KHR_materials_ior": {"ior": 0.0}}}]);
+    })
+    .write(d.path(), "zero");
+    let s = kiln_compiler::import::import(&zero).unwrap();
+    assert_eq!(s.materials[0].gpu.dielectric(), ([1.0; 3], 1.0));
+}
+
+#[test]
 fn malformed_morph_target_tangents() {
     // TANGENT targets are not applied, but reading the targets built an iterator over them: an
     // empty accessor underflowed `count - 1` inside the gltf crate.

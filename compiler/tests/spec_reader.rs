@@ -1023,9 +1023,15 @@ fn agree(name: &str, bytes: &[u8]) -> String {
                 m.emissive_texture,
                 m.flags,
             ],
-            [0, 0],
+            // Format 1.7: zero unless flag bit 4 says they hold the dielectric's F0 and F90.
+            if m.flags & 16 == 0 { [0, 0] } else { m.specular },
         );
         assert_eq!(mine, theirs, "{name}: material {i}");
+        if m.flags & 16 != 0 {
+            // Four IEEE halves in [0, 1]: sign clear, exponent at most 15 (1.0 = 0x3C00).
+            let halves = [mine.4[0] & 0xFFFF, mine.4[0] >> 16, mine.4[1] & 0xFFFF, mine.4[1] >> 16];
+            assert!(halves.iter().all(|&h| h <= 0x3C00), "{name}: material {i} F0/F90 halves {halves:x?}");
+        }
     }
     // The BVH: node fields at the spec's offsets, then the tree and its boxes.
     let nodes = decode_bvh(&f);

@@ -214,10 +214,19 @@ impl<'a> SceneView<'a> {
                     "material {i} uses texture {t} but there are {nt} textures"
                 )));
             }
-            if m.flags & !MaterialFlags::ALL != 0 || m.alpha_mode().is_none() || m.reserved != [0; 2] {
+            if m.flags & !MaterialFlags::ALL != 0 || m.alpha_mode().is_none() {
                 return Err(FormatError::invalid(format!(
                     "material {i} has undefined flag bits {:#x}",
                     m.flags
+                )));
+            }
+            let (f0, f90) = m.dielectric();
+            let unit = |v: &f32| (0.0..=1.0).contains(v);
+            if (m.flags & MaterialFlags::SPECULAR == 0 && m.specular != [0; 2])
+                || !f0.iter().chain([&f90]).all(unit)
+            {
+                return Err(FormatError::invalid(format!(
+                    "material {i}'s dielectric reflectance is not four halves in [0, 1] (F0 {f0:?}, F90 {f90})"
                 )));
             }
         }

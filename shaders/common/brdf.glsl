@@ -14,7 +14,13 @@ struct Material {
     float metallic;
     float roughness;  // perceptual; alpha = roughness²
     bool diffuse_only;
+    vec3 f0;          // the dielectric part's Schlick reflectance at normal incidence (glTF core 0.04)
+    float f90;        // … at grazing incidence (glTF core 1; KHR_materials_specular's factor)
 };
+
+// glTF's core dielectric reflectance (an index of refraction of 1.5), without
+// KHR_materials_ior/specular.
+const vec3 DIELECTRIC_F0 = vec3(0.04);
 
 // GGX alpha of a perceptual roughness, kept away from 0 (a perfect mirror's delta lobe).
 float ggx_alpha(float roughness) {
@@ -43,14 +49,20 @@ float smith_visibility(float n_l, float n_v, float a2) {
     return 0.5 / (n_l * sqrt(n_v * n_v * (1.0 - a2) + a2) + n_v * sqrt(n_l * n_l * (1.0 - a2) + a2));
 }
 
-// Reflectance at normal incidence: 4 % for dielectrics, the base colour for metals.
-vec3 fresnel_f0(vec3 base, float metallic) {
-    return mix(vec3(0.04), base, metallic);
+// Reflectance at normal incidence: the dielectric's F0 (4 % in glTF's core), the base colour for
+// metals.
+vec3 fresnel_f0(Material m) {
+    return mix(m.f0, m.base, m.metallic);
+}
+
+// Reflectance at grazing incidence: the dielectric's F90 (1 in glTF's core), 1 for metals.
+vec3 fresnel_f90(Material m) {
+    return vec3(mix(m.f90, 1.0, m.metallic));
 }
 
 // Schlick's Fresnel at the cosine `c` between the view (or light) direction and the half vector.
-vec3 fresnel_schlick(vec3 f0, float c) {
-    return f0 + (vec3(1.0) - f0) * pow(1.0 - c, 5.0);
+vec3 fresnel_schlick(vec3 f0, vec3 f90, float c) {
+    return f0 + (f90 - f0) * pow(1.0 - c, 5.0);
 }
 
 // Lambert: the diffuse BRDF of albedo `base`.
@@ -69,7 +81,8 @@ float directional_albedo(sampler2D lut, float lut_res, float n_v, float roughnes
 }
 
 // f(l, v): Lambert for diffuse-only materials; otherwise Cook–Torrance GGX with height-correlated
-// Smith visibility and Schlick Fresnel, F0 = mix(0.04, base, metallic), diffuse (1 − F)(1 − metallic)
+// Smith visibility and Schlick Fresnel, F0 = mix(m.f0, base, metallic) (m.f0 0.04 in glTF's core), F90
+// = mix(m.f90, 1, metallic), diffuse (1 − F)(1 − metallic)
 // base / π, specular scaled by 1 + F0 (1 / E − 1).
 vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
     vec3 diffuse = lambert(m.base);
@@ -85,8 +98,8 @@ vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
     float a2 = alpha * alpha;
     float d = ggx_d(n_h, a2);
     float vis = smith_visibility(n_l, n_v, a2);
-    vec3 f0 = fresnel_f0(m.base, m.metallic);
-    vec3 f = fresnel_schlick(f0, v_h);
+    vec3 f0 = fresnel_f0(m);
+    vec3 f = fresnel_schlick(f0, fresnel_f90(m), v_h);
     vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
     return (vec3(1.0) - f) * (1.0 - m.metallic) * diffuse + f * (d * vis) * compensation;
 }

@@ -58,7 +58,7 @@ struct GpuMaterialLayout {
     uint occlusion_texture; // offset 60
     uint emissive_texture; // offset 64
     uint flags; // offset 68
-    uvec2 reserved; // offset 72
+    uvec2 specular; // offset 72
 }; // 80 bytes
 
 struct ReferenceConstants {
@@ -245,6 +245,7 @@ const uint FRAME_PROBE_SPECULAR = 512u;
 const uint MATERIAL_DOUBLE_SIDED = 1u;
 const uint MATERIAL_ALPHA_SHIFT = 1u;
 const uint MATERIAL_DIFFUSE_ONLY = 8u;
+const uint MATERIAL_SPECULAR = 16u;
 const uint NO_TEXTURE = 4294967295u;
 const uint EMITTER_LIGHT = 0u;
 const uint EMITTER_TRIANGLE = 1u;

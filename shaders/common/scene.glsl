@@ -11,6 +11,7 @@
 #define KILN_SCENE_GLSL
 
 #include "brdf.glsl"
+#include "dielectric.glsl"
 #include "lights.glsl"
 #include "textures.glsl"
 #include "vertices.glsl"
@@ -83,6 +84,7 @@ void surface_textured(inout Surface s, GpuMaterialLayout m, vec4 texel[MATERIAL_
     s.mat.metallic = clamp(m.metallic * mr.b, 0.0, 1.0);
     s.mat.roughness = clamp(m.roughness * mr.g, 0.0, 1.0);
     s.mat.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    material_dielectric(m, s.mat.f0, s.mat.f90);
     vec3 e = m.emission * texel[SLOT_EMISSIVE].rgb;
     bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
     s.emission = (s.front || double_sided) ? e : vec3(0.0);
@@ -180,7 +182,7 @@ vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
     float a2 = a * a;
     float d = ggx_d(max(dot(s.ns, h), 0.0), a2);
     float vis = smith_visibility(n_l, n_v, a2);
-    vec3 f = fresnel_schlick(fresnel_f0(s.mat.base, s.mat.metallic), max(dot(wo, h), 0.0));
+    vec3 f = fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), max(dot(wo, h), 0.0));
     // Lambert's base / π, divided after the weights (not lambert(base) times them): the order the
     // reference images were made with; it rounds differently.
     return ((1.0 - f) * (1.0 - s.mat.metallic) * s.mat.base / PI + f * d * vis) * n_l;
@@ -191,7 +193,7 @@ float specular_probability(Surface s, vec3 wo) {
     if (s.mat.diffuse_only) {
         return 0.0;
     }
-    float fresnel = luminance(fresnel_schlick(fresnel_f0(s.mat.base, s.mat.metallic), clamp(dot(s.ns, wo), 0.0, 1.0)));
+    float fresnel = luminance(fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), clamp(dot(s.ns, wo), 0.0, 1.0)));
     float diffuse = luminance(s.mat.base) * (1.0 - s.mat.metallic) * (1.0 - fresnel);
     return clamp(fresnel / max(fresnel + diffuse, 1e-6), 0.05, 0.95);
 }

@@ -3,13 +3,14 @@
 //   0 normal    RG16_SNORM  octahedral shading normal (normal map applied), world space
 //   1 albedo    RGBA8_UNORM base colour, sRGB-encoded here (an SRGB format cannot be a storage
 //                           image, and the visibility-buffer resolve writes the same targets)
-//   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag, occlusion
+//   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag or dielectric F0 (common/dielectric.glsl), occlusion
 //   3 emission  RGBA16F     emitted radiance
 //   4 triangle  R32_UINT    1 + the triangle's index in the index buffer (0: nothing drawn); the
 //                           ray-traced passes rebuild the exact surface point from it
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 #include "../common/normalmap.glsl"
+#include "../common/dielectric.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 1, binding = 0) uniform sampler2D base_color_tex;
@@ -17,7 +18,7 @@ layout(set = 1, binding = 1) uniform sampler2D metallic_roughness_tex;
 layout(set = 1, binding = 2) uniform sampler2D normal_tex;
 layout(set = 1, binding = 3) uniform sampler2D occlusion_tex;
 layout(set = 1, binding = 4) uniform sampler2D emissive_tex;
-layout(push_constant) uniform Material { GpuMaterialLayout material; };
+layout(push_constant) uniform MaterialPush { GpuMaterialLayout material; };
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
@@ -69,8 +70,11 @@ void main() {
     }
     bool diffuse_only = (material.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     out_normal = oct_encode(n);
-    out_albedo = vec4(linear_to_srgb(base.rgb), 1.0);
-    out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), diffuse_only ? 1.0 : 0.0, occlusion);
+    vec3 f0;
+    float f90;
+    material_dielectric(material, f0, f90);
+    out_albedo = vec4(linear_to_srgb(base.rgb), f90);
+    out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), gbuffer_specular_code(diffuse_only, f0), occlusion);
     out_emission = vec4(emission, 1.0);
     out_triangle = in_first_triangle + uint(gl_PrimitiveID) + 1u;
 }

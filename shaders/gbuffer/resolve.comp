@@ -8,6 +8,7 @@
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 #include "../common/normalmap.glsl"
+#include "../common/dielectric.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -91,7 +92,10 @@ void main() {
     vec3 emission = m.emission * texel[SLOT_EMISSIVE].rgb;
     bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     imageStore(out_normal, pixel, vec4(oct_encode(n), 0.0, 0.0));
-    imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), 1.0));
-    imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), diffuse_only ? 1.0 : 0.0, occlusion));
+    vec3 f0;
+    float f90;
+    material_dielectric(m, f0, f90);
+    imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), f90));
+    imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), gbuffer_specular_code(diffuse_only, f0), occlusion));
     imageStore(out_emission, pixel, vec4(emission, 1.0));
 }

@@ -12,6 +12,7 @@
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 #include "../common/brdf.glsl"
+#include "../common/dielectric.glsl"
 #include "../common/lights.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -241,7 +242,7 @@ void main() {
     vec3 p = world_at(pixel, depth);
     vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
     vec4 mat = texelFetch(g_material, pixel, 0);
-    Material m = Material(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
+    Material m = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
     vec3 v = towards_camera(p);
     if (dot(n, v) < 0.0) {
         n = -n;
@@ -282,9 +283,9 @@ void main() {
         radiance += m.base * diffuse_in;
     } else {
         vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.roughness)).rg : vec2(1.0, 0.0);
-        vec3 f0 = fresnel_f0(m.base, m.metallic);
+        vec3 f0 = fresnel_f0(m);
         vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-        vec3 diffuse = (vec3(1.0) - (f0 * rg.r + rg.g)) * (1.0 - m.metallic) * m.base;
+        vec3 diffuse = (vec3(1.0) - (f0 * rg.r + fresnel_f90(m) * rg.g)) * (1.0 - m.metallic) * m.base;
         radiance += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
@@ -309,7 +310,7 @@ void main() {
             vec4 screen = imageLoad(rt_reflections, pixel);
             sky_in = mix(sky_in, screen.rgb, clamp(screen.a, 0.0, 1.0));
         }
-        vec3 split_sum = (f0 * rg.r + rg.g) * sky_in;
+        vec3 split_sum = (f0 * rg.r + fresnel_f90(m) * rg.g) * sky_in;
         radiance += compensation * (traced.a > 0.0 ? traced.rgb / traced.a : split_sum);
     }
 

@@ -268,7 +268,7 @@ vec3 direct_brdf(Primary s, ivec2 pixel, vec3 wi) {
     surf.p = s.p;
     surf.ng = s.ng;
     surf.ns = s.n;
-    surf.mat = Material(srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb), mat.r, mat.g, mat.b > 0.5);
+    surf.mat = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
     bool traced_specular = (frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !surf.mat.diffuse_only
         && surf.mat.roughness <= rt.max_roughness;
     if (!traced_specular) {
@@ -279,7 +279,7 @@ vec3 direct_brdf(Primary s, ivec2 pixel, vec3 wi) {
         return vec3(0.0);
     }
     vec3 h = normalize(s.v + wi);
-    vec3 f = fresnel_schlick(fresnel_f0(surf.mat.base, surf.mat.metallic), max(dot(s.v, h), 0.0));
+    vec3 f = fresnel_schlick(fresnel_f0(surf.mat), fresnel_f90(surf.mat), max(dot(s.v, h), 0.0));
     return (1.0 - f) * (1.0 - surf.mat.metallic) * surf.mat.base / PI * n_l;
 }
 

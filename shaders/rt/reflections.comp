@@ -25,7 +25,7 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, out vec3 origin) 
     origin = offset_ray_origin(s.p, s.ng);
     vec3 wo = -normalize(r.direction);
     vec3 sum = s.emission;
-    vec3 f0 = fresnel_f0(s.mat.base, s.mat.metallic);
+    vec3 f0 = fresnel_f0(s.mat);
     vec3 diffuse = s.mat.diffuse_only ? s.mat.base : s.mat.base * (1.0 - s.mat.metallic);
     // The sky or environment as unshadowed ambient: diffuse from its irradiance, specular from
     // its level prefiltered for the hit's roughness.
@@ -83,8 +83,8 @@ void main() {
         float roughness = mat.g;
         if (mat.b < 0.5 && roughness <= rt.max_roughness) {
             seed_rng(pixel, 3u);
-            vec3 base = srgb_to_linear(texelFetch(g_albedo, pixel, 0).rgb);
-            vec3 f0 = fresnel_f0(base, mat.r);
+            Material m = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
+            vec3 f0 = fresnel_f0(m);
             float a = ggx_alpha(roughness);
             float a2 = a * a;
             mat3 f = basis(s.n);
@@ -96,7 +96,7 @@ void main() {
                 float n_v = max(dot(s.n, s.v), 1e-4);
                 float lv = smith_lambda(n_v, a2);
                 float weight = (1.0 + lv) / (1.0 + lv + smith_lambda(n_l, a2));
-                vec3 fresnel = fresnel_schlick(f0, clamp(dot(s.v, h), 0.0, 1.0));
+                vec3 fresnel = fresnel_schlick(f0, fresnel_f90(m), clamp(dot(s.v, h), 0.0, 1.0));
                 TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, 3.4e38);
                 TraceHit hit = trace(r, false);
                 vec3 scale = fresnel * weight;

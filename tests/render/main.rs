@@ -28,6 +28,7 @@ mod reproject; // the ray-traced running mean carried along a moving camera, res
 mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipelines agree
 mod screen_ao; // SAO and GTAO: a flat floor unoccluded, an inside corner against the estimator and the closed form
 mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows
+mod specular; // KHR_materials_ior and specular: a black mirror floor under a uniform sky against Schlick's closed form (reference, raster)
 mod ssgi; // screen-space GI: a red wall's bleed onto the floor against its closed form, none from off screen
 mod ssr; // screen-space reflections of an emitter in a mirror floor, the split sum where they leave the screen
 mod streaming; // textures streamed coarse first: the first frame shows the coarse levels, output and bench come from the refined ones

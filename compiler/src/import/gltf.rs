@@ -17,6 +17,7 @@ mod buffers;
 mod checks;
 mod extent;
 mod spec_defaults;
+mod specular;
 mod transmission;
 mod uri;
 
@@ -38,6 +39,8 @@ use uri::{load_uri, short};
 const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_texture_transform",
 ];
@@ -968,6 +971,7 @@ impl Importer<'_> {
         if m.double_sided() {
             gpu.flags |= MaterialFlags::DOUBLE_SIDED;
         }
+        self.dielectric_reflectance(&at, &m, &mut gpu)?;
         // Every texture of the material reads one set of coordinates through one transform (the
         // format stores one set per vertex, with the transform baked in); the first texture's
         // mapping is that of all, and a texture mapped otherwise is named in a warning.
@@ -1037,8 +1041,11 @@ impl Importer<'_> {
         }
         let clamped = v.map(|x| x.clamp(lo, hi));
         if clamped != v {
-            let range =
-                if hi == f32::INFINITY { "negative".to_string() } else { format!("outside [{lo}, {hi}]") };
+            let range = match (lo, hi) {
+                (0.0, f32::INFINITY) => "negative".to_string(),
+                (_, f32::INFINITY) => format!("below {lo}"),
+                _ => format!("outside [{lo}, {hi}]"),
+            };
             self.scene.warn(format!("{at}: {field} {} is {range}; clamped to {}", show(&v), show(&clamped)));
         }
         Ok(clamped)

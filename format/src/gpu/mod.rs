@@ -616,6 +616,7 @@ pub fn glsl_layout() -> String {
         ("MATERIAL_DOUBLE_SIDED", crate::sections::MaterialFlags::DOUBLE_SIDED),
         ("MATERIAL_ALPHA_SHIFT", crate::sections::MaterialFlags::ALPHA_MODE_SHIFT),
         ("MATERIAL_DIFFUSE_ONLY", crate::sections::MaterialFlags::DIFFUSE_ONLY),
+        ("MATERIAL_SPECULAR", crate::sections::MaterialFlags::SPECULAR),
         ("NO_TEXTURE", crate::sections::NO_TEXTURE),
         ("EMITTER_LIGHT", EmitterKinds::LIGHT),
         ("EMITTER_TRIANGLE", EmitterKinds::TRIANGLE),
@@ -716,8 +717,8 @@ gpu_struct! {
         pub emissive_texture: u32 => "uint",
         /// See `GpuMaterial`.
         pub flags: u32 => "uint",
-        /// See `GpuMaterial`.
-        pub reserved: [u32; 2] => "uvec2",
+        /// See `GpuMaterial` (four halves: `dielectric_f0`, `dielectric_f90` in `scene.glsl`).
+        pub specular: [u32; 2] => "uvec2",
     }
 }
 

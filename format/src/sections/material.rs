@@ -30,8 +30,12 @@ impl MaterialFlags {
     pub const ALPHA_MODE_MASK: u32 = 0b11 << 1;
     /// Pure Lambertian diffuse, no specular lobe (OBJ materials with `Ks 0 0 0`).
     pub const DIFFUSE_ONLY: u32 = 1 << 3;
+    /// [`GpuMaterial::specular`] holds the dielectric's own reflectance (glTF
+    /// `KHR_materials_ior`, `KHR_materials_specular`); without it the dielectric reflects as
+    /// glTF's core material does (F0 0.04, F90 1). Format 1.7.
+    pub const SPECULAR: u32 = 1 << 4;
     /// Every flag bit defined in this version.
-    pub const ALL: u32 = Self::DOUBLE_SIDED | Self::ALPHA_MODE_MASK | Self::DIFFUSE_ONLY;
+    pub const ALL: u32 = Self::DOUBLE_SIDED | Self::ALPHA_MODE_MASK | Self::DIFFUSE_ONLY | Self::SPECULAR;
 }
 
 /// A metallic-roughness PBR material. 80 bytes; std430-compatible (vec4, vec3 + float, scalars).
@@ -64,11 +68,18 @@ pub struct GpuMaterial {
     pub emissive_texture: u32,
     /// [`MaterialFlags`].
     pub flags: u32,
-    /// Zero.
-    pub reserved: [u32; 2],
+    /// With [`MaterialFlags::SPECULAR`], the dielectric (non-metal) part's Schlick reflectance
+    /// at normal incidence F0 (linear RGB) and at grazing incidence F90, as four IEEE half floats
+    /// in [0, 1]: F0.r and F0.g in word 0 (low half first), F0.b and F90 in word 1
+    /// ([`GpuMaterial::dielectric`]). Zero without the flag.
+    pub specular: [u32; 2],
 }
 
 const _: () = assert!(size_of::<GpuMaterial>() == 80);
+
+/// glTF's dielectric reflectance at normal incidence without `KHR_materials_ior`/`specular`
+/// (an index of refraction of 1.5).
+pub const DIELECTRIC_F0: [f32; 3] = [0.04; 3];
 
 impl Default for GpuMaterial {
     fn default() -> Self {
@@ -86,7 +97,7 @@ impl Default for GpuMaterial {
             occlusion_texture: NO_TEXTURE,
             emissive_texture: NO_TEXTURE,
             flags: 0,
-            reserved: [0; 2],
+            specular: [0; 2],
         }
     }
 }
@@ -101,6 +112,32 @@ impl GpuMaterial {
             self.occlusion_texture,
             self.emissive_texture,
         ]
+    }
+
+    /// The dielectric's (F0 RGB, F90): glTF's core 0.04 and 1 unless [`MaterialFlags::SPECULAR`]
+    /// says [`GpuMaterial::specular`] holds them.
+    pub fn dielectric(&self) -> ([f32; 3], f32) {
+        if self.flags & MaterialFlags::SPECULAR == 0 {
+            return (DIELECTRIC_F0, 1.0);
+        }
+        let h = |w: u32, high: bool| half::f16::from_bits((if high { w >> 16 } else { w }) as u16).to_f32();
+        let [a, b] = self.specular;
+        ([h(a, false), h(a, true), h(b, false)], h(b, true))
+    }
+
+    /// Stores the dielectric's F0 and F90 (each clamped to [0, 1]; NaN as 0) and sets the flag;
+    /// the core values clear it, so that such materials keep their old bytes.
+    pub fn set_dielectric(&mut self, f0: [f32; 3], f90: f32) {
+        let unit = |v: f32| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        let (f0, f90) = (f0.map(unit), unit(f90));
+        let bits = |v: f32| u32::from(half::f16::from_f32(v).to_bits());
+        if (f0, f90) == (DIELECTRIC_F0, 1.0) {
+            self.flags &= !MaterialFlags::SPECULAR;
+            self.specular = [0; 2];
+        } else {
+            self.flags |= MaterialFlags::SPECULAR;
+            self.specular = [bits(f0[0]) | bits(f0[1]) << 16, bits(f0[2]) | bits(f90) << 16];
+        }
     }
 
     /// The alpha mode, if the bits hold a defined one.

@@ -10,7 +10,7 @@ mod texture;
 
 pub use bvh::{BVH_TRAVERSAL_STACK, CwbvhNode};
 pub use geometry::Vertex;
-pub use material::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE};
+pub use material::{AlphaMode, DIELECTRIC_F0, GpuMaterial, MaterialFlags, NO_TEXTURE};
 pub use texture::{
     PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_texture, encode_texture,
     possible_v2_lengths,

@@ -1,0 +1,53 @@
+// The dielectric part's reflectance (glTF KHR_materials_ior and KHR_materials_specular): read
+// from a material record, and carried through the raster G-buffer.
+//
+// In the record (FORMAT.md, "Materials"): with MATERIAL_SPECULAR, `specular` holds F0 (RGB) and
+// F90 as four half floats; without it glTF's core values, F0 0.04 and F90 1.
+//
+// In the G-buffer, whose targets are 8-bit: the material target's blue channel is 1 for
+// diffuse-only materials (as before) and otherwise k/255 with the grey F0 = (k/125)², k ≤ 125
+// (so that it stays below 0.5, where the passes that only ask "diffuse-only?" look, and 0.04 is
+// exact at k = 25); the albedo target's alpha holds F90. The raster frame thus reflects with
+// the F0's luminance: coloured dielectric F0 (specularColorFactor) is kept by the ray-traced
+// passes and the reference only.
+#ifndef KILN_DIELECTRIC_GLSL
+#define KILN_DIELECTRIC_GLSL
+
+#include "layout.glsl"
+#include "packing.glsl"
+#include "brdf.glsl"
+
+void material_dielectric(GpuMaterialLayout m, out vec3 f0, out float f90) {
+    if ((m.flags & MATERIAL_SPECULAR) != 0u) {
+        vec2 a = unpackHalf2x16(m.specular.x);
+        vec2 b = unpackHalf2x16(m.specular.y);
+        f0 = vec3(a, b.x);
+        f90 = b.y;
+    } else {
+        f0 = DIELECTRIC_F0;
+        f90 = 1.0;
+    }
+}
+
+// The material target's blue channel.
+float gbuffer_specular_code(bool diffuse_only, vec3 f0) {
+    if (diffuse_only) {
+        return 1.0;
+    }
+    return round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0) / 255.0;
+}
+
+// The material at a pixel from the G-buffer's albedo and material texels.
+Material gbuffer_material(vec4 albedo, vec4 mat) {
+    Material m;
+    m.base = srgb_to_linear(albedo.rgb);
+    m.metallic = mat.r;
+    m.roughness = mat.g;
+    m.diffuse_only = mat.b > 0.5;
+    float k = min(round(mat.b * 255.0), 125.0) / 125.0;
+    m.f0 = vec3(k * k);
+    m.f90 = albedo.a;
+    return m;
+}
+
+#endif

@@ -1,0 +1,160 @@
+//! glTF `KHR_materials_ior` and `KHR_materials_specular` from the file to the pixel: a black,
+//! nearly mirror-smooth floor (written here as glTF, imported by the compiler) under a uniform
+//! sky of radiance 1 reflects, towards a camera at angle θ from its normal, exactly Schlick's
+//! F0 + (F90 − F0)(1 − cos θ)⁵ (its diffuse part is black, the sky fills the mirror direction),
+//! with the Khronos specification's F0 = min(((ior − 1)/(ior + 1))² · specularColorFactor, 1) ·
+//! specularFactor and F90 = specularFactor, computed here.
+//!
+//! - The reference path tracer keeps F0's colour: each channel within 3 %.
+//! - The raster frame (the direct pass's split sum) carries F0 through the 8-bit G-buffer as its
+//!   luminance: within 6 % of the closed form with that grey F0 (the split-sum table's
+//!   interpolation and the encoding's steps).
+//!
+//! At 30° from the normal F0 decides; at 75° F90 does. And a file whose material words say
+//! something else than FORMAT.md allows (a half above 1; words without the flag) is refused.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use kiln_format::manifest::Camera;
+use kiln_player::reference::{Sampling, render_with};
+use kiln_test_support::gpu_test;
+use kiln_tests::{Options, compile};
+
+use crate::harness::{fast_settings, render};
+
+const W: u32 = 16;
+const H: u32 = 12;
+const IOR: f64 = 2.0;
+const FACTOR: f64 = 0.8;
+const COLOR: [f64; 3] = [1.0, 0.5, 0.25];
+
+/// The floor's buffer: a 200-unit square at y = 0, facing up (positions, then indices).
+fn floor_bin() -> Vec<u8> {
+    let positions: [f32; 12] =
+        [-100.0, 0.0, 100.0, 100.0, 0.0, 100.0, 100.0, 0.0, -100.0, -100.0, 0.0, -100.0];
+    let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bytes: Vec<u8> = positions.iter().flat_map(|v| v.to_le_bytes()).collect();
+    bytes.extend(indices.iter().flat_map(|v| v.to_le_bytes()));
+    bytes
+}
+
+/// The floor's glTF: black, roughness 0.05, the extensions' ior and specular.
+fn floor_gltf() -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},
+  "extensionsUsed":["KHR_materials_ior","KHR_materials_specular"],
+  "scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+  "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"material":0}}]}}],
+  "materials":[{{"pbrMetallicRoughness":{{"baseColorFactor":[0,0,0,1],"metallicFactor":0,"roughnessFactor":0.05}},
+    "extensions":{{"KHR_materials_ior":{{"ior":{IOR}}},
+      "KHR_materials_specular":{{"specularFactor":{FACTOR},"specularColorFactor":[{},{},{}]}}}}}}],
+  "buffers":[{{"byteLength":60,"uri":"floor.bin"}}],
+  "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":12}}],
+  "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-100,0,-100],"max":[100,0,100]}},
+    {{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}}]}}"#,
+        COLOR[0], COLOR[1], COLOR[2]
+    )
+}
+
+/// Schlick's reflectance at cosine `c`, per channel, for the extensions' F0 and F90.
+fn schlick(c: f64) -> [f64; 3] {
+    let r = ((IOR - 1.0) / (IOR + 1.0)).powi(2);
+    COLOR.map(|k| {
+        let f0 = (r * k).min(1.0) * FACTOR;
+        f0 + (FACTOR - f0) * (1.0 - c).powi(5)
+    })
+}
+
+/// The same with F0's luminance in place of its colour (what the raster G-buffer carries).
+fn schlick_grey(c: f64) -> f64 {
+    let r = ((IOR - 1.0) / (IOR + 1.0)).powi(2);
+    let f0 = COLOR.map(|k| (r * k).min(1.0) * FACTOR);
+    let grey = 0.2126 * f0[0] + 0.7152 * f0[1] + 0.0722 * f0[2];
+    grey + (FACTOR - grey) * (1.0 - c).powi(5)
+}
+
+/// A camera 10 units from the floor's middle at `degrees` from its normal, seeing 1°.
+fn camera(degrees: f64) -> Camera {
+    let t = degrees.to_radians();
+    let p = DVec3::new(0.0, t.cos(), t.sin()) * 10.0;
+    Camera {
+        name: "view".into(),
+        position: p.as_vec3().to_array(),
+        target: [0.0; 3],
+        up: [0.0, 1.0, 0.0],
+        vfov_degrees: 1.0,
+        znear: 0.1,
+        zfar: 100.0,
+    }
+}
+
+/// Mean of each channel.
+fn mean(rgb: &[f32]) -> [f64; 3] {
+    let n = (rgb.len() / 3) as f64;
+    [0, 1, 2].map(|c| rgb.iter().skip(c).step_by(3).map(|&v| f64::from(v)).sum::<f64>() / n)
+}
+
+#[test]
+fn ior_and_specular_set_the_dielectric_fresnel_in_the_reference_and_the_raster_frame() {
+    let dir = gpu_test!();
+    let gltf = dir.path().join("floor.gltf");
+    std::fs::write(&gltf, floor_gltf()).unwrap();
+    std::fs::write(dir.path().join("floor.bin"), floor_bin()).unwrap();
+    for degrees in [30.0, 75.0] {
+        let mut scene = kiln_compiler::import::import(&gltf).expect("the floor imports");
+        scene.sky.radiance = [1.0; 3];
+        scene.cameras = vec![camera(degrees)];
+        let bytes = compile(scene, fast_settings());
+        let name = format!("floor{degrees}");
+        let (raster, _) = render(dir.path(), &name, &bytes, |f| Options::new(f, W, H));
+        let file = dir.path().join(format!("{name}.kiln"));
+        let sampling = Sampling { spp: 32, seed: 1, bounces: 4, progress: false };
+        let o = Options::new(&file, W, H).reference().build();
+        let reference = mean(&render_with(&o, sampling, Instant::now()).expect("reference render").1);
+        let c = degrees.to_radians().cos();
+        let want = schlick(c);
+        let raster = mean(&raster);
+        let grey = schlick_grey(c);
+        eprintln!(
+            "{degrees}°: reference {reference:?}, raster {raster:?}, closed form {want:?} (grey {grey:.4})"
+        );
+        for ch in 0..3 {
+            assert!(
+                (reference[ch] - want[ch]).abs() <= 0.03 * want[ch],
+                "{degrees}°: the reference's channel {ch} {} against Schlick's {}",
+                reference[ch],
+                want[ch]
+            );
+            assert!(
+                (raster[ch] - grey).abs() <= 0.06 * grey,
+                "{degrees}°: the raster frame's channel {ch} {} against Schlick's {grey} (grey F0)",
+                raster[ch]
+            );
+        }
+    }
+}
+
+#[test]
+fn damaged_dielectric_reflectance_is_refused() {
+    use kiln_format::{Checksums, KilnFile, SceneView, sections};
+    let dir = tempfile::tempdir().unwrap();
+    let gltf = dir.path().join("floor.gltf");
+    std::fs::write(&gltf, floor_gltf()).unwrap();
+    std::fs::write(dir.path().join("floor.bin"), floor_bin()).unwrap();
+    let good = compile(kiln_compiler::import::import(&gltf).unwrap(), fast_settings());
+    let check = |b: &[u8]| {
+        let f = KilnFile::from_bytes(b, Checksums::Eager).unwrap();
+        SceneView::new(&f).map(|_| ()).map_err(|e| e.to_string())
+    };
+    assert_eq!(check(&good), Ok(()));
+    // Word 1's high half is F90: 0x4000 is 2.0.
+    let above_one =
+        kiln_tests::rewrite(&good, sections::MATERIALS, |d| d[78..80].copy_from_slice(&[0x00, 0x40]));
+    let e = check(&above_one).expect_err("F90 = 2 accepted");
+    assert!(e.contains("dielectric reflectance"), "{e}");
+    // Clear the flag (bit 4 of the flags at 68), keep the words.
+    let unflagged = kiln_tests::rewrite(&good, sections::MATERIALS, |d| d[68] &= !16);
+    let e = check(&unflagged).expect_err("words without the flag accepted");
+    assert!(e.contains("dielectric reflectance"), "{e}");
+}
