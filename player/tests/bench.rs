@@ -306,6 +306,23 @@ fn reported_errors_are_recomputed_from_the_kept_images() {
     let printed: f64 = text.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or(f64::NAN);
     assert!((printed - flip).abs() <= 1e-4, "--diff printed {text:?}, the sweep {flip}");
     assert!(dir.path().join("flip.png").is_file(), "--diff wrote no map");
+    // A reader that has gone (`kiln-bench --diff A B | head -0`): quiet, no panic.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kiln-bench"))
+        .args([
+            "--diff",
+            reference.to_str().unwrap(),
+            image.to_str().unwrap(),
+            "-o",
+            dir.path().to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked") && o.status.code() != Some(101), "{:?}: {stderr}", o.status);
 }
 
 /// The heat map kept beside a measured image (`...-flip.png`: 0 black, 1/3 red, 2/3 yellow, 1
