@@ -7,7 +7,7 @@ use clap::Parser;
 use kiln_player::sweep::cli::{Args, run};
 
 fn main() -> ExitCode {
-    kiln_player::error::quiet_on_closed_stdout();
+    kiln_player::gpu::process::quiet_on_closed_stdout();
     match run(Args::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -69,16 +69,3 @@ pub fn vk(what: &str, e: crate::gpu::vk::Result) -> PlayError {
     };
     PlayError::new(exit, format!("{what} failed: {e}"))
 }
-
-/// Lets a closed standard output end the process quietly, as it ends a C tool: `kiln-bench
-/// --diff A B | head -1`, `kiln-play --bench … | head`. Rust ignores SIGPIPE, so the next
-/// `println!` after the reader went away would panic with "failed printing to stdout: Broken
-/// pipe" and a backtrace. Called first in `main`.
-pub fn quiet_on_closed_stdout() {
-    #[cfg(unix)]
-    // SAFETY: restores the signal's default disposition before any thread is started; no
-    // handler function is installed.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
-}

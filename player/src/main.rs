@@ -6,7 +6,7 @@ use std::time::Instant;
 use kiln_player::cli::{Invocation, parse_from, run, write_generated};
 
 fn main() -> ExitCode {
-    kiln_player::error::quiet_on_closed_stdout();
+    kiln_player::gpu::process::quiet_on_closed_stdout();
     let start = Instant::now();
     let invocation = match parse_from(std::env::args_os()) {
         Ok(i) => i,

@@ -13,6 +13,7 @@
 
 mod commands;
 mod pipelines;
+pub mod process;
 mod raytracing;
 mod resources;
 mod swapchain;

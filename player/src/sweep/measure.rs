@@ -45,7 +45,7 @@ pub fn measure(
     let result = run(&mut session, &options, checkpoints, timing, &mut tick);
     let warnings = session.warnings.clone();
     let errors = session.close();
-    release_freed_memory();
+    crate::gpu::process::release_freed_memory();
     let mut measured = result?;
     if errors > 0 {
         return Err(PlayError::new(Exit::Gpu, format!("the validation layer reported {errors} error(s)")));
@@ -96,17 +96,4 @@ fn run(
     }
     let passes = names.into_iter().zip(per_pass).map(|(n, v)| stats(n, v)).collect();
     Ok(Measured { images, passes, warnings: Vec::new() })
-}
-
-/// Hands the memory a closed session freed back to the system. Each session's driver threads
-/// (lavapipe starts its own per device) allocate from glibc arenas of their own, which keep
-/// freed memory mapped: a sweep of a few hundred sessions on lavapipe grew to 0.7–1 GB resident
-/// at 64 × 64 (10.7 GB once, with more configurations) with under 100 MB actually allocated
-/// (heaptrack). `malloc_trim` returns every arena's free pages.
-fn release_freed_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: malloc_trim only walks glibc's own arenas; it takes no pointers.
-    unsafe {
-        libc::malloc_trim(0);
-    }
 }
