@@ -264,13 +264,19 @@ pub fn ldr_flip_map(reference: RgbImage, test: RgbImage) -> Result<Vec<f32>, Met
 
 /// Mean HDR-FLIP, relative MSE and RMSE of `test` against `reference`.
 pub fn compare(reference: RgbImage, test: RgbImage) -> Result<Errors, MetricError> {
+    Ok(compare_with_map(reference, test)?.0)
+}
+
+/// [`compare`], with the per-pixel HDR-FLIP whose mean it reports (as [`hdr_flip_map`]).
+pub fn compare_with_map(reference: RgbImage, test: RgbImage) -> Result<(Errors, Vec<f32>), MetricError> {
     validate(&reference, &test)?;
     let map = flip::hdr_flip_map(&flip::Frame::new(&reference), test.pixels);
-    Ok(Errors {
+    let errors = Errors {
         flip: mean(&map),
         rel_mse: rel_mse_unchecked(reference.pixels, test.pixels),
         rmse: mse(reference.pixels, test.pixels).sqrt(),
-    })
+    };
+    Ok((errors, map))
 }
 
 fn mean(map: &[f32]) -> f64 {

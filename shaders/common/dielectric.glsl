@@ -29,12 +29,14 @@ void material_dielectric(GpuMaterialLayout m, out vec3 f0, out float f90) {
     }
 }
 
-// The material target's blue channel.
-float gbuffer_specular_code(bool diffuse_only, vec3 f0) {
-    if (diffuse_only) {
-        return 1.0;
-    }
-    return round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0) / 255.0;
+// What the G-buffer holds of material `m`'s reflectance: x the material target's blue channel
+// (1 diffuse-only, else the coded grey F0), y the albedo target's alpha (F90).
+vec2 gbuffer_dielectric(GpuMaterialLayout m) {
+    vec3 f0;
+    float f90;
+    material_dielectric(m, f0, f90);
+    bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    return vec2(diffuse_only ? 1.0 : round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0) / 255.0, f90);
 }
 
 // The material at a pixel from the G-buffer's albedo and material texels.

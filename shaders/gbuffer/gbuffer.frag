@@ -68,13 +68,10 @@ void main() {
     if (material.emissive_texture != NO_TEXTURE) {
         emission *= texture(emissive_tex, in_uv).rgb;
     }
-    bool diffuse_only = (material.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     out_normal = oct_encode(n);
-    vec3 f0;
-    float f90;
-    material_dielectric(material, f0, f90);
-    out_albedo = vec4(linear_to_srgb(base.rgb), f90);
-    out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), gbuffer_specular_code(diffuse_only, f0), occlusion);
+    vec2 dielectric = gbuffer_dielectric(material);
+    out_albedo = vec4(linear_to_srgb(base.rgb), dielectric.y);
+    out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion);
     out_emission = vec4(emission, 1.0);
     out_triangle = in_first_triangle + uint(gl_PrimitiveID) + 1u;
 }

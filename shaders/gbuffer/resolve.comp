@@ -90,12 +90,9 @@ void main() {
         occlusion = mix(1.0, texel[SLOT_OCCLUSION].r, m.occlusion_strength);
     }
     vec3 emission = m.emission * texel[SLOT_EMISSIVE].rgb;
-    bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     imageStore(out_normal, pixel, vec4(oct_encode(n), 0.0, 0.0));
-    vec3 f0;
-    float f90;
-    material_dielectric(m, f0, f90);
-    imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), f90));
-    imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), gbuffer_specular_code(diffuse_only, f0), occlusion));
+    vec2 dielectric = gbuffer_dielectric(m);
+    imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), dielectric.y));
+    imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion));
     imageStore(out_emission, pixel, vec4(emission, 1.0));
 }

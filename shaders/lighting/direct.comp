@@ -284,22 +284,24 @@ void main() {
     } else {
         vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.roughness)).rg : vec2(1.0, 0.0);
         vec3 f0 = fresnel_f0(m);
+        // The split sum's directional albedo of the lobe: F0 R + F90 G.
+        vec3 lobe = f0 * rg.r + fresnel_f90(m) * rg.g;
         vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-        vec3 diffuse = (vec3(1.0) - (f0 * rg.r + fresnel_f90(m) * rg.g)) * (1.0 - m.metallic) * m.base;
+        vec3 diffuse = (vec3(1.0) - lobe) * (1.0 - m.metallic) * m.base;
         radiance += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
         vec3 mirror = reflect(-v, n);
-        vec3 sky_in = env_filtered(mirror, m.roughness, frame.sky.rgb) * occlusion;
+        vec3 filtered = env_filtered(mirror, m.roughness, frame.sky.rgb);
+        vec3 sky_in = filtered * occlusion;
         if (DIRECT_PROBE_SPECULAR && (frame.size.w & FRAME_PROBE_SPECULAR) != 0u) {
             // The probes hold the light that reaches the surface along the mirror direction, the
             // sky's occluded, the room's indirect; as irradiance (a cosine lobe), so the
             // environment's own prefiltered-to-irradiance ratio there gives back its sharpness
             // (1 under the constant sky), bounded where the irradiance is near black. Like the
             // diffuse GI it replaces the material's occlusion: the probes saw the occluders.
-            const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
-            float spread = dot(env_irradiance(mirror, frame.sky.rgb), LUMA);
-            float sharp = dot(env_filtered(mirror, m.roughness, frame.sky.rgb), LUMA);
+            float spread = luminance(env_irradiance(mirror, frame.sky.rgb));
+            float sharp = luminance(filtered);
             float ratio = spread > 0.0 ? clamp(sharp / spread, 0.0, 8.0) : 1.0;
             sky_in = imageLoad(probe_specular, pixel).rgb * ratio;
         }
@@ -310,7 +312,7 @@ void main() {
             vec4 screen = imageLoad(rt_reflections, pixel);
             sky_in = mix(sky_in, screen.rgb, clamp(screen.a, 0.0, 1.0));
         }
-        vec3 split_sum = (f0 * rg.r + fresnel_f90(m) * rg.g) * sky_in;
+        vec3 split_sum = lobe * sky_in;
         radiance += compensation * (traced.a > 0.0 ? traced.rgb / traced.a : split_sum);
     }
 

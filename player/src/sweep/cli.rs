@@ -204,7 +204,7 @@ pub fn run(args: Args) -> PlayResult {
     }
     if let Some(files) = &args.diff {
         super::report::create_dir(&args.out)?;
-        return super::diff::run(&files[0], &files[1], Some(&args.out.join("flip.png")));
+        return super::diff::run(&files[0], &files[1], &args.out.join("flip.png"));
     }
     // Read the old results first: a typo in the path should not cost a whole sweep.
     let old = args.compare.as_deref().map(read_results).transpose()?;

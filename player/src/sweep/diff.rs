@@ -22,27 +22,8 @@ pub fn write_map(path: &Path, width: u32, height: u32, map: &[f32]) -> PlayResul
     write_png(path, width, height, &rgba)
 }
 
-/// The error figures of `image` against `reference` (both linear RGB, row-major) and the
-/// per-pixel HDR-FLIP.
-pub fn measure(
-    width: u32,
-    height: u32,
-    reference: &[f32],
-    image: &[f32],
-) -> Result<(kiln_metrics::Errors, Vec<f32>), kiln_metrics::MetricError> {
-    let rgb = |pixels| kiln_metrics::RgbImage { width, height, pixels };
-    let map = kiln_metrics::hdr_flip_map(rgb(reference), rgb(image))?;
-    let flip = map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len() as f64;
-    let errors = kiln_metrics::Errors {
-        flip,
-        rel_mse: kiln_metrics::rel_mse(rgb(reference), rgb(image))?,
-        rmse: kiln_metrics::rmse(rgb(reference), rgb(image))?,
-    };
-    Ok((errors, map))
-}
-
-/// `--diff`: compares two EXR files, prints the figures and writes `map` (a PNG) when given.
-pub fn run(reference: &Path, image: &Path, map: Option<&Path>) -> PlayResult {
+/// `--diff`: compares two EXR files, prints the figures and writes the heat map to `map` (a PNG).
+pub fn run(reference: &Path, image: &Path, map: &Path) -> PlayResult {
     let (rw, rh, r) = read_exr(reference)?;
     let (w, h, i) = read_exr(image)?;
     if (rw, rh) != (w, h) {
@@ -55,14 +36,16 @@ pub fn run(reference: &Path, image: &Path, map: Option<&Path>) -> PlayResult {
             ),
         ));
     }
-    let (errors, flip_map) = measure(w, h, &r, &i).map_err(|e| {
+    let (errors, flip_map) = kiln_metrics::compare_with_map(
+        super::rgb_image(w, h, &r),
+        super::rgb_image(w, h, &i),
+    )
+    .map_err(|e| {
         PlayError::new(Exit::BadInput, format!("{} against {}: {e}", image.display(), reference.display()))
     })?;
     println!("hdr-flip {:.4}  relmse {:.5}  rmse {:.5}  ({w}x{h})", errors.flip, errors.rel_mse, errors.rmse);
-    if let Some(path) = map {
-        write_map(path, w, h, &flip_map)?;
-        println!("wrote the per-pixel HDR-FLIP to {}", path.display());
-    }
+    write_map(map, w, h, &flip_map)?;
+    println!("wrote the per-pixel HDR-FLIP to {}", map.display());
     Ok(())
 }
 

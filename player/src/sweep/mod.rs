@@ -261,17 +261,18 @@ fn points_of(
             continue;
         }
         let label = config.label(*frames);
-        let (error, flip_map) = match diff::measure(w, h, &reference.rgb, rgb) {
-            Ok((e, map)) => (Figures::from(e), map),
-            Err(e) => {
-                failures.push(Skipped {
-                    effect: config.target.name().into(),
-                    technique: label,
-                    reason: format!("cannot be measured: {e}"),
-                });
-                continue;
-            }
-        };
+        let (error, flip_map) =
+            match kiln_metrics::compare_with_map(rgb_image(w, h, &reference.rgb), rgb_image(w, h, rgb)) {
+                Ok((e, map)) => (Figures::from(e), map),
+                Err(e) => {
+                    failures.push(Skipped {
+                        effect: config.target.name().into(),
+                        technique: label,
+                        reason: format!("cannot be measured: {e}"),
+                    });
+                    continue;
+                }
+            };
         if options.keep_images {
             let what = format!("{}-{label}", config.target);
             report::keep_image(&options.out, camera, &what, w, h, rgb, *frames)?;

@@ -37,9 +37,7 @@ pub fn keep_image(
     rgb: &[f32],
     count: u32,
 ) -> PlayResult {
-    let dir = out.join("images");
-    create_dir(&dir)?;
-    write_exr(&dir.join(file_name(&[&camera_label(camera), what], "exr")), width, height, rgb, count)
+    write_exr(&kept(out, &[&camera_label(camera), what], "exr")?, width, height, rgb, count)
 }
 
 /// Writes the per-pixel HDR-FLIP of a measured image beside it, as `...-flip.png` (a heat map:
@@ -52,14 +50,14 @@ pub fn keep_error_map(
     height: u32,
     map: &[f32],
 ) -> PlayResult {
+    super::diff::write_map(&kept(out, &[&camera_label(camera), what, "flip"], "png")?, width, height, map)
+}
+
+/// The path of a kept file named by `parts` in `OUT/images/`, the folder made.
+fn kept(out: &Path, parts: &[&str], extension: &str) -> PlayResult<PathBuf> {
     let dir = out.join("images");
     create_dir(&dir)?;
-    super::diff::write_map(
-        &dir.join(file_name(&[&camera_label(camera), what, "flip"], "png")),
-        width,
-        height,
-        map,
-    )
+    Ok(dir.join(file_name(parts, extension)))
 }
 
 fn camera_label(camera: &str) -> String {

@@ -25,11 +25,11 @@ impl Importer<'_> {
         m: &::gltf::Material<'_>,
         gpu: &mut GpuMaterial,
     ) -> CliResult {
-        let specular = m.specular();
-        if m.ior().is_none() && specular.is_none() {
+        let (ior, specular) = (m.ior(), m.specular());
+        if ior.is_none() && specular.is_none() {
             return Ok(());
         }
-        let ior = match m.ior() {
+        let ior = match ior {
             // The specification allows 0 beside values of at least 1 (F0 = 1: a perfect mirror).
             Some(0.0) => 0.0,
             Some(ior) => self.physical(at, "KHR_materials_ior.ior", [ior], 1.0, f32::INFINITY)?[0],
