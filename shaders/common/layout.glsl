@@ -176,7 +176,8 @@ struct ScreenGiConstants {
     uint cap; // offset 28
     uint falloff; // offset 32
     uint tiled; // offset 36
-    uvec2 pad; // offset 40
+    uint current; // offset 40
+    uint pad; // offset 44
 }; // 48 bytes
 
 struct SsrConstants {

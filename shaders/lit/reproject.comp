@@ -6,6 +6,9 @@
 // is such light, 0 where there is none: the sky (the GI adds the sky's ambient itself), no
 // previous frame, or a point off the previous image or behind its camera. A surface disoccluded
 // since the previous frame takes the light of whatever covered it then, for one frame.
+// On a frame without history the player makes the pyramid a second time after the direct pass
+// (`gi.current` 1): level 0 is then this frame's radiance where it lies, so that the first frame
+// already shows its screen-space reflections and GI (player/src/render/frame.rs, `again`).
 #include "../common/layout.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -13,6 +16,7 @@ layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
 layout(set = 0, binding = 1) uniform sampler2D depth_tex;
 layout(set = 0, binding = 2, rgba32f) uniform readonly image2D radiance_before;
 layout(set = 0, binding = 3, rgba16f) uniform writeonly image2D lit;
+layout(push_constant) uniform Push { ScreenGiConstants gi; };
 
 #include "../common/reproject.glsl"
 
@@ -25,7 +29,13 @@ void main() {
     vec2 at;
     float depth_then;
     vec4 out_lit = vec4(0.0);
-    if (d > 0.0 && reproject_pixel(p, d, at, depth_then)) {
+    bool found = gi.current != 0u;
+    if (found) {
+        at = vec2(p) + 0.5;
+    } else {
+        found = reproject_pixel(p, d, at, depth_then);
+    }
+    if (d > 0.0 && found) {
         ivec2 size = ivec2(frame.size.xy);
         vec2 x = at - 0.5;
         ivec2 base = ivec2(floor(x));

@@ -95,10 +95,8 @@ vec4 lit_radiance(vec2 at, float level) {
 }
 
 vec4 reflection(ivec2 p) {
-    // The first frame (and the first after a resize) has no previous radiance to show.
-    if (frame.jitter.w != 0.0) {
-        return vec4(0.0);
-    }
+    // A frame without history finds no lit texel at first (alpha 0): it runs again once the
+    // pyramid holds its own radiance (player/src/render/frame.rs, `again`).
     float depth = texelFetch(g_depth, p, 0).r;
     vec4 mat = texelFetch(g_material, p, 0);
     float roughness = mat.g;

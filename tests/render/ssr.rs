@@ -104,10 +104,12 @@ fn ssr_of_a_mirror_floor_shows_an_on_screen_emitter_at_the_mirrored_pixels_and_t
     let dir = gpu_test!();
     let bytes = scene();
     let cam = camera();
-    // SSR shows the previous frame's radiance: the first frame has none, the second shows the
-    // panel; a third for good measure.
+    // SSR shows the previous frame's radiance; the first frame, which has none, makes its lit
+    // pyramid again from its own light and traces again: both show the panel.
     let (ssr, _) =
         render_frames(dir.path(), "ssr", &bytes, 3, |f| Options::new(f, W, H).unshadowed().reflections(SSR));
+    let (first, _) =
+        render(dir.path(), "ssr-first", &bytes, |f| Options::new(f, W, H).unshadowed().reflections(SSR));
     let (none, _) = render(dir.path(), "ssr-none", &bytes, |f| Options::new(f, W, H).unshadowed());
     let (rt, _) = render_frames(dir.path(), "ssr-rt", &bytes, 2, |f| {
         Options::new(f, W, H).unshadowed().rt_reflections(kiln_tests::Reflections::Full)
@@ -172,6 +174,13 @@ fn ssr_of_a_mirror_floor_shows_an_on_screen_emitter_at_the_mirrored_pixels_and_t
          hits at the edge: {m_edge:.3} of the panel"
     );
     assert!((m_on - 1.0).abs() < 0.01 && w_on < 0.03, "ssr does not show the panel: {m_on}, worst {w_on}");
+    let (m_first, w_first) = stats(&first, &on, EMITTED);
+    eprintln!("ssr's first frame: panel mean ratio {m_first:.4} (worst {w_first:.4})");
+    assert!(
+        (m_first - 1.0).abs() < 0.01 && w_first < 0.03,
+        "ssr's first frame does not show the panel: {m_first}, worst {w_first}"
+    );
+    assert!(split(&sky, &first) < 1e-3, "ssr's first frame differs from the split sum on the sky");
     assert!((m_rt - 1.0).abs() < 0.02, "rt: {m_rt}");
     assert!(d_off < 1e-3, "ssr differs from the split sum where the reflection leaves the screen: {d_off}");
     assert!(m_off_rt > 0.9, "rt does not show the off-screen panel: {m_off_rt}");

@@ -286,8 +286,12 @@ gpu_struct! {
         /// neighbouring texels: coherent fetches, noise correlated within the block); 0: every
         /// texel by its own, as the seed.
         pub tiled: u32 => "uint",
+        /// The lit pyramid's level 0: 1 takes this frame's radiance where it lies (the pyramid's
+        /// second making on a frame without history, after the direct pass lit it), 0 the
+        /// previous frame's, reprojected.
+        pub current: u32 => "uint",
         /// Padding.
-        pub pad: [u32; 2] => "uvec2",
+        pub pad: u32 => "uint",
     }
 }
 

@@ -28,6 +28,13 @@ pub struct Frame {
     /// Each pass's name and the milliseconds its constructor (mostly pipeline creation) took
     /// on its own thread, in frame order.
     pub build_ms: Vec<(&'static str, f64)>,
+    /// The passes a frame without history records a second time, right after the direct pass
+    /// (the last of them): the lit pyramid, made now from the radiance this frame lit, the
+    /// passes that read it (screen-space reflections and GI) and what reads theirs, then the
+    /// direct pass again. Without it the first frame's screen-space passes gather nothing and
+    /// show the split-sum fallback (pica_pica's probes preset: HDR-FLIP 0.0639 at one frame,
+    /// 0.0603 from the second on). Empty when nothing reads the lit pyramid.
+    pub again: Vec<usize>,
 }
 
 /// What the passes of a frame are specialised for: the scene's lights.
@@ -146,7 +153,7 @@ fn passes(
     techniques: &Techniques,
     scene_lights: SceneLights,
     decode: TexelDecode,
-) -> PlayResult<Vec<(Box<dyn Pass>, f64)>> {
+) -> PlayResult<Vec<Made>> {
     let mut frame = FrameBuild {
         gpu,
         techniques,
@@ -175,13 +182,13 @@ fn passes(
     // on the H100.
     // Each thread hands back what it made; on an error, the passes the others made are dropped
     // here (none is used by the GPU yet).
-    let results: Vec<PlayResult<(Box<dyn Pass>, f64)>> = std::thread::scope(|s| {
+    let results: Vec<PlayResult<Made>> = std::thread::scope(|s| {
         let threads: Vec<_> = makers
             .into_iter()
-            .map(|(_, m)| {
+            .map(|(stage, m)| {
                 s.spawn(move || {
                     let t = std::time::Instant::now();
-                    m().map(|p| (p, t.elapsed().as_secs_f64() * 1e3))
+                    m().map(|p| (stage, p, t.elapsed().as_secs_f64() * 1e3))
                 })
             })
             .collect();
@@ -195,8 +202,37 @@ fn passes(
     results.into_iter().collect()
 }
 
+/// A pass made: its stage, the pass and the milliseconds its constructor took.
+type Made = (Stage, Box<dyn Pass>, f64);
+
 /// A pass to make: its constructor, run on a thread of its own by [`passes`].
 type Maker<'a> = Box<dyn FnOnce() -> PlayResult<Box<dyn Pass>> + Send + 'a>;
+
+/// [`Frame::again`] of `passes` (in frame order, at `stages`).
+fn again(stages: &[Stage], passes: &[Box<dyn Pass>]) -> Vec<usize> {
+    let (Some(lit), Some(direct)) = (
+        stages.iter().position(|&s| s == Stage::LitPyramid),
+        stages.iter().position(|&s| s == Stage::Direct),
+    ) else {
+        return Vec::new();
+    };
+    // What a pass makes, by name (the size does not change which).
+    let made =
+        |p: &dyn Pass| -> Vec<&'static str> { p.targets(1, 1).into_iter().map(|(t, _)| t.name).collect() };
+    let mut fresh = made(passes[lit].as_ref());
+    let mut again = vec![lit];
+    for (i, p) in passes.iter().enumerate().take(direct).skip(lit + 1) {
+        if p.binds().iter().any(|t| fresh.contains(&t.name)) {
+            fresh.extend(made(p.as_ref()));
+            again.push(i);
+        }
+    }
+    if again.len() == 1 {
+        return Vec::new();
+    }
+    again.push(direct);
+    again
+}
 
 fn make_images(gpu: &Gpu, passes: &[Box<dyn Pass>], width: u32, height: u32) -> PlayResult<FrameImages> {
     let made: Vec<(TargetDecl, ImageDesc)> = passes.iter().flat_map(|p| p.targets(width, height)).collect();
@@ -217,15 +253,18 @@ impl Frame {
         width: u32,
         height: u32,
     ) -> PlayResult<Frame> {
-        let (passes, build_ms): (Vec<_>, Vec<_>) = passes(gpu, techniques, lights, decode)?
+        let made = passes(gpu, techniques, lights, decode)?;
+        let stages: Vec<Stage> = made.iter().map(|(stage, _, _)| *stage).collect();
+        let (passes, build_ms): (Vec<_>, Vec<_>) = made
             .into_iter()
-            .map(|(p, ms)| {
+            .map(|(_, p, ms)| {
                 let name = p.name();
                 (p, (name, ms))
             })
             .unzip();
+        let again = again(&stages, &passes);
         let images = make_images(gpu, &passes, width, height)?;
-        Ok(Frame { passes, images, decode, build_ms })
+        Ok(Frame { passes, images, decode, build_ms, again })
     }
 
     /// Remakes the images for a new size (the GPU must be idle); the caller rebinds.

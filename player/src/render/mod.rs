@@ -99,6 +99,9 @@ pub struct Renderer {
     /// The previous frame's world to clip without jitter; `None` before the first frame and
     /// after a resize (the history images then hold nothing).
     last_view_proj: Option<glam::DMat4>,
+    /// Whether this frame has a previous one to read (the constants say so to the shaders; a
+    /// frame without records [`Frame::again`]).
+    history: bool,
     flags: u32,
     lut_resolution: u32,
     sky: [f32; 3],
@@ -195,6 +198,7 @@ impl Renderer {
             rt_constants,
             accumulated: 0,
             last_view_proj: None,
+            history: false,
             flags,
             lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
             sky: scene.manifest.sky.radiance,
@@ -295,6 +299,7 @@ impl Renderer {
         let previous = self.last_view_proj.unwrap_or(unjittered);
         let reproject = (previous * inverse).as_mat4().to_cols_array();
         let history = self.last_view_proj.is_some();
+        self.history = history;
         self.last_view_proj = Some(unjittered);
         let (view_proj, inv_view_proj) = (vp.as_mat4().to_cols_array(), inverse.as_mat4().to_cols_array());
         let p = camera.position.as_vec3();
@@ -337,10 +342,20 @@ impl Renderer {
         self.rt_constants.accumulated =
             if self.settings.techniques.reprojected_rays().is_some() { 0 } else { self.accumulated };
         self.rt_constants.seed = self.frame_count as u32;
-        let Frame { passes, images, .. } = &mut self.frame;
-        let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants };
-        for (i, p) in passes.iter_mut().enumerate() {
-            p.record(&mut ctx);
+        let Frame { passes, images, again, .. } = &mut self.frame;
+        let again: &[usize] = if self.history { &[] } else { again };
+        let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants, again: false };
+        for i in 0..passes.len() {
+            passes[i].record(&mut ctx);
+            if again.last() == Some(&i) {
+                // A frame without history: the screen-space passes again, over this frame's
+                // light (timed with the direct pass).
+                ctx.again = true;
+                for &j in again {
+                    passes[j].record(&mut ctx);
+                }
+                ctx.again = false;
+            }
             rec.timestamp(&self.timestamps, i as u32 + 1);
         }
         self.frame_count += 1;

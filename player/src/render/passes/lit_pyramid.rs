@@ -6,7 +6,9 @@
 //! k of depth, normals and light reads the same texels of each.
 //!
 //! Reading the previous frame is what makes the gathered light include indirect light (seed
-//! 000's infinite bounces) and costs one frame of lag: the first frame gathers nothing.
+//! 000's infinite bounces) and costs one frame of lag. A frame without a previous one makes the
+//! pyramid again from its own radiance once the direct pass has lit it, and its readers run
+//! again ([`crate::render::frame::Frame::again`]): the first frame shows its reflections.
 
 use kiln_format::gpu::ScreenGiConstants;
 
@@ -101,7 +103,8 @@ impl Pass for LitPyramidPass {
                 (LIT_PYRAMID, Access::Write(Use::STORAGE)),
             ],
         );
-        self.reproject.dispatch(ctx.rec, bytemuck::bytes_of(&ScreenGiConstants::default()), width, height);
+        let level0 = ScreenGiConstants { current: ctx.again as u32, ..Default::default() };
+        self.reproject.dispatch(ctx.rec, bytemuck::bytes_of(&level0), width, height);
         for (level, &(w, h)) in levels(width, height).iter().enumerate().skip(1) {
             // Each level reads the one the previous dispatch wrote.
             ctx.images.access(ctx.rec, &[(LIT_PYRAMID, Access::ReadWrite(Use::STORAGE))]);

@@ -96,6 +96,9 @@ pub struct FrameCtx<'a, 'r> {
     pub scene: &'a GpuScene,
     /// This frame's constants of the ray-traced passes (their push constants).
     pub rt: &'a RtConstants,
+    /// The pass is recorded a second time in a frame without history, over the radiance the
+    /// direct pass lit in this frame ([`crate::render::frame::Frame::again`]).
+    pub again: bool,
 }
 
 /// One pass of the frame. Dropping it releases what it owns: the GPU must be done with it (the

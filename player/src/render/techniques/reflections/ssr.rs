@@ -49,7 +49,8 @@ impl Registered for Ssr {
             &[0.3, 0.6],
         ),
     ];
-    // Not noisy, but it shows the previous frame's radiance: none in the first frame.
+    // Not noisy, but it shows the previous frame's radiance (the first frame its own, without
+    // what its reflections add: frames differ until the bounces settle).
     const STOCHASTIC: bool = true;
 
     fn new(k: &Knobs) -> Result<Ssr, String> {
