@@ -199,6 +199,13 @@ struct DenoiseConstants {
     float sigma_plane; // offset 28
 }; // 32 bytes
 
+struct FxaaConstants {
+    float subpix; // offset 0
+    float threshold; // offset 4
+    float threshold_min; // offset 8
+    uint pad; // offset 12
+}; // 16 bytes
+
 struct ProbeConstants {
     vec3 origin; // offset 0
     float spacing; // offset 12

@@ -32,5 +32,5 @@ mod specular; // KHR_materials_ior and specular: a black mirror floor under a un
 mod ssgi; // screen-space GI: a red wall's bleed onto the floor against its closed form, none from off screen
 mod ssr; // screen-space reflections of an emitter in a mirror floor, the split sum where they leave the screen
 mod streaming; // textures streamed coarse first: the first frame shows the coarse levels, output and bench come from the refined ones
-mod taa; // temporal anti-aliasing against 16× supersampling, still and moving, no ghosts
+mod taa; // temporal anti-aliasing and FXAA against 16× supersampling, still and moving, no ghosts
 mod textures; // BC textures render within a small FLIP of RGBA8; RGBA8-only passes refuse them

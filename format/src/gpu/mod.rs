@@ -314,6 +314,22 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Push constants of fast approximate anti-aliasing (`shaders/fxaa/*`; 16 bytes).
+    pub struct FxaaConstants {
+        /// How much of the sub-pixel blend (single-pixel features, the ends of thin lines)
+        /// applies: 0 none, 1 all (Lottes's "subpix", 0.75 his default).
+        pub subpix: f32 => "float",
+        /// The smallest local contrast, relative to the brightest neighbour's perceptual luma,
+        /// that counts as an edge.
+        pub threshold: f32 => "float",
+        /// The smallest local contrast that counts as an edge in the dark (perceptual luma).
+        pub threshold_min: f32 => "float",
+        /// Padding.
+        pub pad: u32 => "uint",
+    }
+}
+
+gpu_struct! {
     /// Push constants of the spatiotemporal denoiser (`shaders/denoise/*`; 32 bytes).
     pub struct DenoiseConstants {
         /// Signals filtered together (1 or 2: image arrays of two, sharing each tap's geometry).
@@ -501,6 +517,7 @@ pub fn glsl_layout() -> String {
     declare::<ScreenGiConstants>(&mut s);
     declare::<SsrConstants>(&mut s);
     declare::<DenoiseConstants>(&mut s);
+    declare::<FxaaConstants>(&mut s);
     declare::<ProbeConstants>(&mut s);
     declare::<EnvironmentHeader>(&mut s);
     declare::<EnvironmentCell>(&mut s);

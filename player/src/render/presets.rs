@@ -45,6 +45,7 @@ const RT_GI_4: Choice =
     Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(4.0))] };
 const SVGF: Choice = pick(Effect::Denoise, "svgf");
 const TAA: Choice = pick(Effect::Aa, "taa");
+const FXAA: Choice = pick(Effect::Aa, "fxaa");
 
 const PROBES: Choice = pick(Effect::Gi, "probes");
 
@@ -58,8 +59,8 @@ pub const PRESETS: [Preset; 10] = [
     Preset {
         name: "probes",
         help: "no rays: shadow maps, the compiler's irradiance probes for indirect light, screen-space \
-               reflections (needs a file compiled with probes)",
-        choices: &[SHADOW_MAPS, PROBES, SCREEN_REFLECTIONS],
+               reflections, FXAA (needs a file compiled with probes)",
+        choices: &[SHADOW_MAPS, PROBES, SCREEN_REFLECTIONS, FXAA],
     },
     Preset {
         name: "baked-taa",

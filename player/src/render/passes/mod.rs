@@ -11,6 +11,7 @@ pub mod ao;
 pub mod denoise;
 pub mod depth_pyramid;
 pub mod direct;
+pub mod fxaa;
 pub mod gbuffer;
 
 pub mod hiz;

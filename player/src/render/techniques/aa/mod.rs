@@ -12,6 +12,7 @@ techniques! {
     accumulate => Accumulate,
     reproject => Reproject,
     taa => Taa,
+    fxaa => Fxaa,
 }
 
 impl Aa {
