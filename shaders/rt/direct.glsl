@@ -33,22 +33,37 @@
 //    surfaces match (spatial reuse); the survivor's shadow ray is traced, it shades the pixel,
 //    and it is kept, with its surface, for the next frame.
 //
-// The includer includes hybrid.glsl first.
+// The includer includes hybrid.glsl first. Shadow rays go through the BVH, or through the
+// binary line space when the includer defines DIRECT_LS_EXACT (`--shadows linespace`: false,
+// exact triangle tests in the cells at the rays' ends only; true, in every filled cell), as the
+// analytic lights' shadow feelers do (shadows_linespace.glsl).
 #ifndef KILN_DIRECT_GLSL
 #define KILN_DIRECT_GLSL
 
 #include "../common/reproject.glsl"
+#ifdef DIRECT_LS_EXACT
+#define LS_BINDING 32
+#include "../common/linespace.glsl"
+#endif
 
 uint emitter_count() {
     return rt.emitters;
 }
 
 bool emitter_occluded(vec3 from, vec3 ng, vec3 to) {
+#ifdef DIRECT_LS_EXACT
+    return ls_occluded(from, ng, to, DIRECT_LS_EXACT);
+#else
     return occluded(from, ng, to);
+#endif
 }
 
 bool emitter_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
+#ifdef DIRECT_LS_EXACT
+    return ls_occluded_dir(from, ng, dir, DIRECT_LS_EXACT);
+#else
     return occluded_ray(from, ng, dir);
+#endif
 }
 
 #include "../common/emitters.glsl"
@@ -135,7 +150,7 @@ bool similar_surface(Primary s, vec3 q, vec3 nq) {
 }
 
 bool visible(Primary s, LightPoint lp) {
-    return rt.direct_visibility == 0u || !occluded(s.p, s.ng, lp.target);
+    return rt.direct_visibility == 0u || !emitter_occluded(s.p, s.ng, lp.target);
 }
 
 // `rt.direct_candidates` candidates at s, one chosen by RIS.

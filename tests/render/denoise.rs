@@ -121,7 +121,7 @@ fn svgf_keeps_a_flat_lit_floors_mean_and_cuts_its_noise() {
 
 /// A square of half-side 0.6 at height 1 under the lamp (its shadow on the floor has a
 /// penumbra).
-fn occluder() -> Vec<[Vec3; 3]> {
+pub(crate) fn occluder() -> Vec<[Vec3; 3]> {
     square(1.0, 0.6).iter().map(|t| t.map(|p| p + Vec3::new(0.9, 0.0, -0.3))).collect()
 }
 

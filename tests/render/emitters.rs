@@ -3,6 +3,8 @@
 //!   polygon (Lambert) irradiance of the quad;
 //! - the same quad with an emissive texture whose right half is black: the irradiance of the
 //!   left half alone;
+//! - the quad over a plate that shadows part of the floor, its shadow rays through the line
+//!   space: the umbra black, the floor the plate does not shadow at the polygon irradiance;
 //! - a white furnace, a closed box whose walls emit Le and reflect ρ: the direct light alone is
 //!   Le (1 + ρ) everywhere, and with `--gi rt` of b bounces Le (1 + ρ + … + ρ^(b+1)): a lamp
 //!   counted twice (by the GI pass's first rays and by the direct light) or missed shows there.
@@ -93,6 +95,18 @@ pub(crate) fn quad_scene_with(
     extra: &[[Vec3; 3]],
     extra_base: [u8; 3],
 ) -> Vec<u8> {
+    compile(quad_scene_ir(cam, quad, s_max, textured, extra, extra_base), fast_settings())
+}
+
+/// The scene [`quad_scene_with`] compiles.
+fn quad_scene_ir(
+    cam: &Pinhole,
+    quad: &Quad,
+    s_max: f64,
+    textured: bool,
+    extra: &[[Vec3; 3]],
+    extra_base: [u8; 3],
+) -> Scene {
     assert!(!textured || extra.is_empty(), "the texture's UVs assume the floor alone before the lamp");
     let (lamp, lamp_uv) = quad.triangles(if textured { 1.0 } else { s_max });
     let mut tris = square(0.0, 10.0).to_vec();
@@ -129,7 +143,7 @@ pub(crate) fn quad_scene_with(
     }
     scene.sky = Sky { radiance: [0.0; 3] };
     scene.cameras.push(cam.file_camera());
-    compile(scene, fast_settings())
+    scene
 }
 
 /// Renders `frames` frames of `options` and compares every floor pixel in front of the quad
@@ -203,6 +217,63 @@ fn an_emissive_texture_with_a_dark_half_lights_the_floor_from_its_bright_half() 
     check_quad("quad-textured", &quad_scene(&cam, 1.0, true), 0.5, 128, 0.15, |o| {
         o.rt_shadows(0.0, 0.0).ris(32)
     });
+}
+
+#[test]
+fn the_emitters_shadow_rays_through_the_line_space_leave_the_umbra_dark_and_the_rest_lit() {
+    let dir = gpu_test!();
+    // The quad over the floor and a black plate (the denoiser test's block, y = 1) between them.
+    // Each floor pixel is judged by the test's own segments to points of the lamp: none meets
+    // the plate (lit: the polygon irradiance) or every one does (umbra: black).
+    let (cam, quad) = (camera(), Quad::new());
+    let plate = crate::denoise::occluder();
+    let scene = quad_scene_ir(&cam, &quad, 1.0, false, &plate, [0; 3]);
+    let bytes = compile(scene, crate::shadows::line_space_settings());
+    // The plate grown (lit: no segment passes near it) or shrunk (umbra: every segment passes
+    // well inside it) by 0.02, a third of a pixel's footprint on the floor; 16 × 16 lamp
+    // points, corners included (lamp and plate are convex: all corners blocked, all blocked).
+    let on_plate =
+        |q: DVec3, margin: f64| (q.x - 0.9).abs() <= 0.6 + margin && (q.z + 0.3).abs() <= 0.6 + margin;
+    let blocked = |p: DVec3, margin: f64| {
+        let mut n = 0;
+        for i in 0..16 {
+            for j in 0..16 {
+                let l = quad.0.at(i as f64 / 15.0, j as f64 / 15.0);
+                let t = (1.0 - p.y) / (l.y - p.y);
+                n += on_plate(p + (l - p) * t, margin) as u32;
+            }
+        }
+        n
+    };
+    let hides = |d: DVec3| {
+        on_plate(cam.eye + d * ((1.0 - cam.eye.y) / d.y), 0.05) || quad.crossed_by(cam.eye, d, 0.05)
+    };
+    let pixels: Vec<_> =
+        floor_pixels(&cam, 9.5).into_iter().filter(|&(_, p, d)| quad.in_front(p) && !hides(d)).collect();
+    let lit: Vec<_> = pixels.iter().copied().filter(|&(_, p, _)| blocked(p, 0.02) == 0).collect();
+    let umbra: Vec<_> = pixels.iter().copied().filter(|&(_, p, _)| blocked(p, -0.02) == 256).collect();
+    assert!(lit.len() > 1000 && umbra.len() > 50, "{} lit, {} umbra pixels", lit.len(), umbra.len());
+    let a = albedo()[0];
+    let expected = |p: DVec3, _: DVec3| a / std::f64::consts::PI * quad.irradiance(p, 1.0);
+    // Exact in filled shafts: the line space answers as the BVH would. Exact only near the ends:
+    // conservative, a filled shaft between counts as occluded, so lit pixels may only darken.
+    for exact in [true, false] {
+        let name = if exact { "ls-filled" } else { "ls-ends" };
+        let (rgb, _) = render_frames(dir.path(), name, &bytes, 64, |f| {
+            Options::new(f, W, H).line_space_shadows(exact).ris(32)
+        });
+        let (mean, spread) = ratio_stats(&rgb, &lit, expected);
+        let dark = umbra.iter().map(|&(i, _, _)| rgb[i]).fold(0.0f32, f32::max);
+        eprintln!(
+            "{name}: lit floor's mean ratio to the closed form {mean:.4} (spread {spread:.4}); brightest umbra pixel {dark}"
+        );
+        assert_eq!(dark, 0.0, "{name}: the plate's umbra is lit");
+        if exact {
+            assert!((mean - 1.0).abs() < 0.01, "{name}: the lit floor is {mean} of the closed form");
+        } else {
+            assert!(mean < 1.01 && mean > 0.5, "{name}: the lit floor is {mean} of the closed form");
+        }
+    }
 }
 
 /// A closed box (the cube |x|, |y|, |z| ≤ 1) whose walls emit `le` from both sides and reflect

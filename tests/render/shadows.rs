@@ -33,7 +33,7 @@ fn ray_traced_hard_shadows_are_exact_up_to_the_pixel_at_the_umbra_edge() {
 
 /// The compile settings of the line-space cases: a coarse grid (6 cells on the floor's side) so
 /// that most feelers cross cells beyond the exact reach of their ends.
-fn line_space_settings() -> Settings {
+pub(crate) fn line_space_settings() -> Settings {
     Settings {
         shaft_variants: Some(Variants::BINARY),
         voxel_res: VoxelRes::Cells(6),

@@ -2,7 +2,8 @@
 //! emissive triangles chosen by resampled importance sampling, reservoirs reused across frames
 //! and neighbours (ReSTIR DI), one shadow ray for the sample that shades. Two kernels over the
 //! hybrid table: the candidates (and the previous frame's reservoir), then the neighbours and
-//! the shading. The composition adds the light they leave in [`DIRECT`].
+//! the shading. The composition adds the light they leave in [`DIRECT`]. Their shadow rays go
+//! through the BVH, or through the line space with `--shadows linespace` ([`Visibility`]).
 
 use crate::gpu::vk;
 
@@ -38,12 +39,39 @@ pub struct RtDirectPass {
     set: HybridSet,
 }
 
+/// What the shadow rays go through: the shadows technique's structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Visibility {
+    /// The BVH (`--shadows rt`, and `shadowmap`, whose maps are the analytic lights' only).
+    Bvh,
+    /// The binary line space (`--shadows linespace`), exact in every filled shaft or only in
+    /// the cells at the rays' ends.
+    LineSpace {
+        /// Exact triangle tests in every filled shaft.
+        exact: bool,
+    },
+}
+
 impl RtDirectPass {
-    /// Builds both kernels; the texel buffer is decoded as `decode` says.
-    pub fn new(gpu: &Gpu, decode: TexelDecode) -> PlayResult<RtDirectPass> {
-        let set = HybridSet::new(gpu, false, decode)?;
-        let candidates = set.pipeline(gpu, spirv::shader!("rt/direct_candidates.comp"))?;
-        let reuse = set.pipeline(gpu, spirv::shader!("rt/direct_reuse.comp"))?;
+    /// Builds both kernels, their shadow rays through `visibility`; the texel buffer is decoded
+    /// as `decode` says.
+    pub fn new(gpu: &Gpu, decode: TexelDecode, visibility: Visibility) -> PlayResult<RtDirectPass> {
+        let (candidates, reuse) = match visibility {
+            Visibility::Bvh => {
+                (spirv::shader!("rt/direct_candidates.comp"), spirv::shader!("rt/direct_reuse.comp"))
+            }
+            Visibility::LineSpace { exact: false } => (
+                spirv::shader!("rt/direct_candidates_linespace.comp"),
+                spirv::shader!("rt/direct_reuse_linespace.comp"),
+            ),
+            Visibility::LineSpace { exact: true } => (
+                spirv::shader!("rt/direct_candidates_linespace_exact.comp"),
+                spirv::shader!("rt/direct_reuse_linespace_exact.comp"),
+            ),
+        };
+        let set = HybridSet::new(gpu, matches!(visibility, Visibility::LineSpace { .. }), decode)?;
+        let candidates = set.pipeline(gpu, candidates)?;
+        let reuse = set.pipeline(gpu, reuse)?;
         Ok(RtDirectPass { candidates, reuse, set })
     }
 }

@@ -2,8 +2,9 @@
 //! lamps, screens, windows) send to the visible surfaces. The analytic lights are the direct
 //! pass's; this effect adds the emitters' light through an image the composition reads.
 //!
-//! Visibility comes from the shadows technique's choice: shadow rays through the BVH, except
-//! `--shadows none`, which leaves the emitters' light unshadowed as it does the lights'.
+//! Visibility comes from the shadows technique's choice: shadow rays through the line space with
+//! `--shadows linespace` (its `--ls-shadow-test`), through the BVH otherwise, except `--shadows
+//! none`, which leaves the emitters' light unshadowed as it does the lights'.
 
 use super::knobs::{Knob, number, whole};
 use super::techniques;
@@ -69,9 +70,15 @@ macro_rules! traced_direct {
 
         fn passes<'a>(&'a self, frame: &mut $crate::render::frame::FrameBuild<'a>) {
             use $crate::render::frame::Stage;
-            use $crate::render::passes::rt_direct::RtDirectPass;
+            use $crate::render::passes::rt_direct::{RtDirectPass, Visibility};
+            use $crate::render::techniques::Shadows;
+            use $crate::render::techniques::shadows::linespace::LsShadowTest;
+            let visibility = match frame.techniques.shadows {
+                Shadows::LineSpace(l) => Visibility::LineSpace { exact: l.test == LsShadowTest::Filled },
+                _ => Visibility::Bvh,
+            };
             let (gpu, decode) = (frame.gpu, frame.decode);
-            frame.add(Stage::Emitters, move || RtDirectPass::new(gpu, decode));
+            frame.add(Stage::Emitters, move || RtDirectPass::new(gpu, decode, visibility));
         }
     };
 }

@@ -43,8 +43,8 @@ impl Registered for Restir {
     const NAME: &'static str = "restir";
     const HELP: &'static str = "emissive surfaces' light by ReSTIR DI: resampled candidates per pixel, reservoirs \
                                 reused from the previous frame and from neighbours, one shadow ray to the sample \
-                                that shades (one more for the reused candidates; through the BVH, none with \
-                                --shadows none); averaged while the camera is still, reuse stopping once the average \
+                                that shades (one more for the reused candidates; through the line space with \
+                                --shadows linespace, else the BVH; none with --shadows none); averaged while the camera is still, reuse stopping once the average \
                                 holds 8 frames (see --direct-candidates, --direct-spatial, --direct-temporal)";
     const KNOBS: &'static [Knob] = &[CANDIDATES, SPATIAL, TEMPORAL];
     const STOCHASTIC: bool = true;

@@ -20,7 +20,8 @@ impl Registered for Ris {
     const NAME: &'static str = "ris";
     const HELP: &'static str = "emissive surfaces' light by resampled importance sampling: per pixel and frame, \
                                 candidate points on emissive triangles, one kept towards the light it sends, one \
-                                shadow ray (through the BVH; none with --shadows none); averaged while the camera \
+                                shadow ray (through the line space with --shadows linespace, else the BVH; none with \
+                                --shadows none); averaged while the camera \
                                 is still (see --direct-candidates)";
     const KNOBS: &'static [Knob] = &[CANDIDATES];
     const STOCHASTIC: bool = true;

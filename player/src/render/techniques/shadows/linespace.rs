@@ -35,7 +35,8 @@ pub enum LsShadowTest {
 impl Registered for LineSpace {
     const NAME: &'static str = "linespace";
     const HELP: &'static str = "the ray-traced estimator with its shadow feelers through the binary line space \
-                                (seed 004; needs a file compiled with line space, see --ls-shadow-test)";
+                                (seed 004; the emissive surfaces' shadow rays too; needs a file compiled with line \
+                                space, see --ls-shadow-test)";
     const KNOBS: &'static [Knob] = &[
         LIGHT_RADIUS,
         SUN_ANGLE,
