@@ -98,6 +98,13 @@ pub trait Technique: fmt::Debug + Send + Sync {
         false
     }
 
+    /// A shadows technique whose rays go through the line space: `Some(exact)` (exact triangle
+    /// tests in every filled shaft, or only near the rays' ends), so that the emissive
+    /// surfaces' shadow rays take the same way; `None` (the BVH) for every other.
+    fn line_space_visibility(&self) -> Option<bool> {
+        None
+    }
+
     /// What happens to the stochastic passes' samples across frames (the anti-aliasing
     /// techniques say; the others keep no history).
     fn history(&self) -> History {

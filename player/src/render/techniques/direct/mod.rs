@@ -71,11 +71,11 @@ macro_rules! traced_direct {
         fn passes<'a>(&'a self, frame: &mut $crate::render::frame::FrameBuild<'a>) {
             use $crate::render::frame::Stage;
             use $crate::render::passes::rt_direct::{RtDirectPass, Visibility};
-            use $crate::render::techniques::Shadows;
-            use $crate::render::techniques::shadows::linespace::LsShadowTest;
-            let visibility = match frame.techniques.shadows {
-                Shadows::LineSpace(l) => Visibility::LineSpace { exact: l.test == LsShadowTest::Filled },
-                _ => Visibility::Bvh,
+            use $crate::render::techniques::Effect;
+            let shadows = frame.techniques.get(Effect::Shadows);
+            let visibility = match shadows.line_space_visibility() {
+                Some(exact) => Visibility::LineSpace { exact },
+                None => Visibility::Bvh,
             };
             let (gpu, decode) = (frame.gpu, frame.decode);
             frame.add(Stage::Emitters, move || RtDirectPass::new(gpu, decode, visibility));

@@ -63,6 +63,10 @@ impl Registered for LineSpace {
 impl Technique for LineSpace {
     super::traced_shadows!();
 
+    fn line_space_visibility(&self) -> Option<bool> {
+        Some(self.test == LsShadowTest::Filled)
+    }
+
     fn needs(&self) -> Needs {
         Needs { line_space: LsArrays::BINARY_QUERY, ..Needs::TRACED_SURFACES }
     }
