@@ -19,10 +19,12 @@
 
 use glam::{DVec3, Vec3};
 use kiln_test_support::gpu_test;
-use kiln_tests::Options;
+use kiln_tests::{Options, compile};
 
 use crate::emitters::{Quad, camera, quad_scene_with};
-use crate::harness::{H, Pinhole, W, albedo, floor_pixels, pixel_xy, ratio_stats, render_frames, square};
+use crate::harness::{
+    H, Pinhole, W, albedo, fast_settings, floor_pixels, pixel_xy, ratio_stats, render_frames, square,
+};
 use crate::rect::Rect;
 
 /// Σ w² of `iterations` à-trous iterations of the separable kernel `taps` (weights at 0, ±1,
@@ -90,7 +92,7 @@ fn svgf_keeps_a_flat_lit_floors_mean_and_cuts_its_noise() {
     // what it sees).
     let cam = Pinhole::new([0.0, 0.8, 2.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0], 60.0, W, H);
     let quad = ceiling();
-    let bytes = quad_scene_with(&cam, &quad, 1.0, false, &[], [0; 3]);
+    let bytes = compile(quad_scene_with(&cam, &quad, 1.0, false, &[], [0; 3]), fast_settings());
     // 32 candidates: one would draw points uniformly over the 256 m² ceiling, a noise so
     // heavy-tailed (per-pixel variance 26 × the mean²) that neither image's mean is its
     // expectation (raw 0.971, svgf 0.717: SVGF's edge-stopping drops the rare huge samples).
@@ -129,7 +131,7 @@ pub(crate) fn occluder() -> Vec<[Vec3; 3]> {
 fn svgf_bleeds_no_floor_light_into_a_black_block() {
     let dir = gpu_test!();
     let (cam, quad) = (camera(), Quad::new());
-    let bytes = quad_scene_with(&cam, &quad, 1.0, false, &occluder(), [0; 3]);
+    let bytes = compile(quad_scene_with(&cam, &quad, 1.0, false, &occluder(), [0; 3]), fast_settings());
     let noisy = |o: Options| o.rt_shadows(0.0, 0.0).ris(1);
     let (raw, _) = render_frames(dir.path(), "edge-raw", &bytes, 1, |f| noisy(Options::new(f, W, H)));
     let (den, _) =
@@ -164,7 +166,10 @@ fn svgf_converges_to_the_undenoised_image_and_the_closed_form() {
     // A square occluder at height 1 under the lamp casts a penumbra onto the floor: detail the
     // filter must stop blurring as the frames accumulate.
     let quad = Quad::new();
-    let bytes = quad_scene_with(&cam, &quad, 1.0, false, &occluder(), crate::harness::ALBEDO);
+    let bytes = compile(
+        quad_scene_with(&cam, &quad, 1.0, false, &occluder(), crate::harness::ALBEDO),
+        fast_settings(),
+    );
     let frames = 96;
     let opts = |o: Options| o.rt_shadows(0.0, 0.0).ris(16);
     let (raw, _) = render_frames(dir.path(), "conv-raw", &bytes, frames, |f| opts(Options::new(f, W, H)));

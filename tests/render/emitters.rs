@@ -82,24 +82,12 @@ pub(crate) fn camera() -> Pinhole {
 /// A floor of the analytic albedo under the quad's part s ∈ [0, s_max], or with `textured` the
 /// whole quad with an emissive texture black on its right half.
 fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
-    quad_scene_with(cam, &Quad::new(), s_max, textured, &[], ALBEDO)
+    compile(quad_scene_with(cam, &Quad::new(), s_max, textured, &[], ALBEDO), fast_settings())
 }
 
-/// [`quad_scene`] with the lamp `quad` and `extra` triangles of a Lambert material of base
-/// colour `extra_base` (sRGB codes).
+/// The scene of [`quad_scene`] with the lamp `quad` and `extra` triangles of a Lambert material
+/// of base colour `extra_base` (sRGB codes), to compile.
 pub(crate) fn quad_scene_with(
-    cam: &Pinhole,
-    quad: &Quad,
-    s_max: f64,
-    textured: bool,
-    extra: &[[Vec3; 3]],
-    extra_base: [u8; 3],
-) -> Vec<u8> {
-    compile(quad_scene_ir(cam, quad, s_max, textured, extra, extra_base), fast_settings())
-}
-
-/// The scene [`quad_scene_with`] compiles.
-fn quad_scene_ir(
     cam: &Pinhole,
     quad: &Quad,
     s_max: f64,
@@ -227,7 +215,7 @@ fn the_emitters_shadow_rays_through_the_line_space_leave_the_umbra_dark_and_the_
     // the plate (lit: the polygon irradiance) or every one does (umbra: black).
     let (cam, quad) = (camera(), Quad::new());
     let plate = crate::denoise::occluder();
-    let scene = quad_scene_ir(&cam, &quad, 1.0, false, &plate, [0; 3]);
+    let scene = quad_scene_with(&cam, &quad, 1.0, false, &plate, [0; 3]);
     let bytes = compile(scene, crate::shadows::line_space_settings());
     // The plate grown (lit: no segment passes near it) or shrunk (umbra: every segment passes
     // well inside it) by 0.02, a third of a pixel's footprint on the floor; 16 × 16 lamp

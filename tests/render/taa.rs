@@ -84,11 +84,7 @@ fn whole_flip(reference: &[f32], test: &[f32]) -> f64 {
 fn edge_flip(reference: &[f32], test: &[f32]) -> f64 {
     let img = |pixels| kiln_metrics::RgbImage { width: W, height: H, pixels };
     let map = kiln_metrics::ldr_flip_map(img(reference), img(test)).unwrap();
-    let at = |x: i32, y: i32| {
-        let (x, y) = (x.clamp(0, W as i32 - 1) as usize, y.clamp(0, H as i32 - 1) as usize);
-        let i = (y * W as usize + x) * 3;
-        [reference[i], reference[i + 1], reference[i + 2]]
-    };
+    let at = |x, y| rgb_at(reference, x, y);
     let (mut sum, mut n) = (0.0, 0);
     for y in 0..H as i32 {
         for x in 0..W as i32 {
@@ -100,6 +96,28 @@ fn edge_flip(reference: &[f32], test: &[f32]) -> f64 {
         }
     }
     sum / n.max(1) as f64
+}
+
+/// The colour of pixel (x, y) of a `W` × `H` image, (x, y) clamped to the image.
+fn rgb_at(img: &[f32], x: i32, y: i32) -> [f32; 3] {
+    let (x, y) = (x.clamp(0, W as i32 - 1) as usize, y.clamp(0, H as i32 - 1) as usize);
+    let i = (y * W as usize + x) * 3;
+    [img[i], img[i + 1], img[i + 2]]
+}
+
+/// The strips seen by the still camera: the file, the 16× supersampled reference, one sample
+/// per pixel without anti-aliasing.
+fn still_strips(dir: &Path) -> (Vec<u8>, Vec<f32>, Vec<f32>) {
+    let cam = Pinhole::new([0.0, 3.2, 3.2], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
+    let bytes = strips_scene(&cam);
+    let reference = supersampled(dir, &bytes, None);
+    let (aliased, _) = render(dir, "none", &bytes, still(Aa::Off(techniques::aa::none::Off)));
+    (bytes, reference, aliased)
+}
+
+/// The options of the still strips with anti-aliasing `aa`.
+fn still(aa: Aa) -> impl Fn(&Path) -> Options {
+    move |f: &Path| Options::new(f, W, H).unshadowed().aa(aa)
 }
 
 /// The supersampled reference through `camera` (`None`: the file's).
@@ -117,11 +135,7 @@ fn supersampled(dir: &Path, bytes: &[u8], camera: Option<CameraOverride>) -> Vec
 #[test]
 fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
     let dir = gpu_test!();
-    let cam = Pinhole::new([0.0, 3.2, 3.2], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
-    let bytes = strips_scene(&cam);
-    let reference = supersampled(dir.path(), &bytes, None);
-    let opts = |aa: Aa| move |f: &Path| Options::new(f, W, H).unshadowed().aa(aa);
-    let (aliased, _) = render(dir.path(), "none", &bytes, opts(Aa::Off(techniques::aa::none::Off)));
+    let (bytes, reference, aliased) = still_strips(dir.path());
     // A running mean over two cycles of the 16 jitter positions, blended linearly: the box
     // filter's integral by 16 Halton points, as the reference is by a 4 × 4 grid.
     let (mean, _) = render_frames(
@@ -129,7 +143,7 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
         "taa-mean",
         &bytes,
         32,
-        opts(Aa::Taa(techniques::aa::taa::Taa { frames: 1024, luma_weights: false })),
+        still(Aa::Taa(techniques::aa::taa::Taa { frames: 1024, luma_weights: false })),
     );
     // The defaults: 16 frames of history, luma weights.
     let (default, _) = render_frames(
@@ -137,7 +151,7 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
         "taa-default",
         &bytes,
         32,
-        opts(Aa::Taa(techniques::aa::taa::Taa { frames: 16, luma_weights: false })),
+        still(Aa::Taa(techniques::aa::taa::Taa { frames: 16, luma_weights: false })),
     );
     let (f_none, f_mean, f_default) =
         (edge_flip(&reference, &aliased), edge_flip(&reference, &mean), edge_flip(&reference, &default));
@@ -158,21 +172,13 @@ fn taa_on_a_still_camera_converges_to_the_supersampled_image() {
 #[test]
 fn fxaa_brings_one_frame_closer_to_the_supersampled_image_and_leaves_flat_areas_alone() {
     let dir = gpu_test!();
-    let cam = Pinhole::new([0.0, 3.2, 3.2], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 50.0, W, H);
-    let bytes = strips_scene(&cam);
-    let reference = supersampled(dir.path(), &bytes, None);
-    let opts = |aa: Aa| move |f: &Path| Options::new(f, W, H).unshadowed().aa(aa);
-    let (aliased, _) = render(dir.path(), "none", &bytes, opts(Aa::Off(techniques::aa::none::Off)));
+    let (bytes, reference, aliased) = still_strips(dir.path());
     let (smoothed, _) =
-        render(dir.path(), "fxaa", &bytes, opts(Aa::Fxaa(techniques::aa::fxaa::Fxaa { subpix: 0.25 })));
+        render(dir.path(), "fxaa", &bytes, still(Aa::Fxaa(techniques::aa::fxaa::Fxaa { subpix: 0.25 })));
     let (f_none, f_fxaa) = (edge_flip(&reference, &aliased), edge_flip(&reference, &smoothed));
     // Pixels whose 5 × 5 neighbourhood in the one-sample image is one value hold no edge: FXAA
     // must leave them exactly as they are.
-    let at = |img: &[f32], x: i32, y: i32| {
-        let (x, y) = (x.clamp(0, W as i32 - 1) as usize, y.clamp(0, H as i32 - 1) as usize);
-        let i = (y * W as usize + x) * 3;
-        [img[i], img[i + 1], img[i + 2]]
-    };
+    let at = rgb_at;
     let (mut flat, mut changed) = (0, 0);
     for y in 0..H as i32 {
         for x in 0..W as i32 {
