@@ -125,7 +125,8 @@ struct RtConstants {
     uint direct_spatial; // offset 44
     uint direct_temporal; // offset 48
     uint direct_visibility; // offset 52
-}; // 56 bytes
+    float gi_min_roughness; // offset 56
+}; // 60 bytes
 
 struct MarchConstants {
     uint steps; // offset 0

@@ -1,7 +1,7 @@
 //! The hybrid pipeline's ray-traced passes against closed forms: AO under a ceiling, mirror
 //! reflections of a panel and the sky at both resolutions; no firefly where a rough reflection
-//! catches a glossy highlight (bounded by the regularised lobe's peak); and the frame average
-//! restarting.
+//! or a GI path catches a glossy highlight (bounded by the regularised lobe's peak); and the
+//! frame average restarting.
 
 use std::path::Path;
 use std::time::Instant;
@@ -148,50 +148,83 @@ fn ray_traced_reflections_of_a_mirror_floor_show_the_sky_and_an_emitter_at_the_f
     assert!((m_split - 1.0).abs() < 0.03, "the split sum shows the sky everywhere: {m_split}");
 }
 
-#[test]
-fn a_rough_reflection_of_a_glossy_highlight_stays_below_the_regularised_lobes_peak() {
-    let dir = gpu_test!();
-    // A rough metal floor (roughness 0.5) in front of a glossy metal wall (roughness 0.15, F0 1)
-    // at z = −2, a point light of intensity I one unit in front of the wall, no sky. Each floor
-    // pixel's one reflection ray lands anywhere in its wide lobe; the few that meet the wall
-    // where it mirrors the light would, unregularised, carry its highlight's peak
-    // D = 1/(π r⁴) = 629 — fireflies hundreds of times the pixel's mean. With the hit's lobe
-    // widened to the floor's roughness, what a ray brings back is at most
-    // F·G2/G1 (≤ 1) × D_max(0.5)·vis·cos (≤ D_max / (4 n·v)) × I / d² (d ≥ 1): the bound below,
-    // from the geometry alone (floor points at z ≥ −1 see the wall at n·v ≥ 1/√21).
-    let (floor_roughness, wall_roughness, intensity) = (0.5f64, 0.15f32, 4.0f32);
+/// The glossy-wall scene: a floor (y = 0, |x|, |z| ≤ 2) of material `floor` in front of a
+/// glossy metal wall (roughness 0.15, F0 1) at z = −2, a point light of intensity `intensity`
+/// one unit in front of the wall, no sky; the camera looking at the floor and the wall.
+fn glossy_wall(floor: kiln_format::sections::GpuMaterial, intensity: f32) -> (Pinhole, Vec<u8>) {
     let cam = Pinhole::new([0.0, 1.2, 3.5], [0.0, 0.3, -1.0], [0.0, 1.0, 0.0], 60.0, W, H);
     let mut tris: Vec<[Vec3; 3]> = square(0.0, 2.0).to_vec();
     let wall = |x: f32, y: f32| Vec3::new(x, y, -2.0);
     tris.push([wall(-2.0, 0.0), wall(2.0, 0.0), wall(2.0, 2.0)]);
     tris.push([wall(-2.0, 0.0), wall(2.0, 2.0), wall(-2.0, 2.0)]);
     let mut scene = scene_of(&tris);
-    scene.materials[0].gpu = metal(0.9, floor_roughness as f32);
-    scene
-        .materials
-        .push(kiln_compiler::ir::Material { name: "wall".into(), gpu: metal(1.0, wall_roughness) });
+    scene.materials[0].gpu = floor;
+    scene.materials.push(kiln_compiler::ir::Material { name: "wall".into(), gpu: metal(1.0, 0.15) });
     let n = scene.triangle_materials.len();
     scene.triangle_materials[n - 2..].fill(1);
     scene.lights.push(light(LightKind::Point, [0.0, 1.0, -1.0], [0.0, -1.0, 0.0], intensity));
     scene.sky = Sky { radiance: [0.0; 3] };
     scene.cameras.push(cam.file_camera());
-    let bytes = compile(scene, fast_settings());
+    (cam, compile(scene, fast_settings()))
+}
+
+/// The highest radiance a wall of roughness at least `roughness` (metal, F0 1) sends towards
+/// floor points at z ≥ −1 under the glossy-wall light of `intensity`: F (≤ 1) × D_max · vis ·
+/// cos (≤ D_max / (4 n·v), D_max = 1/(π r⁴)) × I / d² (d ≥ 1), with n·v ≥ 1/√21 from the
+/// geometry alone.
+fn wall_peak(roughness: f64, intensity: f32) -> f64 {
+    1.0 / (std::f64::consts::PI * roughness.powi(4)) / (4.0 / 21f64.sqrt()) * intensity as f64
+}
+
+/// The floor pixels at z ≥ −1 and what `with` adds to each over `without`.
+fn floor_added(cam: &Pinhole, with: &[f32], without: &[f32]) -> (usize, f64, f64) {
+    let pixels: Vec<_> = floor_pixels(cam, 1.9).into_iter().filter(|&(_, p, _)| p.z >= -1.0).collect();
+    let added: Vec<f64> = pixels.iter().map(|&(i, _, _)| (with[i] - without[i]) as f64).collect();
+    let max = added.iter().cloned().fold(0.0, f64::max);
+    (pixels.len(), added.iter().sum::<f64>() / added.len() as f64, max)
+}
+
+#[test]
+fn a_rough_reflection_of_a_glossy_highlight_stays_below_the_regularised_lobes_peak() {
+    let dir = gpu_test!();
+    // A rough metal floor (roughness 0.5) before the glossy wall. Each floor pixel's one
+    // reflection ray lands anywhere in its wide lobe; the few that meet the wall where it
+    // mirrors the light would, unregularised, carry its highlight's peak D = 1/(π 0.15⁴) = 629:
+    // fireflies hundreds of times the pixel's mean. With the hit's lobe widened to the floor's
+    // roughness, a ray brings back at most the peak of a wall of roughness 0.5 (F·G2/G1 ≤ 1).
+    let intensity = 4.0;
+    let (cam, bytes) = glossy_wall(metal(0.9, 0.5), intensity);
     // The reflections alone: the frame with them less the frame without (no sky, no GI: the
     // split-sum fallback adds nothing).
     let (with, _) = render(dir.path(), "glossy-rt", &bytes, |f| {
         Options::new(f, W, H).unshadowed().rt_reflections(Reflections::Full)
     });
     let (without, _) = render(dir.path(), "glossy-off", &bytes, |f| Options::new(f, W, H).unshadowed());
-    let a2 = floor_roughness.powi(4);
-    let peak = 1.0 / (std::f64::consts::PI * a2) / (4.0 / 21f64.sqrt()) * intensity as f64;
-    let pixels: Vec<_> = floor_pixels(&cam, 1.9).into_iter().filter(|&(_, p, _)| p.z >= -1.0).collect();
-    assert!(pixels.len() > 2000, "{} floor pixels", pixels.len());
-    let reflected: Vec<f64> = pixels.iter().map(|&(i, _, _)| (with[i] - without[i]) as f64).collect();
-    let max = reflected.iter().cloned().fold(0.0, f64::max);
-    let mean = reflected.iter().sum::<f64>() / reflected.len() as f64;
-    eprintln!("{} floor pixels: reflected mean {mean:.4}, max {max:.3}, bound {peak:.3}", pixels.len());
+    let peak = wall_peak(0.5, intensity);
+    let (n, mean, max) = floor_added(&cam, &with, &without);
+    eprintln!("{n} floor pixels: reflected mean {mean:.4}, max {max:.3}, bound {peak:.3}");
+    assert!(n > 2000, "{n} floor pixels");
     // The wall's highlight is there (the reflections see it) and no sample exceeds the bound.
     assert!(mean > 0.05, "the floor reflects nothing of the wall's highlight: {mean}");
+    assert!(max <= peak * 1.02, "a firefly: {max} above the regularised lobe's peak {peak}");
+}
+
+#[test]
+fn path_traced_gi_off_a_glossy_highlight_stays_below_the_regularised_lobes_peak() {
+    let dir = gpu_test!();
+    // A Lambertian floor of albedo ρ before the glossy wall: each floor pixel's one GI path
+    // leaves along a cosine lobe and the few that meet the wall where it mirrors the light
+    // would bring back its highlight's peak. With the hits' roughness at least the default
+    // --gi-regularize (0.5), one sample adds at most ρ × the peak of a wall of roughness 0.5.
+    let (intensity, rho) = (4.0, 0.8f32);
+    let (cam, bytes) = glossy_wall(lambert_material([rho; 3]), intensity);
+    let (with, _) = render(dir.path(), "glossy-gi", &bytes, |f| Options::new(f, W, H).unshadowed().rt_gi(1));
+    let (without, _) = render(dir.path(), "glossy-no-gi", &bytes, |f| Options::new(f, W, H).unshadowed());
+    let peak = rho as f64 * wall_peak(0.5, intensity);
+    let (n, mean, max) = floor_added(&cam, &with, &without);
+    eprintln!("{n} floor pixels: GI mean {mean:.4}, max {max:.3}, bound {peak:.3}");
+    assert!(n > 2000, "{n} floor pixels");
+    assert!(mean > 0.01, "the floor receives nothing off the wall: {mean}");
     assert!(max <= peak * 1.02, "a firefly: {max} above the regularised lobe's peak {peak}");
 }
 

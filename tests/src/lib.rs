@@ -221,14 +221,17 @@ impl Options {
 
     /// Path-traced diffuse GI counting `bounces` scattering events after the visible surface.
     pub fn rt_gi(mut self, bounces: u32) -> Options {
-        self.0.render.techniques.gi = Gi::Rt(gi::rt::Rt { bounces });
+        let regularize = gi::GI_REGULARIZE.default.number();
+        self.0.render.techniques.gi = Gi::Rt(gi::rt::Rt { bounces, regularize });
         self
     }
 
     /// Path-traced GI through the line space with `bounces` bounces, bounce rays through
     /// `structure`.
     pub fn line_space_gi(mut self, bounces: u32, structure: GiStructure) -> Options {
-        self.0.render.techniques.gi = Gi::LineSpace(gi::linespace::LineSpace { bounces, structure });
+        let regularize = gi::GI_REGULARIZE.default.number();
+        self.0.render.techniques.gi =
+            Gi::LineSpace(gi::linespace::LineSpace { bounces, structure, regularize });
         self
     }
 

@@ -379,7 +379,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 36 bytes).
+    /// Push constants of the hybrid ray-traced passes (`shaders/rt/*.comp`; 60 bytes).
     pub struct RtConstants {
         /// Frames already averaged into the accumulation images at this camera (0: this frame
         /// replaces them).
@@ -414,6 +414,8 @@ gpu_struct! {
         pub direct_temporal: u32 => "uint",
         /// Direct light: 1 where shadow rays decide visibility, 0 for unshadowed light.
         pub direct_visibility: u32 => "uint",
+        /// GI: the least roughness of the surfaces its paths hit (path regularisation; 0 off).
+        pub gi_min_roughness: f32 => "float",
     }
 }
 

@@ -504,7 +504,7 @@ mod tests {
             t.reflections,
             Reflections::Rt(reflections::rt::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 })
         );
-        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2 }));
+        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2, regularize: 0.5 }));
         assert_eq!(t.aa, Aa::Off(aa::none::Off));
         let e = refusal(&["f.kiln", "--gi", "rt", "--gi-bounces", "9"]);
         assert!(e.contains("gi-bounces"), "{e}");
@@ -774,10 +774,10 @@ mod tests {
     #[test]
     fn a_preset_sets_techniques_and_flags_override_it() {
         let t = techniques(&["f.kiln", "--preset", "rt-2"]);
-        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2 }));
+        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2, regularize: 0.5 }));
         assert_eq!((t.name_of(Effect::Shadows), t.name_of(Effect::Denoise)), ("rt", "svgf"));
         let t = techniques(&["f.kiln", "--preset", "rt-2", "--gi-bounces", "3", "--denoise", "none"]);
-        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 3 }));
+        assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 3, regularize: 0.5 }));
         assert_eq!((t.name_of(Effect::Shadows), t.name_of(Effect::Denoise)), ("rt", "none"));
         let t = techniques(&["f.kiln", "--preset", "rt-4-taa", "--gi", "ssgi", "--no-accumulate"]);
         assert_eq!((t.name_of(Effect::Gi), t.name_of(Effect::Aa)), ("ssgi", "none"));

@@ -144,7 +144,10 @@ fn knobs_reach_the_fields_they_name() {
         &[("gi-structure", KnobValue::Choice(2)), ("gi-bounces", KnobValue::Number(3.0))],
     )
     .unwrap();
-    assert_eq!(t.gi, Gi::LineSpace(GiLineSpace { bounces: 3, structure: GiStructure::Preillum }));
+    assert_eq!(
+        t.gi,
+        Gi::LineSpace(GiLineSpace { bounces: 3, structure: GiStructure::Preillum, regularize: 0.5 })
+    );
     t.set(
         Effect::Aa,
         "taa",
@@ -198,7 +201,7 @@ fn needs_follow_the_techniques() {
     assert!(rt.needs().bvh && rt.needs().scene_buffers && !rt.needs().shadow_maps);
     let vis = Techniques { gbuffer: GBuffer::Visibility(super::gbuffer::visibility::Visibility), ..d };
     assert!(vis.needs().scene_buffers && !vis.needs().bvh);
-    let gi = Techniques { gi: Gi::Rt(GiRt { bounces: 1 }), ..d };
+    let gi = Techniques { gi: Gi::Rt(GiRt { bounces: 1, regularize: 0.5 }), ..d };
     assert!(gi.ray_traced() && gi.needs().bvh && gi.needs().scene_buffers);
     assert_eq!(gi.without_rays().gi, Gi::default());
     // The screen-space AO techniques read the G-buffer only, and survive a file without a BVH.
@@ -239,7 +242,7 @@ fn the_fallback_keeps_effects_from_baked_data_and_compiles_no_ray_traced_pass() 
         shadows: Shadows::Rt(ShadowRt { light_radius: 0.1, sun_degrees: 0.5 }),
         ao: Ao::Rt(AoRt { radius: Radius { radius: None, reach: 0.1 } }),
         reflections: Reflections::Rt(ReflRt { resolution: ReflectionRes::Half, max_roughness: 1.0 }),
-        gi: Gi::Rt(GiRt { bounces: 2 }),
+        gi: Gi::Rt(GiRt { bounces: 2, regularize: 0.5 }),
         aa: taa,
         ..d
     };
@@ -275,7 +278,10 @@ fn the_fallback_keeps_effects_from_baked_data_and_compiles_no_ray_traced_pass() 
     let f = mixed.fallback(true).unwrap();
     assert_eq!((f.shadows, f.ao, f.reflections, f.gi), (Shadows::default(), gtao, mixed.reflections, ssgi));
     assert_eq!(mixed.differences(&f), vec![(Effect::Shadows, "linespace", "shadowmap")]);
-    let gi = Techniques { gi: Gi::LineSpace(GiLineSpace { bounces: 1, structure: GiStructure::Pnmt }), ..d };
+    let gi = Techniques {
+        gi: Gi::LineSpace(GiLineSpace { bounces: 1, structure: GiStructure::Pnmt, regularize: 0.5 }),
+        ..d
+    };
     assert_eq!(gi.fallback(true), Some(d));
     // What the fallback reads beyond the requested techniques: the shadow maps at most.
     for t in [all, mixed, gi] {
@@ -345,10 +351,10 @@ fn the_catalogue_builds_ssr_with_its_knobs_and_it_needs_no_rays() {
 fn the_catalogue_builds_gi_rt_with_its_bounces() {
     let mut t = baked();
     t.set(Effect::Gi, "rt", &[]).unwrap();
-    assert_eq!(t.gi, Gi::Rt(GiRt { bounces: 1 }));
+    assert_eq!(t.gi, Gi::Rt(GiRt { bounces: 1, regularize: 0.5 }));
     assert_eq!(t.name_of(Effect::Gi), "rt");
     t.set(Effect::Gi, "rt", &[("gi-bounces", KnobValue::Number(3.0))]).unwrap();
-    assert_eq!(t.gi, Gi::Rt(GiRt { bounces: 3 }));
+    assert_eq!(t.gi, Gi::Rt(GiRt { bounces: 3, regularize: 0.5 }));
     assert_eq!(t.gi.bounces(), Some(3));
     for bad in [0.0, 9.0, 1.5] {
         let e = t.set(Effect::Gi, "rt", &[("gi-bounces", KnobValue::Number(bad))]).unwrap_err();

@@ -30,7 +30,7 @@ impl Registered for Fxaa {
         0.0,
         1.0,
         0.25,
-        &[0.0, 0.25, 0.75],
+        &[0.25, 0.75],
     )];
 
     fn new(k: &Knobs) -> Result<Fxaa, String> {

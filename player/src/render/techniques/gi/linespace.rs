@@ -4,7 +4,7 @@
 //! `shaders/rt/gi_linespace*.comp`).
 
 
-use super::GI_BOUNCES;
+use super::{GI_BOUNCES, GI_REGULARIZE};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::rt_gi::RtGiPass;
 use crate::render::spirv;
@@ -13,12 +13,14 @@ use crate::render::techniques::{Knob, Knobs, Needs, Registered, Technique};
 use crate::scene::linespace::LsArrays;
 
 /// Path-traced diffuse GI through the line space.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LineSpace {
     /// As for [`super::rt::Rt`].
     pub bounces: u32,
     /// What answers the bounce rays.
     pub structure: GiStructure,
+    /// As for [`super::rt::Rt`].
+    pub regularize: f32,
 }
 
 /// What answers the bounce rays of `--gi linespace` (shadow rays: the binary line space).
@@ -39,6 +41,7 @@ impl Registered for LineSpace {
                                 bounces and emissive hits through the BVH (needs a file compiled with line space)";
     const KNOBS: &'static [Knob] = &[
         GI_BOUNCES,
+        GI_REGULARIZE,
         choice(
             "gi-structure",
             "pnmt: the shaft's stored hit, no triangle test (approximate); candidates: the \
@@ -56,7 +59,7 @@ impl Registered for LineSpace {
             "preillum" => GiStructure::Preillum,
             _ => GiStructure::Pnmt,
         };
-        Ok(LineSpace { bounces: k.whole("gi-bounces")?, structure })
+        Ok(LineSpace { bounces: k.whole("gi-bounces")?, structure, regularize: k.number("gi-regularize") })
     }
 }
 

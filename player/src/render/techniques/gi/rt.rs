@@ -2,18 +2,20 @@
 //! pixel per frame, next-event estimation at its hits (`passes/rt_gi.rs`, `shaders/rt/gi.glsl`).
 
 
-use super::GI_BOUNCES;
+use super::{GI_BOUNCES, GI_REGULARIZE};
 use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::rt_gi::RtGiPass;
 use crate::render::spirv;
 use crate::render::techniques::{Knob, Knobs, Registered, Technique};
 
 /// Path-traced diffuse GI through the BVH.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rt {
     /// Scattering events after the primary surface whose light counts (1: the sky, and what
     /// the first surface hit emits and receives directly), 1..=8.
     pub bounces: u32,
+    /// The least roughness of the surfaces the paths hit (0: unbiased).
+    pub regularize: f32,
 }
 
 impl Registered for Rt {
@@ -21,12 +23,12 @@ impl Registered for Rt {
     const HELP: &'static str = "path-traced diffuse GI from the G-buffer through the BVH: one cosine-weighted path per \
                                 pixel per frame, next-event estimation to lights and emissive surfaces at its hits, \
                                 averaged while the camera is still; replaces the sky's diffuse ambient and its AO \
-                                (see --gi-bounces)";
-    const KNOBS: &'static [Knob] = &[GI_BOUNCES];
+                                (see --gi-bounces, --gi-regularize)";
+    const KNOBS: &'static [Knob] = &[GI_BOUNCES, GI_REGULARIZE];
     const STOCHASTIC: bool = true;
 
     fn new(k: &Knobs) -> Result<Rt, String> {
-        Ok(Rt { bounces: k.whole("gi-bounces")? })
+        Ok(Rt { bounces: k.whole("gi-bounces")?, regularize: k.number("gi-regularize") })
     }
 }
 

@@ -1,0 +1,19 @@
+#!/bin/bash
+set -u
+B=/tmp/p/bin; S=/tmp/p/scenes; L=$OUT/log.txt
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader > $L
+cd /tmp
+$B/kiln compile $S/pica_pica/scene.gltf --config $S/pica_pica.toml --shaft-variants none -o pica.kiln -q >> $L 2>&1
+$B/kiln compile $S/box/CornellBox-Original.obj -c $S/box/camera.toml --shaft-variants none -o box.kiln -q >> $L 2>&1
+for v in "" -r0.5 -r1.0; do
+  for s in pica box; do
+    echo "== $s variant '$v'" >> $L
+    ( time timeout 150 $B/kiln-bench$v $s.kiln --effects frame --techniques frame:rt,frame:rt-4 --frames-accumulated 1,4,64 --size 1600x900 --reference-spp 4096 -q -o /tmp/o$s --json > $OUT/$s$v.json ) 2>> $L
+    python3 -c "
+import json
+r=json.load(open('$OUT/$s$v.json'))
+for p in r['points']:
+  e=p['error']; print('$s$v', p['label'], round(p['frame_ms'],3), round(e['flip'],4), '%.3g'%e['rel_mse'])
+" >> $L 2>&1
+  done
+done
