@@ -20,6 +20,7 @@
 // The radiance itself is read bilinearly at the moved position (linear HDR values blended as the
 // pixel's area would be). Only pixels on edges change; flat and smooth areas are left exactly.
 #include "../common/layout.glsl"
+#include "../common/packing.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Frame { FrameConstants frame; };
@@ -35,16 +36,24 @@ vec3 texel(ivec2 p) {
     return imageLoad(radiance, clamp(p, ivec2(0), size() - 1)).rgb;
 }
 
-// The radiance at `at` (pixel units, centres at k + ½), bilinear.
-vec3 bilinear(vec2 at) {
+// The top-left texel of the 2 × 2 around `at` (pixel units, centres at k + ½) and the
+// bilinear weights' fractions `f` towards the others.
+ivec2 bilinear_base(vec2 at, out vec2 f) {
     vec2 x = at - 0.5;
     ivec2 b = ivec2(floor(x));
-    vec2 f = x - vec2(b);
+    f = x - vec2(b);
+    return b;
+}
+
+// The radiance at `at`, bilinear.
+vec3 bilinear(vec2 at) {
+    vec2 f;
+    ivec2 b = bilinear_base(at, f);
     return mix(mix(texel(b), texel(b + ivec2(1, 0)), f.x), mix(texel(b + ivec2(0, 1)), texel(b + ivec2(1, 1)), f.x), f.y);
 }
 
 float luma_of(vec3 c) {
-    float l = max(dot(c, vec3(0.2126, 0.7152, 0.0722)), 0.0) * frame.params.x;
+    float l = max(luminance(c), 0.0) * frame.params.x;
     return sqrt(l / (1.0 + l));
 }
 
@@ -56,9 +65,8 @@ float luma_at(ivec2 p) {
 // texture filters them): the luma of blended HDR colours would lie well above the mean of the
 // two sides' lumas along a bright edge and end the search early.
 float luma_bilinear(vec2 at) {
-    vec2 x = at - 0.5;
-    ivec2 b = ivec2(floor(x));
-    vec2 f = x - vec2(b);
+    vec2 f;
+    ivec2 b = bilinear_base(at, f);
     return mix(mix(luma_at(b), luma_at(b + ivec2(1, 0)), f.x), mix(luma_at(b + ivec2(0, 1)), luma_at(b + ivec2(1, 1)), f.x), f.y);
 }
 

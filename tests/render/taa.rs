@@ -84,18 +84,23 @@ fn whole_flip(reference: &[f32], test: &[f32]) -> f64 {
 fn edge_flip(reference: &[f32], test: &[f32]) -> f64 {
     let img = |pixels| kiln_metrics::RgbImage { width: W, height: H, pixels };
     let map = kiln_metrics::ldr_flip_map(img(reference), img(test)).unwrap();
-    let at = |x, y| rgb_at(reference, x, y);
     let (mut sum, mut n) = (0.0, 0);
     for y in 0..H as i32 {
         for x in 0..W as i32 {
-            let c = at(x, y);
-            if (-2..=2).any(|dy| (-2..=2).any(|dx| at(x + dx, y + dy) != c)) {
+            if !flat_at(reference, x, y) {
                 sum += map[y as usize * W as usize + x as usize] as f64;
                 n += 1;
             }
         }
     }
     sum / n.max(1) as f64
+}
+
+/// Whether the 5 × 5 neighbourhood of pixel (x, y) of a `W` × `H` image is one colour (no edge
+/// within two pixels).
+fn flat_at(img: &[f32], x: i32, y: i32) -> bool {
+    let c = rgb_at(img, x, y);
+    (-2..=2).all(|dy| (-2..=2).all(|dx| rgb_at(img, x + dx, y + dy) == c))
 }
 
 /// The colour of pixel (x, y) of a `W` × `H` image, (x, y) clamped to the image.
@@ -178,19 +183,18 @@ fn fxaa_brings_one_frame_closer_to_the_supersampled_image_and_leaves_flat_areas_
     let (f_none, f_fxaa) = (edge_flip(&reference, &aliased), edge_flip(&reference, &smoothed));
     // Pixels whose 5 × 5 neighbourhood in the one-sample image is one value hold no edge: FXAA
     // must leave them exactly as they are.
-    let at = rgb_at;
     let (mut flat, mut changed) = (0, 0);
     for y in 0..H as i32 {
         for x in 0..W as i32 {
-            let c = at(&aliased, x, y);
-            if (-2..=2).all(|dy| (-2..=2).all(|dx| at(&aliased, x + dx, y + dy) == c)) {
+            if flat_at(&aliased, x, y) {
                 flat += 1;
-                changed += (at(&smoothed, x, y) != c) as u32;
+                changed += (rgb_at(&smoothed, x, y) != rgb_at(&aliased, x, y)) as u32;
             }
         }
     }
     eprintln!(
-        "mean FLIP against 16× supersampling near edges: one sample {f_none:.4}, FXAA {f_fxaa:.4};          {changed} of {flat} flat pixels changed"
+        "mean FLIP against 16× supersampling near edges: one sample {f_none:.4}, FXAA {f_fxaa:.4}; \
+         {changed} of {flat} flat pixels changed"
     );
     assert!(f_none > 0.06, "the test scene does not alias: {f_none}");
     // FXAA estimates each edge pixel's coverage from the staircase's length: short of 16

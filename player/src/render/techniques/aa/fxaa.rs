@@ -26,7 +26,7 @@ impl Registered for Fxaa {
         "how much single-pixel features (specks, the ends of thin lines) are blended into their \
          neighbourhood: 0 none, 1 fully; more smooths aliasing more and blurs texture detail more. \
          Lottes's 0.75 is for LDR images: in HDR it spreads bright emitters' edges (the McGuire \
-         box's relMSE ×4 against 0.25)",
+         box's relMSE ×3 against 0.25)",
         0.0,
         1.0,
         0.25,
