@@ -163,19 +163,56 @@ pub fn bake_to_bytes(loaded: &Loaded) -> CliResult<Vec<u8>> {
     bake::to_bytes(&baked).map_err(|e| CliError::io(e.to_string()))
 }
 
-/// Reads and hashes every input file for the manifest.
+/// Reads and hashes every input file for the manifest. Each is recorded by its path relative to
+/// the first input's folder (the scene file's, or the demo's sidecar's), `/`-separated, so that the
+/// same files compiled from another folder, or named another way (`./a.gltf`, `/abs/a.gltf`,
+/// `sub/../a.gltf`), give the same bytes: a build system's cache is shared between machines whose
+/// checkouts sit in different places. The depfile and the report keep the paths as given.
 pub fn hash_inputs(paths: &[PathBuf]) -> CliResult<Vec<InputFile>> {
+    let base = paths.first().map(|p| lexical_absolute(p)).and_then(|p| p.parent().map(Path::to_path_buf));
     paths
         .iter()
         .map(|p| {
             let bytes = std::fs::read(p).map_err(|e| CliError::io(format!("{}: {e}", p.display())))?;
-            Ok(InputFile {
-                path: p.display().to_string(),
-                bytes: bytes.len() as u64,
-                hash: ContentHash::of(&bytes).to_hex(),
-            })
+            let path = match &base {
+                Some(base) => relative_path(base, &lexical_absolute(p)),
+                None => p.display().to_string(),
+            };
+            Ok(InputFile { path, bytes: bytes.len() as u64, hash: ContentHash::of(&bytes).to_hex() })
         })
         .collect()
+}
+
+/// `p` made absolute against the working directory, with `.` and `..` resolved by the names alone:
+/// links are not followed, since a sandboxed build links each input from somewhere else and the
+/// layout the build gave the files is the one to record.
+fn lexical_absolute(p: &Path) -> PathBuf {
+    use std::path::Component;
+    let joined = match std::env::current_dir() {
+        Ok(cwd) if p.is_relative() => cwd.join(p),
+        _ => p.to_path_buf(),
+    };
+    let mut out = PathBuf::new();
+    for c in joined.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
+}
+
+/// The `/`-separated path from folder `base` to `p` (both absolute and lexically normal), with
+/// `..` where `p` lies outside `base`.
+fn relative_path(base: &Path, p: &Path) -> String {
+    let (b, t): (Vec<_>, Vec<_>) = (base.components().collect(), p.components().collect());
+    let common = b.iter().zip(&t).take_while(|(x, y)| x == y).count();
+    let mut parts: Vec<String> = vec!["..".to_string(); b.len() - common];
+    parts.extend(t[common..].iter().map(|c| c.as_os_str().to_string_lossy().into_owned()));
+    parts.join("/")
 }
 
 /// Counts for reports.

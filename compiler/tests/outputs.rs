@@ -64,3 +64,67 @@ fn quiet_hides_progress_never_warnings() {
     let run = kiln(dir.path(), &["compile", "scene.obj", "-o", "out.kiln", "-q", "-W", "data-loss=ignore"]);
     assert!(!run.expect(0).stderr.contains("missing.png"), "{}", run.stderr);
 }
+
+/// The same files give the same bytes wherever they sit and however their paths are spelled
+/// (issue 46): inputs are recorded relative to the scene file's folder. Before, the manifest held
+/// each path as given, so `./a.obj` and `/abs/a.obj` gave different files and two checkouts in
+/// different places never shared a build cache entry.
+#[test]
+fn output_does_not_depend_on_where_the_inputs_sit() {
+    let root = tempfile::tempdir().unwrap();
+    let root = root.path();
+    // The layout: a scene folder with its OBJ, MTL and texture, and a sidecar beside the folder.
+    let layout = |top: &Path| {
+        std::fs::create_dir_all(top.join("scene/tex")).unwrap();
+        std::fs::write(
+            top.join("scene/room.obj"),
+            "mtllib room.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl lamp\nf 1/1 2/2 3/3\n",
+        )
+        .unwrap();
+        std::fs::write(
+            top.join("scene/room.mtl"),
+            "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\nmap_Kd tex/t.png\n",
+        )
+        .unwrap();
+        image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+            .save(top.join("scene/tex/t.png"))
+            .unwrap();
+        std::fs::write(
+            top.join("room.toml"),
+            "[camera]\nposition = [0.3, 0.3, 2.0]\ntarget = [0.3, 0.3, 0.0]\n[sky]\nradiance = [0.1, 0.1, 0.1]\n",
+        )
+        .unwrap();
+    };
+    let (a, b) = (root.join("a"), root.join("b/deeper/checkout"));
+    layout(&a);
+    layout(&b);
+    std::fs::create_dir_all(a.join("elsewhere")).unwrap();
+    let abs = |p: &Path| p.to_str().unwrap().to_string();
+    let (a_obj, a_toml) = (abs(&a.join("scene/room.obj")), abs(&a.join("room.toml")));
+    let runs: [(&Path, Vec<&str>); 5] = [
+        (&a, vec!["scene/room.obj", "--config", "room.toml"]),
+        (&a.join("scene"), vec!["./room.obj", "--config", "../room.toml"]),
+        (&a.join("elsewhere"), vec![&a_obj, "--config", &a_toml]),
+        (&a, vec!["elsewhere/../scene/./room.obj", "--config", "scene/../room.toml"]),
+        (&b, vec!["scene/room.obj", "--config", "room.toml"]),
+    ];
+    let mut files = Vec::new();
+    for (i, (dir, args)) in runs.iter().enumerate() {
+        let out = root.join(format!("out{i}.kiln"));
+        let mut all = vec!["compile"];
+        all.extend(args.iter().copied());
+        all.extend(["-q", "-o", out.to_str().unwrap()]);
+        kiln(dir, &all).expect(0);
+        files.push(std::fs::read(&out).unwrap());
+    }
+    for (i, f) in files.iter().enumerate().skip(1) {
+        assert!(f == &files[0], "run {i} ({:?}) differs from run 0", runs[i].1);
+    }
+    // What the manifest records: the paths as the asset names them, the sidecar from the scene's folder.
+    let run = kiln(root, &["inspect", "--json", "out0.kiln"]);
+    let json: serde_json::Value = serde_json::from_str(&run.expect(0).stdout).unwrap();
+    let mut paths: Vec<&str> =
+        json["manifest"]["inputs"].as_array().unwrap().iter().map(|i| i["path"].as_str().unwrap()).collect();
+    paths.sort_unstable();
+    assert_eq!(paths, ["../room.toml", "room.mtl", "room.obj", "tex/t.png"]);
+}
