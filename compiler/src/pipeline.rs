@@ -34,6 +34,11 @@ pub struct Loaded {
     pub plan: Plan,
     /// Wall time of import, sidecar and validation, ms.
     pub import_ms: f64,
+    /// Where the manifest records `scene.inputs` from: `(first, folder)` pairs in order, each
+    /// input relative to the folder of the last pair whose `first` is at most its index (the
+    /// scene file's folder for the asset's files, the sidecar's for it and the files it names).
+    /// Empty: relative to the first input's folder.
+    pub input_bases: Vec<(usize, PathBuf)>,
 }
 
 impl Loaded {
@@ -76,6 +81,10 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     };
     let settings = bake_settings(sidecar.as_ref().map(|(c, s)| (*c, s)), &args.bake)?;
     let mut scene = import::import_with(&args.input, settings.normals)?;
+    let mut input_bases = vec![(0, folder_of(&args.input))];
+    if let Some((cfg, _)) = &sidecar {
+        input_bases.push((scene.inputs.len(), folder_of(cfg)));
+    }
     for p in sidecar_inputs {
         if !scene.inputs.contains(&p) {
             scene.inputs.push(p);
@@ -84,9 +93,20 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     if let Some((cfg, sidecar)) = &sidecar {
         sidecar.apply(&mut scene, &cfg.display().to_string())?;
     }
+    if let Some(crate::import::environment::EnvironmentSpec::Image { path, .. }) = &args.bake.environment {
+        input_bases.push((scene.inputs.len(), folder_of(path)));
+    }
     args.bake.apply_environment(&mut scene)?;
     let policy = WarningPolicy::new(args.strict, &args.warning_levels);
-    finish(scene, settings, &args.input.display().to_string(), &policy, quiet, start)
+    let mut loaded = finish(scene, settings, &args.input.display().to_string(), &policy, quiet, start)?;
+    loaded.input_bases = input_bases;
+    Ok(loaded)
+}
+
+/// The folder holding `file`, absolute and resolved by name (see [`lexical_absolute`]).
+fn folder_of(file: &Path) -> PathBuf {
+    let p = lexical_absolute(file);
+    p.parent().map_or(p.clone(), Path::to_path_buf)
 }
 
 /// The bake settings: the sidecar's `[bake]` table (if any), overridden by the command line's.
@@ -145,7 +165,8 @@ pub fn finish(
     }
     let geometry = SceneGeometry::new(&scene);
     let plan = Plan::new(&scene, &geometry, &settings).map_err(CliError::usage)?;
-    Ok(Loaded { scene, geometry, settings, plan, import_ms: start.elapsed().as_secs_f64() * 1e3 })
+    let import_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok(Loaded { scene, geometry, settings, plan, import_ms, input_bases: Vec::new() })
 }
 
 /// Validates, plans and bakes `scene` in memory, quietly and on the calling thread's pool, with no
@@ -164,17 +185,20 @@ pub fn bake_to_bytes(loaded: &Loaded) -> CliResult<Vec<u8>> {
 }
 
 /// Reads and hashes every input file for the manifest. Each is recorded by its path relative to
-/// the first input's folder (the scene file's, or the demo's sidecar's), `/`-separated, so that the
-/// same files compiled from another folder, or named another way (`./a.gltf`, `/abs/a.gltf`,
-/// `sub/../a.gltf`), give the same bytes: a build system's cache is shared between machines whose
-/// checkouts sit in different places. The depfile and the report keep the paths as given.
-pub fn hash_inputs(paths: &[PathBuf]) -> CliResult<Vec<InputFile>> {
-    let base = paths.first().map(|p| lexical_absolute(p)).and_then(|p| p.parent().map(Path::to_path_buf));
+/// the folder `bases` gives it (see [`Loaded::input_bases`]; without bases the first input's: the
+/// demo's sidecar), `/`-separated, so that the same files compiled from another folder, named
+/// another way (`./a.gltf`, `/abs/a.gltf`, `sub/../a.gltf`) or with the sidecar kept elsewhere give
+/// the same bytes: a build system's cache is shared between machines whose checkouts sit in
+/// different places. The depfile and the report keep the paths as given.
+pub fn hash_inputs(paths: &[PathBuf], bases: &[(usize, PathBuf)]) -> CliResult<Vec<InputFile>> {
+    let first = paths.first().map(|p| folder_of(p));
     paths
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
             let bytes = std::fs::read(p).map_err(|e| CliError::io(format!("{}: {e}", p.display())))?;
-            let path = match &base {
+            let base = bases.iter().rev().find(|(start, _)| *start <= i).map(|(_, b)| b).or(first.as_ref());
+            let path = match base {
                 Some(base) => relative_path(base, &lexical_absolute(p)),
                 None => p.display().to_string(),
             };
@@ -300,7 +324,7 @@ pub fn compile(loaded: &Loaded, input_name: &str, output: &Path, out: &OutputArg
         crate::bake::linespace::gpu::open_early(work, plan.shaft_res, plan.pnmt_layout);
     }
     let progress = Progress::new(!out.quiet);
-    let inputs = hash_inputs(&loaded.scene.inputs)?;
+    let inputs = hash_inputs(&loaded.scene.inputs, &loaded.input_bases)?;
     let baked = pool.install(|| bake::bake(&loaded.context(inputs, &progress, cache.as_ref())?));
     let written = baked.and_then(|baked| {
         progress.stage("write");

@@ -248,6 +248,33 @@ fn files_an_asset_names_outside_its_folder_are_refused_unless_allowed() {
     // An asset compiled through a path from elsewhere reads its own folder.
     let run = kiln(top, &["compile", "asset/in.gltf", "-o", "in2.kiln", "-W", "missing-setup=ignore"]);
     assert!(run.code == 0 && run.stderr.is_empty(), "{}", run.stderr);
+    // A sandbox as Bazel makes one: real folders of links to the files. The asset's references
+    // resolve beside its own real file, so they are read, and the bytes are the direct compile's.
+    #[cfg(unix)]
+    {
+        let sb = top.join("sandbox/asset");
+        std::fs::create_dir_all(sb.join("maps")).unwrap();
+        for f in ["in.gltf", "tri.bin", "maps/in.png"] {
+            std::os::unix::fs::symlink(d.join(f), sb.join(f)).unwrap();
+        }
+        let run = kiln(
+            &top.join("sandbox"),
+            &["compile", "asset/in.gltf", "-o", "sb.kiln", "-W", "missing-setup=ignore"],
+        );
+        assert!(run.code == 0 && run.stderr.is_empty(), "{}", run.stderr);
+        let direct = std::fs::read(d.join("in.kiln")).unwrap();
+        assert!(
+            std::fs::read(top.join("sandbox/sb.kiln")).unwrap() == direct,
+            "the sandboxed compile's bytes"
+        );
+        // But a link in the sandbox to a file outside the asset's real folder is still refused.
+        for f in ["link.gltf", "link.png"] {
+            std::os::unix::fs::symlink(d.join(f), sb.join(f)).unwrap();
+        }
+        std::fs::remove_file(d.join("out.kiln")).unwrap();
+        let run = kiln(&sb, &["compile", "link.gltf", "-o", d.join("out.kiln").to_str().unwrap()]);
+        refused(&run, "image 0 ('link.png')");
+    }
 }
 
 /// A three-triangle OBJ in `d` and a sidecar `name.toml` holding `toml`.

@@ -66,7 +66,8 @@ fn quiet_hides_progress_never_warnings() {
 }
 
 /// The same files give the same bytes wherever they sit and however their paths are spelled
-/// (issue 46): inputs are recorded relative to the scene file's folder. Before, the manifest held
+/// (issue 46): inputs are recorded relative to the scene file's folder (the sidecar to its own).
+/// Before, the manifest held
 /// each path as given, so `./a.obj` and `/abs/a.obj` gave different files and two checkouts in
 /// different places never shared a build cache entry.
 #[test]
@@ -98,15 +99,19 @@ fn output_does_not_depend_on_where_the_inputs_sit() {
     let (a, b) = (root.join("a"), root.join("b/deeper/checkout"));
     layout(&a);
     layout(&b);
+    // The sidecar kept in another folder, at another depth.
+    std::fs::create_dir_all(b.join("configs/scenes")).unwrap();
+    std::fs::rename(b.join("room.toml"), b.join("configs/scenes/room.toml")).unwrap();
     std::fs::create_dir_all(a.join("elsewhere")).unwrap();
     let abs = |p: &Path| p.to_str().unwrap().to_string();
     let (a_obj, a_toml) = (abs(&a.join("scene/room.obj")), abs(&a.join("room.toml")));
-    let runs: [(&Path, Vec<&str>); 5] = [
+    let runs: [(&Path, Vec<&str>); 6] = [
         (&a, vec!["scene/room.obj", "--config", "room.toml"]),
         (&a.join("scene"), vec!["./room.obj", "--config", "../room.toml"]),
         (&a.join("elsewhere"), vec![&a_obj, "--config", &a_toml]),
         (&a, vec!["elsewhere/../scene/./room.obj", "--config", "scene/../room.toml"]),
-        (&b, vec!["scene/room.obj", "--config", "room.toml"]),
+        (&b, vec!["scene/room.obj", "--config", "configs/scenes/room.toml"]),
+        (&b.join("configs"), vec!["../scene/room.obj", "--config", "scenes/room.toml"]),
     ];
     let mut files = Vec::new();
     for (i, (dir, args)) in runs.iter().enumerate() {
@@ -120,11 +125,11 @@ fn output_does_not_depend_on_where_the_inputs_sit() {
     for (i, f) in files.iter().enumerate().skip(1) {
         assert!(f == &files[0], "run {i} ({:?}) differs from run 0", runs[i].1);
     }
-    // What the manifest records: the paths as the asset names them, the sidecar from the scene's folder.
+    // What the manifest records: the asset's files from its folder, the sidecar from its own.
     let run = kiln(root, &["inspect", "--json", "out0.kiln"]);
     let json: serde_json::Value = serde_json::from_str(&run.expect(0).stdout).unwrap();
     let mut paths: Vec<&str> =
         json["manifest"]["inputs"].as_array().unwrap().iter().map(|i| i["path"].as_str().unwrap()).collect();
     paths.sort_unstable();
-    assert_eq!(paths, ["../room.toml", "room.mtl", "room.obj", "tex/t.png"]);
+    assert_eq!(paths, ["room.mtl", "room.obj", "room.toml", "tex/t.png"]);
 }

@@ -953,8 +953,9 @@ fn g_tri(geo: &Geometry, t: u32) -> [[f64; 3]; 3] {
 }
 
 /// Reads `bytes` with both readers and compares everything the spec decoder knows; the manifest's
-/// inputs are read from `inputs_at`, the scene file's folder (FORMAT.md: paths are relative to it).
-fn agree(name: &str, bytes: &[u8], inputs_at: &Path) -> String {
+/// inputs are read from the first of `inputs_at` holding them: the scene file's folder, the
+/// sidecar's (FORMAT.md: each path is relative to one of them).
+fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
     let f = spec::open(bytes).unwrap_or_else(|e| panic!("{name}: the spec decoder refuses it: {e}"));
     let file = KilnFile::from_bytes(bytes, Checksums::Eager).unwrap();
     assert_eq!(f.version, (file.header().version_major, file.header().version_minor));
@@ -982,7 +983,9 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &Path) -> String {
     assert_eq!(manifest, theirs, "{name}: manifest");
     // Input hashes: xxh3_128 of the file, hex of the stored (little-endian) bytes.
     for input in &manifest.inputs {
-        let data = std::fs::read(inputs_at.join(&input.path)).unwrap();
+        let at = inputs_at.iter().map(|d| d.join(&input.path)).find(|p| p.is_file());
+        let data =
+            std::fs::read(at.unwrap_or_else(|| panic!("{name}: input {} not found", input.path))).unwrap();
         assert_eq!(input.bytes, data.len() as u64);
         assert_eq!(input.hash, spec::hash_hex(&data), "{name}: hash of {}", input.path);
     }
@@ -1398,7 +1401,7 @@ fn a_reader_written_from_format_md_agrees_with_the_reference_reader() {
     assert_eq!(spec::hash_hex(b"kiln"), "517e62508817fb5b976f7af3aff6e429");
     assert_eq!(spec::hash_hex(b""), "7f498d4624c30160d8984701d306aa99");
     let bytes = fixture();
-    let summary = agree("fixture", &bytes, Path::new("."));
+    let summary = agree("fixture", &bytes, &[]);
     // Every kind the format knows is here (and so read above): a new kind fails this until the
     // fixture writes it and this reader decodes it.
     let f = spec::open(&bytes).unwrap();
@@ -1450,7 +1453,7 @@ fn a_reader_written_from_format_md_decodes_zstd_sections() {
             assert_eq!(z.section(&ze.kind, ze.index), p.section(&pe.kind, pe.index), "{:?}", ze.kind);
         }
     }
-    let summary = agree("fixture, zstd", &zstd, Path::new("."));
+    let summary = agree("fixture, zstd", &zstd, &[]);
     eprintln!("{summary}");
     // The frame rules: a frame cut short, a byte after it, a different declared size are refused.
     let e = z.entries.iter().find(|e| e.codec == 1 && e.size > 16).unwrap();
@@ -1496,7 +1499,7 @@ fn a_reader_written_from_format_md_agrees_on_the_shared_scenes() {
         run::kiln(dir.path(), &args.iter().copied().chain(extra.iter().copied()).collect::<Vec<_>>())
             .expect(0);
         let bytes = std::fs::read(&out).unwrap();
-        let summary = agree(name, &bytes, input.parent().unwrap());
+        let summary = agree(name, &bytes, &[input.parent().unwrap(), side.parent().unwrap()]);
         // `kiln inspect --json` prints each content hash as hex of its stored bytes, in order.
         let run = run::kiln(dir.path(), &["inspect", out.to_str().unwrap(), "--json"]);
         run.expect(0);

@@ -186,6 +186,10 @@ impl LimitArgs {
         };
         let named: Vec<PathBuf> = input.into_iter().chain(sidecar).map(Path::to_path_buf).collect();
         let mut roots: Vec<PathBuf> = named.iter().map(|p| folder(p)).collect();
+        // Also the folder each named file really lies in, when it is a link: a sandboxed build
+        // (Bazel, Buck2) gives the action a folder of links to the source files, and the files
+        // an asset names resolve beside the asset's own real file.
+        roots.extend(named.iter().filter_map(|p| p.canonicalize().ok()).map(|p| folder(&p)));
         roots.extend(self.search_path.iter().cloned());
         let mut files = named;
         if let Some(crate::import::environment::EnvironmentSpec::Image { path, .. }) = &bake.environment {
