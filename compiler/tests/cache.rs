@@ -462,3 +462,64 @@ fn an_environment_change_misses_the_environment_and_the_probes_only() {
     let (stages, _) = demo(d, "d.kiln", Some("c"), &finer);
     assert_eq!(with(&stages, false), ["environment", "probes"], "{stages:?}");
 }
+
+/// One cache shared by two checkouts in different folders (a directory on shared storage, or a
+/// CI cache restored elsewhere): the second compile of the same files takes every stage from it
+/// and writes the first's bytes (issue 46, part 4). Keys hold contents, never paths.
+#[test]
+fn a_cache_filled_from_one_checkout_serves_another_elsewhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = |at: &Path| {
+        std::fs::create_dir_all(at).unwrap();
+        std::fs::write(
+            at.join("s.obj"),
+            "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl lamp\nf 1 2 3\nusemtl red\nf 1 2 4\nf 1 3 4\n",
+        )
+        .unwrap();
+        std::fs::write(
+            at.join("s.mtl"),
+            "newmtl lamp\nKe 4 4 4\nnewmtl red\nKd 0.5 0.1 0.1\n",
+        )
+        .unwrap();
+        sidecar(at, "s.toml", [0.3, 0.3, 1.0]);
+    };
+    let (a, b) = (d.join("a"), d.join("b/other/checkout"));
+    scene(&a);
+    scene(&b);
+    let cache = d.join("shared-cache");
+    let compile = |at: &Path, out: &str| {
+        let report = d.join(format!("{out}.json"));
+        ok(
+            at,
+            &[
+                "compile",
+                "s.obj",
+                "-c",
+                "s.toml",
+                "-o",
+                &d.join(out).display().to_string(),
+                "--report",
+                &report.display().to_string(),
+                "--cache",
+                &cache.display().to_string(),
+                "-q",
+                "-W",
+                "missing-setup=ignore",
+            ],
+        );
+        let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
+        j["stages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|s| s["run"] == true && !matches!(s["stage"].as_str(), Some("import" | "write")))
+            .map(|s| (s["stage"].as_str().unwrap().to_string(), s["cached"].as_bool().unwrap()))
+            .collect::<Vec<_>>()
+    };
+    let first = compile(&a, "a.kiln");
+    assert!(with(&first, true).is_empty() && !first.is_empty(), "a cold cache: {first:?}");
+    let second = compile(&b, "b.kiln");
+    assert_eq!(with(&second, false), Vec::<&str>::new(), "every stage from the cache: {second:?}");
+    same(d, "a.kiln", "b.kiln");
+}

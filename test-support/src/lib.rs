@@ -34,4 +34,6 @@ pub use images::{mse, read_exr, read_npy, write_npy};
 #[cfg(feature = "vulkan")]
 pub use need::vulkan;
 pub use need::{Found, Need, temp_dir};
-pub use tools::{chromium, flip_python, glslc, mitsuba_python, ninja, screenshot, workspace, xvfb_run};
+pub use tools::{
+    bazel_and_buildgrid, chromium, flip_python, glslc, mitsuba_python, ninja, screenshot, workspace, xvfb_run,
+};

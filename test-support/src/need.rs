@@ -18,6 +18,9 @@ pub enum Need {
     Chromium,
     /// `ninja`, for the build-system test (`KILN_REQUIRE_NINJA`).
     Ninja,
+    /// Bazel and BuildGrid (`.venv-buildgrid` or `KILN_BGD`), for the build-engine test
+    /// (`KILN_REQUIRE_BAZEL`).
+    Bazel,
 }
 
 impl Need {
@@ -29,6 +32,7 @@ impl Need {
             Need::Mitsuba => "KILN_REQUIRE_MITSUBA",
             Need::Chromium => "KILN_REQUIRE_CHROMIUM",
             Need::Ninja => "KILN_REQUIRE_NINJA",
+            Need::Bazel => "KILN_REQUIRE_BAZEL",
         }
     }
 
@@ -48,6 +52,11 @@ impl Need {
             }
             Need::Chromium => "Chromium (Debian: chromium fonts-dejavu-core)",
             Need::Ninja => "ninja (Debian: ninja-build)",
+            Need::Bazel => {
+                "Bazel and BuildGrid: run .ci/run, or apt-get install bazel-bootstrap && python3 -m \
+                 venv .venv-buildgrid && .venv-buildgrid/bin/pip install buildgrid==0.4.4 (or name \
+                 its bgd in KILN_BGD)"
+            }
         }
     }
 

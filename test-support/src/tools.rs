@@ -33,6 +33,24 @@ pub fn ninja() -> bool {
     Need::Ninja.check(starts("ninja", &["--version"])).is_some()
 }
 
+/// BuildGrid's `bgd` (`KILN_BGD`, or else `.venv-buildgrid`'s, which `.ci/run` makes), where
+/// `bazel` is on `PATH` too, by the rule ([`Need::Bazel`]).
+pub fn bazel_and_buildgrid() -> Option<PathBuf> {
+    let bgd = std::env::var_os("KILN_BGD")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace().join(".venv-buildgrid/bin/bgd"));
+    let found = starts("bazel", &["--version"]).and_then(|()| {
+        Command::new(&bgd)
+            .arg("--help")
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|_| bgd.clone())
+            .ok_or_else(|| format!("BuildGrid's bgd does not run ({})", bgd.display()))
+    });
+    Need::Bazel.check(found)
+}
+
 /// Whether `xvfb-run` is here, by the rule ([`Need::Xvfb`]).
 pub fn xvfb_run() -> bool {
     Need::Xvfb.check(starts("xvfb-run", &["--help"])).is_some()
