@@ -477,11 +477,7 @@ fn a_cache_filled_from_one_checkout_serves_another_elsewhere() {
             "mtllib s.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl lamp\nf 1 2 3\nusemtl red\nf 1 2 4\nf 1 3 4\n",
         )
         .unwrap();
-        std::fs::write(
-            at.join("s.mtl"),
-            "newmtl lamp\nKe 4 4 4\nnewmtl red\nKd 0.5 0.1 0.1\n",
-        )
-        .unwrap();
+        std::fs::write(at.join("s.mtl"), "newmtl lamp\nKe 4 4 4\nnewmtl red\nKd 0.5 0.1 0.1\n").unwrap();
         sidecar(at, "s.toml", [0.3, 0.3, 1.0]);
     };
     let (a, b) = (d.join("a"), d.join("b/other/checkout"));

@@ -43,6 +43,8 @@ const RT_GI_2: Choice =
     Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(2.0))] };
 const RT_GI_4: Choice =
     Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(4.0))] };
+const RT_GI_8: Choice =
+    Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(8.0))] };
 const SVGF: Choice = pick(Effect::Denoise, "svgf");
 const TAA: Choice = pick(Effect::Aa, "taa");
 const FXAA: Choice = pick(Effect::Aa, "fxaa");
@@ -50,7 +52,7 @@ const FXAA: Choice = pick(Effect::Aa, "fxaa");
 const PROBES: Choice = pick(Effect::Gi, "probes");
 
 /// The presets, cheapest first.
-pub const PRESETS: [Preset; 10] = [
+pub const PRESETS: [Preset; 11] = [
     Preset {
         name: "baked",
         help: "no rays: shadow maps, screen-space GI and reflections",
@@ -96,6 +98,12 @@ pub const PRESETS: [Preset; 10] = [
         name: "rt-4-taa",
         help: "as rt-4 with temporal anti-aliasing",
         choices: &[RT_SHADOWS, RT_REFLECTIONS, RT_GI_4, SVGF, TAA],
+    },
+    Preset {
+        name: "rt-8",
+        help: "as rt with eight bounces of GI (--gi-bounces 8): white rooms lit by one lamp, where \
+               light makes many bounces (McGuire's Cornell box: half rt-4's error)",
+        choices: &[RT_SHADOWS, RT_REFLECTIONS, RT_GI_8, SVGF],
     },
     Preset {
         name: "linespace",
