@@ -55,6 +55,13 @@ fn sidecar(dir: &Path, name: &str, pos: [f32; 3]) -> PathBuf {
 fn demo(dir: &Path, out: &str, cache: Option<&str>, args: &[&str]) -> (Vec<(String, bool)>, String) {
     let report = format!("{out}.json");
     let mut all = vec!["demo", "-o", out, "--report", &report, "--threads", "2", "-q"];
+    // Light bakes (what is cached matters here, not its quality): 16 paths per probe instead of
+    // 256, 64-texel shadow maps instead of 1024, unless the test sets them itself.
+    for (flag, value) in [("--probe-rays", "16"), ("--shadow-res", "64")] {
+        if !args.contains(&flag) {
+            all.extend_from_slice(&[flag, value]);
+        }
+    }
     all.extend_from_slice(args);
     if let Some(c) = cache {
         all.extend_from_slice(&["--cache", c]);
@@ -119,7 +126,12 @@ fn a_warm_cache_reuses_every_stage_and_writes_the_same_bytes() {
     same(d, "plain.kiln", "cold.kiln");
     same(d, "plain.kiln", "warm.kiln");
     // KILN_CACHE names the same cache; --no-cache turns it off.
-    let out = kiln_env(d, &["demo", "-o", "env.kiln", "-c", side, "--report", "env.json", "-q"], Some("c"));
+    let light = ["--probe-rays", "16", "--shadow-res", "64"];
+    let out = kiln_env(
+        d,
+        &[&["demo", "-o", "env.kiln", "-c", side, "--report", "env.json", "-q"][..], &light].concat(),
+        Some("c"),
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     let j: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(d.join("env.json")).unwrap()).unwrap();
@@ -134,7 +146,8 @@ fn a_warm_cache_reuses_every_stage_and_writes_the_same_bytes() {
     same(d, "plain.kiln", "env.kiln");
     let out = kiln_env(
         d,
-        &["demo", "-o", "off.kiln", "-c", side, "--no-cache", "--report", "off.json", "-q"],
+        &[&["demo", "-o", "off.kiln", "-c", side, "--no-cache", "--report", "off.json", "-q"][..], &light]
+            .concat(),
         Some("c"),
     );
     assert!(out.status.success());
@@ -266,6 +279,7 @@ fn concurrent_compiles_into_one_cache_agree() {
         .map(|i| {
             let mut c = Command::new(env!("CARGO_BIN_EXE_kiln"));
             c.args(["demo", "-o", &format!("{i}.kiln"), "--threads", "1", "-q", "--cache", "c"])
+                .args(["--probe-rays", "16", "--shadow-res", "64"])
                 .current_dir(d)
                 .env_remove("KILN_CACHE")
                 .stdout(std::process::Stdio::piped())
