@@ -18,8 +18,8 @@ pub enum Need {
     Chromium,
     /// `ninja`, for the build-system test (`KILN_REQUIRE_NINJA`).
     Ninja,
-    /// Bazel and BuildGrid (`.venv-buildgrid` or `KILN_BGD`), for the build-engine test
-    /// (`KILN_REQUIRE_BAZEL`).
+    /// Bazel, PostgreSQL's server and BuildGrid (`.venv-buildgrid` or `KILN_BGD`), for the
+    /// build-engine test (`KILN_REQUIRE_BAZEL`).
     Bazel,
 }
 
@@ -53,9 +53,9 @@ impl Need {
             Need::Chromium => "Chromium (Debian: chromium fonts-dejavu-core)",
             Need::Ninja => "ninja (Debian: ninja-build)",
             Need::Bazel => {
-                "Bazel and BuildGrid: run .ci/run, or apt-get install bazel-bootstrap && python3 -m \
-                 venv .venv-buildgrid && .venv-buildgrid/bin/pip install buildgrid==0.4.4 (or name \
-                 its bgd in KILN_BGD)"
+                "Bazel, PostgreSQL and BuildGrid: run .ci/run, or apt-get install bazel-bootstrap \
+                 postgresql && python3 -m venv .venv-buildgrid && .venv-buildgrid/bin/pip install \
+                 buildgrid==0.4.4 psycopg2-binary==2.9.13 (or name its bgd in KILN_BGD)"
             }
         }
     }

@@ -33,21 +33,35 @@ pub fn ninja() -> bool {
     Need::Ninja.check(starts("ninja", &["--version"])).is_some()
 }
 
-/// BuildGrid's `bgd` (`KILN_BGD`, or else `.venv-buildgrid`'s, which `.ci/run` makes), where
+/// BuildGrid's `bgd` (`KILN_BGD`, or else `.venv-buildgrid`'s, which `.ci/run` makes) and the
+/// folder of PostgreSQL's server binaries (`/usr/lib/postgresql/<version>/bin`, the newest), where
 /// `bazel` is on `PATH` too, by the rule ([`Need::Bazel`]).
-pub fn bazel_and_buildgrid() -> Option<PathBuf> {
+pub fn bazel_and_buildgrid() -> Option<(PathBuf, PathBuf)> {
     let bgd = std::env::var_os("KILN_BGD")
         .map(PathBuf::from)
         .unwrap_or_else(|| workspace().join(".venv-buildgrid/bin/bgd"));
-    let found = starts("bazel", &["--version"]).and_then(|()| {
-        Command::new(&bgd)
-            .arg("--help")
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|_| bgd.clone())
-            .ok_or_else(|| format!("BuildGrid's bgd does not run ({})", bgd.display()))
-    });
+    let postgres = || {
+        let mut found: Vec<PathBuf> = std::fs::read_dir("/usr/lib/postgresql")
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.path().join("bin"))
+            .filter(|b| b.join("initdb").is_file() && b.join("pg_ctl").is_file())
+            .collect();
+        found.sort_by_key(|b| b.parent().and_then(|v| v.file_name()?.to_str()?.parse::<u32>().ok()));
+        found.pop().ok_or_else(|| "PostgreSQL's server (initdb, pg_ctl) is not installed".to_string())
+    };
+    let found = starts("bazel", &["--version"])
+        .and_then(|()| {
+            Command::new(&bgd)
+                .arg("--help")
+                .output()
+                .ok()
+                .filter(|o| o.status.success())
+                .map(|_| bgd.clone())
+                .ok_or_else(|| format!("BuildGrid's bgd does not run ({})", bgd.display()))
+        })
+        .and_then(|bgd| postgres().map(|pg| (bgd, pg)));
     Need::Bazel.check(found)
 }
 
