@@ -103,9 +103,11 @@ pub fn load(args: &SceneArgs, quiet: bool) -> CliResult<Loaded> {
     Ok(loaded)
 }
 
-/// The folder holding `file`, absolute and resolved by name (see [`lexical_absolute`]).
+/// The folder holding `file`, absolute and resolved by name: links are not followed, since a
+/// sandboxed build links each input from somewhere else and the layout the build gave the files is
+/// the one to record.
 fn folder_of(file: &Path) -> PathBuf {
-    let p = lexical_absolute(file);
+    let p = import::files::lexical(file);
     p.parent().map_or(p.clone(), Path::to_path_buf)
 }
 
@@ -199,34 +201,12 @@ pub fn hash_inputs(paths: &[PathBuf], bases: &[(usize, PathBuf)]) -> CliResult<V
             let bytes = std::fs::read(p).map_err(|e| CliError::io(format!("{}: {e}", p.display())))?;
             let base = bases.iter().rev().find(|(start, _)| *start <= i).map(|(_, b)| b).or(first.as_ref());
             let path = match base {
-                Some(base) => relative_path(base, &lexical_absolute(p)),
+                Some(base) => relative_path(base, &import::files::lexical(p)),
                 None => p.display().to_string(),
             };
             Ok(InputFile { path, bytes: bytes.len() as u64, hash: ContentHash::of(&bytes).to_hex() })
         })
         .collect()
-}
-
-/// `p` made absolute against the working directory, with `.` and `..` resolved by the names alone:
-/// links are not followed, since a sandboxed build links each input from somewhere else and the
-/// layout the build gave the files is the one to record.
-fn lexical_absolute(p: &Path) -> PathBuf {
-    use std::path::Component;
-    let joined = match std::env::current_dir() {
-        Ok(cwd) if p.is_relative() => cwd.join(p),
-        _ => p.to_path_buf(),
-    };
-    let mut out = PathBuf::new();
-    for c in joined.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                out.pop();
-            }
-            other => out.push(other.as_os_str()),
-        }
-    }
-    out
 }
 
 /// The `/`-separated path from folder `base` to `p` (both absolute and lexically normal), with

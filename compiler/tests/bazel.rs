@@ -28,15 +28,24 @@ fn free_port() -> u16 {
     TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
 }
 
-/// Runs `cmd`, as the `postgres` user when the test runs as root (PostgreSQL refuses root);
-/// fails the test with its output if it fails.
-fn run_pg(cmd: &Path, args: &[&str], as_postgres: bool) {
-    let o = if as_postgres {
-        Command::new("runuser").args(["-u", "postgres", "--"]).arg(cmd).args(args).output()
+/// A command running `program`, as the `postgres` user when `as_postgres` (the test runs as
+/// root, which PostgreSQL refuses).
+fn pg_command(program: &Path, as_postgres: bool) -> Command {
+    if as_postgres {
+        let mut c = Command::new("runuser");
+        c.args(["-u", "postgres", "--"]).arg(program);
+        c
     } else {
-        Command::new(cmd).args(args).output()
+        Command::new(program)
     }
-    .unwrap_or_else(|e| panic!("{} does not start: {e}", cmd.display()));
+}
+
+/// Runs `cmd` with `args` as [`pg_command`] does; fails the test with its output if it fails.
+fn run_pg(cmd: &Path, args: &[&str], as_postgres: bool) {
+    let o = pg_command(cmd, as_postgres)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("{} does not start: {e}", cmd.display()));
     assert!(
         o.status.success(),
         "{} {args:?} failed:\n{}{}",
@@ -90,13 +99,8 @@ impl Postgres {
 
 impl Drop for Postgres {
     fn drop(&mut self) {
-        let pg_ctl = self.bin.join("pg_ctl");
         let args = ["-D", self.data.to_str().unwrap(), "-m", "immediate", "stop"];
-        let _ = if self.as_postgres {
-            Command::new("runuser").args(["-u", "postgres", "--"]).arg(&pg_ctl).args(args).output()
-        } else {
-            Command::new(&pg_ctl).args(args).output()
-        };
+        let _ = pg_command(&self.bin.join("pg_ctl"), self.as_postgres).args(args).output();
     }
 }
 

@@ -67,16 +67,19 @@ fn demo(dir: &Path, out: &str, cache: Option<&str>, args: &[&str]) -> (Vec<(Stri
         all.extend_from_slice(&["--cache", c]);
     }
     let stderr = ok(dir, &all);
-    let j: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join(&report)).unwrap()).unwrap();
-    let stages = j["stages"]
+    (stages(&dir.join(&report)), stderr)
+}
+
+/// The `cached` flag of every stage that ran (import and write aside) in the `--report` at `path`.
+fn stages(path: &Path) -> Vec<(String, bool)> {
+    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    j["stages"]
         .as_array()
         .unwrap()
         .iter()
         .filter(|s| s["run"] == true && !matches!(s["stage"].as_str(), Some("import" | "write")))
         .map(|s| (s["stage"].as_str().unwrap().to_string(), s["cached"].as_bool().unwrap()))
-        .collect();
-    (stages, stderr)
+        .collect()
 }
 
 /// The stages with `cached == want`.
@@ -518,14 +521,7 @@ fn a_cache_filled_from_one_checkout_serves_another_elsewhere() {
                 "missing-setup=ignore",
             ],
         );
-        let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap();
-        j["stages"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .filter(|s| s["run"] == true && !matches!(s["stage"].as_str(), Some("import" | "write")))
-            .map(|s| (s["stage"].as_str().unwrap().to_string(), s["cached"].as_bool().unwrap()))
-            .collect::<Vec<_>>()
+        stages(&report)
     };
     let first = compile(&a, "a.kiln");
     assert!(with(&first, true).is_empty() && !first.is_empty(), "a cold cache: {first:?}");

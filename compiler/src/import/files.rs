@@ -58,8 +58,9 @@ pub fn confine(rule: Option<(&[PathBuf], &[PathBuf])>) {
     *CONFINEMENT.lock().unwrap_or_else(|e| e.into_inner()) = rule;
 }
 
-/// `path` made absolute against the working folder, with `.` and `..` resolved as written.
-fn lexical(path: &Path) -> PathBuf {
+/// `path` made absolute against the working folder, with `.` and `..` resolved as written (links
+/// not followed).
+pub(crate) fn lexical(path: &Path) -> PathBuf {
     let mut out =
         if path.is_absolute() { PathBuf::new() } else { std::env::current_dir().unwrap_or_default() };
     for c in path.components() {
