@@ -1,17 +1,20 @@
 //! kiln's reference path tracer (`kiln-play --reference`) against Mitsuba 3, an independent
-//! renderer: the diffuse Cornell box rendered by both from the same geometry, albedos, light and
-//! camera, compared with HDR-FLIP and relative MSE.
+//! renderer: scenes rendered by both from the same geometry, materials, lights and camera,
+//! compared with HDR-FLIP and relative MSE.
 //!
-//! Two cases cover both kinds of emitter kiln's next-event estimation handles: the demo box with
-//! its analytic rect light, and the same box with the light replaced by an emissive quad (one-sided
-//! emissive triangles). Mitsuba renders many more samples per pixel than kiln and serves as the
-//! reference; the mean HDR-FLIP of kiln's image against it must be at most 0.05. For scale, the
-//! tests also print the error of Mitsuba's own image at kiln's sample count (another seed): what
-//! noise alone gives. An unbiased kiln comes close to it.
+//! The cases cover both kinds of emitter kiln's next-event estimation handles (the demo box with
+//! its analytic rect light, and the same box with the light replaced by an emissive quad), vertex
+//! colours, fog, an environment map, and glTF's glossy BSDF (metal, a dielectric with a coloured
+//! F0, a clear coat): Mitsuba renders that through `tests/mitsuba/gltf_bsdf.py`, a Python plugin
+//! written from the definitions. Mitsuba renders many more samples per pixel than kiln and serves
+//! as the reference; the mean HDR-FLIP of kiln's image against it must be at most 0.05, or, where
+//! Mitsuba's own image at kiln's sample count (another seed, printed as the noise floor) is
+//! further off than that, within 15 % of that noise. An unbiased kiln comes close to it.
 //!
 //! The scene goes to Mitsuba as JSON (`tests/mitsuba/render.py` documents the mapping of
-//! kiln's conventions onto Mitsuba's), rendered with the `scalar_rgb` variant on the CPU. The
-//! comparison runs in the same script with `flip_evaluator`, the FLIP authors' implementation.
+//! kiln's conventions onto Mitsuba's), rendered on the CPU (`scalar_rgb`; `llvm_ad_rgb` for glossy
+//! materials). The comparison runs in the same script with `flip_evaluator`, the FLIP authors'
+//! implementation.
 //!
 //! Needs a Vulkan device and a Python with `mitsuba`, `flip-evaluator` and `numpy`: the virtual
 //! environment `.venv-mitsuba` at the workspace root, or the interpreter `KILN_MITSUBA_PYTHON`
@@ -30,7 +33,7 @@ use kiln_compiler::import::demo::{cornell_box, lambert_material};
 use kiln_compiler::ir::{Material, Scene};
 use kiln_compiler::settings::Settings;
 use kiln_format::manifest::{Bounds, LightKind, Medium};
-use kiln_format::sections::{MaterialFlags, NO_TEXTURE, Vertex};
+use kiln_format::sections::{GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
 use kiln_test_support::{gpu_test, mitsuba_python, read_npy, require, workspace, write_npy};
 use kiln_tests::{Options, compile};
 
@@ -47,6 +50,10 @@ const KILN_SPP_FOG: u32 = 1024;
 const MITSUBA_SPP: u32 = 8192;
 /// The bound on mean HDR-FLIP of kiln's image against Mitsuba's.
 const MAX_MEAN_FLIP: f64 = 0.05;
+
+/// kiln's mean FLIP against Mitsuba's reference may exceed `MAX_MEAN_FLIP` only up to this
+/// multiple of Mitsuba's own at kiln's sample count (another seed).
+const NOISE_MARGIN: f64 = 1.15;
 
 /// The renderers take turns, so that each has the machine's cores and its time is its own.
 static MACHINE: Mutex<()> = Mutex::new(());
@@ -68,8 +75,8 @@ fn scene_json(s: &Scene, env_npy: Option<&Path>) -> String {
     for (m, material) in s.materials.iter().enumerate() {
         let g = &material.gpu;
         assert!(
-            g.flags & MaterialFlags::DIFFUSE_ONLY != 0 && g.base_color_texture == NO_TEXTURE,
-            "{}: only untextured Lambertian materials map onto Mitsuba's diffuse here",
+            g.textures().iter().all(|&t| t == NO_TEXTURE),
+            "{}: only untextured materials map onto Mitsuba here",
             material.name
         );
         assert!(
@@ -96,8 +103,27 @@ fn scene_json(s: &Scene, env_npy: Option<&Path>) -> String {
             continue;
         }
         let b = g.base_color;
+        // Lambertian materials become Mitsuba's `diffuse`; the others glTF's BSDF
+        // (`tests/mitsuba/gltf_bsdf.py`), given its parameters.
+        let glossy = if g.flags & MaterialFlags::DIFFUSE_ONLY != 0 {
+            String::new()
+        } else {
+            let (f0, f90) = g.dielectric();
+            format!(
+                r#","material":{{"base_r":{},"base_g":{},"base_b":{},"metallic":{},"roughness":{},"f0_r":{},"f0_g":{},"f0_b":{},"f90":{}}}"#,
+                num(b[0]),
+                num(b[1]),
+                num(b[2]),
+                num(g.metallic),
+                num(g.roughness),
+                num(f0[0]),
+                num(f0[1]),
+                num(f0[2]),
+                num(f90),
+            )
+        };
         meshes.push(format!(
-            r#"{{"name":"{}","albedo":{},"emission":{},"positions":[{}],"triangles":[{}],"colors":[{}]}}"#,
+            r#"{{"name":"{}","albedo":{},"emission":{},"positions":[{}],"triangles":[{}],"colors":[{}]{glossy}}}"#,
             material.name,
             vec3([b[0], b[1], b[2]]),
             vec3(g.emission),
@@ -254,7 +280,15 @@ fn check(case: &str, scene: Scene, kiln_spp: u32) {
         let mitsuba = read_npy(&mitsuba_path, W, H);
         assert_red_left(&format!("{case} (mitsuba)"), &mitsuba);
     }
-    assert!(flip <= MAX_MEAN_FLIP, "{case}: mean FLIP {flip:.4} > {MAX_MEAN_FLIP} (relMSE {rel_mse:.5})");
+    // Where Mitsuba's own noise at kiln's sample count exceeds the bound (glossy highlights), kiln
+    // must come within NOISE_MARGIN of that noise instead: a bias adds to it (a coloured F0 read
+    // as grey: 1.45 times the noise in the glossy case).
+    let floor = n["mean_flip"].as_f64().unwrap();
+    let bound = MAX_MEAN_FLIP.max(NOISE_MARGIN * floor);
+    assert!(
+        flip <= bound,
+        "{case}: mean FLIP {flip:.4} > {bound:.4} (relMSE {rel_mse:.5}; Mitsuba's noise floor {floor:.4})"
+    );
 }
 
 #[test]
@@ -401,4 +435,59 @@ fn cornell_box_with_an_emissive_quad_matches_mitsuba() {
     scene.triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
     scene.triangle_materials.extend([material; 2]);
     check("emissive", scene, KILN_SPP);
+}
+
+#[test]
+fn glossy_blocks_in_the_cornell_box_match_mitsuba() {
+    // glTF's metallic-roughness BSDF (Mitsuba through `tests/mitsuba/gltf_bsdf.py`): the demo box
+    // with its blocks made a rough gold metal and a dielectric with a coloured F0
+    // (KHR_materials_specular), and a smooth blue dielectric floor that mirrors the room and the
+    // light at grazing angles. The rect light's highlights on them come from next-event
+    // estimation, the reflections of the walls from sampling the GGX lobes, both weighted by MIS.
+    let mut scene = cornell_box();
+    let mut add = |name: &str, gpu: GpuMaterial| {
+        scene.materials.push(Material { name: name.into(), gpu });
+        scene.materials.len() as u32 - 1
+    };
+    let gold = add(
+        "gold",
+        GpuMaterial {
+            base_color: [1.0, 0.78, 0.34, 1.0],
+            metallic: 1.0,
+            roughness: 0.35,
+            ..GpuMaterial::default()
+        },
+    );
+    let mut tinted = GpuMaterial {
+        base_color: [0.2, 0.5, 0.25, 1.0],
+        metallic: 0.0,
+        roughness: 0.25,
+        ..GpuMaterial::default()
+    };
+    tinted.set_dielectric([0.25, 0.12, 0.4], 0.8);
+    let tinted = add("tinted", tinted);
+    let floor = add(
+        "floor",
+        GpuMaterial {
+            base_color: [0.3, 0.35, 0.6, 1.0],
+            metallic: 0.0,
+            roughness: 0.15,
+            ..GpuMaterial::default()
+        },
+    );
+    // The demo's triangles: the floor's two first, then the other walls' (8), then the two
+    // blocks' (short, tall), five faces of two triangles each.
+    let blocks = 10;
+    let n = scene.triangle_materials.len();
+    assert_eq!(n, 10 + 2 * blocks, "the demo box's five walls and two blocks");
+    for (i, m) in scene.triangle_materials.iter_mut().enumerate() {
+        if i < 2 {
+            *m = floor;
+        } else if i >= n - 2 * blocks && i < n - blocks {
+            *m = tinted;
+        } else if i >= n - blocks {
+            *m = gold;
+        }
+    }
+    check("glossy", scene, KILN_SPP);
 }

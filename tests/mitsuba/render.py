@@ -15,6 +15,9 @@ emitted radiance) and one-sided rectangular lights. The conventions are kiln's r
 tracer's (shaders/reference/pathtrace.comp), mapped to Mitsuba's:
 
 - Lambertian surfaces reflect on both sides in kiln: `twosided(diffuse)`.
+- A mesh with a `material` (base colour, metallic, roughness, the dielectric's F0 and F90, clear
+  coat and its roughness) is glTF's metallic-roughness BSDF, `gltf_bsdf.py`'s Python plugin:
+  rendered with the `llvm_ad_rgb` variant (Python called once per wavefront, not per sample).
 - Vertex colours (a mesh's optional `colors`, linear RGB per vertex) multiply the albedo: the
   product is written as the PLY's float `r, g, b`, read through `mesh_attribute` `vertex_color`.
 - Emissive triangles emit from the front face only (as Mitsuba's `area` emitter does); flat
@@ -131,12 +134,12 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
             colors = np.asarray(colors, dtype=float).reshape(-1, 3) * np.asarray(m["albedo"], dtype=float)
             reflectance = {"type": "mesh_attribute", "name": "vertex_color"}
         write_ply(path, m["positions"], m["triangles"], colors)
-        shape = {
-            "type": "ply",
-            "filename": path,
-            "face_normals": True,
-            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}},
-        }
+        bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}}
+        material = m.get("material")
+        if material is not None:
+            assert colors is None, "vertex colours on a glossy material are not mapped"
+            bsdf = {"type": "kiln_gltf", **{k: float(v) for k, v in material.items()}}
+        shape = {"type": "ply", "filename": path, "face_normals": True, "bsdf": bsdf}
         if any(v > 0.0 for v in m["emission"]):
             shape["emitter"] = {"type": "area", "radiance": rgb(m["emission"])}
         scene[f"mesh{i}"] = shape
@@ -162,17 +165,54 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
     return scene
 
 
-def render(scene_path, out_path, spp, size, seed):
-    import mitsuba as mi
+def find_libllvm():
+    """Dr.Jit's LLVM back end, which a Python BSDF needs (the scalar variant would call Python
+    once per sample), wants an LLVM newer than Debian 12's default 15: `.ci/run` installs
+    libllvm19. The newest libLLVM-NN.so found, unless DRJIT_LIBLLVM_PATH names one."""
+    if os.environ.get("DRJIT_LIBLLVM_PATH"):
+        return
+    found = []
+    for folder in ("/usr/lib/x86_64-linux-gnu", "/usr/lib/aarch64-linux-gnu", "/usr/lib64", "/usr/lib"):
+        for name in os.listdir(folder) if os.path.isdir(folder) else []:
+            digits = name[len("libLLVM-"):-len(".so")]
+            if name.startswith("libLLVM-") and name.endswith(".so") and digits.isdigit() and int(digits) >= 17:
+                found.append((int(digits), os.path.join(folder, name)))
+    if not found:
+        sys.exit("render.py: glossy materials need Mitsuba's LLVM variant and libLLVM 17 or newer "
+                 "(Debian: apt-get install libllvm19), or DRJIT_LIBLLVM_PATH naming one")
+    os.environ["DRJIT_LIBLLVM_PATH"] = max(found)[1]
 
-    mi.set_variant("scalar_rgb")
+
+# Samples per pixel per pass of the LLVM variant, which holds a pass's paths in memory at once.
+LLVM_PASS_SPP = 256
+
+
+def render(scene_path, out_path, spp, size, seed):
     width, height = (int(v) for v in size.split("x"))
     with open(scene_path) as f:
         desc = json.load(f)
+    glossy = any("material" in m for m in desc["meshes"])
+    if glossy:
+        find_libllvm()
+    import mitsuba as mi
+
+    mi.set_variant("llvm_ad_rgb" if glossy else "scalar_rgb")
+    if glossy:
+        import gltf_bsdf
+
+        gltf_bsdf.register()
     with tempfile.TemporaryDirectory() as tmp:
         scene = mi.load_dict(scene_dict(mi, desc, tmp, width, height, spp, seed))
     t0 = time.perf_counter()
-    image = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float32)
+    if glossy:
+        # Passes of at most LLVM_PASS_SPP samples, each with its own seed, averaged.
+        passes = [LLVM_PASS_SPP] * (spp // LLVM_PASS_SPP) + ([spp % LLVM_PASS_SPP] if spp % LLVM_PASS_SPP else [])
+        total = np.zeros((height, width, 3), dtype=np.float64)
+        for k, n in enumerate(passes):
+            total += np.array(mi.render(scene, spp=n, seed=seed * 100003 + k), dtype=np.float64) * n
+        image = (total / spp).astype(np.float32)
+    else:
+        image = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float32)
     seconds = time.perf_counter() - t0
     assert image.shape == (height, width, 3), image.shape
     np.save(out_path, image)
