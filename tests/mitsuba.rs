@@ -110,7 +110,7 @@ fn scene_json(s: &Scene, env_npy: Option<&Path>) -> String {
         } else {
             let (f0, f90) = g.dielectric();
             format!(
-                r#","material":{{"base_r":{},"base_g":{},"base_b":{},"metallic":{},"roughness":{},"f0_r":{},"f0_g":{},"f0_b":{},"f90":{}}}"#,
+                r#","material":{{"base_r":{},"base_g":{},"base_b":{},"metallic":{},"roughness":{},"f0_r":{},"f0_g":{},"f0_b":{},"f90":{},"clearcoat":{},"clearcoat_roughness":{}}}"#,
                 num(b[0]),
                 num(b[1]),
                 num(b[2]),
@@ -120,6 +120,8 @@ fn scene_json(s: &Scene, env_npy: Option<&Path>) -> String {
                 num(f0[1]),
                 num(f0[2]),
                 num(f90),
+                num(g.clearcoat),
+                num(g.clearcoat_roughness),
             )
         };
         meshes.push(format!(
@@ -441,8 +443,8 @@ fn cornell_box_with_an_emissive_quad_matches_mitsuba() {
 fn glossy_blocks_in_the_cornell_box_match_mitsuba() {
     // glTF's metallic-roughness BSDF (Mitsuba through `tests/mitsuba/gltf_bsdf.py`): the demo box
     // with its blocks made a rough gold metal and a dielectric with a coloured F0
-    // (KHR_materials_specular), and a smooth blue dielectric floor that mirrors the room and the
-    // light at grazing angles. The rect light's highlights on them come from next-event
+    // (KHR_materials_specular), and the floor a rough blue dielectric under a smooth clear coat
+    // (KHR_materials_clearcoat: car paint) that mirrors the room and the light. The rect light's highlights on them come from next-event
     // estimation, the reflections of the walls from sampling the GGX lobes, both weighted by MIS.
     let mut scene = cornell_box();
     let mut add = |name: &str, gpu: GpuMaterial| {
@@ -471,7 +473,9 @@ fn glossy_blocks_in_the_cornell_box_match_mitsuba() {
         GpuMaterial {
             base_color: [0.3, 0.35, 0.6, 1.0],
             metallic: 0.0,
-            roughness: 0.15,
+            roughness: 0.6,
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.15,
             ..GpuMaterial::default()
         },
     );

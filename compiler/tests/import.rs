@@ -11,7 +11,7 @@ use kiln_compiler::import::{import, import_with};
 use kiln_compiler::ir::{Scene, TextureRole};
 use kiln_compiler::settings::Normals;
 use kiln_format::manifest::{LightKind, Wrap};
-use kiln_format::sections::MaterialFlags;
+use kiln_format::sections::{MaterialFlags, NO_TEXTURE};
 use serde_json::json;
 
 /// cos 45° = sin 45°, for quaternions of 90° turns.
@@ -868,6 +868,19 @@ fn far_scenes_keep_their_precision_relative_to_a_stored_origin() {
     assert_eq!(world(s.lights[0].position), [250000.625, 5.0, -89999.75]);
 }
 
+/// Copies the first mesh's first primitive once per material of `g`, each copy using its own.
+fn one_primitive_per_material(g: &mut Gltf) {
+    let prim = g.json["meshes"][0]["primitives"][0].clone();
+    let prims: Vec<_> = (0..g.json["materials"].as_array().map_or(0, Vec::len))
+        .map(|m| {
+            let mut p = prim.clone();
+            p["material"] = m.into();
+            p
+        })
+        .collect();
+    g.json["meshes"][0]["primitives"] = json!(prims);
+}
+
 /// KHR_materials_transmission is read as coverage: an opaque material transmitting t blends
 /// with alpha 1 − t, a blended one multiplies its alpha by 1 − t, a masked one keeps its mask;
 /// each says what is lost. (The reference path tracer's reading of coverage is checked in
@@ -884,15 +897,7 @@ fn transmission_is_read_as_coverage_with_a_warning() {
         {"name": "masked", "alphaMode": "MASK", "extensions": t(0.5)},
         {"name": "none", "extensions": t(0.0)}
     ]);
-    let prim = g.json["meshes"][0]["primitives"][0].clone();
-    let prims: Vec<_> = (0..4)
-        .map(|m| {
-            let mut p = prim.clone();
-            p["material"] = m.into();
-            p
-        })
-        .collect();
-    g.json["meshes"][0]["primitives"] = json!(prims);
+    one_primitive_per_material(&mut g);
     let s = import(&g.write(d.path(), "t")).unwrap();
     let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
     let mode = |g: kiln_format::sections::GpuMaterial| g.flags >> MaterialFlags::ALPHA_MODE_SHIFT & 3;
@@ -907,5 +912,60 @@ fn transmission_is_read_as_coverage_with_a_warning() {
     let warned = |text: &str| s.warnings.iter().filter(|w| w.message.contains(text)).count();
     assert_eq!(warned("is read as coverage"), 2, "{:#?}", s.warnings);
     assert_eq!(warned("on an alpha-masked material is not applied"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("used but not supported"), 0, "{:#?}", s.warnings);
+}
+
+/// KHR_materials_clearcoat, which the gltf crate does not parse, read from its JSON: factors
+/// (clamped into [0, 1] with a warning), both textures (one image in both roles is one data
+/// texture) through their KHR_texture_transform; a payload kiln cannot use costs a warning,
+/// never the import.
+#[test]
+fn clear_coats_are_read_and_bad_payloads_only_warned_about() {
+    let d = tempfile::tempdir().unwrap();
+    write_white_png(d.path());
+    let mut g = Gltf::quad();
+    let coat = |c: serde_json::Value| json!({ "KHR_materials_clearcoat": c });
+    g.textured(
+        json!({"name": "paint", "extensions": coat(json!({
+            "clearcoatFactor": 0.8,
+            "clearcoatRoughnessFactor": 0.2,
+            "clearcoatTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2.0, 3.0]}}},
+            "clearcoatRoughnessTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2.0, 3.0]}}}
+        }))}),
+        "white.png",
+    );
+    g.json["extensionsUsed"] = json!(["KHR_materials_clearcoat", "KHR_texture_transform"]);
+    let mut materials = g.json["materials"].as_array().unwrap().clone();
+    materials.extend([
+        json!({"name": "loud", "extensions": coat(json!({"clearcoatFactor": 3.0, "clearcoatRoughnessFactor": -1.0}))}),
+        json!({"name": "odd", "extensions": coat(json!({"clearcoatFactor": "shiny"}))}),
+        json!({"name": "missing", "extensions": coat(json!({"clearcoatFactor": 1.0, "clearcoatTexture": {"index": 7}}))}),
+        json!({"name": "bumpy", "extensions": coat(json!({"clearcoatFactor": 1.0, "clearcoatNormalTexture": {"index": 0}}))}),
+        json!({"name": "scalar", "extensions": coat(json!(5))}),
+        json!({"name": "bare"}),
+    ]);
+    g.json["materials"] = json!(materials);
+    one_primitive_per_material(&mut g);
+    let s = import(&g.write(d.path(), "coat")).unwrap();
+    let m = |name: &str| s.materials.iter().find(|m| m.name == name).unwrap().gpu;
+    let paint = m("paint");
+    assert_eq!((paint.clearcoat, paint.clearcoat_roughness), (0.8, 0.2));
+    assert_ne!(paint.clearcoat_texture, NO_TEXTURE);
+    assert_eq!(paint.clearcoat_texture, paint.clearcoat_roughness_texture, "one data texture in both slots");
+    // The coat's transform is the material's mapping, baked into the coordinates.
+    assert_eq!(s.uvs[..4], [[0.0, 0.0], [2.0, 0.0], [2.0, 3.0], [0.0, 3.0]]);
+    assert_eq!((m("loud").clearcoat, m("loud").clearcoat_roughness), (1.0, 0.0));
+    assert_eq!(m("odd").clearcoat, 0.0);
+    assert_eq!((m("missing").clearcoat, m("missing").clearcoat_texture), (1.0, NO_TEXTURE));
+    assert_eq!(m("bumpy").clearcoat, 1.0);
+    for name in ["scalar", "bare"] {
+        assert_eq!((m(name).clearcoat, m(name).clearcoat_texture), (0.0, NO_TEXTURE), "{name}");
+    }
+    let warned = |text: &str| s.warnings.iter().filter(|w| w.message.contains(text)).count();
+    assert_eq!(warned("clamped to"), 2, "{:#?}", s.warnings);
+    assert_eq!(warned("\"shiny\", not a number"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("does not name one of the file's 1 textures"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("clearcoatNormalTexture is not applied"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("is not a JSON object"), 1, "{:#?}", s.warnings);
     assert_eq!(warned("used but not supported"), 0, "{:#?}", s.warnings);
 }

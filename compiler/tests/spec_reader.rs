@@ -1003,10 +1003,13 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
     assert_eq!(geo.colors, view.colors, "{name}: COL0");
     assert_eq!(geo.tris, view.triangles, "{name}: TRIS");
     assert_eq!(geo.tmat, view.triangle_materials, "{name}: TMAT");
+    // Format 1.8 writes MATL version 2: 96-byte records.
     let matl = f.section(b"MATL", 0).unwrap();
-    assert_eq!(matl.len(), 80 * view.materials.len());
+    let matl_entry = f.entries.iter().find(|e| &e.kind == b"MATL").unwrap();
+    assert_eq!(matl_entry.version, 2, "{name}: MATL version");
+    assert_eq!(matl.len(), 96 * view.materials.len());
     for (i, m) in view.materials.iter().enumerate() {
-        let b = &matl[80 * i..80 * i + 80];
+        let b = &matl[96 * i..96 * i + 96];
         use spec::{f32_at, f32s, u32_at};
         let mine = (
             f32s::<4>(b, 0),
@@ -1014,6 +1017,8 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
             [f32_at(b, 28), f32_at(b, 32), f32_at(b, 36), f32_at(b, 40), f32_at(b, 44)],
             [u32_at(b, 48), u32_at(b, 52), u32_at(b, 56), u32_at(b, 60), u32_at(b, 64), u32_at(b, 68)],
             [u32_at(b, 72), u32_at(b, 76)],
+            [f32_at(b, 80), f32_at(b, 84)],
+            [u32_at(b, 88), u32_at(b, 92)],
         );
         let theirs = (
             m.base_color,
@@ -1029,6 +1034,8 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
             ],
             // Format 1.7: zero unless flag bit 4 says they hold the dielectric's F0 and F90.
             if m.flags & 16 == 0 { [0, 0] } else { m.specular },
+            [m.clearcoat, m.clearcoat_roughness],
+            [m.clearcoat_texture, m.clearcoat_roughness_texture],
         );
         assert_eq!(mine, theirs, "{name}: material {i}");
         if m.flags & 16 != 0 {
@@ -1383,6 +1390,9 @@ fn fixture_with(codec: Codec) -> Vec<u8> {
     metal.flags &= !kiln_format::sections::MaterialFlags::DIFFUSE_ONLY;
     metal.metallic = 1.0;
     metal.roughness = 0.4;
+    metal.clearcoat = 0.5;
+    metal.clearcoat_roughness = 0.25;
+    metal.clearcoat_texture = 0;
     let settings = Settings {
         voxel_res: VoxelRes::Cells(5),
         shaft_res: Some(3),

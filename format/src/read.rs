@@ -294,11 +294,12 @@ impl KilnFile {
             return Ok(None);
         };
         let loc = |e: FormatError| e.in_section(s.position, kind, index).or_offset(s.entry.offset);
-        if s.known.map(|k| k.element_size) != Some(size_of::<T>()) {
+        let element_size = s.known.map(|k| k.element_size_at(s.entry.version));
+        if element_size != Some(size_of::<T>()) {
             return Err(loc(FormatError::invalid(format!(
                 "element type of {} bytes requested, the section holds {}-byte elements",
                 size_of::<T>(),
-                s.known.map_or(0, |k| k.element_size)
+                element_size.unwrap_or(0)
             ))));
         }
         let bytes = self.decoded_bytes(s).map_err(loc)?;
@@ -467,11 +468,12 @@ fn validate_layout(file: &[u8], max_decoded: u64) -> Result<(Header, Vec<Section
                     8,
                 ));
             }
-            if !entry.raw_size.is_multiple_of(k.element_size as u64) {
+            let element_size = k.element_size_at(entry.version);
+            if !entry.raw_size.is_multiple_of(element_size as u64) {
                 return Err(bad(
                     format!(
                         "{} section of {} bytes is not a whole number of {}-byte elements",
-                        k.name, entry.raw_size, k.element_size
+                        k.name, entry.raw_size, element_size
                     ),
                     32,
                 ));

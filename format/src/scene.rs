@@ -1,13 +1,15 @@
 //! A validated view of a file's scene sections: every cross-reference checked once, so that
 //! the player and the queries can index without further checks.
 
+use std::borrow::Cow;
+
 use crate::error::{FormatError, Result};
 use crate::manifest::{ColorSpace, LightKind, Manifest};
 use crate::read::KilnFile;
 use crate::sections::{
-    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, MATERIALS, MEDIA_VISIBILITY,
-    MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES, TextureData, UVS,
-    VERTICES, Vertex, decode_texture, possible_v2_lengths,
+    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, GpuMaterialV1, MATERIALS,
+    MEDIA_VISIBILITY, MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES,
+    TextureData, UVS, VERTICES, Vertex, decode_texture, possible_v2_lengths,
 };
 
 /// Borrowed, validated scene data of a [`KilnFile`].
@@ -25,8 +27,8 @@ pub struct SceneView<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Material of each triangle.
     pub triangle_materials: &'a [u32],
-    /// Materials.
-    pub materials: &'a [GpuMaterial],
+    /// Materials: borrowed from a version 2 `MATL`, converted from a version 1 (no clear coat).
+    pub materials: Cow<'a, [GpuMaterial]>,
     /// BVH nodes (empty if the file has no BVH).
     pub bvh: &'a [CwbvhNode],
     /// The file, for sections read on demand (textures).
@@ -46,7 +48,13 @@ impl<'a> SceneView<'a> {
         let colors: &[[u16; 4]] = file.pod(COLORS, 0)?.unwrap_or(&[]);
         let triangles: &[[u32; 3]] = file.pod(TRIANGLES, 0)?.unwrap_or(&[]);
         let triangle_materials: &[u32] = file.pod(TRIANGLE_MATERIALS, 0)?.unwrap_or(&[]);
-        let materials: &[GpuMaterial] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
+        let materials: Cow<'a, [GpuMaterial]> = match file.find(MATERIALS, 0).map(|s| s.entry.version) {
+            Some(1) => {
+                let old: &[GpuMaterialV1] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
+                old.iter().map(|&m| GpuMaterial::from(m)).collect::<Vec<_>>().into()
+            }
+            _ => file.pod(MATERIALS, 0)?.unwrap_or(&[]).into(),
+        };
         let bvh: &[CwbvhNode] = file.pod(BVH_NODES, 0)?.unwrap_or(&[]);
         // Texture sizes are checked here from the table; their bytes (the bulk of most files)
         // are checksummed when first read, through `texture`.
@@ -205,7 +213,15 @@ impl<'a> SceneView<'a> {
         }
         let nt = self.manifest.textures.len() as u64;
         for (i, m) in self.materials.iter().enumerate() {
-            let scalars = [m.metallic, m.roughness, m.alpha_cutoff, m.normal_scale, m.occlusion_strength];
+            let scalars = [
+                m.metallic,
+                m.roughness,
+                m.alpha_cutoff,
+                m.normal_scale,
+                m.occlusion_strength,
+                m.clearcoat,
+                m.clearcoat_roughness,
+            ];
             if !finite(&m.base_color) || !finite(&m.emission) || !finite(&scalars) {
                 return Err(FormatError::invalid(format!("material {i} has a non-finite parameter")));
             }
@@ -227,6 +243,12 @@ impl<'a> SceneView<'a> {
             {
                 return Err(FormatError::invalid(format!(
                     "material {i}'s dielectric reflectance is not four halves in [0, 1] (F0 {f0:?}, F90 {f90})"
+                )));
+            }
+            if !unit(&m.clearcoat) || !unit(&m.clearcoat_roughness) {
+                return Err(FormatError::invalid(format!(
+                    "material {i}'s clear coat {} or its roughness {} is outside [0, 1]",
+                    m.clearcoat, m.clearcoat_roughness
                 )));
             }
         }

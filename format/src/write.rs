@@ -190,9 +190,9 @@ impl<'a> FileWriter<'a> {
         let bytes = bytes.into();
         if let Some(k) = sections::info(kind)
             && version <= k.version
-            && bytes.len() % k.element_size != 0
+            && bytes.len() % k.element_size_at(version) != 0
         {
-            return Err(WriteError::Ragged { kind, len: bytes.len(), element: k.element_size });
+            return Err(WriteError::Ragged { kind, len: bytes.len(), element: k.element_size_at(version) });
         }
         if self.pending.iter().any(|p| p.kind == kind && p.index == index) {
             return Err(WriteError::Duplicate(kind, index));

@@ -262,3 +262,38 @@ fn failed_atomic_write_keeps_the_old_file() {
     let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(names.len(), 1);
 }
+
+#[test]
+fn version_1_materials_read_as_materials_without_a_coat() {
+    // A material as formats 1.0 to 1.7 stored it: 80 bytes, written field by field here
+    // (FORMAT.md's `MATL` table): base colour, emission, metallic, roughness, alpha cutoff,
+    // normal scale, occlusion strength, five texture numbers, flags, the dielectric's halves.
+    let mut v1 = Vec::new();
+    let floats = [0.8f32, 0.5, 0.25, 1.0, 2.0, 3.0, 4.0, 0.0, 0.7, 0.5, 1.0, 0.9];
+    for f in floats {
+        v1.extend(f.to_le_bytes());
+    }
+    for u in [0u32, u32::MAX, u32::MAX, u32::MAX, u32::MAX, 1, 0, 0] {
+        v1.extend(u.to_le_bytes());
+    }
+    assert_eq!(v1.len(), 80);
+    let bytes = common::small_file_with_materials(1, &v1);
+    let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = kiln_format::scene::SceneView::new(&f).unwrap();
+    let m = &view.materials[0];
+    assert_eq!(m.base_color, [0.8, 0.5, 0.25, 1.0]);
+    assert_eq!(m.emission, [2.0, 3.0, 4.0]);
+    assert_eq!((m.metallic, m.roughness, m.alpha_cutoff), (0.0, 0.7, 0.5));
+    assert_eq!((m.normal_scale, m.occlusion_strength), (1.0, 0.9));
+    assert_eq!(m.base_color_texture, 0);
+    assert_eq!(m.flags, 1);
+    assert_eq!(m.specular, [0, 0]);
+    // No coat, and no coat textures (not texture 0, which zeroed words would name).
+    assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.0, 0.0));
+    assert_eq!((m.clearcoat_texture, m.clearcoat_roughness_texture), (u32::MAX, u32::MAX));
+
+    // 80 bytes are not a whole version-2 record: refused, not written as a torn material.
+    let mut w = FileWriter::new();
+    let err = w.raw(sections::MATERIALS, 0, 2, &v1[..], ContentHash::of(b"m")).unwrap_err();
+    assert!(err.to_string().contains("96"), "{err}");
+}

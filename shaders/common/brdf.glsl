@@ -16,6 +16,8 @@ struct Material {
     bool diffuse_only;
     vec3 f0;          // the dielectric part's Schlick reflectance at normal incidence (glTF core 0.04)
     float f90;        // … at grazing incidence (glTF core 1; KHR_materials_specular's factor)
+    float clearcoat;  // KHR_materials_clearcoat's strength (0: no coat); passes that trace rays only
+    float clearcoat_roughness;  // the coat's perceptual roughness
 };
 
 // glTF's core dielectric reflectance (an index of refraction of 1.5), without

@@ -49,6 +49,9 @@ Material gbuffer_material(vec4 albedo, vec4 mat) {
     float k = min(round(mat.b * 255.0), 125.0) / 125.0;
     m.f0 = vec3(k * k);
     m.f90 = albedo.a;
+    // The G-buffer's 8-bit targets are full: the raster frame has no clear coat.
+    m.clearcoat = 0.0;
+    m.clearcoat_roughness = 0.0;
     return m;
 }
 

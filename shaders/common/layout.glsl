@@ -59,7 +59,11 @@ struct GpuMaterialLayout {
     uint emissive_texture; // offset 64
     uint flags; // offset 68
     uvec2 specular; // offset 72
-}; // 80 bytes
+    float clearcoat; // offset 80
+    float clearcoat_roughness; // offset 84
+    uint clearcoat_texture; // offset 88
+    uint clearcoat_roughness_texture; // offset 92
+}; // 96 bytes
 
 struct ReferenceConstants {
     vec4 eye; // offset 0

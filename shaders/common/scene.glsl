@@ -62,6 +62,7 @@ struct Surface {
     vec3 p;
     vec3 ng;        // geometric normal, facing the incoming ray
     vec3 ns;        // shading normal, same side as ng
+    vec3 nc;        // the clear coat's normal: the interpolated normal (no normal map), same side
     bool front;     // the ray hit the triangle's front (counter-clockwise) face
     Material mat;
     vec3 emission;  // emitted radiance towards the ray (zero from a back face of a one-sided material)
@@ -72,6 +73,9 @@ struct Surface {
 // texture only where the material emits.
 uint surface_slots(GpuMaterialLayout m) {
     uint slots = (1u << SLOT_BASE_COLOR) | (1u << SLOT_METALLIC_ROUGHNESS) | (1u << SLOT_NORMAL);
+    if (m.clearcoat > 0.0) {
+        slots |= (1u << SLOT_CLEARCOAT) | (1u << SLOT_CLEARCOAT_ROUGHNESS);
+    }
     return any(greaterThan(m.emission, vec3(0.0))) ? slots | (1u << SLOT_EMISSIVE) : slots;
 }
 
@@ -85,6 +89,8 @@ void surface_textured(inout Surface s, GpuMaterialLayout m, vec4 texel[MATERIAL_
     s.mat.roughness = clamp(m.roughness * mr.g, 0.0, 1.0);
     s.mat.diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
     material_dielectric(m, s.mat.f0, s.mat.f90);
+    s.mat.clearcoat = clamp(m.clearcoat * texel[SLOT_CLEARCOAT].r, 0.0, 1.0);
+    s.mat.clearcoat_roughness = clamp(m.clearcoat_roughness * texel[SLOT_CLEARCOAT_ROUGHNESS].g, 0.0, 1.0);
     vec3 e = m.emission * texel[SLOT_EMISSIVE].rgb;
     bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
     s.emission = (s.front || double_sided) ? e : vec3(0.0);
@@ -109,6 +115,7 @@ Surface surface_at(TraceRay r, TraceHit h) {
     uvec3 idx = uvec3(indices[3u * tri], indices[3u * tri + 1u], indices[3u * tri + 2u]);
     vec3 ns = w0 * vertex_normal(idx.x) + h.u * vertex_normal(idx.y) + h.v * vertex_normal(idx.z);
     ns = dot(ns, ns) > 0.0 ? normalize(ns) : ng;
+    vec3 nc = ns;
     GpuMaterialLayout m = materials[tri_materials[tri]];
     vec2 uv = vec2(0.0);
     bool textured = m.base_color_texture != NO_TEXTURE || m.metallic_roughness_texture != NO_TEXTURE || m.normal_texture != NO_TEXTURE
@@ -142,13 +149,18 @@ Surface surface_at(TraceRay r, TraceHit h) {
     if (!s.front) {
         ng = -ng;
         ns = -ns;
+        nc = -nc;
     }
     // A shading normal on the far side of the surface would light the wrong hemisphere.
     if (dot(ns, ng) <= 0.0) {
         ns = ng;
     }
+    if (dot(nc, ng) <= 0.0) {
+        nc = ng;
+    }
     s.ng = ng;
     s.ns = ns;
+    s.nc = nc;
     surface_textured(s, m, texel, interpolated_color(idx, h.u, h.v));
     return s;
 }
@@ -164,11 +176,27 @@ bool trace_surface(TraceRay r, out Surface s) {
 }
 
 // ---------------------------------------------------------------- BRDF sampling
-// f(wo, wi) · |n·wi|, zero below the geometric surface.
-vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
-    if (dot(s.ng, wi) <= 0.0) {
-        return vec3(0.0);
+// The clear coat (KHR_materials_clearcoat's `fresnel_coat`): a GGX lobe of the coat's roughness
+// about its normal nc, of weight w = clearcoat · Fc with Fc the Schlick Fresnel of an index of
+// refraction of 1.5 at the view direction (F0 0.04), over the base, which keeps 1 − w:
+// f_cos = (1 − w) f_base (ns·wi) + w D_c Vis_c (nc·wi).
+float coat_weight(Surface s, vec3 wo) {
+    return s.mat.clearcoat * fresnel_schlick(DIELECTRIC_F0, vec3(1.0), clamp(dot(s.nc, wo), 0.0, 1.0)).x;
+}
+
+// The coat's GGX lobe times nc·wi (no Fresnel: it is in the weight).
+float coat_cos(Surface s, vec3 wo, vec3 wi) {
+    float n_l = dot(s.nc, wi);
+    float n_v = dot(s.nc, wo);
+    if (n_l <= 0.0 || n_v <= 0.0) {
+        return 0.0;
     }
+    float a = ggx_alpha(s.mat.clearcoat_roughness);
+    float a2 = a * a;
+    return ggx_d(max(dot(s.nc, normalize(wo + wi)), 0.0), a2) * smith_visibility(n_l, n_v, a2) * n_l;
+}
+
+vec3 base_brdf_cos(Surface s, vec3 wo, vec3 wi) {
     float n_l = dot(s.ns, wi);
     float n_v = dot(s.ns, wo);
     if (n_l <= 0.0 || n_v <= 0.0) {
@@ -188,7 +216,20 @@ vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
     return ((1.0 - f) * (1.0 - s.mat.metallic) * s.mat.base / PI + f * d * vis) * n_l;
 }
 
-// Probability of choosing the specular lobe.
+// f(wo, wi) · |n·wi|, zero below the geometric surface.
+vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
+    if (dot(s.ng, wi) <= 0.0) {
+        return vec3(0.0);
+    }
+    vec3 base = base_brdf_cos(s, wo, wi);
+    if (s.mat.clearcoat <= 0.0) {
+        return base;
+    }
+    float w = coat_weight(s, wo);
+    return base * (1.0 - w) + w * coat_cos(s, wo, wi);
+}
+
+// Probability of choosing the specular lobe (of the base's two).
 float specular_probability(Surface s, vec3 wo) {
     if (s.mat.diffuse_only) {
         return 0.0;
@@ -198,13 +239,26 @@ float specular_probability(Surface s, vec3 wo) {
     return clamp(fresnel / max(fresnel + diffuse, 1e-6), 0.05, 0.95);
 }
 
+// Probability of sampling the clear coat's lobe (else the base's): its weight against the base's
+// reflectance estimate, at least 0.1 (a sharp coat highlight is rare under the base's lobes) and
+// at most 0.9; 0 without a coat.
+float coat_probability(Surface s, vec3 wo) {
+    if (s.mat.clearcoat <= 0.0) {
+        return 0.0;
+    }
+    float w = coat_weight(s, wo);
+    float base = luminance(fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), clamp(dot(s.ns, wo), 0.0, 1.0)))
+        + luminance(s.mat.base) * (1.0 - s.mat.metallic);
+    return clamp(w / max(w + (1.0 - w) * base, 1e-6), 0.1, 0.9);
+}
+
 mat3 basis(vec3 n) {
     vec3 t = abs(n.z) < 0.999 ? normalize(cross(vec3(0.0, 0.0, 1.0), n)) : normalize(cross(vec3(1.0, 0.0, 0.0), n));
     return mat3(t, cross(n, t), n);
 }
 
-// Solid-angle density of sampling wi with `sample_brdf`.
-float brdf_pdf(Surface s, vec3 wo, vec3 wi) {
+// Density of the base's lobes (diffuse and GGX) at wi.
+float base_pdf(Surface s, vec3 wo, vec3 wi) {
     float n_l = dot(s.ns, wi);
     if (n_l <= 0.0 || dot(s.ng, wi) <= 0.0) {
         return 0.0;
@@ -220,6 +274,23 @@ float brdf_pdf(Surface s, vec3 wo, vec3 wi) {
     float a2 = a * a;
     float specular = smith_g1(n_v, a2) * ggx_d(max(dot(s.ns, h), 0.0), a2) / (4.0 * n_v);
     return ps * specular + (1.0 - ps) * diffuse;
+}
+
+// Solid-angle density of sampling wi with `sample_brdf`.
+float brdf_pdf(Surface s, vec3 wo, vec3 wi) {
+    float pc = coat_probability(s, wo);
+    if (pc == 0.0) {
+        return base_pdf(s, wo, wi);
+    }
+    float coat = 0.0;
+    float n_l = dot(s.nc, wi);
+    if (n_l > 0.0 && dot(s.ng, wi) > 0.0) {
+        float n_v = max(dot(s.nc, wo), 1e-6);
+        float a = ggx_alpha(s.mat.clearcoat_roughness);
+        float a2 = a * a;
+        coat = smith_g1(n_v, a2) * ggx_d(max(dot(s.nc, normalize(wo + wi)), 0.0), a2) / (4.0 * n_v);
+    }
+    return pc * coat + (1.0 - pc) * base_pdf(s, wo, wi);
 }
 
 // GGX visible-normal sampling (Heitz 2018) in the local frame where the normal is +z.
@@ -241,6 +312,13 @@ vec3 sample_vndf(vec3 v, float a, vec2 xi) {
 // A direction sampled with density `brdf_pdf`; `specular`: it came from the GGX lobe (rather
 // than the cosine-weighted diffuse one).
 vec3 sample_brdf_lobe(Surface s, vec3 wo, out bool specular) {
+    float pc = coat_probability(s, wo);
+    if (pc > 0.0 && rnd() < pc) {
+        specular = true;
+        mat3 c = basis(s.nc);
+        vec2 xi = vec2(rnd(), rnd());
+        return reflect(-wo, c * sample_vndf(transpose(c) * wo, ggx_alpha(s.mat.clearcoat_roughness), xi));
+    }
     mat3 f = basis(s.ns);
     float ps = specular_probability(s, wo);
     vec2 xi = vec2(rnd(), rnd());

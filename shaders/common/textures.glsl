@@ -141,15 +141,20 @@ const uint SLOT_METALLIC_ROUGHNESS = 1u;
 const uint SLOT_NORMAL = 2u;
 const uint SLOT_OCCLUSION = 3u;
 const uint SLOT_EMISSIVE = 4u;
-const uint MATERIAL_SLOTS = 5u;
-const uint ALL_MATERIAL_SLOTS = (1u << MATERIAL_SLOTS) - 1u;
+const uint SLOT_CLEARCOAT = 5u;            // R: clear coat strength
+const uint SLOT_CLEARCOAT_ROUGHNESS = 6u;  // G: the coat's roughness
+const uint MATERIAL_SLOTS = 7u;
+// The slots the G-buffer reads (its targets have no room for the clear coat).
+const uint GBUFFER_MATERIAL_SLOTS = (1u << SLOT_CLEARCOAT) - 1u;
 
 uint material_texture(GpuMaterialLayout m, uint slot) {
     return slot == SLOT_BASE_COLOR ? m.base_color_texture
         : slot == SLOT_METALLIC_ROUGHNESS ? m.metallic_roughness_texture
         : slot == SLOT_NORMAL ? m.normal_texture
         : slot == SLOT_OCCLUSION ? m.occlusion_texture
-                                 : m.emissive_texture;
+        : slot == SLOT_EMISSIVE ? m.emissive_texture
+        : slot == SLOT_CLEARCOAT ? m.clearcoat_texture
+                                 : m.clearcoat_roughness_texture;
 }
 
 // The textures of material `m` in the slots of the mask `slots` at `uv` (trilinear by the

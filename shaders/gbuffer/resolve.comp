@@ -74,7 +74,7 @@ void main() {
         n = -n;
     }
     vec4 texel[MATERIAL_SLOTS];
-    material_texels(m, ALL_MATERIAL_SLOTS, uv, duv_dx, duv_dy, texel);
+    material_texels(m, GBUFFER_MATERIAL_SLOTS, uv, duv_dx, duv_dy, texel);
     if (m.normal_texture != NO_TEXTURE) {
         vec3 dp_dx = (bx.x - b.x) * e1 + (bx.y - b.y) * e2;
         vec3 dp_dy = (by.x - b.x) * e1 + (by.y - b.y) * e2;

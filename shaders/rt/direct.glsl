@@ -283,6 +283,7 @@ vec3 direct_brdf(Primary s, ivec2 pixel, vec3 wi) {
     surf.p = s.p;
     surf.ng = s.ng;
     surf.ns = s.n;
+    surf.nc = s.n;
     surf.mat = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
     bool traced_specular = (frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !surf.mat.diffuse_only
         && surf.mat.roughness <= rt.max_roughness;

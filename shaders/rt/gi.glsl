@@ -111,6 +111,7 @@ vec3 gi_sample(Primary s) {
         // relMSE after 64 frames of rt-4 0.0185, 0.0070 at 0.5, FLIP better at 1 and 4 frames
         // and equal at 64; at 1.0 the lost gloss costs more than the noise it saves).
         h.mat.roughness = max(h.mat.roughness, rt.gi_min_roughness);
+        h.mat.clearcoat_roughness = max(h.mat.clearcoat_roughness, rt.gi_min_roughness);
         if (bounce > 1u) {
             float tmax = hit ? length(h.p - r.origin) : 3.4e38;
             result += throughput * rect_lights_seen(r.origin, r.direction, tmax, pdf_brdf);

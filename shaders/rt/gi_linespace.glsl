@@ -34,6 +34,7 @@ Surface surface_of_record(LsRecord rec, vec3 dir) {
     }
     s.ng = n;
     s.ns = n;
+    s.nc = n;
     // The stored point is quantised (up to a 65535th of the cell per axis), so it may lie a hair
     // behind the surface it stands for; lifted by the quantisation step plus the margin towards
     // the ray, the rays leaving it do not hit that surface again.

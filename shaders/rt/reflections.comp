@@ -33,6 +33,7 @@
 vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughness, out vec3 origin) {
     Surface s = surface_at(r, h);
     s.mat.roughness = max(s.mat.roughness, min_roughness);
+    s.mat.clearcoat_roughness = max(s.mat.clearcoat_roughness, min_roughness);
     origin = offset_ray_origin(s.p, s.ng);
     vec3 wo = -normalize(r.direction);
     vec3 sum = s.emission;

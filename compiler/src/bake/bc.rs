@@ -21,6 +21,10 @@ pub struct Usage {
     pub normal: bool,
     /// Occlusion (R).
     pub occlusion: bool,
+    /// Clear coat strength (R).
+    pub clearcoat: bool,
+    /// Clear coat roughness (G).
+    pub clearcoat_roughness: bool,
 }
 
 impl Usage {
@@ -32,6 +36,8 @@ impl Usage {
             u.metallic_roughness |= m.metallic_roughness_texture == i;
             u.normal |= m.normal_texture == i;
             u.occlusion |= m.occlusion_texture == i;
+            u.clearcoat |= m.clearcoat_texture == i;
+            u.clearcoat_roughness |= m.clearcoat_roughness_texture == i;
         }
         debug_assert!(i != NO_TEXTURE);
         u
@@ -43,6 +49,8 @@ impl Usage {
             | (self.metallic_roughness as u8) << 1
             | (self.normal as u8) << 2
             | (self.occlusion as u8) << 3
+            | (self.clearcoat as u8) << 4
+            | (self.clearcoat_roughness as u8) << 5
     }
 }
 
@@ -88,6 +96,44 @@ pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
             channels: vec![0, 1],
             why: "normal map: BC5 of x, y (z reconstructed)",
         },
+        // The stored channels are those some slot reads: R (occlusion, clear coat), G
+        // (roughness, clear coat roughness), B (metalness).
+        TextureRole::Data if usage.clearcoat || usage.clearcoat_roughness => {
+            let red = usage.occlusion || usage.clearcoat;
+            let green = usage.metallic_roughness || usage.clearcoat_roughness;
+            match (red, green, usage.metallic_roughness) {
+                (true, _, true) => Choice {
+                    format: PixelFormat::Bc7,
+                    swizzle: [R, G, Swizzle::B, One],
+                    channels: vec![0, 1, 2],
+                    why: "clear coat with metallic-roughness: BC7 linear of R, G, B",
+                },
+                (false, _, true) => Choice {
+                    format: PixelFormat::Bc5,
+                    swizzle: [Zero, R, G, One],
+                    channels: vec![1, 2],
+                    why: "clear coat roughness with metallic-roughness: BC5 of G, B",
+                },
+                (true, true, false) => Choice {
+                    format: PixelFormat::Bc5,
+                    swizzle: [R, G, Zero, One],
+                    channels: vec![0, 1],
+                    why: "clear coat and its roughness: BC5 of R, G",
+                },
+                (true, false, false) => Choice {
+                    format: PixelFormat::Bc4,
+                    swizzle: [R, R, R, One],
+                    channels: vec![0],
+                    why: "clear coat: BC4 of R",
+                },
+                (false, _, false) => Choice {
+                    format: PixelFormat::Bc4,
+                    swizzle: [Zero, R, Zero, One],
+                    channels: vec![1],
+                    why: "clear coat roughness: BC4 of G",
+                },
+            }
+        }
         TextureRole::Data => match (usage.metallic_roughness, usage.occlusion) {
             (true, true) => Choice {
                 format: PixelFormat::Bc7,

@@ -15,6 +15,7 @@ use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, V
 
 mod buffers;
 mod checks;
+mod clearcoat;
 mod extent;
 mod spec_defaults;
 mod specular;
@@ -38,6 +39,7 @@ use uri::{load_uri, short};
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
 const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
@@ -63,10 +65,14 @@ impl UvMapping {
     /// transform's offset · rotation · scale (glTF's `KHR_texture_transform`).
     fn of(tex_coord: u32, transform: Option<::gltf::texture::TextureTransform>) -> UvMapping {
         let Some(t) = transform else { return UvMapping { set: tex_coord, matrix: Self::IDENTITY } };
-        let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
+        Self::transformed(t.tex_coord().unwrap_or(tex_coord), t.offset(), t.rotation(), t.scale())
+    }
+
+    /// Set `set` through the transform of offset `[ox, oy]`, rotation `r` and scale `[sx, sy]`.
+    fn transformed(set: u32, [ox, oy]: [f32; 2], r: f32, [sx, sy]: [f32; 2]) -> UvMapping {
         let (sn, c) = r.sin_cos();
         UvMapping {
-            set: t.tex_coord().unwrap_or(tex_coord),
+            set,
             // translation · rotation · scale as the extension's GLSL writes them (column-major
             // `mat3(cos, sin, 0, -sin, cos, 0, 0, 0, 1)`).
             matrix: [c * sx, -sn * sy, ox, sn * sx, c * sy, oy],
@@ -972,6 +978,7 @@ impl Importer<'_> {
             gpu.flags |= MaterialFlags::DOUBLE_SIDED;
         }
         self.dielectric_reflectance(&at, &m, &mut gpu)?;
+        let [coat, coat_roughness] = self.clearcoat(&at, &m, &mut gpu)?;
         // Every texture of the material reads one set of coordinates through one transform (the
         // format stores one set per vertex, with the transform baked in); the first texture's
         // mapping is that of all, and a texture mapped otherwise is named in a warning.
@@ -984,6 +991,8 @@ impl Importer<'_> {
             m.normal_texture().map(|i| (i.texture(), UvMapping::of(i.tex_coord(), None))),
             m.occlusion_texture().map(|i| (i.texture(), UvMapping::of(i.tex_coord(), None))),
             m.emissive_texture().map(info),
+            coat,
+            coat_roughness,
         ];
         let mapping = refs.iter().flatten().map(|(_, u)| *u).next().unwrap_or(UvMapping::of(0, None));
         for (t, u) in refs.iter().flatten() {
@@ -1003,8 +1012,10 @@ impl Importer<'_> {
             TextureRole::Normal,
             TextureRole::Data,
             TextureRole::Color,
+            TextureRole::Data,
+            TextureRole::Data,
         ];
-        let mut slots = [NO_TEXTURE; 5];
+        let mut slots = [NO_TEXTURE; 7];
         for (k, r) in refs.into_iter().enumerate() {
             if let Some((t, _)) = r {
                 slots[k] = self.texture(t, roles[k]);
@@ -1016,6 +1027,8 @@ impl Importer<'_> {
             gpu.normal_texture,
             gpu.occlusion_texture,
             gpu.emissive_texture,
+            gpu.clearcoat_texture,
+            gpu.clearcoat_roughness_texture,
         ] = slots;
         let index = self.scene.materials.len() as u32;
         self.uv_mappings.insert(index, mapping);

@@ -649,6 +649,14 @@ gpu_struct! {
         pub flags: u32 => "uint",
         /// See `GpuMaterial` (four halves: `dielectric_f0`, `dielectric_f90` in `scene.glsl`).
         pub specular: [u32; 2] => "uvec2",
+        /// See `GpuMaterial`.
+        pub clearcoat: f32 => "float",
+        /// See `GpuMaterial`.
+        pub clearcoat_roughness: f32 => "float",
+        /// See `GpuMaterial`.
+        pub clearcoat_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub clearcoat_roughness_texture: u32 => "uint",
     }
 }
 

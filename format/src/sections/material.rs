@@ -38,7 +38,8 @@ impl MaterialFlags {
     pub const ALL: u32 = Self::DOUBLE_SIDED | Self::ALPHA_MODE_MASK | Self::DIFFUSE_ONLY | Self::SPECULAR;
 }
 
-/// A metallic-roughness PBR material. 80 bytes; std430-compatible (vec4, vec3 + float, scalars).
+/// A metallic-roughness PBR material. 96 bytes; std430-compatible (vec4, vec3 + float, scalars).
+/// `MATL` version 2 (format 1.8); version 1 held the first 80 bytes ([`GpuMaterialV1`]).
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuMaterial {
@@ -73,9 +74,47 @@ pub struct GpuMaterial {
     /// in [0, 1]: F0.r and F0.g in word 0 (low half first), F0.b and F90 in word 1
     /// ([`GpuMaterial::dielectric`]). Zero without the flag.
     pub specular: [u32; 2],
+    /// Clear coat layer's strength in [0, 1] (glTF `KHR_materials_clearcoat`'s
+    /// `clearcoatFactor`); 0 without a coat. Format 1.8.
+    pub clearcoat: f32,
+    /// The coat's perceptual roughness in [0, 1] (`clearcoatRoughnessFactor`); GGX α = its square.
+    pub clearcoat_roughness: f32,
+    /// Texture whose R multiplies `clearcoat` (linear), or [`NO_TEXTURE`].
+    pub clearcoat_texture: u32,
+    /// Texture whose G multiplies `clearcoat_roughness` (linear), or [`NO_TEXTURE`].
+    pub clearcoat_roughness_texture: u32,
 }
 
-const _: () = assert!(size_of::<GpuMaterial>() == 80);
+const _: () = assert!(size_of::<GpuMaterial>() == 96);
+
+/// A material as `MATL` version 1 (formats 1.0 to 1.7) stores it: [`GpuMaterial`]'s first 80
+/// bytes, without the clear coat. Read into a [`GpuMaterial`] with no coat.
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuMaterialV1 {
+    /// The fields of [`GpuMaterial`] up to and including `specular`, as raw words.
+    pub words: [u32; 20],
+}
+
+const _: () = assert!(size_of::<GpuMaterialV1>() == 80);
+
+impl From<GpuMaterialV1> for GpuMaterial {
+    fn from(old: GpuMaterialV1) -> GpuMaterial {
+        let mut words = [0u32; 24];
+        words[..20].copy_from_slice(&old.words);
+        let mut m: GpuMaterial = bytemuck::cast(words);
+        m.clearcoat = 0.0;
+        m.clearcoat_roughness = 0.0;
+        m.clearcoat_texture = NO_TEXTURE;
+        m.clearcoat_roughness_texture = NO_TEXTURE;
+        m
+    }
+}
+
+/// How many of [`GpuMaterial::textures`]' slots the raster G-buffer passes bind (base colour,
+/// metallic-roughness, normal, occlusion, emissive); the clear coat's are read by the passes
+/// that trace rays.
+pub const RASTER_SLOTS: usize = 5;
 
 /// glTF's dielectric reflectance at normal incidence without `KHR_materials_ior`/`specular`
 /// (an index of refraction of 1.5).
@@ -98,19 +137,26 @@ impl Default for GpuMaterial {
             emissive_texture: NO_TEXTURE,
             flags: 0,
             specular: [0; 2],
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
+            clearcoat_texture: NO_TEXTURE,
+            clearcoat_roughness_texture: NO_TEXTURE,
         }
     }
 }
 
 impl GpuMaterial {
-    /// The texture slots, in field order.
-    pub fn textures(&self) -> [u32; 5] {
+    /// The texture slots, in field order: the [`RASTER_SLOTS`] the raster G-buffer reads, then
+    /// the clear coat's.
+    pub fn textures(&self) -> [u32; 7] {
         [
             self.base_color_texture,
             self.metallic_roughness_texture,
             self.normal_texture,
             self.occlusion_texture,
             self.emissive_texture,
+            self.clearcoat_texture,
+            self.clearcoat_roughness_texture,
         ]
     }
 

@@ -10,7 +10,9 @@ mod texture;
 
 pub use bvh::{BVH_TRAVERSAL_STACK, CwbvhNode};
 pub use geometry::Vertex;
-pub use material::{AlphaMode, DIELECTRIC_F0, GpuMaterial, MaterialFlags, NO_TEXTURE};
+pub use material::{
+    AlphaMode, DIELECTRIC_F0, GpuMaterial, GpuMaterialV1, MaterialFlags, NO_TEXTURE, RASTER_SLOTS,
+};
 pub use texture::{
     PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_texture, encode_texture,
     possible_v2_lengths,
@@ -122,7 +124,7 @@ pub const KNOWN: &[KindInfo] = &[
     KindInfo {
         kind: MATERIALS,
         name: "materials",
-        version: 1,
+        version: 2,
         element_size: size_of::<GpuMaterial>(),
         required: false,
         indexed: false,
@@ -258,6 +260,14 @@ const fn pod_kind_at(
     description: &'static str,
 ) -> KindInfo {
     KindInfo { kind, name, version, element_size, required: false, indexed: false, description }
+}
+
+impl KindInfo {
+    /// The size of one element in a section of this kind at layout `version`: `element_size`,
+    /// except for the older layouts whose elements were smaller (`MATL` version 1: 80 bytes).
+    pub fn element_size_at(&self, version: u16) -> usize {
+        if self.kind == MATERIALS && version == 1 { size_of::<GpuMaterialV1>() } else { self.element_size }
+    }
 }
 
 /// What this crate knows of `kind`, if anything.

@@ -17,6 +17,22 @@ pub fn small_file() -> Vec<u8> {
 /// when it is large enough) and its sections compressed as `compression` says.
 #[allow(dead_code)] // Not every test binary that includes this module uses it.
 pub fn small_file_with(texture: u32, compression: Compression) -> Vec<u8> {
+    let materials = [GpuMaterial { base_color_texture: 0, ..Default::default() }];
+    small_file_built(
+        texture,
+        compression,
+        sections::info(sections::MATERIALS).unwrap().version,
+        bytemuck::cast_slice(&materials),
+    )
+}
+
+/// [`small_file`] with its one material's `MATL` section given as bytes at layout `version`.
+#[allow(dead_code)] // Not every test binary that includes this module uses it.
+pub fn small_file_with_materials(version: u16, materials: &[u8]) -> Vec<u8> {
+    small_file_built(2, Compression::None, version, materials)
+}
+
+fn small_file_built(texture: u32, compression: Compression, matl_version: u16, materials: &[u8]) -> Vec<u8> {
     let vertices = [
         Vertex { position: [0.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
         Vertex { position: [1.0, 0.0, 0.0], normal: [0.0, 0.0, 1.0] },
@@ -26,7 +42,6 @@ pub fn small_file_with(texture: u32, compression: Compression) -> Vec<u8> {
     let uvs: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
     let triangles: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
     let tmat = [0u32, 0];
-    let materials = [GpuMaterial { base_color_texture: 0, ..Default::default() }];
     // One root with one leaf of two triangles; box [0,1]^2 x [0, 0].
     // Steps of 1/128: 128 steps reach 1 exactly, so the box holds the quad (FORMAT.md's must).
     let mut root = CwbvhNode { p: [0.0; 3], e: [127 - 7, 127 - 7, 127 - 7], ..Default::default() };
@@ -75,7 +90,7 @@ pub fn small_file_with(texture: u32, compression: Compression) -> Vec<u8> {
     w.pod(sections::UVS, 0, &uvs, h(b"uv")).unwrap();
     w.pod(sections::TRIANGLES, 0, &triangles, h(b"t")).unwrap();
     w.pod(sections::TRIANGLE_MATERIALS, 0, &tmat, h(b"tm")).unwrap();
-    w.pod(sections::MATERIALS, 0, &materials, h(b"mat")).unwrap();
+    w.raw(sections::MATERIALS, 0, matl_version, materials, h(b"mat")).unwrap();
     w.pod(sections::BVH_NODES, 0, &nodes, h(b"b")).unwrap();
     // A version-2 texture section: the 16-byte header (RGBA8, identity swizzle), then the chain.
     let texture =

@@ -188,7 +188,7 @@ impl<'f> Prepared<'f> {
                 view.vertices,
                 view.triangles,
                 view.triangle_materials,
-                view.materials,
+                &view.materials,
                 &storage,
                 emitter_luminance,
             )
@@ -552,7 +552,7 @@ impl GpuScene {
             } else if let (Some(r), true) =
                 (&self.reference, now.scene_buffers && kind == sections::MATERIALS)
             {
-                up.buffer(&r.materials, 0, bytemuck::cast_slice(view.materials))?;
+                up.buffer(&r.materials, 0, bytemuck::cast_slice(&view.materials))?;
             } else if let (Some(r), true) =
                 (&self.reference, now.scene_buffers && kind == sections::TRIANGLE_MATERIALS)
             {
@@ -723,7 +723,7 @@ fn reference_buffers(
     let sizes = [
         ("leaf indices", std::mem::size_of_val(view.triangles)),
         ("triangle materials", std::mem::size_of_val(view.triangle_materials)),
-        ("materials", std::mem::size_of_val(view.materials)),
+        ("materials", std::mem::size_of_val(&*view.materials)),
         ("emitters", std::mem::size_of_val(tables.emitters.as_slice())),
         ("triangle emitters", std::mem::size_of_val(tables.triangle_emitter.as_slice())),
         ("emissive triangles", std::mem::size_of_val(tables.emissive.as_slice())),

@@ -4,7 +4,7 @@
 
 use crate::gpu::vk;
 use kiln_format::gpu::GpuMaterialLayout;
-use kiln_format::sections::NO_TEXTURE;
+use kiln_format::sections::{NO_TEXTURE, RASTER_SLOTS};
 
 use super::Shared;
 use crate::error::PlayResult;
@@ -40,7 +40,7 @@ impl SceneDraws {
     /// The layouts (sets are allocated by [`SceneDraws::bind`]).
     pub fn new(gpu: &Gpu) -> PlayResult<SceneDraws> {
         let frame_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Uniform)], 1)?;
-        let material_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); 5], 64)?;
+        let material_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); RASTER_SLOTS], 64)?;
         Ok(SceneDraws {
             frame_layout,
             material_layout,
@@ -94,6 +94,8 @@ impl SceneDraws {
                     &mut layout.normal_texture,
                     &mut layout.occlusion_texture,
                     &mut layout.emissive_texture,
+                    &mut layout.clearcoat_texture,
+                    &mut layout.clearcoat_roughness_texture,
                 ] {
                     if *t as usize >= scene.textures.len() {
                         *t = NO_TEXTURE;
@@ -110,8 +112,8 @@ impl SceneDraws {
             }
         };
         for (m, &set) in scene.materials.iter().zip(&self.material_sets) {
-            let writes: Vec<Write> = m
-                .textures()
+            // The G-buffer's slots (the clear coat's are read by the passes that trace rays).
+            let writes: Vec<Write> = m.textures()[..RASTER_SLOTS]
                 .iter()
                 .enumerate()
                 .map(|(i, &t)| Write::Sampled(i as u32, vec![texture(t)]))
