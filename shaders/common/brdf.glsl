@@ -82,19 +82,28 @@ float directional_albedo(sampler2D lut, float lut_res, float n_v, float roughnes
     return max(rg.r + rg.g, 1e-3);
 }
 
+// KHR_materials_clearcoat over the base's f: (1 − w) f + w D_c Vis_c with w = clearcoat · Fc,
+// Fc Schlick of F0 0.04 at n·v (the coat's normal is the surface's here).
+vec3 coat_over(Material m, vec3 base, float n_v, float n_h, float n_l) {
+    float w = m.clearcoat * (DIELECTRIC_F0.x + (1.0 - DIELECTRIC_F0.x) * pow(1.0 - n_v, 5.0));
+    float a = ggx_alpha(m.clearcoat_roughness);
+    float a2 = a * a;
+    return base * (1.0 - w) + w * ggx_d(n_h, a2) * smith_visibility(n_l, n_v, a2);
+}
+
 // f(l, v): Lambert for diffuse-only materials; otherwise Cook–Torrance GGX with height-correlated
 // Smith visibility and Schlick Fresnel, F0 = mix(m.f0, base, metallic) (m.f0 0.04 in glTF's core), F90
 // = mix(m.f90, 1, metallic), diffuse (1 − F)(1 − metallic)
-// base / π, specular scaled by 1 + F0 (1 / E − 1).
+// base / π, specular scaled by 1 + F0 (1 / E − 1); under a clear coat, `coat_over` of that.
 vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
     vec3 diffuse = lambert(m.base);
-    if (m.diffuse_only) {
-        return diffuse;
-    }
     vec3 h = normalize(v + l);
     float n_v = max(dot(n, v), 1e-4);
     float n_l = max(dot(n, l), 1e-4);
     float n_h = max(dot(n, h), 0.0);
+    if (m.diffuse_only) {
+        return m.clearcoat > 0.0 ? coat_over(m, diffuse, n_v, n_h, n_l) : diffuse;
+    }
     float v_h = max(dot(v, h), 0.0);
     float alpha = ggx_alpha(m.roughness);
     float a2 = alpha * alpha;
@@ -103,7 +112,8 @@ vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
     vec3 f0 = fresnel_f0(m);
     vec3 f = fresnel_schlick(f0, fresnel_f90(m), v_h);
     vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-    return (vec3(1.0) - f) * (1.0 - m.metallic) * diffuse + f * (d * vis) * compensation;
+    vec3 base = (vec3(1.0) - f) * (1.0 - m.metallic) * diffuse + f * (d * vis) * compensation;
+    return m.clearcoat > 0.0 ? coat_over(m, base, n_v, n_h, n_l) : base;
 }
 
 #endif

@@ -49,10 +49,24 @@ Material gbuffer_material(vec4 albedo, vec4 mat) {
     float k = min(round(mat.b * 255.0), 125.0) / 125.0;
     m.f0 = vec3(k * k);
     m.f90 = albedo.a;
-    // The G-buffer's 8-bit targets are full: the raster frame has no clear coat.
+    // The clear coat is in the emission target's alpha (`gbuffer_coat`); the caller that reads
+    // that target sets it.
     m.clearcoat = 0.0;
     m.clearcoat_roughness = 0.0;
     return m;
+}
+
+// The clear coat in the G-buffer: the emission target's alpha (half float, which holds whole
+// numbers up to 2048 exactly) holds 32 · round(31 · clearcoat) + round(31 · roughness): 0 is no
+// coat, and each parameter keeps steps of 1/31.
+float gbuffer_coat(float clearcoat, float roughness) {
+    return round(clamp(clearcoat, 0.0, 1.0) * 31.0) * 32.0 + round(clamp(roughness, 0.0, 1.0) * 31.0);
+}
+
+// The (clearcoat, roughness) that `gbuffer_coat` coded as `a`.
+vec2 gbuffer_coat_decode(float a) {
+    float k = round(clamp(a, 0.0, 1023.0));
+    return vec2(floor(k / 32.0), mod(k, 32.0)) / 31.0;
 }
 
 #endif

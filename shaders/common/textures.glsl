@@ -144,8 +144,7 @@ const uint SLOT_EMISSIVE = 4u;
 const uint SLOT_CLEARCOAT = 5u;            // R: clear coat strength
 const uint SLOT_CLEARCOAT_ROUGHNESS = 6u;  // G: the coat's roughness
 const uint MATERIAL_SLOTS = 7u;
-// The slots the G-buffer reads (its targets have no room for the clear coat).
-const uint GBUFFER_MATERIAL_SLOTS = (1u << SLOT_CLEARCOAT) - 1u;
+const uint ALL_MATERIAL_SLOTS = (1u << MATERIAL_SLOTS) - 1u;
 
 uint material_texture(GpuMaterialLayout m, uint slot) {
     return slot == SLOT_BASE_COLOR ? m.base_color_texture

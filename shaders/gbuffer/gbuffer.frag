@@ -4,7 +4,7 @@
 //   1 albedo    RGBA8_UNORM base colour, sRGB-encoded here (an SRGB format cannot be a storage
 //                           image, and the visibility-buffer resolve writes the same targets)
 //   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag or dielectric F0 (common/dielectric.glsl), occlusion
-//   3 emission  RGBA16F     emitted radiance
+//   3 emission  RGBA16F     emitted radiance; alpha the clear coat (common/dielectric.glsl)
 //   4 triangle  R32_UINT    1 + the triangle's index in the index buffer (0: nothing drawn); the
 //                           ray-traced passes rebuild the exact surface point from it
 #include "../common/layout.glsl"
@@ -18,6 +18,8 @@ layout(set = 1, binding = 1) uniform sampler2D metallic_roughness_tex;
 layout(set = 1, binding = 2) uniform sampler2D normal_tex;
 layout(set = 1, binding = 3) uniform sampler2D occlusion_tex;
 layout(set = 1, binding = 4) uniform sampler2D emissive_tex;
+layout(set = 1, binding = 5) uniform sampler2D clearcoat_tex;
+layout(set = 1, binding = 6) uniform sampler2D clearcoat_roughness_tex;
 layout(push_constant) uniform MaterialPush { GpuMaterialLayout material; };
 
 layout(location = 0) in vec3 in_position;
@@ -72,6 +74,14 @@ void main() {
     vec2 dielectric = gbuffer_dielectric(material);
     out_albedo = vec4(linear_to_srgb(base.rgb), dielectric.y);
     out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion);
-    out_emission = vec4(emission, 1.0);
+    float coat = material.clearcoat;
+    float coat_roughness = material.clearcoat_roughness;
+    if (coat > 0.0 && material.clearcoat_texture != NO_TEXTURE) {
+        coat *= texture(clearcoat_tex, in_uv).r;
+    }
+    if (coat > 0.0 && material.clearcoat_roughness_texture != NO_TEXTURE) {
+        coat_roughness *= texture(clearcoat_roughness_tex, in_uv).g;
+    }
+    out_emission = vec4(emission, gbuffer_coat(coat, coat_roughness));
     out_triangle = in_first_triangle + uint(gl_PrimitiveID) + 1u;
 }

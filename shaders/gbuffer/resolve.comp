@@ -74,7 +74,7 @@ void main() {
         n = -n;
     }
     vec4 texel[MATERIAL_SLOTS];
-    material_texels(m, GBUFFER_MATERIAL_SLOTS, uv, duv_dx, duv_dy, texel);
+    material_texels(m, ALL_MATERIAL_SLOTS, uv, duv_dx, duv_dy, texel);
     if (m.normal_texture != NO_TEXTURE) {
         vec3 dp_dx = (bx.x - b.x) * e1 + (bx.y - b.y) * e2;
         vec3 dp_dy = (by.x - b.x) * e1 + (by.y - b.y) * e2;
@@ -94,5 +94,7 @@ void main() {
     vec2 dielectric = gbuffer_dielectric(m);
     imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), dielectric.y));
     imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion));
-    imageStore(out_emission, pixel, vec4(emission, 1.0));
+    float coat = clamp(m.clearcoat * texel[SLOT_CLEARCOAT].r, 0.0, 1.0);
+    float coat_roughness = clamp(m.clearcoat_roughness * texel[SLOT_CLEARCOAT_ROUGHNESS].g, 0.0, 1.0);
+    imageStore(out_emission, pixel, vec4(emission, gbuffer_coat(coat, coat_roughness)));
 }

@@ -243,6 +243,10 @@ void main() {
     vec3 n = oct_decode(texelFetch(g_normal, pixel, 0).rg);
     vec4 mat = texelFetch(g_material, pixel, 0);
     Material m = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
+    vec4 emitted = texelFetch(g_emission, pixel, 0);
+    vec2 coat = gbuffer_coat_decode(emitted.a);
+    m.clearcoat = coat.x;
+    m.clearcoat_roughness = coat.y;
     vec3 v = towards_camera(p);
     if (dot(n, v) < 0.0) {
         n = -n;
@@ -252,7 +256,7 @@ void main() {
     float e_albedo = m.diffuse_only ? 1.0 : directional_albedo(brdf_lut, lut_res, n_v, m.roughness);
     float angle = 6.2831853 * hash(uvec2(pixel));
 
-    vec3 radiance = texelFetch(g_emission, pixel, 0).rgb;
+    vec3 radiance = emitted.rgb;
     if (DIRECT_EMISSIVE && (frame.size.w & FRAME_RT_DIRECT) != 0u) {
         radiance += imageLoad(rt_direct, pixel).rgb;
     }
@@ -279,8 +283,18 @@ void main() {
     if (DIRECT_GI && (frame.size.w & FRAME_SCREEN_GI) != 0u) {
         diffuse_in += imageLoad(rt_gi, pixel).rgb;
     }
+    // The clear coat (KHR_materials_clearcoat) keeps 1 − w of the light the base reflects, and
+    // reflects w of the sky's prefiltered light about the mirror direction with its lobe's
+    // directional albedo (the split sum's R + G: the coat's Fresnel is in w).
+    float coat_w = m.clearcoat * (DIELECTRIC_F0.x + (1.0 - DIELECTRIC_F0.x) * pow(1.0 - n_v, 5.0));
+    vec3 coat_sky = vec3(0.0);
+    if (coat_w > 0.0) {
+        vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.clearcoat_roughness)).rg : vec2(1.0, 0.0);
+        coat_sky = coat_w * (rg.r + rg.g) * env_filtered(reflect(-v, n), m.clearcoat_roughness, frame.sky.rgb) * occlusion;
+    }
+    vec3 ambient = vec3(0.0);
     if (m.diffuse_only) {
-        radiance += m.base * diffuse_in;
+        ambient += m.base * diffuse_in;
     } else {
         vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.roughness)).rg : vec2(1.0, 0.0);
         vec3 f0 = fresnel_f0(m);
@@ -288,7 +302,7 @@ void main() {
         vec3 lobe = f0 * rg.r + fresnel_f90(m) * rg.g;
         vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
         vec3 diffuse = (vec3(1.0) - lobe) * (1.0 - m.metallic) * m.base;
-        radiance += diffuse * diffuse_in;
+        ambient += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
         vec3 mirror = reflect(-v, n);
@@ -313,8 +327,9 @@ void main() {
             sky_in = mix(sky_in, screen.rgb, clamp(screen.a, 0.0, 1.0));
         }
         vec3 split_sum = lobe * sky_in;
-        radiance += compensation * (traced.a > 0.0 ? traced.rgb / traced.a : split_sum);
+        ambient += compensation * (traced.a > 0.0 ? traced.rgb / traced.a : split_sum);
     }
+    radiance += ambient * (1.0 - coat_w) + coat_sky;
 
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight light = lights[i];

@@ -12,7 +12,19 @@ pub fn read_exr(path: &Path) -> Vec<f32> {
 /// Writes linear RGB (row 0 at the top) as a NumPy float32 array of shape (height, width, 3).
 pub fn write_npy(path: &Path, w: u32, h: u32, rgb: &[f32]) {
     assert_eq!(rgb.len(), (w * h * 3) as usize);
-    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({h}, {w}, 3), }}");
+    let data: Vec<u8> = rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
+    write_npy_array(path, "<f4", (h, w, 3), &data);
+}
+
+/// Writes RGBA8 texels (row 0 at the top) as a NumPy uint8 array of shape (height, width, 4).
+pub fn write_npy_rgba8(path: &Path, w: u32, h: u32, rgba: &[u8]) {
+    assert_eq!(rgba.len(), (w * h * 4) as usize);
+    write_npy_array(path, "|u1", (h, w, 4), rgba);
+}
+
+/// A NumPy array file (format 1.0) of element type `descr` and shape `(h, w, c)` holding `data`.
+fn write_npy_array(path: &Path, descr: &str, (h, w, c): (u32, u32, u32), data: &[u8]) {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': ({h}, {w}, {c}), }}");
     while (10 + header.len() + 1) % 64 != 0 {
         header.push(' ');
     }
@@ -20,9 +32,7 @@ pub fn write_npy(path: &Path, w: u32, h: u32, rgb: &[f32]) {
     let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
     bytes.extend((header.len() as u16).to_le_bytes());
     bytes.extend(header.as_bytes());
-    for v in rgb {
-        bytes.extend(v.to_le_bytes());
-    }
+    bytes.extend(data);
     std::fs::write(path, bytes).unwrap();
 }
 

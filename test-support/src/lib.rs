@@ -30,7 +30,7 @@ mod images;
 mod need;
 mod tools;
 
-pub use images::{mse, read_exr, read_npy, write_npy};
+pub use images::{mse, read_exr, read_npy, write_npy, write_npy_rgba8};
 #[cfg(feature = "vulkan")]
 pub use need::vulkan;
 pub use need::{Found, Need, temp_dir};

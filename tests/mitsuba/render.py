@@ -54,18 +54,29 @@ import time
 import numpy as np
 
 
-def write_ply(path, positions, triangles, colors=None):
+def write_ply(path, positions, triangles, colors=None, normals=None, uvs=None):
     """Binary PLY; `colors` (linear RGB per vertex) become float r, g, b properties, which
-    Mitsuba's PLY loader turns into the `vertex_color` mesh attribute."""
+    Mitsuba's PLY loader turns into the `vertex_color` mesh attribute; `normals` nx, ny, nz;
+    `uvs` u, v (as kiln stores them: v down the image)."""
     positions = np.asarray(positions, dtype="<f4").reshape(-1, 3)
     triangles = np.asarray(triangles, dtype="<u4").reshape(-1, 3)
     fields = [("p", "<f4", 3)]
     props = "property float x\nproperty float y\nproperty float z\n"
+    if normals is not None:
+        fields.append(("n", "<f4", 3))
+        props += "property float nx\nproperty float ny\nproperty float nz\n"
+    if uvs is not None:
+        fields.append(("uv", "<f4", 2))
+        props += "property float u\nproperty float v\n"
     if colors is not None:
         fields.append(("c", "<f4", 3))
         props += "property float r\nproperty float g\nproperty float b\n"
     vertices = np.zeros(len(positions), dtype=fields)
     vertices["p"] = positions
+    if normals is not None:
+        vertices["n"] = np.asarray(normals, dtype="<f4").reshape(-1, 3)
+    if uvs is not None:
+        vertices["uv"] = np.asarray(uvs, dtype="<f4").reshape(-1, 2)
     if colors is not None:
         vertices["c"] = np.asarray(colors, dtype="<f4").reshape(-1, 3)
     header = (
@@ -133,15 +144,26 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
             # The base colour times the vertex colour: the albedo is baked into the colours.
             colors = np.asarray(colors, dtype=float).reshape(-1, 3) * np.asarray(m["albedo"], dtype=float)
             reflectance = {"type": "mesh_attribute", "name": "vertex_color"}
-        write_ply(path, m["positions"], m["triangles"], colors)
+        normals = m.get("normals") or None
+        uvs = m.get("uvs") or None
+        write_ply(path, m["positions"], m["triangles"], colors, normals, uvs)
         bsdf = {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}}
         material = m.get("material")
         if material is not None:
             assert colors is None, "vertex colours on a glossy material are not mapped"
-            bsdf = {"type": "kiln_gltf", **{k: float(v) for k, v in material.items()}}
-        shape = {"type": "ply", "filename": path, "face_normals": True, "bsdf": bsdf}
+            number = lambda v: v if isinstance(v, (str, bool)) else float(v)
+            bsdf = {"type": "kiln_gltf", **{k: number(v) for k, v in material.items()}}
+            # Coverage: kiln meets the surface with this probability; Mitsuba's `mask`.
+            if m.get("coverage", 1.0) < 1.0:
+                bsdf = {"type": "mask", "opacity": float(m["coverage"]), "bsdf": bsdf}
+        shape = {"type": "ply", "filename": path, "face_normals": normals is None, "bsdf": bsdf}
         if any(v > 0.0 for v in m["emission"]):
-            shape["emitter"] = {"type": "area", "radiance": rgb(m["emission"])}
+            radiance = rgb(m["emission"])
+            if "emission_tex" in m:
+                import gltf_bsdf
+
+                radiance = gltf_bsdf.texture(m["emission_tex"], True, "repeat", True, scale=m["emission"])
+            shape["emitter"] = {"type": "area", "radiance": radiance}
         scene[f"mesh{i}"] = shape
     env = desc.get("environment")
     if env is not None:

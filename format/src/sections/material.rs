@@ -111,10 +111,8 @@ impl From<GpuMaterialV1> for GpuMaterial {
     }
 }
 
-/// How many of [`GpuMaterial::textures`]' slots the raster G-buffer passes bind (base colour,
-/// metallic-roughness, normal, occlusion, emissive); the clear coat's are read by the passes
-/// that trace rays.
-pub const RASTER_SLOTS: usize = 5;
+/// How many texture slots a material has ([`GpuMaterial::textures`]).
+pub const MATERIAL_SLOTS: usize = 7;
 
 /// glTF's dielectric reflectance at normal incidence without `KHR_materials_ior`/`specular`
 /// (an index of refraction of 1.5).
@@ -146,9 +144,8 @@ impl Default for GpuMaterial {
 }
 
 impl GpuMaterial {
-    /// The texture slots, in field order: the [`RASTER_SLOTS`] the raster G-buffer reads, then
-    /// the clear coat's.
-    pub fn textures(&self) -> [u32; 7] {
+    /// The texture slots, in field order (the G-buffer's bindings 0 to 6).
+    pub fn textures(&self) -> [u32; MATERIAL_SLOTS] {
         [
             self.base_color_texture,
             self.metallic_roughness_texture,

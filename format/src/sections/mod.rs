@@ -11,7 +11,7 @@ mod texture;
 pub use bvh::{BVH_TRAVERSAL_STACK, CwbvhNode};
 pub use geometry::Vertex;
 pub use material::{
-    AlphaMode, DIELECTRIC_F0, GpuMaterial, GpuMaterialV1, MaterialFlags, NO_TEXTURE, RASTER_SLOTS,
+    AlphaMode, DIELECTRIC_F0, GpuMaterial, GpuMaterialV1, MATERIAL_SLOTS, MaterialFlags, NO_TEXTURE,
 };
 pub use texture::{
     PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_texture, encode_texture,

@@ -4,7 +4,7 @@
 
 use crate::gpu::vk;
 use kiln_format::gpu::GpuMaterialLayout;
-use kiln_format::sections::{NO_TEXTURE, RASTER_SLOTS};
+use kiln_format::sections::{MATERIAL_SLOTS, NO_TEXTURE};
 
 use super::Shared;
 use crate::error::PlayResult;
@@ -40,7 +40,7 @@ impl SceneDraws {
     /// The layouts (sets are allocated by [`SceneDraws::bind`]).
     pub fn new(gpu: &Gpu) -> PlayResult<SceneDraws> {
         let frame_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Uniform)], 1)?;
-        let material_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); RASTER_SLOTS], 64)?;
+        let material_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); MATERIAL_SLOTS], 64)?;
         Ok(SceneDraws {
             frame_layout,
             material_layout,
@@ -112,8 +112,8 @@ impl SceneDraws {
             }
         };
         for (m, &set) in scene.materials.iter().zip(&self.material_sets) {
-            // The G-buffer's slots (the clear coat's are read by the passes that trace rays).
-            let writes: Vec<Write> = m.textures()[..RASTER_SLOTS]
+            let writes: Vec<Write> = m
+                .textures()
                 .iter()
                 .enumerate()
                 .map(|(i, &t)| Write::Sampled(i as u32, vec![texture(t)]))
