@@ -12,9 +12,8 @@
 //! further off than that, within 15 % of that noise. An unbiased kiln comes close to it.
 //!
 //! The scene goes to Mitsuba as JSON (`tests/mitsuba/render.py` documents the mapping of
-//! kiln's conventions onto Mitsuba's), rendered on the CPU (`scalar_rgb`; `llvm_ad_rgb` for glossy
-//! materials). The comparison runs in the same script with `flip_evaluator`, the FLIP authors'
-//! implementation.
+//! kiln's conventions onto Mitsuba's), rendered on the CPU by the `llvm_ad_rgb` variant. The
+//! comparison runs in the same script with `flip_evaluator`, the FLIP authors' implementation.
 //!
 //! Needs a Vulkan device and a Python with `mitsuba`, `flip-evaluator` and `numpy`: the virtual
 //! environment `.venv-mitsuba` at the workspace root, or the interpreter `KILN_MITSUBA_PYTHON`

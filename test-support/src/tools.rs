@@ -127,7 +127,8 @@ pub fn flip_python() -> Option<PathBuf> {
     python_with("flip_evaluator and numpy", "import flip_evaluator, numpy")
 }
 
-/// The Python with Mitsuba 3 (its `scalar_rgb` variant), flip-evaluator and numpy, by the rule
+/// The Python with Mitsuba 3 (imported with its `scalar_rgb` variant; `render.py` renders with
+/// `llvm_ad_rgb` and says when libLLVM is missing), flip-evaluator and numpy, by the rule
 /// ([`Need::Mitsuba`]).
 pub fn mitsuba_python() -> Option<PathBuf> {
     python_with(

@@ -1,7 +1,8 @@
-"""Renders a kiln test scene with Mitsuba 3 (variant scalar_rgb) and compares images with FLIP.
+"""Renders a kiln test scene with Mitsuba 3 (variant llvm_ad_rgb) and compares images with FLIP.
 
     render.py render SCENE.json OUT.npy SPP WIDTHxHEIGHT [SEED]
-        Renders the scene that tests/mitsuba.rs wrote and saves linear RGB radiance as float32
+        Renders the scene that tests/mitsuba.rs wrote (variant llvm_ad_rgb, in passes of 256
+        samples per pixel) and saves linear RGB radiance as float32
         (height, width, 3), row 0 at the top. Prints one JSON line: {"spp", "seconds"}.
 
     render.py compare REFERENCE.npy TEST.npy [FLIP_MAP.npy]
@@ -16,8 +17,8 @@ tracer's (shaders/reference/pathtrace.comp), mapped to Mitsuba's:
 
 - Lambertian surfaces reflect on both sides in kiln: `twosided(diffuse)`.
 - A mesh with a `material` (base colour, metallic, roughness, the dielectric's F0 and F90, clear
-  coat and its roughness) is glTF's metallic-roughness BSDF, `gltf_bsdf.py`'s Python plugin:
-  rendered with the `llvm_ad_rgb` variant (Python called once per wavefront, not per sample).
+  coat and its roughness, textures) is glTF's metallic-roughness BSDF, `gltf_bsdf.py`'s Python
+  plugin.
 - Vertex colours (a mesh's optional `colors`, linear RGB per vertex) multiply the albedo: the
   product is written as the PLY's float `r, g, b`, read through `mesh_attribute` `vertex_color`.
 - Emissive triangles emit from the front face only (as Mitsuba's `area` emitter does); flat
@@ -188,9 +189,10 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
 
 
 def find_libllvm():
-    """Dr.Jit's LLVM back end, which a Python BSDF needs (the scalar variant would call Python
-    once per sample), wants an LLVM newer than Debian 12's default 15: `.ci/run` installs
-    libllvm19. The newest libLLVM-NN.so found, unless DRJIT_LIBLLVM_PATH names one."""
+    """Dr.Jit's LLVM back end (vectorised: several times faster than the scalar variant on
+    these scenes, and a Python BSDF is called once per wavefront, not per sample) wants an LLVM
+    newer than Debian 12's default 15: `.ci/run` installs libllvm19. The newest libLLVM-NN.so
+    found, unless DRJIT_LIBLLVM_PATH names one."""
     if os.environ.get("DRJIT_LIBLLVM_PATH"):
         return
     found = []
@@ -200,7 +202,7 @@ def find_libllvm():
             if name.startswith("libLLVM-") and name.endswith(".so") and digits.isdigit() and int(digits) >= 17:
                 found.append((int(digits), os.path.join(folder, name)))
     if not found:
-        sys.exit("render.py: glossy materials need Mitsuba's LLVM variant and libLLVM 17 or newer "
+        sys.exit("render.py: Mitsuba's LLVM variant needs libLLVM 17 or newer "
                  "(Debian: apt-get install libllvm19), or DRJIT_LIBLLVM_PATH naming one")
     os.environ["DRJIT_LIBLLVM_PATH"] = max(found)[1]
 
@@ -213,28 +215,22 @@ def render(scene_path, out_path, spp, size, seed):
     width, height = (int(v) for v in size.split("x"))
     with open(scene_path) as f:
         desc = json.load(f)
-    glossy = any("material" in m for m in desc["meshes"])
-    if glossy:
-        find_libllvm()
+    find_libllvm()
     import mitsuba as mi
 
-    mi.set_variant("llvm_ad_rgb" if glossy else "scalar_rgb")
-    if glossy:
-        import gltf_bsdf
+    mi.set_variant("llvm_ad_rgb")
+    import gltf_bsdf
 
-        gltf_bsdf.register()
+    gltf_bsdf.register()
     with tempfile.TemporaryDirectory() as tmp:
         scene = mi.load_dict(scene_dict(mi, desc, tmp, width, height, spp, seed))
     t0 = time.perf_counter()
-    if glossy:
-        # Passes of at most LLVM_PASS_SPP samples, each with its own seed, averaged.
-        passes = [LLVM_PASS_SPP] * (spp // LLVM_PASS_SPP) + ([spp % LLVM_PASS_SPP] if spp % LLVM_PASS_SPP else [])
-        total = np.zeros((height, width, 3), dtype=np.float64)
-        for k, n in enumerate(passes):
-            total += np.array(mi.render(scene, spp=n, seed=seed * 100003 + k), dtype=np.float64) * n
-        image = (total / spp).astype(np.float32)
-    else:
-        image = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float32)
+    # Passes of at most LLVM_PASS_SPP samples, each with its own seed, averaged.
+    passes = [LLVM_PASS_SPP] * (spp // LLVM_PASS_SPP) + ([spp % LLVM_PASS_SPP] if spp % LLVM_PASS_SPP else [])
+    total = np.zeros((height, width, 3), dtype=np.float64)
+    for k, n in enumerate(passes):
+        total += np.array(mi.render(scene, spp=n, seed=seed * 100003 + k), dtype=np.float64) * n
+    image = (total / spp).astype(np.float32)
     seconds = time.perf_counter() - t0
     assert image.shape == (height, width, 3), image.shape
     np.save(out_path, image)
