@@ -82,13 +82,24 @@ float directional_albedo(sampler2D lut, float lut_res, float n_v, float roughnes
     return max(rg.r + rg.g, 1e-3);
 }
 
-// KHR_materials_clearcoat over the base's f: (1 − w) f + w D_c Vis_c with w = clearcoat · Fc,
-// Fc Schlick of F0 0.04 at n·v (the coat's normal is the surface's here).
-vec3 coat_over(Material m, vec3 base, float n_v, float n_h, float n_l) {
-    float w = m.clearcoat * (DIELECTRIC_F0.x + (1.0 - DIELECTRIC_F0.x) * pow(1.0 - n_v, 5.0));
-    float a = ggx_alpha(m.clearcoat_roughness);
+// KHR_materials_clearcoat's weight w = clearcoat · Fc, Fc the Schlick Fresnel of an index of
+// refraction of 1.5 (F0 0.04) at the cosine n_v of the view direction to the coat's normal.
+float coat_weight(float clearcoat, float n_v) {
+    return clearcoat * fresnel_schlick(DIELECTRIC_F0, vec3(1.0), n_v).x;
+}
+
+// The coat's lobe D · Vis of perceptual roughness `roughness` (its Fresnel is in the weight).
+float coat_lobe(float roughness, float n_h, float n_v, float n_l) {
+    float a = ggx_alpha(roughness);
     float a2 = a * a;
-    return base * (1.0 - w) + w * ggx_d(n_h, a2) * smith_visibility(n_l, n_v, a2);
+    return ggx_d(n_h, a2) * smith_visibility(n_l, n_v, a2);
+}
+
+// The clear coat over the base's f: (1 − w) f + w D_c Vis_c (the coat's normal is the surface's
+// here).
+vec3 coat_over(Material m, vec3 base, float n_v, float n_h, float n_l) {
+    float w = coat_weight(m.clearcoat, n_v);
+    return base * (1.0 - w) + w * coat_lobe(m.clearcoat_roughness, n_h, n_v, n_l);
 }
 
 // f(l, v): Lambert for diffuse-only materials; otherwise Cook–Torrance GGX with height-correlated

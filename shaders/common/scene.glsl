@@ -181,7 +181,7 @@ bool trace_surface(TraceRay r, out Surface s) {
 // refraction of 1.5 at the view direction (F0 0.04), over the base, which keeps 1 − w:
 // f_cos = (1 − w) f_base (ns·wi) + w D_c Vis_c (nc·wi).
 float coat_weight(Surface s, vec3 wo) {
-    return s.mat.clearcoat * fresnel_schlick(DIELECTRIC_F0, vec3(1.0), clamp(dot(s.nc, wo), 0.0, 1.0)).x;
+    return coat_weight(s.mat.clearcoat, clamp(dot(s.nc, wo), 0.0, 1.0));
 }
 
 // The coat's GGX lobe times nc·wi (no Fresnel: it is in the weight).
@@ -191,9 +191,7 @@ float coat_cos(Surface s, vec3 wo, vec3 wi) {
     if (n_l <= 0.0 || n_v <= 0.0) {
         return 0.0;
     }
-    float a = ggx_alpha(s.mat.clearcoat_roughness);
-    float a2 = a * a;
-    return ggx_d(max(dot(s.nc, normalize(wo + wi)), 0.0), a2) * smith_visibility(n_l, n_v, a2) * n_l;
+    return coat_lobe(s.mat.clearcoat_roughness, max(dot(s.nc, normalize(wo + wi)), 0.0), n_v, n_l) * n_l;
 }
 
 vec3 base_brdf_cos(Surface s, vec3 wo, vec3 wi) {
@@ -229,12 +227,17 @@ vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
     return base * (1.0 - w) + w * coat_cos(s, wo, wi);
 }
 
+// The luminance of the base's Fresnel reflectance towards wo.
+float base_fresnel(Surface s, vec3 wo) {
+    return luminance(fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), clamp(dot(s.ns, wo), 0.0, 1.0)));
+}
+
 // Probability of choosing the specular lobe (of the base's two).
 float specular_probability(Surface s, vec3 wo) {
     if (s.mat.diffuse_only) {
         return 0.0;
     }
-    float fresnel = luminance(fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), clamp(dot(s.ns, wo), 0.0, 1.0)));
+    float fresnel = base_fresnel(s, wo);
     float diffuse = luminance(s.mat.base) * (1.0 - s.mat.metallic) * (1.0 - fresnel);
     return clamp(fresnel / max(fresnel + diffuse, 1e-6), 0.05, 0.95);
 }
@@ -247,14 +250,23 @@ float coat_probability(Surface s, vec3 wo) {
         return 0.0;
     }
     float w = coat_weight(s, wo);
-    float base = luminance(fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), clamp(dot(s.ns, wo), 0.0, 1.0)))
-        + luminance(s.mat.base) * (1.0 - s.mat.metallic);
+    float base = base_fresnel(s, wo) + luminance(s.mat.base) * (1.0 - s.mat.metallic);
     return clamp(w / max(w + (1.0 - w) * base, 1e-6), 0.1, 0.9);
 }
 
 mat3 basis(vec3 n) {
     vec3 t = abs(n.z) < 0.999 ? normalize(cross(vec3(0.0, 0.0, 1.0), n)) : normalize(cross(vec3(1.0, 0.0, 0.0), n));
     return mat3(t, cross(n, t), n);
+}
+
+// Density of reflecting wo into wi about a GGX visible normal of perceptual roughness `roughness`
+// around n (`sample_ggx_reflection`).
+float ggx_reflection_pdf(vec3 n, float roughness, vec3 wo, vec3 wi) {
+    float n_v = max(dot(n, wo), 1e-6);
+    vec3 h = normalize(wo + wi);
+    float a = ggx_alpha(roughness);
+    float a2 = a * a;
+    return smith_g1(n_v, a2) * ggx_d(max(dot(n, h), 0.0), a2) / (4.0 * n_v);
 }
 
 // Density of the base's lobes (diffuse and GGX) at wi.
@@ -268,12 +280,7 @@ float base_pdf(Surface s, vec3 wo, vec3 wi) {
     if (ps == 0.0) {
         return diffuse;
     }
-    float n_v = max(dot(s.ns, wo), 1e-6);
-    vec3 h = normalize(wo + wi);
-    float a = ggx_alpha(s.mat.roughness);
-    float a2 = a * a;
-    float specular = smith_g1(n_v, a2) * ggx_d(max(dot(s.ns, h), 0.0), a2) / (4.0 * n_v);
-    return ps * specular + (1.0 - ps) * diffuse;
+    return ps * ggx_reflection_pdf(s.ns, s.mat.roughness, wo, wi) + (1.0 - ps) * diffuse;
 }
 
 // Solid-angle density of sampling wi with `sample_brdf`.
@@ -282,14 +289,8 @@ float brdf_pdf(Surface s, vec3 wo, vec3 wi) {
     if (pc == 0.0) {
         return base_pdf(s, wo, wi);
     }
-    float coat = 0.0;
-    float n_l = dot(s.nc, wi);
-    if (n_l > 0.0 && dot(s.ng, wi) > 0.0) {
-        float n_v = max(dot(s.nc, wo), 1e-6);
-        float a = ggx_alpha(s.mat.clearcoat_roughness);
-        float a2 = a * a;
-        coat = smith_g1(n_v, a2) * ggx_d(max(dot(s.nc, normalize(wo + wi)), 0.0), a2) / (4.0 * n_v);
-    }
+    bool above = dot(s.nc, wi) > 0.0 && dot(s.ng, wi) > 0.0;
+    float coat = above ? ggx_reflection_pdf(s.nc, s.mat.clearcoat_roughness, wo, wi) : 0.0;
     return pc * coat + (1.0 - pc) * base_pdf(s, wo, wi);
 }
 
@@ -309,24 +310,27 @@ vec3 sample_vndf(vec3 v, float a, vec2 xi) {
     return normalize(vec3(a * nh.x, a * nh.y, max(nh.z, 0.0)));
 }
 
+// wo reflected about a GGX visible normal of perceptual roughness `roughness` sampled with `xi`
+// in the frame `f` (normal f[2]).
+vec3 sample_ggx_reflection(mat3 f, float roughness, vec3 wo, vec2 xi) {
+    return reflect(-wo, f * sample_vndf(transpose(f) * wo, ggx_alpha(roughness), xi));
+}
+
 // A direction sampled with density `brdf_pdf`; `specular`: it came from the GGX lobe (rather
 // than the cosine-weighted diffuse one).
 vec3 sample_brdf_lobe(Surface s, vec3 wo, out bool specular) {
     float pc = coat_probability(s, wo);
     if (pc > 0.0 && rnd() < pc) {
         specular = true;
-        mat3 c = basis(s.nc);
         vec2 xi = vec2(rnd(), rnd());
-        return reflect(-wo, c * sample_vndf(transpose(c) * wo, ggx_alpha(s.mat.clearcoat_roughness), xi));
+        return sample_ggx_reflection(basis(s.nc), s.mat.clearcoat_roughness, wo, xi);
     }
     mat3 f = basis(s.ns);
     float ps = specular_probability(s, wo);
     vec2 xi = vec2(rnd(), rnd());
     specular = rnd() < ps;
     if (specular) {
-        vec3 v = transpose(f) * wo;
-        vec3 h = f * sample_vndf(v, ggx_alpha(s.mat.roughness), xi);
-        return reflect(-wo, h);
+        return sample_ggx_reflection(f, s.mat.roughness, wo, xi);
     }
     float r = sqrt(xi.x);
     float phi = 2.0 * PI * xi.y;

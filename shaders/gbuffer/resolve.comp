@@ -94,7 +94,6 @@ void main() {
     vec2 dielectric = gbuffer_dielectric(m);
     imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), dielectric.y));
     imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion));
-    float coat = clamp(m.clearcoat * texel[SLOT_CLEARCOAT].r, 0.0, 1.0);
-    float coat_roughness = clamp(m.clearcoat_roughness * texel[SLOT_CLEARCOAT_ROUGHNESS].g, 0.0, 1.0);
-    imageStore(out_emission, pixel, vec4(emission, gbuffer_coat(coat, coat_roughness)));
+    float coat = gbuffer_coat(m.clearcoat * texel[SLOT_CLEARCOAT].r, m.clearcoat_roughness * texel[SLOT_CLEARCOAT_ROUGHNESS].g);
+    imageStore(out_emission, pixel, vec4(emission, coat));
 }

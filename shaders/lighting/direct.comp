@@ -286,7 +286,7 @@ void main() {
     // The clear coat (KHR_materials_clearcoat) keeps 1 − w of the light the base reflects, and
     // reflects w of the sky's prefiltered light about the mirror direction with its lobe's
     // directional albedo (the split sum's R + G: the coat's Fresnel is in w).
-    float coat_w = m.clearcoat * (DIELECTRIC_F0.x + (1.0 - DIELECTRIC_F0.x) * pow(1.0 - n_v, 5.0));
+    float coat_w = coat_weight(m.clearcoat, n_v);
     vec3 coat_sky = vec3(0.0);
     if (coat_w > 0.0) {
         vec2 rg = lut_res >= 1.0 ? texture(brdf_lut, vec2(n_v, m.clearcoat_roughness)).rg : vec2(1.0, 0.0);

@@ -45,21 +45,31 @@ fn floor_bin() -> Vec<u8> {
     bytes
 }
 
-/// The floor's glTF: black, roughness 0.05, the extensions' ior and specular.
-fn floor_gltf() -> String {
+/// The floor's glTF with `material` (a glTF material object) and `extensions` used.
+fn floor_gltf_with(extensions: &str, material: &str) -> String {
     format!(
         r#"{{"asset":{{"version":"2.0"}},
-  "extensionsUsed":["KHR_materials_ior","KHR_materials_specular"],
+  "extensionsUsed":[{extensions}],
   "scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
   "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"material":0}}]}}],
-  "materials":[{{"pbrMetallicRoughness":{{"baseColorFactor":[0,0,0,1],"metallicFactor":0,"roughnessFactor":0.05}},
-    "extensions":{{"KHR_materials_ior":{{"ior":{IOR}}},
-      "KHR_materials_specular":{{"specularFactor":{FACTOR},"specularColorFactor":[{},{},{}]}}}}}}],
+  "materials":[{material}],
   "buffers":[{{"byteLength":60,"uri":"floor.bin"}}],
   "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":12}}],
   "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-100,0,-100],"max":[100,0,100]}},
-    {{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}}]}}"#,
-        COLOR[0], COLOR[1], COLOR[2]
+    {{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}}]}}"#
+    )
+}
+
+/// The floor's glTF: black, roughness 0.05, the extensions' ior and specular.
+fn floor_gltf() -> String {
+    floor_gltf_with(
+        r#""KHR_materials_ior","KHR_materials_specular""#,
+        &format!(
+            r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[0,0,0,1],"metallicFactor":0,"roughnessFactor":0.05}},
+    "extensions":{{"KHR_materials_ior":{{"ior":{IOR}}},
+      "KHR_materials_specular":{{"specularFactor":{FACTOR},"specularColorFactor":[{},{},{}]}}}}}}"#,
+            COLOR[0], COLOR[1], COLOR[2]
+        ),
     )
 }
 
@@ -92,6 +102,18 @@ fn camera(degrees: f64) -> Camera {
         vfov_degrees: 1.0,
         znear: 0.1,
         zfar: 100.0,
+    }
+}
+
+/// Asserts that each channel of `got` lies within `tolerance` (relative) of `want`'s.
+fn assert_within(what: &str, got: [f64; 3], want: [f64; 3], tolerance: f64) {
+    for ch in 0..3 {
+        assert!(
+            (got[ch] - want[ch]).abs() <= tolerance * want[ch],
+            "{what}: channel {ch} {} against the closed form's {}",
+            got[ch],
+            want[ch]
+        );
     }
 }
 
@@ -136,36 +158,19 @@ fn ior_and_specular_set_the_dielectric_fresnel_in_the_reference_and_the_raster_f
         eprintln!(
             "{degrees}°: reference {reference:?}, raster {raster:?}, closed form {want:?} (grey {grey:.4})"
         );
-        for ch in 0..3 {
-            assert!(
-                (reference[ch] - want[ch]).abs() <= 0.03 * want[ch],
-                "{degrees}°: the reference's channel {ch} {} against Schlick's {}",
-                reference[ch],
-                want[ch]
-            );
-            assert!(
-                (raster[ch] - grey).abs() <= 0.06 * grey,
-                "{degrees}°: the raster frame's channel {ch} {} against Schlick's {grey} (grey F0)",
-                raster[ch]
-            );
-        }
+        assert_within(&format!("{degrees}°: the reference"), reference, want, 0.03);
+        assert_within(&format!("{degrees}°: the raster frame (grey F0)"), raster, [grey; 3], 0.06);
     }
 }
 
 /// The coated floor's glTF: grey Lambertian base (no specular lobe), a smooth full clear coat.
 fn coated_floor_gltf() -> String {
-    r#"{"asset":{"version":"2.0"},
-  "extensionsUsed":["KHR_materials_specular","KHR_materials_clearcoat"],
-  "scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
-  "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],
-  "materials":[{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":1},
+    floor_gltf_with(
+        r#""KHR_materials_specular","KHR_materials_clearcoat""#,
+        r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":1},
     "extensions":{"KHR_materials_specular":{"specularFactor":0},
-      "KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":0.05}}}],
-  "buffers":[{"byteLength":60,"uri":"floor.bin"}],
-  "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12}],
-  "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-100,0,-100],"max":[100,0,100]},
-    {"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}]}"#
-        .to_string()
+      "KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":0.05}}}"#,
+    )
 }
 
 #[test]
@@ -180,24 +185,12 @@ fn a_clear_coat_reflects_its_fresnel_over_the_base_in_the_reference_and_the_rast
         let fc = 0.04 + 0.96 * (1.0 - degrees.to_radians().cos()).powi(5);
         let want = 0.5 * (1.0 - fc) + fc;
         eprintln!("coat {degrees}°: reference {reference:?}, raster {raster:?}, closed form {want:.4}");
-        for ch in 0..3 {
-            assert!(
-                (reference[ch] - want).abs() <= 0.02 * want,
-                "{degrees}°: the reference's channel {ch} {} against {want}",
-                reference[ch]
-            );
-            assert!(
-                (raster[ch] - want).abs() <= 0.02 * want,
-                "{degrees}°: the raster frame's channel {ch} {} against {want}",
-                raster[ch]
-            );
-        }
+        assert_within(&format!("coat {degrees}°: the reference"), reference, [want; 3], 0.02);
+        assert_within(&format!("coat {degrees}°: the raster frame"), raster, [want; 3], 0.02);
     }
     // A coat of 2 (offset 80 of the 96-byte record) is refused.
     use kiln_format::{Checksums, KilnFile, SceneView, sections};
-    let mut scene = kiln_compiler::import::import(&gltf).unwrap();
-    scene.cameras = vec![camera(30.0)];
-    let good = compile(scene, fast_settings());
+    let good = std::fs::read(dir.path().join("coated30.kiln")).unwrap();
     let two =
         kiln_tests::rewrite(&good, sections::MATERIALS, |d| d[80..84].copy_from_slice(&2.0f32.to_le_bytes()));
     let f = KilnFile::from_bytes(&two, Checksums::Eager).unwrap();

@@ -98,21 +98,29 @@ pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
         },
         // The stored channels are those some slot reads: R (occlusion, clear coat), G
         // (roughness, clear coat roughness), B (metalness).
-        TextureRole::Data if usage.clearcoat || usage.clearcoat_roughness => {
+        TextureRole::Data => {
+            let coat = usage.clearcoat || usage.clearcoat_roughness;
             let red = usage.occlusion || usage.clearcoat;
             let green = usage.metallic_roughness || usage.clearcoat_roughness;
+            let why = |plain, coated| if coat { coated } else { plain };
             match (red, green, usage.metallic_roughness) {
                 (true, _, true) => Choice {
                     format: PixelFormat::Bc7,
                     swizzle: [R, G, Swizzle::B, One],
                     channels: vec![0, 1, 2],
-                    why: "clear coat with metallic-roughness: BC7 linear of R, G, B",
+                    why: why(
+                        "occlusion + metallic-roughness: BC7 linear of R, G, B",
+                        "clear coat with metallic-roughness: BC7 linear of R, G, B",
+                    ),
                 },
                 (false, _, true) => Choice {
                     format: PixelFormat::Bc5,
                     swizzle: [Zero, R, G, One],
                     channels: vec![1, 2],
-                    why: "clear coat roughness with metallic-roughness: BC5 of G, B",
+                    why: why(
+                        "metallic-roughness: BC5 of G (roughness), B (metalness)",
+                        "clear coat roughness with metallic-roughness: BC5 of G, B",
+                    ),
                 },
                 (true, true, false) => Choice {
                     format: PixelFormat::Bc5,
@@ -124,37 +132,17 @@ pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
                     format: PixelFormat::Bc4,
                     swizzle: [R, R, R, One],
                     channels: vec![0],
-                    why: "clear coat: BC4 of R",
+                    why: why("occlusion: BC4 of R", "clear coat: BC4 of R"),
                 },
-                (false, _, false) => Choice {
+                (false, true, false) => Choice {
                     format: PixelFormat::Bc4,
                     swizzle: [Zero, R, Zero, One],
                     channels: vec![1],
                     why: "clear coat roughness: BC4 of G",
                 },
+                (false, false, false) => rgba8("read by no material slot: kept RGBA8"),
             }
         }
-        TextureRole::Data => match (usage.metallic_roughness, usage.occlusion) {
-            (true, true) => Choice {
-                format: PixelFormat::Bc7,
-                swizzle: [R, G, Swizzle::B, One],
-                channels: vec![0, 1, 2],
-                why: "occlusion + metallic-roughness: BC7 linear of R, G, B",
-            },
-            (true, false) => Choice {
-                format: PixelFormat::Bc5,
-                swizzle: [Zero, R, G, One],
-                channels: vec![1, 2],
-                why: "metallic-roughness: BC5 of G (roughness), B (metalness)",
-            },
-            (false, true) => Choice {
-                format: PixelFormat::Bc4,
-                swizzle: [R, R, R, One],
-                channels: vec![0],
-                why: "occlusion: BC4 of R",
-            },
-            (false, false) => rgba8("read by no material slot: kept RGBA8"),
-        },
     }
 }
 

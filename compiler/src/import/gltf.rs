@@ -10,31 +10,32 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use ::gltf::{Accessor, Document, Gltf};
 use glam::{DMat3, DMat4, DVec3};
-use kiln_format::manifest::{Camera, Light, LightKind, OrthographicCamera, Wrap};
-use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
+use kiln_format::manifest::{Camera, Light, LightKind, OrthographicCamera};
+use kiln_format::sections::Vertex;
 
 mod buffers;
 mod checks;
 mod clearcoat;
 mod extent;
+mod material;
 mod spec_defaults;
 mod specular;
 mod transmission;
 mod uri;
+mod uv_mapping;
 
-use super::files::ReadError;
 use super::geometry::{
     Sharing, check_position, corner_normals, given_corner_normals, split_by_normal, stored, unorm16,
 };
 use super::images::{TextureRequest, decode_all};
 use super::read_input;
 use crate::exit::{CliError, CliResult, Exit};
-use crate::ir::{Material, Scene, TextureRole, WarningClass};
+use crate::ir::{Scene, TextureRole, WarningClass};
 use crate::settings::Normals;
 use buffers::load_buffers;
 use checks::{check_glb_header, check_references, guard, named, node_parents};
 use extent::declared_extent;
-use uri::{load_uri, short};
+use uv_mapping::UvMapping;
 
 /// Extensions whose meaning kiln implements; a file requiring any other is refused.
 const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -46,44 +47,6 @@ const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_texture_transform",
 ];
-
-/// How a material's textures map a primitive's texture coordinates: the set they read and the
-/// `KHR_texture_transform` they apply (baked into the stored coordinates, which the format holds
-/// one set of).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct UvMapping {
-    /// `TEXCOORD_n`.
-    set: u32,
-    /// u' = m[0]·u + m[1]·v + m[2], v' = m[3]·u + m[4]·v + m[5].
-    matrix: [f32; 6],
-}
-
-impl UvMapping {
-    const IDENTITY: [f32; 6] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-
-    /// The mapping of a texture reference: its set, or the transform's override of it, and the
-    /// transform's offset · rotation · scale (glTF's `KHR_texture_transform`).
-    fn of(tex_coord: u32, transform: Option<::gltf::texture::TextureTransform>) -> UvMapping {
-        let Some(t) = transform else { return UvMapping { set: tex_coord, matrix: Self::IDENTITY } };
-        Self::transformed(t.tex_coord().unwrap_or(tex_coord), t.offset(), t.rotation(), t.scale())
-    }
-
-    /// Set `set` through the transform of offset `[ox, oy]`, rotation `r` and scale `[sx, sy]`.
-    fn transformed(set: u32, [ox, oy]: [f32; 2], r: f32, [sx, sy]: [f32; 2]) -> UvMapping {
-        let (sn, c) = r.sin_cos();
-        UvMapping {
-            set,
-            // translation · rotation · scale as the extension's GLSL writes them (column-major
-            // `mat3(cos, sin, 0, -sin, cos, 0, 0, 0, 1)`).
-            matrix: [c * sx, -sn * sy, ox, sn * sx, c * sy, oy],
-        }
-    }
-
-    fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
-        let m = &self.matrix;
-        [m[0] * uv[0] + m[1] * uv[1] + m[2], m[3] * uv[0] + m[4] * uv[1] + m[5]]
-    }
-}
 
 /// World triangles beyond this are refused (instancing can multiply a small file's geometry).
 const MAX_TRIANGLES: usize = 1 << 28;
@@ -911,211 +874,6 @@ impl Importer<'_> {
             )));
         }
         Ok(())
-    }
-
-    fn material(&mut self, m: ::gltf::Material) -> CliResult<u32> {
-        if let Some(&i) = self.materials.get(&m.index()) {
-            return Ok(i);
-        }
-        let name = match (m.index(), m.name()) {
-            (_, Some(n)) => n.to_string(),
-            (Some(i), None) => format!("material{i}"),
-            (None, None) => "default".to_string(),
-        };
-        let pbr = m.pbr_metallic_roughness();
-        let at = format!("{}: material '{name}'", self.file);
-        // Factors outside their physical range (glTF 2.0's, and ≥ 0 for emission) are clamped
-        // with a warning naming the field; a non-finite one is refused (JSON has no NaN and
-        // serde_json refuses a number past f32's range, so only a product can overflow).
-        let pbr_field = |f: &str| format!("pbrMetallicRoughness.{f}");
-        let base_color =
-            self.physical(&at, &pbr_field("baseColorFactor"), pbr.base_color_factor(), 0.0, 1.0)?;
-        let [metallic] =
-            self.physical(&at, &pbr_field("metallicFactor"), [pbr.metallic_factor()], 0.0, 1.0)?;
-        let [roughness] =
-            self.physical(&at, &pbr_field("roughnessFactor"), [pbr.roughness_factor()], 0.0, 1.0)?;
-        let emissive = self.physical(&at, "emissiveFactor", m.emissive_factor(), 0.0, f32::INFINITY)?;
-        let [strength] = self.physical(
-            &at,
-            "KHR_materials_emissive_strength.emissiveStrength",
-            [m.emissive_strength().unwrap_or(1.0)],
-            0.0,
-            f32::INFINITY,
-        )?;
-        let mut gpu = GpuMaterial {
-            base_color,
-            emission: emissive.map(|e| e * strength),
-            metallic,
-            roughness,
-            alpha_cutoff: m.alpha_cutoff().unwrap_or(0.5),
-            normal_scale: m.normal_texture().map_or(1.0, |t| t.scale()),
-            occlusion_strength: m.occlusion_texture().map_or(1.0, |t| t.strength()),
-            ..GpuMaterial::default()
-        };
-        if !gpu.emission.iter().all(|v| v.is_finite()) {
-            return Err(CliError::input(format!(
-                "{at}: emissiveFactor {emissive:?} × KHR_materials_emissive_strength.emissiveStrength \
-                 {strength:?} is not finite"
-            )));
-        }
-        for (field, v) in [
-            ("alphaCutoff", gpu.alpha_cutoff),
-            ("normalTexture.scale", gpu.normal_scale),
-            ("occlusionTexture.strength", gpu.occlusion_strength),
-        ] {
-            self.physical(&at, field, [v], f32::NEG_INFINITY, f32::INFINITY)?;
-        }
-        let mut alpha = match m.alpha_mode() {
-            ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            ::gltf::material::AlphaMode::Mask => AlphaMode::Mask,
-            ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
-        };
-        if let Some(t) = m.transmission() {
-            alpha = self.transmission_as_coverage(&at, &t, alpha, &mut gpu)?;
-        }
-        gpu.flags = (alpha as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
-        if m.double_sided() {
-            gpu.flags |= MaterialFlags::DOUBLE_SIDED;
-        }
-        self.dielectric_reflectance(&at, &m, &mut gpu)?;
-        let [coat, coat_roughness] = self.clearcoat(&at, &m, &mut gpu)?;
-        // Every texture of the material reads one set of coordinates through one transform (the
-        // format stores one set per vertex, with the transform baked in); the first texture's
-        // mapping is that of all, and a texture mapped otherwise is named in a warning.
-        fn info(i: ::gltf::texture::Info<'_>) -> (::gltf::Texture<'_>, UvMapping) {
-            (i.texture(), UvMapping::of(i.tex_coord(), i.texture_transform()))
-        }
-        let refs = [
-            pbr.base_color_texture().map(info),
-            pbr.metallic_roughness_texture().map(info),
-            m.normal_texture().map(|i| (i.texture(), UvMapping::of(i.tex_coord(), None))),
-            m.occlusion_texture().map(|i| (i.texture(), UvMapping::of(i.tex_coord(), None))),
-            m.emissive_texture().map(info),
-            coat,
-            coat_roughness,
-        ];
-        let mapping = refs.iter().flatten().map(|(_, u)| *u).next().unwrap_or(UvMapping::of(0, None));
-        for (t, u) in refs.iter().flatten() {
-            if u.set != mapping.set || (u.matrix != mapping.matrix && u.matrix != UvMapping::IDENTITY) {
-                self.scene.warn(format!(
-                    "{}: material '{name}' maps texture {} with other texture coordinates or another \
-                     transform than its first texture; it is sampled with the first's (TEXCOORD_{})",
-                    self.file,
-                    t.index(),
-                    mapping.set
-                ));
-            }
-        }
-        let roles = [
-            TextureRole::Color,
-            TextureRole::Data,
-            TextureRole::Normal,
-            TextureRole::Data,
-            TextureRole::Color,
-            TextureRole::Data,
-            TextureRole::Data,
-        ];
-        let mut slots = [NO_TEXTURE; 7];
-        for (k, r) in refs.into_iter().enumerate() {
-            if let Some((t, _)) = r {
-                slots[k] = self.texture(t, roles[k]);
-            }
-        }
-        [
-            gpu.base_color_texture,
-            gpu.metallic_roughness_texture,
-            gpu.normal_texture,
-            gpu.occlusion_texture,
-            gpu.emissive_texture,
-            gpu.clearcoat_texture,
-            gpu.clearcoat_roughness_texture,
-        ] = slots;
-        let index = self.scene.materials.len() as u32;
-        self.uv_mappings.insert(index, mapping);
-        self.scene.materials.push(Material { name, gpu });
-        self.materials.insert(m.index(), index);
-        Ok(index)
-    }
-
-    /// `v`, the value of material field `field` (of the material `at` names), clamped into
-    /// [`lo`, `hi`] with a warning (class data-loss) when it lies outside; an error when it is
-    /// not finite (JSON has no NaN, but a number past f32's range reads as infinite).
-    fn physical<const N: usize>(
-        &mut self,
-        at: &str,
-        field: &str,
-        v: [f32; N],
-        lo: f32,
-        hi: f32,
-    ) -> CliResult<[f32; N]> {
-        let show = |v: &[f32; N]| if N == 1 { v[0].to_string() } else { format!("{v:?}") };
-        if !v.iter().all(|x| x.is_finite()) {
-            return Err(CliError::input(format!("{at}: {field} is {}, not a finite number", show(&v))));
-        }
-        let clamped = v.map(|x| x.clamp(lo, hi));
-        if clamped != v {
-            let range = match (lo, hi) {
-                (0.0, f32::INFINITY) => "negative".to_string(),
-                (_, f32::INFINITY) => format!("below {lo}"),
-                _ => format!("outside [{lo}, {hi}]"),
-            };
-            self.scene.warn(format!("{at}: {field} {} is {range}; clamped to {}", show(&v), show(&clamped)));
-        }
-        Ok(clamped)
-    }
-
-    fn texture(&mut self, t: ::gltf::Texture, role: TextureRole) -> u32 {
-        if let Some(&i) = self.textures.get(&(t.index(), role)) {
-            return i;
-        }
-        let Some(img) = t.source() else {
-            self.scene.warn(format!(
-                "{}: texture {} has no image (an extension kiln does not read may supply it); the material \
-                 samples no texture there",
-                self.file,
-                t.index()
-            ));
-            return NO_TEXTURE;
-        };
-        let name = img.name().map(str::to_string).unwrap_or_else(|| match img.source() {
-            ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => uri.to_string(),
-            _ => format!("image{}", img.index()),
-        });
-        let bytes = match img.source() {
-            ::gltf::image::Source::View { view, .. } => {
-                let buf = &self.buffers[view.buffer().index()];
-                buf.get(view.offset()..view.offset().saturating_add(view.length()))
-                    .map(<[u8]>::to_vec)
-                    .ok_or_else(|| format!("buffer view {} runs past the end of its buffer", view.index()))
-            }
-            ::gltf::image::Source::Uri { uri, .. } => {
-                let what = format!("image {} ('{}')", img.index(), short(uri));
-                load_uri(uri, &self.base, &mut self.scene.inputs, &what).map_err(|e| match e {
-                    ReadError::Confined(e) => {
-                        self.escapes.push(e.clone());
-                        e
-                    }
-                    ReadError::Unreadable(e) => e,
-                })
-            }
-        };
-        let s = t.sampler();
-        let wrap = |w: ::gltf::texture::WrappingMode| match w {
-            ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-            ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
-            ::gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
-        };
-        let index = (self.scene.textures.len() + self.requests.len()) as u32;
-        self.requests.push(TextureRequest {
-            name,
-            bytes,
-            role,
-            wrap_u: wrap(s.wrap_s()),
-            wrap_v: wrap(s.wrap_t()),
-            mag_linear: s.mag_filter() != Some(::gltf::texture::MagFilter::Nearest),
-        });
-        self.textures.insert((t.index(), role), index);
-        index
     }
 
     fn add_camera(&mut self, camera: &::gltf::Camera, world: &DMat4, node: usize) {

@@ -1,10 +1,9 @@
 //! `KHR_materials_clearcoat`: a clear, glossy layer over the material (car paint, lacquer,
 //! varnish). The format stores its strength and roughness and their textures (format 1.8,
-//! FORMAT.md "Materials"); the reference path tracer and the ray-traced passes' hits shade it as
-//! the extension defines (a GGX lobe of index of refraction 1.5 over the base, which keeps what
-//! the coat's Fresnel does not reflect). What is lost, said in a warning: the coat's own normal
-//! map (`clearcoatNormalTexture`: the coat takes the surface's interpolated normal) and, in the
-//! raster frame, the coat itself (the G-buffer's targets are full).
+//! FORMAT.md "Materials"); every technique shades it as the extension defines (a GGX lobe of index
+//! of refraction 1.5 over the base, which keeps what the coat's Fresnel does not reflect; the
+//! raster frame approximates, docs/compiler.md). What is lost, said in a warning: the coat's own
+//! normal map (`clearcoatNormalTexture`: the coat takes the surface's interpolated normal).
 //!
 //! The gltf crate does not parse this extension, so its JSON is read here; being an extension's
 //! payload, nothing in it can fail the import: a field of the wrong type, or a texture that does
@@ -94,25 +93,6 @@ impl<'a> Importer<'a> {
         };
         let texture = doc.textures().nth(index as usize)?;
         let transform = info.get("extensions").and_then(|e| e.get("KHR_texture_transform"));
-        let mapping = match transform {
-            None => UvMapping { set: tex_coord, matrix: UvMapping::IDENTITY },
-            Some(t) => {
-                let pair = |k: &str, default: [f32; 2]| match t.get(k).and_then(Value::as_array) {
-                    Some(a) if a.len() == 2 && a.iter().all(Value::is_number) => {
-                        [a[0].as_f64().unwrap_or(0.0) as f32, a[1].as_f64().unwrap_or(0.0) as f32]
-                    }
-                    _ => default,
-                };
-                let rotation = t.get("rotation").and_then(Value::as_f64).unwrap_or(0.0) as f32;
-                let set = t.get("texCoord").and_then(Value::as_u64).and_then(|v| u32::try_from(v).ok());
-                UvMapping::transformed(
-                    set.unwrap_or(tex_coord),
-                    pair("offset", [0.0; 2]),
-                    rotation,
-                    pair("scale", [1.0; 2]),
-                )
-            }
-        };
-        Some((texture, mapping))
+        Some((texture, UvMapping::from_json(tex_coord, transform)))
     }
 }
