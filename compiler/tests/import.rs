@@ -881,37 +881,54 @@ fn one_primitive_per_material(g: &mut Gltf) {
     g.json["meshes"][0]["primitives"] = json!(prims);
 }
 
-/// KHR_materials_transmission is read as coverage: an opaque material transmitting t blends
-/// with alpha 1 − t, a blended one multiplies its alpha by 1 − t, a masked one keeps its mask;
-/// each says what is lost. (The reference path tracer's reading of coverage is checked in
+/// KHR_materials_transmission is read into the material's transmission (format 1.9), whatever
+/// its alpha mode (a blended material keeps its alpha as coverage, a masked one its mask), with
+/// its texture through its KHR_texture_transform; a factor above 1 is clamped with a warning.
+/// (Its shading is checked against Mitsuba in tests/mitsuba.rs and against a closed form in
 /// tests/render/reference.rs.)
 #[test]
-fn transmission_is_read_as_coverage_with_a_warning() {
+fn transmission_is_read_with_its_texture() {
     let d = tempfile::tempdir().unwrap();
+    write_white_png(d.path());
     let mut g = Gltf::quad();
-    g.json["extensionsUsed"] = json!(["KHR_materials_transmission"]);
-    let t = |factor: f32| json!({"KHR_materials_transmission": {"transmissionFactor": factor}});
-    g.json["materials"] = json!([
-        {"name": "glass", "extensions": t(0.75)},
-        {"name": "tinted", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.5]}, "extensions": t(0.5)},
-        {"name": "masked", "alphaMode": "MASK", "extensions": t(0.5)},
-        {"name": "none", "extensions": t(0.0)}
+    let t = |v: serde_json::Value| json!({ "KHR_materials_transmission": v });
+    g.textured(
+        json!({"name": "paper", "extensions": t(json!({
+            "transmissionFactor": 0.6,
+            "transmissionTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2.0, 3.0]}}}
+        }))}),
+        "white.png",
+    );
+    g.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_texture_transform"]);
+    let mut materials = g.json["materials"].as_array().unwrap().clone();
+    materials.extend([
+        json!({"name": "glass", "extensions": t(json!({"transmissionFactor": 0.75}))}),
+        json!({"name": "tinted", "alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.5]}, "extensions": t(json!({"transmissionFactor": 0.5}))}),
+        json!({"name": "masked", "alphaMode": "MASK", "extensions": t(json!({"transmissionFactor": 0.5}))}),
+        json!({"name": "loud", "extensions": t(json!({"transmissionFactor": 2.5}))}),
+        json!({"name": "none", "extensions": t(json!({"transmissionFactor": 0.0}))}),
     ]);
+    g.json["materials"] = json!(materials);
     one_primitive_per_material(&mut g);
     let s = import(&g.write(d.path(), "t")).unwrap();
     let m = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap().gpu;
     let mode = |g: kiln_format::sections::GpuMaterial| g.flags >> MaterialFlags::ALPHA_MODE_SHIFT & 3;
-    let blend = kiln_format::sections::AlphaMode::Blend as u32;
-    assert_eq!((m("glass").base_color[3], mode(m("glass"))), (0.25, blend));
-    assert_eq!((m("tinted").base_color[3], mode(m("tinted"))), (0.25, blend));
-    assert_eq!(mode(m("masked")), kiln_format::sections::AlphaMode::Mask as u32);
-    assert_eq!(
-        (m("none").base_color[3], mode(m("none"))),
-        (1.0, kiln_format::sections::AlphaMode::Opaque as u32)
-    );
+    use kiln_format::sections::AlphaMode;
+    let paper = m("paper");
+    assert_eq!(paper.transmission, 0.6);
+    assert_ne!(paper.transmission_texture, NO_TEXTURE);
+    // The texture's transform is the material's mapping, baked into the coordinates.
+    assert_eq!(s.uvs[..4], [[0.0, 0.0], [2.0, 0.0], [2.0, 3.0], [0.0, 3.0]]);
+    assert_eq!((m("glass").transmission, m("glass").base_color[3]), (0.75, 1.0));
+    assert_eq!(mode(m("glass")), AlphaMode::Opaque as u32, "transmission is no longer coverage");
+    assert_eq!((m("tinted").transmission, m("tinted").base_color[3]), (0.5, 0.5));
+    assert_eq!(mode(m("tinted")), AlphaMode::Blend as u32);
+    assert_eq!((m("masked").transmission, mode(m("masked"))), (0.5, AlphaMode::Mask as u32));
+    assert_eq!(m("loud").transmission, 1.0);
+    assert_eq!((m("none").transmission, m("none").transmission_texture), (0.0, NO_TEXTURE));
     let warned = |text: &str| s.warnings.iter().filter(|w| w.message.contains(text)).count();
-    assert_eq!(warned("is read as coverage"), 2, "{:#?}", s.warnings);
-    assert_eq!(warned("on an alpha-masked material is not applied"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("transmissionFactor"), 1, "{:#?}", s.warnings);
+    assert_eq!(warned("coverage"), 0, "{:#?}", s.warnings);
     assert_eq!(warned("used but not supported"), 0, "{:#?}", s.warnings);
 }
 

@@ -1003,13 +1003,13 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
     assert_eq!(geo.colors, view.colors, "{name}: COL0");
     assert_eq!(geo.tris, view.triangles, "{name}: TRIS");
     assert_eq!(geo.tmat, view.triangle_materials, "{name}: TMAT");
-    // Format 1.8 writes MATL version 2: 96-byte records.
+    // Format 1.9 writes MATL version 3: 112-byte records.
     let matl = f.section(b"MATL", 0).unwrap();
     let matl_entry = f.entries.iter().find(|e| &e.kind == b"MATL").unwrap();
-    assert_eq!(matl_entry.version, 2, "{name}: MATL version");
-    assert_eq!(matl.len(), 96 * view.materials.len());
+    assert_eq!(matl_entry.version, 3, "{name}: MATL version");
+    assert_eq!(matl.len(), 112 * view.materials.len());
     for (i, m) in view.materials.iter().enumerate() {
-        let b = &matl[96 * i..96 * i + 96];
+        let b = &matl[112 * i..112 * i + 112];
         use spec::{f32_at, f32s, u32_at};
         let mine = (
             f32s::<4>(b, 0),
@@ -1019,6 +1019,7 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
             [u32_at(b, 72), u32_at(b, 76)],
             [f32_at(b, 80), f32_at(b, 84)],
             [u32_at(b, 88), u32_at(b, 92)],
+            (f32_at(b, 96), u32_at(b, 100), [u32_at(b, 104), u32_at(b, 108)]),
         );
         let theirs = (
             m.base_color,
@@ -1036,6 +1037,8 @@ fn agree(name: &str, bytes: &[u8], inputs_at: &[&Path]) -> String {
             if m.flags & 16 == 0 { [0, 0] } else { m.specular },
             [m.clearcoat, m.clearcoat_roughness],
             [m.clearcoat_texture, m.clearcoat_roughness_texture],
+            // Format 1.9: the transmission, its texture, two reserved zero words.
+            (m.transmission, m.transmission_texture, [0, 0]),
         );
         assert_eq!(mine, theirs, "{name}: material {i}");
         if m.flags & 16 != 0 {
@@ -1393,6 +1396,8 @@ fn fixture_with(codec: Codec) -> Vec<u8> {
     metal.clearcoat = 0.5;
     metal.clearcoat_roughness = 0.25;
     metal.clearcoat_texture = 0;
+    metal.transmission = 0.3;
+    metal.transmission_texture = 0;
     let settings = Settings {
         voxel_res: VoxelRes::Cells(5),
         shaft_res: Some(3),

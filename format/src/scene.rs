@@ -7,9 +7,9 @@ use crate::error::{FormatError, Result};
 use crate::manifest::{ColorSpace, LightKind, Manifest};
 use crate::read::KilnFile;
 use crate::sections::{
-    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, GpuMaterialV1, MATERIALS,
-    MEDIA_VISIBILITY, MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS, TRIANGLES,
-    TextureData, UVS, VERTICES, Vertex, decode_texture, possible_v2_lengths,
+    BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, GpuMaterialV1, GpuMaterialV2,
+    MATERIALS, MEDIA_VISIBILITY, MaterialFlags, NO_TEXTURE, SHADOW_MAP, TEXTURE, TRIANGLE_MATERIALS,
+    TRIANGLES, TextureData, UVS, VERTICES, Vertex, decode_texture, possible_v2_lengths,
 };
 
 /// Borrowed, validated scene data of a [`KilnFile`].
@@ -27,7 +27,8 @@ pub struct SceneView<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Material of each triangle.
     pub triangle_materials: &'a [u32],
-    /// Materials: borrowed from a version 2 `MATL`, converted from a version 1 (no clear coat).
+    /// Materials: borrowed from a version 3 `MATL`, converted from versions 1 and 2 (no clear coat,
+    /// no transmission).
     pub materials: Cow<'a, [GpuMaterial]>,
     /// BVH nodes (empty if the file has no BVH).
     pub bvh: &'a [CwbvhNode],
@@ -51,7 +52,11 @@ impl<'a> SceneView<'a> {
         let materials: Cow<'a, [GpuMaterial]> = match file.find(MATERIALS, 0).map(|s| s.entry.version) {
             Some(1) => {
                 let old: &[GpuMaterialV1] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
-                old.iter().map(|&m| GpuMaterial::from(m)).collect::<Vec<_>>().into()
+                old.iter().map(|m| GpuMaterial::from_words(&m.words)).collect::<Vec<_>>().into()
+            }
+            Some(2) => {
+                let old: &[GpuMaterialV2] = file.pod(MATERIALS, 0)?.unwrap_or(&[]);
+                old.iter().map(|m| GpuMaterial::from_words(&m.words)).collect::<Vec<_>>().into()
             }
             _ => file.pod(MATERIALS, 0)?.unwrap_or(&[]).into(),
         };
@@ -221,6 +226,7 @@ impl<'a> SceneView<'a> {
                 m.occlusion_strength,
                 m.clearcoat,
                 m.clearcoat_roughness,
+                m.transmission,
             ];
             if !finite(&m.base_color) || !finite(&m.emission) || !finite(&scalars) {
                 return Err(FormatError::invalid(format!("material {i} has a non-finite parameter")));
@@ -249,6 +255,12 @@ impl<'a> SceneView<'a> {
                 return Err(FormatError::invalid(format!(
                     "material {i}'s clear coat {} or its roughness {} is outside [0, 1]",
                     m.clearcoat, m.clearcoat_roughness
+                )));
+            }
+            if !unit(&m.transmission) || m.reserved != [0; 2] {
+                return Err(FormatError::invalid(format!(
+                    "material {i}'s transmission {} is outside [0, 1] or its reserved words {:?} are not zero",
+                    m.transmission, m.reserved
                 )));
             }
         }

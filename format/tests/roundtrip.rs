@@ -291,9 +291,44 @@ fn version_1_materials_read_as_materials_without_a_coat() {
     // No coat, and no coat textures (not texture 0, which zeroed words would name).
     assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.0, 0.0));
     assert_eq!((m.clearcoat_texture, m.clearcoat_roughness_texture), (u32::MAX, u32::MAX));
+    assert_eq!((m.transmission, m.transmission_texture, m.reserved), (0.0, u32::MAX, [0, 0]));
 
     // 80 bytes are not a whole version-2 record: refused, not written as a torn material.
     let mut w = FileWriter::new();
     let err = w.raw(sections::MATERIALS, 0, 2, &v1[..], ContentHash::of(b"m")).unwrap_err();
     assert!(err.to_string().contains("96"), "{err}");
+}
+
+#[test]
+fn version_2_materials_read_as_materials_that_transmit_nothing() {
+    // A material as format 1.8 stored it: 96 bytes, written field by field here (FORMAT.md's
+    // `MATL` table): the 80 of version 1, then the coat's strength, roughness and two textures.
+    let mut v2 = Vec::new();
+    for f in [0.8f32, 0.5, 0.25, 1.0, 0.0, 0.0, 0.0, 1.0, 0.3, 0.5, 1.0, 1.0] {
+        v2.extend(f.to_le_bytes());
+    }
+    for u in [u32::MAX, u32::MAX, u32::MAX, u32::MAX, u32::MAX, 0, 0, 0] {
+        v2.extend(u.to_le_bytes());
+    }
+    for f in [0.75f32, 0.125] {
+        v2.extend(f.to_le_bytes());
+    }
+    for u in [u32::MAX, u32::MAX] {
+        v2.extend(u.to_le_bytes());
+    }
+    assert_eq!(v2.len(), 96);
+    let bytes = common::small_file_with_materials(2, &v2);
+    let f = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = kiln_format::scene::SceneView::new(&f).unwrap();
+    let m = &view.materials[0];
+    assert_eq!((m.metallic, m.roughness), (1.0, 0.3));
+    assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.75, 0.125));
+    assert_eq!((m.clearcoat_texture, m.clearcoat_roughness_texture), (u32::MAX, u32::MAX));
+    // No transmission and no transmission texture (not texture 0, which zeroed words would name).
+    assert_eq!((m.transmission, m.transmission_texture, m.reserved), (0.0, u32::MAX, [0, 0]));
+
+    // 96 bytes are not a whole version-3 record: refused.
+    let mut w = FileWriter::new();
+    let err = w.raw(sections::MATERIALS, 0, 3, &v2[..], ContentHash::of(b"m")).unwrap_err();
+    assert!(err.to_string().contains("112"), "{err}");
 }

@@ -18,6 +18,8 @@ struct Material {
     float f90;        // … at grazing incidence (glTF core 1; KHR_materials_specular's factor)
     float clearcoat;  // KHR_materials_clearcoat's strength (0: no coat); passes that trace rays only
     float clearcoat_roughness;  // the coat's perceptual roughness
+    float transmission;  // KHR_materials_transmission's thin-walled transmission (0: opaque);
+                         // passes that trace rays only (the G-buffer folds it into the albedo)
 };
 
 // glTF's core dielectric reflectance (an index of refraction of 1.5), without

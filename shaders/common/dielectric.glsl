@@ -53,7 +53,17 @@ Material gbuffer_material(vec4 albedo, vec4 mat) {
     // that target sets it.
     m.clearcoat = 0.0;
     m.clearcoat_roughness = 0.0;
+    m.transmission = 0.0;
     return m;
+}
+
+// The base colour the G-buffer holds for a surface of base colour `base` that transmits the
+// fraction `transmission` of its dielectric part's light (KHR_materials_transmission): the raster
+// frame draws no light through surfaces, so it keeps their reflection and the (1 − t) part of
+// their diffuse light, the base colour scaled by 1 − t (1 − metallic) (exact for dielectrics; a
+// partly metallic one also loses that share of its metal's F0).
+vec3 gbuffer_base(vec3 base, float metallic, float transmission) {
+    return base * (1.0 - clamp(transmission, 0.0, 1.0) * (1.0 - clamp(metallic, 0.0, 1.0)));
 }
 
 // The clear coat in the G-buffer: the emission target's alpha (half float, which holds whole

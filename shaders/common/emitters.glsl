@@ -201,7 +201,7 @@ vec3 sample_emitter(Surface s, vec3 wo, bool mis) {
         return vec3(0.0);
     }
     vec3 f = brdf_cos(s, wo, es.wi);
-    if (all(equal(f, vec3(0.0))) || emitter_blocked(es, s.p, s.ng)) {
+    if (all(equal(f, vec3(0.0))) || emitter_blocked(es, s.p, facing(s.ng, es.wi))) {
         return vec3(0.0);
     }
     float weight = (es.delta || !mis) ? 1.0 : power_heuristic(es.pdf, brdf_pdf(s, wo, es.wi));
@@ -274,7 +274,7 @@ vec3 sample_environment(Surface s, vec3 wo, vec3 sky, bool mis) {
         return vec3(0.0);
     }
     vec3 f = brdf_cos(s, wo, wi);
-    if (all(equal(f, vec3(0.0))) || emitter_occluded_dir(s.p, s.ng, wi)) {
+    if (all(equal(f, vec3(0.0))) || emitter_occluded_dir(s.p, facing(s.ng, wi), wi)) {
         return vec3(0.0);
     }
     float weight = mis ? power_heuristic(pdf, brdf_pdf(s, wo, wi)) : 1.0;

@@ -63,7 +63,10 @@ struct GpuMaterialLayout {
     float clearcoat_roughness; // offset 84
     uint clearcoat_texture; // offset 88
     uint clearcoat_roughness_texture; // offset 92
-}; // 96 bytes
+    float transmission; // offset 96
+    uint transmission_texture; // offset 100
+    uvec2 reserved; // offset 104
+}; // 112 bytes
 
 struct ReferenceConstants {
     vec4 eye; // offset 0

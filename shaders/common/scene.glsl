@@ -76,6 +76,9 @@ uint surface_slots(GpuMaterialLayout m) {
     if (m.clearcoat > 0.0) {
         slots |= (1u << SLOT_CLEARCOAT) | (1u << SLOT_CLEARCOAT_ROUGHNESS);
     }
+    if (m.transmission > 0.0) {
+        slots |= 1u << SLOT_TRANSMISSION;
+    }
     return any(greaterThan(m.emission, vec3(0.0))) ? slots | (1u << SLOT_EMISSIVE) : slots;
 }
 
@@ -91,6 +94,7 @@ void surface_textured(inout Surface s, GpuMaterialLayout m, vec4 texel[MATERIAL_
     material_dielectric(m, s.mat.f0, s.mat.f90);
     s.mat.clearcoat = clamp(m.clearcoat * texel[SLOT_CLEARCOAT].r, 0.0, 1.0);
     s.mat.clearcoat_roughness = clamp(m.clearcoat_roughness * texel[SLOT_CLEARCOAT_ROUGHNESS].g, 0.0, 1.0);
+    s.mat.transmission = clamp(m.transmission * texel[SLOT_TRANSMISSION].r, 0.0, 1.0);
     vec3 e = m.emission * texel[SLOT_EMISSIVE].rgb;
     bool double_sided = (m.flags & MATERIAL_DOUBLE_SIDED) != 0u;
     s.emission = (s.front || double_sided) ? e : vec3(0.0);
@@ -119,7 +123,8 @@ Surface surface_at(TraceRay r, TraceHit h) {
     GpuMaterialLayout m = materials[tri_materials[tri]];
     vec2 uv = vec2(0.0);
     bool textured = m.base_color_texture != NO_TEXTURE || m.metallic_roughness_texture != NO_TEXTURE || m.normal_texture != NO_TEXTURE
-        || m.emissive_texture != NO_TEXTURE || m.occlusion_texture != NO_TEXTURE;
+        || m.emissive_texture != NO_TEXTURE || m.occlusion_texture != NO_TEXTURE || m.clearcoat_texture != NO_TEXTURE
+        || m.clearcoat_roughness_texture != NO_TEXTURE || m.transmission_texture != NO_TEXTURE;
     if (textured) {
         uv = triangle_uv(tri, h.u, h.v);
     }
@@ -194,9 +199,26 @@ float coat_cos(Surface s, vec3 wo, vec3 wi) {
     return coat_lobe(s.mat.clearcoat_roughness, max(dot(s.nc, normalize(wo + wi)), 0.0), n_v, n_l) * n_l;
 }
 
+// wi mirrored through the surface's tangent plane (about the shading normal): a thin wall's
+// transmitted direction as the reflected one it mirrors.
+vec3 mirrored(Surface s, vec3 wi) {
+    return wi - 2.0 * dot(s.ns, wi) * s.ns;
+}
+
+// The base's f · |ns·wi| for wi above the surface (reflection) or, where the material transmits,
+// below it (KHR_materials_transmission, thin-walled): with F the Schlick Fresnel at the half
+// vector h of wo and wi (of wo and wi mirrored for transmission), t the transmission, m the
+// metalness, the reflection is (1 − F)(1 − m)(1 − t) base / π + F D Vis and the transmission
+// (1 − F)(1 − m) t base D Vis: the specular lobe mirrored through the surface, tinted by the base
+// colour, its light taken from the diffuse part (FORMAT.md, "Transmission").
 vec3 base_brdf_cos(Surface s, vec3 wo, vec3 wi) {
     float n_l = dot(s.ns, wi);
     float n_v = dot(s.ns, wo);
+    bool through = n_l < 0.0 && s.mat.transmission > 0.0 && !s.mat.diffuse_only;
+    if (through) {
+        wi = mirrored(s, wi);
+        n_l = -n_l;
+    }
     if (n_l <= 0.0 || n_v <= 0.0) {
         return vec3(0.0);
     }
@@ -209,14 +231,24 @@ vec3 base_brdf_cos(Surface s, vec3 wo, vec3 wi) {
     float d = ggx_d(max(dot(s.ns, h), 0.0), a2);
     float vis = smith_visibility(n_l, n_v, a2);
     vec3 f = fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), max(dot(wo, h), 0.0));
+    if (through) {
+        return (1.0 - f) * (1.0 - s.mat.metallic) * s.mat.transmission * s.mat.base * (d * vis * n_l);
+    }
     // Lambert's base / π, divided after the weights (not lambert(base) times them): the order the
     // reference images were made with; it rounds differently.
-    return ((1.0 - f) * (1.0 - s.mat.metallic) * s.mat.base / PI + f * d * vis) * n_l;
+    return ((1.0 - f) * (1.0 - s.mat.metallic) * (1.0 - s.mat.transmission) * s.mat.base / PI + f * d * vis) * n_l;
 }
 
-// f(wo, wi) · |n·wi|, zero below the geometric surface.
+// The side of a surface of geometric normal ng that the direction w leaves by (for the offset of
+// a ray along w): ng, or −ng for light passing through a transmitting surface.
+vec3 facing(vec3 ng, vec3 w) {
+    return dot(ng, w) < 0.0 ? -ng : ng;
+}
+
+// f(wo, wi) · |n·wi|: zero below the geometric surface unless the material transmits.
 vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
-    if (dot(s.ng, wi) <= 0.0) {
+    float g = dot(s.ng, wi);
+    if (g == 0.0 || (g < 0.0 && s.mat.transmission <= 0.0)) {
         return vec3(0.0);
     }
     vec3 base = base_brdf_cos(s, wo, wi);
@@ -269,18 +301,30 @@ float ggx_reflection_pdf(vec3 n, float roughness, vec3 wo, vec3 wi) {
     return smith_g1(n_v, a2) * ggx_d(max(dot(n, h), 0.0), a2) / (4.0 * n_v);
 }
 
-// Density of the base's lobes (diffuse and GGX) at wi.
+// Probability of transmitting (of the base's non-specular choice; the rest is diffuse): the
+// transmission t, as the two share (1 − F)(1 − m) base in the proportions t and 1 − t.
+float transmission_probability(Surface s) {
+    return s.mat.diffuse_only ? 0.0 : s.mat.transmission;
+}
+
+// Density of the base's lobes (diffuse, GGX reflection and its mirror image, the transmission)
+// at wi.
 float base_pdf(Surface s, vec3 wo, vec3 wi) {
     float n_l = dot(s.ns, wi);
-    if (n_l <= 0.0 || dot(s.ng, wi) <= 0.0) {
+    float g = dot(s.ng, wi);
+    float pt = transmission_probability(s);
+    float ps = specular_probability(s, wo);
+    if (n_l < 0.0 && g < 0.0 && pt > 0.0) {
+        return (1.0 - ps) * pt * ggx_reflection_pdf(s.ns, s.mat.roughness, wo, mirrored(s, wi));
+    }
+    if (n_l <= 0.0 || g <= 0.0) {
         return 0.0;
     }
     float diffuse = n_l / PI;
-    float ps = specular_probability(s, wo);
     if (ps == 0.0) {
         return diffuse;
     }
-    return ps * ggx_reflection_pdf(s.ns, s.mat.roughness, wo, wi) + (1.0 - ps) * diffuse;
+    return ps * ggx_reflection_pdf(s.ns, s.mat.roughness, wo, wi) + (1.0 - ps) * (1.0 - pt) * diffuse;
 }
 
 // Solid-angle density of sampling wi with `sample_brdf`.
@@ -316,25 +360,40 @@ vec3 sample_ggx_reflection(mat3 f, float roughness, vec3 wo, vec2 xi) {
     return reflect(-wo, f * sample_vndf(transpose(f) * wo, ggx_alpha(roughness), xi));
 }
 
-// A direction sampled with density `brdf_pdf`; `specular`: it came from the GGX lobe (rather
-// than the cosine-weighted diffuse one).
+// `w` where it lies on its lobe's side of the surface (above the geometric normal and the
+// lobe's normal n for reflection, below both for transmission), else the zero direction, which
+// every BRDF and density gives 0: `brdf_pdf` counts each lobe's density on its own side only,
+// so that a reflection sampled below a transmitting surface is not taken for a transmission.
+vec3 on_side(Surface s, vec3 n, vec3 w, bool through) {
+    float k = through ? -1.0 : 1.0;
+    return k * dot(n, w) > 0.0 && k * dot(s.ng, w) > 0.0 ? w : vec3(0.0);
+}
+
+// A direction sampled with density `brdf_pdf` (or the zero direction, see `on_side`);
+// `specular`: it came from a GGX lobe (rather than the cosine-weighted diffuse one).
 vec3 sample_brdf_lobe(Surface s, vec3 wo, out bool specular) {
     float pc = coat_probability(s, wo);
     if (pc > 0.0 && rnd() < pc) {
         specular = true;
         vec2 xi = vec2(rnd(), rnd());
-        return sample_ggx_reflection(basis(s.nc), s.mat.clearcoat_roughness, wo, xi);
+        return on_side(s, s.nc, sample_ggx_reflection(basis(s.nc), s.mat.clearcoat_roughness, wo, xi), false);
     }
     mat3 f = basis(s.ns);
     float ps = specular_probability(s, wo);
     vec2 xi = vec2(rnd(), rnd());
     specular = rnd() < ps;
     if (specular) {
-        return sample_ggx_reflection(f, s.mat.roughness, wo, xi);
+        return on_side(s, s.ns, sample_ggx_reflection(f, s.mat.roughness, wo, xi), false);
+    }
+    float pt = transmission_probability(s);
+    // Transmitting materials draw one more number; opaque ones the same numbers as before.
+    if (pt > 0.0 && rnd() < pt) {
+        specular = true;
+        return on_side(s, s.ns, mirrored(s, sample_ggx_reflection(f, s.mat.roughness, wo, xi)), true);
     }
     float r = sqrt(xi.x);
     float phi = 2.0 * PI * xi.y;
-    return f * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - xi.x)));
+    return on_side(s, s.ns, f * vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - xi.x))), false);
 }
 
 vec3 sample_brdf(Surface s, vec3 wo) {

@@ -143,7 +143,8 @@ const uint SLOT_OCCLUSION = 3u;
 const uint SLOT_EMISSIVE = 4u;
 const uint SLOT_CLEARCOAT = 5u;            // R: clear coat strength
 const uint SLOT_CLEARCOAT_ROUGHNESS = 6u;  // G: the coat's roughness
-const uint MATERIAL_SLOTS = 7u;
+const uint SLOT_TRANSMISSION = 7u;         // R: transmission
+const uint MATERIAL_SLOTS = 8u;
 const uint ALL_MATERIAL_SLOTS = (1u << MATERIAL_SLOTS) - 1u;
 
 uint material_texture(GpuMaterialLayout m, uint slot) {
@@ -153,7 +154,8 @@ uint material_texture(GpuMaterialLayout m, uint slot) {
         : slot == SLOT_OCCLUSION ? m.occlusion_texture
         : slot == SLOT_EMISSIVE ? m.emissive_texture
         : slot == SLOT_CLEARCOAT ? m.clearcoat_texture
-                                 : m.clearcoat_roughness_texture;
+        : slot == SLOT_CLEARCOAT_ROUGHNESS ? m.clearcoat_roughness_texture
+                                           : m.transmission_texture;
 }
 
 // The textures of material `m` in the slots of the mask `slots` at `uv` (trilinear by the

@@ -20,6 +20,7 @@ layout(set = 1, binding = 3) uniform sampler2D occlusion_tex;
 layout(set = 1, binding = 4) uniform sampler2D emissive_tex;
 layout(set = 1, binding = 5) uniform sampler2D clearcoat_tex;
 layout(set = 1, binding = 6) uniform sampler2D clearcoat_roughness_tex;
+layout(set = 1, binding = 7) uniform sampler2D transmission_tex;
 layout(push_constant) uniform MaterialPush { GpuMaterialLayout material; };
 
 layout(location = 0) in vec3 in_position;
@@ -72,7 +73,11 @@ void main() {
     }
     out_normal = oct_encode(n);
     vec2 dielectric = gbuffer_dielectric(material);
-    out_albedo = vec4(linear_to_srgb(base.rgb), dielectric.y);
+    float transmission = material.transmission;
+    if (transmission > 0.0 && material.transmission_texture != NO_TEXTURE) {
+        transmission *= texture(transmission_tex, in_uv).r;
+    }
+    out_albedo = vec4(linear_to_srgb(gbuffer_base(base.rgb, metallic, transmission)), dielectric.y);
     out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion);
     float coat = material.clearcoat;
     float coat_roughness = material.clearcoat_roughness;

@@ -316,7 +316,7 @@ vec3 radiance(TraceRay r) {
         if (all(equal(throughput, vec3(0.0)))) {
             break;
         }
-        r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, FAR);
+        r = make_ray(offset_ray_origin(s.p, facing(s.ng, wi)), wi, 0.0, FAR);
     }
     return result;
 }

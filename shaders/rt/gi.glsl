@@ -74,7 +74,7 @@ vec3 sky_seen(Surface s, vec3 wo) {
     }
     vec3 wi = sample_brdf(s, wo);
     float pdf = brdf_pdf(s, wo, wi);
-    if (pdf <= 0.0 || gi_occluded_dir(s.p, s.ng, wi)) {
+    if (pdf <= 0.0 || gi_occluded_dir(s.p, facing(s.ng, wi), wi)) {
         return vec3(0.0);
     }
     return brdf_cos(s, wo, wi) / pdf * frame.sky.rgb;
@@ -145,8 +145,8 @@ vec3 gi_sample(Primary s) {
         if (all(equal(throughput, vec3(0.0)))) {
             break;
         }
-        r = make_ray(offset_ray_origin(h.p, h.ng), wi, 0.0, 3.4e38);
-        origin_ng = h.ng;
+        origin_ng = facing(h.ng, wi);
+        r = make_ray(offset_ray_origin(h.p, origin_ng), wi, 0.0, 3.4e38);
     }
     return result;
 }

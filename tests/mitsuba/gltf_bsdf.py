@@ -1,11 +1,12 @@
 """glTF's metallic-roughness BSDF as kiln defines it, written for Mitsuba 3 (a Python plugin,
 registered as "kiln_gltf"), so that Mitsuba's own path tracer integrates exactly the material
 kiln's reference path tracer claims to render. Written from the definitions (FORMAT.md,
-"Materials"; the glTF specification and its KHR_materials_specular, _ior and _clearcoat
-extensions), not from kiln's shaders:
+"Materials"; the glTF specification and its KHR_materials_specular, _ior, _clearcoat and
+_transmission extensions), not from kiln's shaders:
 
-    f(v, l) · cos = [ (1 − F)(1 − metallic) base / π + F · D · Vis ] (ns·l) · (1 − c · Fc)
-                  + c · Fc · Dc · Visc · (nc·l)
+    l above:  f(v, l) · cos = [ (1 − F)(1 − metallic)(1 − t) base / π + F · D · Vis ] (ns·l) · (1 − c · Fc)
+                            + c · Fc · Dc · Visc · (nc·l)
+    l below:  f(v, l) · |cos| = (1 − F)(1 − metallic) t base · D · Vis · |ns·l| · (1 − c · Fc)
 
 - F = F0 + (F90 − F0)(1 − v·h)⁵ (Schlick) with F0 = mix(dielectric F0, base, metallic) and
   F90 = mix(dielectric F90, 1, metallic); the dielectric's F0 and F90 are glTF's core 0.04 and 1
@@ -16,6 +17,11 @@ extensions), not from kiln's shaders:
   Fc = 0.04 + 0.96 (1 − nc·v)⁵ (an index of refraction of 1.5, the Fresnel of the view direction
   to the coat's normal, as the extension's `fresnel_coat` defines it), Dc and Visc GGX and Smith
   of α = (clearcoat roughness × its texture's G)². The coat's normal nc is the interpolated one.
+- Transmission (KHR_materials_transmission, thin-walled: no KHR_materials_volume): t = the
+  transmission factor × its texture's R. Light below the surface (l on the far side of both the
+  geometric and the shading normal) passes through the specular lobe mirrored through the
+  surface: D, Vis and F are those of the reflection towards l' = l − 2 (ns·l) ns, the half vector
+  that of v and l'; the transmitted light takes the share t of what the diffuse part had.
 - Textures (optional, `.npy` arrays of RGBA8 texels, rows top to bottom, read at the mesh's uv
   with v down the image, bilinear on the linear values): the base colour (sRGB) multiplies the
   base colour factor, the metallic-roughness texture's B and G the factors, the normal map
@@ -27,7 +33,8 @@ extensions), not from kiln's shaders:
   surface is replaced by the geometric one; nothing reflects below the geometric surface.
 
 Sampling is Mitsuba's own: a cosine-weighted hemisphere and Mitsuba's GGX visible-normal
-sampling (`MicrofacetDistribution`), one lobe chosen uniformly; the density is the mixture's.
+sampling (`MicrofacetDistribution`), its reflection mirrored through the surface for the
+transmission, one lobe chosen uniformly; the density is the mixture's.
 """
 
 import drjit as dr
@@ -82,6 +89,7 @@ class GltfBsdf(mi.BSDF):
         self.clearcoat = get("clearcoat", 0.0)
         self.coat_roughness = get("clearcoat_roughness", 0.0)
         self.normal_scale = get("normal_scale", 1.0)
+        self.transmission = get("transmission", 0.0)
         wrap = str(props.get("wrap", "repeat"))
         linear = bool(props.get("linear", True))
         tex = lambda name, srgb: (
@@ -92,14 +100,18 @@ class GltfBsdf(mi.BSDF):
         self.normal_tex = tex("normal_tex", False)
         self.coat_tex = tex("clearcoat_tex", False)
         self.coat_roughness_tex = tex("clearcoat_roughness_tex", False)
-        self.lobes = 3 if self.clearcoat > 0.0 else 2
+        self.transmission_tex = tex("transmission_tex", False)
+        self.lobes = 2 + (self.clearcoat > 0.0) + (self.transmission > 0.0)
         flags = mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
+        if self.transmission > 0.0:
+            flags = flags | mi.BSDFFlags.GlossyTransmission
         self.m_flags = flags | mi.BSDFFlags.FrontSide | mi.BSDFFlags.BackSide
         self.m_components = [self.m_flags]
 
     def _surface(self, si):
         """The material and normals at `si`, turned to the side of the view direction:
-        (base, metallic, roughness, clearcoat, coat roughness, ng, ns, nc, wi) in world space."""
+        (base, metallic, roughness, clearcoat, coat roughness, ng, ns, nc, wi, transmission) in
+        world space."""
         wi = si.to_world(si.wi)
         n = dr.normalize(si.sh_frame.n)
         ns = n
@@ -129,11 +141,23 @@ class GltfBsdf(mi.BSDF):
             coat = coat * self.coat_tex.eval(si).x
         if self.coat_roughness_tex is not None:
             coat_roughness = coat_roughness * self.coat_roughness_tex.eval(si).y
+        transmission = mi.Float(self.transmission)
+        if self.transmission_tex is not None:
+            transmission = transmission * self.transmission_tex.eval(si).x
         clamp = lambda v: dr.clip(v, 0.0, 1.0)
-        return (base, clamp(metallic), clamp(roughness), clamp(coat), clamp(coat_roughness), ng, ns, nc, wi)
+        return (
+            base, clamp(metallic), clamp(roughness), clamp(coat), clamp(coat_roughness), ng, ns, nc, wi,
+            clamp(transmission),
+        )
 
     def _eval(self, s, wo):
-        base, metallic, roughness, coat, coat_roughness, ng, ns, nc, wi = s
+        base, metallic, roughness, coat, coat_roughness, ng, ns, nc, wi, t = s
+        below = (dr.dot(ng, wo) < 0.0) & (dr.dot(ns, wo) < 0.0)
+        if self.transmission > 0.0:
+            # The transmitted direction as the reflection it mirrors.
+            wo = dr.select(below, wo - 2.0 * dr.dot(ns, wo) * ns, wo)
+        else:
+            below = mi.Bool(False)
         n_v, n_l = dr.dot(ns, wi), dr.dot(ns, wo)
         h = dr.normalize(wi + wo)
         a = _alpha(roughness)
@@ -141,44 +165,59 @@ class GltfBsdf(mi.BSDF):
         f0 = dr.lerp(self.f0, base, metallic)
         f90 = dr.lerp(self.f90, 1.0, metallic)
         fresnel = f0 + (f90 - f0) * dr.power(1.0 - dr.maximum(dr.dot(wi, h), 0.0), 5.0)
-        spec = fresnel * _ggx_d(dr.maximum(dr.dot(ns, h), 0.0), a2) * _visibility(n_l, n_v, a2)
-        value = ((1.0 - fresnel) * (1.0 - metallic) * base * INV_PI + spec) * n_l
+        lobe = _ggx_d(dr.maximum(dr.dot(ns, h), 0.0), a2) * _visibility(n_l, n_v, a2)
+        reflected = ((1.0 - fresnel) * (1.0 - metallic) * (1.0 - t) * base * INV_PI + fresnel * lobe) * n_l
+        transmitted = (1.0 - fresnel) * (1.0 - metallic) * t * base * lobe * n_l
+        value = dr.select(below, transmitted, reflected)
         value = dr.select((n_v > 0.0) & (n_l > 0.0), value, 0.0)
         if self.clearcoat > 0.0:
             c_v, c_l = dr.dot(nc, wi), dr.dot(nc, wo)
             c2 = _alpha(coat_roughness) ** 2
             w = coat * (0.04 + 0.96 * dr.power(1.0 - dr.clip(c_v, 0.0, 1.0), 5.0))
             layer = _ggx_d(dr.maximum(dr.dot(nc, h), 0.0), c2) * _visibility(c_l, c_v, c2) * c_l
-            value = value * (1.0 - w) + w * dr.select((c_v > 0.0) & (c_l > 0.0), layer, 0.0)
-        return dr.select(dr.dot(ng, wo) > 0.0, value, 0.0)
+            value = value * (1.0 - w) + w * dr.select((c_v > 0.0) & (c_l > 0.0) & ~below, layer, 0.0)
+        return dr.select((dr.dot(ng, wo) > 0.0) | below, value, 0.0)
 
     def _lobes(self, s):
-        """The lobes' frames and GGX distributions: (normal, alpha or None for the cosine lobe)."""
-        _, _, roughness, _, coat_roughness, _, ns, nc, _ = s
-        lobes = [(ns, None), (ns, _alpha(roughness))]
-        return lobes + [(nc, _alpha(coat_roughness))] if self.lobes == 3 else lobes
+        """The lobes: (normal, alpha or None for the cosine lobe, mirrored through the surface)."""
+        _, _, roughness, _, coat_roughness, _, ns, nc, _, _ = s
+        lobes = [(ns, None, False), (ns, _alpha(roughness), False)]
+        if self.clearcoat > 0.0:
+            lobes.append((nc, _alpha(coat_roughness), False))
+        if self.transmission > 0.0:
+            lobes.append((ns, _alpha(roughness), True))
+        return lobes
 
     def _pdf(self, s, wo):
         ng, wi = s[5], s[8]
-        h = dr.normalize(wi + wo)
         pdf = mi.Float(0.0)
-        for n, alpha in self._lobes(s):
+        for n, alpha, mirror in self._lobes(s):
             frame = mi.Frame3f(n)
+            side = dr.dot(ng, wo) < 0.0 if mirror else dr.dot(ng, wo) > 0.0
+            w = wo - 2.0 * dr.dot(n, wo) * n if mirror else wo
             if alpha is None:
-                pdf += dr.maximum(mi.warp.square_to_cosine_hemisphere_pdf(frame.to_local(wo)), 0.0)
+                p = dr.maximum(mi.warp.square_to_cosine_hemisphere_pdf(frame.to_local(w)), 0.0)
             else:
+                h = dr.normalize(wi + w)
                 distr = mi.MicrofacetDistribution(mi.MicrofacetType.GGX, alpha, True)
-                jacobian = 1.0 / (4.0 * dr.maximum(dr.dot(wo, h), 1e-12))
-                ok = (dr.dot(n, wi) > 0.0) & (dr.dot(n, wo) > 0.0)
-                pdf += dr.select(ok, distr.pdf(frame.to_local(wi), frame.to_local(h)) * jacobian, 0.0)
-        return dr.select(dr.dot(ng, wo) > 0.0, pdf / self.lobes, 0.0)
+                jacobian = 1.0 / (4.0 * dr.maximum(dr.dot(w, h), 1e-12))
+                ok = (dr.dot(n, wi) > 0.0) & (dr.dot(n, w) > 0.0)
+                if mirror:
+                    ok = ok & (dr.dot(n, wo) < 0.0)
+                p = dr.select(ok, distr.pdf(frame.to_local(wi), frame.to_local(h)) * jacobian, 0.0)
+            pdf += dr.select(side, p, 0.0)
+        return pdf / self.lobes
 
     def sample(self, ctx, si, sample1, sample2, active=True):
         s = self._surface(si)
         wi = s[8]
         lobe = dr.minimum(mi.UInt32(sample1 * self.lobes), self.lobes - 1)
         wo = mi.Vector3f(0.0)
-        for k, (n, alpha) in enumerate(self._lobes(s)):
+        # A sample outside its own lobe's side (a reflection below the surface, a transmission
+        # above it) counts nothing: each lobe's density in `_pdf` is that of its side alone.
+        valid = mi.Bool(False)
+        ng = s[5]
+        for k, (n, alpha, mirror) in enumerate(self._lobes(s)):
             frame = mi.Frame3f(n)
             if alpha is None:
                 local = mi.warp.square_to_cosine_hemisphere(sample2)
@@ -186,16 +225,24 @@ class GltfBsdf(mi.BSDF):
                 distr = mi.MicrofacetDistribution(mi.MicrofacetType.GGX, alpha, True)
                 m, _ = distr.sample(frame.to_local(wi), sample2)
                 local = mi.reflect(frame.to_local(wi), m)
-            wo = dr.select(lobe == k, frame.to_world(local), wo)
+                if mirror:
+                    local = mi.Vector3f(local.x, local.y, -local.z)
+            w = frame.to_world(local)
+            side = (local.z < 0.0) & (dr.dot(ng, w) < 0.0) if mirror else (local.z > 0.0) & (dr.dot(ng, w) > 0.0)
+            wo = dr.select(lobe == k, w, wo)
+            valid = dr.select(lobe == k, side, valid)
         pdf = self._pdf(s, wo)
         value = self._eval(s, wo)
         bs = dr.zeros(mi.BSDFSample3f)
         bs.wo = si.to_local(wo)
         bs.pdf = pdf
         bs.eta = 1.0
-        bs.sampled_type = mi.UInt32(+mi.BSDFFlags.GlossyReflection)
+        through = dr.dot(s[5], wo) < 0.0
+        bs.sampled_type = dr.select(
+            through, mi.UInt32(+mi.BSDFFlags.GlossyTransmission), mi.UInt32(+mi.BSDFFlags.GlossyReflection)
+        )
         bs.sampled_component = mi.UInt32(0)
-        ok = active & (pdf > 0.0)
+        ok = active & valid & (pdf > 0.0)
         return bs, dr.select(ok, value / dr.maximum(pdf, 1e-30), 0.0)
 
     def eval(self, ctx, si, wo, active=True):

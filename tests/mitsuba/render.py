@@ -185,6 +185,8 @@ def scene_dict(mi, desc, tmp, width, height, spp, seed):
             "bsdf": {"type": "null"},
             "emitter": {"type": "area", "radiance": rgb(l["radiance"])},
         }
+    for i, l in enumerate(desc.get("point_lights", [])):
+        scene[f"point{i}"] = {"type": "point", "position": l["position"], "intensity": rgb(l["intensity"])}
     return scene
 
 

@@ -107,19 +107,26 @@ fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
 }
 
 #[test]
-fn reference_path_tracer_sees_through_blended_surfaces_by_their_coverage() {
+fn reference_path_tracer_sees_through_blended_and_transmitting_surfaces() {
     let dir = gpu_test!();
-    // An emitter of radiance 1 seen through a black, alpha-blended pane of alpha a: rays meet the
-    // pane with probability a (stochastic coverage) and reach the emitter otherwise, so the
-    // pixels behind the pane see 1 − a and the others 1 (the pane reflects nothing). Imported
-    // glTF transmission is read as such coverage (KHR_materials_transmission).
+    // An emitter of radiance 1 behind two panes, the sky black:
+    // - left, a black alpha-blended pane of alpha a: rays meet it with probability a (stochastic
+    //   coverage) and reach the emitter otherwise, so the pixels behind it see 1 − a;
+    // - right, a smooth thin glass of base colour c transmitting all of its diffuse light
+    //   (KHR_materials_transmission): light passes unbent, tinted, less what the glass reflects,
+    //   so the pixels behind it see (1 − F) c per channel, F the Schlick Fresnel of F0 0.04 at
+    //   the view angle (below 15° here: F = 0.04 to 1e-7), while what it reflects towards the
+    //   camera is the black sky.
+    // The pixels beside the panes see the emitter, 1.
     let a = 0.3f32;
-    let quad = |z: f32, h: f32| {
+    let c = [0.9f32, 0.5, 0.25];
+    let rect = |z: f32, x0: f32, x1: f32, h: f32| {
         let p = |x: f32, y: f32| Vec3::new(x, y, z);
-        [[p(-h, -h), p(h, -h), p(h, h)], [p(-h, -h), p(h, h), p(-h, h)]]
+        [[p(x0, -h), p(x1, -h), p(x1, h)], [p(x0, -h), p(x1, h), p(x0, h)]]
     };
-    let mut tris = quad(-2.0, 4.0).to_vec();
-    tris.extend(quad(-1.0, 0.5));
+    let mut tris = rect(-2.0, -4.0, 4.0, 4.0).to_vec();
+    tris.extend(rect(-1.0, -0.9, -0.1, 0.5));
+    tris.extend(rect(-1.0, 0.1, 0.9, 0.5));
     let mut scene = scene_of(&tris);
     let mut emitter = kiln_compiler::import::demo::lambert_material([0.0; 3]);
     emitter.emission = [1.0; 3];
@@ -127,11 +134,19 @@ fn reference_path_tracer_sees_through_blended_surfaces_by_their_coverage() {
     pane.base_color[3] = a;
     pane.flags |= (kiln_format::sections::AlphaMode::Blend as u32)
         << kiln_format::sections::MaterialFlags::ALPHA_MODE_SHIFT;
+    let glass = kiln_format::sections::GpuMaterial {
+        base_color: [c[0], c[1], c[2], 1.0],
+        metallic: 0.0,
+        roughness: 0.0,
+        transmission: 1.0,
+        ..Default::default()
+    };
     scene.materials = vec![
         kiln_compiler::ir::Material { name: "emitter".into(), gpu: emitter },
         kiln_compiler::ir::Material { name: "pane".into(), gpu: pane },
+        kiln_compiler::ir::Material { name: "glass".into(), gpu: glass },
     ];
-    scene.triangle_materials = vec![0, 0, 1, 1];
+    scene.triangle_materials = vec![0, 0, 1, 1, 2, 2];
     scene.sky = Sky { radiance: [0.0; 3] };
     let cam = Pinhole::new([0.0, 0.0, 2.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 40.0, W, H);
     scene.cameras.push(cam.file_camera());
@@ -139,29 +154,54 @@ fn reference_path_tracer_sees_through_blended_surfaces_by_their_coverage() {
     std::fs::write(&file, compile(scene, fast_settings())).unwrap();
     let o = Options::new(&file, W, H).reference().build();
     let (_, rgb) = kiln_player::reference::render(&o, 256, Instant::now()).expect("reference render");
-    // Pixels whose ray crosses z = −1 well inside the pane, and well outside it.
-    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    // Pixels whose ray crosses z = −1 well inside a pane, and well outside both; the glass's
+    // expected value per pixel from its view angle.
+    let (mut inside, mut glass, mut outside) = (Vec::new(), Vec::new(), Vec::new());
     for y in 0..H {
         for x in 0..W {
             let d = cam.ray(x, y, W, H);
             let q = DVec3::new(0.0, 0.0, 2.0) + d * (3.0 / -d.z);
-            let r = q.x.abs().max(q.y.abs());
-            let v = rgb[3 * (y * W + x) as usize] as f64;
-            if r < 0.4 {
-                inside.push(v);
-            } else if r > 0.6 {
-                outside.push(v);
+            let i = 3 * (y * W + x) as usize;
+            let within = |x0: f64, x1: f64| q.x > x0 + 0.1 && q.x < x1 - 0.1 && q.y.abs() < 0.4;
+            if within(-0.9, -0.1) {
+                inside.push(rgb[i] as f64);
+            } else if within(0.1, 0.9) {
+                let cos = -d.normalize().z;
+                let f = 0.04 + 0.96 * (1.0 - cos).powi(5);
+                for k in 0..3 {
+                    glass.push((rgb[i + k] as f64, (1.0 - f) * c[k] as f64));
+                }
+            } else if q.x.abs() > 1.0 || q.y.abs() > 0.6 {
+                outside.push(rgb[i] as f64);
             }
         }
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let (mi, mo) = (mean(&inside), mean(&outside));
+    let got: f64 = glass.iter().map(|g| g.0).sum();
+    let expected: f64 = glass.iter().map(|g| g.1).sum();
+    let by_channel = |k: usize| {
+        let (g, e) = glass.iter().skip(k).step_by(3).fold((0.0, 0.0), |(g, e), p| (g + p.0, e + p.1));
+        g / e
+    };
     eprintln!(
-        "behind the pane {mi:.4} ({} pixels), beside it {mo:.4} ({} pixels)",
+        "behind the pane {mi:.4} ({} pixels), behind the glass {:.4} of (1 − F) c (RGB {:.4} {:.4} {:.4}; {} pixels), beside {mo:.4} ({} pixels)",
         inside.len(),
+        got / expected,
+        by_channel(0),
+        by_channel(1),
+        by_channel(2),
+        glass.len() / 3,
         outside.len()
     );
-    assert!(inside.len() > 300 && outside.len() > 300);
+    assert!(inside.len() > 100 && glass.len() > 300 && outside.len() > 300);
     assert!((mo - 1.0).abs() < 0.01, "the emitter seen directly: {mo}");
     assert!((mi - (1.0 - a as f64)).abs() < 0.02, "behind a pane of alpha {a}: {mi}, expected {}", 1.0 - a);
+    for k in 0..3 {
+        assert!(
+            (by_channel(k) - 1.0).abs() < 0.02,
+            "behind the glass, channel {k}: {} of (1 − F) c",
+            by_channel(k)
+        );
+    }
 }

@@ -25,6 +25,8 @@ pub struct Usage {
     pub clearcoat: bool,
     /// Clear coat roughness (G).
     pub clearcoat_roughness: bool,
+    /// Transmission (R).
+    pub transmission: bool,
 }
 
 impl Usage {
@@ -38,6 +40,7 @@ impl Usage {
             u.occlusion |= m.occlusion_texture == i;
             u.clearcoat |= m.clearcoat_texture == i;
             u.clearcoat_roughness |= m.clearcoat_roughness_texture == i;
+            u.transmission |= m.transmission_texture == i;
         }
         debug_assert!(i != NO_TEXTURE);
         u
@@ -51,6 +54,7 @@ impl Usage {
             | (self.occlusion as u8) << 3
             | (self.clearcoat as u8) << 4
             | (self.clearcoat_roughness as u8) << 5
+            | (self.transmission as u8) << 6
     }
 }
 
@@ -96,11 +100,11 @@ pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
             channels: vec![0, 1],
             why: "normal map: BC5 of x, y (z reconstructed)",
         },
-        // The stored channels are those some slot reads: R (occlusion, clear coat), G
-        // (roughness, clear coat roughness), B (metalness).
+        // The stored channels are those some slot reads: R (occlusion, clear coat, transmission),
+        // G (roughness, clear coat roughness), B (metalness).
         TextureRole::Data => {
-            let coat = usage.clearcoat || usage.clearcoat_roughness;
-            let red = usage.occlusion || usage.clearcoat;
+            let coat = usage.clearcoat || usage.clearcoat_roughness || usage.transmission;
+            let red = usage.occlusion || usage.clearcoat || usage.transmission;
             let green = usage.metallic_roughness || usage.clearcoat_roughness;
             let why = |plain, coated| if coat { coated } else { plain };
             match (red, green, usage.metallic_roughness) {
@@ -110,7 +114,7 @@ pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
                     channels: vec![0, 1, 2],
                     why: why(
                         "occlusion + metallic-roughness: BC7 linear of R, G, B",
-                        "clear coat with metallic-roughness: BC7 linear of R, G, B",
+                        "clear coat or transmission with metallic-roughness: BC7 linear of R, G, B",
                     ),
                 },
                 (false, _, true) => Choice {
@@ -126,13 +130,13 @@ pub fn choose(t: &Texture, usage: Usage, setting: TextureFormat) -> Choice {
                     format: PixelFormat::Bc5,
                     swizzle: [R, G, Zero, One],
                     channels: vec![0, 1],
-                    why: "clear coat and its roughness: BC5 of R, G",
+                    why: "clear coat (or transmission) and the coat's roughness: BC5 of R, G",
                 },
                 (true, false, false) => Choice {
                     format: PixelFormat::Bc4,
                     swizzle: [R, R, R, One],
                     channels: vec![0],
-                    why: why("occlusion: BC4 of R", "clear coat: BC4 of R"),
+                    why: why("occlusion: BC4 of R", "clear coat or transmission: BC4 of R"),
                 },
                 (false, true, false) => Choice {
                     format: PixelFormat::Bc4,

@@ -244,6 +244,8 @@ pub struct MaterialToml {
     pub clearcoat: Option<f32>,
     /// The clear coat's perceptual roughness.
     pub clearcoat_roughness: Option<f32>,
+    /// Thin-walled transmission (glTF `KHR_materials_transmission`).
+    pub transmission: Option<f32>,
     /// Pure Lambertian (no specular lobe).
     pub diffuse_only: Option<bool>,
     /// Shade both faces.
@@ -430,6 +432,9 @@ fn apply_material(o: &MaterialToml, gpu: &mut kiln_format::sections::GpuMaterial
     if let Some(v) = o.clearcoat_roughness {
         gpu.clearcoat_roughness = v;
     }
+    if let Some(v) = o.transmission {
+        gpu.transmission = v;
+    }
     for (flag, value) in
         [(MaterialFlags::DIFFUSE_ONLY, o.diffuse_only), (MaterialFlags::DOUBLE_SIDED, o.double_sided)]
     {
@@ -441,13 +446,14 @@ fn apply_material(o: &MaterialToml, gpu: &mut kiln_format::sections::GpuMaterial
     }
     // Each field within what a material can be: a base colour above 1 reflects more light than
     // arrives (the glTF importer clamps it; a sidecar is written by hand, so it is refused).
-    let fields: [(&str, &[f32], f32); 6] = [
+    let fields: [(&str, &[f32], f32); 7] = [
         ("base_color", &gpu.base_color, 1.0),
         ("emission", &gpu.emission, f32::INFINITY),
         ("metallic", &[gpu.metallic], 1.0),
         ("roughness", &[gpu.roughness], 1.0),
         ("clearcoat", &[gpu.clearcoat], 1.0),
         ("clearcoat_roughness", &[gpu.clearcoat_roughness], 1.0),
+        ("transmission", &[gpu.transmission], 1.0),
     ];
     for (field, values, most) in fields {
         if let Some(v) = values.iter().find(|v| !(v.is_finite() && (0.0..=most).contains(*v))) {

@@ -657,6 +657,12 @@ gpu_struct! {
         pub clearcoat_texture: u32 => "uint",
         /// See `GpuMaterial`.
         pub clearcoat_roughness_texture: u32 => "uint",
+        /// See `GpuMaterial`.
+        pub transmission: f32 => "float",
+        /// See `GpuMaterial`.
+        pub transmission_texture: u32 => "uint",
+        /// See `GpuMaterial` (zero).
+        pub reserved: [u32; 2] => "uvec2",
     }
 }
 

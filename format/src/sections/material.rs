@@ -38,8 +38,9 @@ impl MaterialFlags {
     pub const ALL: u32 = Self::DOUBLE_SIDED | Self::ALPHA_MODE_MASK | Self::DIFFUSE_ONLY | Self::SPECULAR;
 }
 
-/// A metallic-roughness PBR material. 96 bytes; std430-compatible (vec4, vec3 + float, scalars).
-/// `MATL` version 2 (format 1.8); version 1 held the first 80 bytes ([`GpuMaterialV1`]).
+/// A metallic-roughness PBR material. 112 bytes; std430-compatible (vec4, vec3 + float, scalars).
+/// `MATL` version 3 (format 1.9); version 2 (format 1.8) held the first 96 bytes, version 1
+/// (formats 1.0 to 1.7) the first 80 ([`GpuMaterial::from_words`] reads them).
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuMaterial {
@@ -83,36 +84,59 @@ pub struct GpuMaterial {
     pub clearcoat_texture: u32,
     /// Texture whose G multiplies `clearcoat_roughness` (linear), or [`NO_TEXTURE`].
     pub clearcoat_roughness_texture: u32,
+    /// Fraction of the dielectric's non-reflected light that passes through the surface, in
+    /// [0, 1] (glTF `KHR_materials_transmission`'s `transmissionFactor`); thin-walled, tinted
+    /// by the base colour. Format 1.9.
+    pub transmission: f32,
+    /// Texture whose R multiplies `transmission` (linear), or [`NO_TEXTURE`].
+    pub transmission_texture: u32,
+    /// Zero; what the std430 array stride (a multiple of 16 bytes) leaves.
+    pub reserved: [u32; 2],
 }
 
-const _: () = assert!(size_of::<GpuMaterial>() == 96);
+const _: () = assert!(size_of::<GpuMaterial>() == 112);
 
-/// A material as `MATL` version 1 (formats 1.0 to 1.7) stores it: [`GpuMaterial`]'s first 80
-/// bytes, without the clear coat. Read into a [`GpuMaterial`] with no coat.
+/// The record sizes of `MATL`'s versions, in 32-bit words: version 1 (formats 1.0 to 1.7) 20,
+/// version 2 (1.8, the clear coat) 24, version 3 (1.9, transmission) 28.
+pub fn material_words(version: u16) -> usize {
+    match version {
+        1 => 20,
+        2 => 24,
+        _ => size_of::<GpuMaterial>() / 4,
+    }
+}
+
+/// A record of `MATL` version 1 (formats 1.0 to 1.7): [`GpuMaterial`]'s first 20 words.
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct GpuMaterialV1 {
-    /// The fields of [`GpuMaterial`] up to and including `specular`, as raw words.
+    /// The words as stored.
     pub words: [u32; 20],
 }
 
-const _: () = assert!(size_of::<GpuMaterialV1>() == 80);
+/// A record of `MATL` version 2 (format 1.8): [`GpuMaterial`]'s first 24 words.
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct GpuMaterialV2 {
+    /// The words as stored.
+    pub words: [u32; 24],
+}
 
-impl From<GpuMaterialV1> for GpuMaterial {
-    fn from(old: GpuMaterialV1) -> GpuMaterial {
-        let mut words = [0u32; 24];
-        words[..20].copy_from_slice(&old.words);
-        let mut m: GpuMaterial = bytemuck::cast(words);
-        m.clearcoat = 0.0;
-        m.clearcoat_roughness = 0.0;
-        m.clearcoat_texture = NO_TEXTURE;
-        m.clearcoat_roughness_texture = NO_TEXTURE;
-        m
+impl GpuMaterial {
+    /// A material from a record of an older `MATL` version (its first `words.len()` words, see
+    /// [`material_words`]): the fields that version lacks take the values that mean "absent"
+    /// (no coat, no transmission).
+    pub fn from_words(words: &[u32]) -> GpuMaterial {
+        // The default holds them: no coat, no transmission, no textures for either.
+        let mut all: [u32; 28] = bytemuck::cast(GpuMaterial::default());
+        let n = words.len().min(all.len());
+        all[..n].copy_from_slice(&words[..n]);
+        bytemuck::cast(all)
     }
 }
 
 /// How many texture slots a material has ([`GpuMaterial::textures`]).
-pub const MATERIAL_SLOTS: usize = 7;
+pub const MATERIAL_SLOTS: usize = 8;
 
 /// glTF's dielectric reflectance at normal incidence without `KHR_materials_ior`/`specular`
 /// (an index of refraction of 1.5).
@@ -139,12 +163,15 @@ impl Default for GpuMaterial {
             clearcoat_roughness: 0.0,
             clearcoat_texture: NO_TEXTURE,
             clearcoat_roughness_texture: NO_TEXTURE,
+            transmission: 0.0,
+            transmission_texture: NO_TEXTURE,
+            reserved: [0; 2],
         }
     }
 }
 
 impl GpuMaterial {
-    /// The texture slots, in field order (the G-buffer's bindings 0 to 6).
+    /// The texture slots, in field order (the G-buffer's bindings 0 to 7).
     pub fn textures(&self) -> [u32; MATERIAL_SLOTS] {
         [
             self.base_color_texture,
@@ -154,6 +181,7 @@ impl GpuMaterial {
             self.emissive_texture,
             self.clearcoat_texture,
             self.clearcoat_roughness_texture,
+            self.transmission_texture,
         ]
     }
 

@@ -11,7 +11,8 @@ mod texture;
 pub use bvh::{BVH_TRAVERSAL_STACK, CwbvhNode};
 pub use geometry::Vertex;
 pub use material::{
-    AlphaMode, DIELECTRIC_F0, GpuMaterial, GpuMaterialV1, MATERIAL_SLOTS, MaterialFlags, NO_TEXTURE,
+    AlphaMode, DIELECTRIC_F0, GpuMaterial, GpuMaterialV1, GpuMaterialV2, MATERIAL_SLOTS, MaterialFlags,
+    NO_TEXTURE, material_words,
 };
 pub use texture::{
     PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_texture, encode_texture,
@@ -124,7 +125,7 @@ pub const KNOWN: &[KindInfo] = &[
     KindInfo {
         kind: MATERIALS,
         name: "materials",
-        version: 2,
+        version: 3,
         element_size: size_of::<GpuMaterial>(),
         required: false,
         indexed: false,
@@ -264,9 +265,14 @@ const fn pod_kind_at(
 
 impl KindInfo {
     /// The size of one element in a section of this kind at layout `version`: `element_size`,
-    /// except for the older layouts whose elements were smaller (`MATL` version 1: 80 bytes).
+    /// except for the older layouts whose elements were smaller (`MATL` versions 1 and 2: 80 and
+    /// 96 bytes).
     pub fn element_size_at(&self, version: u16) -> usize {
-        if self.kind == MATERIALS && version == 1 { size_of::<GpuMaterialV1>() } else { self.element_size }
+        if self.kind == MATERIALS && version < self.version {
+            4 * material_words(version)
+        } else {
+            self.element_size
+        }
     }
 }
 

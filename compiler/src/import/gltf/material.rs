@@ -3,7 +3,7 @@
 //! `clearcoat.rs`, `transmission.rs`), one texture-coordinate mapping per material.
 
 use kiln_format::manifest::Wrap;
-use kiln_format::sections::{AlphaMode, GpuMaterial, MaterialFlags, NO_TEXTURE};
+use kiln_format::sections::{AlphaMode, GpuMaterial, MATERIAL_SLOTS, MaterialFlags, NO_TEXTURE};
 
 use super::uri::{load_uri, short};
 use super::{Importer, UvMapping};
@@ -65,20 +65,18 @@ impl Importer<'_> {
         ] {
             self.physical(&at, field, [v], f32::NEG_INFINITY, f32::INFINITY)?;
         }
-        let mut alpha = match m.alpha_mode() {
+        let alpha = match m.alpha_mode() {
             ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             ::gltf::material::AlphaMode::Mask => AlphaMode::Mask,
             ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
-        if let Some(t) = m.transmission() {
-            alpha = self.transmission_as_coverage(&at, &t, alpha, &mut gpu)?;
-        }
         gpu.flags = (alpha as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
         if m.double_sided() {
             gpu.flags |= MaterialFlags::DOUBLE_SIDED;
         }
         self.dielectric_reflectance(&at, &m, &mut gpu)?;
         let [coat, coat_roughness] = self.clearcoat(&at, &m, &mut gpu)?;
+        let transmission = self.transmission(&at, &m, &mut gpu)?;
         // Every texture of the material reads one set of coordinates through one transform (the
         // format stores one set per vertex, with the transform baked in); the first texture's
         // mapping is that of all, and a texture mapped otherwise is named in a warning.
@@ -93,6 +91,7 @@ impl Importer<'_> {
             m.emissive_texture().map(info),
             coat,
             coat_roughness,
+            transmission,
         ];
         let mapping = refs.iter().flatten().map(|(_, u)| *u).next().unwrap_or(UvMapping::of(0, None));
         for (t, u) in refs.iter().flatten() {
@@ -114,8 +113,9 @@ impl Importer<'_> {
             TextureRole::Color,
             TextureRole::Data,
             TextureRole::Data,
+            TextureRole::Data,
         ];
-        let mut slots = [NO_TEXTURE; 7];
+        let mut slots = [NO_TEXTURE; MATERIAL_SLOTS];
         for (k, r) in refs.into_iter().enumerate() {
             if let Some((t, _)) = r {
                 slots[k] = self.texture(t, roles[k]);
@@ -129,6 +129,7 @@ impl Importer<'_> {
             gpu.emissive_texture,
             gpu.clearcoat_texture,
             gpu.clearcoat_roughness_texture,
+            gpu.transmission_texture,
         ] = slots;
         let index = self.scene.materials.len() as u32;
         self.uv_mappings.insert(index, mapping);

@@ -1,27 +1,33 @@
-//! `KHR_materials_transmission` read as coverage: a surface that transmits a fraction t of the
-//! light is met by a fraction 1 − t of the rays (alpha blending, which the ray-traced passes and
-//! the reference path tracer read as stochastic coverage). What that keeps: light through glass,
-//! unbent, at the right strength for a thin, clear, untinted pane seen head-on. What it loses,
-//! said in a data-loss warning: the transmitted light's tint (the base colour), the glass's
-//! Fresnel reflection over the transmitted part, refraction, roughness of the transmission, and
-//! the transmission texture. Before, a transmissive material was opaque: ToyCar's glass dome and
-//! the LightsPunctualLamp's shade were solid grey, and closed ToyCar's cabin to the sky.
+//! `KHR_materials_transmission`: light passing through a surface (glass, a paper shade, a
+//! film). The format stores the factor and its texture (format 1.9, FORMAT.md "Transmission");
+//! the reference path tracer and the passes that trace rays shade it thin-walled, as the
+//! extension does without `KHR_materials_volume`: the specular lobe mirrored through the surface,
+//! tinted by the base colour, taking its light from the diffuse part. The raster frame draws
+//! nothing through surfaces: it keeps their reflection and scales their diffuse light by 1 − t
+//! (docs/compiler.md). The texture's R multiplies the factor.
+//!
+//! Before format 1.9 the factor was read as coverage (light passing unbent, untinted and
+//! without the glass's reflection); an alpha-blended material's alpha still is coverage, apart
+//! from its transmission.
 
-use kiln_format::sections::{AlphaMode, GpuMaterial};
+use ::gltf::Texture;
+use kiln_format::sections::{GpuMaterial, MaterialFlags};
 
-use super::Importer;
+use super::{Importer, UvMapping};
 use crate::exit::CliResult;
 
 impl Importer<'_> {
-    /// Folds the transmission factor into `gpu`'s alpha (blending where the material was
-    /// opaque); returns the alpha mode the material has then.
-    pub(super) fn transmission_as_coverage(
+    /// Reads material `m`'s transmission (if any) into `gpu`; returns the reference of its
+    /// texture, for the caller to load and check with the others.
+    pub(super) fn transmission<'m>(
         &mut self,
         at: &str,
-        t: &::gltf::material::Transmission<'_>,
-        alpha: AlphaMode,
+        m: &::gltf::Material<'m>,
         gpu: &mut GpuMaterial,
-    ) -> CliResult<AlphaMode> {
+    ) -> CliResult<Option<(Texture<'m>, UvMapping)>> {
+        let Some(t) = m.transmission() else {
+            return Ok(None);
+        };
         let [factor] = self.physical(
             at,
             "KHR_materials_transmission.transmissionFactor",
@@ -29,37 +35,17 @@ impl Importer<'_> {
             0.0,
             1.0,
         )?;
-        if t.transmission_texture().is_some() {
-            self.scene.warn(format!(
-                "{at}: KHR_materials_transmission's transmissionTexture is not applied (the factor alone is)"
-            ));
-        }
         if factor == 0.0 {
-            return Ok(alpha);
+            return Ok(None);
         }
-        let mode = match alpha {
-            // glTF ignores an opaque material's alpha: coverage is the transmission's alone.
-            AlphaMode::Opaque => {
-                gpu.base_color[3] = 1.0 - factor;
-                AlphaMode::Blend
-            }
-            AlphaMode::Blend => {
-                gpu.base_color[3] *= 1.0 - factor;
-                AlphaMode::Blend
-            }
-            AlphaMode::Mask => {
-                self.scene.warn(format!(
-                    "{at}: KHR_materials_transmission (factor {factor}) on an alpha-masked material is not \
-                     applied: the mask keeps its alpha"
-                ));
-                return Ok(alpha);
-            }
-        };
-        self.scene.warn(format!(
-            "{at}: KHR_materials_transmission (factor {factor}) is read as coverage {}: light passes \
-             unbent and untinted, without the glass's reflection over it",
-            1.0 - factor
-        ));
-        Ok(mode)
+        if gpu.flags & MaterialFlags::DIFFUSE_ONLY != 0 {
+            // Not reachable from glTF today (diffuse-only is OBJ's Ks 0), kept honest anyway.
+            self.scene
+                .warn(format!("{at}: KHR_materials_transmission on a diffuse-only material is not applied"));
+            return Ok(None);
+        }
+        gpu.transmission = factor;
+        Ok(t.transmission_texture()
+            .map(|i| (i.texture(), UvMapping::of(i.tex_coord(), i.texture_transform()))))
     }
 }

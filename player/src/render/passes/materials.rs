@@ -96,6 +96,7 @@ impl SceneDraws {
                     &mut layout.emissive_texture,
                     &mut layout.clearcoat_texture,
                     &mut layout.clearcoat_roughness_texture,
+                    &mut layout.transmission_texture,
                 ] {
                     if *t as usize >= scene.textures.len() {
                         *t = NO_TEXTURE;
