@@ -141,8 +141,12 @@ pub struct Scene {
     /// Sky: constant radiance (with an environment, its mean radiance).
     pub sky: Sky,
     /// The environment's light in every direction, when one was given (`[sky] image`/`model`,
-    /// `--environment`): baked by the `environment` stage.
+    /// `--environment`, the glTF's `EXT_lights_image_based`): baked by the `environment` stage.
     pub environment: Option<EnvironmentImage>,
+    /// The name of `environment` while it is the one the asset gave (glTF
+    /// `EXT_lights_image_based`), for the warning when a sidecar's or the command line's sky
+    /// replaces it (`import::environment::replace_asset_environment`).
+    pub asset_environment: Option<String>,
     /// Participating media.
     pub media: Vec<Medium>,
     /// Every file read (asset, buffers, images, sidecar), in reading order.

@@ -75,9 +75,10 @@ impl EnvironmentSpec {
 }
 
 /// Sets `scene`'s environment from `spec` placed by `placement`; `source` names where the request
-/// came from in messages. Replaces any earlier environment (and its sun). The manifest's constant
-/// sky becomes the baked map's mean radiance (what a reader that ignores the environment's
-/// sections shows).
+/// came from in messages. Replaces any earlier environment (and its sun); replacing the asset's own
+/// (glTF `EXT_lights_image_based`) is said in a warning ([`replace_asset_environment`]). The
+/// manifest's constant sky becomes the baked map's mean radiance (what a reader that ignores the
+/// environment's sections shows).
 pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, source: &str) -> CliResult<()> {
     let bad = |msg: String| CliError::input(format!("{source}: {msg}"));
     if !(placement.intensity.is_finite() && placement.intensity >= 0.0) {
@@ -90,7 +91,7 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
         return Err(bad("environment rotation must be finite".into()));
     }
     scene.lights.retain(|l| l.name != preetham::SUN_NAME && l.name != EXTRACTED_SUN_NAME);
-    let (mut name, width, mut pixels) = match spec {
+    let (name, width, pixels) = match spec {
         EnvironmentSpec::Image { path, .. } => {
             let (w, pixels) = load_image(path, scene).map_err(bad)?;
             (path.display().to_string(), w, pixels)
@@ -107,12 +108,38 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
         }
         EnvironmentSpec::Studio => ("studio".to_owned(), GENERATED_WIDTH, generate(GENERATED_WIDTH, studio)),
     };
+    replace_asset_environment(scene, source, &name);
+    let take_sun = matches!(spec, EnvironmentSpec::Image { extract_sun: true, .. });
+    set_map(scene, Map { name, width, pixels }, placement, take_sun, source);
+    Ok(())
+}
+
+/// An equirectangular radiance map in memory: linear RGB, rows of `width` (twice the row count)
+/// from the zenith down, in the mapping of `kiln_format::environment`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Map {
+    /// Where it came from, for messages, the plan and the report.
+    pub name: String,
+    /// Width in pixels, even; the height is half of it.
+    pub width: u32,
+    /// Radiance per pixel, finite and non-negative.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// Makes `map` the scene's environment: every radiance times `placement.intensity` (checked
+/// finite and non-negative by the caller), a sun in it taken out as a directional light when
+/// `take_sun` ([`extract_sun`], turned by `placement.rotation_degrees`), channels past what the
+/// baked map holds warned about (`source` names where the map came from). The one path by which
+/// every source (a file, a model, the glTF's image-based light) becomes the [`EnvironmentImage`].
+pub fn set_map(scene: &mut Scene, map: Map, placement: Placement, take_sun: bool, source: &str) {
+    let Map { mut name, width, mut pixels } = map;
+    debug_assert!(
+        width >= 2 * MIN_HEIGHT && width % 2 == 0 && pixels.len() == (width * (width / 2)) as usize
+    );
     for p in &mut pixels {
         *p = p.map(|c| c * placement.intensity);
     }
-    if let EnvironmentSpec::Image { extract_sun: true, .. } = spec
-        && let Some(sun) = extract_sun(&mut pixels, width, placement.rotation_degrees)
-    {
+    if take_sun && let Some(sun) = extract_sun(&mut pixels, width, placement.rotation_degrees) {
         name = format!(
             "{name} (sun of {:.2}° radius taken out as a directional light of {:.4})",
             (1.0 - sun.solid_angle / std::f64::consts::TAU).acos().to_degrees(),
@@ -136,7 +163,29 @@ pub fn apply(scene: &mut Scene, spec: &EnvironmentSpec, placement: Placement, so
         pixels,
         rotation_degrees: placement.rotation_degrees,
     });
-    Ok(())
+}
+
+/// Called where a sidecar or the command line sets the sky (`by` names what replaces it): when
+/// the environment is still the one the asset gave (glTF `EXT_lights_image_based`), a data-loss
+/// warning says that it is replaced (what the file holds is then not what the asset says, as
+/// `--strict` means) and the environment is dropped.
+pub fn replace_asset_environment(scene: &mut Scene, source: &str, by: &str) {
+    if let Some(asset) = scene.asset_environment.take() {
+        scene.environment = None;
+        scene.warn(format!("{source}: the sky given here ({by}) replaces the asset's environment, {asset}"));
+    }
+}
+
+/// Replaces each NaN, infinite or negative channel of `pixels` by 0; returns how many there were.
+pub fn zero_non_radiance(pixels: &mut [[f32; 3]]) -> u64 {
+    let mut bad = 0;
+    for c in pixels.iter_mut().flatten() {
+        if !(c.is_finite() && *c >= 0.0) {
+            bad += 1;
+            *c = 0.0;
+        }
+    }
+    bad
 }
 
 /// Reads and decodes an HDR image (recording it as an input) and checks its shape; non-finite or
@@ -162,20 +211,8 @@ fn load_image(path: &Path, scene: &mut Scene) -> Result<(u32, Vec<[f32; 3]>), St
             2 * MIN_HEIGHT
         )));
     }
-    let mut bad = 0u64;
-    let mut pixels: Vec<[f32; 3]> = img
-        .pixels()
-        .map(|p| {
-            p.0.map(|c| {
-                if c.is_finite() && c >= 0.0 {
-                    c
-                } else {
-                    bad += 1;
-                    0.0
-                }
-            })
-        })
-        .collect();
+    let mut pixels: Vec<[f32; 3]> = img.pixels().map(|p| p.0).collect();
+    let bad = zero_non_radiance(&mut pixels);
     if bad > 0 {
         scene.warn(named(format!("{bad} pixel channels are NaN, infinite or negative; they count as black")));
     }

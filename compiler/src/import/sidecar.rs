@@ -367,8 +367,10 @@ impl Sidecar {
                 }
                 scene.sky = Sky { radiance };
             }
-            if let Some((spec, placement)) = s.environment(&self.dir).map_err(err)? {
-                environment::apply(scene, &spec, placement, source)?;
+            match s.environment(&self.dir).map_err(err)? {
+                Some((spec, placement)) => environment::apply(scene, &spec, placement, source)?,
+                // A constant sky (an empty `[sky]` is a black one) replaces the asset's environment.
+                None => environment::replace_asset_environment(scene, source, "[sky], a constant sky"),
             }
         }
         for (i, m) in self.media.iter().enumerate() {

@@ -182,24 +182,7 @@ impl Importer<'_> {
             ::gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => uri.to_string(),
             _ => format!("image{}", img.index()),
         });
-        let bytes = match img.source() {
-            ::gltf::image::Source::View { view, .. } => {
-                let buf = &self.buffers[view.buffer().index()];
-                buf.get(view.offset()..view.offset().saturating_add(view.length()))
-                    .map(<[u8]>::to_vec)
-                    .ok_or_else(|| format!("buffer view {} runs past the end of its buffer", view.index()))
-            }
-            ::gltf::image::Source::Uri { uri, .. } => {
-                let what = format!("image {} ('{}')", img.index(), short(uri));
-                load_uri(uri, &self.base, &mut self.scene.inputs, &what).map_err(|e| match e {
-                    ReadError::Confined(e) => {
-                        self.escapes.push(e.clone());
-                        e
-                    }
-                    ReadError::Unreadable(e) => e,
-                })
-            }
-        };
+        let bytes = self.image_bytes(&img);
         let s = t.sampler();
         let wrap = |w: ::gltf::texture::WrappingMode| match w {
             ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
@@ -217,5 +200,28 @@ impl Importer<'_> {
         });
         self.textures.insert((t.index(), role), index);
         index
+    }
+
+    /// The encoded bytes of `img`: its buffer view's, or its URI's (data, or a file read within
+    /// the confinement: a file outside it is also recorded in `escapes`, which fail the import).
+    pub(super) fn image_bytes(&mut self, img: &::gltf::Image) -> Result<Vec<u8>, String> {
+        match img.source() {
+            ::gltf::image::Source::View { view, .. } => {
+                let buf = &self.buffers[view.buffer().index()];
+                buf.get(view.offset()..view.offset().saturating_add(view.length()))
+                    .map(<[u8]>::to_vec)
+                    .ok_or_else(|| format!("buffer view {} runs past the end of its buffer", view.index()))
+            }
+            ::gltf::image::Source::Uri { uri, .. } => {
+                let what = format!("image {} ('{}')", img.index(), short(uri));
+                load_uri(uri, &self.base, &mut self.scene.inputs, &what).map_err(|e| match e {
+                    ReadError::Confined(e) => {
+                        self.escapes.push(e.clone());
+                        e
+                    }
+                    ReadError::Unreadable(e) => e,
+                })
+            }
+        }
     }
 }
