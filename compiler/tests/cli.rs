@@ -35,7 +35,8 @@ fn demo_inspect_verify() {
     let run = kiln(dir.path(), &["inspect", "demo.kiln", "--json"]);
     run.expect(0);
     let j: serde_json::Value = serde_json::from_str(&run.stdout).expect("inspect --json is JSON");
-    assert_eq!(j["format_version"], "1.8");
+    let version = format!("{}.{}", kiln_format::header::VERSION_MAJOR, kiln_format::header::VERSION_MINOR);
+    assert_eq!(j["format_version"], version.as_str());
     let kinds: Vec<&str> =
         j["sections"].as_array().unwrap().iter().map(|s| s["kind"].as_str().unwrap()).collect();
     assert_eq!(

@@ -156,13 +156,15 @@ fn the_every_kind_fixture_holds_every_kind_the_format_knows() {
     let missing: Vec<_> = known.difference(&present).collect();
     assert!(missing.is_empty(), "the every-kind fixture lacks {missing:?}: extend every_kind_file()");
     assert!(file.skipped().next().is_none(), "the fixture holds kinds the reader skips");
-    // Both shadow-map shapes, and a visibility volume for each light.
+    // Both shadow-map shapes, a visibility volume for each light and the sky's three (format 1.10).
     let manifest = file.manifest().unwrap();
     let projections: Vec<_> = manifest.shadow_maps.iter().map(|m| m.projection).collect();
     assert!(projections.contains(&ShadowProjection::Cube), "{projections:?}");
     assert!(projections.contains(&ShadowProjection::Perspective), "{projections:?}");
     assert_eq!(file.all_of(sections::SHADOW_MAP).len(), manifest.shadow_maps.len());
-    assert_eq!(file.all_of(sections::MEDIA_VISIBILITY).len(), manifest.lights.len());
+    let sky = kiln_format::manifest::MediaVisibilityInfo::SKY;
+    assert_eq!(file.all_of(sections::MEDIA_VISIBILITY).len(), manifest.lights.len() + sky.len());
+    assert!(manifest.media_visibility.as_ref().is_some_and(|v| v.lights.ends_with(&sky)));
     // Each section has bytes to damage.
     for s in file.sections() {
         assert!(s.entry.size > 0, "section {}#{} is empty", s.entry.kind, s.entry.index);

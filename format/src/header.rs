@@ -12,7 +12,7 @@ pub const MAGIC: [u8; 8] = [0x89, b'K', b'L', b'N', b'\r', b'\n', 0x1a, b'\n'];
 /// Major version this crate reads and writes.
 pub const VERSION_MAJOR: u16 = 1;
 /// Newest minor version this crate knows (and writes).
-pub const VERSION_MINOR: u16 = 9;
+pub const VERSION_MINOR: u16 = 10;
 /// Size of the header in bytes.
 pub const HEADER_SIZE: usize = 64;
 /// Flag bits 0..16 must be understood by a reader; none are defined in 1.0.

@@ -226,11 +226,17 @@ pub struct MediaVisibilityInfo {
     pub dims: [u32; 3],
     /// Shadow rays per cell and light.
     pub samples: u32,
-    /// The lights with a volume, in `MVIS` index order.
+    /// The lights with a volume, in `MVIS` index order; [`MediaVisibilityInfo::SKY`]'s entries
+    /// (format 1.10) name the sky's three grids.
     pub lights: Vec<u32>,
 }
 
 impl MediaVisibilityInfo {
+    /// The entries of `lights` that name the sky's grids of red, green and blue (format 1.10):
+    /// per cell, the sky's light reaching it through the geometry and the medium, relative to
+    /// the sky's whole (FORMAT.md, "MVIS").
+    pub const SKY: [u32; 3] = [u32::MAX - 2, u32::MAX - 1, u32::MAX];
+
     /// Cells of each light's `MVIS` section.
     pub fn cells(&self) -> u64 {
         self.dims.iter().map(|&d| d as u64).product()

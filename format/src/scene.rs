@@ -4,7 +4,7 @@
 use std::borrow::Cow;
 
 use crate::error::{FormatError, Result};
-use crate::manifest::{ColorSpace, LightKind, Manifest};
+use crate::manifest::{ColorSpace, LightKind, Manifest, MediaVisibilityInfo};
 use crate::read::KilnFile;
 use crate::sections::{
     BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, GpuMaterialV1, GpuMaterialV2,
@@ -399,7 +399,9 @@ impl<'a> SceneView<'a> {
                     let what = format!("light-visibility volume {i}");
                     file.pod_exact::<u8>(MEDIA_VISIBILITY, i as u32, cells, &what)?
                         .ok_or_else(|| FormatError::invalid(format!("{what} is missing")))?;
-                    if l as usize >= m.lights.len() {
+                    let sky = MediaVisibilityInfo::SKY.contains(&l)
+                        && v.lights.iter().filter(|&&k| k == l).count() == 1;
+                    if l as usize >= m.lights.len() && !sky {
                         return Err(FormatError::invalid(format!(
                             "light-visibility volume {i}: light {l} of {}",
                             m.lights.len()

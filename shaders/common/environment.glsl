@@ -88,20 +88,26 @@ vec3 env_filtered(vec3 r, float roughness, vec3 sky) {
     return mix(c0, c1, lod - float(l0));
 }
 
+// The environment's nine harmonics (irradiance / pi, band l holding the cosine lobe's factor
+// A_l = 1, 2/3, 1/4) evaluated at unit direction n with band l further scaled by band[l].
+vec3 env_harmonics(vec3 n, vec3 band) {
+    float b[9] = float[9](0.2820948, 0.4886025 * n.y, 0.4886025 * n.z, 0.4886025 * n.x,
+                          1.0925484 * n.x * n.y, 1.0925484 * n.y * n.z, 0.31539157 * (3.0 * n.z * n.z - 1.0),
+                          1.0925484 * n.x * n.z, 0.5462742 * (n.x * n.x - n.y * n.y));
+    vec3 e = vec3(0.0);
+    for (int k = 0; k < 9; k++) {
+        e += environment.sh[k].rgb * b[k] * band[k == 0 ? 0 : (k < 4 ? 1 : 2)];
+    }
+    return max(e, vec3(0.0));
+}
+
 // Mean radiance over the cosine-weighted hemisphere around unit normal n (irradiance / pi): a
 // Lambertian surface of albedo a reflects a times this.
 vec3 env_irradiance(vec3 n, vec3 sky) {
     if (!env_present()) {
         return sky;
     }
-    float b[9] = float[9](0.2820948, 0.4886025 * n.y, 0.4886025 * n.z, 0.4886025 * n.x,
-                          1.0925484 * n.x * n.y, 1.0925484 * n.y * n.z, 0.31539157 * (3.0 * n.z * n.z - 1.0),
-                          1.0925484 * n.x * n.z, 0.5462742 * (n.x * n.x - n.y * n.y));
-    vec3 e = vec3(0.0);
-    for (int k = 0; k < 9; k++) {
-        e += environment.sh[k].rgb * b[k];
-    }
-    return max(e, vec3(0.0));
+    return env_harmonics(n, vec3(1.0));
 }
 
 // Solid-angle density with which env_sample draws unit direction d.

@@ -143,7 +143,8 @@ struct MarchConstants {
     uint dims_y; // offset 16
     uint dims_z; // offset 20
     uint lights; // offset 24
-}; // 28 bytes
+    uint sky_volume; // offset 28
+}; // 32 bytes
 
 struct GodRayConstants {
     uint light; // offset 0

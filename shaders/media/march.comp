@@ -16,6 +16,11 @@
 // volume (trilinear between cell centres; 1 for lights without one, i.e. not casting shadows);
 // d_light the distance from the point to the box's boundary towards the light (analytic
 // transmittance in a homogeneous box). Works with the light off screen and behind the camera.
+// The sky (an environment or the constant sky) adds σs · V_sky,c(x) · L_p(d) per channel c, with
+// V_sky the compiler's grids of the sky's light reaching x through the geometry and the medium
+// (relative to the sky's whole) and L_p the sky convolved with the phase function: its nine
+// spherical harmonics (the environment's irradiance harmonics divided by the cosine lobe's band
+// factors 1, 2/3, 1/4) times Henyey–Greenstein's g^l, at d (exact for a uniform sky).
 #include "../common/layout.glsl"
 #include "../common/lights.glsl"
 
@@ -29,6 +34,8 @@ layout(set = 0, binding = 4, std430) readonly buffer VolumeOf { int volume_of[];
 layout(set = 0, binding = 5) uniform sampler2D g_depth;
 layout(set = 0, binding = 6, rgba32f) uniform image2D radiance;
 layout(push_constant) uniform Push { MarchConstants mc; };
+#define ENV_BINDING 7
+#include "../common/environment.glsl"   // bindings 7-8
 
 #include "../common/pixel.glsl"
 #include "../common/media.glsl"
@@ -56,6 +63,20 @@ float visibility(uint base, vec3 lo, vec3 hi, vec3 p) {
     return v / 255.0;
 }
 
+// The sky convolved with Henyey–Greenstein of anisotropy g, towards the camera along d: the light
+// scattered towards −d per unit σs from a uniform sphere of the sky (the constant sky without an
+// environment).
+vec3 sky_phase(vec3 d, float g) {
+    if (!env_present()) {
+        return frame.sky.rgb;
+    }
+    // The harmonics hold the irradiance over π, band l scaled by A_l = 1, 2/3, 1/4; the phase
+    // function's own band factors are g^l: band l scaled by g^l / A_l. Light arriving from ω
+    // (towards the sky) scatters towards the camera at cos θ = ω · d (both travel directions
+    // negated), so the convolution is evaluated at d.
+    return env_harmonics(d, vec3(1.0, 1.5 * g, 4.0 * g * g));
+}
+
 // The light medium m scatters towards the camera at p (per unit σs·length, before the camera-
 // side transmittance): Σ lights p(θ) · L · V · e^{−σt·d_light}.
 vec3 in_scattered(uint m, vec3 p, vec3 d) {
@@ -81,6 +102,12 @@ vec3 in_scattered(uint m, vec3 p, vec3 d) {
         vec2 out_span = box_span(lo, hi, p, wl, 0.0, dist);
         float inside = max(out_span.y - out_span.x, 0.0);
         sum += hg(g, dot(wl, d)) * li * v * exp(-sigma_t * inside);
+    }
+    if (m == mc.volume_medium && mc.sky_volume != 0xFFFFFFFFu) {
+        uint stride = (mc.dims_x * mc.dims_y * mc.dims_z + 3u) & ~3u;
+        vec3 v = vec3(visibility(mc.sky_volume, lo, hi, p), visibility(mc.sky_volume + stride, lo, hi, p),
+                      visibility(mc.sky_volume + 2u * stride, lo, hi, p));
+        sum += v * sky_phase(d, g);
     }
     return sum;
 }

@@ -304,25 +304,35 @@ impl Plan {
                 ),
             )
         });
+        // The sky's grids (three: red, green, blue) where a sky lights the scene.
+        let sky = scene.environment.is_some() || kiln_format::gpu::luminance(scene.sky.radiance) > 0.0;
         stages.push(if scene.media.is_empty() {
             skip(Stage::MediaVisibility, "the scene has no participating medium")
-        } else if casters == 0 {
-            skip(Stage::MediaVisibility, "no light casts shadows: every cell sees every light")
+        } else if casters == 0 && !sky {
+            skip(Stage::MediaVisibility, "no light casts shadows and no sky lights the scene")
         } else {
             let dims = crate::bake::media::dims(&scene.media[0], settings.media_volume_res);
-            let cells = dims.iter().map(|&d| d as u64).product::<u64>() * casters as u64;
+            let cells = dims.iter().map(|&d| d as u64).product::<u64>();
+            let sky_grids = if sky { 3 } else { 0 };
             spending.add(Product {
                 what: format!(
-                    "light-visibility volumes of {}x{}x{} cells for {casters} lights (--media-volume-res {})",
-                    dims[0], dims[1], dims[2], settings.media_volume_res
+                    "light-visibility volumes of {}x{}x{} cells for {casters} lights{} (--media-volume-res {})",
+                    dims[0],
+                    dims[1],
+                    dims[2],
+                    if sky { " and the sky" } else { "" },
+                    settings.media_volume_res
                 ),
-                bytes: cells,
-                rays: cells * crate::bake::media::SAMPLES as u64,
+                bytes: cells * (casters as u64 + sky_grids),
+                rays: cells
+                    * (casters as u64 * crate::bake::media::SAMPLES as u64
+                        + if sky { crate::bake::media::SKY_SAMPLES as u64 } else { 0 }),
             })?;
             run(
                 Stage::MediaVisibility,
                 format!(
-                    "medium 0, {casters} lights, {} cells on the longest axis; read by kiln-play {}",
+                    "medium 0, {casters} lights{}, {} cells on the longest axis; read by kiln-play {}",
+                    if sky { " and the sky (3 grids)" } else { "" },
                     settings.media_volume_res,
                     readers::list(readers::MEDIA_VISIBILITY)
                 ),

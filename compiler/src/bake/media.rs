@@ -1,6 +1,7 @@
 //! The light-visibility volume of a participating medium: over the medium's box, nearly cubic
 //! cells (box / dims per axis) holding, per light, the fraction of shadow rays from points in the
-//! cell that reach the light.
+//! cell that reach the light; and, where a sky lights the scene (an environment or a constant
+//! sky), three grids of the sky's light reaching each cell (format 1.10, [`sky_grids`]).
 //! A player ray-marching single scattering looks visibility up here instead of in a screen-space
 //! image, so shafts stay right when the light is off screen or behind geometry (seed 002's main
 //! failure cases).
@@ -20,6 +21,12 @@ pub fn dims(m: &Medium, res: u32) -> [u32; 3] {
     let ext = Vec3::from(m.bounds.max) - Vec3::from(m.bounds.min);
     let cell = ext.max_element() / res as f32;
     [0, 1, 2].map(|a| ((ext[a] / cell).ceil() as u32).clamp(1, res))
+}
+
+/// The cell (x, y, z) of linear index `i` (x fastest).
+fn cell_of(i: usize, dims: [u32; 3]) -> [u32; 3] {
+    let (w, h) = (dims[0] as usize, dims[1] as usize);
+    [(i % w) as u32, ((i / w) % h) as u32, (i / (w * h)) as u32]
 }
 
 /// The k-th sample point of cell `c` (stratified, jittered by a hash of the cell).
@@ -82,11 +89,7 @@ pub fn bake(
             (0..cells)
                 .into_par_iter()
                 .map(|i| {
-                    let c = [
-                        (i % dims[0] as usize) as u32,
-                        ((i / dims[0] as usize) % dims[1] as usize) as u32,
-                        (i / (dims[0] * dims[1]) as usize) as u32,
-                    ];
+                    let c = cell_of(i, dims);
                     let seen = (0..SAMPLES)
                         .filter(|&k| visible(scene, light, sample_point(m, dims, c, k), k))
                         .count();
@@ -98,10 +101,115 @@ pub fn bake(
     (MediaVisibilityInfo { medium: index, dims, samples: SAMPLES, lights }, volumes)
 }
 
-/// The light-visibility stage: the volume of medium 0, one grid per shadow-casting light.
+/// Directions per cell for the sky's grids: 8 bands of equal solid angle in cos θ by 4 in φ,
+/// jittered per cell.
+pub const SKY_SAMPLES: u32 = 32;
+
+/// Two numbers in [0, 1) from cell `cell` and sample `k` (a PCG-style hash: independent across
+/// cells and samples, the same on every machine).
+fn jitter(cell: u32, k: u32) -> [f32; 2] {
+    let mut h = cell.wrapping_mul(0x9e37_79b9) ^ k.wrapping_mul(0x85eb_ca6b).rotate_left(13);
+    let mut next = || {
+        h = h.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        let w = ((h >> ((h >> 28) + 4)) ^ h).wrapping_mul(277_803_737);
+        ((w >> 22) ^ w) >> 8
+    };
+    let a = next();
+    let b = next();
+    [a as f32 / (1u32 << 24) as f32, b as f32 / (1u32 << 24) as f32]
+}
+
+/// The sky's radiance luminance towards unit direction `d`: the environment's texel (nearest,
+/// turned by its rotation) or the constant sky's.
+fn sky_luminance(scene: &crate::ir::Scene, d: Vec3) -> f32 {
+    let Some(env) = &scene.environment else {
+        return kiln_format::gpu::luminance(scene.sky.radiance);
+    };
+    // The map is turned by +rotation about y: the texel seen along d is the source's along d
+    // turned back.
+    let (s, c) = (-env.rotation_degrees.to_radians()).sin_cos();
+    let local = Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+    let [u, v] = kiln_format::environment::direction_to_uv(local);
+    let x = ((u * env.width as f32) as u32).min(env.width - 1);
+    let y = ((v * env.height as f32) as u32).min(env.height - 1);
+    kiln_format::gpu::luminance(env.pixels[(y * env.width + x) as usize])
+}
+
+/// The sky's three grids over medium `m` (R, G, B, x fastest): per cell, the sky's light that
+/// reaches it through the geometry and through the medium itself, relative to the sky's whole:
+/// Σ_k w_k V_k e^{−σt,c·d_k} / Σ_k w_k over [`SKY_SAMPLES`] directions of equal solid angle from
+/// points of the cell, w_k the sky's luminance along direction k, V_k whether the ray escapes the
+/// geometry, d_k its length inside the medium's box. Lit by the sky's radiance L and its phase
+/// function, the cell scatters σs · (that) · ∫ p L dω / ∫ L dω-weighted (exact for a uniform sky
+/// and any phase function; the player convolves the sky with the phase function).
+pub fn sky_grids(
+    scene: &crate::ir::Scene,
+    shading: &ShadingScene,
+    m: &Medium,
+    dims: [u32; 3],
+) -> [Vec<u8>; 3] {
+    let cells = (dims[0] * dims[1] * dims[2]) as usize;
+    let sigma_t = Vec3::from(m.sigma_a) + Vec3::from(m.sigma_s);
+    let (lo, hi) = (Vec3::from(m.bounds.min), Vec3::from(m.bounds.max));
+    let tris =
+        kiln_format::query::IndexedTriangles { vertices: shading.vertices, triangles: shading.triangles };
+    let values: Vec<[u8; 3]> = (0..cells)
+        .into_par_iter()
+        .map(|i| {
+            let c = cell_of(i, dims);
+            let (mut sum, mut weight) = (Vec3::ZERO, 0.0f32);
+            for k in 0..SKY_SAMPLES {
+                let p = sample_point(m, dims, c, k % SAMPLES);
+                // A direction in band k / 4 of cos θ and k % 4 of φ, jittered within them by a
+                // hash of the cell and k.
+                let [jc, jp] = jitter(i as u32, k);
+                let cos = 1.0 - 2.0 * (((k / 4) as f32 + jc) / (SKY_SAMPLES / 4) as f32);
+                let phi = std::f32::consts::TAU * (((k % 4) as f32 + jp) / 4.0);
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let d = Vec3::new(sin * phi.cos(), cos, sin * phi.sin());
+                let w = sky_luminance(scene, d);
+                weight += w;
+                if w <= 0.0 {
+                    continue;
+                }
+                let ray = kiln_format::query::Ray::new(p, d, 0.0, f32::INFINITY);
+                if kiln_format::query::BvhQuery::new(shading.bvh, &tris).any_hit(&ray) {
+                    continue;
+                }
+                // Length inside the box from p (inside it) along d.
+                let t = [0, 1, 2]
+                    .map(|a| {
+                        if d[a] > 0.0 {
+                            (hi[a] - p[a]) / d[a]
+                        } else if d[a] < 0.0 {
+                            (lo[a] - p[a]) / d[a]
+                        } else {
+                            f32::INFINITY
+                        }
+                    })
+                    .into_iter()
+                    .fold(f32::INFINITY, f32::min)
+                    .max(0.0);
+                sum += w * (-sigma_t * t).exp();
+            }
+            let v = if weight > 0.0 { sum / weight } else { Vec3::ZERO };
+            v.to_array().map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+        })
+        .collect();
+    [0, 1, 2].map(|ch| values.iter().map(|v| v[ch]).collect())
+}
+
+/// The light-visibility stage: the volume of medium 0, one grid per shadow-casting light, then
+/// the sky's three where a sky lights the scene.
 pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let res = ctx.settings.media_volume_res;
-    let (info, volumes) = bake(&ctx.shading(), &ctx.scene.media, 0, res);
+    let shading = ctx.shading();
+    let (mut info, mut volumes) = bake(&shading, &ctx.scene.media, 0, res);
+    let sky = ctx.scene.environment.is_some() || kiln_format::gpu::luminance(ctx.scene.sky.radiance) > 0.0;
+    if sky && let Some(m) = ctx.scene.media.first() {
+        volumes.extend(sky_grids(ctx.scene, &shading, m, info.dims));
+        info.lights.extend(MediaVisibilityInfo::SKY);
+    }
     let mut out = super::Sections::default();
     for (i, v) in volumes.into_iter().enumerate() {
         out.push(kiln_format::sections::MEDIA_VISIBILITY, i as u32, v);

@@ -365,7 +365,13 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
         Stage::MediaVisibility => {
             h.part("res", &s.media_volume_res.to_le_bytes())
                 .part("lights-media", &records_bytes(&scene.lights, &scene.media))
+                .part("sky", bytemuck::cast_slice(&scene.sky.radiance))
                 .hash("geometry", &ctx.geometry_key);
+            // The sky's volume weighs directions by the environment's light.
+            if let Some(env) = &scene.environment {
+                h.part("environment", bytemuck::cast_slice(&env.pixels))
+                    .part("environment-rotation", &env.rotation_degrees.to_le_bytes());
+            }
         }
         Stage::VoxelGrid | Stage::LineSpace => {
             // The grid over the corners in stored order; PNMT records read normals (in the

@@ -195,6 +195,9 @@ gpu_struct! {
         /// Lights with a volume: `volume_of[light]` is its first byte in the volume buffer, −1
         /// without one (unshadowed in the medium).
         pub lights: u32 => "uint",
+        /// The first byte of the sky's red grid in the volume buffer (green and blue follow, one
+        /// grid's bytes rounded up to 4 apart); `u32::MAX`: no sky grids, the sky scatters nothing.
+        pub sky_volume: u32 => "uint",
     }
 }
 

@@ -43,6 +43,8 @@ pub struct MediaBuffers {
     pub dims: [u32; 3],
     /// Entries of `volume_of`.
     pub lights: u32,
+    /// The first byte of the sky's red grid in `volumes` (`u32::MAX`: none).
+    pub sky_volume: u32,
     /// Where section `MVIS#i` goes in `volumes`.
     offsets: Vec<u64>,
 }
@@ -62,6 +64,17 @@ impl MediaBuffers {
         let stride = volume_bytes.next_multiple_of(4);
         let offsets: Vec<u64> = (0..lights_with.len() as u64).map(|i| i * stride).collect();
         let mut volume_of = vec![-1i32; manifest.lights.len()];
+        let sky = lights_with.iter().position(|&l| l == kiln_format::manifest::MediaVisibilityInfo::SKY[0]);
+        // Validated with the manifest: the sky's three grids are consecutive entries, red first.
+        let sky_volume = match sky {
+            Some(i)
+                if lights_with.get(i..i + 3)
+                    == Some(&kiln_format::manifest::MediaVisibilityInfo::SKY[..]) =>
+            {
+                u32::try_from(offsets[i]).unwrap_or(u32::MAX)
+            }
+            _ => u32::MAX,
+        };
         for (i, &light) in lights_with.iter().enumerate() {
             let at = i32::try_from(offsets[i]).map_err(|_| {
                 PlayError::new(Exit::BadInput, "the light-visibility volumes exceed 2 GiB: too many to march")
@@ -85,6 +98,7 @@ impl MediaBuffers {
             volume_medium,
             dims,
             lights: volume_of.len() as u32,
+            sky_volume,
             offsets,
         };
         up.buffer(&buffers.table, 0, bytemuck::cast_slice(&media))?;

@@ -38,6 +38,8 @@ impl MediaMarchPass {
             Binding::one(Storage),
             Binding::one(Sampled),
             Binding::one(StorageImage),
+            Binding::one(Storage),
+            Binding::one(Storage),
         ];
         let kernel = Kernel::new(
             gpu,
@@ -73,20 +75,21 @@ impl Pass for MediaMarchPass {
             dims_y: m.dims[1],
             dims_z: m.dims[2],
             lights: m.lights,
+            sky_volume: m.sky_volume,
         };
         let img = |t: &TargetDecl| shared.images.get(t).view;
-        self.kernel.write(
-            gpu,
-            &[
-                Write::Buffer(0, shared.frame_ubo),
-                Write::Buffer(1, shared.lights),
-                Write::Buffer(2, &m.table),
-                Write::Buffer(3, &m.volumes),
-                Write::Buffer(4, &m.volume_of),
-                Write::Sampled(5, vec![(img(&DEPTH), shared.scene.nearest_clamp)]),
-                Write::StorageImage(6, img(&RADIANCE)),
-            ],
-        )
+        let mut writes = vec![
+            Write::Buffer(0, shared.frame_ubo),
+            Write::Buffer(1, shared.lights),
+            Write::Buffer(2, &m.table),
+            Write::Buffer(3, &m.volumes),
+            Write::Buffer(4, &m.volume_of),
+            Write::Sampled(5, vec![(img(&DEPTH), shared.scene.nearest_clamp)]),
+            Write::StorageImage(6, img(&RADIANCE)),
+        ];
+        // The environment's harmonics light the media with the sky (bindings 7-8).
+        writes.extend(shared.scene.environment_writes(7)?);
+        self.kernel.write(gpu, &writes)
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {

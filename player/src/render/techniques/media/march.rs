@@ -1,6 +1,7 @@
 //! `--media march`: single scattering by marching each pixel's view ray through the media in
-//! world space: light visibility from the baked volume (trilinear), transmittance analytic
-//! (`passes/media.rs`, `shaders/media/march.comp`).
+//! world space: light visibility from the baked volume (trilinear), transmittance analytic, the
+//! sky's light from the baked sky grids (format 1.10) times the sky convolved with the phase
+//! function (`passes/media.rs`, `shaders/media/march.comp`).
 
 use super::{casters, no_medium};
 use crate::render::frame::{FrameBuild, Stage};
@@ -19,7 +20,8 @@ impl Registered for March {
     const NAME: &'static str = "march";
     const HELP: &'static str = "single scattering: each pixel's view ray marched through the media in world space \
                                 (light visibility from the compiler's baked volume, transmittance analytic; works \
-                                with the light off screen), see --media-steps";
+                                with the light off screen; the sky's light too, where the file has the sky's grids), \
+                                see --media-steps";
     const KNOBS: &'static [Knob] = &[whole(number(
         "media-steps",
         "steps along the view ray through each medium",
