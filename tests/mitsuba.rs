@@ -630,7 +630,8 @@ fn damaged_helmet_under_the_studio_matches_mitsuba() {
 #[ignore = "a public model from ../shared/scenes; minutes on lavapipe"]
 fn toy_car_under_the_studio_matches_mitsuba() {
     // KHR_materials_clearcoat with its texture over a textured, normal-mapped body (issue 45's
-    // target: FLIP 0.06), the glass read as coverage, 7 cm across, from the file's first camera.
+    // target: FLIP 0.06), the windows a thin-walled transmission, 7 cm across, from the file's
+    // first camera.
     let Some(scene) = khronos_under_the_studio("ToyCar/glTF/ToyCar.gltf", None) else {
         return;
     };
