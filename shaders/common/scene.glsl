@@ -214,8 +214,17 @@ vec3 mirrored(Surface s, vec3 wi) {
 vec3 base_brdf_cos(Surface s, vec3 wo, vec3 wi) {
     float n_l = dot(s.ns, wi);
     float n_v = dot(s.ns, wo);
-    bool through = n_l < 0.0 && s.mat.transmission > 0.0 && !s.mat.diffuse_only;
+    // The side wi leaves by is the geometric surface's; where the shading normal puts wi on the
+    // other side, nothing (as `base_pdf`, which samples neither there): a transmitting surface
+    // would otherwise reflect light from behind it, or transmit light from in front.
+    bool through = dot(s.ng, wi) < 0.0;
+    if (through != (n_l < 0.0)) {
+        return vec3(0.0);
+    }
     if (through) {
+        if (s.mat.transmission <= 0.0 || s.mat.diffuse_only) {
+            return vec3(0.0);
+        }
         wi = mirrored(s, wi);
         n_l = -n_l;
     }
@@ -256,7 +265,8 @@ vec3 brdf_cos(Surface s, vec3 wo, vec3 wi) {
         return base;
     }
     float w = coat_weight(s, wo);
-    return base * (1.0 - w) + w * coat_cos(s, wo, wi);
+    // Below the surface the coat only dims what passes through it.
+    return base * (1.0 - w) + (g > 0.0 ? w * coat_cos(s, wo, wi) : 0.0);
 }
 
 // The luminance of the base's Fresnel reflectance towards wo.
