@@ -183,6 +183,12 @@ impl Scene {
             || self.environment.as_ref().is_some_and(|e| e.pixels.iter().flatten().any(|&c| c > 0.0))
     }
 
+    /// Whether a sky lights the scene: an environment, or a constant sky of non-zero radiance (what
+    /// the media's sky grids are baked for).
+    pub fn sky_lights(&self) -> bool {
+        self.environment.is_some() || kiln_format::gpu::luminance(self.sky.radiance) > 0.0
+    }
+
     /// Records a warning of data loss (what most import warnings are).
     pub fn warn(&mut self, message: impl Into<String>) {
         self.warn_as(WarningClass::DataLoss, message);

@@ -48,7 +48,7 @@ pub fn uv_to_direction(u: f32, v: f32) -> Vec3 {
 }
 
 /// Row-major index of the texel of a `w` × `h` map that holds unit direction `d`.
-fn texel_of(d: Vec3, w: u32, h: u32) -> usize {
+pub fn texel_of(d: Vec3, w: u32, h: u32) -> usize {
     let [u, v] = direction_to_uv(d);
     let x = ((u * w as f32) as u32).min(w - 1);
     let y = ((v * h as f32) as u32).min(h - 1);

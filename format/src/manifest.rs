@@ -237,6 +237,13 @@ impl MediaVisibilityInfo {
     /// the sky's whole (FORMAT.md, "MVIS").
     pub const SKY: [u32; 3] = [u32::MAX - 2, u32::MAX - 1, u32::MAX];
 
+    /// The entry of `lights` (and index of `MVIS`) of the sky's red grid: where the three sky
+    /// entries stand as FORMAT.md requires, consecutive, red first. (The reader refuses a file
+    /// with a sky entry anywhere else.)
+    pub fn sky_index(&self) -> Option<usize> {
+        self.lights.windows(3).position(|w| w == Self::SKY)
+    }
+
     /// Cells of each light's `MVIS` section.
     pub fn cells(&self) -> u64 {
         self.dims.iter().map(|&d| d as u64).product()

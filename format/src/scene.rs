@@ -4,7 +4,7 @@
 use std::borrow::Cow;
 
 use crate::error::{FormatError, Result};
-use crate::manifest::{ColorSpace, LightKind, Manifest, MediaVisibilityInfo};
+use crate::manifest::{ColorSpace, LightKind, Manifest};
 use crate::read::KilnFile;
 use crate::sections::{
     BRDF_LUT, BVH_NODES, BVH_TRAVERSAL_STACK, COLORS, CwbvhNode, GpuMaterial, GpuMaterialV1, GpuMaterialV2,
@@ -394,14 +394,15 @@ impl<'a> SceneView<'a> {
                         v.lights.len()
                     )));
                 }
+                let sky = v.sky_index();
                 for (i, &l) in v.lights.iter().enumerate() {
                     // The length against the record before decoding.
                     let what = format!("light-visibility volume {i}");
                     file.pod_exact::<u8>(MEDIA_VISIBILITY, i as u32, cells, &what)?
                         .ok_or_else(|| FormatError::invalid(format!("{what} is missing")))?;
-                    let sky = MediaVisibilityInfo::SKY.contains(&l)
-                        && v.lights.iter().filter(|&&k| k == l).count() == 1;
-                    if l as usize >= m.lights.len() && !sky {
+                    // The sky's three entries, consecutive and red first: no light's index.
+                    let of_sky = sky.is_some_and(|s| (s..s + 3).contains(&i));
+                    if l as usize >= m.lights.len() && !of_sky {
                         return Err(FormatError::invalid(format!(
                             "light-visibility volume {i}: light {l} of {}",
                             m.lights.len()

@@ -305,7 +305,7 @@ impl Plan {
             )
         });
         // The sky's grids (three: red, green, blue) where a sky lights the scene.
-        let sky = scene.environment.is_some() || kiln_format::gpu::luminance(scene.sky.radiance) > 0.0;
+        let sky = scene.sky_lights();
         stages.push(if scene.media.is_empty() {
             skip(Stage::MediaVisibility, "the scene has no participating medium")
         } else if casters == 0 && !sky {

@@ -127,12 +127,8 @@ fn sky_luminance(scene: &crate::ir::Scene, d: Vec3) -> f32 {
     };
     // The map is turned by +rotation about y: the texel seen along d is the source's along d
     // turned back.
-    let (s, c) = (-env.rotation_degrees.to_radians()).sin_cos();
-    let local = Vec3::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
-    let [u, v] = kiln_format::environment::direction_to_uv(local);
-    let x = ((u * env.width as f32) as u32).min(env.width - 1);
-    let y = ((v * env.height as f32) as u32).min(env.height - 1);
-    kiln_format::gpu::luminance(env.pixels[(y * env.width + x) as usize])
+    let local = glam::Quat::from_rotation_y(-env.rotation_degrees.to_radians()) * d;
+    kiln_format::gpu::luminance(env.pixels[kiln_format::environment::texel_of(local, env.width, env.height)])
 }
 
 /// The sky's three grids over medium `m` (R, G, B, x fastest): per cell, the sky's light that
@@ -205,8 +201,9 @@ pub fn stage(ctx: &super::BakeContext) -> super::Sections {
     let res = ctx.settings.media_volume_res;
     let shading = ctx.shading();
     let (mut info, mut volumes) = bake(&shading, &ctx.scene.media, 0, res);
-    let sky = ctx.scene.environment.is_some() || kiln_format::gpu::luminance(ctx.scene.sky.radiance) > 0.0;
-    if sky && let Some(m) = ctx.scene.media.first() {
+    if ctx.scene.sky_lights()
+        && let Some(m) = ctx.scene.media.first()
+    {
         volumes.extend(sky_grids(ctx.scene, &shading, m, info.dims));
         info.lights.extend(MediaVisibilityInfo::SKY);
     }

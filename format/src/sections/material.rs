@@ -100,8 +100,8 @@ const _: () = assert!(size_of::<GpuMaterial>() == 112);
 /// version 2 (1.8, the clear coat) 24, version 3 (1.9, transmission) 28.
 pub fn material_words(version: u16) -> usize {
     match version {
-        1 => 20,
-        2 => 24,
+        1 => size_of::<GpuMaterialV1>() / 4,
+        2 => size_of::<GpuMaterialV2>() / 4,
         _ => size_of::<GpuMaterial>() / 4,
     }
 }
@@ -128,7 +128,7 @@ impl GpuMaterial {
     /// (no coat, no transmission).
     pub fn from_words(words: &[u32]) -> GpuMaterial {
         // The default holds them: no coat, no transmission, no textures for either.
-        let mut all: [u32; 28] = bytemuck::cast(GpuMaterial::default());
+        let mut all: [u32; size_of::<GpuMaterial>() / 4] = bytemuck::cast(GpuMaterial::default());
         let n = words.len().min(all.len());
         all[..n].copy_from_slice(&words[..n]);
         bytemuck::cast(all)

@@ -64,17 +64,9 @@ impl MediaBuffers {
         let stride = volume_bytes.next_multiple_of(4);
         let offsets: Vec<u64> = (0..lights_with.len() as u64).map(|i| i * stride).collect();
         let mut volume_of = vec![-1i32; manifest.lights.len()];
-        let sky = lights_with.iter().position(|&l| l == kiln_format::manifest::MediaVisibilityInfo::SKY[0]);
-        // Validated with the manifest: the sky's three grids are consecutive entries, red first.
-        let sky_volume = match sky {
-            Some(i)
-                if lights_with.get(i..i + 3)
-                    == Some(&kiln_format::manifest::MediaVisibilityInfo::SKY[..]) =>
-            {
-                u32::try_from(offsets[i]).unwrap_or(u32::MAX)
-            }
-            _ => u32::MAX,
-        };
+        // The sky's grids: consecutive, red first (validated with the manifest).
+        let sky = manifest.media_visibility.as_ref().filter(|_| volumes).and_then(|v| v.sky_index());
+        let sky_volume = sky.and_then(|i| u32::try_from(offsets[i]).ok()).unwrap_or(u32::MAX);
         for (i, &light) in lights_with.iter().enumerate() {
             let at = i32::try_from(offsets[i]).map_err(|_| {
                 PlayError::new(Exit::BadInput, "the light-visibility volumes exceed 2 GiB: too many to march")
