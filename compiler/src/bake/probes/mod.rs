@@ -8,8 +8,8 @@
 //! direction) and one of distance moments (DDGI's: the mean and mean square of the distance,
 //! weighted by cos^[`DISTANCE_EXPONENT`] around each texel's direction), from which the player's
 //! Chebyshev test keeps light from leaking through walls. Before that each probe is moved out of
-//! geometry (when a quarter of its rays hit back faces it is inside: it moves through the nearest
-//! back face) and away from surfaces closer than [`MIN_SURFACE_DISTANCE`] spacings, within
+//! geometry (when a quarter of its rays hit back faces of single-sided surfaces, or 5/8 the backs
+//! of double-sided ones by their winding, it is inside: it moves through the nearest back face) and away from surfaces closer than [`MIN_SURFACE_DISTANCE`] spacings, within
 //! [`MAX_OFFSET`] spacings of its grid point; one still inside is switched off (DDGI's
 //! relocation and classification, Majercik et al. 2021).
 
@@ -23,7 +23,7 @@ use kiln_format::probes::{
 use kiln_format::sections::{PROBE_GRID, PROBE_IRRADIANCE, PROBE_STATES, PROBE_VISIBILITY};
 use rayon::prelude::*;
 
-use self::trace::{Tracer, fibonacci_direction, path_rng};
+use self::trace::{Side, Tracer, fibonacci_direction, path_rng};
 use super::{BakeContext, Sections};
 
 /// Interior texels along an irradiance tile's edge (8 × 8 directions: irradiance is smooth).
@@ -38,6 +38,12 @@ pub const DISTANCE_EXPONENT: i32 = 50;
 const RELOCATION_RAYS: u32 = 64;
 /// A probe whose test rays hit back faces this often is inside geometry.
 const INSIDE_FRACTION: f32 = 0.25;
+/// What a back face of a double-sided surface (by its winding) counts for against
+/// [`INSIDE_FRACTION`]: inside takes more than 5/8 of the rays on such backs. Exporters often mark
+/// closed meshes double-sided, and a probe in one sees their backs all round (Khronos ToyCar:
+/// none of 980 probes was switched off, and the ones inside its body blackened the roof); an
+/// open sheet (a canopy, a cloth) covers at most half of a probe's view, which stays out.
+const DOUBLE_SIDED_BACK: f32 = INSIDE_FRACTION / 0.625;
 /// Probes are moved at least this many spacings from the surfaces around them (where the
 /// limit on offsets allows).
 pub const MIN_SURFACE_DISTANCE: f32 = 0.1;
@@ -166,21 +172,30 @@ struct Survey {
 }
 
 fn survey(tracer: &Tracer, p: Vec3) -> Survey {
-    let (mut back, mut nearest_back, mut nearest_front) = (0, None::<(f32, Vec3)>, None::<(f32, Vec3)>);
+    let (mut back, mut nearest_back, mut nearest_front) = (0.0, None::<(f32, Vec3)>, None::<(f32, Vec3)>);
+    let keep = |slot: &mut Option<(f32, Vec3)>, t: f32, d: Vec3| {
+        if slot.is_none_or(|(nearest, _)| t < nearest) {
+            *slot = Some((t, d));
+        }
+    };
     for i in 0..RELOCATION_RAYS {
         let d = fibonacci_direction(i, RELOCATION_RAYS);
         let Some(h) = tracer.trace(p, d, f32::INFINITY) else { continue };
-        let slot = if tracer.inside(&h, d) {
-            back += 1;
-            &mut nearest_back
-        } else {
-            &mut nearest_front
-        };
-        if slot.is_none_or(|(t, _)| h.t < t) {
-            *slot = Some((h.t, d));
+        match tracer.side(&h, d) {
+            Side::Front => keep(&mut nearest_front, h.t, d),
+            Side::SingleBack => {
+                back += 1.0;
+                keep(&mut nearest_back, h.t, d);
+            }
+            // A way out where the probe is inside, a surface to keep away from where it is not.
+            Side::DoubleBack => {
+                back += DOUBLE_SIDED_BACK;
+                keep(&mut nearest_back, h.t, d);
+                keep(&mut nearest_front, h.t, d);
+            }
         }
     }
-    Survey { inside: back as f32 > INSIDE_FRACTION * RELOCATION_RAYS as f32, nearest_back, nearest_front }
+    Survey { inside: back > INSIDE_FRACTION * RELOCATION_RAYS as f32, nearest_back, nearest_front }
 }
 
 /// Moves the probe at grid point `g` out of geometry and away from surfaces: its position, or

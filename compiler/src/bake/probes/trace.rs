@@ -129,6 +129,18 @@ impl Sky<'_> {
     }
 }
 
+/// The side of a surface a ray meets ([`Tracer::side`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The side its winding faces.
+    Front,
+    /// The back of a single-sided surface: the inside of something.
+    SingleBack,
+    /// The back of a double-sided surface by its winding: the inside of a closed mesh its
+    /// author marked double-sided (most exporters' default), or the far side of an open sheet.
+    DoubleBack,
+}
+
 /// What the bake traces against.
 pub struct Tracer<'a> {
     /// Materials, textures, lights, BVH.
@@ -244,8 +256,19 @@ impl<'a> Tracer<'a> {
     /// Whether the ray along `d` that found `h` met the back of a single-sided surface: it
     /// comes from inside something (a double-sided material has no inside).
     pub fn inside(&self, h: &SurfaceHit, d: Vec3) -> bool {
-        h.ng.dot(d) > 0.0
-            && self.shading.materials[h.material as usize].flags & MaterialFlags::DOUBLE_SIDED == 0
+        self.side(h, d) == Side::SingleBack
+    }
+
+    /// Which side of its surface the ray along `d` that found `h` met, the back told by the
+    /// triangle's winding (its geometric normal) whatever the material's sidedness.
+    pub fn side(&self, h: &SurfaceHit, d: Vec3) -> Side {
+        if h.ng.dot(d) <= 0.0 {
+            Side::Front
+        } else if self.shading.materials[h.material as usize].flags & MaterialFlags::DOUBLE_SIDED == 0 {
+            Side::SingleBack
+        } else {
+            Side::DoubleBack
+        }
     }
 
     /// Radiance the surface `h` emits back along `d` (the ray that found it).
