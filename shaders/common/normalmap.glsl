@@ -16,8 +16,13 @@ vec3 normal_texel(vec4 texel) {
 vec3 normal_mapped(vec3 n, vec3 dp1, vec3 dp2, vec2 duv1, vec2 duv2, vec3 sample_ts, float scale) {
     vec3 dp2perp = cross(dp2, n);
     vec3 dp1perp = cross(n, dp1);
-    vec3 t = dp2perp * duv1.x + dp1perp * duv2.x;
-    vec3 b = dp2perp * duv1.y + dp1perp * duv2.y;
+    // The cotangent frame is ±(dp/du, dp/dv): the sign of (dp1 × dp2)·n. Schüler's formula
+    // assumes it positive, as OpenGL's window y (up) gives; Vulkan's y runs down the framebuffer
+    // (dFdy, and the resolve's next row), which negated both axes and turned every normal map's
+    // tilt by 180° about the normal against the path tracer's.
+    float side = dot(cross(dp1, dp2), n) < 0.0 ? -1.0 : 1.0;
+    vec3 t = (dp2perp * duv1.x + dp1perp * duv2.x) * side;
+    vec3 b = (dp2perp * duv1.y + dp1perp * duv2.y) * side;
     float invmax = inversesqrt(max(max(dot(t, t), dot(b, b)), 1e-20));
     vec3 m = vec3(sample_ts.xy * scale, sample_ts.z);
     // glTF uv runs down the image; its tangent-space y (green) points up: flip the bitangent.

@@ -3,7 +3,9 @@
 
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
-use kiln_format::manifest::{LightKind, Sky};
+use kiln_compiler::ir::{Texture, TextureRole};
+use kiln_compiler::settings::{Settings, TextureFormat};
+use kiln_format::manifest::{LightKind, Sky, Wrap};
 use kiln_test_support::gpu_test;
 use kiln_tests::{GBuffer, Options, compile, scene_of};
 
@@ -149,4 +151,80 @@ fn an_orthographic_camera_sees_the_lit_square_where_its_parallel_rays_meet_it() 
     let (_, rgb) =
         kiln_player::reference::render(&o, 4, std::time::Instant::now()).expect("reference render");
     check(&rgb, "reference");
+}
+
+/// A normal map tilting a floor's shading normal 60° towards −z (worked out here from the
+/// texel's codes: tangent +x along u, glTF's green axis up the image, where v decreases), under a
+/// directional light straight down and a black sky. Seen from −z, facing the tilt, every pixel is
+/// Lambert's albedo/π · E · (n·ŷ); seen from +z, where the shading normal faces away from the eye
+/// (n·v < 0) while the surface faces it, every pixel is black: the path tracer reflects nothing
+/// towards a direction below the shading normal (as Mitsuba 3's BSDFs), and the frame's passes
+/// agree. Both G-buffers and the reference path tracer. Planted and seen failing: the cotangent
+/// frame's bitangent not negated (common/normalmap.glsl: the frame lit from +z and black from −z);
+/// the direct pass keeping a normal that faces away from the eye (the floor lit from +z).
+#[test]
+fn a_normal_map_tilts_the_floor_the_same_way_in_the_frame_and_the_path_tracer() {
+    let dir = gpu_test!();
+    let mut scene = scene_of(&square(0.0, 10.0));
+    scene.uvs = scene
+        .vertices
+        .iter()
+        .map(|v| [(v.position[0] + 10.0) / 20.0, (v.position[2] + 10.0) / 20.0])
+        .collect();
+    // Tangent-space (0, sin 60°, cos 60°) as 8-bit codes; z is rebuilt from x and y.
+    let codes = [128u8, 238, 191, 255];
+    scene.textures.push(Texture {
+        name: "tilt".into(),
+        width: 4,
+        height: 4,
+        rgba: codes.repeat(16),
+        role: TextureRole::Normal,
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        mag_linear: true,
+    });
+    let m = &mut scene.materials[0].gpu;
+    *m = lambert_material(ALBEDO.map(srgb8));
+    m.normal_texture = 0;
+    let irradiance = 2.0;
+    scene.lights.push(light(LightKind::Directional, [0.0; 3], [0.0, -1.0, 0.0], irradiance));
+    scene.sky = Sky { radiance: [0.0; 3] };
+    let unit = |c: u8| c as f64 / 255.0 * 2.0 - 1.0;
+    let (x, y) = (unit(codes[0]), unit(codes[1]));
+    let n = DVec3::new(x, (1.0 - x * x - y * y).sqrt(), -y).normalize();
+    let a = albedo();
+    let lit = a.map(|k| k / std::f64::consts::PI * irradiance as f64 * n.y);
+    for (side, z) in [("facing", -8.0), ("away", 8.0)] {
+        let cam = Pinhole::new([0.0, 2.0, z], [0.0, 0.0, -z / 4.0], [0.0, 1.0, 0.0], 50.0, W, H);
+        let mut scene = scene.clone();
+        scene.cameras.push(cam.file_camera());
+        let bytes = compile(scene, Settings { texture_format: TextureFormat::Rgba8, ..fast_settings() });
+        let pixels = crate::harness::floor_pixels(&cam, 9.5);
+        let away = side == "away";
+        assert!(
+            pixels.iter().all(|&(_, p, _)| (n.dot(cam.eye - p) < 0.0) == away),
+            "{side}: the shading normal does not face the way the test means"
+        );
+        let check = |name: &str, rgb: &[f32]| {
+            eprintln!("{side}, {name}:");
+            if away {
+                let bright = pixels.iter().map(|&(i, _, _)| rgb[i]).fold(0.0f32, f32::max);
+                assert!(bright == 0.0, "{side}, {name}: a floor pixel is {bright}, not black");
+            } else {
+                let compared = compare_plane(rgb, &cam, 9.5, |_, _| true, |_| lit, TOLERANCE);
+                assert!(compared > (W * H / 3) as usize, "{side}, {name}: only {compared} pixels compared");
+            }
+        };
+        for mode in [GBuffer::Raster, GBuffer::Visibility] {
+            let name = format!("tilt-{side}-{mode:?}");
+            let (rgb, _) = render(dir.path(), &name, &bytes, |f| Options::new(f, W, H).gbuffer(mode));
+            check(&format!("{mode:?}"), &rgb);
+        }
+        let file = dir.path().join(format!("tilt-{side}.kiln"));
+        std::fs::write(&file, &bytes).unwrap();
+        let o = Options::new(&file, W, H).unshadowed().reference().build();
+        let (_, rgb) =
+            kiln_player::reference::render(&o, 2, std::time::Instant::now()).expect("reference render");
+        check("reference", &rgb);
+    }
 }
