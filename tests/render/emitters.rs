@@ -16,6 +16,7 @@
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
 use kiln_compiler::ir::{Material, Scene, Texture, TextureRole};
+use kiln_compiler::settings::{Settings, TextureFormat};
 use kiln_format::manifest::{Sky, Wrap};
 use kiln_format::sections::MaterialFlags;
 use kiln_test_support::gpu_test;
@@ -82,7 +83,10 @@ pub(crate) fn camera() -> Pinhole {
 /// A floor of the analytic albedo under the quad's part s ∈ [0, s_max], or with `textured` the
 /// whole quad with an emissive texture black on its right half.
 fn quad_scene(cam: &Pinhole, s_max: f64, textured: bool) -> Vec<u8> {
-    compile(quad_scene_with(cam, &Quad::new(), s_max, textured, &[], ALBEDO), fast_settings())
+    // The texture as it is: the passes' BC decoders are judged by tests/render/textures.rs, and
+    // their pipelines would cost this test a cold compile of their own (117 s of the suite).
+    let settings = Settings { texture_format: TextureFormat::Rgba8, ..fast_settings() };
+    compile(quad_scene_with(cam, &Quad::new(), s_max, textured, &[], ALBEDO), settings)
 }
 
 /// The scene of [`quad_scene`] with the lamp `quad` and `extra` triangles of a Lambert material
