@@ -18,8 +18,7 @@ struct Material {
     float f90;        // … at grazing incidence (glTF core 1; KHR_materials_specular's factor)
     float clearcoat;  // KHR_materials_clearcoat's strength (0: no coat); passes that trace rays only
     float clearcoat_roughness;  // the coat's perceptual roughness
-    float transmission;  // KHR_materials_transmission's thin-walled transmission (0: opaque);
-                         // passes that trace rays only (the G-buffer folds it into the albedo)
+    float transmission;  // KHR_materials_transmission's thin-walled transmission (0: opaque)
 };
 
 // glTF's core dielectric reflectance (an index of refraction of 1.5), without
@@ -125,8 +124,29 @@ vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
     vec3 f0 = fresnel_f0(m);
     vec3 f = fresnel_schlick(f0, fresnel_f90(m), v_h);
     vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-    vec3 base = (vec3(1.0) - f) * (1.0 - m.metallic) * diffuse + f * (d * vis) * compensation;
+    vec3 base = (vec3(1.0) - f) * (1.0 - m.metallic) * (1.0 - m.transmission) * diffuse + f * (d * vis) * compensation;
     return m.clearcoat > 0.0 ? coat_over(m, base, n_v, n_h, n_l) : base;
+}
+
+// f(l, v) for light arriving from behind a thin-walled transmitting surface (n·l < 0;
+// KHR_materials_transmission, as the path tracer's `base_brdf_cos`): the specular lobe about l
+// mirrored through the surface, tinted by the base colour, its light the dielectric diffuse
+// part's share t: (1 − F)(1 − metallic) t base D Vis; under a clear coat, times the 1 − w the coat
+// lets through. Zero for materials that do not transmit.
+vec3 transmitted_brdf(Material m, vec3 n, vec3 v, vec3 l) {
+    if (m.transmission <= 0.0 || m.diffuse_only) {
+        return vec3(0.0);
+    }
+    vec3 mirrored = l - 2.0 * dot(n, l) * n;
+    float n_l = max(dot(n, mirrored), 1e-4);
+    float n_v = max(dot(n, v), 1e-4);
+    vec3 h = normalize(v + mirrored);
+    float alpha = ggx_alpha(m.roughness);
+    float a2 = alpha * alpha;
+    vec3 f = fresnel_schlick(fresnel_f0(m), fresnel_f90(m), max(dot(v, h), 0.0));
+    vec3 through = (vec3(1.0) - f) * (1.0 - m.metallic) * m.transmission * m.base
+        * (ggx_d(max(dot(n, h), 0.0), a2) * smith_visibility(n_l, n_v, a2));
+    return m.clearcoat > 0.0 ? through * (1.0 - coat_weight(m.clearcoat, n_v)) : through;
 }
 
 #endif

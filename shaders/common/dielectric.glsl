@@ -5,11 +5,12 @@
 // F90 as four half floats; without it glTF's core values, F0 0.04 and F90 1.
 //
 // In the G-buffer, whose targets are 8-bit: the material target's blue channel is 1 for
-// diffuse-only materials (as before) and otherwise k/255 with the grey F0 = (k/125)², k ≤ 125
-// (so that it stays below 0.5, where the passes that only ask "diffuse-only?" look, and 0.04 is
-// exact at k = 25); the albedo target's alpha holds F90. The raster frame thus reflects with
-// the F0's luminance: coloured dielectric F0 (specularColorFactor) is kept by the ray-traced
-// passes and the reference only.
+// diffuse-only materials and otherwise k/255 with the grey F0 = (k/125)², k ≤ 125 (0.04 is
+// exact at k = 25), or, for a surface that transmits (KHR_materials_transmission), k = 127 +
+// round(127 t), 128..254, with glTF's core F0 (packing.glsl decodes it); the albedo target's
+// alpha holds F90. The raster frame thus reflects with the F0's luminance, and a transmitting
+// surface with the core's: coloured dielectric F0 (specularColorFactor) is kept by the
+// ray-traced passes and the reference only.
 #ifndef KILN_DIELECTRIC_GLSL
 #define KILN_DIELECTRIC_GLSL
 
@@ -29,14 +30,17 @@ void material_dielectric(GpuMaterialLayout m, out vec3 f0, out float f90) {
     }
 }
 
-// What the G-buffer holds of material `m`'s reflectance: x the material target's blue channel
-// (1 diffuse-only, else the coded grey F0), y the albedo target's alpha (F90).
-vec2 gbuffer_dielectric(GpuMaterialLayout m) {
+// What the G-buffer holds of material `m`'s reflectance where it transmits `transmission`: x the
+// material target's blue channel (1 diffuse-only, the coded transmission, else the coded grey
+// F0), y the albedo target's alpha (F90).
+vec2 gbuffer_dielectric(GpuMaterialLayout m, float transmission) {
     vec3 f0;
     float f90;
     material_dielectric(m, f0, f90);
     bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
-    return vec2(diffuse_only ? 1.0 : round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0) / 255.0, f90);
+    float t = round(clamp(transmission, 0.0, 1.0) * 127.0);
+    float code = diffuse_only ? 255.0 : t > 0.0 ? 127.0 + t : round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0);
+    return vec2(code / 255.0, f90);
 }
 
 // The material at a pixel from the G-buffer's albedo and material texels.
@@ -45,25 +49,16 @@ Material gbuffer_material(vec4 albedo, vec4 mat) {
     m.base = srgb_to_linear(albedo.rgb);
     m.metallic = mat.r;
     m.roughness = mat.g;
-    m.diffuse_only = mat.b > 0.5;
+    m.diffuse_only = gbuffer_diffuse_only(mat);
+    m.transmission = gbuffer_transmission(mat);
     float k = min(round(mat.b * 255.0), 125.0) / 125.0;
-    m.f0 = vec3(k * k);
+    m.f0 = m.transmission > 0.0 ? DIELECTRIC_F0 : vec3(k * k);
     m.f90 = albedo.a;
     // The clear coat is in the emission target's alpha (`gbuffer_coat`); the caller that reads
     // that target sets it.
     m.clearcoat = 0.0;
     m.clearcoat_roughness = 0.0;
-    m.transmission = 0.0;
     return m;
-}
-
-// The base colour the G-buffer holds for a surface of base colour `base` that transmits the
-// fraction `transmission` of its dielectric part's light (KHR_materials_transmission): the raster
-// frame draws no light through surfaces, so it keeps their reflection and the (1 − t) part of
-// their diffuse light, the base colour scaled by 1 − t (1 − metallic) (exact for dielectrics; a
-// partly metallic one also loses that share of its metal's F0).
-vec3 gbuffer_base(vec3 base, float metallic, float transmission) {
-    return base * (1.0 - clamp(transmission, 0.0, 1.0) * (1.0 - clamp(metallic, 0.0, 1.0)));
 }
 
 // The clear coat in the G-buffer: the emission target's alpha (half float, which holds whole

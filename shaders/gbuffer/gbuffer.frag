@@ -3,7 +3,7 @@
 //   0 normal    RG16_SNORM  octahedral shading normal (normal map applied), world space
 //   1 albedo    RGBA8_UNORM base colour, sRGB-encoded here (an SRGB format cannot be a storage
 //                           image, and the visibility-buffer resolve writes the same targets)
-//   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag or dielectric F0 (common/dielectric.glsl), occlusion
+//   2 material  RGBA8_UNORM metallic, roughness, diffuse-only flag, transmission or dielectric F0 (common/dielectric.glsl), occlusion
 //   3 emission  RGBA16F     emitted radiance; alpha the clear coat (common/dielectric.glsl)
 //   4 triangle  R32_UINT    1 + the triangle's index in the index buffer (0: nothing drawn); the
 //                           ray-traced passes rebuild the exact surface point from it
@@ -72,12 +72,12 @@ void main() {
         emission *= texture(emissive_tex, in_uv).rgb;
     }
     out_normal = oct_encode(n);
-    vec2 dielectric = gbuffer_dielectric(material);
     float transmission = material.transmission;
     if (transmission > 0.0 && material.transmission_texture != NO_TEXTURE) {
         transmission *= texture(transmission_tex, in_uv).r;
     }
-    out_albedo = vec4(linear_to_srgb(gbuffer_base(base.rgb, metallic, transmission)), dielectric.y);
+    vec2 dielectric = gbuffer_dielectric(material, transmission);
+    out_albedo = vec4(linear_to_srgb(base.rgb), dielectric.y);
     out_material = vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion);
     float coat = material.clearcoat;
     float coat_roughness = material.clearcoat_roughness;

@@ -91,9 +91,9 @@ void main() {
     }
     vec3 emission = m.emission * texel[SLOT_EMISSIVE].rgb;
     imageStore(out_normal, pixel, vec4(oct_encode(n), 0.0, 0.0));
-    vec2 dielectric = gbuffer_dielectric(m);
     float transmission = m.transmission * texel[SLOT_TRANSMISSION].r;
-    imageStore(out_albedo, pixel, vec4(linear_to_srgb(gbuffer_base(base.rgb, metallic, transmission)), dielectric.y));
+    vec2 dielectric = gbuffer_dielectric(m, transmission);
+    imageStore(out_albedo, pixel, vec4(linear_to_srgb(base.rgb), dielectric.y));
     imageStore(out_material, pixel, vec4(clamp(metallic, 0.0, 1.0), clamp(roughness, 0.0, 1.0), dielectric.x, occlusion));
     float coat = gbuffer_coat(m.clearcoat * texel[SLOT_CLEARCOAT].r, m.clearcoat_roughness * texel[SLOT_CLEARCOAT_ROUGHNESS].g);
     imageStore(out_emission, pixel, vec4(emission, coat));

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_EXT_control_flow_attributes : require
-// Direct light and composition: every analytic light over the G-buffer, shadowed by the baked
+// Direct light and composition: every analytic light over the G-buffer (through thin-walled
+// transmitting surfaces from behind too), shadowed by the baked
 // shadow maps (PCF; PCSS for rect lights) or by the ray-traced visibility, the emissive
 // triangles' light from the direct-light image (`--direct`), plus the sky or environment
 // through the split-sum table (its diffuse part times the ray-traced AO, or replaced by the
@@ -211,6 +212,16 @@ vec4 reflection_at(ivec2 pixel, vec3 p, vec3 n) {
     return weight > 1e-6 ? vec4(sum / weight, 1.0) : vec4(0.0);
 }
 
+// f · |n·l| of the light arriving along l: reflected above the surface, and below it through a
+// thin-walled transmitting surface's mirrored lobe (`transmitted_brdf`; zero for opaque ones).
+vec3 f_cos(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
+    float n_l = dot(n, l);
+    if (n_l > 0.0) {
+        return brdf(m, n, v, l, e_albedo) * n_l;
+    }
+    return n_l < 0.0 ? transmitted_brdf(m, n, v, l) * -n_l : vec3(0.0);
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     uvec2 size = frame.size.xy;
@@ -301,7 +312,7 @@ void main() {
         // The split sum's directional albedo of the lobe: F0 R + F90 G.
         vec3 lobe = f0 * rg.r + fresnel_f90(m) * rg.g;
         vec3 compensation = vec3(1.0) + f0 * (1.0 / e_albedo - 1.0);
-        vec3 diffuse = (vec3(1.0) - lobe) * (1.0 - m.metallic) * m.base;
+        vec3 diffuse = (vec3(1.0) - lobe) * (1.0 - m.metallic) * (1.0 - m.transmission) * m.base;
         ambient += diffuse * diffuse_in;
         // The traced reflection estimates the single-scattering lobe; the same multiple-
         // scattering compensation as the split sum applies.
@@ -338,10 +349,7 @@ void main() {
         if (light.kind == LIGHT_DIRECTIONAL) {
             vec3 l = -light.direction;
             shadow_dir = l;
-            float n_l = dot(n, l);
-            if (n_l > 0.0) {
-                contribution = brdf(m, n, v, l, e_albedo) * light.radiance * n_l;
-            }
+            contribution = f_cos(m, n, v, l, e_albedo) * light.radiance;
         } else if (DIRECT_RECT_LIGHTS && light.kind == LIGHT_RECT) {
             vec3 up = cross(light.direction, light.right);
             float area = light.width * light.height;
@@ -357,11 +365,10 @@ void main() {
                     }
                     vec3 l = to / d;
                     float cos_light = dot(-l, light.direction);
-                    float n_l = dot(n, l);
-                    if (cos_light <= 0.0 || n_l <= 0.0) {
+                    if (cos_light <= 0.0) {
                         continue;
                     }
-                    contribution += brdf(m, n, v, l, e_albedo) * light.radiance * (cos_light * area / (16.0 * d * d)) * n_l;
+                    contribution += f_cos(m, n, v, l, e_albedo) * light.radiance * (cos_light * area / (16.0 * d * d));
                 }
             }
         } else {
@@ -369,17 +376,18 @@ void main() {
             float d = length(to);
             vec3 l = to / max(d, 1e-12);
             shadow_dir = l;
-            float n_l = dot(n, l);
-            if (d > 0.0 && n_l > 0.0 && (light.range <= 0.0 || d <= light.range)) {
+            if (d > 0.0 && (light.range <= 0.0 || d <= light.range)) {
                 float cone = 1.0;
                 if (light.kind == LIGHT_SPOT) {
                     cone = spot_cone(light, l);
                 }
-                contribution = brdf(m, n, v, l, e_albedo) * light.radiance * (cone / (d * d)) * n_l;
+                contribution = f_cos(m, n, v, l, e_albedo) * light.radiance * (cone / (d * d));
             }
         }
         if (any(greaterThan(contribution, vec3(0.0)))) {
-            contribution *= shadow_factor(i, light, p, n, shadow_dir, angle);
+            // Light through a transmitting surface is shadowed from its far side.
+            bool behind = m.transmission > 0.0 && dot(n, shadow_dir) < 0.0;
+            contribution *= shadow_factor(i, light, p, behind ? -n : n, shadow_dir, angle);
             // Light through participating media arrives dimmed (towards the light's position,
             // a rect light's centre; out of every box for directional lights).
             uint media_count = uint(frame.sky.w);

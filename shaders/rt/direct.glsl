@@ -287,7 +287,9 @@ vec3 direct_brdf(Primary s, ivec2 pixel, vec3 wi) {
     surf.mat = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
     bool traced_specular = (frame.size.w & FRAME_RT_REFLECTIONS) != 0u && !surf.mat.diffuse_only
         && surf.mat.roughness <= rt.max_roughness;
-    if (!traced_specular) {
+    // Light from behind a transmitting surface comes through its transmitted lobe, which no
+    // reflection carries.
+    if (!traced_specular || dot(s.ng, wi) < 0.0) {
         return brdf_cos(surf, s.v, wi);
     }
     float n_l = dot(s.n, wi);
@@ -296,7 +298,7 @@ vec3 direct_brdf(Primary s, ivec2 pixel, vec3 wi) {
     }
     vec3 h = normalize(s.v + wi);
     vec3 f = fresnel_schlick(fresnel_f0(surf.mat), fresnel_f90(surf.mat), max(dot(s.v, h), 0.0));
-    return (1.0 - f) * (1.0 - surf.mat.metallic) * surf.mat.base / PI * n_l;
+    return (1.0 - f) * (1.0 - surf.mat.metallic) * (1.0 - surf.mat.transmission) * surf.mat.base / PI * n_l;
 }
 
 void reuse_main() {

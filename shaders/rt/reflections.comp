@@ -93,7 +93,7 @@ void main() {
     if (primary_at(pixel, s)) {
         vec4 mat = texelFetch(g_material, pixel, 0);
         float roughness = mat.g;
-        if (mat.b < 0.5 && roughness <= rt.max_roughness) {
+        if (!gbuffer_diffuse_only(mat) && roughness <= rt.max_roughness) {
             seed_rng(pixel, 3u);
             Material m = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
             vec3 f0 = fresnel_f0(m);

@@ -7,7 +7,7 @@
 // Fixes of the thesis's code: the ray ends where it enters the sphere light (the thesis's
 // `tmax = distance + radius` let geometry behind the light occlude it), origins are offset
 // robustly instead of by tmin = 0.001, and a light below the surface's plane counts as shadowed
-// without tracing.
+// without tracing (unless the surface transmits: then the ray leaves from its far side).
 //
 // The includer defines how rays are traced, after including hybrid.glsl:
 //   bool shadow_occluded(vec3 from, vec3 ng, vec3 to)       the segment from a surface point
@@ -16,7 +16,9 @@
 #ifndef KILN_SHADOWS_GLSL
 #define KILN_SHADOWS_GLSL
 
-float visibility(Primary s, GpuLight l) {
+// `through`: the surface transmits (KHR_materials_transmission), so a light behind it is traced
+// from its far side.
+float visibility(Primary s, GpuLight l, bool through) {
     vec3 wi;
     float dist;
     if (l.kind == LIGHT_DIRECTIONAL) {
@@ -52,13 +54,15 @@ float visibility(Primary s, GpuLight l) {
             dist = d;
         }
     }
-    if (dot(wi, s.ng) <= 0.0 || dist <= 0.0) {
+    float side = dot(wi, s.ng);
+    if (side == 0.0 || (side < 0.0 && !through) || dist <= 0.0) {
         return 0.0;
     }
+    vec3 ng = side < 0.0 ? -s.ng : s.ng;
     if (l.kind == LIGHT_DIRECTIONAL) {
-        return shadow_occluded_dir(s.p, s.ng, wi) ? 0.0 : 1.0;
+        return shadow_occluded_dir(s.p, ng, wi) ? 0.0 : 1.0;
     }
-    return shadow_occluded(s.p, s.ng, s.p + wi * dist) ? 0.0 : 1.0;
+    return shadow_occluded(s.p, ng, s.p + wi * dist) ? 0.0 : 1.0;
 }
 
 void main() {
@@ -68,9 +72,10 @@ void main() {
     }
     Primary s;
     bool surface = primary_at(pixel, s);
+    bool through = surface && gbuffer_transmission(texelFetch(g_material, pixel, 0)) > 0.0;
     seed_rng(pixel, 1u);
     for (uint i = 0u; i < rt.shadow_lights; i++) {
-        float v = surface ? visibility(s, lights[i]) : 1.0;
+        float v = surface ? visibility(s, lights[i], through) : 1.0;
         ivec3 at = ivec3(pixel, int(i));
         imageStore(rt_shadows, at, vec4(accumulate(imageLoad(rt_shadows, at).r, v)));
     }

@@ -100,7 +100,7 @@ vec4 reflection(ivec2 p) {
     float depth = texelFetch(g_depth, p, 0).r;
     vec4 mat = texelFetch(g_material, p, 0);
     float roughness = mat.g;
-    if (!(depth > 0.0) || mat.b > 0.5 || roughness > ssr.max_roughness) {
+    if (!(depth > 0.0) || gbuffer_diffuse_only(mat) || roughness > ssr.max_roughness) {
         return vec4(0.0);
     }
     vec2 at = vec2(p) + 0.5;

@@ -6,6 +6,7 @@ use kiln_compiler::import::demo::lambert_material;
 use kiln_compiler::ir::{Texture, TextureRole};
 use kiln_compiler::settings::{Settings, TextureFormat};
 use kiln_format::manifest::{LightKind, Sky, Wrap};
+use kiln_format::sections::MaterialFlags;
 use kiln_test_support::gpu_test;
 use kiln_tests::{GBuffer, Options, compile, scene_of};
 
@@ -227,4 +228,70 @@ fn a_normal_map_tilts_the_floor_the_same_way_in_the_frame_and_the_path_tracer() 
             kiln_player::reference::render(&o, 2, std::time::Instant::now()).expect("reference render");
         check("reference", &rgb);
     }
+}
+
+/// A thin-walled transmitting sheet (KHR_materials_transmission: t = 1, roughness 0.6, glTF's
+/// core F0 0.04) at y = 0, lit only from below by a slanting directional light, the sky black:
+/// everything the camera above sees comes through the transmitted lobe, E (1 − F) t c D Vis (n·l′)
+/// per pixel, l′ the direction to the light mirrored through the sheet, h the half vector of v and
+/// l′, D and Vis glTF's GGX and height-correlated Smith terms with α = roughness², F Schlick's at
+/// v·h, all written here from the glTF specification. Both G-buffers with shadow maps, the
+/// visibility G-buffer with ray-traced shadows, and the path tracer. Planted and seen failing: the
+/// ray-traced shadows refusing lights below the surface (black), the lobe turned by negating the
+/// light's direction instead of mirroring it.
+#[test]
+fn light_from_behind_comes_through_a_transmitting_sheet_by_the_mirrored_lobe() {
+    let dir = gpu_test!();
+    let cam = Pinhole::new([0.0, 6.0, 7.0], [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 55.0, W, H);
+    let mut scene = scene_of(&square(0.0, 10.0));
+    let roughness = 0.6f32;
+    let m = &mut scene.materials[0].gpu;
+    *m = lambert_material(ALBEDO.map(srgb8));
+    m.flags &= !MaterialFlags::DIFFUSE_ONLY;
+    m.flags |= MaterialFlags::DOUBLE_SIDED;
+    m.metallic = 0.0;
+    m.roughness = roughness;
+    m.transmission = 1.0;
+    let irradiance = 3.0;
+    let travel = DVec3::new(0.3, 1.0, -0.2).normalize();
+    scene.lights.push(light(LightKind::Directional, [0.0; 3], travel.as_vec3().to_array(), irradiance));
+    scene.sky = Sky { radiance: [0.0; 3] };
+    scene.cameras.push(cam.file_camera());
+    let bytes = compile(scene, fast_settings());
+    let c = albedo();
+    let a2 = (roughness as f64).powi(4);
+    let expected = |p: DVec3| {
+        let n = DVec3::Y;
+        let v = (cam.eye - p).normalize();
+        let l = DVec3::new(-travel.x, travel.y, -travel.z); // towards the light, mirrored
+        let h = (v + l).normalize();
+        let (n_h, n_v, n_l) = (n.dot(h), n.dot(v), n.dot(l));
+        let d = a2 / (std::f64::consts::PI * (n_h * n_h * (a2 - 1.0) + 1.0).powi(2));
+        let vis =
+            0.5 / (n_l * (n_v * n_v * (1.0 - a2) + a2).sqrt() + n_v * (n_l * n_l * (1.0 - a2) + a2).sqrt());
+        let f = 0.04 + 0.96 * (1.0 - v.dot(h)).powi(5);
+        c.map(|k| irradiance as f64 * (1.0 - f) * k * d * vis * n_l)
+    };
+    let check = |name: &str, rgb: &[f32], tolerance: f64| {
+        eprintln!("{name}:");
+        let n = compare_plane(rgb, &cam, 9.5, |_, _| true, expected, tolerance);
+        assert!(n > (W * H / 3) as usize, "{name}: only {n} pixels compared");
+    };
+    for mode in [GBuffer::Raster, GBuffer::Visibility] {
+        let (rgb, _) =
+            render(dir.path(), &format!("sheet-{mode:?}"), &bytes, |f| Options::new(f, W, H).gbuffer(mode));
+        check(&format!("{mode:?}, shadow maps"), &rgb, TOLERANCE);
+    }
+    let (rgb, _) = render(dir.path(), "sheet-rt", &bytes, |f| {
+        Options::new(f, W, H).gbuffer(GBuffer::Visibility).rt_shadows(0.0, 0.0)
+    });
+    check("visibility, ray-traced shadows", &rgb, TOLERANCE);
+    let file = dir.path().join("sheet.kiln");
+    std::fs::write(&file, &bytes).unwrap();
+    let o = Options::new(&file, W, H).reference().build();
+    let (_, rgb) =
+        kiln_player::reference::render(&o, 4, std::time::Instant::now()).expect("reference render");
+    // The path tracer's samples spread over each pixel, where the closed form is taken at its
+    // centre.
+    check("reference", &rgb, 0.02);
 }
