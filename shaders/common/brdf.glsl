@@ -128,24 +128,30 @@ vec3 brdf(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
     return m.clearcoat > 0.0 ? coat_over(m, base, n_v, n_h, n_l) : base;
 }
 
-// f(l, v) for light arriving from behind a thin-walled transmitting surface (n·l < 0;
-// KHR_materials_transmission, as the path tracer's `base_brdf_cos`): the specular lobe about l
-// mirrored through the surface, tinted by the base colour, its light the dielectric diffuse
-// part's share t: (1 − F)(1 − metallic) t base D Vis; under a clear coat, times the 1 − w the coat
-// lets through. Zero for materials that do not transmit.
+// The thin-walled transmitted lobe's f (KHR_materials_transmission; FORMAT.md, "Transmission")
+// towards v for light whose direction, mirrored through the surface, is `mirrored` (n·mirrored =
+// n_l, n·v = n_v, both > 0): the specular lobe about it, tinted by the base colour, its light the
+// dielectric diffuse part's share t: (1 − F)(1 − metallic) t base D Vis, F at the half vector.
+// The one formula of the frame (`transmitted_brdf`) and the path tracer (`base_brdf_cos`).
+vec3 transmitted_lobe(Material m, vec3 n, vec3 v, vec3 mirrored, float n_l, float n_v) {
+    vec3 h = normalize(v + mirrored);
+    float alpha = ggx_alpha(m.roughness);
+    float a2 = alpha * alpha;
+    vec3 f = fresnel_schlick(fresnel_f0(m), fresnel_f90(m), max(dot(v, h), 0.0));
+    return (vec3(1.0) - f) * (1.0 - m.metallic) * m.transmission * m.base
+        * (ggx_d(max(dot(n, h), 0.0), a2) * smith_visibility(n_l, n_v, a2));
+}
+
+// f(l, v) for light arriving from behind a thin-walled transmitting surface (n·l < 0): the
+// transmitted lobe about l mirrored through the surface; under a clear coat, times the 1 − w the
+// coat lets through. Zero for materials that do not transmit.
 vec3 transmitted_brdf(Material m, vec3 n, vec3 v, vec3 l) {
     if (m.transmission <= 0.0 || m.diffuse_only) {
         return vec3(0.0);
     }
     vec3 mirrored = l - 2.0 * dot(n, l) * n;
-    float n_l = max(dot(n, mirrored), 1e-4);
     float n_v = max(dot(n, v), 1e-4);
-    vec3 h = normalize(v + mirrored);
-    float alpha = ggx_alpha(m.roughness);
-    float a2 = alpha * alpha;
-    vec3 f = fresnel_schlick(fresnel_f0(m), fresnel_f90(m), max(dot(v, h), 0.0));
-    vec3 through = (vec3(1.0) - f) * (1.0 - m.metallic) * m.transmission * m.base
-        * (ggx_d(max(dot(n, h), 0.0), a2) * smith_visibility(n_l, n_v, a2));
+    vec3 through = transmitted_lobe(m, n, v, mirrored, max(dot(n, mirrored), 1e-4), n_v);
     return m.clearcoat > 0.0 ? through * (1.0 - coat_weight(m.clearcoat, n_v)) : through;
 }
 

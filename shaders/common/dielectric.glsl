@@ -38,8 +38,9 @@ vec2 gbuffer_dielectric(GpuMaterialLayout m, float transmission) {
     float f90;
     material_dielectric(m, f0, f90);
     bool diffuse_only = (m.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
-    float t = round(clamp(transmission, 0.0, 1.0) * 127.0);
-    float code = diffuse_only ? 255.0 : t > 0.0 ? 127.0 + t : round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0);
+    float t = round(clamp(transmission, 0.0, 1.0) * GBUFFER_TRANSMISSION_STEPS);
+    float code = diffuse_only ? 255.0
+        : t > 0.0 ? GBUFFER_TRANSMISSION_STEPS + t : round(sqrt(clamp(luminance(f0), 0.0, 1.0)) * 125.0);
     return vec2(code / 255.0, f90);
 }
 

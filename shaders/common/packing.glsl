@@ -43,13 +43,16 @@ vec3 demodulator(vec3 base) {
 // The G-buffer material target's blue channel (8 bits, common/dielectric.glsl): 255 a
 // diffuse-only material, 128..254 a thin-walled transmission of (k − 127) / 127 (its F0 glTF's
 // core 0.04), 0..125 the coded grey F0 of an opaque one.
+#define GBUFFER_TRANSMISSION_STEPS 127.0
+
 bool gbuffer_diffuse_only(vec4 mat) {
     return mat.b * 255.0 > 254.5;
 }
 
 float gbuffer_transmission(vec4 mat) {
     float k = round(mat.b * 255.0);
-    return k >= 128.0 && k <= 254.0 ? (k - 127.0) / 127.0 : 0.0;
+    float t = k - GBUFFER_TRANSMISSION_STEPS;
+    return t >= 1.0 && t <= GBUFFER_TRANSMISSION_STEPS ? t / GBUFFER_TRANSMISSION_STEPS : 0.0;
 }
 
 #endif

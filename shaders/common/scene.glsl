@@ -234,15 +234,15 @@ vec3 base_brdf_cos(Surface s, vec3 wo, vec3 wi) {
     if (s.mat.diffuse_only) {
         return lambert(s.mat.base) * n_l;
     }
+    if (through) {
+        return transmitted_lobe(s.mat, s.ns, wo, wi, n_l, n_v) * n_l;
+    }
     vec3 h = normalize(wo + wi);
     float a = ggx_alpha(s.mat.roughness);
     float a2 = a * a;
     float d = ggx_d(max(dot(s.ns, h), 0.0), a2);
     float vis = smith_visibility(n_l, n_v, a2);
     vec3 f = fresnel_schlick(fresnel_f0(s.mat), fresnel_f90(s.mat), max(dot(wo, h), 0.0));
-    if (through) {
-        return (1.0 - f) * (1.0 - s.mat.metallic) * s.mat.transmission * s.mat.base * (d * vis * n_l);
-    }
     // Lambert's base / π, divided after the weights (not lambert(base) times them): the order the
     // reference images were made with; it rounds differently.
     return ((1.0 - f) * (1.0 - s.mat.metallic) * (1.0 - s.mat.transmission) * s.mat.base / PI + f * d * vis) * n_l;

@@ -58,7 +58,7 @@ float visibility(Primary s, GpuLight l, bool through) {
     if (side == 0.0 || (side < 0.0 && !through) || dist <= 0.0) {
         return 0.0;
     }
-    vec3 ng = side < 0.0 ? -s.ng : s.ng;
+    vec3 ng = facing(s.ng, wi);
     if (l.kind == LIGHT_DIRECTIONAL) {
         return shadow_occluded_dir(s.p, ng, wi) ? 0.0 : 1.0;
     }
