@@ -219,9 +219,10 @@ fn a_setting_change_misses_exactly_the_stages_that_read_it() {
     let side = sidecar(d, "a.toml", [0.2, 1.2, 0.1]);
     let side = side.to_str().unwrap();
     demo(d, "base.kiln", Some("c"), &["-c", side]);
-    let cases: [(&[&str], &[&str]); 5] = [
+    let cases: [(&[&str], &[&str]); 6] = [
         (&["--shadow-res", "128"], &["shadow-maps"]),
         (&["--probe-rays", "64"], &["probes"]),
+        (&["--probe-regularize", "0.25"], &["probes"]),
         (&["--brdf-lut-res", "32"], &["brdf-lut", "probes"]),
         (&["--shaft-res", "3"], &["voxel-grid", "line-space"]),
         // Everything stored in BVH order, and everything that traces rays through it.

@@ -594,6 +594,9 @@ fn export_writes_readable_images() {
     run::kiln(dir.path(), &["demo", "-o", "p.kiln", "--probe-spacing", "0.02", "--probe-rays", "512"])
         .expect(2)
         .says("lower --probe-rays or raise --probe-spacing");
+    run::kiln(dir.path(), &["demo", "-o", "p.kiln", "--probe-regularize", "1.5"])
+        .expect(2)
+        .says("not a roughness from 0 to 1");
     run::kiln(dir.path(), &["demo", "-o", "p.kiln", "--probe-spacing", "0.001"])
         .expect(2)
         .says("raise it to at least");

@@ -135,6 +135,7 @@ fn probe_plan(
         budget,
         layers,
         settings.probe_rays,
+        settings.probe_regularize.0,
     )?;
     // Paths a bake may trace: 2^28 (minutes on 16 cores; a hostile sidecar asks for more).
     const MAX_PATHS: u64 = 1 << 28;
@@ -155,7 +156,7 @@ fn probe_plan(
         ),
     };
     let reason = format!(
-        "{x}x{y}x{z} probes every {} scene units{why_spacing}, {}, {} paths each{}; read by kiln-play {}",
+        "{x}x{y}x{z} probes every {} scene units{why_spacing}, {}, {} paths each{}{}; read by kiln-play {}",
         short(layout.spacing as f64),
         if layout.bytes() < 1 << 20 {
             format!("{:.1} KiB", layout.bytes() as f64 / 1024.0)
@@ -163,6 +164,11 @@ fn probe_plan(
             mib(layout.bytes())
         },
         layout.rays,
+        if layout.min_roughness > 0.0 {
+            format!(" (surfaces met at least {} rough: --probe-regularize)", layout.min_roughness)
+        } else {
+            String::new()
+        },
         if emits { ", emissive surfaces' direct light in a layer of its own" } else { "" },
         readers::list(readers::PROBES)
     );

@@ -337,15 +337,16 @@ pub fn stage_key(ctx: &BakeContext, stage: Stage) -> ContentHash {
         }
         Stage::Probes => {
             // Paths through the stored geometry, shaded by the materials, textures, lights and
-            // sky; the layout (spacing, dims, rays) as the plan resolved it.
+            // sky; the layout (spacing, dims, rays, regularisation) as the plan resolved it.
             let l = ctx.plan.probes.map(|l| {
                 format!(
-                    "{:?} {} {:?} {} {}",
+                    "{:?} {} {:?} {} {} {}",
                     l.origin.to_array(),
                     l.spacing.to_bits(),
                     l.dims,
                     l.layers,
-                    l.rays
+                    l.rays,
+                    l.min_roughness.to_bits()
                 )
             });
             let lut = if ctx.plan.runs(Stage::BrdfLut) { s.brdf_lut_res } else { 0 };

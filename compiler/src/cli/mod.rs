@@ -273,6 +273,13 @@ bounce, whenever something lights the scene) or off [default: auto, or the sidec
     #[arg(long, value_name = "MiB", value_parser = crate::settings::PROBE_BUDGET.parser(), help_heading = "Lighting bakes",
           help = crate::settings::PROBE_BUDGET.help("Size budget of the probe volume in MiB when --probe-spacing is not given"))]
     pub probe_budget: Option<u32>,
+    /// Least roughness of the surfaces the probe paths meet.
+    #[arg(long, value_name = "R", value_parser = crate::settings::ProbeRegularize::parse, help_heading = "Lighting bakes",
+          help = format!("Path regularisation of the probe bake: the surfaces its paths meet are treated as at least \
+this rough (perceptual roughness, 0 to 1; 0: as the asset says). Probes store irradiance, where a glossy \
+highlight counts for its energy, not its sharpness: widening it keeps the energy and removes the fireflies \
+of highlights one path in thousands catches [default: {}]", crate::settings::ProbeRegularize::DEFAULT.0))]
+    pub probe_regularize: Option<crate::settings::ProbeRegularize>,
     /// Width of the environment's radiance map.
     #[arg(long, value_name = "N", value_parser = crate::settings::ENVIRONMENT_RES.parser(), help_heading = "Environment",
           help = crate::settings::ENVIRONMENT_RES.help("Width of the environment's radiance map in texels (height half of it; a narrower image keeps its width). Its GGX-prefiltered levels (256 wide at most), irradiance harmonics and sampling table (512 wide at most) are baked from it"))]
@@ -355,6 +362,7 @@ impl BakeArgs {
         set(&mut settings.probe_spacing, self.probe_spacing.map(Some));
         set(&mut settings.probe_rays, self.probe_rays);
         set(&mut settings.probe_budget, self.probe_budget);
+        set(&mut settings.probe_regularize, self.probe_regularize);
         set(&mut settings.environment_res, self.environment_res);
         set(&mut settings.normals, self.normals);
         set(&mut settings.codec, self.codec);

@@ -284,6 +284,8 @@ pub struct BakeToml {
     pub probe_rays: Option<u32>,
     /// Budget of the probe volume, MiB.
     pub probe_budget: Option<u32>,
+    /// Least roughness of the surfaces the probe paths meet, 0 to 1.
+    pub probe_regularize: Option<f64>,
     /// Widest environment radiance map, texels.
     pub environment_res: Option<u32>,
     /// Normals where the asset gives none: `"flat"`, `"smooth"` or `"smooth:ANGLE"`.

@@ -65,6 +65,8 @@ pub struct ProbeLayout {
     pub layers: u32,
     /// Rays per probe.
     pub rays: u32,
+    /// The least perceptual roughness of the surfaces the paths meet (`--probe-regularize`).
+    pub min_roughness: f32,
 }
 
 impl ProbeLayout {
@@ -111,6 +113,7 @@ pub fn layout(
     budget: u64,
     layers: u32,
     rays: u32,
+    min_roughness: f32,
 ) -> Result<ProbeLayout, String> {
     let (lo, hi) = (Vec3::from(bounds.min), Vec3::from(bounds.max));
     let extent = (hi - lo).max(Vec3::ZERO);
@@ -151,7 +154,7 @@ pub fn layout(
     let dims = dims_for(spacing).map(|d| d as u32);
     let span = Vec3::new(dims[0] as f32 - 1.0, dims[1] as f32 - 1.0, dims[2] as f32 - 1.0) * spacing;
     let origin = (lo + hi) * 0.5 - span * 0.5;
-    Ok(ProbeLayout { origin, spacing, dims, layers, rays })
+    Ok(ProbeLayout { origin, spacing, dims, layers, rays, min_roughness })
 }
 
 /// One probe's bake: its state and interior texels.
@@ -386,6 +389,7 @@ pub fn stage(ctx: &BakeContext) -> Sections {
             None => trace::Sky::Constant(Vec3::from(ctx.scene.sky.radiance)),
         },
         luminance.as_deref(),
+        layout.min_roughness,
     );
     ctx.progress.count("probes", layout.count());
     let header = layout.header(0);

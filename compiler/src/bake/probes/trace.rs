@@ -153,6 +153,8 @@ pub struct Tracer<'a> {
     pub sky: Sky<'a>,
     tris: IndexedTriangles<'a>,
     emitters: Emitters,
+    /// The least perceptual roughness of the surfaces the paths meet (path regularisation).
+    min_roughness: f32,
 }
 
 impl std::fmt::Debug for Tracer<'_> {
@@ -172,6 +174,7 @@ impl<'a> Tracer<'a> {
         triangle_materials: &'a [u32],
         sky: Sky<'a>,
         luminance: Option<&[f32]>,
+        min_roughness: f32,
     ) -> Tracer<'a> {
         let tris = IndexedTriangles { vertices: shading.vertices, triangles: shading.triangles };
         let mut emitters = Emitters { pdf: vec![0.0; shading.triangles.len()], ..Default::default() };
@@ -198,7 +201,7 @@ impl<'a> Tracer<'a> {
         if let Some(last) = emitters.cdf.last_mut() {
             *last = 1.0;
         }
-        Tracer { shading, uvs, triangle_materials, sky, tris, emitters }
+        Tracer { shading, uvs, triangle_materials, sky, tris, emitters, min_roughness }
     }
 
     /// Whether the scene has emissive triangles.
@@ -330,7 +333,8 @@ impl<'a> Tracer<'a> {
         let mut throughput = Vec3::ONE;
         let mut out = Vec3::ZERO;
         for bounce in 1..=MAX_BOUNCES {
-            let s = self.shading.surface(h.material, h.uv);
+            let mut s = self.shading.surface(h.material, h.uv);
+            s.roughness = s.roughness.max(self.min_roughness);
             // Shade the side the ray came from.
             let (mut n, ng) = if h.ng.dot(v) < 0.0 { (-h.n, -h.ng) } else { (h.n, h.ng) };
             if n.dot(v) <= 0.0 {
