@@ -327,6 +327,21 @@ fn an_emissive_floor_fills_the_octahedral_maps_by_their_formula() {
     }
 }
 
+/// A directional light of irradiance `e` shining straight down.
+fn overhead_sun(e: f32) -> kiln_format::manifest::Light {
+    kiln_format::manifest::Light {
+        name: "sun".into(),
+        kind: kiln_format::manifest::LightKind::Directional,
+        position: [0.0; 3],
+        direction: [0.0, -1.0, 0.0],
+        right: [1.0, 0.0, 0.0],
+        color: [1.0; 3],
+        intensity: e,
+        range: 0.0,
+        casts_shadows: true,
+    }
+}
+
 /// A white-ish floor under a directional light shining straight down (irradiance E, no sky): the
 /// floor's radiance is ρE/π everywhere, so a probe above it holds (ρE/π)(1 − t·ŷ)/2 along t in
 /// the layer of reflected light (one bounce: the floor sees nothing of itself), and nothing
@@ -337,17 +352,7 @@ fn a_floor_under_the_sun_reflects_into_the_probes_by_the_closed_form() {
     let mut s = Scene { name: "sunlit".into(), ..Default::default() };
     s.materials.push(material(rho, [0.0; 3]));
     floor_and_speck(&mut s, 0, 0);
-    s.lights.push(kiln_format::manifest::Light {
-        name: "sun".into(),
-        kind: kiln_format::manifest::LightKind::Directional,
-        position: [0.0; 3],
-        direction: [0.0, -1.0, 0.0],
-        right: [1.0, 0.0, 0.0],
-        color: [1.0; 3],
-        intensity: e,
-        range: 0.0,
-        casts_shadows: true,
-    });
+    s.lights.push(overhead_sun(e));
     let v = Volume::read(&compile(s, settings(1024, Some(8.0))));
     assert_eq!(v.layers, 1, "nothing emits");
     let c = [12, 0, 12];
@@ -376,17 +381,7 @@ fn a_polished_floor_reflects_its_light_into_the_probes_for_its_energy() {
     metal.gpu.flags &= !kiln_format::sections::MaterialFlags::DIFFUSE_ONLY;
     s.materials.push(metal);
     floor_and_speck(&mut s, 0, 0);
-    s.lights.push(kiln_format::manifest::Light {
-        name: "sun".into(),
-        kind: kiln_format::manifest::LightKind::Directional,
-        position: [0.0; 3],
-        direction: [0.0, -1.0, 0.0],
-        right: [1.0, 0.0, 0.0],
-        color: [1.0; 3],
-        intensity: e,
-        range: 0.0,
-        casts_shadows: true,
-    });
+    s.lights.push(overhead_sun(e));
     let v = Volume::read(&compile(s, settings(1024, Some(8.0))));
     let c = [12, 0, 12];
     let mut checked = 0;
