@@ -52,7 +52,7 @@ const FXAA: Choice = pick(Effect::Aa, "fxaa");
 const PROBES: Choice = pick(Effect::Gi, "probes");
 
 /// The presets, cheapest first.
-pub const PRESETS: [Preset; 11] = [
+pub const PRESETS: [Preset; 12] = [
     Preset {
         name: "baked",
         help: "no rays: shadow maps, screen-space GI and reflections",
@@ -63,6 +63,12 @@ pub const PRESETS: [Preset; 11] = [
         help: "no rays: shadow maps, the compiler's irradiance probes for indirect light, screen-space \
                reflections, FXAA (needs a file compiled with probes)",
         choices: &[SHADOW_MAPS, PROBES, SCREEN_REFLECTIONS, FXAA],
+    },
+    Preset {
+        name: "probes-rt",
+        help: "as probes with ray-traced soft shadows (--shadows rt): the probes' indirect light, exact \
+               direct shadows (needs a file compiled with probes)",
+        choices: &[RT_SHADOWS, PROBES, SCREEN_REFLECTIONS, FXAA],
     },
     Preset {
         name: "baked-taa",
