@@ -404,6 +404,45 @@ fn a_polished_floor_reflects_its_light_into_the_probes_for_its_energy() {
     assert!(checked >= 6, "{checked} texels within 32° of the nadir");
 }
 
+/// The default frame takes the emissive surfaces' direct light from the probes where no probe
+/// gets 1 % of its light straight from them, and computes it per pixel otherwise. A floor of
+/// albedo ρ = 0.5 under a vertical sun (E = 3) and a 0.5 × 0.5 quad facing down 1 above the
+/// centre probe (0, 1, 0), emitting Le: from that probe the floor fills the lower hemisphere at
+/// radiance ρE/π (∫L dω = 2ρE = 3, less its shadow), the quad Ω = 4 atan(ab / (d √(a² + b² + d²)))
+/// = 0.2356 sr at Le (∫L dω = 0.2356 Le); each layer's texels sum to about 16/π of its ∫L dω,
+/// so the share is about 0.2356 Le / (3 + 0.2356 Le): 0.08 % for Le = 0.01 (the probes), 44 %
+/// for Le = 10 (per pixel). Farther probes see less of the quad. Planted and seen failing: the
+/// share read from the first layer (the dim quad kept its per-pixel pass).
+#[test]
+fn the_default_frame_lights_dim_emitters_from_the_probes() {
+    let direct_for = |le: f32| {
+        let mut s = Scene { name: "lamp".into(), ..Default::default() };
+        s.materials.push(material(0.5, [0.0; 3]));
+        s.materials.push(material(0.5, [le; 3]));
+        floor_and_speck(&mut s, 0, 0);
+        let (a, y) = (0.25, 2.0);
+        // Wound to face down (−y).
+        quad(&mut s, [Vec3::new(-a, y, -a), Vec3::new(a, y, -a), Vec3::new(a, y, a), Vec3::new(-a, y, a)], 1);
+        s.lights.push(overhead_sun(3.0));
+        let bytes = compile(s, settings(64, Some(8.0)));
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("lamp.kiln");
+        std::fs::write(&path, bytes).unwrap();
+        let kiln_player::cli::Invocation::Play(args) =
+            kiln_player::cli::parse_from(["kiln-play", path.to_str().unwrap()]).unwrap()
+        else {
+            panic!("a play command")
+        };
+        let t = args.techniques(&path).unwrap();
+        assert_eq!(t.name_of(kiln_player::render::Effect::Gi), "probes", "the file's default frame");
+        t.name_of(kiln_player::render::Effect::Direct)
+    };
+    let share = |le: f32| 0.2356 * le / (3.0 + 0.2356 * le);
+    assert!(share(0.01) < 0.01 && share(10.0) > 0.01);
+    assert_eq!(direct_for(0.01), "none", "share about {}", share(0.01));
+    assert_eq!(direct_for(10.0), "restir", "share about {}", share(10.0));
+}
+
 /// Two slabs through the middle of the grid: in the thin one, probes whose grid point lies
 /// within reach of a face move out of it; in the thick one they are too deep and are switched
 /// off. No probe that is on lies inside a slab.

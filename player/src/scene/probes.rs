@@ -71,3 +71,56 @@ impl ProbeImages {
         }
     }
 }
+
+/// How much of the light the probes saw came straight from emissive surfaces: per probe that is
+/// on, the luminance of its second irradiance layer (the emitters seen directly) over both
+/// layers', summed over its interior texels; the given `quantile` of those shares (0: the least,
+/// 1: the most). `None` for a volume of one layer (nothing emits) or no probe with light.
+pub fn emitted_share(volume: &ProbeVolume, quantile: f32) -> Option<f32> {
+    let h = &volume.header;
+    if h.layers < 2 {
+        return None;
+    }
+    let n = h.irradiance_texels;
+    let tile = n + 2;
+    let [width, height, _] = h.irradiance_extent();
+    let luminance = |t: u32| {
+        let [r, g, b] = kiln_format::probes::decode_rgb9e5(t);
+        kiln_format::gpu::luminance([r, g, b]) as f64
+    };
+    let mut shares: Vec<f32> = Vec::new();
+    for z in 0..h.dims[2] {
+        for y in 0..h.dims[1] {
+            for x in 0..h.dims[0] {
+                if volume.states[h.index(x, y, z)].active != 1.0 {
+                    continue;
+                }
+                let mut sums = [0.0f64; 2];
+                for (layer, sum) in sums.iter_mut().enumerate() {
+                    let slice = (layer as u32 * h.dims[2] + z) as usize * (width * height) as usize;
+                    for j in 0..n {
+                        let row = slice + ((y * tile + 1 + j) * width) as usize;
+                        for i in 0..n {
+                            let t = volume
+                                .irradiance
+                                .get(row + (x * tile + 1 + i) as usize)
+                                .copied()
+                                .unwrap_or(0);
+                            *sum += luminance(t);
+                        }
+                    }
+                }
+                let total = sums[0] + sums[1];
+                if total > 0.0 && total.is_finite() {
+                    shares.push((sums[1] / total) as f32);
+                }
+            }
+        }
+    }
+    if shares.is_empty() {
+        return None;
+    }
+    shares.sort_by(f32::total_cmp);
+    let k = ((shares.len() - 1) as f32 * quantile.clamp(0.0, 1.0)).round() as usize;
+    Some(shares[k])
+}

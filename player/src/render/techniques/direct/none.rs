@@ -8,7 +8,9 @@ plain_technique! {
     Off,
     "none",
     "emissive surfaces light nothing directly (the camera still sees them; --gi rt finds them with its \
-     bounce rays)"
+     bounce rays; --gi probes adds the light the compiler baked from them). The default frame of a file \
+     with probes takes this where no probe gets 1 % of its light straight from emissive surfaces \
+     (dim decals and indicator lights: Khronos ToyCar's 88,837 emissive triangles), and says so"
 }
 
 impl Technique for Off {}
