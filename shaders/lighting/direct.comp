@@ -291,6 +291,12 @@ void main() {
     // and the gathered light adds to it.
     bool gi = DIRECT_GI && (frame.size.w & FRAME_RT_GI) != 0u;
     vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : env_irradiance(n, frame.sky.rgb) * occlusion;
+    if (gi && DIRECT_PROBE_SPECULAR && (frame.size.w & FRAME_PROBE_SPECULAR) != 0u) {
+        // The probes' confidence (their alpha): below 1 past the volume's outermost probes on a
+        // side the surface faces out of, where the sky stands in for the missing probes.
+        vec4 probe = imageLoad(rt_gi, pixel);
+        diffuse_in = mix(env_irradiance(n, frame.sky.rgb) * occlusion, probe.rgb, clamp(probe.a, 0.0, 1.0));
+    }
     if (DIRECT_GI && (frame.size.w & FRAME_SCREEN_GI) != 0u) {
         diffuse_in += imageLoad(rt_gi, pixel).rgb;
     }
@@ -328,7 +334,8 @@ void main() {
             float spread = luminance(env_irradiance(mirror, frame.sky.rgb));
             float sharp = luminance(filtered);
             float ratio = spread > 0.0 ? clamp(sharp / spread, 0.0, 8.0) : 1.0;
-            sky_in = imageLoad(probe_specular, pixel).rgb * ratio;
+            vec4 probe = imageLoad(probe_specular, pixel);
+            sky_in = mix(sky_in, probe.rgb * ratio, clamp(probe.a, 0.0, 1.0));
         }
         if (DIRECT_SCREEN_REFLECTIONS && (frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {
             // The split sum's prefiltered incoming radiance: what the screen showed along the

@@ -19,6 +19,8 @@
 // direct pass's split sum takes for its incoming radiance in place of the sky's
 // (FRAME_PROBE_SPECULAR): a cosine lobe stands in for the glossy lobe, as DDGI's glossy
 // fallback does, so that metal indoors reflects the lit room and not the sky outside it.
+// Alpha of both: the probes' confidence, below 1 past the volume's outermost probes on a side
+// the surface faces out of, where the direct pass blends towards the unoccluded sky.
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 
@@ -118,6 +120,20 @@ void main() {
         total += weight;
     }
     float inverse = total > 0.0 ? 1.0 / total : 0.0;
-    imageStore(gi_out, pixel, vec4(sum * inverse, 1.0));
-    imageStore(specular_out, pixel, vec4(sum_mirror * inverse, 1.0));
+    // Beyond the outermost probes on a side where the surface faces out of the volume (a car's
+    // roof at the top of its bounds, a helmet's crown), no probe lies on the side the surface
+    // sees, only ones behind or under it (inside the car): the volume ends there, and what lies
+    // beyond it is the sky. The direct pass blends towards its unoccluded sky light by how far
+    // past the last layer the lookup point lies (half a spacing: all sky; the outermost layer
+    // lies a quarter to three quarters of a spacing inside the bounds, and the lookup point moves
+    // 0.1 along the normal and 0.2 towards the eye) times how squarely the surface faces out. A surface facing back into the volume (a room's wall at its bounds)
+    // keeps the probes.
+    vec3 last = vec3(max(dims - 1, ivec3(0)));
+    vec3 beyond_hi = max(g - last, vec3(0.0));
+    vec3 beyond_lo = max(-g, vec3(0.0));
+    vec3 out_hi = clamp(2.0 * beyond_hi, 0.0, 1.0) * max(n, vec3(0.0));
+    vec3 out_lo = clamp(2.0 * beyond_lo, 0.0, 1.0) * max(-n, vec3(0.0));
+    float sky = clamp(max(max(max(out_hi.x, out_hi.y), out_hi.z), max(max(out_lo.x, out_lo.y), out_lo.z)), 0.0, 1.0);
+    imageStore(gi_out, pixel, vec4(sum * inverse, 1.0 - sky));
+    imageStore(specular_out, pixel, vec4(sum_mirror * inverse, 1.0 - sky));
 }

@@ -149,3 +149,43 @@ fn probes_light_glossy_metal_by_what_it_mirrors() {
     eprintln!("metal floor {floor:.4} against Le {LE}");
     assert!((floor - f64::from(LE)).abs() <= 0.03 * f64::from(LE), "the metal floor {floor} against Le {LE}");
 }
+
+/// A table under an open sky: a 2 × 2 top at y = 1 facing up over a 4 × 4 floor, under a uniform
+/// sky of radiance `SKY`, nothing else. The top is the highest thing in the scene, so every probe
+/// lies below it (the volume's outermost layer is 0.1 under it, the probes between top and floor
+/// see its dark underside); its upward face sees the whole sky, which sends it the irradiance
+/// π·SKY: a diffuse top of albedo ρ shows ρ·SKY. Before the probes stepped aside past their
+/// volume's last layer on a side the surface faces out of, the top read the probes under it
+/// (Khronos ToyCar's roof: a dark patch over its decal). Planted and seen failing: the probes
+/// kept at full weight there (the top black: 0.0000 against 0.4023).
+#[test]
+fn a_surface_facing_out_of_the_probe_volume_sees_the_sky() {
+    const SKY: f32 = 0.8;
+    let dir = gpu_test!();
+    let rho = srgb8(188);
+    let mut s = Scene { name: "table".into(), ..Default::default() };
+    s.materials.push(Material { name: "grey".into(), gpu: lambert_material([rho; 3]) });
+    let (r, y) = (2.0, 1.0);
+    quad(
+        &mut s,
+        [Vec3::new(-r, 0.0, r), Vec3::new(r, 0.0, r), Vec3::new(r, 0.0, -r), Vec3::new(-r, 0.0, -r)],
+        0,
+    );
+    let t = 1.0;
+    quad(&mut s, [Vec3::new(-t, y, t), Vec3::new(t, y, t), Vec3::new(t, y, -t), Vec3::new(-t, y, -t)], 0);
+    s.sky = kiln_format::manifest::Sky { radiance: [SKY; 3] };
+    let settings = Settings {
+        probes: kiln_compiler::settings::Probes::Auto,
+        probe_spacing: Some(ProbeSpacing(0.2)),
+        probe_rays: 64,
+        ..fast_settings()
+    };
+    let bytes = compile(s, settings);
+    // Straight down onto the middle of the top, seeing only the top.
+    let camera =
+        CameraOverride { position: [0.0, 3.0, 0.0], target: [0.0, 0.0, 0.001], vfov_degrees: Some(10.0) };
+    let (top, _) = render(dir.path(), "table", &bytes, |f| probes(f, camera));
+    let (got, want) = (mean(&top), (rho * SKY) as f64);
+    eprintln!("the table's top {got:.4}, closed form {want:.4}");
+    assert!((got - want).abs() <= 0.02 * want, "the table's top {got} against rho * sky {want}");
+}
