@@ -5,6 +5,9 @@
 //! (`--direct restir`, dropped where nothing emits). A preset names only what it changes from
 //! the defaults; flags given beside `--preset` override it.
 
+use kiln_format::KilnFile;
+use kiln_format::probes::{PROBE_KINDS, ProbeHeader, ProbeVolume};
+
 use super::techniques::{Effect, KnobValue, Techniques};
 
 /// One effect's technique in a preset, with the knobs it sets.
@@ -119,17 +122,37 @@ pub const PRESETS: [Preset; 12] = [
     },
 ];
 
-/// The preset the default frame of the file at `path` uses when the command line chooses no
-/// preset or budget: `probes` where the file has irradiance probes and `gi` (the `--gi` given)
+/// The preset the default frame of a file uses when the command line chooses no preset or
+/// budget: `probes` where the file has irradiance probes (`probes`) and `gi` (the `--gi` given)
 /// is none, the best measured point of the frame charts below 2 ms (docs/benchmarks/probes/).
-/// An unreadable file answers none: the session reports it.
-pub fn default_for(path: &std::path::Path, gi: Option<&str>) -> Option<&'static Preset> {
-    (has_probes(path) && gi.is_none()).then(|| Preset::named("probes").ok()).flatten()
+pub fn default_for(probes: bool, gi: Option<&str>) -> Option<&'static Preset> {
+    (probes && gi.is_none()).then(|| Preset::named("probes").ok()).flatten()
 }
 
-/// Whether the file at `path` holds irradiance probes (an unreadable one does not).
-pub fn has_probes(path: &std::path::Path) -> bool {
-    crate::session::open_file(path).is_ok_and(|f| f.find(kiln_format::sections::PROBE_GRID, 0).is_some())
+/// Whether `file` holds irradiance probes.
+pub fn has_probes(file: &KilnFile) -> bool {
+    file.find(kiln_format::sections::PROBE_GRID, 0).is_some()
+}
+
+/// The largest share of the light a probe sees straight from emissive surfaces below which the
+/// default frame takes their direct light from the probes' emitted layer instead of a per-pixel
+/// pass. Khronos ToyCar's 88,837 emissive triangles (its decals) reach 0.6 % at most (median
+/// 0.001 %): the per-pixel pass cost 1.6 of the frame's 3.9 ms on an H200 at 1600 × 900 and
+/// changed its FLIP by nothing (0.1587 either way); the McGuire box (lit by its lamp) has 48 %
+/// at the median, LightsPunctualLamp 18 % at the probe beside its bulb.
+pub const DIM_EMITTERS: f32 = 0.01;
+
+/// The probes' largest emitted share ([`crate::scene::probes::emitted_share`]) when `file` has
+/// probes and it is below [`DIM_EMITTERS`]; `None` otherwise (no probes, nothing emits, a
+/// damaged volume: the session says).
+pub fn dim_emitters(file: &KilnFile) -> Option<f32> {
+    // The header first: a volume of one layer (nothing emits) needs none of its sections decoded.
+    let header = file.group_header::<ProbeHeader>(&PROBE_KINDS, "probe volume").ok()??;
+    if header.layers < 2 {
+        return None;
+    }
+    let volume = ProbeVolume::read(file).ok()??;
+    crate::scene::probes::emitted_share(&volume).filter(|&s| s < DIM_EMITTERS)
 }
 
 impl Preset {
@@ -190,10 +213,12 @@ mod tests {
             path
         };
         let (with, without) = (write("with.kiln", true), write("without.kiln", false));
-        let chosen = default_for(&with, None).expect("the probe preset");
+        // As the command line asks: an unreadable file has no probes (the session reports it).
+        let probes = |path: &std::path::Path| crate::session::open_file(path).is_ok_and(|f| has_probes(&f));
+        let chosen = default_for(probes(&with), None).expect("the probe preset");
         assert_eq!(chosen.choice(Effect::Gi).map(|c| c.technique), Some("probes"));
-        assert!(default_for(&with, Some("rt")).is_none());
-        assert!(default_for(&without, None).is_none());
-        assert!(default_for(&dir.path().join("missing.kiln"), None).is_none());
+        assert!(default_for(probes(&with), Some("rt")).is_none());
+        assert!(default_for(probes(&without), None).is_none());
+        assert!(default_for(probes(&dir.path().join("missing.kiln")), None).is_none());
     }
 }

@@ -74,9 +74,9 @@ impl ProbeImages {
 
 /// How much of the light the probes saw came straight from emissive surfaces: per probe that is
 /// on, the luminance of its second irradiance layer (the emitters seen directly) over both
-/// layers', summed over its interior texels; the given `quantile` of those shares (0: the least,
-/// 1: the most). `None` for a volume of one layer (nothing emits) or no probe with light.
-pub fn emitted_share(volume: &ProbeVolume, quantile: f32) -> Option<f32> {
+/// layers', summed over its interior texels; the largest of those shares. `None` for a volume of
+/// one layer (nothing emits) or no probe with light.
+pub fn emitted_share(volume: &ProbeVolume) -> Option<f32> {
     let h = &volume.header;
     if h.layers < 2 {
         return None;
@@ -88,7 +88,7 @@ pub fn emitted_share(volume: &ProbeVolume, quantile: f32) -> Option<f32> {
         let [r, g, b] = kiln_format::probes::decode_rgb9e5(t);
         kiln_format::gpu::luminance([r, g, b]) as f64
     };
-    let mut shares: Vec<f32> = Vec::new();
+    let mut largest: Option<f32> = None;
     for z in 0..h.dims[2] {
         for y in 0..h.dims[1] {
             for x in 0..h.dims[0] {
@@ -112,15 +112,11 @@ pub fn emitted_share(volume: &ProbeVolume, quantile: f32) -> Option<f32> {
                 }
                 let total = sums[0] + sums[1];
                 if total > 0.0 && total.is_finite() {
-                    shares.push((sums[1] / total) as f32);
+                    let share = (sums[1] / total) as f32;
+                    largest = Some(largest.map_or(share, |l| l.max(share)));
                 }
             }
         }
     }
-    if shares.is_empty() {
-        return None;
-    }
-    shares.sort_by(f32::total_cmp);
-    let k = ((shares.len() - 1) as f32 * quantile.clamp(0.0, 1.0)).round() as usize;
-    Some(shares[k])
+    largest
 }
