@@ -3,15 +3,16 @@
 
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
-use kiln_compiler::ir::{Texture, TextureRole};
+use kiln_compiler::ir::TextureRole;
 use kiln_compiler::settings::{Settings, TextureFormat};
-use kiln_format::manifest::{LightKind, Sky, Wrap};
+use kiln_format::manifest::{LightKind, Sky};
 use kiln_format::sections::MaterialFlags;
 use kiln_test_support::gpu_test;
 use kiln_tests::{GBuffer, Options, compile, scene_of};
 
 use crate::harness::{
-    ALBEDO, H, Pinhole, TOLERANCE, W, albedo, compare_plane, fast_settings, light, render, square, srgb8,
+    ALBEDO, H, Pinhole, TOLERANCE, W, albedo, compare_plane, fast_settings, light, render, square,
+    square_uvs, srgb8, texture,
 };
 
 #[test]
@@ -167,23 +168,10 @@ fn an_orthographic_camera_sees_the_lit_square_where_its_parallel_rays_meet_it() 
 fn a_normal_map_tilts_the_floor_the_same_way_in_the_frame_and_the_path_tracer() {
     let dir = gpu_test!();
     let mut scene = scene_of(&square(0.0, 10.0));
-    scene.uvs = scene
-        .vertices
-        .iter()
-        .map(|v| [(v.position[0] + 10.0) / 20.0, (v.position[2] + 10.0) / 20.0])
-        .collect();
+    square_uvs(&mut scene, 1.0);
     // Tangent-space (0, sin 60°, cos 60°) as 8-bit codes; z is rebuilt from x and y.
     let codes = [128u8, 238, 191, 255];
-    scene.textures.push(Texture {
-        name: "tilt".into(),
-        width: 4,
-        height: 4,
-        rgba: codes.repeat(16),
-        role: TextureRole::Normal,
-        wrap_u: Wrap::Repeat,
-        wrap_v: Wrap::Repeat,
-        mag_linear: true,
-    });
+    scene.textures.push(texture("tilt", 4, 4, TextureRole::Normal, |_, _| codes));
     let m = &mut scene.materials[0].gpu;
     *m = lambert_material(ALBEDO.map(srgb8));
     m.normal_texture = 0;

@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::lambert_material;
+use kiln_compiler::ir::{Scene, Texture, TextureRole};
 use kiln_compiler::settings::Settings;
-use kiln_format::manifest::{Camera, Light, LightKind};
+use kiln_format::manifest::{Camera, Light, LightKind, Wrap};
 use kiln_format::sections::{GpuMaterial, MaterialFlags};
 use kiln_player::headless::{self, HeadlessResult};
 use kiln_player::image_out::read_exr;
@@ -146,6 +147,40 @@ impl Pinhole {
 pub fn square(y: f32, s: f32) -> [[Vec3; 3]; 2] {
     let p = |x: f32, z: f32| Vec3::new(x, y, z);
     [[p(-s, -s), p(-s, s), p(s, s)], [p(-s, -s), p(s, s), p(s, -s)]]
+}
+
+/// A `width` × `height` texture, repeating, bilinearly magnified, whose texel (x, y) is
+/// `f(x / width, y / height)`.
+pub fn texture(
+    name: &str,
+    width: u32,
+    height: u32,
+    role: TextureRole,
+    f: impl Fn(f32, f32) -> [u8; 4],
+) -> Texture {
+    let rgba = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .flat_map(|(x, y)| f(x as f32 / width as f32, y as f32 / height as f32))
+        .collect();
+    Texture {
+        name: name.into(),
+        width,
+        height,
+        rgba,
+        role,
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        mag_linear: true,
+    }
+}
+
+/// Texture coordinates over the floor [`square`]`(y, 10)`: `repeats` times across it in u and v.
+pub fn square_uvs(scene: &mut Scene, repeats: f32) {
+    scene.uvs = scene
+        .vertices
+        .iter()
+        .map(|v| [(v.position[0] + 10.0) / 20.0 * repeats, (v.position[2] + 10.0) / 20.0 * repeats])
+        .collect();
 }
 
 /// A white light that casts shadows (`direction`: where a directional light travels).

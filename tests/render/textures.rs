@@ -3,50 +3,22 @@
 //! compiled with `--texture-format bc` renders within a small FLIP of the same floor compiled
 //! with `rgba8`; passes that read textures as RGBA8 words refuse the BC file by name.
 
-use kiln_compiler::ir::{Texture, TextureRole};
+use kiln_compiler::ir::TextureRole;
 use kiln_compiler::settings::{Settings, TextureFormat};
-use kiln_format::manifest::{LightKind, Wrap};
+use kiln_format::manifest::LightKind;
 use kiln_format::sections::{self, PixelFormat};
 use kiln_format::{Checksums, KilnFile, SceneView};
 use kiln_player::render::TexelDecode;
 use kiln_test_support::gpu_test;
 use kiln_tests::{GBuffer, Options, compile, scene_of};
 
-use crate::harness::{H, Pinhole, W, fast_settings, light, render, square};
-
-/// A smooth pattern with some edges: what a texture usually holds, with a size that leaves
-/// partial blocks at the right and bottom of every level.
-fn texture(
-    name: &str,
-    width: u32,
-    height: u32,
-    role: TextureRole,
-    f: impl Fn(f32, f32) -> [u8; 4],
-) -> Texture {
-    let rgba = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .flat_map(|(x, y)| f(x as f32 / width as f32, y as f32 / height as f32))
-        .collect();
-    Texture {
-        name: name.into(),
-        width,
-        height,
-        rgba,
-        role,
-        wrap_u: Wrap::Repeat,
-        wrap_v: Wrap::Repeat,
-        mag_linear: true,
-    }
-}
+use crate::harness::{H, Pinhole, W, fast_settings, light, render, square, square_uvs, texture};
 
 fn textured_floor(format: TextureFormat) -> Vec<u8> {
     let mut scene = scene_of(&square(0.0, 10.0));
-    // UVs over the floor: the square's corners map to [0, 2]² (the textures repeat).
-    scene.uvs = scene
-        .vertices
-        .iter()
-        .map(|v| [(v.position[0] + 10.0) / 10.0, (v.position[2] + 10.0) / 10.0])
-        .collect();
+    // UVs over the floor: the square's corners map to [0, 2]² (the textures repeat); sizes that
+    // leave partial blocks at the right and bottom of every level.
+    square_uvs(&mut scene, 2.0);
     let unorm = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
     scene.textures = vec![
         texture("albedo", 37, 29, TextureRole::Color, |u, v| {
