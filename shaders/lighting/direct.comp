@@ -290,12 +290,18 @@ void main() {
     // Screen-space GI gathers what the screen shows: the sky's ambient (darkened by AO) stays,
     // and the gathered light adds to it.
     bool gi = DIRECT_GI && (frame.size.w & FRAME_RT_GI) != 0u;
-    vec3 diffuse_in = gi ? imageLoad(rt_gi, pixel).rgb : env_irradiance(n, frame.sky.rgb) * occlusion;
-    if (gi && DIRECT_PROBE_SPECULAR && (frame.size.w & FRAME_PROBE_SPECULAR) != 0u) {
-        // The probes' confidence (their alpha): below 1 past the volume's outermost probes on a
-        // side the surface faces out of, where the sky stands in for the missing probes.
-        vec4 probe = imageLoad(rt_gi, pixel);
-        diffuse_in = mix(env_irradiance(n, frame.sky.rgb) * occlusion, probe.rgb, clamp(probe.a, 0.0, 1.0));
+    vec3 diffuse_in;
+    if (gi) {
+        vec4 traced = imageLoad(rt_gi, pixel);
+        diffuse_in = traced.rgb;
+        // The probes' alpha is their confidence: below 1 past the volume's outermost probes on a
+        // side the surface faces out of, where the sky stands in for the missing probes. (The
+        // ray-traced GI's alpha is its variance, hence the flag.)
+        if (DIRECT_PROBE_SPECULAR && (frame.size.w & FRAME_PROBE_SPECULAR) != 0u && traced.a < 1.0) {
+            diffuse_in = mix(env_irradiance(n, frame.sky.rgb) * occlusion, traced.rgb, max(traced.a, 0.0));
+        }
+    } else {
+        diffuse_in = env_irradiance(n, frame.sky.rgb) * occlusion;
     }
     if (DIRECT_GI && (frame.size.w & FRAME_SCREEN_GI) != 0u) {
         diffuse_in += imageLoad(rt_gi, pixel).rgb;

@@ -126,14 +126,14 @@ void main() {
     // beyond it is the sky. The direct pass blends towards its unoccluded sky light by how far
     // past the last layer the lookup point lies (half a spacing: all sky; the outermost layer
     // lies a quarter to three quarters of a spacing inside the bounds, and the lookup point moves
-    // 0.1 along the normal and 0.2 towards the eye) times how squarely the surface faces out. A surface facing back into the volume (a room's wall at its bounds)
-    // keeps the probes.
+    // 0.1 along the normal and 0.2 towards the eye) times how squarely the surface faces out (a
+    // unit normal's component: each product stays within [0, 1]). A surface facing back into the
+    // volume (a room's wall at its bounds) keeps the probes.
     vec3 last = vec3(max(dims - 1, ivec3(0)));
-    vec3 beyond_hi = max(g - last, vec3(0.0));
-    vec3 beyond_lo = max(-g, vec3(0.0));
-    vec3 out_hi = clamp(2.0 * beyond_hi, 0.0, 1.0) * max(n, vec3(0.0));
-    vec3 out_lo = clamp(2.0 * beyond_lo, 0.0, 1.0) * max(-n, vec3(0.0));
-    float sky = clamp(max(max(max(out_hi.x, out_hi.y), out_hi.z), max(max(out_lo.x, out_lo.y), out_lo.z)), 0.0, 1.0);
+    vec3 out_hi = clamp(2.0 * (g - last), 0.0, 1.0) * max(n, vec3(0.0));
+    vec3 out_lo = clamp(-2.0 * g, 0.0, 1.0) * max(-n, vec3(0.0));
+    vec3 out_most = max(out_hi, out_lo);
+    float sky = max(max(out_most.x, out_most.y), out_most.z);
     imageStore(gi_out, pixel, vec4(sum * inverse, 1.0 - sky));
     imageStore(specular_out, pixel, vec4(sum_mirror * inverse, 1.0 - sky));
 }
