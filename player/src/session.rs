@@ -21,7 +21,7 @@ use crate::error::{Exit, PlayError, PlayResult};
 use crate::gpu::{CommandPool, Gpu, GpuOptions, Recorder, Semaphore, SemaphoreOp};
 use crate::render::Needs;
 use crate::render::background::{Built, FrameBuild};
-use crate::render::frame::{Frame, SceneLights};
+use crate::render::frame::{Frame, SceneTraits};
 use crate::render::techniques::Effect;
 use crate::render::{Dummies, PassTimes, Readable, Readback, RenderSettings, Renderer, Techniques};
 use crate::scene::upload::Uploader;
@@ -329,13 +329,13 @@ impl Session {
         let (width, height, readback) = (options.width, options.height, options.readback);
         let Plan { requested, fallback, first_needs, mut warnings } = plan;
         render.techniques = requested;
-        let lights = SceneLights::of(prepared.manifest());
+        let traits = SceneTraits::of(prepared.manifest(), prepared.materials());
         let decode = prepared.texel_decode();
         // The chosen techniques' pipelines behind a fallback compile on a thread of their own,
         // started first: they take longest. Dropped on an error below, it waits for the thread
         // and drops what it built.
         let background = match fallback {
-            Some(_) => Some(FrameBuild::spawn(&gpu, requested, lights, decode, width, height)?),
+            Some(_) => Some(FrameBuild::spawn(&gpu, requested, traits, decode, width, height)?),
             None => None,
         };
         let first = fallback.unwrap_or(requested);
@@ -345,7 +345,7 @@ impl Session {
             let pipes = s.spawn(|| {
                 let t = Instant::now();
                 // The frame's targets too: allocating them costs milliseconds on some drivers.
-                let frame = Frame::new(&gpu, &first, lights, decode, width, height)?;
+                let frame = Frame::new(&gpu, &first, traits, decode, width, height)?;
                 let rb = readback.map(|r| Readback::new(&gpu, r, width, height)).transpose()?;
                 Ok((frame, rb, ms(t), Instant::now()))
             });

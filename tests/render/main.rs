@@ -27,6 +27,7 @@ mod reference; // the reference path tracer's GGX in a white furnace
 mod reproject; // the ray-traced running mean carried along a moving camera, restarted where disoccluded
 mod scenes; // the demo and PICA PICA scenes: clean, lit, the G-buffers and pipelines agree
 mod screen_ao; // SAO and GTAO: a flat floor unoccluded, an inside corner against the estimator and the closed form
+mod see_through; // blended and transmitting surfaces over the lit frame: a sheet of alpha a and a glass slab in front of an emissive wall against their closed forms
 mod shadows; // an occluder's umbra, from shadow maps and from ray-traced shadows
 mod specular; // KHR_materials_ior and specular: a black mirror floor under a uniform sky against Schlick's closed form (reference, raster)
 mod ssgi; // screen-space GI: a red wall's bleed onto the floor against its closed form, none from off screen

@@ -211,6 +211,17 @@ impl GpuMaterial {
         }
     }
 
+    /// Whether what lies behind the surface shows through it: alpha-blended (glTF BLEND) with
+    /// a base colour alpha below 1 or a base colour texture (whose alpha may be), or
+    /// transmitting (`KHR_materials_transmission`). The raster frame draws such surfaces in a
+    /// layer of their own over the opaque ones (the player's see-through layer).
+    pub fn see_through(&self) -> bool {
+        let blended = self.alpha_mode() == Some(AlphaMode::Blend)
+            && (self.base_color[3] < 1.0 || self.base_color_texture != NO_TEXTURE);
+        let transmits = self.transmission > 0.0 && (self.flags & MaterialFlags::DIFFUSE_ONLY) == 0;
+        blended || transmits
+    }
+
     /// The alpha mode, if the bits hold a defined one.
     pub fn alpha_mode(&self) -> Option<AlphaMode> {
         match (self.flags & MaterialFlags::ALPHA_MODE_MASK) >> MaterialFlags::ALPHA_MODE_SHIFT {

@@ -20,7 +20,7 @@ mod swapchain;
 
 pub use commands::{CommandPool, ImageRows, Recorder, Semaphore, SemaphoreOp, TimestampPool, Use};
 pub use pipelines::{
-    Binding, BindingKind, ComputePipeline, GraphicsDesc, GraphicsPipeline, SetLayout, Write,
+    Binding, BindingKind, ComputePipeline, GraphicsDesc, GraphicsPipeline, Landing, SetLayout, Write,
 };
 pub use raytracing::{AccelerationStructures, RayTracingPipeline, RayTracingShaders};
 pub use resources::{Buffer, Image, ImageDesc, Sampler, SamplerKey, View};

@@ -342,6 +342,19 @@ pub struct GraphicsDesc<'a> {
     /// Cull back (clockwise) faces in hardware; otherwise nothing is culled and the fragment
     /// shader decides facing.
     pub cull_back: bool,
+    /// How its fragments land in the targets.
+    pub landing: Landing,
+}
+
+/// How a graphics pipeline's fragments land in its targets. (One way for every target: each
+/// target its own would need the `independentBlend` feature.)
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Landing {
+    /// Depth-tested (the nearest wins, reversed Z) and written.
+    Nearest,
+    /// Added to what the targets hold (one-plus-one blending), without depth test or write:
+    /// every fragment counts, in any order.
+    Summed,
 }
 
 /// A graphics pipeline for dynamic rendering and its layout, released when dropped.
@@ -404,18 +417,25 @@ impl GraphicsPipeline {
             .line_width(1.0);
         let multisample = vk::PipelineMultisampleStateCreateInfo::default()
             .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let nearest = d.landing == Landing::Nearest;
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
-            .depth_test_enable(true)
-            .depth_write_enable(true)
+            .depth_test_enable(nearest)
+            .depth_write_enable(nearest)
             .depth_compare_op(vk::CompareOp::GREATER_OR_EQUAL); // reversed Z
-        let blend_attachments: Vec<vk::PipelineColorBlendAttachmentState> = d
-            .colors
-            .iter()
-            .map(|_| {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
-            })
-            .collect();
+        let written =
+            vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
+        let attachment = match d.landing {
+            Landing::Nearest => written,
+            Landing::Summed => written
+                .blend_enable(true)
+                .src_color_blend_factor(vk::BlendFactor::ONE)
+                .dst_color_blend_factor(vk::BlendFactor::ONE)
+                .color_blend_op(vk::BlendOp::ADD)
+                .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                .alpha_blend_op(vk::BlendOp::ADD),
+        };
+        let blend_attachments = vec![attachment; d.colors.len()];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);

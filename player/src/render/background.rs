@@ -11,7 +11,7 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-use super::frame::{Frame, SceneLights};
+use super::frame::{Frame, SceneTraits};
 use super::techniques::Techniques;
 use super::texels::TexelDecode;
 use crate::error::{Exit, PlayError, PlayResult};
@@ -42,7 +42,7 @@ impl FrameBuild {
     pub fn spawn(
         gpu: &Arc<Gpu>,
         techniques: Techniques,
-        lights: SceneLights,
+        scene: SceneTraits,
         decode: TexelDecode,
         width: u32,
         height: u32,
@@ -52,7 +52,7 @@ impl FrameBuild {
             .name("kiln-pipelines".into())
             .spawn(move || {
                 let t = Instant::now();
-                let frame = Frame::new(&device, &techniques, lights, decode, width, height)?;
+                let frame = Frame::new(&device, &techniques, scene, decode, width, height)?;
                 Ok(Built { frame, ms: t.elapsed().as_secs_f64() * 1e3, done: Instant::now() })
             })
             .map_err(|e| PlayError::new(Exit::Gpu, format!("cannot start the pipeline thread: {e}")))?;

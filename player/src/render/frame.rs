@@ -9,6 +9,7 @@ use super::passes::Pass;
 use super::passes::depth_pyramid::{DepthPyramidPass, Reduction};
 use super::passes::direct::DirectPass;
 use super::passes::lit_pyramid::LitPyramidPass;
+use super::passes::see_through::{SeeThroughComposite, SeeThroughRaster};
 use super::passes::tonemap::TonemapPass;
 use super::techniques::{Effect, Techniques};
 use super::texels::TexelDecode;
@@ -37,24 +38,33 @@ pub struct Frame {
     pub again: Vec<usize>,
 }
 
-/// What the passes of a frame are specialised for: the scene's lights.
+/// What the passes of a frame are specialised for: the scene's lights and whether it has
+/// see-through surfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct SceneLights {
+pub struct SceneTraits {
     /// How many analytic lights the scene has.
-    pub count: usize,
+    pub lights: usize,
     /// Whether one of them is a rect light (the direct pass leaves their code out otherwise).
-    pub rect: bool,
+    pub rect_lights: bool,
+    /// Whether a material is see-through ([`kiln_format::sections::GpuMaterial::see_through`]):
+    /// the G-buffer then leaves those surfaces out and the see-through layer draws them over
+    /// the lit frame ([`super::passes::see_through`]).
+    pub see_through: bool,
 }
 
-impl SceneLights {
-    /// The lights of `manifest`.
-    pub fn of(manifest: &kiln_format::Manifest) -> SceneLights {
-        SceneLights {
-            count: manifest.lights.len(),
-            rect: manifest
+impl SceneTraits {
+    /// The traits of a scene with `manifest` and `materials`.
+    pub fn of(
+        manifest: &kiln_format::Manifest,
+        materials: &[kiln_format::sections::GpuMaterial],
+    ) -> SceneTraits {
+        SceneTraits {
+            lights: manifest.lights.len(),
+            rect_lights: manifest
                 .lights
                 .iter()
                 .any(|l| matches!(l.kind, kiln_format::manifest::LightKind::Rect { .. })),
+            see_through: materials.iter().any(|m| m.see_through()),
         }
     }
 }
@@ -86,6 +96,8 @@ pub enum Stage {
     Denoise,
     /// Direct light and composition.
     Direct,
+    /// The see-through layer over the lit frame.
+    SeeThrough,
     /// Participating media.
     Media,
     /// Temporal anti-aliasing's resolve.
@@ -108,8 +120,8 @@ pub struct FrameBuild<'a> {
     pub gpu: &'a Gpu,
     /// Every effect's technique.
     pub techniques: &'a Techniques,
-    /// The scene's lights.
-    pub lights: SceneLights,
+    /// What the scene holds that the passes are specialised for.
+    pub scene: SceneTraits,
     /// How passes that read the texel buffer decode it.
     pub decode: TexelDecode,
     makers: Vec<(Stage, Maker<'a>)>,
@@ -146,18 +158,18 @@ impl<'a> FrameBuild<'a> {
     }
 }
 
-/// Builds the passes `techniques` need, in frame order, for a scene of `lights` whose texel
-/// buffer is decoded as `decode` says.
+/// Builds the passes `techniques` need, in frame order, for a `scene` whose texel buffer is
+/// decoded as `decode` says.
 fn passes(
     gpu: &Gpu,
     techniques: &Techniques,
-    scene_lights: SceneLights,
+    scene: SceneTraits,
     decode: TexelDecode,
 ) -> PlayResult<Vec<Made>> {
     let mut frame = FrameBuild {
         gpu,
         techniques,
-        lights: scene_lights,
+        scene,
         decode,
         makers: Vec::new(),
         depth_pyramid: None,
@@ -172,7 +184,15 @@ fn passes(
     if frame.lit_pyramid {
         frame.add(Stage::LitPyramid, move || LitPyramidPass::new(gpu));
     }
-    frame.add(Stage::Direct, move || DirectPass::new(gpu, techniques, scene_lights.rect));
+    frame.add(Stage::Direct, move || DirectPass::new(gpu, techniques, scene.rect_lights));
+    if scene.see_through {
+        // After the G-buffer technique's passes (a stage keeps the order passes were added in):
+        // the layer is drawn in front of the opaque depth they leave.
+        frame.add(Stage::GBuffer, move || SeeThroughRaster::new(gpu));
+        let media = techniques.dims_surfaces();
+        frame.add(Stage::SeeThrough, move || DirectPass::see_through(gpu, media, scene.rect_lights));
+        frame.add(Stage::SeeThrough, move || SeeThroughComposite::new(gpu));
+    }
     frame.add(Stage::Tonemap, move || TonemapPass::new(gpu));
     let mut makers = frame.makers;
     // Stable: a stage's passes keep the order they were added in.
@@ -231,6 +251,8 @@ fn again(stages: &[Stage], passes: &[Box<dyn Pass>]) -> Vec<usize> {
         return Vec::new();
     }
     again.push(direct);
+    // The see-through layer goes over the radiance the direct pass lit again.
+    again.extend((direct + 1..stages.len()).filter(|&i| stages[i] == Stage::SeeThrough));
     again
 }
 
@@ -241,19 +263,19 @@ fn make_images(gpu: &Gpu, passes: &[Box<dyn Pass>], width: u32, height: u32) -> 
 }
 
 impl Frame {
-    /// The passes of `techniques` and their images at `width` × `height`, for a scene of
-    /// `lights` whose texel buffer `decode` reads (known from the file's tables before
+    /// The passes of `techniques` and their images at `width` × `height`, for a `scene` whose
+    /// texel buffer `decode` reads (known from the file's tables before
     /// its sections upload: the pipelines are built while the scene uploads). On failure
     /// everything made is released (dropped).
     pub fn new(
         gpu: &Gpu,
         techniques: &Techniques,
-        lights: SceneLights,
+        scene: SceneTraits,
         decode: TexelDecode,
         width: u32,
         height: u32,
     ) -> PlayResult<Frame> {
-        let made = passes(gpu, techniques, lights, decode)?;
+        let made = passes(gpu, techniques, scene, decode)?;
         let stages: Vec<Stage> = made.iter().map(|(stage, _, _)| *stage).collect();
         let (passes, build_ms): (Vec<_>, Vec<_>) = made
             .into_iter()

@@ -235,6 +235,11 @@ impl Prepared<'_> {
     pub fn manifest(&self) -> &kiln_format::Manifest {
         &self.view.manifest
     }
+
+    /// The file's materials.
+    pub fn materials(&self) -> &[kiln_format::sections::GpuMaterial] {
+        &self.view.materials
+    }
 }
 
 /// The BVH on the GPU: nodes as in the file and triangle corners in leaf order.

@@ -9,7 +9,7 @@ use crate::gpu::vk;
 
 use super::gbuffer::{ALBEDO, DEPTH, EMISSION, MATERIAL, NORMAL};
 use super::kernel::Kernel;
-use super::{FrameCtx, Pass, Shared, ao, probes, rt_direct, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Pass, Shared, ao, probes, rt_direct, rt_gi, rt_reflections, rt_shadows, see_through};
 use crate::error::PlayResult;
 use crate::gpu::{Binding, BindingKind, Gpu, ImageDesc, Use, Write};
 use crate::render::graph::{Access, TargetDecl};
@@ -65,10 +65,17 @@ const RAY_TRACED: [(TargetDecl, u32); 6] = [
     (probes::SPECULAR, 20),
 ];
 
-/// The direct-light pass: its kernel and the ray-traced images it reads, by binding (each
-/// signal's denoised image where the denoiser filters it).
+/// The direct-light pass: its kernel, the G-buffer it lights and the image it writes, and the
+/// ray-traced images it reads, by binding (each signal's denoised image where the denoiser
+/// filters it).
 #[derive(Debug)]
-pub struct DirectPass(Kernel, [(TargetDecl, u32); 6]);
+pub struct DirectPass {
+    kernel: Kernel,
+    inputs: [(TargetDecl, u32); 6],
+    gbuffer: [TargetDecl; 5],
+    output: TargetDecl,
+    name: &'static str,
+}
 
 impl DirectPass {
     /// Builds the pipeline, specialised for `techniques` (and rect lights or none): the code for
@@ -76,13 +83,6 @@ impl DirectPass {
     /// pass on the H100 (docs/benchmarks/codec/auto-default).
     pub fn new(gpu: &Gpu, techniques: &Techniques, rect_lights: bool) -> PlayResult<DirectPass> {
         let constants = Self::constants(techniques.flags(), techniques.dims_surfaces(), rect_lights);
-        let kernel = Kernel::specialized(
-            gpu,
-            &Self::bindings(),
-            spirv::shader!("lighting/direct.comp"),
-            0,
-            &constants,
-        )?;
         let mut inputs = RAY_TRACED;
         for noisy in techniques.noisy() {
             for (t, _) in &mut inputs {
@@ -91,7 +91,42 @@ impl DirectPass {
                 }
             }
         }
-        Ok(DirectPass(kernel, inputs))
+        Self::make(gpu, &constants, inputs, GBUFFER, RADIANCE, "direct")
+    }
+
+    /// The same kernel over the see-through layer's G-buffer into its own image
+    /// ([`see_through::RADIANCE`]): every screen-space and ray-traced input left out (they were
+    /// made for the opaque surfaces behind it), so that the layer is lit by the analytic lights
+    /// (shadowed by the shadow maps where the frame uses them, else unshadowed), the sky or
+    /// environment through the split sum, and its emission; the media dim it as `media` says.
+    pub fn see_through(gpu: &Gpu, media: bool, rect_lights: bool) -> PlayResult<DirectPass> {
+        let constants = Self::constants(0, media, rect_lights);
+        Self::make(
+            gpu,
+            &constants,
+            RAY_TRACED,
+            see_through::GBUFFER,
+            see_through::RADIANCE,
+            "see-through light",
+        )
+    }
+
+    fn make(
+        gpu: &Gpu,
+        constants: &[u32],
+        inputs: [(TargetDecl, u32); 6],
+        gbuffer: [TargetDecl; 5],
+        output: TargetDecl,
+        name: &'static str,
+    ) -> PlayResult<DirectPass> {
+        let kernel = Kernel::specialized(
+            gpu,
+            &Self::bindings(),
+            spirv::shader!("lighting/direct.comp"),
+            0,
+            constants,
+        )?;
+        Ok(DirectPass { kernel, inputs, gbuffer, output, name })
     }
 
     /// Specialization constants by id (`direct.comp`): 0 is unused (the texel decoders' id), then
@@ -126,15 +161,15 @@ impl DirectPass {
 
 impl Pass for DirectPass {
     fn name(&self) -> &'static str {
-        "direct"
+        self.name
     }
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
-        vec![(RADIANCE, RADIANCE.sized(width, height, 1))]
+        vec![(self.output, self.output.sized(width, height, 1))]
     }
 
     fn binds(&self) -> Vec<TargetDecl> {
-        GBUFFER.iter().copied().chain(self.1.iter().map(|(t, _)| *t)).collect()
+        self.gbuffer.iter().copied().chain(self.inputs.iter().map(|(t, _)| *t)).collect()
     }
 
     fn bind(&mut self, gpu: &Gpu, shared: &Shared) -> PlayResult {
@@ -151,26 +186,26 @@ impl Pass for DirectPass {
             Write::Sampled(4, maps_2d),
             Write::Sampled(5, maps_cube),
         ];
-        for (i, t) in GBUFFER.iter().enumerate() {
+        for (i, t) in self.gbuffer.iter().enumerate() {
             writes.push(Write::Sampled(6 + i as u32, vec![(img(t), near)]));
         }
-        writes.push(Write::StorageImage(11, img(&RADIANCE)));
-        for (t, binding) in &self.1 {
+        writes.push(Write::StorageImage(11, img(&self.output)));
+        for (t, binding) in &self.inputs {
             writes.push(Write::StorageImage(*binding, img(t)));
         }
         // The media table when a media technique uploaded it (the frame constants then count
         // its entries), else any storage buffer: no entry is read.
         writes.push(Write::Buffer(16, scene.media.as_ref().map_or(shared.lights, |m| &m.table)));
         writes.extend(scene.environment_writes(18)?);
-        self.0.write(gpu, &writes)
+        self.kernel.write(gpu, &writes)
     }
 
     fn record(&mut self, ctx: &mut FrameCtx) {
-        let mut io = super::gbuffer::sampled(&GBUFFER);
-        io.extend(self.1.iter().map(|(t, _)| (*t, Access::Read(Use::STORAGE))));
-        io.push((RADIANCE, Access::Write(Use::STORAGE)));
+        let mut io = super::gbuffer::sampled(&self.gbuffer);
+        io.extend(self.inputs.iter().map(|(t, _)| (*t, Access::Read(Use::STORAGE))));
+        io.push((self.output, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
-        self.0.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
+        self.kernel.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
     }
 }
 

@@ -4,10 +4,10 @@
 
 use crate::gpu::vk;
 
-use super::materials::SceneDraws;
+use super::materials::{SceneDraws, see_through};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
-use crate::gpu::{Gpu, GraphicsPipeline, ImageDesc, Use};
+use crate::gpu::{Gpu, GraphicsPipeline, ImageDesc, Landing, Use};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -19,7 +19,8 @@ const COLOR_USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
         | vk::ImageUsageFlags::STORAGE.as_raw(),
 );
 
-const fn color(name: &'static str, format: vk::Format) -> TargetDecl {
+/// A G-buffer colour target (attachment, storage, sampled).
+pub const fn color(name: &'static str, format: vk::Format) -> TargetDecl {
     TargetDecl { name, format, usage: COLOR_USAGE, array: false }
 }
 
@@ -56,22 +57,25 @@ pub fn sampled(targets: &[TargetDecl]) -> Vec<(TargetDecl, Access)> {
 pub struct GBufferPass {
     pipeline: GraphicsPipeline,
     draws: SceneDraws,
+    /// Whether see-through surfaces are left to the see-through layer.
+    opaque_only: bool,
 }
 
 impl GBufferPass {
-    /// Builds the pipeline.
-    pub fn new(gpu: &Gpu) -> PlayResult<GBufferPass> {
+    /// Builds the pipeline; with `opaque_only`, see-through surfaces are not drawn (the
+    /// see-through layer draws them).
+    pub fn new(gpu: &Gpu, opaque_only: bool) -> PlayResult<GBufferPass> {
         let draws = SceneDraws::new(gpu)?;
         let formats = COLORS.map(|c| c.format);
         let pipeline = draws.pipeline(
             gpu,
-            spirv::shader!("gbuffer/gbuffer.vert"),
             spirv::shader!("gbuffer/gbuffer.frag"),
             &formats,
             DEPTH.format,
             false,
+            Landing::Nearest,
         )?;
-        Ok(GBufferPass { pipeline, draws })
+        Ok(GBufferPass { pipeline, draws, opaque_only })
     }
 }
 
@@ -95,7 +99,8 @@ impl Pass for GBufferPass {
         ctx.images.access(ctx.rec, &io);
         let colors: Vec<_> = COLORS.iter().map(|t| ctx.images.get(t)).collect();
         ctx.rec.begin_rendering(&colors, ctx.images.get(&DEPTH), true);
-        self.draws.draw(ctx.rec, ctx.scene, |_| &self.pipeline);
+        let opaque_only = self.opaque_only;
+        self.draws.draw(ctx.rec, ctx.scene, |m| (!opaque_only || !see_through(m)).then_some(&self.pipeline));
         ctx.rec.end_rendering();
     }
 }

@@ -8,7 +8,9 @@ use kiln_format::sections::{MATERIAL_SLOTS, NO_TEXTURE};
 
 use super::Shared;
 use crate::error::PlayResult;
-use crate::gpu::{Binding, BindingKind, Gpu, GraphicsDesc, GraphicsPipeline, Recorder, SetLayout, Write};
+use crate::gpu::{
+    Binding, BindingKind, Gpu, GraphicsDesc, GraphicsPipeline, Landing, Recorder, SetLayout, Write,
+};
 use crate::scene::GpuScene;
 
 /// Vertex buffer strides of the raster passes: positions + normals (`Vertex`), texture
@@ -24,11 +26,19 @@ pub const ATTRIBUTES: [(u32, u32, vk::Format, u32); 4] = [
     (3, 1, vk::Format::R16G16B16A16_UNORM, 8),
 ];
 
+/// Whether a material as pushed is see-through ([`kiln_format::sections::GpuMaterial::see_through`]).
+pub fn see_through(m: &GpuMaterialLayout) -> bool {
+    bytemuck::cast::<GpuMaterialLayout, kiln_format::sections::GpuMaterial>(*m).see_through()
+}
+
 /// Set layouts, sets and pushed materials of a raster pass (the layouts, and the sets with
 /// them, released when dropped).
 #[derive(Debug)]
 pub struct SceneDraws {
+    /// The frame's set: its constants, and with [`SceneDraws::see_through`] the opaque
+    /// G-buffer's depth (binding 1) and the split-sum table (binding 2).
     frame_layout: SetLayout,
+    see_through: bool,
     material_layout: SetLayout,
     frame_set: vk::DescriptorSet,
     material_sets: Vec<vk::DescriptorSet>,
@@ -39,10 +49,23 @@ pub struct SceneDraws {
 impl SceneDraws {
     /// The layouts (sets are allocated by [`SceneDraws::bind`]).
     pub fn new(gpu: &Gpu) -> PlayResult<SceneDraws> {
-        let frame_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Uniform)], 1)?;
+        Self::make(gpu, false)
+    }
+
+    /// [`SceneDraws::new`] for the see-through layer: its frame set also samples the opaque
+    /// G-buffer's depth (binding 1) and the split-sum table (binding 2).
+    pub fn see_through(gpu: &Gpu) -> PlayResult<SceneDraws> {
+        Self::make(gpu, true)
+    }
+
+    fn make(gpu: &Gpu, see_through: bool) -> PlayResult<SceneDraws> {
+        use BindingKind::{Sampled, Uniform};
+        let frame_bindings = [Binding::one(Uniform), Binding::one(Sampled), Binding::one(Sampled)];
+        let frame_layout = SetLayout::new(gpu, &frame_bindings[..if see_through { 3 } else { 1 }], 1)?;
         let material_layout = SetLayout::new(gpu, &[Binding::one(BindingKind::Sampled); MATERIAL_SLOTS], 64)?;
         Ok(SceneDraws {
             frame_layout,
+            see_through,
             material_layout,
             frame_set: vk::DescriptorSet::null(),
             material_sets: Vec::new(),
@@ -50,21 +73,21 @@ impl SceneDraws {
         })
     }
 
-    /// A triangle-list pipeline over the scene's vertex layout with these sets, writing
-    /// `colors` and the depth target.
+    /// A triangle-list pipeline over the scene's vertex layout (`shaders/gbuffer/gbuffer.vert`)
+    /// with these sets and `fragment`, writing `colors` and the depth target.
     pub fn pipeline(
         &self,
         gpu: &Gpu,
-        vertex: &[u8],
         fragment: &[u8],
         colors: &[vk::Format],
         depth: vk::Format,
         cull_back: bool,
+        landing: Landing,
     ) -> PlayResult<GraphicsPipeline> {
         GraphicsPipeline::new(
             gpu,
             &GraphicsDesc {
-                vertex,
+                vertex: crate::render::spirv::shader!("gbuffer/gbuffer.vert"),
                 fragment,
                 vertex_strides: &VERTEX_STRIDES,
                 attributes: &ATTRIBUTES,
@@ -73,6 +96,7 @@ impl SceneDraws {
                 sets: &[&self.frame_layout, &self.material_layout],
                 push_bytes: std::mem::size_of::<GpuMaterialLayout>() as u32,
                 cull_back,
+                landing,
             },
         )
     }
@@ -105,6 +129,19 @@ impl SceneDraws {
                 self.materials.push(layout);
             }
         }
+        if self.see_through {
+            // Written at every bind: the depth target is remade on a resize.
+            let depth = shared.images.get(&super::gbuffer::DEPTH).view;
+            let lut = scene.brdf_lut.as_ref().map_or(shared.dummies.white.view, |i| i.view);
+            self.frame_layout.write(
+                gpu,
+                self.frame_set,
+                &[
+                    Write::Sampled(1, vec![(depth, scene.nearest_clamp)]),
+                    Write::Sampled(2, vec![(lut, scene.linear_clamp)]),
+                ],
+            );
+        }
         let white = (shared.dummies.white.view, scene.linear_clamp);
         let texture = |t: u32| -> (vk::ImageView, vk::Sampler) {
             match scene.texture_views.get(t as usize) {
@@ -124,12 +161,13 @@ impl SceneDraws {
         Ok(())
     }
 
-    /// Records one draw per material, with the pipeline `pick` chooses for its material.
+    /// Records one draw per material, with the pipeline `pick` chooses for its material (none:
+    /// the material is not drawn).
     pub fn draw<'p>(
         &self,
         rec: &Recorder,
         scene: &GpuScene,
-        pick: impl Fn(&GpuMaterialLayout) -> &'p GraphicsPipeline,
+        pick: impl Fn(&GpuMaterialLayout) -> Option<&'p GraphicsPipeline>,
     ) {
         if scene.draws.is_empty() {
             return;
@@ -138,7 +176,7 @@ impl SceneDraws {
         let mut bound: Option<&GraphicsPipeline> = None;
         for d in &scene.draws {
             let m = &self.materials[d.material as usize];
-            let p = pick(m);
+            let Some(p) = pick(m) else { continue };
             if bound.is_none_or(|b| !std::ptr::eq(b, p)) {
                 rec.bind_graphics(p, &[self.frame_set]);
                 bound = Some(p);

@@ -30,6 +30,7 @@ pub mod rt_gi;
 pub mod rt_history;
 pub mod rt_reflections;
 pub mod rt_shadows;
+pub mod see_through;
 
 pub mod sousa;
 pub mod ssgi;

@@ -4,10 +4,10 @@
 use kiln_format::sections::MaterialFlags;
 
 use super::gbuffer::{DEPTH, TRIANGLE};
-use super::materials::SceneDraws;
+use super::materials::{SceneDraws, see_through};
 use super::{FrameCtx, Pass, Shared};
 use crate::error::PlayResult;
-use crate::gpu::{Gpu, GraphicsPipeline, ImageDesc, Use};
+use crate::gpu::{Gpu, GraphicsPipeline, ImageDesc, Landing, Use};
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::spirv;
 
@@ -20,19 +20,22 @@ pub struct VisibilityPass {
     /// Masked or double-sided materials: the shader decides.
     raster: GraphicsPipeline,
     draws: SceneDraws,
+    /// Whether see-through surfaces are left to the see-through layer.
+    opaque_only: bool,
 }
 
 impl VisibilityPass {
-    /// Builds the pipelines.
-    pub fn new(gpu: &Gpu) -> PlayResult<VisibilityPass> {
+    /// Builds the pipelines; with `opaque_only`, see-through surfaces are not drawn (the
+    /// see-through layer draws them).
+    pub fn new(gpu: &Gpu, opaque_only: bool) -> PlayResult<VisibilityPass> {
         let draws = SceneDraws::new(gpu)?;
         let colors = [TRIANGLE.format];
         let build = |fragment: &[u8], cull: bool| {
-            draws.pipeline(gpu, spirv::shader!("gbuffer/gbuffer.vert"), fragment, &colors, DEPTH.format, cull)
+            draws.pipeline(gpu, fragment, &colors, DEPTH.format, cull, Landing::Nearest)
         };
         let opaque = build(spirv::shader!("gbuffer/visibility_opaque.frag"), true)?;
         let raster = build(spirv::shader!("gbuffer/visibility.frag"), false)?;
-        Ok(VisibilityPass { opaque, raster, draws })
+        Ok(VisibilityPass { opaque, raster, draws, opaque_only })
     }
 }
 
@@ -56,9 +59,12 @@ impl Pass for VisibilityPass {
         // writes on GPUs with few raster units): the resolve marks pixels at the far plane empty.
         ctx.rec.begin_rendering(&[ctx.images.get(&TRIANGLE)], ctx.images.get(&DEPTH), false);
         self.draws.draw(ctx.rec, ctx.scene, |m| {
+            if self.opaque_only && see_through(m) {
+                return None;
+            }
             let opaque_one_sided = m.flags & MaterialFlags::DOUBLE_SIDED == 0
                 && (m.flags >> MaterialFlags::ALPHA_MODE_SHIFT) & 3 != 1;
-            if opaque_one_sided { &self.opaque } else { &self.raster }
+            Some(if opaque_one_sided { &self.opaque } else { &self.raster })
         });
         ctx.rec.end_rendering();
     }

@@ -40,7 +40,7 @@ impl Aa {
 /// capped at `frames` while the camera moves.
 fn reproject_rays(frame: &mut FrameBuild<'_>, frames: u32) {
     if frame.techniques.ray_traced() {
-        let lights = frame.lights.count;
+        let lights = frame.scene.lights;
         let targets = frame.techniques.each().filter_map(|t| t.accumulated(lights)).collect();
         let gpu = frame.gpu;
         frame.add(Stage::Accumulate, move || RtHistoryPass::new(gpu, targets, frames));

@@ -13,7 +13,7 @@ plain_technique! {
 
 impl Technique for Raster {
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
-        let gpu = frame.gpu;
-        frame.add(Stage::GBuffer, move || GBufferPass::new(gpu));
+        let (gpu, see_through) = (frame.gpu, frame.scene.see_through);
+        frame.add(Stage::GBuffer, move || GBufferPass::new(gpu, see_through));
     }
 }

@@ -22,8 +22,8 @@ impl Technique for Visibility {
     }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
-        let (gpu, decode) = (frame.gpu, frame.decode);
-        frame.add(Stage::GBuffer, move || VisibilityPass::new(gpu));
+        let (gpu, decode, see_through) = (frame.gpu, frame.decode, frame.scene.see_through);
+        frame.add(Stage::GBuffer, move || VisibilityPass::new(gpu, see_through));
         frame.add(Stage::GBuffer, move || ResolvePass::new(gpu, decode));
     }
 }

@@ -73,7 +73,7 @@ impl Technique for Rt {
     }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
-        let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
+        let (gpu, lights, decode) = (frame.gpu, frame.scene.lights, frame.decode);
         frame.add(Stage::Reflections, move || RtReflectionsPass::new(gpu, self.resolution.step(), lights, decode));
     }
 

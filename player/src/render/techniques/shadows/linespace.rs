@@ -74,7 +74,7 @@ impl Technique for LineSpace {
 
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
-        let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
+        let (gpu, lights, decode) = (frame.gpu, frame.scene.lights, frame.decode);
         let code = match self.test {
             LsShadowTest::Ends => spirv::shader!("rt/shadows_linespace.comp"),
             LsShadowTest::Filled => spirv::shader!("rt/shadows_linespace_exact.comp"),

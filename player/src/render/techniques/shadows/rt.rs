@@ -34,7 +34,7 @@ impl Technique for Rt {
 
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
-        let (gpu, lights, decode) = (frame.gpu, frame.lights.count, frame.decode);
+        let (gpu, lights, decode) = (frame.gpu, frame.scene.lights, frame.decode);
         frame.add(Stage::Shadows, move || RtShadowsPass::new(gpu, spirv::shader!("rt/shadows.comp"), false, lights, decode));
     }
 }
