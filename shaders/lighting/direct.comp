@@ -67,6 +67,9 @@ layout(set = 0, binding = 17, rgba32f) uniform readonly image2D rt_direct;
 #include "../common/environment.glsl"
 // The probes' irradiance along each pixel's mirror direction (FRAME_PROBE_SPECULAR: `--gi probes`).
 layout(set = 0, binding = 20, rgba16f) uniform readonly image2D probe_specular;
+// The first pixel of the dispatch: (0, 0) over the whole frame; the see-through layer's screen
+// area (passes/see_through.rs) where the pass lights that layer.
+layout(push_constant) uniform Origin { uvec2 origin; };
 
 // A Vogel spiral of 16 taps in the unit disk.
 vec2 tap(int i, float angle) {
@@ -155,7 +158,7 @@ float shadow_cube_factor(GpuShadow s, vec3 p, vec3 n, vec3 l, float light_radius
 
 float shadow_factor(uint index, GpuLight light, vec3 p, vec3 n, vec3 l, float angle) {
     if (DIRECT_RT_SHADOWS && (frame.size.w & FRAME_RT_SHADOWS) != 0u) {
-        ivec3 at = ivec3(gl_GlobalInvocationID.xy, int(index));
+        ivec3 at = ivec3(ivec2(gl_GlobalInvocationID.xy + origin), int(index));
         return index < uint(imageSize(rt_shadows).z) ? imageLoad(rt_shadows, at).r : 1.0;
     }
     if ((frame.size.w & FRAME_SHADOW_MAPS) == 0u || light.shadow < 0) {
@@ -223,7 +226,7 @@ vec3 f_cos(Material m, vec3 n, vec3 v, vec3 l, float e_albedo) {
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy + origin);
     uvec2 size = frame.size.xy;
     if (any(greaterThanEqual(uvec2(pixel), size))) {
         return;

@@ -23,10 +23,14 @@ layout(set = 0, binding = 3) uniform sampler2D s_absorbed;
 // The nearest surface's own light, and the frame's radiance (read behind, written over).
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D s_radiance;
 layout(set = 0, binding = 5, rgba32f) uniform image2D radiance;
+// Where the layer was drawn this frame (x0, y0, x1, y1; passes/see_through.rs `screen_area`):
+// outside it its targets hold an earlier frame's.
+layout(push_constant) uniform Area { uvec4 area; };
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(uvec2(pixel), frame.size.xy))) {
+    // Dispatched over the area alone.
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy + area.xy);
+    if (any(greaterThanEqual(uvec2(pixel), min(area.zw, frame.size.xy)))) {
         return;
     }
     if (!(texelFetch(s_depth, pixel, 0).r > 0.0)) {

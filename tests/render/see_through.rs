@@ -55,11 +55,12 @@ fn dielectric(rgba: [f32; 4], roughness: f32) -> GpuMaterial {
     m
 }
 
-fn centre_mean(rgb: &[f32]) -> [f64; 3] {
+/// The mean over the pixels x0..x1 × y0..y1.
+fn block_mean(rgb: &[f32], (x0, x1): (u32, u32), (y0, y1): (u32, u32)) -> [f64; 3] {
     let mut sum = [0.0f64; 3];
     let mut n = 0.0;
-    for y in H / 2 - 2..H / 2 + 2 {
-        for x in W / 2 - 2..W / 2 + 2 {
+    for y in y0..y1 {
+        for x in x0..x1 {
             let i = 3 * (y * W + x) as usize;
             for c in 0..3 {
                 sum[c] += rgb[i + c] as f64;
@@ -82,8 +83,16 @@ fn check(name: &str, got: [f64; 3], want: [f64; 3], tolerance: f64) {
     }
 }
 
+fn centre_mean(rgb: &[f32]) -> [f64; 3] {
+    block_mean(rgb, (W / 2 - 2, W / 2 + 2), (H / 2 - 2, H / 2 + 2))
+}
+
+/// The sheet covers the image's upper left quadrant only, so that the layer's screen area (its
+/// projected bounds) is a quarter of the image: the quadrant shows (1 − a) Le, the lower right
+/// one the bare wall.
 /// Planted and seen failing: the coverage left out of the composition (a blended surface let
-/// through only what it transmits): 0.0000 against 0.7000.
+/// through only what it transmits): 0.0000 against 0.7000; the screen area's rows not flipped
+/// (the lower left quadrant drawn instead): 1.0000 against 0.7000.
 #[test]
 fn a_blended_sheet_shows_the_wall_behind_by_one_minus_its_alpha() {
     let dir = gpu_test!();
@@ -93,17 +102,25 @@ fn a_blended_sheet_shows_the_wall_behind_by_one_minus_its_alpha() {
     let mut sheet = dielectric([0.0, 0.0, 0.0, ALPHA], 1.0);
     sheet.flags |= (AlphaMode::Blend as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
     s.materials.push(Material { name: "sheet".into(), gpu: sheet });
-    let r = 1.0;
+    // The upper left quadrant of the view (x < 0, y > 0), well past its edges.
     quad(
         &mut s,
-        [Vec3::new(-r, -r, 0.0), Vec3::new(r, -r, 0.0), Vec3::new(r, r, 0.0), Vec3::new(-r, r, 0.0)],
+        [
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ],
         1,
     );
     let bytes = compile(s, fast_settings());
     let want = [((1.0 - ALPHA) * LE) as f64; 3];
     for (name, g) in [("raster", GBuffer::Raster), ("visibility", GBuffer::Visibility)] {
         let (rgb, _) = render(dir.path(), &format!("blended-{name}"), &bytes, |f| options(f, g));
-        check(&format!("blended sheet, {name} G-buffer"), centre_mean(&rgb), want, 0.01);
+        let sheet = block_mean(&rgb, (2, W / 2 - 2), (2, H / 2 - 2));
+        check(&format!("blended sheet, {name} G-buffer"), sheet, want, 0.01);
+        let bare = block_mean(&rgb, (W / 2 + 2, W - 2), (H / 2 + 2, H - 2));
+        check(&format!("bare wall beside it, {name} G-buffer"), bare, [LE as f64; 3], 0.01);
     }
 }
 

@@ -434,6 +434,19 @@ impl<'a> Recorder<'a> {
     /// Begins dynamic rendering into colour targets (cleared to zero when `clear_colors`, else
     /// left undefined where nothing is drawn) and a depth target (cleared to 0: reversed Z).
     pub fn begin_rendering(&self, colors: &[&Image], depth: &Image, clear_colors: bool) {
+        self.begin_rendering_in(colors, Some(depth), clear_colors, None);
+    }
+
+    /// [`Recorder::begin_rendering`] with the depth target optional, and confined to `area`
+    /// (the whole image without one): clears, rasterisation and stores stay inside it, what is
+    /// outside keeps what it held.
+    pub fn begin_rendering_in(
+        &self,
+        colors: &[&Image],
+        depth: Option<&Image>,
+        clear_colors: bool,
+        area: Option<vk::Rect2D>,
+    ) {
         let color_infos: Vec<vk::RenderingAttachmentInfo> = colors
             .iter()
             .map(|c| {
@@ -449,20 +462,26 @@ impl<'a> Recorder<'a> {
                     .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })
             })
             .collect();
-        let depth_info = vk::RenderingAttachmentInfo::default()
-            .image_view(depth.view)
-            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: 0 },
-            });
-        let extent = vk::Extent2D { width: depth.desc.width, height: depth.desc.height };
-        let info = vk::RenderingInfo::default()
-            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
-            .layer_count(1)
-            .color_attachments(&color_infos)
-            .depth_attachment(&depth_info);
+        let depth_info = depth.map(|d| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(d.view)
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: 0 },
+                })
+        });
+        let Some(size) = depth.or(colors.first().copied()).map(|i| (i.desc.width, i.desc.height)) else {
+            return;
+        };
+        let extent = vk::Extent2D { width: size.0, height: size.1 };
+        let area = area.unwrap_or(vk::Rect2D { offset: vk::Offset2D::default(), extent });
+        let mut info =
+            vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(&color_infos);
+        if let Some(d) = &depth_info {
+            info = info.depth_attachment(d);
+        }
         unsafe {
             self.gpu.device.cmd_begin_rendering(self.cmd, &info);
             // A negative-height viewport makes clip-space y point up the image.
@@ -475,11 +494,7 @@ impl<'a> Recorder<'a> {
                 max_depth: 1.0,
             };
             self.gpu.device.cmd_set_viewport(self.cmd, 0, &[viewport]);
-            self.gpu.device.cmd_set_scissor(
-                self.cmd,
-                0,
-                &[vk::Rect2D { offset: vk::Offset2D::default(), extent }],
-            );
+            self.gpu.device.cmd_set_scissor(self.cmd, 0, &[area]);
         }
     }
 

@@ -99,6 +99,8 @@ pub struct Renderer {
     /// The previous frame's world to clip without jitter; `None` before the first frame and
     /// after a resize (the history images then hold nothing).
     last_view_proj: Option<glam::DMat4>,
+    /// This frame's world to clip without jitter (the see-through layer's screen area).
+    view_proj: glam::DMat4,
     /// Whether this frame has a previous one to read (the constants say so to the shaders; a
     /// frame without records [`Frame::again`]).
     history: bool,
@@ -198,6 +200,7 @@ impl Renderer {
             rt_constants,
             accumulated: 0,
             last_view_proj: None,
+            view_proj: glam::DMat4::IDENTITY,
             history: false,
             flags,
             lut_resolution: scene.brdf_lut.as_ref().map_or(0, |i| i.desc.width),
@@ -301,6 +304,7 @@ impl Renderer {
         let history = self.last_view_proj.is_some();
         self.history = history;
         self.last_view_proj = Some(unjittered);
+        self.view_proj = unjittered;
         let (view_proj, inv_view_proj) = (vp.as_mat4().to_cols_array(), inverse.as_mat4().to_cols_array());
         let p = camera.position.as_vec3();
         let (right, up, half) = camera.image_axes();
@@ -344,7 +348,13 @@ impl Renderer {
         self.rt_constants.seed = self.frame_count as u32;
         let Frame { passes, images, again, .. } = &mut self.frame;
         let again: &[usize] = if self.history { &[] } else { again };
-        let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants, again: false };
+        let see_through_area = passes::see_through::screen_area(
+            scene.see_through_bounds,
+            self.view_proj,
+            images.width,
+            images.height,
+        );
+        let mut ctx = FrameCtx { rec, images, scene, rt: &self.rt_constants, again: false, see_through_area };
         for i in 0..passes.len() {
             passes[i].record(&mut ctx);
             if again.last() == Some(&i) {

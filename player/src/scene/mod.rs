@@ -230,6 +230,24 @@ impl GpuScene {
     }
 }
 
+/// [`GpuScene::see_through_bounds`] of a prepared file.
+fn see_through_bounds(prepared: &Prepared) -> Option<[glam::Vec3; 2]> {
+    let (vertices, materials) = (prepared.view.vertices, &prepared.view.materials);
+    let mut bounds: Option<[glam::Vec3; 2]> = None;
+    for d in &prepared.draws {
+        if !materials.get(d.material as usize).is_some_and(|m| m.see_through()) {
+            continue;
+        }
+        let range = d.first as usize..(d.first + d.count) as usize;
+        for &i in prepared.indices.get(range).unwrap_or(&[]) {
+            let Some(v) = vertices.get(i as usize) else { continue };
+            let p = glam::Vec3::from(v.position);
+            bounds = Some(bounds.map_or([p, p], |[lo, hi]| [lo.min(p), hi.max(p)]));
+        }
+    }
+    bounds
+}
+
 impl Prepared<'_> {
     /// The file's manifest.
     pub fn manifest(&self) -> &kiln_format::Manifest {
@@ -304,6 +322,10 @@ pub struct GpuScene {
     pub indices: Buffer,
     /// One draw per material with triangles.
     pub draws: Vec<Draw>,
+    /// The world bounds (min, max) of the see-through materials' triangles
+    /// ([`GpuMaterial::see_through`]), if any: the see-through layer draws only where they
+    /// project.
+    pub see_through_bounds: Option<[glam::Vec3; 2]>,
     /// Materials (pushed as constants per draw).
     pub materials: Vec<GpuMaterial>,
     /// Textures sampled through a coarse view, waiting for their finer levels (declared before
@@ -413,6 +435,7 @@ impl GpuScene {
             attributes,
             indices,
             draws: prepared.draws.clone(),
+            see_through_bounds: see_through_bounds(prepared),
             materials: view.materials.to_vec(),
             coarse: Vec::new(),
             textures: Vec::new(),

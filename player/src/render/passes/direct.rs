@@ -75,6 +75,8 @@ pub struct DirectPass {
     gbuffer: [TargetDecl; 5],
     output: TargetDecl,
     name: &'static str,
+    /// Whether it lights the see-through layer, over that layer's screen area alone.
+    see_through: bool,
 }
 
 impl DirectPass {
@@ -123,10 +125,11 @@ impl DirectPass {
             gpu,
             &Self::bindings(),
             spirv::shader!("lighting/direct.comp"),
-            0,
+            8,
             constants,
         )?;
-        Ok(DirectPass { kernel, inputs, gbuffer, output, name })
+        let see_through = output == see_through::RADIANCE;
+        Ok(DirectPass { kernel, inputs, gbuffer, output, name, see_through })
     }
 
     /// Specialization constants by id (`direct.comp`): 0 is unused (the texel decoders' id), then
@@ -205,7 +208,17 @@ impl Pass for DirectPass {
         io.extend(self.inputs.iter().map(|(t, _)| (*t, Access::Read(Use::STORAGE))));
         io.push((self.output, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
-        self.kernel.dispatch(ctx.rec, &[], ctx.images.width, ctx.images.height);
+        // The see-through layer is lit over its screen area alone; the frame everywhere.
+        let area = if self.see_through {
+            ctx.see_through_area
+        } else {
+            vk::Rect2D {
+                offset: vk::Offset2D::default(),
+                extent: vk::Extent2D { width: ctx.images.width, height: ctx.images.height },
+            }
+        };
+        let origin = [area.offset.x.max(0) as u32, area.offset.y.max(0) as u32];
+        self.kernel.dispatch(ctx.rec, bytemuck::cast_slice(&origin), area.extent.width, area.extent.height);
     }
 }
 

@@ -101,6 +101,8 @@ pub struct FrameCtx<'a, 'r> {
     /// The pass is recorded a second time in a frame without history, over the radiance the
     /// direct pass lit in this frame ([`crate::render::frame::Frame::again`]).
     pub again: bool,
+    /// Where the see-through surfaces may show this frame ([`see_through::screen_area`]).
+    pub see_through_area: crate::gpu::vk::Rect2D,
 }
 
 /// One pass of the frame. Dropping it releases what it owns: the GPU must be done with it (the
