@@ -19,7 +19,7 @@ use kiln_tests::{compile, rewrite};
 fn settings(rays: u32, spacing: Option<f32>) -> Settings {
     Settings {
         shaft_variants: Some(0),
-        probe_rays: rays,
+        probe_rays: Some(rays),
         probe_spacing: spacing.map(ProbeSpacing),
         ..Default::default()
     }

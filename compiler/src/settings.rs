@@ -222,8 +222,16 @@ pub const SHADOW_RES: Ranged = Ranged { key: "shadow_res", default: 1024, min: 1
 pub const MEDIA_VOLUME_RES: Ranged = Ranged { key: "media_volume_res", default: 64, min: 2, max: 512 };
 
 /// Rays traced per probe of the irradiance volume (each a path of every bounce; a quarter as
-/// many next-event samples of the emissive triangles join them).
+/// many next-event samples of the emissive triangles join them). The default is for scenes whose
+/// every material is pure Lambertian; [`PROBE_RAYS_GLOSSY`] where one has a specular lobe.
 pub const PROBE_RAYS: Ranged = Ranged { key: "probe_rays", default: 256, min: 16, max: 65536 };
+
+/// [`PROBE_RAYS`]' default for a scene with a glossy (not pure Lambertian) material. Light
+/// reflected off glossy surfaces reaches a probe concentrated in few directions, even with the
+/// paths regularised: pica_pica's one-frame FLIP (`probes-rt`, H200 reference) was 0.0453 at 256
+/// paths, 0.0452 at 512 and 0.0426 at 1,024 (docs/benchmarks/probe-rays/). Lambertian scenes
+/// such as the demo keep 256: the test suite compiles it dozens of times.
+pub const PROBE_RAYS_GLOSSY: u32 = 1024;
 
 /// Size budget of the probe volume, MiB, when its spacing is chosen from the scene's size.
 pub const PROBE_BUDGET: Ranged = Ranged { key: "probe_budget", default: 2, min: 1, max: 4096 };
@@ -419,8 +427,9 @@ pub struct Settings {
     pub probes: Probes,
     /// Probe spacing; `None`: from the scene's size within [`PROBE_BUDGET`].
     pub probe_spacing: Option<ProbeSpacing>,
-    /// Rays per probe.
-    pub probe_rays: u32,
+    /// Rays per probe; `None`: [`PROBE_RAYS`]' default, [`PROBE_RAYS_GLOSSY`] for a scene with a
+    /// glossy material.
+    pub probe_rays: Option<u32>,
     /// Probe volume budget, MiB (when the spacing is chosen).
     pub probe_budget: u32,
     /// Least roughness of the surfaces the probe paths meet.
@@ -451,7 +460,7 @@ impl Default for Settings {
             media_volume_res: MEDIA_VOLUME_RES.default,
             probes: Probes::Auto,
             probe_spacing: None,
-            probe_rays: PROBE_RAYS.default,
+            probe_rays: None,
             probe_budget: PROBE_BUDGET.default,
             probe_regularize: ProbeRegularize::DEFAULT,
             environment_res: ENVIRONMENT_RES.default,
@@ -481,6 +490,7 @@ impl Settings {
         for (table, value, setting) in [
             (SHAFT_RES, b.shaft_res, &mut self.shaft_res),
             (LINE_SPACE_BUDGET, b.line_space_budget, &mut self.line_space_budget),
+            (PROBE_RAYS, b.probe_rays, &mut self.probe_rays),
         ] {
             if let Some(n) = value {
                 *setting = Some(table.check(n)?);
@@ -490,7 +500,6 @@ impl Settings {
             (BRDF_LUT_RES, b.brdf_lut_res, &mut self.brdf_lut_res),
             (SHADOW_RES, b.shadow_res, &mut self.shadow_res),
             (MEDIA_VOLUME_RES, b.media_volume_res, &mut self.media_volume_res),
-            (PROBE_RAYS, b.probe_rays, &mut self.probe_rays),
             (PROBE_BUDGET, b.probe_budget, &mut self.probe_budget),
             (ENVIRONMENT_RES, b.environment_res, &mut self.environment_res),
         ] {
@@ -546,7 +555,13 @@ impl Settings {
             ("media-volume-res".into(), self.media_volume_res.to_string()),
             ("probes".into(), self.probes.name().into()),
             ("probe-spacing".into(), self.probe_spacing.map_or_else(|| "plan".into(), |s| s.0.to_string())),
-            ("probe-rays".into(), self.probe_rays.to_string()),
+            (
+                "probe-rays".into(),
+                self.probe_rays.map_or_else(
+                    || format!("default: {}, {PROBE_RAYS_GLOSSY} with glossy materials", PROBE_RAYS.default),
+                    |n| n.to_string(),
+                ),
+            ),
             ("probe-budget".into(), self.probe_budget.to_string()),
             ("probe-regularize".into(), self.probe_regularize.0.to_string()),
             ("environment-res".into(), self.environment_res.to_string()),

@@ -138,7 +138,7 @@ fn every_kind_file_with(codec: Codec) -> Vec<u8> {
         media_volume_res: MEDIA_VOLUME_RES.min,
         // Eight probes, quickly.
         probe_spacing: Some(kiln_compiler::settings::ProbeSpacing(1.0)),
-        probe_rays: 16,
+        probe_rays: Some(16),
         codec,
         ..Default::default()
     };

@@ -528,10 +528,14 @@ fn plan_skips_each_lighting_bake_with_its_reason() {
     assert!(find(&p, "probes").2.starts_with("nothing lights the scene"), "{:?}", find(&p, "probes"));
     let lit = find(&plan(floor_and_blocker()), "probes");
     assert!(lit.1 && lit.2.contains("read by kiln-play --gi probes"), "{lit:?}");
-    // A glossy material needs the table.
+    // A glossy material needs the table, and its probes four times the paths.
+    assert!(lit.2.contains("256 paths each (every material Lambertian"), "{lit:?}");
     let mut s = floor_and_blocker();
     s.materials[0].gpu.flags = 0;
-    assert!(find(&plan(s), "brdf-lut").1);
+    let p = plan(s);
+    assert!(find(&p, "brdf-lut").1);
+    let glossy = find(&p, "probes");
+    assert!(glossy.2.contains("1024 paths each (glossy materials"), "{glossy:?}");
 }
 
 #[test]
@@ -549,7 +553,7 @@ fn export_writes_readable_images() {
                 shaft_variants: Some(0),
                 // 4 × 1 × 4 probes over the 2 × 0.5 × 2 bounds.
                 probe_spacing: Some(kiln_compiler::settings::ProbeSpacing(0.5)),
-                probe_rays: 16,
+                probe_rays: Some(16),
                 ..Default::default()
             },
         ),

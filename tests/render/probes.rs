@@ -51,7 +51,7 @@ fn rooms() -> Vec<u8> {
     let settings = Settings {
         probes: kiln_compiler::settings::Probes::Auto,
         probe_spacing: Some(ProbeSpacing(0.2)),
-        probe_rays: 256,
+        probe_rays: Some(256),
         ..fast_settings()
     };
     compile(s, settings)
@@ -128,7 +128,7 @@ fn furnace() -> Vec<u8> {
     let settings = Settings {
         probes: kiln_compiler::settings::Probes::Auto,
         probe_spacing: Some(ProbeSpacing(0.5)),
-        probe_rays: 256,
+        probe_rays: Some(256),
         ..fast_settings()
     };
     compile(s, settings)
@@ -177,7 +177,7 @@ fn a_surface_facing_out_of_the_probe_volume_sees_the_sky() {
     let settings = Settings {
         probes: kiln_compiler::settings::Probes::Auto,
         probe_spacing: Some(ProbeSpacing(0.2)),
-        probe_rays: 64,
+        probe_rays: Some(64),
         ..fast_settings()
     };
     let bytes = compile(s, settings);

@@ -129,12 +129,23 @@ fn probe_plan(
     });
     let layers = if emits { 2 } else { 1 };
     let budget = settings.probe_budget as u64 * (1 << 20);
+    let glossy = scene.triangle_materials.iter().any(|&m| {
+        scene
+            .materials
+            .get(m as usize)
+            .is_some_and(|m| m.gpu.flags & kiln_format::sections::MaterialFlags::DIFFUSE_ONLY == 0)
+    });
+    let rays = settings.probe_rays.unwrap_or(if glossy {
+        crate::settings::PROBE_RAYS_GLOSSY
+    } else {
+        crate::settings::PROBE_RAYS.default
+    });
     let layout = probes::layout(
         &geometry.bounds,
         settings.probe_spacing.map(|s| s.0),
         budget,
         layers,
-        settings.probe_rays,
+        rays,
         settings.probe_regularize.0,
     )?;
     // Paths a bake may trace: 2^28 (minutes on 16 cores; a hostile sidecar asks for more).
@@ -155,8 +166,13 @@ fn probe_plan(
             settings.probe_budget
         ),
     };
+    let why_rays = match (settings.probe_rays, glossy) {
+        (Some(_), _) => "",
+        (None, true) => " (glossy materials: the default for them, --probe-rays)",
+        (None, false) => " (every material Lambertian: --probe-rays)",
+    };
     let reason = format!(
-        "{x}x{y}x{z} probes every {} scene units{why_spacing}, {}, {} paths each{}{}; read by kiln-play {}",
+        "{x}x{y}x{z} probes every {} scene units{why_spacing}, {}, {} paths each{why_rays}{}{}; read by kiln-play {}",
         short(layout.spacing as f64),
         if layout.bytes() < 1 << 20 {
             format!("{:.1} KiB", layout.bytes() as f64 / 1024.0)

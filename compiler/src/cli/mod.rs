@@ -267,7 +267,7 @@ bounce, whenever something lights the scene) or off [default: auto, or the sidec
     pub probe_spacing: Option<crate::settings::ProbeSpacing>,
     /// Rays per probe.
     #[arg(long, value_name = "N", value_parser = crate::settings::PROBE_RAYS.parser(), help_heading = "Lighting bakes",
-          help = crate::settings::PROBE_RAYS.help("Paths traced per probe (more: less noise, longer bake)"))]
+          help = format!("Paths traced per probe (more: less noise, longer bake), {}..={} [default: {} where every material is Lambertian, {} where one is glossy]", crate::settings::PROBE_RAYS.min, crate::settings::PROBE_RAYS.max, crate::settings::PROBE_RAYS.default, crate::settings::PROBE_RAYS_GLOSSY))]
     pub probe_rays: Option<u32>,
     /// Budget of the probe volume.
     #[arg(long, value_name = "MiB", value_parser = crate::settings::PROBE_BUDGET.parser(), help_heading = "Lighting bakes",
@@ -360,7 +360,7 @@ impl BakeArgs {
         set(&mut settings.media_volume_res, self.media_volume_res);
         set(&mut settings.probes, self.probes);
         set(&mut settings.probe_spacing, self.probe_spacing.map(Some));
-        set(&mut settings.probe_rays, self.probe_rays);
+        set(&mut settings.probe_rays, self.probe_rays.map(Some));
         set(&mut settings.probe_budget, self.probe_budget);
         set(&mut settings.probe_regularize, self.probe_regularize);
         set(&mut settings.environment_res, self.environment_res);
