@@ -112,6 +112,23 @@ vec4 sample_texture(uint index, vec2 uv) {
     return filtered(t, uv, 0u, 0u, 0.0, (t.flags & TEXTURE_LINEAR) == 0u);
 }
 
+#ifdef TEXTURE_STOCHASTIC
+// Mip 0's bilinear filter by one texel: the corner chosen with probability equal to its bilinear
+// weight (stochastic texture filtering, Pharr et al. 2024), from the includer's
+// `texture_xi()` (uniform in [0, 1)). Its mean is the bilinear value, so an estimator linear in
+// the texel (base colour, emission) stays unbiased, and one BC block is decoded instead of four.
+// What is not linear in it (roughness, the normal) is filtered after shading, as a path tracer
+// averaging many samples per pixel filters anyway.
+vec4 stochastic_bilinear(GpuTexture t, vec2 uv) {
+    uvec3 l = texture_level(t, 0u);
+    vec2 x = uv * vec2(l.xy) - 0.5;
+    ivec2 i = ivec2(floor(x));
+    vec2 fr = x - vec2(i);
+    ivec2 o = ivec2(texture_xi() < fr.x ? 1 : 0, texture_xi() < fr.y ? 1 : 0);
+    return level_texel(t, l, i.x + o.x, i.y + o.y);
+}
+#endif
+
 // Trilinear filtering with the level chosen from the uv footprint of a pixel (the larger of its
 // two screen-axis derivatives, as isotropic hardware filtering does); magnification follows the
 // texture's filter.
@@ -132,6 +149,11 @@ vec4 sample_texture_grad(uint index, vec2 uv, vec2 dx, vec2 dy) {
         f = lod - float(l0);
         nearest = false;
     }
+#ifdef TEXTURE_STOCHASTIC
+    if (lod <= 0.0 && !nearest) {
+        return stochastic_bilinear(t, uv);
+    }
+#endif
     return filtered(t, uv, l0, l1, f, nearest);
 }
 

@@ -16,7 +16,8 @@
 // Smith and Schlick F; α = roughness²) sampled with cosine-weighted diffuse and GGX visible
 // normals (Heitz 2018), or pure Lambert for diffuse-only materials. All surfaces are two-sided
 // for reflection; emission leaves the front face only unless the material is double-sided.
-// Textures: mip 0, bilinear, from a texel buffer (portable: no descriptor indexing needed).
+// Textures: mip 0, bilinear, from a texel buffer (portable: no descriptor indexing needed); the
+// materials' by one texel chosen by its bilinear weight (the same mean, a quarter of the decoding).
 // Participating media (`rc.media.x` homogeneous boxes; overlapping boxes add their
 // coefficients): free-flight distances sampled in one colour channel chosen uniformly and
 // weighted by the mean of the three channels' densities (spectral MIS, so chromatic media stay
@@ -46,6 +47,12 @@ layout(set = 0, binding = 14, std430) readonly buffer Media { GpuMedium media[];
 layout(push_constant) uniform Sample { uint sample_index; };
 
 #include "../common/random.glsl"
+// The materials' textures are filtered stochastically (`common/textures.glsl`): one texel of
+// mip 0's bilinear footprint per lookup, chosen by its weight.
+#define TEXTURE_STOCHASTIC
+float texture_xi() {
+    return rnd();
+}
 #include "../common/scene.glsl"
 
 // ---------------------------------------------------------------- emitters
