@@ -42,7 +42,13 @@ fn main() {
             })
         };
         let t = std::time::Instant::now();
-        match Kernel::specialized(&gpu, &DirectPass::bindings(), &code, 0, &constants) {
+        match Kernel::specialized(
+            &gpu,
+            &DirectPass::bindings(),
+            &code,
+            kiln_player::render::passes::direct::PUSH_BYTES,
+            &constants,
+        ) {
             Ok(_kernel) => {
                 let how = if default { "specialised for the defaults" } else { "every path" };
                 println!("{path} {how} {:.1} ms", t.elapsed().as_secs_f64() * 1e3);

@@ -250,7 +250,9 @@ void main() {
         }
     }
     if (depth <= 0.0 || t_seen < 1.0) {
-        imageStore(radiance_out, pixel, vec4(seen, 1.0));
+        // Alpha 0 where a rect light hides the surface: over the see-through layer the light is
+        // already what the opaque pass shows there (see_through.comp leaves such pixels).
+        imageStore(radiance_out, pixel, vec4(seen, depth > 0.0 ? 0.0 : 1.0));
         return;
     }
     vec3 p = world_at(pixel, depth);

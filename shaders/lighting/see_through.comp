@@ -23,8 +23,8 @@ layout(set = 0, binding = 3) uniform sampler2D s_absorbed;
 // The nearest surface's own light, and the frame's radiance (read behind, written over).
 layout(set = 0, binding = 4, rgba32f) uniform readonly image2D s_radiance;
 layout(set = 0, binding = 5, rgba32f) uniform image2D radiance;
-// Where the layer was drawn this frame (x0, y0, x1, y1; passes/see_through.rs `screen_area`):
-// outside it its targets hold an earlier frame's.
+// Where the layer was drawn this frame (x0, y0, x1, y1, exclusive; passes/see_through.rs
+// `screen_area`): outside it its targets are undefined.
 layout(push_constant) uniform Area { uvec4 area; };
 
 void main() {
@@ -38,7 +38,11 @@ void main() {
     }
     float a = clamp(texelFetch(s_coverage, pixel, 0).r, 0.0, 1.0);
     vec3 passed = exp(-max(texelFetch(s_absorbed, pixel, 0).rgb, vec3(0.0)));
+    vec4 front = imageLoad(s_radiance, pixel);
+    if (front.a == 0.0) {
+        // A rect light in front of the layer's surface: the opaque pass shows it already.
+        return;
+    }
     vec3 behind = imageLoad(radiance, pixel).rgb;
-    vec3 front = imageLoad(s_radiance, pixel).rgb;
-    imageStore(radiance, pixel, vec4(a * front + passed * behind, 1.0));
+    imageStore(radiance, pixel, vec4(a * front.rgb + passed * behind, 1.0));
 }

@@ -21,7 +21,7 @@ use kiln_test_support::gpu_test;
 use kiln_tests::boxes::{cuboid, quad};
 use kiln_tests::{GBuffer, Options, compile};
 
-use crate::harness::{fast_settings, render};
+use crate::harness::{fast_settings, render, srgb8};
 
 const W: u32 = 16;
 const H: u32 = 12;
@@ -87,39 +87,46 @@ fn centre_mean(rgb: &[f32]) -> [f64; 3] {
     block_mean(rgb, (W / 2 - 2, W / 2 + 2), (H / 2 - 2, H / 2 + 2))
 }
 
-/// The sheet covers the image's upper left quadrant only, so that the layer's screen area (its
-/// projected bounds) is a quarter of the image: the quadrant shows (1 − a) Le, the lower right
-/// one the bare wall.
-/// Planted and seen failing: the coverage left out of the composition (a blended surface let
-/// through only what it transmits): 0.0000 against 0.7000; the screen area's rows not flipped
-/// (the lower left quadrant drawn instead): 1.0000 against 0.7000.
+/// The sheet, white Lambertian of albedo ρ, covers the image's lower right quadrant only, under a
+/// uniform sky of radiance S: the quadrant shows a ρ S + (1 − a) Le (the sheet's own light, which
+/// the layer's direct pass makes, and the wall through it), the upper left one the bare wall.
+/// The layer's screen area (its projected bounds) is that quadrant, so that its passes start
+/// at a pixel other than the first.
+/// Planted and seen failing, against 0.7866: the coverage left out of the composition (a blended
+/// surface let through only what it transmits): 0.0861; the screen area's rows not flipped (the
+/// upper right quadrant drawn instead): 1.0000; the layer's direct pass dispatched from the first
+/// pixel instead of the area's (its light never made where the sheet is): 1.0000.
 #[test]
-fn a_blended_sheet_shows_the_wall_behind_by_one_minus_its_alpha() {
+fn a_blended_sheet_shows_its_light_and_the_wall_behind_by_its_alpha() {
     let dir = gpu_test!();
     const ALPHA: f32 = 0.3;
+    const SKY: f32 = 0.5;
+    let rho = srgb8(200);
     let mut s = Scene { name: "blended".into(), ..Default::default() };
     wall(&mut s);
-    let mut sheet = dielectric([0.0, 0.0, 0.0, ALPHA], 1.0);
+    s.sky = kiln_format::manifest::Sky { radiance: [SKY; 3] };
+    let mut sheet = lambert_material([rho; 3]);
+    sheet.base_color[3] = ALPHA;
     sheet.flags |= (AlphaMode::Blend as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
     s.materials.push(Material { name: "sheet".into(), gpu: sheet });
-    // The upper left quadrant of the view (x < 0, y > 0), well past its edges.
+    // The lower right quadrant of the view (x > 0, y < 0), well past its edges.
     quad(
         &mut s,
         [
-            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(0.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
             Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(-1.0, 1.0, 0.0),
         ],
         1,
     );
     let bytes = compile(s, fast_settings());
-    let want = [((1.0 - ALPHA) * LE) as f64; 3];
+    let want = [(ALPHA * rho * SKY + (1.0 - ALPHA) * LE) as f64; 3];
     for (name, g) in [("raster", GBuffer::Raster), ("visibility", GBuffer::Visibility)] {
         let (rgb, _) = render(dir.path(), &format!("blended-{name}"), &bytes, |f| options(f, g));
-        let sheet = block_mean(&rgb, (2, W / 2 - 2), (2, H / 2 - 2));
+        let sheet = block_mean(&rgb, (W / 2 + 2, W - 2), (H / 2 + 2, H - 2));
         check(&format!("blended sheet, {name} G-buffer"), sheet, want, 0.01);
-        let bare = block_mean(&rgb, (W / 2 + 2, W - 2), (H / 2 + 2, H - 2));
+        let bare = block_mean(&rgb, (2, W / 2 - 2), (2, H / 2 - 2));
         check(&format!("bare wall beside it, {name} G-buffer"), bare, [LE as f64; 3], 0.01);
     }
 }

@@ -438,8 +438,9 @@ impl<'a> Recorder<'a> {
     }
 
     /// [`Recorder::begin_rendering`] with the depth target optional, and confined to `area`
-    /// (the whole image without one): clears, rasterisation and stores stay inside it, what is
-    /// outside keeps what it held.
+    /// (the whole image without one): clears, rasterisation and stores stay inside it (what is
+    /// outside is whatever the image's last layout transition left: undefined after one from
+    /// UNDEFINED). At least one target must be given.
     pub fn begin_rendering_in(
         &self,
         colors: &[&Image],
@@ -472,9 +473,10 @@ impl<'a> Recorder<'a> {
                     depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: 0 },
                 })
         });
-        let Some(size) = depth.or(colors.first().copied()).map(|i| (i.desc.width, i.desc.height)) else {
-            return;
-        };
+        let size = depth
+            .or(colors.first().copied())
+            .map(|i| (i.desc.width, i.desc.height))
+            .expect("dynamic rendering needs at least one target");
         let extent = vk::Extent2D { width: size.0, height: size.1 };
         let area = area.unwrap_or(vk::Rect2D { offset: vk::Offset2D::default(), extent });
         let mut info =

@@ -359,7 +359,8 @@ impl Renderer {
             passes[i].record(&mut ctx);
             if again.last() == Some(&i) {
                 // A frame without history: the screen-space passes again, over this frame's
-                // light (timed with the direct pass).
+                // light (timed with the last pass of the list: the direct pass, or the
+                // see-through composite after it).
                 ctx.again = true;
                 for &j in again {
                     passes[j].record(&mut ctx);

@@ -26,6 +26,9 @@ pub const RADIANCE: TargetDecl = TargetDecl {
     array: false,
 };
 
+/// Bytes of `direct.comp`'s push constants: the dispatch's first pixel (`uvec2 origin`).
+pub const PUSH_BYTES: u32 = 8;
+
 /// What a specialization constant of `direct.comp` says may happen in the frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SpecInput {
@@ -125,7 +128,7 @@ impl DirectPass {
             gpu,
             &Self::bindings(),
             spirv::shader!("lighting/direct.comp"),
-            8,
+            PUSH_BYTES,
             constants,
         )?;
         let see_through = output == see_through::RADIANCE;
