@@ -986,3 +986,57 @@ fn clear_coats_are_read_and_bad_payloads_only_warned_about() {
     assert_eq!(warned("is not a JSON object"), 1, "{:#?}", s.warnings);
     assert_eq!(warned("used but not supported"), 0, "{:#?}", s.warnings);
 }
+
+/// Alpha-blended materials whose alpha is 1 everywhere become opaque; any alpha below 1 — the
+/// factor, one texel of the base colour texture, one vertex colour — keeps them blended. Read
+/// back from the compiled file's material table. Planted and seen failing: the texture's texels
+/// not looked at (the material with one translucent texel made opaque).
+#[test]
+fn blended_materials_with_alpha_one_everywhere_compile_opaque() {
+    use kiln_compiler::import::demo::lambert_material;
+    use kiln_compiler::ir::{Material, Texture};
+    use kiln_format::sections::{AlphaMode, GpuMaterial, MATERIALS, Vertex};
+    use kiln_format::{Checksums, KilnFile};
+
+    let mut s = Scene { name: "blends".into(), ..Default::default() };
+    let texture = |alpha_of_one: u8| Texture {
+        name: format!("t{alpha_of_one}"),
+        width: 2,
+        height: 2,
+        rgba: vec![200, 200, 200, 255, 200, 200, 200, 255, 200, 200, 200, 255, 200, 200, 200, alpha_of_one],
+        role: TextureRole::Color,
+        wrap_u: Wrap::Repeat,
+        wrap_v: Wrap::Repeat,
+        mag_linear: true,
+    };
+    s.textures = vec![texture(255), texture(128)];
+    // (base colour alpha, texture, a vertex colour alpha below 1) per material.
+    let cases: [(f32, u32, bool); 5] = [
+        (1.0, 0, false),
+        (1.0, 1, false),
+        (0.5, NO_TEXTURE, false),
+        (1.0, NO_TEXTURE, true),
+        (1.0, NO_TEXTURE, false),
+    ];
+    for (i, &(alpha, tex, vertex_alpha)) in cases.iter().enumerate() {
+        let mut g = lambert_material([0.8; 3]);
+        g.base_color[3] = alpha;
+        g.base_color_texture = tex;
+        g.flags |= (AlphaMode::Blend as u32) << MaterialFlags::ALPHA_MODE_SHIFT;
+        s.materials.push(Material { name: format!("m{i}"), gpu: g });
+        let (x, b) = (i as f32 * 2.0, s.vertices.len() as u32);
+        for p in [[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x + 1.0, 1.0, 0.0], [x, 1.0, 0.0]] {
+            s.vertices.push(Vertex { position: p, normal: [0.0, 0.0, 1.0] });
+            s.uvs.push([p[0] - x, p[1]]);
+            s.colors.push([u16::MAX, u16::MAX, u16::MAX, if vertex_alpha { 30000 } else { u16::MAX }]);
+        }
+        s.triangles.extend([[b, b + 1, b + 2], [b, b + 2, b + 3]]);
+        s.triangle_materials.extend([i as u32; 2]);
+    }
+    let bytes = kiln_compiler::pipeline::compile_to_bytes(s, Default::default(), "test").unwrap();
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let materials: &[GpuMaterial] = file.pod(MATERIALS, 0).unwrap().unwrap();
+    let modes: Vec<_> = materials.iter().map(|m| m.alpha_mode()).collect();
+    use AlphaMode::{Blend, Opaque};
+    assert_eq!(modes, [Some(Opaque), Some(Blend), Some(Blend), Some(Blend), Some(Opaque)]);
+}

@@ -54,6 +54,7 @@ pub fn finish(scene: &mut Scene, source: &str) -> CliResult<()> {
     if !scene.uses_textures() {
         scene.uvs.clear();
     }
+    settle_opaque_blends(scene);
     let b = bounds(scene);
     let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
     let diagonal = (hi - lo).length().max(f32::MIN_POSITIVE);
@@ -98,4 +99,37 @@ pub fn finish(scene: &mut Scene, source: &str) -> CliResult<()> {
         scene.warn_as(WarningClass::MissingSetup, format!("{source}: the scene has no lights, no emissive materials and a black sky; it will render black (add lights in a sidecar, or light it with --environment studio, a neutral built-in environment)"));
     }
     Ok(())
+}
+
+/// Alpha-blended (glTF BLEND) materials whose alpha is 1 everywhere — the factor, every texel of
+/// the base colour texture and the vertex colours of their triangles — are made opaque. They look
+/// the same (the path tracer meets such a surface with probability 1), and the player's
+/// see-through layer, which lights less than the G-buffer does, is kept for the surfaces that need
+/// it: exporters often mark whole models BLEND.
+fn settle_opaque_blends(scene: &mut Scene) {
+    use kiln_format::sections::{AlphaMode, MaterialFlags, NO_TEXTURE};
+    let mut translucent_colors = vec![false; scene.materials.len()];
+    if !scene.colors.is_empty() {
+        for (t, &m) in scene.triangles.iter().zip(&scene.triangle_materials) {
+            if t.iter().any(|&v| scene.colors.get(v as usize).is_some_and(|c| c[3] < u16::MAX))
+                && let Some(x) = translucent_colors.get_mut(m as usize)
+            {
+                *x = true;
+            }
+        }
+    }
+    let textures = &scene.textures;
+    for (m, translucent) in scene.materials.iter_mut().zip(translucent_colors) {
+        let g = &mut m.gpu;
+        if g.alpha_mode() != Some(AlphaMode::Blend) || !(g.base_color[3] >= 1.0) || translucent {
+            continue;
+        }
+        let texture_opaque = g.base_color_texture == NO_TEXTURE
+            || textures
+                .get(g.base_color_texture as usize)
+                .is_some_and(|t| t.rgba.chunks_exact(4).all(|p| p[3] == u8::MAX));
+        if texture_opaque {
+            g.flags &= !MaterialFlags::ALPHA_MODE_MASK;
+        }
+    }
 }
