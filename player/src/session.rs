@@ -329,7 +329,7 @@ impl Session {
         let (width, height, readback) = (options.width, options.height, options.readback);
         let Plan { requested, fallback, first_needs, mut warnings } = plan;
         render.techniques = requested;
-        let traits = SceneTraits::of(prepared.manifest(), prepared.materials());
+        let traits = SceneTraits::of(prepared.manifest(), prepared.see_through_bounds().is_some());
         let decode = prepared.texel_decode();
         // The chosen techniques' pipelines behind a fallback compile on a thread of their own,
         // started first: they take longest. Dropped on an error below, it waits for the thread

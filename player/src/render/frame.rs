@@ -46,25 +46,23 @@ pub struct SceneTraits {
     pub lights: usize,
     /// Whether one of them is a rect light (the direct pass leaves their code out otherwise).
     pub rect_lights: bool,
-    /// Whether a material is see-through ([`kiln_format::sections::GpuMaterial::see_through`]):
-    /// the G-buffer then leaves those surfaces out and the see-through layer draws them over
-    /// the lit frame ([`super::passes::see_through`]).
+    /// Whether the scene has triangles of a see-through material
+    /// ([`kiln_format::sections::GpuMaterial::see_through`]): the G-buffer then leaves those
+    /// surfaces out and the see-through layer draws them over the lit frame
+    /// ([`super::passes::see_through`]).
     pub see_through: bool,
 }
 
 impl SceneTraits {
-    /// The traits of a scene with `manifest` and `materials`.
-    pub fn of(
-        manifest: &kiln_format::Manifest,
-        materials: &[kiln_format::sections::GpuMaterial],
-    ) -> SceneTraits {
+    /// The traits of a scene with `manifest`, and see-through triangles where `see_through`.
+    pub fn of(manifest: &kiln_format::Manifest, see_through: bool) -> SceneTraits {
         SceneTraits {
             lights: manifest.lights.len(),
             rect_lights: manifest
                 .lights
                 .iter()
                 .any(|l| matches!(l.kind, kiln_format::manifest::LightKind::Rect { .. })),
-            see_through: materials.iter().any(|m| m.see_through()),
+            see_through,
         }
     }
 }

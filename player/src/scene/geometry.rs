@@ -3,7 +3,7 @@
 
 use kiln_format::gpu::GpuVertexAttributes;
 use kiln_format::scene::SceneView;
-use kiln_format::sections::Vertex;
+use kiln_format::sections::{GpuMaterial, Vertex};
 
 /// One draw: the triangles of one material, contiguous in the index buffer.
 #[derive(Debug, Clone, Copy)]
@@ -76,6 +76,27 @@ pub(super) fn vertex_attributes(view: &SceneView) -> Vec<GpuVertexAttributes> {
 /// The material of each triangle in draw (index buffer) order.
 pub(super) fn raster_materials(draws: &[Draw]) -> Vec<u32> {
     draws.iter().flat_map(|d| std::iter::repeat_n(d.material, d.count as usize / 3)).collect()
+}
+
+/// The world bounds (min, max) of the triangles of the draws whose material is see-through
+/// ([`GpuMaterial::see_through`]), `None` where no such draw exists: where the see-through
+/// layer may show.
+pub fn see_through_bounds(
+    draws: &[Draw],
+    indices: &[u32],
+    vertices: &[Vertex],
+    materials: &[GpuMaterial],
+) -> Option<[glam::Vec3; 2]> {
+    let mut bounds: Option<[glam::Vec3; 2]> = None;
+    for d in draws.iter().filter(|d| materials.get(d.material as usize).is_some_and(|m| m.see_through())) {
+        let range = d.first as usize..(d.first + d.count) as usize;
+        for &i in indices.get(range).unwrap_or(&[]) {
+            let Some(v) = vertices.get(i as usize) else { continue };
+            let p = glam::Vec3::from(v.position);
+            bounds = Some(bounds.map_or([p, p], |[lo, hi]| [lo.min(p), hi.max(p)]));
+        }
+    }
+    bounds
 }
 
 #[cfg(test)]

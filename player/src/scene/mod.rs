@@ -15,6 +15,7 @@ pub mod environment;
 mod geometry;
 pub mod linespace;
 pub mod media;
+mod prepared;
 pub mod probes;
 pub mod reference;
 mod textures;
@@ -22,6 +23,7 @@ pub mod upload;
 
 pub use geometry::{Draw, sort_by_material, triangle_corners};
 use geometry::{raster_materials, vertex_attributes};
+pub use prepared::Prepared;
 use textures::CoarseTexture;
 pub use textures::{COARSE_SIDE, TextureUpload, first_coarse_level};
 
@@ -80,28 +82,6 @@ impl SectionFate {
     }
 }
 
-/// The CPU side of loading, done while the device is being created: the file validated, the
-/// checksums of every section to upload verified (which also pages them in), and the index
-/// buffer sorted by material.
-pub struct Prepared<'f> {
-    view: SceneView<'f>,
-    needs: Needs,
-    indices: Vec<u32>,
-    draws: Vec<Draw>,
-    /// Triangle corners in leaf order, (x, y, z, 0) each, when the BVH is needed.
-    bvh_triangles: Vec<[f32; 4]>,
-    /// Emitter and texture tables of the reference path tracer.
-    reference: Option<reference::ReferenceTables>,
-    /// Where the line-space arrays go, when a technique reads them.
-    line_space: Option<linespace::LineSpaceLayout>,
-}
-
-impl std::fmt::Debug for Prepared<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Prepared").field("draws", &self.draws.len()).finish()
-    }
-}
-
 /// What one pass of the upload makes resident: the sections `now` reads, and the geometry
 /// (vertices, attributes, sorted indices) in the first pass.
 #[derive(Debug, Clone, Copy)]
@@ -129,80 +109,6 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
 
-impl<'f> Prepared<'f> {
-    /// Validates `file` and prepares what the upload of `needs` copies. First verifies and
-    /// decodes, on all cores, the compressed sections that an upload of `first` reads (the rest
-    /// decode when first read), and returns the wall time of that too: run while the driver
-    /// creates the device, it leaves the upload only copies.
-    pub fn new(file: &'f KilnFile, needs: Needs, first: Needs) -> PlayResult<(Prepared<'f>, f64)> {
-        let t = std::time::Instant::now();
-        let positions: Vec<usize> = file
-            .sections()
-            .iter()
-            .filter(|s| {
-                s.known.is_some()
-                    && (uploads(s.entry.kind, first)
-                        || linespace::LineSpaceLayout::may_upload(s.entry.kind, first.line_space))
-            })
-            .map(|s| s.position)
-            .collect();
-        // Sections whose length a record fixes are compared with it first, without decoding.
-        kiln_format::scene::check_declared_sizes(file).map_err(bad)?;
-        file.decode_sections(&positions).map_err(bad)?;
-        let decode_ms = t.elapsed().as_secs_f64() * 1e3;
-        let view = SceneView::new(file).map_err(bad)?;
-        let line_space = if needs.line_space & linespace::LsArrays::ALL != 0 {
-            linespace::LineSpaceLayout::new(
-                file,
-                view.triangles.len(),
-                view.materials.len(),
-                needs.line_space,
-            )?
-        } else {
-            None
-        };
-        for s in file.sections() {
-            let ls = line_space.as_ref().is_some_and(|l| l.uploads(s.entry.kind));
-            if s.known.is_some() && (uploads(s.entry.kind, needs) || ls) {
-                file.verify_section(s.position).map_err(bad)?;
-            }
-        }
-        let (indices, draws) =
-            sort_by_material(view.triangles, view.triangle_materials, view.materials.len());
-        let bvh_triangles =
-            if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
-        // The ray-traced passes read each texture as stored (RGBA8 or BC blocks, the GLSL decodes
-        // them); their table needs each texture's format and swizzle from its section header.
-        let storage = if needs.scene_buffers && needs.textures {
-            (0..view.manifest.textures.len())
-                .map(|i| view.texture(i).map(|t| (t.format, t.swizzle)))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(bad)?
-        } else {
-            Vec::new()
-        };
-        let emitter_luminance = view.emitter_luminance().map_err(bad)?;
-        let reference = needs.scene_buffers.then(|| {
-            reference::tables(
-                &view.manifest,
-                view.vertices,
-                view.triangles,
-                view.triangle_materials,
-                &view.materials,
-                &storage,
-                emitter_luminance,
-            )
-        });
-        Ok((Prepared { view, needs, indices, draws, bvh_triangles, reference, line_space }, decode_ms))
-    }
-
-    /// How the passes that read the texel buffer must decode it: from the texture table they
-    /// read (the formats in the textures' section headers), known before any section uploads.
-    pub fn texel_decode(&self) -> TexelDecode {
-        self.reference.as_ref().map_or(TexelDecode::Rgba8, |r| TexelDecode::of(&r.textures))
-    }
-}
-
 impl GpuScene {
     /// Descriptor writes of what every ray-traced pass reads ([`bindings::TABLE`] but the
     /// lights, which the pass writes). `None` without the BVH or the scene buffers.
@@ -227,36 +133,6 @@ impl GpuScene {
         self.environment.as_ref().map(|e| e.writes(first)).ok_or_else(|| {
             PlayError::new(Exit::Gpu, "the environment's buffers were not uploaded with the geometry")
         })
-    }
-}
-
-/// [`GpuScene::see_through_bounds`] of a prepared file.
-fn see_through_bounds(prepared: &Prepared) -> Option<[glam::Vec3; 2]> {
-    let (vertices, materials) = (prepared.view.vertices, &prepared.view.materials);
-    let mut bounds: Option<[glam::Vec3; 2]> = None;
-    for d in &prepared.draws {
-        if !materials.get(d.material as usize).is_some_and(|m| m.see_through()) {
-            continue;
-        }
-        let range = d.first as usize..(d.first + d.count) as usize;
-        for &i in prepared.indices.get(range).unwrap_or(&[]) {
-            let Some(v) = vertices.get(i as usize) else { continue };
-            let p = glam::Vec3::from(v.position);
-            bounds = Some(bounds.map_or([p, p], |[lo, hi]| [lo.min(p), hi.max(p)]));
-        }
-    }
-    bounds
-}
-
-impl Prepared<'_> {
-    /// The file's manifest.
-    pub fn manifest(&self) -> &kiln_format::Manifest {
-        &self.view.manifest
-    }
-
-    /// The file's materials.
-    pub fn materials(&self) -> &[kiln_format::sections::GpuMaterial] {
-        &self.view.materials
     }
 }
 
@@ -435,7 +311,7 @@ impl GpuScene {
             attributes,
             indices,
             draws: prepared.draws.clone(),
-            see_through_bounds: see_through_bounds(prepared),
+            see_through_bounds: prepared.see_through_bounds,
             materials: view.materials.to_vec(),
             coarse: Vec::new(),
             textures: Vec::new(),

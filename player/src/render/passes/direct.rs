@@ -78,8 +78,6 @@ pub struct DirectPass {
     gbuffer: [TargetDecl; 5],
     output: TargetDecl,
     name: &'static str,
-    /// Whether it lights the see-through layer, over that layer's screen area alone.
-    see_through: bool,
 }
 
 impl DirectPass {
@@ -131,8 +129,7 @@ impl DirectPass {
             PUSH_BYTES,
             constants,
         )?;
-        let see_through = output == see_through::RADIANCE;
-        Ok(DirectPass { kernel, inputs, gbuffer, output, name, see_through })
+        Ok(DirectPass { kernel, inputs, gbuffer, output, name })
     }
 
     /// Specialization constants by id (`direct.comp`): 0 is unused (the texel decoders' id), then
@@ -212,7 +209,7 @@ impl Pass for DirectPass {
         io.push((self.output, Access::Write(Use::STORAGE)));
         ctx.images.access(ctx.rec, &io);
         // The see-through layer is lit over its screen area alone; the frame everywhere.
-        let area = if self.see_through {
+        let area = if self.output == see_through::RADIANCE {
             ctx.see_through_area
         } else {
             vk::Rect2D {
