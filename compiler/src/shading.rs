@@ -20,7 +20,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use kiln_format::manifest::{Light, LightKind, Wrap};
 use kiln_format::query::{BvhQuery, IndexedTriangles, Ray, offset_origin};
-use kiln_format::sections::{CwbvhNode, GpuMaterial, MaterialFlags, NO_TEXTURE, Vertex};
+use kiln_format::sections::{CwbvhNode, GpuMaterial, NO_TEXTURE, Vertex};
 
 use crate::ir::{Texture, TextureRole};
 
@@ -127,7 +127,7 @@ impl ShadingScene<'_> {
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),
             emission,
-            diffuse_only: g.flags & MaterialFlags::DIFFUSE_ONLY != 0,
+            diffuse_only: g.diffuse_only(),
             dielectric: {
                 let (f0, f90) = g.dielectric();
                 (Vec3::from(f0), f90)

@@ -155,4 +155,19 @@ vec3 transmitted_brdf(Material m, vec3 n, vec3 v, vec3 l) {
     return m.clearcoat > 0.0 ? through * (1.0 - coat_weight(m.clearcoat, n_v)) : through;
 }
 
+// The share of the light from straight behind a thin-walled transmitting surface that its
+// transmitted lobe lets through towards the viewer: the lobe's directional albedo without its
+// Fresnel reflectance, (1 − metallic) t base ((R + G) − (F0 R + F90 G)) from the split-sum
+// table's `rg` at n·v = `n_v` and the roughness (the integral of `transmitted_lobe`'s
+// (1 − F) D Vis cos over the lobe), times the 1 − w a clear coat lets through. Zero for
+// materials that do not transmit.
+vec3 transmitted_albedo(Material m, float n_v, vec2 rg) {
+    if (m.transmission <= 0.0 || m.diffuse_only) {
+        return vec3(0.0);
+    }
+    vec3 lobe = vec3(rg.r + rg.g) - (fresnel_f0(m) * rg.r + fresnel_f90(m) * rg.g);
+    vec3 through = (1.0 - m.metallic) * m.transmission * m.base * max(lobe, vec3(0.0));
+    return m.clearcoat > 0.0 ? through * (1.0 - coat_weight(m.clearcoat, n_v)) : through;
+}
+
 #endif

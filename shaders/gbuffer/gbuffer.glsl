@@ -15,11 +15,8 @@
 //   0 absorbed  RGBA16F     summed over every see-through surface in front of the opaque one:
 //                           −ln of the share of the light from straight behind that the surface
 //                           lets through towards the camera, a T + (1 − a) for coverage a and
-//                           T = t (1 − metallic) base · ((R + G) − (F0 R + F90 G)) · (1 − w):
-//                           its transmitted lobe's directional albedo without its Fresnel
-//                           reflectance (the split-sum table's R, G at n·v and its roughness:
-//                           the integral of (1 − F) D Vis cos over the lobe), times the 1 − w a
-//                           clear coat lets through; T 0 where it does not transmit
+//                           T its `transmitted_albedo` (common/brdf.glsl; 0 where it does not
+//                           transmit)
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 #include "../common/normalmap.glsl"
@@ -146,21 +143,18 @@ void main() {
     out_emission = vec4(emission, gbuffer_coat(coat, coat_roughness));
     out_triangle = in_first_triangle + uint(gl_PrimitiveID) + 1u;
 #ifdef SEE_THROUGH
-    vec3 through = vec3(0.0);
-    bool diffuse_only = (material.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
-    if (transmission > 0.0 && !diffuse_only) {
-        vec3 v = towards_camera(in_position);
-        float n_v = clamp(abs(dot(n, v)), 1e-4, 1.0);
-        float r = clamp(roughness, 0.0, 1.0);
-        vec2 rg = frame.params.y >= 1.0 ? texture(brdf_lut, vec2(n_v, r)).rg : vec2(1.0, 0.0);
-        vec3 f0;
-        float f90;
-        material_dielectric(material, f0, f90);
-        float m = clamp(metallic, 0.0, 1.0);
-        vec3 lobe = vec3(rg.r + rg.g) - (mix(f0, base.rgb, m) * rg.r + mix(f90, 1.0, m) * rg.g);
-        through = clamp(transmission, 0.0, 1.0) * (1.0 - m) * base.rgb * max(lobe, vec3(0.0))
-            * (1.0 - coat_weight(clamp(coat, 0.0, 1.0), n_v));
-    }
+    Material lit;
+    lit.base = base.rgb;
+    lit.metallic = clamp(metallic, 0.0, 1.0);
+    lit.roughness = clamp(roughness, 0.0, 1.0);
+    lit.diffuse_only = (material.flags & MATERIAL_DIFFUSE_ONLY) != 0u;
+    material_dielectric(material, lit.f0, lit.f90);
+    lit.clearcoat = clamp(coat, 0.0, 1.0);
+    lit.clearcoat_roughness = clamp(coat_roughness, 0.0, 1.0);
+    lit.transmission = clamp(transmission, 0.0, 1.0);
+    float n_v = clamp(abs(dot(n, towards_camera(in_position))), 1e-4, 1.0);
+    vec2 rg = frame.params.y >= 1.0 ? texture(brdf_lut, vec2(n_v, lit.roughness)).rg : vec2(1.0, 0.0);
+    vec3 through = transmitted_albedo(lit, n_v, rg);
     vec3 passed = coverage * through + (1.0 - coverage);
     out_absorbed = vec4(-log(max(passed, vec3(1e-6))), 0.0);
 #endif

@@ -129,12 +129,10 @@ fn probe_plan(
     });
     let layers = if emits { 2 } else { 1 };
     let budget = settings.probe_budget as u64 * (1 << 20);
-    let glossy = scene.triangle_materials.iter().any(|&m| {
-        scene
-            .materials
-            .get(m as usize)
-            .is_some_and(|m| m.gpu.flags & kiln_format::sections::MaterialFlags::DIFFUSE_ONLY == 0)
-    });
+    let glossy = scene
+        .triangle_materials
+        .iter()
+        .any(|&m| scene.materials.get(m as usize).is_some_and(|m| !m.gpu.diffuse_only()));
     let rays = settings.probe_rays.unwrap_or(if glossy {
         crate::settings::PROBE_RAYS_GLOSSY
     } else {
@@ -264,11 +262,7 @@ impl Plan {
             run(Stage::Bvh, format!("CWBVH, preset {}", settings.bvh_preset.name())),
         ];
         let mut stages = stages;
-        let specular = scene
-            .materials
-            .iter()
-            .filter(|m| m.gpu.flags & kiln_format::sections::MaterialFlags::DIFFUSE_ONLY == 0)
-            .count();
+        let specular = scene.materials.iter().filter(|m| !m.gpu.diffuse_only()).count();
         stages.push(if specular == 0 {
             skip(Stage::BrdfLut, "every material is pure Lambertian: no specular lobe to pre-integrate")
         } else {

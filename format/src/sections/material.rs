@@ -218,8 +218,14 @@ impl GpuMaterial {
     pub fn see_through(&self) -> bool {
         let blended = self.alpha_mode() == Some(AlphaMode::Blend)
             && (self.base_color[3] < 1.0 || self.base_color_texture != NO_TEXTURE);
-        let transmits = self.transmission > 0.0 && (self.flags & MaterialFlags::DIFFUSE_ONLY) == 0;
+        let transmits = self.transmission > 0.0 && !self.diffuse_only();
         blended || transmits
+    }
+
+    /// Whether the material is pure Lambertian, without a specular lobe
+    /// ([`MaterialFlags::DIFFUSE_ONLY`]).
+    pub fn diffuse_only(&self) -> bool {
+        self.flags & MaterialFlags::DIFFUSE_ONLY != 0
     }
 
     /// The alpha mode, if the bits hold a defined one.

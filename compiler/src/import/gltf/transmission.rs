@@ -11,7 +11,7 @@
 //! from its transmission.
 
 use ::gltf::Texture;
-use kiln_format::sections::{GpuMaterial, MaterialFlags};
+use kiln_format::sections::GpuMaterial;
 
 use super::{Importer, UvMapping};
 use crate::exit::CliResult;
@@ -38,7 +38,7 @@ impl Importer<'_> {
         if factor == 0.0 {
             return Ok(None);
         }
-        if gpu.flags & MaterialFlags::DIFFUSE_ONLY != 0 {
+        if gpu.diffuse_only() {
             // Not reachable from glTF today (diffuse-only is OBJ's Ks 0), kept honest anyway.
             self.scene
                 .warn(format!("{at}: KHR_materials_transmission on a diffuse-only material is not applied"));
