@@ -1,6 +1,6 @@
 #version 460
 #extension GL_EXT_control_flow_attributes : require
-// The reference path tracer: one unbiased sample per pixel per dispatch, accumulated.
+// The reference path tracer: unbiased samples per pixel, `sample_count` per dispatch, accumulated.
 //
 // Paths: camera rays jittered over the pixel (box filter); at each vertex next-event estimation
 // towards one emitter chosen in proportion to its power (analytic lights, emissive triangles),
@@ -43,8 +43,12 @@ layout(set = 0, binding = 13, rgba32f) uniform image2D accumulation;
 layout(set = 0, binding = 14, std430) readonly buffer Media { GpuMedium media[]; };
 #define ENV_BINDING 15
 #include "../common/environment.glsl"   // bindings 15-16
-// Index of this sample (0 first): 0 overwrites the accumulation, later ones add to it.
-layout(push_constant) uniform Sample { uint sample_index; };
+// The dispatch's samples: `sample_count` of them from index `sample_index` (0 first: the
+// dispatch starting at 0 overwrites the accumulation, later ones add to it).
+layout(push_constant) uniform Samples {
+    uint sample_index;
+    uint sample_count;
+};
 
 #include "../common/random.glsl"
 // The materials' textures are filtered stochastically (`common/textures.glsl`): one texel of
@@ -247,93 +251,19 @@ vec3 medium_emitter(vec3 p, vec3 d_in) {
 }
 
 // ---------------------------------------------------------------- paths
-vec3 radiance(TraceRay r) {
-    vec3 result = vec3(0.0);
-    vec3 throughput = vec3(1.0);
-    float pdf_brdf = 0.0;  // density of the last BRDF sample; 0 for camera rays (no MIS)
-    float pdf_env = 0.0;   // pdf_brdf where the last vertex also sampled the environment, else 0
-    vec3 last_p = r.origin;
-    for (uint depth = 0u; depth < rc.params.y; depth++) {
-        TraceHit h = trace(r, false);
-        float tmax = h.t == NO_HIT ? FAR : h.t;
-        segment_origin = r.origin;
-        segment_dir = r.direction;
-        float t_flight = tmax;
-        vec3 flight = vec3(1.0);
-        bool scattered = medium_count() != 0u && sample_flight(r.origin, r.direction, tmax, t_flight, flight);
-        result += throughput * rect_lights_seen(r.origin, r.direction, t_flight, pdf_brdf);
-        throughput *= flight;
-        if (scattered) {
-            if (rc.params.w != 0u && depth >= rc.params.w) {
-                break;
-            }
-            vec3 p = r.origin + t_flight * r.direction;
-            result += throughput * medium_emitter(p, r.direction);
-            vec3 wi = sample_phase(p, r.direction);
-            vec3 f = phase(p, r.direction, wi, pdf_brdf);
-            pdf_env = 0.0;
-            if (pdf_brdf <= 0.0) {
-                break;
-            }
-            throughput *= f / pdf_brdf;
-            if (depth >= 3u) {
-                float q = min(max(throughput.r, max(throughput.g, throughput.b)), 0.95);
-                if (rnd() >= q) {
-                    break;
-                }
-                throughput /= q;
-            }
-            if (all(equal(throughput, vec3(0.0)))) {
-                break;
-            }
-            r = make_ray(p, wi, 0.0, FAR);
-            continue;
-        }
-        if (h.t == NO_HIT) {
-            vec3 d = normalize(r.direction);
-            result += throughput * env_radiance(d, rc.sky.rgb) * environment_seen_weight(d, pdf_env);
-            break;
-        }
-        Surface s = surface_at(r, h);
-        if (any(greaterThan(s.emission, vec3(0.0)))) {
-            float d = h.t * length(r.direction);
-            float cos_l = abs(dot(s.ng, normalize(r.direction)));
-            result += throughput * s.emission * triangle_emission_weight(h.triangle, d, cos_l, pdf_brdf);
-        }
-        if (rc.params.w != 0u && depth >= rc.params.w) {
-            break;
-        }
-        vec3 wo = -normalize(r.direction);
-        result += throughput * sample_emitter(s, wo, true);
-        result += throughput * sample_environment(s, wo, rc.sky.rgb, true);
-        vec3 wi = sample_brdf(s, wo);
-        pdf_brdf = brdf_pdf(s, wo, wi);
-        pdf_env = pdf_brdf;
-        if (pdf_brdf <= 0.0) {
-            break;
-        }
-        throughput *= brdf_cos(s, wo, wi) / pdf_brdf;
-        if (depth >= 3u) {
-            float q = min(max(throughput.r, max(throughput.g, throughput.b)), 0.95);
-            if (rnd() >= q) {
-                break;
-            }
-            throughput /= q;
-        }
-        if (all(equal(throughput, vec3(0.0)))) {
-            break;
-        }
-        r = make_ray(offset_ray_origin(s.p, facing(s.ng, wi)), wi, 0.0, FAR);
-    }
-    return result;
-}
+// A path being sampled: the ray of its next segment and what it has gathered.
+struct Path {
+    TraceRay r;
+    vec3 result;
+    vec3 throughput;
+    float pdf_brdf;  // density of the last BRDF sample; 0 for camera rays (no MIS)
+    float pdf_env;   // pdf_brdf where the last vertex also sampled the environment, else 0
+    uint depth;
+};
 
-void main() {
-    uvec2 pixel = gl_GlobalInvocationID.xy;
-    if (any(greaterThanEqual(pixel, rc.size.xy))) {
-        return;
-    }
-    rng = hash(pixel.x + rc.size.x * pixel.y) ^ hash(sample_index * 0x9e3779b9u + rc.params.z);
+// Sample `index` of `pixel`: its random sequence and its camera ray, jittered over the pixel.
+Path start_path(uvec2 pixel, uint index) {
+    rng = hash(pixel.x + rc.size.x * pixel.y) ^ hash(index * 0x9e3779b9u + rc.params.z);
     vec2 jitter = vec2(rnd(), rnd());
     vec2 ndc = vec2((float(pixel.x) + jitter.x) / float(rc.size.x) * 2.0 - 1.0, 1.0 - (float(pixel.y) + jitter.y) / float(rc.size.y) * 2.0);
     // Perspective (up.w = 0): eye.w is tan(vfov / 2), right.w the aspect ratio. Orthographic
@@ -341,11 +271,124 @@ void main() {
     vec3 offset = (rc.right.xyz * ndc.x * rc.right.w + rc.up.xyz * ndc.y) * rc.eye.w;
     bool ortho = rc.up.w != 0.0;
     vec3 dir = ortho ? rc.forward.xyz : normalize(rc.forward.xyz + offset);
-    vec3 l = radiance(make_ray(ortho ? rc.eye.xyz + offset : rc.eye.xyz, dir, 0.0, 3.4e38));
-    // A non-finite sample would poison the average; it is dropped (counted as zero).
-    if (any(isnan(l)) || any(isinf(l))) {
-        l = vec3(0.0);
+    Path path;
+    path.r = make_ray(ortho ? rc.eye.xyz + offset : rc.eye.xyz, dir, 0.0, 3.4e38);
+    path.result = vec3(0.0);
+    path.throughput = vec3(1.0);
+    path.pdf_brdf = 0.0;
+    path.pdf_env = 0.0;
+    path.depth = 0u;
+    return path;
+}
+
+// Russian roulette from the fourth vertex: false where the path ends.
+bool survives(inout Path path) {
+    if (path.depth >= 3u) {
+        float q = min(max(path.throughput.r, max(path.throughput.g, path.throughput.b)), 0.95);
+        if (rnd() >= q) {
+            return false;
+        }
+        path.throughput /= q;
     }
-    vec3 sum = sample_index == 0u ? l : imageLoad(accumulation, ivec2(pixel)).rgb + l;
+    return !all(equal(path.throughput, vec3(0.0)));
+}
+
+// One vertex of the path: traces its segment, gathers the light found there and sets up the
+// next segment. False once the path has ended.
+bool extend(inout Path path) {
+    if (path.depth >= rc.params.y) {
+        return false;
+    }
+    TraceRay r = path.r;
+    TraceHit h = trace(r, false);
+    float tmax = h.t == NO_HIT ? FAR : h.t;
+    segment_origin = r.origin;
+    segment_dir = r.direction;
+    float t_flight = tmax;
+    vec3 flight = vec3(1.0);
+    bool scattered = medium_count() != 0u && sample_flight(r.origin, r.direction, tmax, t_flight, flight);
+    path.result += path.throughput * rect_lights_seen(r.origin, r.direction, t_flight, path.pdf_brdf);
+    path.throughput *= flight;
+    bool last = rc.params.w != 0u && path.depth >= rc.params.w;
+    if (scattered) {
+        if (last) {
+            return false;
+        }
+        vec3 p = r.origin + t_flight * r.direction;
+        path.result += path.throughput * medium_emitter(p, r.direction);
+        vec3 wi = sample_phase(p, r.direction);
+        vec3 f = phase(p, r.direction, wi, path.pdf_brdf);
+        path.pdf_env = 0.0;
+        if (path.pdf_brdf <= 0.0) {
+            return false;
+        }
+        path.throughput *= f / path.pdf_brdf;
+        if (!survives(path)) {
+            return false;
+        }
+        path.r = make_ray(p, wi, 0.0, FAR);
+        path.depth++;
+        return true;
+    }
+    if (h.t == NO_HIT) {
+        vec3 d = normalize(r.direction);
+        path.result += path.throughput * env_radiance(d, rc.sky.rgb) * environment_seen_weight(d, path.pdf_env);
+        return false;
+    }
+    Surface s = surface_at(r, h);
+    if (any(greaterThan(s.emission, vec3(0.0)))) {
+        float d = h.t * length(r.direction);
+        float cos_l = abs(dot(s.ng, normalize(r.direction)));
+        path.result += path.throughput * s.emission * triangle_emission_weight(h.triangle, d, cos_l, path.pdf_brdf);
+    }
+    if (last) {
+        return false;
+    }
+    vec3 wo = -normalize(r.direction);
+    path.result += path.throughput * sample_emitter(s, wo, true);
+    path.result += path.throughput * sample_environment(s, wo, rc.sky.rgb, true);
+    vec3 wi = sample_brdf(s, wo);
+    path.pdf_brdf = brdf_pdf(s, wo, wi);
+    path.pdf_env = path.pdf_brdf;
+    if (path.pdf_brdf <= 0.0) {
+        return false;
+    }
+    path.throughput *= brdf_cos(s, wo, wi) / path.pdf_brdf;
+    if (!survives(path)) {
+        return false;
+    }
+    path.r = make_ray(offset_ray_origin(s.p, facing(s.ng, wi)), wi, 0.0, FAR);
+    path.depth++;
+    return true;
+}
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, rc.size.xy))) {
+        return;
+    }
+    // The dispatch's samples as one loop of vertices (path regeneration): an invocation whose
+    // path has ended starts its pixel's next sample at once, where a loop over samples would
+    // leave it idle until the longest path of its subgroup ended. Paths' lengths vary most
+    // where glass and metal keep their throughput (ToyCar); the idle share shrinks as the
+    // dispatch's samples grow.
+    vec3 sum = vec3(0.0);
+    uint taken = 0u;
+    Path path = start_path(pixel, sample_index);
+    while (taken < sample_count) {
+        if (!extend(path)) {
+            // A non-finite sample would poison the average; it is dropped (counted as zero).
+            if (!any(isnan(path.result)) && !any(isinf(path.result))) {
+                sum += path.result;
+            }
+            taken++;
+            if (taken < sample_count) {
+                path = start_path(pixel, sample_index + taken);
+            }
+        }
+    }
+    if (sample_index != 0u) {
+        sum += imageLoad(accumulation, ivec2(pixel)).rgb;
+    }
     imageStore(accumulation, ivec2(pixel), vec4(sum, 1.0));
 }

@@ -1,5 +1,5 @@
-//! The reference path tracer's pass (`shaders/reference/pathtrace.comp`): one unbiased sample
-//! per pixel per dispatch, summed into an accumulation target. [`crate::reference`] drives it
+//! The reference path tracer's pass (`shaders/reference/pathtrace.comp`): unbiased samples per
+//! pixel, several per dispatch, summed into an accumulation target. [`crate::reference`] drives it
 //! for a fixed sample count and writes the mean.
 
 use crate::gpu::vk;
@@ -41,7 +41,7 @@ impl PathTracePass {
             gpu,
             &bindings,
             spirv::shader!("reference/pathtrace.comp"),
-            std::mem::size_of::<u32>() as u32,
+            std::mem::size_of::<[u32; 2]>() as u32,
             decode,
         )?))
     }
@@ -77,9 +77,10 @@ impl PathTracePass {
         self.0.write(gpu, &writes)
     }
 
-    /// Records sample `index` (0 overwrites the accumulation, later ones add to it).
-    pub fn record(&self, rec: &crate::gpu::Recorder, images: &mut FrameImages, index: u32) {
+    /// Records samples `first .. first + count` (first 0 overwrites the accumulation, later
+    /// ones add to it).
+    pub fn record(&self, rec: &crate::gpu::Recorder, images: &mut FrameImages, first: u32, count: u32) {
         images.access(rec, &[(ACCUMULATION, Access::ReadWrite(Use::STORAGE))]);
-        self.0.dispatch(rec, bytemuck::bytes_of(&index), images.width, images.height);
+        self.0.dispatch(rec, bytemuck::bytes_of(&[first, count]), images.width, images.height);
     }
 }
