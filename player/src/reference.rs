@@ -164,27 +164,36 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
         let t0 = Instant::now();
         let progress = progress && std::io::stderr().is_terminal();
         let mut taken = 0u32;
-        // Batches grow until one takes about 50 ms: few submissions, yet no long-running
-        // command buffer that a watchdog could take for a hang.
-        let mut batch = 1u32;
+        // A dispatch takes a few samples per pixel, more (up to SAMPLES_PER_DISPATCH) while
+        // one stays short; a submission holds more dispatches while it takes under 25 ms: few
+        // submissions, yet no long-running dispatch or command buffer that a watchdog could
+        // take for a hang.
+        let mut per_dispatch = 4u32.min(SAMPLES_PER_DISPATCH);
+        let mut dispatches = 1u32;
         while taken < spp {
-            let n = batch.min(spp - taken);
             let started = Instant::now();
             let rec = pool.begin(gpu)?;
             let mut recorded = 0;
-            while recorded < n {
-                let count = (n - recorded).min(SAMPLES_PER_DISPATCH);
+            let mut recorded_dispatches = 0;
+            while recorded_dispatches < dispatches && taken + recorded < spp {
+                let count = per_dispatch.min(spp - taken - recorded);
                 pass.record(&rec, images, taken + recorded, count);
                 recorded += count;
+                recorded_dispatches += 1;
             }
             pool.submit(gpu, &[], &[])?;
             pool.wait(gpu)?;
-            taken += n;
+            taken += recorded;
             let ms = started.elapsed().as_secs_f64() * 1e3;
-            if ms < 25.0 {
-                batch = (batch * 2).min(256);
-            } else if ms > 100.0 && batch > 1 {
-                batch /= 2;
+            let per = ms / recorded_dispatches as f64;
+            if per < 50.0 && per_dispatch < SAMPLES_PER_DISPATCH {
+                per_dispatch *= 2;
+            } else if per > 200.0 && per_dispatch > 1 {
+                per_dispatch /= 2;
+            } else if ms < 25.0 {
+                dispatches = (dispatches * 2).min(256);
+            } else if ms > 100.0 && dispatches > 1 {
+                dispatches /= 2;
             }
             if progress {
                 eprint!("\r{taken}/{spp} samples per pixel ({:.1} s)", t0.elapsed().as_secs_f64());

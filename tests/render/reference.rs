@@ -70,7 +70,24 @@ fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
     // point receives the same radiance, so the light after at most N scattering events is
     // Le (1 + ρ + … + ρ^N) everywhere, and Le / (1 − ρ) without a limit. The bounce limit that
     // kiln-bench uses for its direct-light and two-bounce references must give exactly these.
-    let (emission, rho) = (1.0f32, 0.5f64);
+    let rho = 0.5f64;
+    let file = glowing_box(dir.path(), rho);
+    let o = Options::new(&file, W, H).reference().build();
+    for (bounces, expected) in [(1u32, 1.0 + rho), (2, 1.0 + rho + rho * rho), (0, 1.0 / (1.0 - rho))] {
+        let sampling =
+            kiln_player::reference::Sampling { bounces, ..kiln_player::reference::Sampling::new(64) };
+        let (_, rgb) =
+            kiln_player::reference::render_with(&o, sampling, Instant::now()).expect("reference render");
+        let mean = rgb.iter().map(|&v| v as f64).sum::<f64>() / rgb.len() as f64;
+        eprintln!("{bounces} bounces (0: all): mean {mean:.4}, expected {expected:.4}");
+        assert!((mean / expected - 1.0).abs() < 0.01, "{bounces} bounces: mean {mean}, expected {expected}");
+    }
+}
+
+/// A closed box, the cube [-1, 1]³, whose walls all emit 1 and reflect diffusely with albedo
+/// `rho`, seen from inside; written to `dir`.
+fn glowing_box(dir: &std::path::Path, rho: f64) -> std::path::PathBuf {
+    let emission = 1.0f32;
     let mut tris = Vec::new();
     for axis in 0..3 {
         for sign in [-1.0f32, 1.0] {
@@ -92,18 +109,41 @@ fn reference_path_tracer_counts_exactly_the_bounces_it_is_limited_to() {
     scene.sky = Sky { radiance: [0.0; 3] };
     let cam = Pinhole::new([0.0, 0.2, 0.5], [0.3, 0.0, -1.0], [0.0, 1.0, 0.0], 70.0, W, H);
     scene.cameras.push(cam.file_camera());
-    let file = dir.path().join("glowing-box.kiln");
+    let file = dir.join("glowing-box.kiln");
     std::fs::write(&file, compile(scene, fast_settings())).unwrap();
+    file
+}
+
+#[test]
+fn reference_samples_taken_in_one_dispatch_are_independent() {
+    let dir = gpu_test!();
+    // The path tracer takes several samples per pixel in one dispatch, starting the next as a
+    // path ends. The mean of N independent samples has 1/N of their variance: between two
+    // 16-sample images of different seeds, the squared differences must be 1/16 of those
+    // between two one-sample images. A sample repeated, or drawn from its predecessor's
+    // sequence, within a dispatch would leave more. Inside the glowing box every path ends by
+    // Russian roulette after a random number of bounces, so the invocations of one dispatch
+    // regenerate at different times.
+    let file = glowing_box(dir.path(), 0.5);
     let o = Options::new(&file, W, H).reference().build();
-    for (bounces, expected) in [(1u32, 1.0 + rho), (2, 1.0 + rho + rho * rho), (0, 1.0 / (1.0 - rho))] {
+    let render = |spp: u32, seed: u32| {
         let sampling =
-            kiln_player::reference::Sampling { bounces, ..kiln_player::reference::Sampling::new(64) };
-        let (_, rgb) =
-            kiln_player::reference::render_with(&o, sampling, Instant::now()).expect("reference render");
-        let mean = rgb.iter().map(|&v| v as f64).sum::<f64>() / rgb.len() as f64;
-        eprintln!("{bounces} bounces (0: all): mean {mean:.4}, expected {expected:.4}");
-        assert!((mean / expected - 1.0).abs() < 0.01, "{bounces} bounces: mean {mean}, expected {expected}");
-    }
+            kiln_player::reference::Sampling { seed, ..kiln_player::reference::Sampling::new(spp) };
+        kiln_player::reference::render_with(&o, sampling, Instant::now()).expect("reference render").1
+    };
+    let variance = |a: &[f32], b: &[f32]| {
+        a.iter().zip(b).map(|(&x, &y)| (x as f64 - y as f64).powi(2)).sum::<f64>() / (2.0 * a.len() as f64)
+    };
+    // Paths of random length make the one-sample variance heavy-tailed: it is averaged over
+    // four pairs of images.
+    let one = (0..4).map(|k| variance(&render(1, 2 * k + 11), &render(1, 2 * k + 12))).sum::<f64>() / 4.0;
+    let sixteen = variance(&render(16, 21), &render(16, 22));
+    let ratio = one / sixteen;
+    eprintln!(
+        "per-pixel variance: 1 sample {one:.5}, 16 samples {sixteen:.6}, ratio {ratio:.2} (expected 16)"
+    );
+    assert!(one > 0.01, "the one-sample images barely differ ({one}): the test sees no noise");
+    assert!((12.0..21.0).contains(&ratio), "16 samples reduce the variance {ratio:.2}×, not 16×");
 }
 
 #[test]
