@@ -682,6 +682,46 @@ fn emitted_luminance_averages_the_emissive_texture_over_each_triangle() {
     }
 }
 
+/// A triangle over a two-texel ramp of its emissive texture (white then black, bilinear,
+/// clamped) weighs what it emits on average. Its texture coordinates (0, 0), (1, 0), (1, 1) make
+/// u = s + r of its barycentric weights, whose density over the triangle is 2u; the radiance is
+/// 1 up to u = 1/4, 0 past 3/4 and 3/2 − 2u between, so the mean is
+/// ∫₀^¼ 2u du + ∫_¼^¾ (3/2 − 2u) 2u du = 1/16 + 5/24 = 13/48 of the factor (0.2708).
+#[test]
+fn emitted_luminance_of_a_triangle_over_a_few_texels_is_its_mean() {
+    use kiln_compiler::ir::{Texture, TextureRole};
+    use kiln_format::manifest::Wrap;
+    let mut s = Scene { name: "ramp".into(), ..Default::default() };
+    s.textures.push(Texture {
+        name: "ramp".into(),
+        width: 2,
+        height: 1,
+        rgba: vec![255, 255, 255, 255, 0, 0, 0, 255],
+        role: TextureRole::Color,
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::ClampToEdge,
+        mag_linear: true,
+    });
+    let mut m = kiln_compiler::import::demo::lambert_material([0.5; 3]);
+    m.emission = [1.0; 3];
+    m.emissive_texture = 0;
+    s.materials.push(Material { name: "ramp".into(), gpu: m });
+    for (p, uv) in
+        [([0.0, 0.0, 0.0], [0.0, 0.0]), ([1.0, 0.0, 0.0], [1.0, 0.0]), ([1.0, 0.0, -1.0], [1.0, 1.0])]
+    {
+        s.vertices.push(Vertex { position: p, normal: [0.0, 1.0, 0.0] });
+        s.uvs.push(uv);
+    }
+    s.triangles.push([0, 1, 2]);
+    s.triangle_materials.push(0);
+    let bytes = compile(s, Settings { shaft_variants: Some(0), ..Default::default() });
+    let file = KilnFile::from_bytes(&bytes, Checksums::Eager).unwrap();
+    let view = SceneView::new(&file).unwrap();
+    let lum: &[f32] = view.emitter_luminance().unwrap().expect("an emissive texture: the section");
+    let want = 13.0 / 48.0;
+    assert!((lum[0] - want).abs() < 0.03 * want, "mean emitted luminance {} against {want}", lum[0]);
+}
+
 #[test]
 fn the_environment_on_the_command_line_plans_inspects_and_exports() {
     let dir = tempfile::tempdir().unwrap();

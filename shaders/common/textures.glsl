@@ -129,6 +129,20 @@ vec4 stochastic_bilinear(GpuTexture t, vec2 uv) {
 }
 #endif
 
+// Mip 0 as `sample_texture` filters it, for what an estimator is linear in (emitted radiance):
+// with TEXTURE_STOCHASTIC, one texel of the bilinear footprint chosen by its weight (the same
+// mean; ToyCar's lamps' emissive texture, sampled at every vertex's next-event estimation, is
+// then decoded once instead of four times).
+vec4 sample_texture_linear(uint index, vec2 uv) {
+#ifdef TEXTURE_STOCHASTIC
+    GpuTexture t = textures[index];
+    if ((t.flags & TEXTURE_LINEAR) != 0u) {
+        return stochastic_bilinear(t, uv);
+    }
+#endif
+    return sample_texture(index, uv);
+}
+
 // Trilinear filtering with the level chosen from the uv footprint of a pixel (the larger of its
 // two screen-axis derivatives, as isotropic hardware filtering does); magnification follows the
 // texture's filter.

@@ -339,3 +339,71 @@ fn a_white_furnace_converges_to_the_geometric_series_of_its_bounces() {
     assert!((mean / series(4) - 1.0).abs() < 0.01, "direct + GI: mean {mean}, expected {}", series(4));
     assert!(worst < 0.1, "direct + GI: 5 % of the pixels are over {:.2}% off", worst * 100.0);
 }
+
+#[test]
+fn the_reference_lights_the_floor_from_a_bilinearly_filtered_emissive_texture() {
+    let dir = gpu_test!();
+    // The quad's emissive texture is two texels, white then black, filtered bilinearly and
+    // clamped: the emitted radiance is 4 where s ≤ 1/4, 0 where s ≥ 3/4, and falls linearly
+    // between. By parts, the irradiance is then 2 ∫ E(p, s) ds over s ∈ [1/4, 3/4], E(p, s)
+    // the closed form of the part [0, s], integrated here by the midpoint rule. The path
+    // tracer's next-event estimation reads one texel of the footprint chosen by its bilinear
+    // weight: the light's mean, and its place, must be the filtered texture's.
+    let cam = camera();
+    let quad = Quad::new();
+    let mut scene = quad_scene_with(&cam, &quad, 1.0, true, &[], ALBEDO);
+    scene.textures[0] = Texture {
+        name: "ramp".into(),
+        width: 2,
+        height: 1,
+        rgba: vec![255, 255, 255, 255, 0, 0, 0, 255],
+        role: TextureRole::Color,
+        wrap_u: Wrap::ClampToEdge,
+        wrap_v: Wrap::ClampToEdge,
+        mag_linear: true,
+    };
+    let settings = Settings { texture_format: TextureFormat::Rgba8, ..fast_settings() };
+    let file = dir.path().join("ramp.kiln");
+    std::fs::write(&file, compile(scene, settings)).unwrap();
+    let o = Options::new(&file, W, H).reference().build();
+    let (_, rgb) =
+        kiln_player::reference::render(&o, 256, std::time::Instant::now()).expect("reference render");
+    let a = albedo()[0];
+    let steps = 200;
+    let expected = |p: DVec3| {
+        let ds = 0.5 / steps as f64;
+        let e: f64 = (0..steps).map(|i| quad.irradiance(p, 0.25 + (i as f64 + 0.5) * ds)).sum::<f64>() * ds;
+        a / std::f64::consts::PI * 2.0 * e
+    };
+    let keep = |p: DVec3, d: DVec3| quad.in_front(p) && !quad.crossed_by(cam.eye, d, 0.05);
+    let pixels: Vec<_> = floor_pixels(&cam, 9.5).into_iter().filter(|&(_, p, d)| keep(p, d)).collect();
+    // Ratios of sums: where the light comes only from the ramp's dim end, a pixel's relative
+    // noise is large.
+    let ratio = |set: &[(usize, DVec3, DVec3)]| {
+        let rendered: f64 = set.iter().map(|&(i, _, _)| rgb[i] as f64).sum();
+        rendered / set.iter().map(|&(_, p, _)| expected(p)).sum::<f64>()
+    };
+    let mean = ratio(&pixels);
+    eprintln!("ramp: {} pixels, their sum's ratio to the integral's {mean:.5}", pixels.len());
+    assert!(pixels.len() > (W * H / 2) as usize, "only {} floor pixels", pixels.len());
+    assert!((mean - 1.0).abs() < 0.01, "the floor's ratio to the integral is {mean}");
+    // Where the light lies shows in the 12 × 12 blocks' means.
+    let mut worst = 0.0f64;
+    for by in 0..H / 12 {
+        for bx in 0..W / 12 {
+            let block: Vec<_> = pixels
+                .iter()
+                .copied()
+                .filter(|&(i, _, _)| {
+                    let (x, y) = crate::harness::pixel_xy(i);
+                    (x / 12, y / 12) == (bx, by)
+                })
+                .collect();
+            if block.len() >= 72 {
+                worst = worst.max((ratio(&block) - 1.0).abs());
+            }
+        }
+    }
+    eprintln!("ramp: worst 12 × 12 block off by {worst:.4}");
+    assert!(worst < 0.02, "a 12 × 12 block's mean is {worst} off the integral");
+}
