@@ -104,15 +104,18 @@ pub struct Options(SessionOptions);
 
 impl Options {
     /// `file` at `width` × `height` with the validation layer on, otherwise what `kiln-play` does
-    /// without flags but for its one ray-traced pass: shadow maps, raster G-buffer, and no direct
-    /// light of emissive surfaces (`--direct none`; [`Options::ris`], [`Options::restir`] turn
-    /// it on).
+    /// without flags but for its one ray-traced pass: shadow maps, no direct light of emissive
+    /// surfaces (`--direct none`; [`Options::ris`], [`Options::restir`] turn it on), and the
+    /// raster G-buffer (kiln-play's default is the visibility buffer; the tests that judge a
+    /// technique keep the G-buffer they were written with; `scenes.rs`, `textures.rs` and
+    /// `analytic.rs` compare the two).
     pub fn new(file: impl Into<PathBuf>, width: u32, height: u32) -> Options {
         let mut o = SessionOptions {
             gpu: GpuOptions { validate: true, ..Default::default() },
             ..SessionOptions::new(file, width, height)
         };
         o.render.techniques.direct = Direct::Off(direct::none::Off);
+        o.render.techniques.gbuffer = GBufferTechnique::Raster(gbuffer::raster::Raster);
         Options(o)
     }
 

@@ -11,9 +11,12 @@ use super::*;
 
 /// The default techniques without the one ray-traced default (`--direct restir`, which a session
 /// drops for a file whose materials emit nothing): the frame from baked data alone.
+/// The defaults with nothing read but the frame's own sections: the raster G-buffer, no
+/// emissive surfaces' direct light.
 fn baked() -> Techniques {
     let mut t = Techniques::default();
     t.set(Effect::Direct, "none", &[]).unwrap();
+    t.set(Effect::GBuffer, "raster", &[]).unwrap();
     t
 }
 
@@ -21,11 +24,15 @@ fn baked() -> Techniques {
 fn the_default_lights_with_emissive_surfaces_by_restir_which_is_ray_traced() {
     let d = Techniques::default();
     assert_eq!(d.name_of(Effect::Direct), "restir");
+    // The visibility buffer, which resolves materials from the scene's buffers.
+    assert_eq!(d.name_of(Effect::GBuffer), "visibility");
     assert!(d.ray_traced() && d.needs().bvh && d.needs().scene_buffers);
     assert_eq!(d.flags(), kiln_format::gpu::FrameFlags::RT_DIRECT);
     // While its pipelines compile, frames show no emitters' light; without a BVH it is off.
-    assert_eq!(d.fallback(true).unwrap(), baked());
-    assert_eq!(d.without_rays(), baked());
+    let mut unlit = d;
+    unlit.set(Effect::Direct, "none", &[]).unwrap();
+    assert_eq!(d.fallback(true).unwrap(), unlit);
+    assert_eq!(d.without_rays(), unlit);
 }
 
 #[test]
