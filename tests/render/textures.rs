@@ -153,3 +153,30 @@ fn the_reference_filters_textures_bilinearly_on_average() {
     eprintln!("{} pixels, mean |reference − bilinear| {error:.4}", pixels.len());
     assert!(error < 0.04, "the reference's texture lookups average {error} away from the bilinear filter");
 }
+
+/// The reference path tracer decodes block-compressed textures once, at upload, into an RGBA8
+/// texel buffer (no BC decoder in its shader). Its image of the BC floor must then be the image
+/// of the same floor compiled RGBA8 (no block anywhere), but for the encoding error: the same
+/// random sequence makes the two differ only where a texel does.
+#[test]
+fn the_reference_renders_bc_textures_as_their_rgba8_originals() {
+    use std::time::Instant;
+    let dir = gpu_test!();
+    let mut images = Vec::new();
+    for (name, format) in [("bc", TextureFormat::Bc), ("rgba8", TextureFormat::Rgba8)] {
+        let file = dir.path().join(format!("floor-{name}.kiln"));
+        std::fs::write(&file, textured_floor(format)).unwrap();
+        let o = Options::new(&file, W, H).reference().build();
+        images.push(kiln_player::reference::render(&o, 16, Instant::now()).expect("reference render").1);
+    }
+    let tone = |v: &[f32]| -> Vec<f32> { v.iter().map(|&x| x / (1.0 + x)).collect() };
+    let (a, b) = (tone(&images[0]), tone(&images[1]));
+    let img = |p| kiln_metrics::RgbImage { width: W, height: H, pixels: p };
+    let flip = kiln_metrics::ldr_flip(img(&a), img(&b)).unwrap();
+    let lit = images[1].chunks_exact(3).filter(|p| p.iter().sum::<f32>() > 0.01).count();
+    eprintln!(
+        "reference of the textured floor: mean FLIP {flip:.4} between the BC and RGBA8 files, {lit} lit pixels"
+    );
+    assert!(lit > (W * H / 3) as usize, "only {lit} lit pixels");
+    assert!(flip < 0.02, "mean FLIP {flip} between the references of the BC and RGBA8 files");
+}

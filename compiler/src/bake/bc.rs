@@ -238,50 +238,9 @@ pub fn encode(t: &Texture, choice: &Choice, chain: Vec<u8>) -> Vec<u8> {
     out
 }
 
-/// Decodes one stored level to RGBA8 of its stored channels (missing ones 0, alpha 255), through
-/// `bcdec_rs`, a decoder independent of the encoder.
-pub fn decode_level(format: PixelFormat, bytes: &[u8], width: u32, height: u32) -> Vec<u8> {
-    if format == PixelFormat::Rgba8 {
-        return bytes[..(width * height * 4) as usize].to_vec();
-    }
-    let (bw, bh) = (width.div_ceil(4) as usize, height.div_ceil(4) as usize);
-    let bb = format.block_bytes() as usize;
-    let mut out = vec![0u8; width as usize * height as usize * 4];
-    for by in 0..bh {
-        for bx in 0..bw {
-            let block = &bytes[(by * bw + bx) * bb..][..bb];
-            let mut px = [0u8; 64];
-            match format {
-                PixelFormat::Bc7 => bcdec_rs::bc7(block, &mut px, 16),
-                PixelFormat::Bc5 => {
-                    let mut rg = [0u8; 32];
-                    bcdec_rs::bc5(block, &mut rg, 8, false);
-                    for i in 0..16 {
-                        px[i * 4..i * 4 + 4].copy_from_slice(&[rg[i * 2], rg[i * 2 + 1], 0, 255]);
-                    }
-                }
-                PixelFormat::Bc4 => {
-                    let mut r = [0u8; 16];
-                    bcdec_rs::bc4(block, &mut r, 4, false);
-                    for i in 0..16 {
-                        px[i * 4..i * 4 + 4].copy_from_slice(&[r[i], 0, 0, 255]);
-                    }
-                }
-                PixelFormat::Rgba8 => unreachable!(),
-            }
-            for y in 0..4 {
-                for x in 0..4 {
-                    let (tx, ty) = (bx * 4 + x, by * 4 + y);
-                    if tx < width as usize && ty < height as usize {
-                        let dst = (ty * width as usize + tx) * 4;
-                        out[dst..dst + 4].copy_from_slice(&px[(y * 4 + x) * 4..][..4]);
-                    }
-                }
-            }
-        }
-    }
-    out
-}
+/// Decodes one stored level to RGBA8 of its stored channels (`bcdec_rs`, independent of the
+/// encoder): the format crate's, which the player's reference path tracer also uses.
+pub use kiln_format::sections::decode_level;
 
 /// A texture's line in the compile report.
 #[derive(Debug, Clone, Serialize)]

@@ -15,8 +15,8 @@ pub use material::{
     NO_TEXTURE, material_words,
 };
 pub use texture::{
-    PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_texture, encode_texture,
-    possible_v2_lengths,
+    PixelFormat, Swizzle, TEXTURE_HEADER_BYTES, TextureData, TextureHeader, decode_level, decode_texture,
+    encode_texture, possible_v2_lengths,
 };
 
 use crate::table::SectionKind;

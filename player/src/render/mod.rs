@@ -77,7 +77,9 @@ impl RenderSettings {
                     | crate::scene::linespace::LsArrays::IF_PRESENT,
                 ..Needs::RAYS
             }),
-            Purpose::Reference => n.union(Needs::TRACED_SURFACES),
+            // The path tracer decodes no BC block: its texel buffer holds RGBA8 (ToyCar 59–62 →
+            // 66–70 M samples/s on an H200, docs/benchmarks/reference-speed/).
+            Purpose::Reference => n.union(Needs { decoded_texels: true, ..Needs::TRACED_SURFACES }),
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
+use kiln_format::sections::PixelFormat;
 
 use super::geometry::{see_through_bounds, sort_by_material, triangle_corners};
 use super::{Draw, bad, linespace, reference, uploads};
@@ -77,9 +78,12 @@ impl<'f> Prepared<'f> {
             if needs.bvh { triangle_corners(view.vertices, view.triangles) } else { Vec::new() };
         // The ray-traced passes read each texture as stored (RGBA8 or BC blocks, the GLSL decodes
         // them); their table needs each texture's format and swizzle from its section header.
+        // How the texel buffer stores each texture: as the file does, or RGBA8 of the stored
+        // channels where the run decodes the blocks at upload (the swizzle is unchanged).
+        let stored = |format| if needs.decoded_texels { PixelFormat::Rgba8 } else { format };
         let storage = if needs.scene_buffers && needs.textures {
             (0..view.manifest.textures.len())
-                .map(|i| view.texture(i).map(|t| (t.format, t.swizzle)))
+                .map(|i| view.texture(i).map(|t| (stored(t.format), t.swizzle)))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(bad)?
         } else {

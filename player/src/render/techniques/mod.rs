@@ -323,6 +323,10 @@ pub struct Needs {
     pub media_volumes: bool,
     /// The irradiance probe volume (`PRBG`, `PRBS`, `PRBI`, `PRBV`).
     pub probes: bool,
+    /// The texel buffer decoded to RGBA8 where the file stores block-compressed textures: four
+    /// times the memory, no BC decoding in the shaders (the reference path tracer's, which
+    /// reads five textures at every vertex of ToyCar).
+    pub decoded_texels: bool,
 }
 
 impl Needs {
@@ -338,6 +342,7 @@ impl Needs {
             media: self.media || o.media,
             media_volumes: self.media_volumes || o.media_volumes,
             probes: self.probes || o.probes,
+            decoded_texels: self.decoded_texels || o.decoded_texels,
         }
     }
 
@@ -353,6 +358,7 @@ impl Needs {
             media: self.media && !o.media,
             media_volumes: self.media_volumes && !o.media_volumes,
             probes: self.probes && !o.probes,
+            decoded_texels: self.decoded_texels && !o.decoded_texels,
         }
     }
 
@@ -367,6 +373,7 @@ impl Needs {
         media: false,
         media_volumes: false,
         probes: false,
+        decoded_texels: false,
     };
     /// What ray queries through the BVH read.
     pub const RAYS: Needs = Needs { bvh: true, ..Needs::NONE };
