@@ -377,7 +377,7 @@ mod tests {
         let t = techniques(&[
             "f.kiln",
             "--gbuffer",
-            "visibility",
+            "raster",
             "--shadows",
             "rt",
             "--light-radius",
@@ -402,7 +402,7 @@ mod tests {
         ]);
         assert_eq!(
             t.gbuffer,
-            GBuffer::Visibility(crate::render::techniques::gbuffer::visibility::Visibility)
+            GBuffer::Raster(crate::render::techniques::gbuffer::raster::Raster)
         );
         assert_eq!(t.shadows, Shadows::Rt(shadows::rt::Rt { light_radius: 1.0, sun_degrees: 0.53 }));
         assert_eq!(t.ao, Ao::Rt(ao::rt::Rt { radius: Radius { radius: Some(0.5), reach: 0.1 } }));

@@ -5,6 +5,10 @@ use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
 use kiln_format::sections::PixelFormat;
 
+/// The largest texel buffer decoded to RGBA8: 2²⁷ bytes, the storage-buffer range every Vulkan
+/// device offers (lavapipe's limit). Beyond it the blocks stay, decoded in the shader.
+const DECODED_TEXELS_MAX: u64 = 1 << 27;
+
 use super::geometry::{see_through_bounds, sort_by_material, triangle_corners};
 use super::{Draw, bad, linespace, reference, uploads};
 use crate::error::PlayResult;
@@ -79,8 +83,16 @@ impl<'f> Prepared<'f> {
         // The ray-traced passes read each texture as stored (RGBA8 or BC blocks, the GLSL decodes
         // them); their table needs each texture's format and swizzle from its section header.
         // How the texel buffer stores each texture: as the file does, or RGBA8 of the stored
-        // channels where the run decodes the blocks at upload (the swizzle is unchanged).
-        let stored = |format| if needs.decoded_texels { PixelFormat::Rgba8 } else { format };
+        // channels where the run decodes the blocks at upload (the swizzle is unchanged) and the
+        // decoded chains fit one storage buffer of the size every device allows.
+        let decoded_bytes: u64 = view
+            .manifest
+            .textures
+            .iter()
+            .map(|t| PixelFormat::Rgba8.chain_bytes(t.width, t.height, t.mip_levels).unwrap_or(0))
+            .sum();
+        let decode = needs.decoded_texels && decoded_bytes <= DECODED_TEXELS_MAX;
+        let stored = |format| if decode { PixelFormat::Rgba8 } else { format };
         let storage = if needs.scene_buffers && needs.textures {
             (0..view.manifest.textures.len())
                 .map(|i| view.texture(i).map(|t| (stored(t.format), t.swizzle)))

@@ -9,10 +9,9 @@ use super::shadows::linespace::{LineSpace as ShadowLineSpace, LsShadowTest};
 use super::shadows::rt::Rt as ShadowRt;
 use super::*;
 
-/// The default techniques without the one ray-traced default (`--direct restir`, which a session
-/// drops for a file whose materials emit nothing): the frame from baked data alone.
-/// The defaults with nothing read but the frame's own sections: the raster G-buffer, no
-/// emissive surfaces' direct light.
+/// The defaults with nothing read but the frame's own sections: the raster G-buffer, and no
+/// emissive surfaces' direct light (`--direct restir`, which a session drops for a file whose
+/// materials emit nothing).
 fn baked() -> Techniques {
     let mut t = Techniques::default();
     t.set(Effect::Direct, "none", &[]).unwrap();
