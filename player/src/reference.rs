@@ -153,7 +153,7 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?);
-        owned.pass = Some(PathTracePass::new(gpu, r.texel_decode)?);
+        owned.pass = Some(PathTracePass::new(gpu, r.texel_decode, r.media_count > 0)?);
         let (ubo, lights) = (owned.ubo.as_ref().expect("set"), owned.lights.as_ref().expect("set"));
         let images = owned.images.as_mut().expect("set");
         let pass = owned.pass.as_mut().expect("set");

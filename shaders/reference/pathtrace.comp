@@ -78,8 +78,12 @@ bool emitter_occluded_dir(vec3 from, vec3 ng, vec3 dir) {
 // ---------------------------------------------------------------- media
 const float FAR = 3.4e38;
 
+// Whether the file has participating media (set by the player, `passes/pathtrace.rs`): without,
+// the compiler drops the media's code, whose registers every path would otherwise reserve.
+layout(constant_id = 1) const bool HAS_MEDIA = true;
+
 uint medium_count() {
-    return rc.media.x;
+    return HAS_MEDIA ? rc.media.x : 0u;
 }
 
 #include "../common/media.glsl"

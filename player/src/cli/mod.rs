@@ -400,10 +400,7 @@ mod tests {
             "2",
             "--no-accumulate",
         ]);
-        assert_eq!(
-            t.gbuffer,
-            GBuffer::Raster(crate::render::techniques::gbuffer::raster::Raster)
-        );
+        assert_eq!(t.gbuffer, GBuffer::Raster(crate::render::techniques::gbuffer::raster::Raster));
         assert_eq!(t.shadows, Shadows::Rt(shadows::rt::Rt { light_radius: 1.0, sun_degrees: 0.53 }));
         assert_eq!(t.ao, Ao::Rt(ao::rt::Rt { radius: Radius { radius: Some(0.5), reach: 0.1 } }));
         assert_eq!(

@@ -29,20 +29,22 @@ pub const ACCUMULATION: TargetDecl = TargetDecl {
 pub struct PathTracePass(Kernel);
 
 impl PathTracePass {
-    /// Builds the pipeline for a texel buffer that `decode` reads.
-    pub fn new(gpu: &Gpu, decode: TexelDecode) -> PlayResult<PathTracePass> {
+    /// Builds the pipeline for a texel buffer that `decode` reads, with the participating
+    /// media's code only where the file has `media`.
+    pub fn new(gpu: &Gpu, decode: TexelDecode, media: bool) -> PlayResult<PathTracePass> {
         use BindingKind::*;
         let mut bindings = vec![Binding::one(Uniform)];
         bindings.extend([Binding::one(Storage); 12]);
         bindings.push(Binding::one(StorageImage));
         bindings.push(Binding::one(Storage));
         bindings.extend([Binding::one(Storage); 2]);
-        Ok(PathTracePass(Kernel::reading_texels(
+        let [texels_bc] = decode.constants();
+        Ok(PathTracePass(Kernel::specialized(
             gpu,
             &bindings,
             spirv::shader!("reference/pathtrace.comp"),
             std::mem::size_of::<[u32; 2]>() as u32,
-            decode,
+            &[texels_bc, media as u32],
         )?))
     }
 
