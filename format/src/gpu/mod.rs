@@ -437,6 +437,15 @@ gpu_struct! {
     }
 }
 
+impl GpuTexture {
+    /// The pixel format of its texels in the buffer (the [`TextureFlags::FORMAT_SHIFT`] bits,
+    /// what the shaders read).
+    pub fn pixel_format(&self) -> crate::sections::PixelFormat {
+        use crate::sections::PixelFormat;
+        PixelFormat::from_u32((self.flags >> TextureFlags::FORMAT_SHIFT) & 3).unwrap_or(PixelFormat::Rgba8)
+    }
+}
+
 gpu_struct! {
     /// A vertex's attributes besides position and normal, as the player interleaves them from
     /// `UVS0` and `COL0` (std430, 16 bytes): the raster passes' second vertex stream and what

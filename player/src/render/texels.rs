@@ -8,7 +8,8 @@
 //! false the driver drops them before compiling, so only a file that has BC textures pays for
 //! them.
 
-use kiln_format::gpu::{GpuTexture, TextureFlags};
+use kiln_format::gpu::GpuTexture;
+use kiln_format::sections::PixelFormat;
 
 /// The `constant_id` of `TEXELS_BC` in `shaders/common/textures.glsl`.
 pub const TEXELS_BC_ID: u32 = 0;
@@ -25,9 +26,9 @@ pub enum TexelDecode {
 
 impl TexelDecode {
     /// The decode a texture table needs: [`TexelDecode::Bc`] when any texture's format (the
-    /// bits the shaders read, [`TextureFlags::FORMAT_SHIFT`]) is not RGBA8.
+    /// bits the shaders read, [`GpuTexture::pixel_format`]) is not RGBA8.
     pub fn of(textures: &[GpuTexture]) -> TexelDecode {
-        if textures.iter().any(|t| (t.flags >> TextureFlags::FORMAT_SHIFT) & 3 != 0) {
+        if textures.iter().any(|t| t.pixel_format() != PixelFormat::Rgba8) {
             TexelDecode::Bc
         } else {
             TexelDecode::Rgba8
@@ -47,6 +48,7 @@ impl TexelDecode {
 mod tests {
     use super::*;
     use crate::render::spirv;
+    use kiln_format::gpu::TextureFlags;
 
     fn texture(format: u32) -> GpuTexture {
         GpuTexture {

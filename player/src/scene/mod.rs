@@ -30,7 +30,7 @@ pub use textures::{COARSE_SIDE, TextureUpload, first_coarse_level};
 use std::collections::HashMap;
 
 use crate::gpu::vk;
-use kiln_format::gpu::{GpuVertexAttributes, TextureFlags};
+use kiln_format::gpu::GpuVertexAttributes;
 use kiln_format::manifest::{Manifest, ShadowProjection};
 use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
@@ -524,8 +524,7 @@ impl GpuScene {
                     (Some(r), Some(tables)) if now.scene_buffers => {
                         let t = tables.textures[index as usize];
                         let data = view.texture(index as usize).map_err(bad)?;
-                        let buffered = (t.flags >> TextureFlags::FORMAT_SHIFT) & 3;
-                        if buffered == data.format as u32 {
+                        if t.pixel_format() == data.format {
                             up.buffer(&r.texels, t.offset as u64 * 4, data.levels)?;
                         } else {
                             // The table says RGBA8 where the file stores blocks

@@ -5,14 +5,14 @@ use kiln_format::read::KilnFile;
 use kiln_format::scene::SceneView;
 use kiln_format::sections::PixelFormat;
 
-/// The largest texel buffer decoded to RGBA8: 2²⁷ bytes, the storage-buffer range every Vulkan
-/// device offers (lavapipe's limit). Beyond it the blocks stay, decoded in the shader.
-const DECODED_TEXELS_MAX: u64 = 1 << 27;
-
 use super::geometry::{see_through_bounds, sort_by_material, triangle_corners};
 use super::{Draw, bad, linespace, reference, uploads};
 use crate::error::PlayResult;
 use crate::render::{Needs, TexelDecode};
+
+/// The largest texel buffer decoded to RGBA8: 2²⁷ bytes, the storage-buffer range every Vulkan
+/// device offers (lavapipe's limit). Beyond it the blocks stay, decoded in the shader.
+const DECODED_TEXELS_MAX: u64 = 1 << 27;
 
 /// The CPU side of loading, done while the device is being created: the file validated, the
 /// checksums of every section to upload verified (which also pages them in), and the index
@@ -85,13 +85,14 @@ impl<'f> Prepared<'f> {
         // How the texel buffer stores each texture: as the file does, or RGBA8 of the stored
         // channels where the run decodes the blocks at upload (the swizzle is unchanged) and the
         // decoded chains fit one storage buffer of the size every device allows.
-        let decoded_bytes: u64 = view
-            .manifest
-            .textures
-            .iter()
-            .map(|t| PixelFormat::Rgba8.chain_bytes(t.width, t.height, t.mip_levels).unwrap_or(0))
-            .sum();
-        let decode = needs.decoded_texels && decoded_bytes <= DECODED_TEXELS_MAX;
+        let decode = needs.decoded_texels
+            && view
+                .manifest
+                .textures
+                .iter()
+                .map(|t| PixelFormat::Rgba8.chain_bytes(t.width, t.height, t.mip_levels).unwrap_or(0))
+                .sum::<u64>()
+                <= DECODED_TEXELS_MAX;
         let stored = |format| if decode { PixelFormat::Rgba8 } else { format };
         let storage = if needs.scene_buffers && needs.textures {
             (0..view.manifest.textures.len())
