@@ -70,7 +70,7 @@ EmissivePoint point_on_emitter(vec3 p0, vec3 e1, vec3 e2, vec3 emission, uint te
     ep.double_sided = double_sided;
     ep.le = emission;
     if (texture != NO_TEXTURE) {
-        ep.le *= sample_texture_linear(texture, triangle_uv(tri, b1, b2)).rgb;
+        ep.le *= mip0(textures[texture], triangle_uv(tri, b1, b2)).rgb;
     }
     return ep;
 }

@@ -106,7 +106,8 @@ vec4 filtered(GpuTexture t, vec2 uv, uint l0, uint l1, float f, bool nearest) {
     return sum;
 }
 
-// Mip 0, bilinear or nearest as the texture's filter says (what the path tracer samples).
+// Mip 0, bilinear or nearest as the texture's filter says, always deterministic (the traversal's
+// alpha test: a ray's coverage must not change when it meets the same point again).
 vec4 sample_texture(uint index, vec2 uv) {
     GpuTexture t = textures[index];
     return filtered(t, uv, 0u, 0u, 0.0, (t.flags & TEXTURE_LINEAR) == 0u);
@@ -129,18 +130,17 @@ vec4 stochastic_bilinear(GpuTexture t, vec2 uv) {
 }
 #endif
 
-// Mip 0 as `sample_texture` filters it, for what an estimator is linear in (emitted radiance):
-// with TEXTURE_STOCHASTIC, one texel of the bilinear footprint chosen by its weight (the same
-// mean; ToyCar's lamps' emissive texture, sampled at every vertex's next-event estimation, is
-// then decoded once instead of four times).
-vec4 sample_texture_linear(uint index, vec2 uv) {
+// Mip 0 of `t` as the texture's filter says; with TEXTURE_STOCHASTIC a bilinear filter reads one
+// texel of its footprint (`stochastic_bilinear`: the same mean, for what an estimator is linear
+// in, such as the emitted radiance next-event estimation reads at every vertex).
+vec4 mip0(GpuTexture t, vec2 uv) {
+    bool nearest = (t.flags & TEXTURE_LINEAR) == 0u;
 #ifdef TEXTURE_STOCHASTIC
-    GpuTexture t = textures[index];
-    if ((t.flags & TEXTURE_LINEAR) != 0u) {
+    if (!nearest) {
         return stochastic_bilinear(t, uv);
     }
 #endif
-    return sample_texture(index, uv);
+    return filtered(t, uv, 0u, 0u, 0.0, nearest);
 }
 
 // Trilinear filtering with the level chosen from the uv footprint of a pixel (the larger of its
@@ -154,21 +154,12 @@ vec4 sample_texture_grad(uint index, vec2 uv, vec2 dx, vec2 dy) {
     footprint = isnan(footprint) || isinf(footprint) ? 1e30 : footprint;
     float levels = float((t.flags >> TEXTURE_LEVELS_SHIFT) & 31u);
     float lod = clamp(log2(max(footprint, 1e-8)), 0.0, max(levels - 1.0, 0.0));
-    uint l0 = 0u, l1 = 0u;
-    float f = 0.0;
-    bool nearest = (t.flags & TEXTURE_LINEAR) == 0u;
-    if (lod > 0.0) {
-        l0 = min(uint(floor(lod)), uint(max(levels - 1.0, 0.0)));
-        l1 = min(l0 + 1u, uint(levels) - 1u);
-        f = lod - float(l0);
-        nearest = false;
+    if (lod <= 0.0) {
+        return mip0(t, uv);
     }
-#ifdef TEXTURE_STOCHASTIC
-    if (lod <= 0.0 && !nearest) {
-        return stochastic_bilinear(t, uv);
-    }
-#endif
-    return filtered(t, uv, l0, l1, f, nearest);
+    uint l0 = min(uint(floor(lod)), uint(max(levels - 1.0, 0.0)));
+    uint l1 = min(l0 + 1u, uint(levels) - 1u);
+    return filtered(t, uv, l0, l1, lod - float(l0), false);
 }
 
 // A material's texture slots: bit k of a slot mask is slot k of `material_texels`' array.
