@@ -173,3 +173,12 @@ pub fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     out.extend_from_slice(&bin);
     out
 }
+
+/// Writes `white.png` (2 × 2 opaque white) into `dir`: the texture the material tests' glTF
+/// documents name.
+#[allow(dead_code)] // Not every test file that includes this module names a texture.
+pub fn write_white_png(dir: &Path) {
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([255, 255, 255, 255]))
+        .save(dir.join("white.png"))
+        .unwrap();
+}
