@@ -42,7 +42,7 @@
 
 #include "../common/reproject.glsl"
 #ifdef DIRECT_LS_EXACT
-#define LS_BINDING 32
+#define LS_BINDING 36
 #include "../common/linespace.glsl"
 #endif
 

@@ -19,7 +19,7 @@
 #define GI_LS_PREILLUM 2
 
 #include "hybrid.glsl"
-#define LS_BINDING 32
+#define LS_BINDING 36
 #include "../common/linespace.glsl"
 
 // The surface of a PNMT record seen along `dir`: its stored normal as both geometric and

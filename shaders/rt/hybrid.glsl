@@ -51,14 +51,22 @@ layout(set = 0, binding = 26, rgba32f) uniform image2D rt_direct;
 layout(set = 0, binding = 27, rgba32ui) uniform uimage2D reservoirs_then;
 layout(set = 0, binding = 28, rgba32ui) uniform uimage2D reservoirs_now;
 layout(set = 0, binding = 29, rgba32f) uniform image2D surfaces_then;
-// The environment (`common/environment.glsl`): bindings 30-31; the line space's follow at 32.
+// The environment (`common/environment.glsl`): bindings 30-31.
 #define ENV_BINDING 30
 #include "../common/environment.glsl"
+// The compiler's irradiance probes (`common/probes.glsl`), which light the reflections' hits
+// where the file has them (`probe_volume.dims.x` 0: it has none, and the rest are placeholders);
+// the line space's bindings follow at 36.
+layout(set = 0, binding = 32) uniform ProbeVolume { ProbeConstants probe_volume; };
+layout(set = 0, binding = 33) uniform sampler2DArray probe_irradiance_atlas;
+layout(set = 0, binding = 34) uniform sampler2DArray probe_visibility_atlas;
+layout(set = 0, binding = 35, std430) readonly buffer ProbeStates { vec4 probe_states[]; };
 layout(push_constant) uniform Params { RtConstants rt; };
 
 #include "../common/random.glsl"
 #include "../common/scene.glsl"
 #include "../common/pixel.glsl"
+#include "../common/probes.glsl"
 
 // The visible surface under a pixel.
 struct Primary {

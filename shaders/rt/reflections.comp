@@ -41,9 +41,29 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughne
     vec3 diffuse = s.mat.diffuse_only ? s.mat.base : s.mat.base * (1.0 - s.mat.metallic);
     // The sky or environment as unshadowed ambient: diffuse from its irradiance, specular from
     // its level prefiltered for the hit's roughness.
-    sum += env_irradiance(s.ns, frame.sky.rgb) * diffuse;
+    vec3 mirror = reflect(-wo, s.ns);
+    vec3 diffuse_in = env_irradiance(s.ns, frame.sky.rgb);
+    vec3 specular_in = env_filtered(mirror, s.mat.roughness, frame.sky.rgb);
+    if (probe_volume.dims.x != 0u) {
+        // Where the file has probes, their light stands in for the sky's as the direct pass
+        // takes it at the visible surfaces (`--gi probes`): the room's indirect light and, with
+        // the sky occluded, the light the emissive surfaces send (no other term of this pass
+        // counts them). Without, metal reflecting an indirectly lit room showed it as dark as
+        // the sky outside: pica_pica's aluminium alcoves at 55 % of the reference's radiance
+        // after 64 frames of `--preset rt-8` (docs/benchmarks/reflection-probes/).
+        vec3 n = dot(s.ns, wo) < 0.0 ? -s.ns : s.ns;
+        ProbeLight pl = probe_light(probe_volume, s.p, n, wo, true);
+        float confidence = clamp(pl.confidence, 0.0, 1.0);
+        diffuse_in = mix(diffuse_in, pl.irradiance, confidence);
+        // The probes' irradiance about the mirror direction, sharpened by the environment's own
+        // prefiltered-to-irradiance ratio there, as the direct pass's split sum does.
+        float spread = luminance(env_irradiance(mirror, frame.sky.rgb));
+        float ratio = spread > 0.0 ? clamp(luminance(specular_in) / spread, 0.0, 8.0) : 1.0;
+        specular_in = mix(specular_in, pl.mirror * ratio, confidence);
+    }
+    sum += diffuse_in * diffuse;
     if (!s.mat.diffuse_only) {
-        sum += env_filtered(reflect(-wo, s.ns), s.mat.roughness, frame.sky.rgb) * f0;
+        sum += specular_in * f0;
     }
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight l = lights[i];

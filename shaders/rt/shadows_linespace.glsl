@@ -7,7 +7,7 @@
 #define KILN_SHADOWS_LINESPACE_GLSL
 
 #include "hybrid.glsl"
-#define LS_BINDING 32
+#define LS_BINDING 36
 #include "../common/linespace.glsl"
 
 bool shadow_occluded(vec3 from, vec3 ng, vec3 to) {

@@ -29,7 +29,7 @@ use kiln_test_support::gpu_test;
 use kiln_tests::boxes::{cuboid, quad};
 use kiln_tests::{Options, compile};
 
-use crate::harness::{fast_settings, render, srgb8};
+use crate::harness::{fast_settings, render, render_frames, srgb8};
 
 const W: u32 = 32;
 const H: u32 = 24;
@@ -105,16 +105,18 @@ fn probes_light_a_room_as_the_reference_does_and_nothing_through_its_wall() {
     }
 }
 
-/// The furnace: a closed 2-unit box of black walls emitting `LE`, a white metal floor.
-fn furnace() -> Vec<u8> {
+/// The furnace: a closed 2-unit box of walls of albedo `rho` emitting `LE`, a white metal floor of
+/// `roughness`. White metal reflects all it receives, so the radiance is the same everywhere and
+/// in every direction: LE / (1 − rho).
+fn furnace(rho: f32, roughness: f32) -> Vec<u8> {
     let mut s = Scene { name: "furnace".into(), ..Default::default() };
-    let mut wall = lambert_material([0.0; 3]);
+    let mut wall = lambert_material([rho; 3]);
     wall.emission = [LE; 3];
     s.materials.push(Material { name: "glow".into(), gpu: wall });
     let metal = kiln_format::sections::GpuMaterial {
         base_color: [1.0; 4],
         metallic: 1.0,
-        roughness: 0.5,
+        roughness,
         ..Default::default()
     };
     s.materials.push(Material { name: "metal".into(), gpu: metal });
@@ -136,18 +138,39 @@ fn furnace() -> Vec<u8> {
 
 const LE: f32 = 0.75;
 
+/// Looking down at the floor's middle from a little aside, so that the mirror direction is not
+/// the wall straight above only.
+fn at_the_floor() -> CameraOverride {
+    CameraOverride { position: [0.3, 1.0, 0.2], target: [0.0, 0.0, 0.0], vfov_degrees: Some(20.0) }
+}
+
 #[test]
 fn probes_light_glossy_metal_by_what_it_mirrors() {
     let dir = gpu_test!();
-    let bytes = furnace();
-    // Looking down at the floor's middle from a little aside, so that the mirror direction is
-    // not the wall straight above only.
-    let camera =
-        CameraOverride { position: [0.3, 1.0, 0.2], target: [0.0, 0.0, 0.0], vfov_degrees: Some(20.0) };
-    let (floor, _) = render(dir.path(), "furnace", &bytes, |f| probes(f, camera));
+    let bytes = furnace(0.0, 0.5);
+    let (floor, _) = render(dir.path(), "furnace", &bytes, |f| probes(f, at_the_floor()));
     let floor = mean(&floor);
     eprintln!("metal floor {floor:.4} against Le {LE}");
     assert!((floor - f64::from(LE)).abs() <= 0.03 * f64::from(LE), "the metal floor {floor} against Le {LE}");
+}
+
+/// The ray-traced reflections' hits lit by the probes: in the furnace with walls of albedo 1/2,
+/// the metal floor reflects walls of radiance LE / (1 − 1/2) = 2 LE, of which LE is their
+/// emission and LE the light they reflect, which only the probes give at the hits (the sky is
+/// black, and the reflections' own light terms are the analytic lights: none here). Planted and
+/// seen failing: the hits lit by the sky as before (the floor 0.7496 against 1.5).
+#[test]
+fn ray_traced_reflections_see_the_probes_light_at_their_hits() {
+    let dir = gpu_test!();
+    let rho = 0.5;
+    let bytes = furnace(rho, 0.2);
+    let frames = 8;
+    let (floor, _) = render_frames(dir.path(), "furnace-rt", &bytes, frames, |f| {
+        probes(f, at_the_floor()).rt_reflections(kiln_tests::Reflections::Full)
+    });
+    let (got, want) = (mean(&floor), f64::from(LE / (1.0 - rho)));
+    eprintln!("metal floor through ray-traced reflections {got:.4}, closed form {want:.4}");
+    assert!((got - want).abs() <= 0.05 * want, "the metal floor {got} against LE / (1 - rho) = {want}");
 }
 
 /// A table under an open sky: a 2 × 2 top at y = 1 facing up over a 4 × 4 floor, under a uniform

@@ -96,9 +96,10 @@ pub struct Args {
     /// knob flags given beside it override its choices; `kiln-bench --list` says what each sets.
     /// Without --preset, --budget-ms and --gi, a file compiled with irradiance probes renders
     /// with `probes` (about 1 ms on the H200 with the default visibility G-buffer: the McGuire
-    /// box 0.082 HDR-FLIP against 0.342 for the screen-space `baked`; pica_pica 0.0447 against
-    /// `baked` 0.0586 and `hybrid` 0.0576; `probes-rt` adds ray-traced shadows: 0.0426 at
-    /// 1.33 ms).
+    /// box 0.082 HDR-FLIP against 0.342 for the screen-space `baked`; pica_pica 0.0444 against
+    /// `baked` 0.0583 and `hybrid` 0.0573; `probes-rt` adds ray-traced shadows: 0.0423 at
+    /// 1.33 ms; `probes-rt-refl` ray-traced reflections too: 0.0391 after 16 still frames at
+    /// 1.52 ms, against `probes-rt`'s 0.0426).
     #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
     pub preset: Option<String>,
     /// Choose the whole frame by a GPU budget: of the frame presets measured (by

@@ -41,6 +41,11 @@ const RT_SHADOWS: Choice = pick(Effect::Shadows, "rt");
 const SCREEN_GI: Choice = pick(Effect::Gi, "ssgi");
 const SCREEN_REFLECTIONS: Choice = pick(Effect::Reflections, "ssr");
 const RT_REFLECTIONS: Choice = pick(Effect::Reflections, "rt");
+const RT_REFLECTIONS_HALF: Choice = Choice {
+    effect: Effect::Reflections,
+    technique: "rt",
+    knobs: &[("reflection-res", KnobValue::Choice(1))],
+};
 const RT_GI: Choice = pick(Effect::Gi, "rt");
 const RT_GI_2: Choice =
     Choice { effect: Effect::Gi, technique: "rt", knobs: &[("gi-bounces", KnobValue::Number(2.0))] };
@@ -55,7 +60,7 @@ const FXAA: Choice = pick(Effect::Aa, "fxaa");
 const PROBES: Choice = pick(Effect::Gi, "probes");
 
 /// The presets, cheapest first.
-pub const PRESETS: [Preset; 12] = [
+pub const PRESETS: [Preset; 13] = [
     Preset {
         name: "baked",
         help: "no rays: shadow maps, screen-space GI and reflections",
@@ -72,6 +77,12 @@ pub const PRESETS: [Preset; 12] = [
         help: "as probes with ray-traced soft shadows (--shadows rt): the probes' indirect light, exact \
                direct shadows (needs a file compiled with probes)",
         choices: &[RT_SHADOWS, PROBES, SCREEN_REFLECTIONS, FXAA],
+    },
+    Preset {
+        name: "probes-rt-refl",
+        help: "as probes-rt with ray-traced glossy reflections at half resolution, their hits lit by the \
+               probes: metal shows the room it mirrors, off screen too (needs a file compiled with probes)",
+        choices: &[RT_SHADOWS, PROBES, RT_REFLECTIONS_HALF, FXAA],
     },
     Preset {
         name: "baked-taa",

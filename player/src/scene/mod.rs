@@ -104,7 +104,7 @@ fn uploads(kind: kiln_format::table::SectionKind, needs: Needs) -> bool {
         || (kind == sections::SHADOW_MAP && needs.shadow_maps)
         || (kind == sections::BVH_NODES && needs.bvh)
         || (kind == sections::MEDIA_VISIBILITY && needs.media_volumes)
-        || (kiln_format::probes::PROBE_KINDS.contains(&kind) && needs.probes)
+        || (kiln_format::probes::PROBE_KINDS.contains(&kind) && needs.any_probes())
         || kiln_format::environment::ENVIRONMENT_KINDS.contains(&kind)
         || ((kind == sections::TRIANGLE_MATERIALS || kind == sections::MATERIALS) && needs.scene_buffers)
 }
@@ -415,15 +415,20 @@ impl GpuScene {
         if first {
             self.environment = Some(environment::EnvironmentBuffers::new(gpu, file, up)?);
         }
-        if now.probes {
-            let volume = kiln_format::probes::ProbeVolume::read(file).map_err(bad)?.ok_or_else(|| {
-                PlayError::new(
-                    Exit::BadInput,
-                    "--gi probes: the file has no irradiance probes; recompile it with kiln compile \
-                     (probes are baked unless --probes off is given or nothing lights the scene)",
-                )
-            })?;
-            self.probes = Some(probes::ProbeImages::new(gpu, &volume, up)?);
+        // Once: a later stage may ask again (the reflections' `probes_if_present` after the
+        // first frame's `--gi probes`), and replacing them would free images bound in flight.
+        if now.any_probes() && self.probes.is_none() {
+            match kiln_format::probes::ProbeVolume::read(file).map_err(bad)? {
+                Some(volume) => self.probes = Some(probes::ProbeImages::new(gpu, &volume, up)?),
+                None if now.probes => {
+                    return Err(PlayError::new(
+                        Exit::BadInput,
+                        "--gi probes: the file has no irradiance probes; recompile it with kiln compile \
+                         (probes are baked unless --probes off is given or nothing lights the scene)",
+                    ));
+                }
+                None => {}
+            }
         }
         for s in file.sections() {
             let kind = s.entry.kind;
@@ -545,9 +550,9 @@ impl GpuScene {
                 }
             } else if kiln_format::environment::ENVIRONMENT_KINDS.contains(&kind) {
                 // Uploaded with the geometry, before this loop.
-            } else if kiln_format::probes::PROBE_KINDS.contains(&kind) && all.probes {
+            } else if kiln_format::probes::PROBE_KINDS.contains(&kind) && all.any_probes() {
                 // Uploaded together before this loop.
-                fate.after_first_frame = !now.probes && first;
+                fate.after_first_frame = !now.any_probes() && first;
             } else if (kind == sections::BRDF_LUT && all.brdf_lut && !now.brdf_lut)
                 || (kind == sections::SHADOW_MAP && all.shadow_maps && !now.shadow_maps)
             {
@@ -589,7 +594,7 @@ impl GpuScene {
                 } else if kind == sections::MEDIA_VISIBILITY {
                     no_reader(|n| n.media_volumes)
                 } else if kiln_format::probes::PROBE_KINDS.contains(&kind) {
-                    no_reader(|n| n.probes)
+                    no_reader(|n| n.any_probes())
                 } else if kind == sections::SHADOW_MAP {
                     no_reader(|n| n.shadow_maps)
                 } else {

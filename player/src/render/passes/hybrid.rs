@@ -2,23 +2,28 @@
 //! (`shaders/rt/hybrid.glsl`): the frame constants, the scene as the traversal and shading read
 //! it, the G-buffer, every ray-traced target (those of passes that are off are 1 × 1
 //! placeholders), the emitter table of next-event estimation and the emissive triangles' table of
-//! the direct light of emissive surfaces. Each pass has its own set of
-//! this layout.
+//! the direct light of emissive surfaces, the environment and the irradiance probes (placeholders
+//! where the file has none). Each pass has its own set of this layout.
 
 use crate::gpu::vk;
-use kiln_format::gpu::RtConstants;
+use gpu_allocator::MemoryLocation;
+use kiln_format::gpu::{ProbeConstants, RtConstants};
 
 use super::gbuffer::{ALBEDO, MATERIAL, NORMAL, TRIANGLE};
-use super::{FrameCtx, Shared, ao, rt_direct, rt_gi, rt_reflections, rt_shadows};
+use super::{FrameCtx, Shared, ao, probes, rt_direct, rt_gi, rt_reflections, rt_shadows};
 use crate::error::{Exit, PlayError, PlayResult};
-use crate::gpu::{Binding, BindingKind, ComputePipeline, Gpu, SetLayout, Write};
+use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Gpu, SetLayout, Write};
 use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::scene::bindings as scene_bindings;
 use crate::scene::linespace::LineSpaceBuffers;
 
 /// The first of the line space's bindings (`LS_BINDING` in the line-space kernels).
-pub const LINE_SPACE_BINDING: u32 = 32;
+pub const LINE_SPACE_BINDING: u32 = 36;
+
+/// The first of the irradiance probes' four bindings (`shaders/rt/hybrid.glsl`): their
+/// constants, the irradiance and visibility atlases, the probes' states.
+pub const PROBE_BINDING: u32 = 32;
 
 /// The first of the environment's two bindings (`ENV_BINDING` in `shaders/rt/hybrid.glsl`).
 pub const ENVIRONMENT_BINDING: u32 = 30;
@@ -45,6 +50,8 @@ pub struct HybridSet {
     decode: TexelDecode,
     /// Whether the layout ends with the line space's bindings (at [`LINE_SPACE_BINDING`]).
     line_space: bool,
+    /// The probes' constants (`ProbeConstants`, uniform; zero dimensions without probes).
+    probe_constants: Buffer,
     /// The set (allocated by the first [`HybridSet::bind`]).
     pub set: vk::DescriptorSet,
 }
@@ -63,14 +70,29 @@ impl HybridSet {
         bindings.push(Binding::one(Storage));
         bindings.extend([Binding::one(StorageImage); 4]);
         bindings.extend([Binding::one(Storage); 2]);
+        debug_assert_eq!(bindings.len() as u32, PROBE_BINDING);
+        bindings.extend([
+            Binding::one(Uniform),
+            Binding::one(Sampled),
+            Binding::one(Sampled),
+            Binding::one(Storage),
+        ]);
         debug_assert_eq!(bindings.len() as u32, LINE_SPACE_BINDING);
         if line_space {
             bindings.extend(LineSpaceBuffers::bindings());
         }
+        let probe_constants = Buffer::new(
+            gpu,
+            "probe constants",
+            std::mem::size_of::<ProbeConstants>() as u64,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+            MemoryLocation::CpuToGpu,
+        )?;
         Ok(HybridSet {
             layout: SetLayout::new(gpu, &bindings, 1)?,
             decode,
             line_space,
+            probe_constants,
             set: vk::DescriptorSet::null(),
         })
     }
@@ -128,6 +150,22 @@ impl HybridSet {
             writes.push(Write::StorageImage(26 + i as u32, img(t)));
         }
         writes.extend(scene.environment_writes(ENVIRONMENT_BINDING)?);
+        // The probes where the file has them (`Needs::probes_if_present`), else zero constants
+        // (the shaders test the dimensions) and placeholders that are never read.
+        let (constants, atlases, states) = match &scene.probes {
+            Some(p) => {
+                let c = p.constants(probes::NORMAL_BIAS, probes::VIEW_BIAS);
+                (c, [p.irradiance.view, p.visibility.view], &p.states)
+            }
+            None => (ProbeConstants::default(), [shared.dummies.array.view; 2], &r.emitters),
+        };
+        self.probe_constants.write(bytemuck::bytes_of(&constants))?;
+        writes.extend([
+            Write::Buffer(PROBE_BINDING, &self.probe_constants),
+            Write::Sampled(PROBE_BINDING + 1, vec![(atlases[0], scene.linear_clamp)]),
+            Write::Sampled(PROBE_BINDING + 2, vec![(atlases[1], scene.linear_clamp)]),
+            Write::Buffer(PROBE_BINDING + 3, states),
+        ]);
         if self.line_space {
             let ls = scene.line_space.as_ref().ok_or_else(|| {
                 PlayError::new(Exit::Gpu, "a line-space pass is bound to a scene without its line space")

@@ -29,6 +29,12 @@ pub const SPECULAR: TargetDecl = TargetDecl {
     array: false,
 };
 
+/// The lookup point's default move along the surface normal, in probe spacings (`--gi probes`'
+/// knob's default, and the reflections' hits', [`super::hybrid`]).
+pub const NORMAL_BIAS: f32 = 0.1;
+/// The lookup point's default move towards the viewer, in probe spacings.
+pub const VIEW_BIAS: f32 = 0.2;
+
 /// The G-buffer targets it samples, in binding order (1–2).
 const GBUFFER: [TargetDecl; 2] = [DEPTH, NORMAL];
 

@@ -323,6 +323,9 @@ pub struct Needs {
     pub media_volumes: bool,
     /// The irradiance probe volume (`PRBG`, `PRBS`, `PRBI`, `PRBV`).
     pub probes: bool,
+    /// The irradiance probe volume where the file has one (the ray-traced reflections light
+    /// their hits with it; without, with the sky).
+    pub probes_if_present: bool,
     /// The texel buffer decoded to RGBA8 where the file stores block-compressed textures: four
     /// times the memory, no BC decoding in the shaders (the reference path tracer's, which
     /// reads five textures at every vertex of ToyCar).
@@ -342,8 +345,14 @@ impl Needs {
             media: self.media || o.media,
             media_volumes: self.media_volumes || o.media_volumes,
             probes: self.probes || o.probes,
+            probes_if_present: self.probes_if_present || o.probes_if_present,
             decoded_texels: self.decoded_texels || o.decoded_texels,
         }
+    }
+
+    /// Whether the probe volume is read (required or where present).
+    pub fn any_probes(self) -> bool {
+        self.probes || self.probes_if_present
     }
 
     /// What `self` reads beyond `o`.
@@ -358,6 +367,7 @@ impl Needs {
             media: self.media && !o.media,
             media_volumes: self.media_volumes && !o.media_volumes,
             probes: self.probes && !o.probes,
+            probes_if_present: self.probes_if_present && !o.any_probes(),
             decoded_texels: self.decoded_texels && !o.decoded_texels,
         }
     }
@@ -373,6 +383,7 @@ impl Needs {
         media: false,
         media_volumes: false,
         probes: false,
+        probes_if_present: false,
         decoded_texels: false,
     };
     /// What ray queries through the BVH read.

@@ -4,7 +4,7 @@
 //! normal and towards the camera (`passes/probes.rs`, `shaders/probes/`). No rays at run time.
 
 use crate::render::frame::{FrameBuild, Stage};
-use crate::render::passes::probes::ProbesPass;
+use crate::render::passes::probes::{NORMAL_BIAS, ProbesPass, VIEW_BIAS};
 use crate::render::techniques::knobs::number;
 use crate::render::techniques::{Knob, Knobs, Needs, Registered, Technique};
 
@@ -36,7 +36,7 @@ impl Registered for Probes {
              a surface from shadowing itself in the probes' distance maps)",
             0.0,
             1.0,
-            0.1,
+            NORMAL_BIAS,
             &[0.05, 0.2],
         ),
         number(
@@ -44,7 +44,7 @@ impl Registered for Probes {
             "how far the lookup point moves towards the camera, in probe spacings",
             0.0,
             1.0,
-            0.2,
+            VIEW_BIAS,
             &[0.1, 0.4],
         ),
     ];

@@ -1,5 +1,7 @@
 //! `--reflections rt`: one GGX visible-normal sample per pixel (or per 2 × 2) per frame through
-//! the BVH, shaded at the hit (`passes/rt_reflections.rs`, `shaders/rt/reflections.comp`).
+//! the BVH, shaded at the hit (`passes/rt_reflections.rs`, `shaders/rt/reflections.comp`): its
+//! lights, each with one shadow ray, and the irradiance probes' light where the file has them,
+//! else the sky's.
 
 use kiln_format::gpu::FrameFlags;
 
@@ -7,7 +9,7 @@ use crate::render::frame::{FrameBuild, Stage};
 use crate::render::passes::rt_history::{Accumulated, Kind};
 use crate::render::passes::rt_reflections::{self, RtReflectionsPass};
 use crate::render::techniques::knobs::{UNBOUNDED, choice, number};
-use crate::render::techniques::{Knob, Knobs, RayInputs, RayScene, Registered, Technique};
+use crate::render::techniques::{Knob, Knobs, Needs, RayInputs, RayScene, Registered, Technique};
 
 /// Ray-traced glossy reflections.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,7 +42,8 @@ impl ReflectionRes {
 impl Registered for Rt {
     const NAME: &'static str = "rt";
     const HELP: &'static str = "ray-traced glossy reflections (GGX visible-normal samples, one per pixel per frame \
-                                at --reflection-res)";
+                                at --reflection-res); the hits lit by their lights and by the compiler's \
+                                irradiance probes where the file has them (the sky's light where not)";
     const KNOBS: &'static [Knob] = &[
         choice(
             "reflection-res",
@@ -70,6 +73,11 @@ impl Registered for Rt {
 impl Technique for Rt {
     fn ray_traced(&self) -> bool {
         true
+    }
+
+    /// The probes light the hits where the file has them (`shaders/rt/reflections.comp`).
+    fn needs(&self) -> Needs {
+        Needs { probes_if_present: true, ..Needs::NONE }
     }
 
     fn passes<'a>(&'a self, frame: &mut FrameBuild<'a>) {
