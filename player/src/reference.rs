@@ -116,12 +116,18 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
     let cam = &session.camera;
     let (right, up, half) = cam.image_axes();
     let sky = scene.manifest.sky.radiance;
+    let env_luminance = scene.environment.as_ref().filter(|e| e.present).map_or(0.0, |e| e.mean_luminance);
+    let environment_share = crate::scene::reference::environment_share(
+        env_luminance,
+        crate::scene::reference::scene_radius(&scene.manifest),
+        if r.emitter_count > 0 { r.emitter_power } else { 0.0 },
+    );
     let constants = ReferenceConstants {
         eye: [cam.position.x as f32, cam.position.y as f32, cam.position.z as f32, half as f32],
         right: [right.x as f32, right.y as f32, right.z as f32, w as f32 / h as f32],
         up: [up.x as f32, up.y as f32, up.z as f32, if cam.ortho.is_some() { 1.0 } else { 0.0 }],
         forward: [cam.forward.x as f32, cam.forward.y as f32, cam.forward.z as f32, 0.0],
-        sky: [sky[0], sky[1], sky[2], 0.0],
+        sky: [sky[0], sky[1], sky[2], environment_share],
         size: [w, h, spp, r.emitter_count],
         params: [scene.manifest.lights.len() as u32, MAX_PATH, seed, bounces],
         media: [r.media_count, 0, 0, 0],

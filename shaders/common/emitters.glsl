@@ -19,6 +19,20 @@
 #ifndef KILN_EMITTERS_GLSL
 #define KILN_EMITTERS_GLSL
 
+// The probability with which the includer chose the emitter table for the next-event
+// estimation at hand (and, for `rect_lights_seen` and `triangle_emission_weight`, at the vertex
+// the ray left): every light pdf is multiplied by it. The reference path tracer, which defines
+// EMITTER_CHOICES and sets them, shares one shadow ray per surface vertex between the table and
+// the environment; for the GI pass both are the constant 1.
+#ifdef EMITTER_CHOICES
+float emitter_choice = 1.0;
+// The same for the environment (`sample_environment`, `environment_seen_weight`).
+float env_choice = 1.0;
+#else
+const float emitter_choice = 1.0;
+const float env_choice = 1.0;
+#endif
+
 float power_heuristic(float a, float b) {
     float a2 = a * a;
     return a2 / max(a2 + b * b, 1e-30);
@@ -139,12 +153,12 @@ EmitterSample sample_emitter_light(vec3 origin) {
         es.delta = false;
         es.wi = lp.wi;
         es.li = lp.le;
-        es.pdf = e.pdf * lp.d2 / (lp.cos_l * lp.area);
+        es.pdf = emitter_choice * e.pdf * lp.d2 / (lp.cos_l * lp.area);
         es.target = lp.target;
         return es;
     }
     GpuLight l = lights[e.index];
-    es.pdf = e.pdf;
+    es.pdf = emitter_choice * e.pdf;
     if (l.kind == LIGHT_DIRECTIONAL) {
         es.wi = -l.direction;
         es.directional = true;
@@ -163,7 +177,7 @@ EmitterSample sample_emitter_light(vec3 origin) {
             return es;
         }
         es.li = l.radiance;
-        es.pdf = e.pdf * d2 / (cos_l * area);
+        es.pdf = emitter_choice * e.pdf * d2 / (cos_l * area);
         es.delta = false;
     } else {
         es.target = l.position;
@@ -236,7 +250,7 @@ vec3 rect_lights_seen(vec3 origin, vec3 dir, float tmax, float pdf_brdf) {
         }
         float denom = dot(dir, l.direction);
         float area = l.width * l.height;
-        float pdf_light = e.pdf * t * t / (-denom * area);
+        float pdf_light = emitter_choice * e.pdf * t * t / (-denom * area);
         vec3 seen = l.radiance * (pdf_brdf > 0.0 ? power_heuristic(pdf_brdf, pdf_light) : 1.0);
 #ifdef EMITTER_TRANSMITTANCE
         seen *= emitter_seen_weight(t);
@@ -257,7 +271,7 @@ float triangle_emission_weight(uint tri, float d, float cos_l, float pdf_brdf) {
     }
     vec3 p0 = bvh_tris[3u * tri].xyz, p1 = bvh_tris[3u * tri + 1u].xyz, p2 = bvh_tris[3u * tri + 2u].xyz;
     float area = 0.5 * length(cross(p1 - p0, p2 - p0));
-    float pdf_light = emitters[e].pdf * d * d / max(cos_l * area, 1e-30);
+    float pdf_light = emitter_choice * emitters[e].pdf * d * d / max(cos_l * area, 1e-30);
     return power_heuristic(pdf_brdf, pdf_light);
 }
 
@@ -270,6 +284,7 @@ float triangle_emission_weight(uint tri, float d, float cos_l, float pdf_brdf) {
 vec3 sample_environment(Surface s, vec3 wo, vec3 sky, bool mis) {
     float pdf;
     vec3 wi = env_sample(vec3(rnd(), rnd(), rnd()), pdf);
+    pdf *= env_choice;
     if (!(pdf > 0.0)) {
         return vec3(0.0);
     }
@@ -297,7 +312,7 @@ vec3 sample_environment(Surface s, vec3 wo, vec3 sky, bool mis) {
 // with density `pdf_brdf` against `sample_environment` (1 for a ray not sampled from a BRDF, or
 // without an environment).
 float environment_seen_weight(vec3 dir, float pdf_brdf) {
-    return (pdf_brdf > 0.0 && env_present()) ? power_heuristic(pdf_brdf, env_pdf(dir)) : 1.0;
+    return (pdf_brdf > 0.0 && env_present()) ? power_heuristic(pdf_brdf, env_choice * env_pdf(dir)) : 1.0;
 }
 #endif
 

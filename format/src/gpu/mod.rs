@@ -149,7 +149,8 @@ gpu_struct! {
         pub up: [f32; 4] => "vec4",
         /// Unit forward vector, w unused.
         pub forward: [f32; 4] => "vec4",
-        /// Sky radiance, w unused.
+        /// Sky radiance, w = the probability that next-event estimation at a surface samples the
+        /// environment rather than the emitter table (one shadow ray per vertex).
         pub sky: [f32; 4] => "vec4",
         /// Image width, height, samples per pixel requested, emitter count (the index of the
         /// sample being taken is a push constant).

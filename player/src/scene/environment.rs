@@ -20,6 +20,9 @@ pub struct EnvironmentBuffers {
     pub table: Buffer,
     /// Whether the file has an environment.
     pub present: bool,
+    /// Its mean radiance over the sphere of directions, as luminance (0 without one): what the
+    /// reference path tracer weighs its light against the emitters' with.
+    pub mean_luminance: f32,
 }
 
 impl EnvironmentBuffers {
@@ -51,7 +54,11 @@ impl EnvironmentBuffers {
             up.buffer(&radiance, (head + map_bytes.len()) as u64, filtered_bytes)?;
         }
         up.buffer(&table, 0, table_bytes)?;
-        Ok(EnvironmentBuffers { radiance, table, present: env.is_some() })
+        // The harmonics' band 0 (irradiance over π, whose cosine factor is 1 in band 0) times
+        // the constant basis function: the mean radiance over all directions.
+        let mean = header.sh[0].map(|c| c * 0.282_094_8);
+        let mean_luminance = kiln_format::gpu::luminance([mean[0], mean[1], mean[2]]).max(0.0);
+        Ok(EnvironmentBuffers { radiance, table, present: env.is_some(), mean_luminance })
     }
 
     /// The descriptor writes of the two buffers at `first` and `first + 1`.

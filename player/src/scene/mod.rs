@@ -176,6 +176,8 @@ pub struct ReferenceBuffers {
     pub texel_decode: TexelDecode,
     /// Entries in `emitters`.
     pub emitter_count: u32,
+    /// The emitters' summed power ([`reference::ReferenceTables::emitter_power`]).
+    pub emitter_power: f64,
     /// Entries in `emissive`.
     pub emissive_count: u32,
     /// Entries in `media`.
@@ -662,6 +664,7 @@ fn reference_buffers(
         media: next(),
         texel_decode: TexelDecode::of(&tables.textures),
         emitter_count: tables.emitters.len() as u32,
+        emitter_power: tables.emitter_power,
         emissive_count: tables.emissive.len() as u32,
         media_count: tables.media.len() as u32,
     })

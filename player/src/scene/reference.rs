@@ -28,6 +28,8 @@ pub struct ReferenceTables {
     pub texel_words: u64,
     /// The participating media (the manifest's, validated when the file was opened).
     pub media: Vec<GpuMedium>,
+    /// The emitters' summed power (the units of [`environment_share`]).
+    pub emitter_power: f64,
 }
 
 fn wrap_bits(w: Wrap) -> u32 {
@@ -54,6 +56,36 @@ fn light_power(l: &kiln_format::manifest::Light, scene_radius: f32) -> f32 {
 }
 
 pub use kiln_format::environment::alias_table;
+
+/// The least probability either light source keeps in [`environment_share`]: a source with
+/// little power is still sampled now and then (its light may be all a shadowed corner gets).
+const LEAST_SHARE: f32 = 0.1;
+
+/// The probability with which the reference path tracer's next-event estimation at a surface
+/// samples the environment rather than the emitter table: one shadow ray per vertex, shared by
+/// power. The environment's power is what it sends through the scene's bounding sphere, π r²
+/// times its radiance integrated over the sphere of directions (4π × its mean), as a directional
+/// light's is π r² times its irradiance ([`light_power`]); the emitters' is the table's sum in
+/// the same units. Each source keeps at least [`LEAST_SHARE`] when both exist; 0 without an
+/// environment, 1 without emitters.
+pub fn environment_share(env_mean_luminance: f32, scene_radius: f32, emitter_power: f64) -> f32 {
+    let pi = std::f64::consts::PI;
+    let env = 4.0 * pi * pi * f64::from(scene_radius).powi(2) * f64::from(env_mean_luminance);
+    if !(env > 0.0 && env.is_finite()) {
+        return 0.0;
+    }
+    if !(emitter_power > 0.0 && emitter_power.is_finite()) {
+        return 1.0;
+    }
+    ((env / (env + emitter_power)) as f32).clamp(LEAST_SHARE, 1.0 - LEAST_SHARE)
+}
+
+/// The radius of the scene's bounding sphere (0 where the bounds are not finite).
+pub fn scene_radius(manifest: &Manifest) -> f32 {
+    let b = &manifest.bounds;
+    let radius = (Vec3::from(b.max) - Vec3::from(b.min)).length() * 0.5;
+    if radius.is_finite() { radius } else { 0.0 }
+}
 
 /// The emissive triangles of `power` ((kind, index, power) entries) as the direct light of
 /// emissive surfaces reads them: corners, emission, flags and an alias table by power.
@@ -109,9 +141,7 @@ pub fn tables(
     storage: &[(PixelFormat, [Swizzle; 4])],
     emitter_luminance: Option<&[f32]>,
 ) -> ReferenceTables {
-    let b = &manifest.bounds;
-    let radius = (Vec3::from(b.max) - Vec3::from(b.min)).length() * 0.5;
-    let radius = if radius.is_finite() { radius } else { 0.0 };
+    let radius = scene_radius(manifest);
     let mut power: Vec<(u32, u32, f32)> = manifest
         .lights
         .iter()
@@ -133,7 +163,11 @@ pub fn tables(
     }
     power.retain(|p| p.2 > 0.0 && p.2.is_finite());
     let total: f64 = power.iter().map(|p| p.2 as f64).sum();
-    let mut tables = ReferenceTables { triangle_emitter: vec![-1; triangles.len()], ..Default::default() };
+    let mut tables = ReferenceTables {
+        triangle_emitter: vec![-1; triangles.len()],
+        emitter_power: total,
+        ..Default::default()
+    };
     let alias = alias_table(&power.iter().map(|p| p.2 as f64).collect::<Vec<_>>());
     for (i, (&(kind, index, p), (keep, alias))) in power.iter().zip(alias).enumerate() {
         tables.emitters.push(GpuEmitter { kind, index, keep, pdf: (p as f64 / total) as f32, alias });
