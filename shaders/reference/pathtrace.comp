@@ -34,7 +34,14 @@
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+// Samples per pixel taken side by side: the workgroup's z (`STREAMS`, constant 2, set by the
+// player, passes/pathtrace.rs), each invocation of a pixel every STREAMS-th sample of the
+// dispatch, their sums joined in shared memory. A small image has too few pixels to fill a large
+// GPU (640 × 360 is 230,400 invocations; an H200 keeps 270,336 in flight), and a workgroup's
+// slowest path holds up fewer of its pixels' samples.
+layout(local_size_x = 8, local_size_y = 8, local_size_z_id = 2) in;
+const uint MAX_STREAMS = 4u;
+shared vec3 stream_sums[64u * MAX_STREAMS];
 
 layout(set = 0, binding = 0) uniform Constants { ReferenceConstants rc; };
 #include "../common/scene_bindings.glsl"   // bindings 1-8: the scene, the lights
@@ -391,28 +398,43 @@ bool extend(inout Path path) {
 
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;
-    if (any(greaterThanEqual(pixel, rc.size.xy))) {
-        return;
-    }
+    uint stream = gl_LocalInvocationID.z;
+    uint streams = min(gl_WorkGroupSize.z, MAX_STREAMS);
+    bool inside = all(lessThan(pixel, rc.size.xy));
     // The dispatch's samples as one loop of vertices (path regeneration): an invocation whose
     // path has ended starts its pixel's next sample at once, where a loop over samples would
     // leave it idle until the longest path of its subgroup ended. Paths' lengths vary most
     // where glass and metal keep their throughput (ToyCar); the idle share shrinks as the
     // dispatch's samples grow.
     vec3 sum = vec3(0.0);
-    uint taken = 0u;
-    Path path = start_path(pixel, sample_index);
-    while (taken < sample_count) {
-        if (!extend(path)) {
-            // A non-finite sample would poison the average; it is dropped (counted as zero).
-            if (!any(isnan(path.result)) && !any(isinf(path.result))) {
-                sum += path.result;
-            }
-            taken++;
-            if (taken < sample_count) {
-                path = start_path(pixel, sample_index + taken);
+    uint taken = stream;
+    if (inside && taken < sample_count) {
+        Path path = start_path(pixel, sample_index + taken);
+        while (taken < sample_count) {
+            if (!extend(path)) {
+                // A non-finite sample would poison the average; it is dropped (counted as zero).
+                if (!any(isnan(path.result)) && !any(isinf(path.result))) {
+                    sum += path.result;
+                }
+                taken += streams;
+                if (taken < sample_count) {
+                    path = start_path(pixel, sample_index + taken);
+                }
             }
         }
+    }
+    if (streams > 1u) {
+        stream_sums[gl_LocalInvocationIndex] = sum;
+        barrier();
+        if (stream != 0u) {
+            return;
+        }
+        for (uint k = 1u; k < streams; k++) {
+            sum += stream_sums[gl_LocalInvocationIndex + 64u * k];
+        }
+    }
+    if (!inside) {
+        return;
     }
     if (sample_index != 0u) {
         sum += imageLoad(accumulation, ivec2(pixel)).rgb;

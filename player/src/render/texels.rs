@@ -89,14 +89,19 @@ mod tests {
             let bytes = std::fs::read(spirv::shader_dir().join(format!("{source}.spv"))).unwrap();
             let bytes = bytes.as_slice();
             let source = source.as_str();
-            let (consts, decoders) = spec_constants(bytes);
+            let (consts, numbers, decoders) = spec_constants(bytes);
             if source == "reference/pathtrace.comp" {
-                // TEXELS_BC and HAS_MEDIA, both set by passes/pathtrace.rs.
+                // TEXELS_BC, HAS_MEDIA and the workgroup's depth (STREAMS), all set by
+                // passes/pathtrace.rs.
                 let mut consts = consts;
                 consts.sort();
                 assert_eq!(consts, [(TEXELS_BC_ID, false), (1, true)], "{source}");
+                assert_eq!(numbers, [2], "{source}");
                 decoding += 1;
-            } else if decoders {
+                continue;
+            }
+            assert!(numbers.is_empty(), "{source}: numeric specialization constants {numbers:?}");
+            if decoders {
                 assert_eq!(consts, [(TEXELS_BC_ID, false)], "{source}: TEXELS_BC");
                 decoding += 1;
             } else if source == "lighting/direct.comp" {
@@ -114,13 +119,14 @@ mod tests {
         assert!(decoding >= 10, "only {decoding} shaders have the BC decoders");
     }
 
-    /// (SpecId, default) of every boolean specialization constant of a SPIR-V module (panics on
-    /// any other kind), and whether it has the BC7 decoder (the first word of
+    /// (SpecId, default) of every boolean specialization constant of a SPIR-V module, the
+    /// SpecIds of its numeric ones, and whether it has the BC7 decoder (the first word of
     /// `BC7_PARTITION` in `shaders/common/bc.glsl` is one of its constants).
-    fn spec_constants(bytes: &[u8]) -> (Vec<(u32, bool)>, bool) {
+    fn spec_constants(bytes: &[u8]) -> (Vec<(u32, bool)>, Vec<u32>, bool) {
         let words: Vec<u32> =
             bytes.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect();
         let (mut ids, mut defaults) = (Vec::new(), std::collections::HashMap::new());
+        let mut numbers = std::collections::HashSet::new();
         let mut decoder = false;
         let mut i = 5;
         while i < words.len() {
@@ -133,14 +139,22 @@ mod tests {
                 48 | 49 => {
                     defaults.insert(w[2], op == 48);
                 }
-                // OpSpecConstant (a number)
-                50 => panic!("a numeric specialization constant"),
+                // OpSpecConstant %type %result value (a number)
+                50 => {
+                    numbers.insert(w[2]);
+                }
                 // OpConstant %type %result value
                 43 if w.len() == 4 && w[3] == 0x0f3f_cccc => decoder = true,
                 _ => {}
             }
             i += count.max(1);
         }
-        (ids.into_iter().map(|(target, id)| (id, defaults[&target])).collect(), decoder)
+        let (numeric, boolean): (Vec<_>, Vec<_>) =
+            ids.into_iter().partition(|(target, _)| numbers.contains(target));
+        let mut numeric: Vec<u32> = numeric.into_iter().map(|(_, id)| id).collect();
+        // (glslc declares a workgroup size's constant twice: alone and inside gl_WorkGroupSize.)
+        numeric.sort();
+        numeric.dedup();
+        (boolean.into_iter().map(|(target, id)| (id, defaults[&target])).collect(), numeric, decoder)
     }
 }

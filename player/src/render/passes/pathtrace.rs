@@ -24,6 +24,13 @@ pub const ACCUMULATION: TargetDecl = TargetDecl {
     array: false,
 };
 
+/// Samples of a pixel taken side by side (`STREAMS` in the shader, at most its `MAX_STREAMS`).
+/// Measured on an H200, 1,024 spp, 1, 2 and 4 (the images the same to the bit): at 640 × 360
+/// ToyCar 85.0 / 95.4 / 101.2 M samples/s, LightsPunctualLamp 496 / 647 / 819, pica_pica 156 /
+/// 190 / 209; at 1600 × 900 104 / 107 / 114, 959 / 1,058 / 1,177 and 234 / 224 / 224
+/// (docs/benchmarks/reference-speed/h200-streams.txt).
+const STREAMS: u32 = 4;
+
 /// The path tracer's pipeline and set.
 #[derive(Debug)]
 pub struct PathTracePass(Kernel);
@@ -44,7 +51,7 @@ impl PathTracePass {
             &bindings,
             spirv::shader!("reference/pathtrace.comp"),
             std::mem::size_of::<[u32; 2]>() as u32,
-            &[texels_bc, media as u32],
+            &[texels_bc, media as u32, STREAMS],
         )?))
     }
 
