@@ -116,11 +116,10 @@ fn sample(session: &Session, sampling: Sampling) -> PlayResult<(ReferenceReport,
     let cam = &session.camera;
     let (right, up, half) = cam.image_axes();
     let sky = scene.manifest.sky.radiance;
-    let env_luminance = scene.environment.as_ref().filter(|e| e.present).map_or(0.0, |e| e.mean_luminance);
     let environment_share = crate::scene::reference::environment_share(
-        env_luminance,
+        scene.environment.as_ref().map_or(0.0, |e| e.mean_luminance),
         crate::scene::reference::scene_radius(&scene.manifest),
-        if r.emitter_count > 0 { r.emitter_power } else { 0.0 },
+        r.emitter_power,
     );
     let constants = ReferenceConstants {
         eye: [cam.position.x as f32, cam.position.y as f32, cam.position.z as f32, half as f32],

@@ -9,6 +9,8 @@
 #ifndef KILN_ENVIRONMENT_GLSL
 #define KILN_ENVIRONMENT_GLSL
 
+#include "packing.glsl"
+
 layout(set = 0, binding = ENV_BINDING, std430) readonly buffer Environment {
     EnvironmentHeader environment;
     uint env_texels[];  // the radiance map, then the prefiltered levels (E5B9G9R9)
@@ -108,6 +110,16 @@ vec3 env_irradiance(vec3 n, vec3 sky) {
         return sky;
     }
     return env_harmonics(n, vec3(1.0));
+}
+
+// How much sharper the environment is about unit direction d than its irradiance there: its
+// level prefiltered for a lobe (`filtered`, env_filtered's answer about d) over its mean
+// cosine-weighted radiance, by luminance (1 under the constant sky), bounded where the irradiance
+// is near black. What turns light known as a cosine lobe about the mirror direction (the
+// probes') into a glossy lobe's.
+float env_sharpness(vec3 d, vec3 filtered, vec3 sky) {
+    float spread = luminance(env_irradiance(d, sky));
+    return spread > 0.0 ? clamp(luminance(filtered) / spread, 0.0, 8.0) : 1.0;
 }
 
 // Solid-angle density with which env_sample draws unit direction d.

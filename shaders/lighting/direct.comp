@@ -342,10 +342,8 @@ void main() {
             // environment's own prefiltered-to-irradiance ratio there gives back its sharpness
             // (1 under the constant sky), bounded where the irradiance is near black. Like the
             // diffuse GI it replaces the material's occlusion: the probes saw the occluders.
-            float spread = luminance(env_irradiance(mirror, frame.sky.rgb));
-            float sharp = luminance(filtered);
-            float ratio = spread > 0.0 ? clamp(sharp / spread, 0.0, 8.0) : 1.0;
             vec4 probe = imageLoad(probe_specular, pixel);
+            float ratio = env_sharpness(mirror, filtered, frame.sky.rgb);
             sky_in = mix(sky_in, probe.rgb * ratio, clamp(probe.a, 0.0, 1.0));
         }
         if (DIRECT_SCREEN_REFLECTIONS && (frame.size.w & FRAME_SCREEN_REFLECTIONS) != 0u) {

@@ -34,8 +34,8 @@
 #include "../common/layout.glsl"
 #include "../common/packing.glsl"
 
-// Samples per pixel taken side by side: the workgroup's z (`STREAMS`, constant 2, set by the
-// player, passes/pathtrace.rs), each invocation of a pixel every STREAMS-th sample of the
+// Samples per pixel taken side by side: the workgroup's z (specialization constant 2, `STREAMS`
+// in passes/pathtrace.rs), each invocation of a pixel every STREAMS-th sample of the
 // dispatch, their sums joined in shared memory. A small image has too few pixels to fill a large
 // GPU (640 × 360 is 230,400 invocations; an H200 keeps 270,336 in flight), and a workgroup's
 // slowest path holds up fewer of its pixels' samples.

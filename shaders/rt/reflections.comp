@@ -55,10 +55,9 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughne
         ProbeLight pl = probe_light(probe_volume, s.p, n, wo, true);
         float confidence = clamp(pl.confidence, 0.0, 1.0);
         diffuse_in = mix(diffuse_in, pl.irradiance, confidence);
-        // The probes' irradiance about the mirror direction, sharpened by the environment's own
-        // prefiltered-to-irradiance ratio there, as the direct pass's split sum does.
-        float spread = luminance(env_irradiance(mirror, frame.sky.rgb));
-        float ratio = spread > 0.0 ? clamp(luminance(specular_in) / spread, 0.0, 8.0) : 1.0;
+        // The probes' irradiance about the mirror direction, sharpened as the direct pass's split
+        // sum does.
+        float ratio = env_sharpness(mirror, specular_in, frame.sky.rgb);
         specular_in = mix(specular_in, pl.mirror * ratio, confidence);
     }
     sum += diffuse_in * diffuse;

@@ -56,7 +56,8 @@ impl EnvironmentBuffers {
         up.buffer(&table, 0, table_bytes)?;
         // The harmonics' band 0 (irradiance over π, whose cosine factor is 1 in band 0) times
         // the constant basis function: the mean radiance over all directions.
-        let mean = header.sh[0].map(|c| c * 0.282_094_8);
+        let y00 = kiln_format::environment::sh_basis(glam::Vec3::Y)[0];
+        let mean = header.sh[0].map(|c| c * y00);
         let mean_luminance = kiln_format::gpu::luminance([mean[0], mean[1], mean[2]]).max(0.0);
         Ok(EnvironmentBuffers { radiance, table, present: env.is_some(), mean_luminance })
     }
