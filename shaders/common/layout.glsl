@@ -133,7 +133,8 @@ struct RtConstants {
     uint direct_temporal; // offset 48
     uint direct_visibility; // offset 52
     float gi_min_roughness; // offset 56
-}; // 60 bytes
+    float metal_bounce_roughness; // offset 60
+}; // 64 bytes
 
 struct MarchConstants {
     uint steps; // offset 0

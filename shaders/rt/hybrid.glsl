@@ -30,7 +30,8 @@ layout(set = 0, binding = 17, r32f) uniform image2D rt_ao;
 layout(set = 0, binding = 18, rgba32f) uniform image2D rt_reflections;  // rgb, a = 1 where traced
 // Between the two reflection passes, per reflection sample: the radiance without the lights'
 // shadowed terms (a = 1 where traced), the hit's offset origin (w = 1 on a hit), and each
-// light's unshadowed term, which the lean shadow pass adds where the light is visible.
+// light's unshadowed term, which the lean shadow pass adds where the light is visible (then the
+// same for the hit of a metal hit's own reflection, and that hit's origin: reflections.comp).
 layout(set = 0, binding = 19, rgba32f) uniform image2D refl_partial;
 layout(set = 0, binding = 20, rgba32f) uniform image2D refl_origin;
 layout(set = 0, binding = 21, rgba32f) uniform image2DArray refl_lights;

@@ -17,30 +17,77 @@
 // masking term and the pdf (it used Fresnel alone), and diffuse-only materials are not traced.
 #include "hybrid.glsl"
 
-// Radiance leaving the hit towards -dir, without the shadowed terms of the lights that the
-// shadow pass handles (stored, scaled by `scale`, in their `refl_lights` layers); the hit's
-// offset origin goes to `origin`. The hit's roughness is at least `min_roughness`, the
-// reflecting pixel's (path regularisation, Kaplanyan & Dachsbacher 2013): a rough pixel's ray
-// lands anywhere in a wide lobe, and a glossy hit's highlight of a point light caught by one
-// ray in thousands is a firefly of thousands of times the pixel's mean (pica_pica's bulb seen
-// through two reflections: one pixel at 2,800 times the reference after four frames, relMSE
-// 0.98). Widening the hit's lobe to the pixel's spreads the highlight over the footprint it is
-// seen through, as the pixel's own blur would after many frames, and keeps most of its energy
-// (GGX is normalised; what the wider lobe sends to grazing angles or past the surface's edge is
+// One GGX visible-normal sample (Heitz 2018) of the specular lobe of material m at a surface of
+// shading normal n and geometric normal ng (both on v's side) seen from v: the reflected
+// direction wi and the one-sample weight F(v·h) · G2 / G1(v) of the lobe's reflected radiance
+// (the lobe's pdf cancels D and G1); zero below either normal.
+vec3 sample_lobe(Material m, vec3 n, vec3 ng, vec3 v, out vec3 wi) {
+    float a = ggx_alpha(m.roughness);
+    mat3 f = basis(n);
+    vec3 h = f * sample_vndf(transpose(f) * v, a, vec2(rnd(), rnd()));
+    wi = reflect(-v, h);
+    float n_l = dot(n, wi);
+    if (n_l <= 0.0 || dot(wi, ng) <= 0.0) {
+        return vec3(0.0);
+    }
+    float a2 = a * a;
+    float lv = smith_lambda(max(dot(n, v), 1e-4), a2);
+    float g = (1.0 + lv) / (1.0 + lv + smith_lambda(n_l, a2));
+    return fresnel_schlick(fresnel_f0(m), fresnel_f90(m), clamp(dot(v, h), 0.0, 1.0)) * g;
+}
+
+// The unshadowed term of light l at surface s seen from wo, and the direction towards it.
+vec3 light_term(GpuLight l, Surface s, vec3 wo, out vec3 wi) {
+    vec3 li = vec3(0.0);
+    if (l.kind == LIGHT_DIRECTIONAL) {
+        wi = -l.direction;
+        li = l.radiance;
+    } else {
+        vec3 to = l.position - s.p;
+        float dist = length(to);
+        wi = to / max(dist, 1e-30);
+        if (dist > 0.0 && (l.range <= 0.0 || dist <= l.range)) {
+            li = l.radiance / (dist * dist);
+            if (l.kind == LIGHT_SPOT) {
+                li *= spot_cone(l, wi);
+            } else if (l.kind == LIGHT_RECT) {
+                // The rectangle seen from the hit as one point at its centre.
+                li *= max(dot(-wi, l.direction), 0.0) * l.width * l.height;
+            }
+        }
+    }
+    return any(greaterThan(li, vec3(0.0))) ? brdf_cos(s, wo, wi) * li : vec3(0.0);
+}
+
+bool light_occluded(GpuLight l, vec3 origin, vec3 wi) {
+    return l.kind == LIGHT_DIRECTIONAL ? occluded_ray_from(origin, wi) : occluded_from(origin, l.position);
+}
+
+// A hit's material at least `min_roughness` rough, the reflecting surface's (path
+// regularisation, Kaplanyan & Dachsbacher 2013): a rough pixel's ray lands anywhere in a wide
+// lobe, and a glossy hit's highlight of a point light caught by one ray in thousands is a
+// firefly of thousands of times the pixel's mean (pica_pica's bulb seen through two
+// reflections: one pixel at 2,800 times the reference after four frames, relMSE 0.98).
+// Widening the hit's lobe to the pixel's spreads the highlight over the footprint it is seen
+// through, as the pixel's own blur would after many frames, and keeps most of its energy (GGX
+// is normalised; what the wider lobe sends to grazing angles or past the surface's edge is
 // lost: 19 % of a wall's highlight in the worst case of tests/render/raytraced.rs, over 256
 // frames). A smooth pixel (a mirror) keeps the hit's sharp highlight, which is then coherent
 // across pixels rather than noise.
-vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughness, out vec3 origin) {
+Surface regularised_hit(TraceRay r, TraceHit h, float min_roughness) {
     Surface s = surface_at(r, h);
     s.mat.roughness = max(s.mat.roughness, min_roughness);
     s.mat.clearcoat_roughness = max(s.mat.clearcoat_roughness, min_roughness);
-    origin = offset_ray_origin(s.p, s.ng);
-    vec3 wo = -normalize(r.direction);
+    return s;
+}
+
+// Radiance leaving surface s towards wo but its lights' terms (and, where `specular` is false,
+// its specular lobe's light from around): emission, and the sky or environment as unshadowed
+// ambient (diffuse from its irradiance, specular from its level prefiltered for the hit's
+// roughness), or the probes' light where the file has them.
+vec3 ambient_light(Surface s, vec3 wo, bool specular) {
     vec3 sum = s.emission;
-    vec3 f0 = fresnel_f0(s.mat);
     vec3 diffuse = s.mat.diffuse_only ? s.mat.base : s.mat.base * (1.0 - s.mat.metallic);
-    // The sky or environment as unshadowed ambient: diffuse from its irradiance, specular from
-    // its level prefiltered for the hit's roughness.
     vec3 mirror = reflect(-wo, s.ns);
     vec3 diffuse_in = env_irradiance(s.ns, frame.sky.rgb);
     vec3 specular_in = env_filtered(mirror, s.mat.roughness, frame.sky.rgb);
@@ -61,36 +108,79 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughne
         specular_in = mix(specular_in, pl.mirror * ratio, confidence);
     }
     sum += diffuse_in * diffuse;
-    if (!s.mat.diffuse_only) {
-        sum += specular_in * f0;
+    if (specular && !s.mat.diffuse_only) {
+        sum += specular_in * fresnel_f0(s.mat);
+    }
+    return sum;
+}
+
+// Whether the specular lobe of a hit is traced once more rather than read from the probes or
+// the sky: smooth metal, whose light is all in that lobe and which mirrors its surroundings
+// sharply, where the probes' cosine lobe about the mirror direction blurs the room it shows
+// (pica_pica's console: its metal deck mirrors the metal panel above it, which mirrors the lit
+// room; read from the probes the deck was a third darker than the reference).
+bool traced_onwards(Surface s) {
+    return !s.mat.diffuse_only && s.mat.metallic >= 0.5 && s.mat.roughness < rt.metal_bounce_roughness;
+}
+
+// Radiance leaving a second hit towards -r.direction but its lights' shadowed terms, which go,
+// scaled by `scale`, to their layers after the first hit's (`rt.reflection_lights` + i), and its
+// offset origin to the layer after those (w = 1), for the shadow pass to trace.
+vec3 shade_second_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughness) {
+    Surface s = regularised_hit(r, h, min_roughness);
+    vec3 wo = -normalize(r.direction);
+    vec3 origin = offset_ray_origin(s.p, s.ng);
+    vec3 sum = ambient_light(s, wo, true);
+    for (uint i = 0u; i < frame.size.z; i++) {
+        vec3 wi;
+        vec3 term = light_term(lights[i], s, wo, wi);
+        if (i < rt.reflection_lights) {
+            imageStore(refl_lights, ivec3(cell, int(rt.reflection_lights + i)), vec4(term * scale, 0.0));
+        } else if (any(greaterThan(term, vec3(0.0))) && !light_occluded(lights[i], origin, wi)) {
+            sum += term;
+        }
+    }
+    imageStore(refl_lights, ivec3(cell, int(2u * rt.reflection_lights)), vec4(origin, 1.0));
+    return sum;
+}
+
+// Radiance leaving the hit towards -dir, without the shadowed terms of the lights that the
+// shadow pass handles (stored, scaled by `scale`, in their `refl_lights` layers, and a second
+// hit's after them); the hit's offset origin goes to `origin`. The hit is regularised to the reflecting pixel's roughness
+// (`regularised_hit`). Smooth metal's specular lobe is traced one bounce further
+// (`traced_onwards`), the rest reads the probes or the sky (`ambient_light`).
+vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughness, out vec3 origin) {
+    Surface s = regularised_hit(r, h, min_roughness);
+    origin = offset_ray_origin(s.p, s.ng);
+    vec3 wo = -normalize(r.direction);
+    bool onwards = traced_onwards(s);
+    vec3 sum = ambient_light(s, wo, !onwards);
+    bool second = false;
+    if (onwards) {
+        vec3 wi;
+        vec3 weight = sample_lobe(s.mat, s.ns, s.ng, wo, wi);
+        if (any(greaterThan(weight, vec3(0.0)))) {
+            TraceRay r2 = make_ray(origin, wi, 0.0, 3.4e38);
+            TraceHit h2 = trace(r2, false);
+            if (h2.t == NO_HIT) {
+                sum += weight * env_radiance(wi, frame.sky.rgb);
+            } else {
+                sum += weight * shade_second_hit(r2, h2, cell, scale * weight, s.mat.roughness);
+                second = true;
+            }
+        }
+    }
+    if (!second) {
+        imageStore(refl_lights, ivec3(cell, int(2u * rt.reflection_lights)), vec4(0.0));
     }
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight l = lights[i];
         vec3 wi;
-        vec3 li = vec3(0.0);
-        if (l.kind == LIGHT_DIRECTIONAL) {
-            wi = -l.direction;
-            li = l.radiance;
-        } else {
-            vec3 to = l.position - s.p;
-            float dist = length(to);
-            wi = to / max(dist, 1e-30);
-            if (dist > 0.0 && (l.range <= 0.0 || dist <= l.range)) {
-                li = l.radiance / (dist * dist);
-                if (l.kind == LIGHT_SPOT) {
-                    li *= spot_cone(l, wi);
-                } else if (l.kind == LIGHT_RECT) {
-                    // The rectangle seen from the hit as one point at its centre.
-                    li *= max(dot(-wi, l.direction), 0.0) * l.width * l.height;
-                }
-            }
-        }
-        vec3 term = any(greaterThan(li, vec3(0.0))) ? brdf_cos(s, wo, wi) * li : vec3(0.0);
+        vec3 term = light_term(l, s, wo, wi);
         if (i < rt.reflection_lights) {
             // Every layer is written for every hit: the shadow pass reads them all.
             imageStore(refl_lights, ivec3(cell, int(i)), vec4(term * scale, 0.0));
-        } else if (any(greaterThan(term, vec3(0.0)))
-            && !(l.kind == LIGHT_DIRECTIONAL ? occluded_ray_from(origin, wi) : occluded_from(origin, l.position))) {
+        } else if (any(greaterThan(term, vec3(0.0))) && !light_occluded(l, origin, wi)) {
             sum += term;
         }
     }
@@ -115,22 +205,12 @@ void main() {
         if (!gbuffer_diffuse_only(mat) && roughness <= rt.max_roughness) {
             seed_rng(pixel, 3u);
             Material m = gbuffer_material(texelFetch(g_albedo, pixel, 0), mat);
-            vec3 f0 = fresnel_f0(m);
-            float a = ggx_alpha(roughness);
-            float a2 = a * a;
-            mat3 f = basis(s.n);
-            vec3 h = f * sample_vndf(transpose(f) * s.v, a, vec2(rnd(), rnd()));
-            vec3 wi = reflect(-s.v, h);
+            vec3 wi;
+            vec3 scale = sample_lobe(m, s.n, s.ng, s.v, wi);
             vec3 radiance = vec3(0.0);
-            float n_l = dot(s.n, wi);
-            if (n_l > 0.0 && dot(wi, s.ng) > 0.0) {
-                float n_v = max(dot(s.n, s.v), 1e-4);
-                float lv = smith_lambda(n_v, a2);
-                float weight = (1.0 + lv) / (1.0 + lv + smith_lambda(n_l, a2));
-                vec3 fresnel = fresnel_schlick(f0, fresnel_f90(m), clamp(dot(s.v, h), 0.0, 1.0));
+            if (any(greaterThan(scale, vec3(0.0)))) {
                 TraceRay r = make_ray(offset_ray_origin(s.p, s.ng), wi, 0.0, 3.4e38);
                 TraceHit hit = trace(r, false);
-                vec3 scale = fresnel * weight;
                 if (hit.t == NO_HIT) {
                     radiance = scale * env_radiance(wi, frame.sky.rgb);
                 } else {

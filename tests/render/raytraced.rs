@@ -1,14 +1,15 @@
 //! The hybrid pipeline's ray-traced passes against closed forms: AO under a ceiling, mirror
-//! reflections of a panel and the sky at both resolutions; no firefly where a rough reflection
-//! or a GI path catches a glossy highlight (bounded by the regularised lobe's peak); and the
-//! frame average restarting.
+//! reflections of a panel and the sky at both resolutions; a mirror seen in a mirror (the metal
+//! bounce); no firefly where a rough reflection or a GI path catches a glossy highlight (bounded
+//! by the regularised lobe's peak); and the frame average restarting.
 
 use std::path::Path;
 use std::time::Instant;
 
 use glam::{DVec3, Vec3};
 use kiln_compiler::import::demo::{cornell_box, lambert_material};
-use kiln_format::manifest::{LightKind, Sky};
+use kiln_format::manifest::{Light, LightKind, Sky};
+use kiln_format::sections::GpuMaterial;
 use kiln_test_support::gpu_test;
 use kiln_tests::{Options, Reflections, compile, scene_of};
 
@@ -146,6 +147,139 @@ fn ray_traced_reflections_of_a_mirror_floor_show_the_sky_and_an_emitter_at_the_f
     let on_panel: Vec<_> = pixels.iter().copied().filter(|&(_, p, d)| sees(p, d) == Some(true)).collect();
     let (m_split, _) = ratio_stats(&split, &on_panel, |_, d| fresnel(d) * sky as f64);
     assert!((m_split - 1.0).abs() < 0.03, "the split sum shows the sky everywhere: {m_split}");
+}
+
+/// The periscope of `a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects`: mirrors
+/// A and B of smooth metal of F0 `base`, the panel above B of material `panel`, a black sky,
+/// `lights`; the file's bytes.
+fn periscope(cam: &Pinhole, base: f32, panel: GpuMaterial, lights: Vec<Light>) -> Vec<u8> {
+    let quad = |c: Vec3, t1: Vec3, t2: Vec3| {
+        let p = [c - t1 - t2, c + t1 - t2, c + t1 + t2, c - t1 + t2];
+        [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
+    };
+    let r2 = std::f32::consts::FRAC_1_SQRT_2;
+    let mut tris =
+        quad(Vec3::new(0.0, 0.0, -3.0), Vec3::new(r2, 0.0, -r2), Vec3::new(0.0, 0.5, 0.0)).to_vec();
+    tris.extend(quad(Vec3::new(3.0, 0.0, -3.0), Vec3::new(r2, r2, 0.0), Vec3::new(0.0, 0.0, 1.0)));
+    // The panel, 4 × 4 around (3, 3, −3), wound to face down.
+    let (x0, x1, z0, z1, y) = PANEL;
+    let p = |x: f32, z: f32| Vec3::new(x, y, z);
+    tris.push([p(x0, z0), p(x1, z0), p(x1, z1)]);
+    tris.push([p(x0, z0), p(x1, z1), p(x0, z1)]);
+    let mut scene = scene_of(&tris);
+    scene.materials[0].gpu = metal(base, 0.0);
+    scene.materials.push(kiln_compiler::ir::Material { name: "panel".into(), gpu: panel });
+    let n = scene.triangle_materials.len();
+    scene.triangle_materials[n - 2..].fill(1);
+    scene.sky = Sky { radiance: [0.0; 3] };
+    scene.lights = lights;
+    scene.cameras.push(cam.file_camera());
+    compile(scene, fast_settings())
+}
+
+/// The periscope's panel: x0, x1, z0, z1 and its height.
+const PANEL: (f32, f32, f32, f32, f32) = (1.0, 5.0, -5.0, -1.0, 3.0);
+
+#[test]
+fn a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects() {
+    let dir = gpu_test!();
+    // A periscope: the camera looks along −z at mirror A (normal (1, 0, 1)/√2, 3 units ahead),
+    // which turns its rays towards +x onto mirror B (normal (−1, 1, 0)/√2), which turns them up
+    // into a panel at y = 3; the sky is black. Both mirrors are smooth metal of F0 = `base`
+    // (α = 10⁻³: G2/G1 = 1), so a pixel shows F(45°)² times the panel's radiance where the
+    // doubly mirrored ray meets it, Schlick's F at 45° incidence on both. Twice: the panel
+    // emitting E, and the panel of albedo ρ lit by a point light below it (whose term at that
+    // second hit, ρ/π · I cos θ / d², the shadow pass adds, its shadow ray from the second
+    // hit). Read from the sky about B's mirror direction (a single bounce) the pixel is black.
+    let (base, emitted, rho, intensity) = (0.8f32, 3.0f32, 0.7f32, 6.0f32);
+    let lamp = DVec3::new(4.5, 2.0, -4.5);
+    let cam = Pinhole::new([0.0, 0.0, 0.0], [0.0, 0.0, -3.0], [0.0, 1.0, 0.0], 10.0, W, H);
+    // Each pixel's path by its own arithmetic: the point where a ray meets a mirror's plane and
+    // whether it lies inside it (with a margin), then the mirrored direction.
+    let bounce = |o: DVec3, d: DVec3, centre: DVec3, n: DVec3, half: (f64, f64), t1: DVec3| {
+        let t = (centre - o).dot(n) / d.dot(n);
+        let q = o + d * t;
+        let (u, v) = ((q - centre).dot(t1), (q - centre).dot(n.cross(t1)));
+        (t > 0.0 && u.abs() < half.0 - 0.05 && v.abs() < half.1 - 0.05).then(|| (q, d - n * (2.0 * d.dot(n))))
+    };
+    let s = std::f64::consts::FRAC_1_SQRT_2;
+    let (na, nb) = (DVec3::new(s, 0.0, s), DVec3::new(-s, s, 0.0));
+    let schlick = |c: f64| base as f64 + (1.0 - base as f64) * (1.0 - c).powi(5);
+    let (x0, x1, z0, z1, y) = PANEL;
+    // (pixel, F_A F_B, the panel point)
+    let mut pixels = Vec::new();
+    for yy in 0..H {
+        for xx in 0..W {
+            let d = cam.ray(xx, yy, W, H);
+            let Some((qa, da)) =
+                bounce(cam.eye, d, DVec3::new(0.0, 0.0, -3.0), na, (1.0, 0.5), DVec3::new(s, 0.0, -s))
+            else {
+                continue;
+            };
+            let Some((qb, db)) =
+                bounce(qa, da, DVec3::new(3.0, 0.0, -3.0), nb, (1.0, 1.0), DVec3::new(s, s, 0.0))
+            else {
+                continue;
+            };
+            let at = qb + db * ((y as f64 - qb.y) / db.y);
+            let inside = |v: f64, lo: f32, hi: f32| v > lo as f64 + 0.05 && v < hi as f64 - 0.05;
+            if db.y > 0.0 && inside(at.x, x0, x1) && inside(at.z, z0, z1) {
+                pixels.push((3 * (yy * W + xx) as usize, schlick(-d.dot(na)) * schlick(-da.dot(nb)), at));
+            }
+        }
+    }
+    assert!(
+        pixels.len() > (W * H) as usize / 2,
+        "{} pixels see the panel through both mirrors",
+        pixels.len()
+    );
+    let mut glow = lambert_material([0.0; 3]);
+    glow.emission = [emitted; 3];
+    let lit = light(LightKind::Point, lamp.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity);
+    let cases = [
+        (
+            "emissive",
+            periscope(&cam, base, glow, vec![]),
+            Box::new(|_: DVec3| emitted as f64) as Box<dyn Fn(DVec3) -> f64>,
+        ),
+        (
+            "lit",
+            periscope(&cam, base, lambert_material([rho; 3]), vec![lit]),
+            Box::new(|q: DVec3| {
+                let d2 = (lamp - q).length_squared();
+                rho as f64 / std::f64::consts::PI * intensity as f64 * ((q.y - lamp.y) / d2.sqrt()) / d2
+            }),
+        ),
+    ];
+    for (name, bytes, radiance) in &cases {
+        let (rgb, _) = render_frames(dir.path(), name, bytes, 4, |f| {
+            Options::new(f, W, H).rt_reflections(Reflections::Full)
+        });
+        // The image against F² L, and each 8 × 8 block of it: a pixel alone moves by a few
+        // percent where the lit panel's light falls off, the lobe (α = 10⁻³) landing its rays a
+        // pixel's footprint apart there.
+        let mut blocks = std::collections::BTreeMap::new();
+        for &(i, f, q) in &pixels {
+            let (x, y) = pixel_xy(i);
+            let b: &mut (f64, f64) = blocks.entry((x / 8, y / 8)).or_default();
+            *b = (b.0 + rgb[i] as f64, b.1 + f * radiance(q));
+        }
+        let (got, want) = blocks.values().fold((0.0, 0.0), |(g, w), b| (g + b.0, w + b.1));
+        let mean = got / want;
+        let worst = blocks.values().fold(0.0f64, |w, b| w.max((b.0 / b.1 - 1.0).abs()));
+        eprintln!(
+            "{name}: {} pixels through both mirrors: ratio {mean:.4}, worst block {worst:.4}",
+            pixels.len()
+        );
+        assert!((mean - 1.0).abs() < 0.01, "{name}: the mirrors show {mean} times F² L");
+        assert!(worst < 0.03, "{name}: a block through both mirrors is off by {worst}");
+        // Without the metal bounce B's lobe reads the black sky.
+        let (one, _) = render_frames(dir.path(), &format!("{name}-one"), bytes, 2, |f| {
+            Options::new(f, W, H).rt_reflections(Reflections::Full).metal_bounce(0.0)
+        });
+        let dark = pixels.iter().map(|&(i, _, _)| one[i] as f64).fold(0.0f64, f64::max);
+        assert!(dark < 1e-3, "{name}: with --reflection-metal-bounce 0 mirror B shows the sky, not {dark}");
+    }
 }
 
 /// The glossy-wall scene: a floor (y = 0, |x|, |z| ≤ 2) of material `floor` in front of a

@@ -211,8 +211,20 @@ impl Options {
             Reflections::Full => ReflectionRes::Full,
             Reflections::Half => ReflectionRes::Half,
         };
-        self.0.render.techniques.reflections =
-            ReflectionsTechnique::Rt(reflections::rt::Rt { resolution: res, max_roughness: 1.0 });
+        self.0.render.techniques.reflections = ReflectionsTechnique::Rt(reflections::rt::Rt {
+            resolution: res,
+            max_roughness: 1.0,
+            metal_bounce: reflections::rt::METAL_BOUNCE,
+        });
+        self
+    }
+
+    /// With ray-traced reflections: metal hits smoother than `roughness` reflect by one more
+    /// traced ray (`--reflection-metal-bounce`; 0: never).
+    pub fn metal_bounce(mut self, roughness: f32) -> Options {
+        if let ReflectionsTechnique::Rt(r) = &mut self.0.render.techniques.reflections {
+            r.metal_bounce = roughness;
+        }
         self
     }
 

@@ -420,6 +420,9 @@ gpu_struct! {
         pub direct_visibility: u32 => "uint",
         /// GI: the least roughness of the surfaces its paths hit (path regularisation; 0 off).
         pub gi_min_roughness: f32 => "float",
+        /// Reflections: metal hits smoother than this trace their own specular lobe one bounce
+        /// further (0: none; their lobe reads the probes or the sky).
+        pub metal_bounce_roughness: f32 => "float",
     }
 }
 

@@ -98,8 +98,8 @@ pub struct Args {
     /// with `probes` (about 1 ms on the H200 with the default visibility G-buffer: the McGuire
     /// box 0.082 HDR-FLIP against 0.342 for the screen-space `baked`; pica_pica 0.0444 against
     /// `baked` 0.0583 and `hybrid` 0.0573; `probes-rt` adds ray-traced shadows: 0.0423 at
-    /// 1.33 ms; `probes-rt-refl` ray-traced reflections too: 0.0391 after 16 still frames at
-    /// 1.52 ms, against `probes-rt`'s 0.0426).
+    /// 1.33 ms; `probes-rt-refl` ray-traced reflections too: 0.0378 after 16 still frames at
+    /// 1.72 ms, against `probes-rt`'s 0.0426).
     #[arg(long, value_name = "NAME", value_parser = clap::builder::PossibleValuesParser::new(crate::render::presets::PRESETS.map(|p| p.name)))]
     pub preset: Option<String>,
     /// Choose the whole frame by a GPU budget: of the frame presets measured (by
@@ -406,7 +406,11 @@ mod tests {
         assert_eq!(t.ao, Ao::Rt(ao::rt::Rt { radius: Radius { radius: Some(0.5), reach: 0.1 } }));
         assert_eq!(
             t.reflections,
-            Reflections::Rt(reflections::rt::Rt { resolution: ReflectionRes::Half, max_roughness: 0.4 })
+            Reflections::Rt(reflections::rt::Rt {
+                resolution: ReflectionRes::Half,
+                max_roughness: 0.4,
+                metal_bounce: reflections::rt::METAL_BOUNCE
+            })
         );
         assert_eq!(t.gi, Gi::Rt(gi::rt::Rt { bounces: 2, regularize: 0.5 }));
         assert_eq!(t.aa, Aa::Off(aa::none::Off));

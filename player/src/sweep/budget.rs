@@ -49,21 +49,21 @@ pub struct Measurements {
 /// The built-in table: pica_pica (`tests/scenes/pica_pica.toml`, compiled with the defaults) at
 /// 1600 × 900 on an NVIDIA H200 against a 4096-spp all-bounce reference, one frame, the
 /// visibility G-buffer (the raster one measured slower at equal error): kiln-bench's frame chart
-/// (`kiln-bench --effects frame --frames-accumulated 1,16`, medians of 100 frames), after the
-/// ray-traced reflections' hits were lit by the probes (`docs/benchmarks/reflection-probes/`).
+/// (`kiln-bench --effects frame --frames-accumulated 1,16`, medians of 100 frames), after metal
+/// hit by a reflection ray reflected by one more (`docs/benchmarks/metal-bounce/`).
 const BUILT_IN: [(&str, &str, f64, f64); 12] = [
-    ("visibility", "probes", 0.994, 0.0444),
-    ("visibility", "probes-rt", 1.332, 0.0423),
-    ("visibility", "baked", 1.336, 0.0583),
-    ("visibility", "baked-taa", 1.396, 0.0600),
-    ("visibility", "probes-rt-refl", 1.522, 0.0423),
-    ("visibility", "hybrid", 1.671, 0.0573),
-    ("visibility", "rt", 5.113, 0.0565),
-    ("visibility", "rt-taa", 5.273, 0.0585),
-    ("visibility", "rt-2", 7.268, 0.0455),
-    ("visibility", "rt-4", 9.828, 0.0417),
-    ("visibility", "rt-4-taa", 9.982, 0.0439),
-    ("visibility", "rt-8", 12.836, 0.0410),
+    ("visibility", "probes", 0.993, 0.0444),
+    ("visibility", "probes-rt", 1.327, 0.0423),
+    ("visibility", "baked", 1.331, 0.0584),
+    ("visibility", "baked-taa", 1.388, 0.0601),
+    ("visibility", "hybrid", 1.663, 0.0574),
+    ("visibility", "probes-rt-refl", 1.717, 0.0414),
+    ("visibility", "rt", 5.743, 0.0556),
+    ("visibility", "rt-taa", 5.899, 0.0576),
+    ("visibility", "rt-2", 7.884, 0.0446),
+    ("visibility", "rt-4", 10.425, 0.0408),
+    ("visibility", "rt-4-taa", 10.591, 0.0430),
+    ("visibility", "rt-8", 13.434, 0.0401),
 ];
 
 /// Whether preset `name` reads the file's irradiance probes.
@@ -89,7 +89,7 @@ impl Measurements {
             })
             .collect();
         Measurements {
-            what: "pica_pica on an NVIDIA H200 (built in: docs/benchmarks/reflection-probes)".into(),
+            what: "pica_pica on an NVIDIA H200 (built in: docs/benchmarks/metal-bounce)".into(),
             width: 1600,
             height: 900,
             points,
@@ -230,7 +230,7 @@ mod tests {
                 Err(e) => {
                     assert!(fits.is_empty(), "budget {budget}: refused ({e}) though {} fit", fits.len());
                     assert_eq!(e.exit, Exit::Usage);
-                    assert!(e.message.contains("1.336 ms"), "{}", e.message);
+                    assert!(e.message.contains("1.331 ms"), "{}", e.message);
                 }
             }
         }

@@ -23,7 +23,9 @@ pub const REFLECTIONS: TargetDecl = rgba32("rt reflections", false);
 pub const PARTIAL: TargetDecl = rgba32("reflection partial", false);
 /// Between the kernels: the hits' offset ray origins.
 pub const ORIGINS: TargetDecl = rgba32("reflection origins", false);
-/// Between the kernels: each light's unshadowed term, one layer per light.
+/// Between the kernels: each light's unshadowed term at the hit, one layer per light, then the
+/// same at a metal hit's own reflection's hit, then that second hit's origin (w = 1 where there
+/// is one).
 pub const LIGHT_TERMS: TargetDecl = rgba32("reflection light terms", true);
 /// The pass's targets in binding order (`shaders/rt/hybrid.glsl`, bindings 18–21).
 pub const TARGETS: [TargetDecl; 4] = [REFLECTIONS, PARTIAL, ORIGINS, LIGHT_TERMS];
@@ -62,7 +64,10 @@ impl Pass for RtReflectionsPass {
 
     fn targets(&self, width: u32, height: u32) -> Vec<(TargetDecl, ImageDesc)> {
         let (w, h) = (width.div_ceil(self.step), height.div_ceil(self.step));
-        TARGETS.iter().map(|t| (*t, t.sized(w, h, if *t == LIGHT_TERMS { self.lights } else { 1 }))).collect()
+        TARGETS
+            .iter()
+            .map(|t| (*t, t.sized(w, h, if *t == LIGHT_TERMS { 2 * self.lights + 1 } else { 1 })))
+            .collect()
     }
 
     fn binds(&self) -> Vec<TargetDecl> {

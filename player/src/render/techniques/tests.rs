@@ -177,7 +177,11 @@ fn knobs_are_checked_and_named_in_errors() {
     t.set(Effect::Reflections, "rt", &[("reflection-res", KnobValue::Choice(1))]).unwrap();
     assert_eq!(
         t.reflections,
-        Reflections::Rt(ReflRt { resolution: ReflectionRes::Half, max_roughness: 1.0 })
+        Reflections::Rt(ReflRt {
+            resolution: ReflectionRes::Half,
+            max_roughness: 1.0,
+            metal_bounce: super::reflections::rt::METAL_BOUNCE
+        })
     );
 }
 
@@ -247,7 +251,11 @@ fn the_fallback_keeps_effects_from_baked_data_and_compiles_no_ray_traced_pass() 
     let all = Techniques {
         shadows: Shadows::Rt(ShadowRt { light_radius: 0.1, sun_degrees: 0.5 }),
         ao: Ao::Rt(AoRt { radius: Radius { radius: None, reach: 0.1 } }),
-        reflections: Reflections::Rt(ReflRt { resolution: ReflectionRes::Half, max_roughness: 1.0 }),
+        reflections: Reflections::Rt(ReflRt {
+            resolution: ReflectionRes::Half,
+            max_roughness: 1.0,
+            metal_bounce: super::reflections::rt::METAL_BOUNCE,
+        }),
         gi: Gi::Rt(GiRt { bounces: 2, regularize: 0.5 }),
         aa: taa,
         ..d
