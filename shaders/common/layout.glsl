@@ -279,5 +279,6 @@ const uint TEXTURE_FORMAT_SHIFT = 13u;
 const uint TEXTURE_SWIZZLE_SHIFT = 16u;
 const uint MAX_SHADOW_MAPS = 8u;
 const uint MAX_RT_SHADOW_LIGHTS = 16u;
+const uint REFLECTION_SECOND_HIT_LIGHTS = 4u;
 
 #endif

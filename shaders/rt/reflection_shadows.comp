@@ -5,11 +5,11 @@
 // averaged into the reflection image over frames.
 #include "hybrid.glsl"
 
-// The stored terms of the lights (from layer `first` on) that a shadow ray from `origin` finds
-// unoccluded, summed.
-vec3 lit_terms(ivec2 c, vec3 origin, uint first) {
+// The stored terms of the first `count` lights (from layer `first` on) that a shadow ray from
+// `origin` finds unoccluded, summed.
+vec3 lit_terms(ivec2 c, vec3 origin, uint first, uint count) {
     vec3 sum = vec3(0.0);
-    for (uint i = 0u; i < rt.reflection_lights; i++) {
+    for (uint i = 0u; i < count; i++) {
         vec3 term = imageLoad(refl_lights, ivec3(c, int(first + i))).rgb;
         if (!any(greaterThan(term, vec3(0.0)))) {
             continue;
@@ -33,12 +33,14 @@ void main() {
     vec4 value = imageLoad(refl_partial, c);
     vec4 origin = imageLoad(refl_origin, c);
     if (origin.w > 0.0) {
-        value.rgb += lit_terms(c, origin.xyz, 0u);
-        // A metal hit's own reflection's hit (reflections.comp, `traced_onwards`): its terms
-        // follow the first hit's, its origin after them.
-        vec4 second = imageLoad(refl_lights, ivec3(c, int(2u * rt.reflection_lights)));
+        value.rgb += lit_terms(c, origin.xyz, 0u, rt.reflection_lights);
+        // A metal hit's own reflection's hit (reflections.comp, `traced_onwards`): the terms of
+        // its first REFLECTION_SECOND_HIT_LIGHTS lights follow the first hit's, its origin after
+        // them.
+        uint count = min(rt.reflection_lights, REFLECTION_SECOND_HIT_LIGHTS);
+        vec4 second = imageLoad(refl_lights, ivec3(c, int(rt.reflection_lights + count)));
         if (second.w > 0.0) {
-            value.rgb += lit_terms(c, second.xyz, rt.reflection_lights);
+            value.rgb += lit_terms(c, second.xyz, rt.reflection_lights, count);
         }
     }
     if (any(isnan(value)) || any(isinf(value))) {

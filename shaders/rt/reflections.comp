@@ -123,24 +123,36 @@ bool traced_onwards(Surface s) {
     return !s.mat.diffuse_only && s.mat.metallic >= 0.5 && s.mat.roughness < rt.metal_bounce_roughness;
 }
 
-// Radiance leaving a second hit towards -r.direction but its lights' shadowed terms, which go,
-// scaled by `scale`, to their layers after the first hit's (`rt.reflection_lights` + i), and its
-// offset origin to the layer after those (w = 1), for the shadow pass to trace.
+// The lights whose shadow rays at a second hit the shadow pass traces (the first ones), and the
+// layer of `refl_lights` that holds that hit's origin, after their terms.
+uint second_hit_lights() {
+    return min(rt.reflection_lights, REFLECTION_SECOND_HIT_LIGHTS);
+}
+
+uint second_origin_layer() {
+    return rt.reflection_lights + second_hit_lights();
+}
+
+// Radiance leaving a second hit towards -r.direction but the shadowed terms of the lights the
+// shadow pass handles, which go, scaled by `scale`, to their layers after the first hit's
+// (`rt.reflection_lights` + i), and its offset origin to the layer after those (w = 1); any
+// further lights' shadow rays are traced here.
 vec3 shade_second_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughness) {
     Surface s = regularised_hit(r, h, min_roughness);
     vec3 wo = -normalize(r.direction);
     vec3 origin = offset_ray_origin(s.p, s.ng);
     vec3 sum = ambient_light(s, wo, true);
+    uint deferred = second_hit_lights();
     for (uint i = 0u; i < frame.size.z; i++) {
         vec3 wi;
         vec3 term = light_term(lights[i], s, wo, wi);
-        if (i < rt.reflection_lights) {
+        if (i < deferred) {
             imageStore(refl_lights, ivec3(cell, int(rt.reflection_lights + i)), vec4(term * scale, 0.0));
         } else if (any(greaterThan(term, vec3(0.0))) && !light_occluded(lights[i], origin, wi)) {
             sum += term;
         }
     }
-    imageStore(refl_lights, ivec3(cell, int(2u * rt.reflection_lights)), vec4(origin, 1.0));
+    imageStore(refl_lights, ivec3(cell, int(second_origin_layer())), vec4(origin, 1.0));
     return sum;
 }
 
@@ -171,7 +183,7 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughne
         }
     }
     if (!second) {
-        imageStore(refl_lights, ivec3(cell, int(2u * rt.reflection_lights)), vec4(0.0));
+        imageStore(refl_lights, ivec3(cell, int(second_origin_layer())), vec4(0.0));
     }
     for (uint i = 0u; i < frame.size.z; i++) {
         GpuLight l = lights[i];

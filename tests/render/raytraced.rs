@@ -188,11 +188,13 @@ fn a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects() {
     // into a panel at y = 3; the sky is black. Both mirrors are smooth metal of F0 = `base`
     // (α = 10⁻³: G2/G1 = 1), so a pixel shows F(45°)² times the panel's radiance where the
     // doubly mirrored ray meets it, Schlick's F at 45° incidence on both. Twice: the panel
-    // emitting E, and the panel of albedo ρ lit by a point light below it (whose term at that
-    // second hit, ρ/π · I cos θ / d², the shadow pass adds, its shadow ray from the second
-    // hit). Read from the sky about B's mirror direction (a single bounce) the pixel is black.
+    // emitting E, and the panel of albedo ρ lit by five point lights below it (whose terms at
+    // that second hit, ρ/π · I cos θ / d² each, are shadow-tested from the second hit). Read from the sky about B's mirror direction (a single bounce) the pixel is black.
     let (base, emitted, rho, intensity) = (0.8f32, 3.0f32, 0.7f32, 6.0f32);
-    let lamp = DVec3::new(4.5, 2.0, -4.5);
+    // Five lamps under the panel, off the mirrors' paths: the shadow pass traces the second
+    // hit's rays to the first REFLECTION_SECOND_HIT_LIGHTS (4), the shading kernel the fifth's.
+    let lamps = [(4.5, 2.0, -4.5), (1.5, 2.0, -1.5), (4.6, 2.1, -1.4), (1.4, 1.9, -4.6), (3.2, 2.2, -5.5)]
+        .map(|(x, y, z)| DVec3::new(x, y, z));
     let cam = Pinhole::new([0.0, 0.0, 0.0], [0.0, 0.0, -3.0], [0.0, 1.0, 0.0], 10.0, W, H);
     // Each pixel's path by its own arithmetic: the point where a ray meets a mirror's plane and
     // whether it lies inside it (with a margin), then the mirrored direction.
@@ -235,7 +237,10 @@ fn a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects() {
     );
     let mut glow = lambert_material([0.0; 3]);
     glow.emission = [emitted; 3];
-    let lit = light(LightKind::Point, lamp.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity);
+    let lit: Vec<Light> = lamps
+        .iter()
+        .map(|l| light(LightKind::Point, l.as_vec3().to_array(), [0.0, -1.0, 0.0], intensity))
+        .collect();
     let cases = [
         (
             "emissive",
@@ -244,10 +249,16 @@ fn a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects() {
         ),
         (
             "lit",
-            periscope(&cam, base, lambert_material([rho; 3]), vec![lit]),
+            periscope(&cam, base, lambert_material([rho; 3]), lit),
             Box::new(|q: DVec3| {
-                let d2 = (lamp - q).length_squared();
-                rho as f64 / std::f64::consts::PI * intensity as f64 * ((q.y - lamp.y) / d2.sqrt()) / d2
+                let irradiance: f64 = lamps
+                    .iter()
+                    .map(|&lamp| {
+                        let d2 = (lamp - q).length_squared();
+                        intensity as f64 * ((q.y - lamp.y) / d2.sqrt()) / d2
+                    })
+                    .sum();
+                rho as f64 / std::f64::consts::PI * irradiance
             }),
         ),
     ];

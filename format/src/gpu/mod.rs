@@ -472,6 +472,12 @@ pub const MAX_SHADOW_MAPS: usize = 8;
 /// further lights are drawn unshadowed (`MAX_RT_SHADOW_LIGHTS` in `layout.glsl`).
 pub const MAX_RT_SHADOW_LIGHTS: usize = 16;
 
+/// Lights whose shadow rays at the hits of metal hits' own reflections (the reflections' metal
+/// bounce) are traced by the reflections' shadow kernel, the first ones; the shading kernel
+/// traces any further ones inline (`REFLECTION_SECOND_HIT_LIGHTS` in `layout.glsl`). Each costs
+/// an image layer at the reflections' resolution (23 MB at 1600 × 900).
+pub const REFLECTION_SECOND_HIT_LIGHTS: usize = 4;
+
 /// Alignment and size of a GLSL type under std430 (std140 differs only for arrays and structs,
 /// which these layouts do not nest).
 fn glsl_align_size(ty: &str) -> (usize, usize) {
@@ -578,6 +584,7 @@ pub fn glsl_layout() -> String {
         ("TEXTURE_SWIZZLE_SHIFT", TextureFlags::SWIZZLE_SHIFT),
         ("MAX_SHADOW_MAPS", MAX_SHADOW_MAPS as u32),
         ("MAX_RT_SHADOW_LIGHTS", MAX_RT_SHADOW_LIGHTS as u32),
+        ("REFLECTION_SECOND_HIT_LIGHTS", REFLECTION_SECOND_HIT_LIGHTS as u32),
     ] {
         s.push_str(&format!("const uint {name} = {v}u;\n"));
     }

@@ -12,6 +12,7 @@ use crate::gpu::{ComputePipeline, Gpu, ImageDesc, Use};
 use crate::render::TexelDecode;
 use crate::render::graph::{Access, TargetDecl};
 use crate::render::{MAX_RT_SHADOW_LIGHTS, spirv};
+use kiln_format::gpu::REFLECTION_SECOND_HIT_LIGHTS;
 
 const fn rgba32(name: &'static str, array: bool) -> TargetDecl {
     TargetDecl { name, format: vk::Format::R32G32B32A32_SFLOAT, usage: vk::ImageUsageFlags::STORAGE, array }
@@ -24,11 +25,16 @@ pub const PARTIAL: TargetDecl = rgba32("reflection partial", false);
 /// Between the kernels: the hits' offset ray origins.
 pub const ORIGINS: TargetDecl = rgba32("reflection origins", false);
 /// Between the kernels: each light's unshadowed term at the hit, one layer per light, then the
-/// same at a metal hit's own reflection's hit, then that second hit's origin (w = 1 where there
-/// is one).
+/// same at a metal hit's own reflection's hit for the first [`REFLECTION_SECOND_HIT_LIGHTS`],
+/// then that second hit's origin (w = 1 where there is one): [`light_layers`].
 pub const LIGHT_TERMS: TargetDecl = rgba32("reflection light terms", true);
 /// The pass's targets in binding order (`shaders/rt/hybrid.glsl`, bindings 18–21).
 pub const TARGETS: [TargetDecl; 4] = [REFLECTIONS, PARTIAL, ORIGINS, LIGHT_TERMS];
+
+/// Layers of [`LIGHT_TERMS`] for `lights` lights with reflection-hit shadow rays.
+pub fn light_layers(lights: u32) -> u32 {
+    lights + lights.min(REFLECTION_SECOND_HIT_LIGHTS as u32) + 1
+}
 
 /// Lights whose reflection-hit shadow rays are traced.
 pub fn lights(lights: usize) -> u32 {
@@ -66,7 +72,7 @@ impl Pass for RtReflectionsPass {
         let (w, h) = (width.div_ceil(self.step), height.div_ceil(self.step));
         TARGETS
             .iter()
-            .map(|t| (*t, t.sized(w, h, if *t == LIGHT_TERMS { 2 * self.lights + 1 } else { 1 })))
+            .map(|t| (*t, t.sized(w, h, if *t == LIGHT_TERMS { light_layers(self.lights) } else { 1 })))
             .collect()
     }
 
