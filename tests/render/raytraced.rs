@@ -263,7 +263,7 @@ fn a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects() {
         ),
     ];
     for (name, bytes, radiance) in &cases {
-        let (rgb, _) = render_frames(dir.path(), name, bytes, 4, |f| {
+        let (rgb, _) = render_frames(dir.path(), name, bytes, 2, |f| {
             Options::new(f, W, H).rt_reflections(Reflections::Full)
         });
         // The image against F² L, and each 8 × 8 block of it: a pixel alone moves by a few
@@ -285,7 +285,7 @@ fn a_mirror_seen_in_a_mirror_shows_what_the_second_mirror_reflects() {
         assert!((mean - 1.0).abs() < 0.01, "{name}: the mirrors show {mean} times F² L");
         assert!(worst < 0.03, "{name}: a block through both mirrors is off by {worst}");
         // Without the metal bounce B's lobe reads the black sky.
-        let (one, _) = render_frames(dir.path(), &format!("{name}-one"), bytes, 2, |f| {
+        let (one, _) = render_frames(dir.path(), &format!("{name}-one"), bytes, 1, |f| {
             Options::new(f, W, H).rt_reflections(Reflections::Full).metal_bounce(0.0)
         });
         let dark = pixels.iter().map(|&(i, _, _)| one[i] as f64).fold(0.0f64, f64::max);
