@@ -3,12 +3,13 @@
 // Per traced pixel one GGX visible-normal sample (Heitz 2018) of the specular lobe; the stored
 // value is F(v·h) · G2 / G1(v) · L(wi), the unbiased one-sample estimate of the lobe's reflected
 // radiance (the composition adds it in place of the split-sum ambient specular). At the hit:
-// emission, every light with one hard shadow ray to its centre (as in the thesis), and the sky as
-// unshadowed ambient; a miss sees the sky.
+// emission, every light with one hard shadow ray to its centre (as in the thesis), and the sky
+// or the probes as unshadowed ambient; a miss sees the sky. A hit on smooth metal traces its own
+// lobe once more and shades that second hit the same way (`traced_onwards`).
 //
 // The shadow rays at the hits are not traced here: this pass stores each light's unshadowed
-// term and the hit's ray origin, and `reflection_shadows.comp`, a small kernel, traces them and
-// accumulates. Traced inside this large kernel (low occupancy) they took 72 % of its time on an
+// term and the hit's ray origin (and a second hit's), and `reflection_shadows.comp`, a small
+// kernel, traces them and accumulates. Traced inside this large kernel (low occupancy) they took 72 % of its time on an
 // H200; traversal is latency-bound and wants many rays in flight.
 //
 // Fixes of the thesis's code: surfaces that are too *rough* are skipped (its test was inverted
