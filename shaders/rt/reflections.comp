@@ -9,8 +9,8 @@
 //
 // The shadow rays at the hits are not traced here: this pass stores each light's unshadowed
 // term and the hit's ray origin (and a second hit's), and `reflection_shadows.comp`, a small
-// kernel, traces them and accumulates. Traced inside this large kernel (low occupancy) they took 72 % of its time on an
-// H200; traversal is latency-bound and wants many rays in flight.
+// kernel, traces them and accumulates. Traced inside this large kernel (low occupancy) they
+// took 72 % of its time on an H200; traversal is latency-bound and wants many rays in flight.
 //
 // Fixes of the thesis's code: surfaces that are too *rough* are skipped (its test was inverted
 // and skipped the smooth ones), a sample below the surface contributes zero instead of being
@@ -134,6 +134,23 @@ uint second_origin_layer() {
     return rt.reflection_lights + second_hit_lights();
 }
 
+// The lights' terms at hit s seen from wo: those of the first `deferred` lights go unshadowed,
+// scaled by `scale`, to `refl_lights` layers `first_layer` + i for the shadow pass (every one
+// written: it reads them all); the rest are shadow-tested from `origin` here and summed.
+vec3 light_terms(Surface s, vec3 wo, vec3 origin, ivec2 cell, vec3 scale, uint first_layer, uint deferred) {
+    vec3 sum = vec3(0.0);
+    for (uint i = 0u; i < frame.size.z; i++) {
+        vec3 wi;
+        vec3 term = light_term(lights[i], s, wo, wi);
+        if (i < deferred) {
+            imageStore(refl_lights, ivec3(cell, int(first_layer + i)), vec4(term * scale, 0.0));
+        } else if (any(greaterThan(term, vec3(0.0))) && !light_occluded(lights[i], origin, wi)) {
+            sum += term;
+        }
+    }
+    return sum;
+}
+
 // Radiance leaving a second hit towards -r.direction but the shadowed terms of the lights the
 // shadow pass handles, which go, scaled by `scale`, to their layers after the first hit's
 // (`rt.reflection_lights` + i), and its offset origin to the layer after those (w = 1); any
@@ -142,26 +159,16 @@ vec3 shade_second_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_
     Surface s = regularised_hit(r, h, min_roughness);
     vec3 wo = -normalize(r.direction);
     vec3 origin = offset_ray_origin(s.p, s.ng);
-    vec3 sum = ambient_light(s, wo, true);
-    uint deferred = second_hit_lights();
-    for (uint i = 0u; i < frame.size.z; i++) {
-        vec3 wi;
-        vec3 term = light_term(lights[i], s, wo, wi);
-        if (i < deferred) {
-            imageStore(refl_lights, ivec3(cell, int(rt.reflection_lights + i)), vec4(term * scale, 0.0));
-        } else if (any(greaterThan(term, vec3(0.0))) && !light_occluded(lights[i], origin, wi)) {
-            sum += term;
-        }
-    }
     imageStore(refl_lights, ivec3(cell, int(second_origin_layer())), vec4(origin, 1.0));
-    return sum;
+    return ambient_light(s, wo, true)
+        + light_terms(s, wo, origin, cell, scale, rt.reflection_lights, second_hit_lights());
 }
 
 // Radiance leaving the hit towards -dir, without the shadowed terms of the lights that the
 // shadow pass handles (stored, scaled by `scale`, in their `refl_lights` layers, and a second
-// hit's after them); the hit's offset origin goes to `origin`. The hit is regularised to the reflecting pixel's roughness
-// (`regularised_hit`). Smooth metal's specular lobe is traced one bounce further
-// (`traced_onwards`), the rest reads the probes or the sky (`ambient_light`).
+// hit's after them); the hit's offset origin goes to `origin`. The hit is regularised to the
+// reflecting pixel's roughness (`regularised_hit`). Smooth metal's specular lobe is traced one
+// bounce further (`traced_onwards`), the rest reads the probes or the sky (`ambient_light`).
 vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughness, out vec3 origin) {
     Surface s = regularised_hit(r, h, min_roughness);
     origin = offset_ray_origin(s.p, s.ng);
@@ -186,18 +193,7 @@ vec3 shade_hit(TraceRay r, TraceHit h, ivec2 cell, vec3 scale, float min_roughne
     if (!second) {
         imageStore(refl_lights, ivec3(cell, int(second_origin_layer())), vec4(0.0));
     }
-    for (uint i = 0u; i < frame.size.z; i++) {
-        GpuLight l = lights[i];
-        vec3 wi;
-        vec3 term = light_term(l, s, wo, wi);
-        if (i < rt.reflection_lights) {
-            // Every layer is written for every hit: the shadow pass reads them all.
-            imageStore(refl_lights, ivec3(cell, int(i)), vec4(term * scale, 0.0));
-        } else if (any(greaterThan(term, vec3(0.0))) && !light_occluded(l, origin, wi)) {
-            sum += term;
-        }
-    }
-    return sum;
+    return sum + light_terms(s, wo, origin, cell, scale, 0u, rt.reflection_lights);
 }
 
 void main() {
